@@ -1,0 +1,79 @@
+//! A convex collision shape attached to a body, with world-frame features cached once per tick.
+
+use crate::geom::{Aabb, ConvexPolygon, Pose, Vec2};
+
+/// A convex piece of a body. `local` is expressed in the body frame (origin at the centre of mass);
+/// `world_*` are refreshed by [`Collider::update`] at the start of every tick.
+#[derive(Clone, Debug)]
+pub struct Collider {
+    /// Index of the owning body in the world.
+    pub body: usize,
+    /// True if the owning body is dynamic (pairs of two fixed colliders are never tested).
+    pub dynamic: bool,
+    /// The polygon in the body frame (m).
+    pub local: ConvexPolygon,
+    /// Vertices in world coordinates (m), counter-clockwise.
+    pub world_vertices: Vec<Vec2>,
+    /// Outward unit edge normals in world coordinates.
+    pub world_normals: Vec<Vec2>,
+    /// Unit edge tangents in world coordinates.
+    pub world_tangents: Vec<Vec2>,
+    /// World bounding box (m), not inflated.
+    pub aabb: Aabb,
+}
+
+impl Collider {
+    /// A collider for body `body` with shape `local` (body frame), placed at `pose`.
+    pub fn new(body: usize, dynamic: bool, local: ConvexPolygon, pose: &Pose) -> Self {
+        let n = local.len();
+        let mut c = Self {
+            body,
+            dynamic,
+            local,
+            world_vertices: vec![Vec2::ZERO; n],
+            world_normals: vec![Vec2::ZERO; n],
+            world_tangents: vec![Vec2::ZERO; n],
+            aabb: Aabb::EMPTY,
+        };
+        c.update(pose);
+        c
+    }
+
+    /// Recomputes the world-frame features for the body pose `pose` (no allocation).
+    pub fn update(&mut self, pose: &Pose) {
+        let rot = pose.rot();
+        let mut aabb = Aabb::EMPTY;
+        for i in 0..self.local.len() {
+            let v = pose.pos + rot.apply(self.local.vertices()[i]);
+            self.world_vertices[i] = v;
+            self.world_normals[i] = rot.apply(self.local.normals()[i]);
+            self.world_tangents[i] = rot.apply(self.local.tangents()[i]);
+            aabb.grow(v);
+        }
+        self.aabb = aabb;
+    }
+
+    /// Number of vertices (= edges).
+    #[inline]
+    pub fn len(&self) -> usize {
+        self.local.len()
+    }
+
+    /// Always false.
+    #[inline]
+    pub fn is_empty(&self) -> bool {
+        false
+    }
+
+    /// Signed distance `d = n_e·(p − E0_e)` of world point `p` from the line of edge `e` (m), positive outside.
+    #[inline]
+    pub fn edge_distance(&self, e: usize, p: Vec2) -> f64 {
+        self.world_normals[e].dot(p - self.world_vertices[e])
+    }
+
+    /// Edge coordinate `s = t_e·(p − E0_e)` of world point `p` along edge `e` (m).
+    #[inline]
+    pub fn edge_coordinate(&self, e: usize, p: Vec2) -> f64 {
+        self.world_tangents[e].dot(p - self.world_vertices[e])
+    }
+}

@@ -1,0 +1,24 @@
+//! Two-level collision detection (§9): a global proximity stage every `N_g` ticks (AABBs with
+//! sort-and-sweep, then GJK distance) and a local stage every tick for proximate pairs
+//! (closest-feature tracking, signed distances, VE candidates).
+
+mod collider;
+
+pub use collider::Collider;
+
+/// A vertex–edge candidate produced by the local stage (§9.5): vertex `vertex` of collider
+/// `vertex_collider` against edge `edge` of collider `edge_collider`.
+///
+/// Ordering is lexicographic on `(vertex_collider, vertex, edge_collider, edge)`; candidates are sorted
+/// before use so that everything downstream is deterministic.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct VeCandidate {
+    /// Collider that owns the vertex (the "A" side).
+    pub vertex_collider: u32,
+    /// Vertex index in that collider.
+    pub vertex: u32,
+    /// Collider that owns the edge (the "B" side).
+    pub edge_collider: u32,
+    /// Edge index in that collider (edge `i` runs from vertex `i` to `i+1`).
+    pub edge: u32,
+}

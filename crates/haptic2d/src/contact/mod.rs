@@ -1,0 +1,1 @@
+//! Contact records, the contact state machine, god-objects and simultaneous impacts (§7, §8).

@@ -1,0 +1,1 @@
+//! Teleoperation controllers coupling the device to the virtual slave (§11) and passivity tools (§12).

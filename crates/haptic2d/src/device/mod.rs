@@ -1,0 +1,1 @@
+//! The dual-pantograph ("twin pantograph") planar haptic device (§10).

@@ -1,0 +1,39 @@
+//! Planar geometry: vectors, poses, convex polygons and their features, AABBs and mass properties.
+
+mod aabb;
+mod mass;
+mod polygon;
+mod pose;
+
+pub use aabb::Aabb;
+pub use mass::MassProperties;
+pub use polygon::{ConvexPolygon, PolygonError};
+pub use pose::{Pose, Rot};
+
+/// A 2-D vector of `f64` (glam's `DVec2`, as re-exported by parry2d-f64). Units depend on use (m, m/s, N).
+pub type Vec2 = parry2d_f64::math::Vector;
+
+/// Scalar cross product `a × b = a_x b_y − a_y b_x` (§0.3).
+#[inline]
+pub fn cross(a: Vec2, b: Vec2) -> f64 {
+    a.x * b.y - a.y * b.x
+}
+
+/// `perp(a) = (−a_y, a_x)`: `a` rotated by +90° (§0.3).
+#[inline]
+pub fn perp(a: Vec2) -> Vec2 {
+    Vec2::new(-a.y, a.x)
+}
+
+/// Wraps an angle to `(−π, π]` (rad). Used for display and for angle differences only.
+#[inline]
+pub fn wrap_angle(a: f64) -> f64 {
+    let two_pi = std::f64::consts::TAU;
+    let mut r = a % two_pi;
+    if r <= -std::f64::consts::PI {
+        r += two_pi;
+    } else if r > std::f64::consts::PI {
+        r -= two_pi;
+    }
+    r
+}

@@ -1,0 +1,1 @@
+//! Passive numerical integration (§6): per-DOF integrators, minimum mass, the energy ledger.

@@ -1,0 +1,158 @@
+//! Haessig–Friedland reset-integrator friction (§1), per VE contact: the paper's model (eq. 2).
+
+use super::{FrictionInput, FrictionLaw, FrictionMode};
+
+/// How Coulomb proportionality to the normal load enters (§1, "Load dependence").
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LoadScaling {
+    /// Constant `Kr`, strain limit `p0 = μk·F_n/Kr` (default).
+    #[default]
+    Limit,
+    /// Constant strain limit `p0`, stiffness `Kr = μk·F_n/p0`.
+    Stiffness,
+}
+
+/// The reset integrator: a bounded strain `p` that integrates the relative tangential displacement in
+/// stick and is held at `±p0` in slip.
+///
+/// Stick: `F_f = (1 + a)·Kr·p + β·S0`; slip: `F_f = Kr·p`; the force on A is `F_t = −F_f`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ResetIntegrator {
+    /// Kinetic strain stiffness `Kr` (N/m); with `LoadScaling::Stiffness` it is recomputed each sample.
+    pub kr: f64,
+    /// Static friction coefficient `μs`.
+    pub mu_s: f64,
+    /// Kinetic friction coefficient `μk`.
+    pub mu_k: f64,
+    /// Stick damping `β` (N·s/m).
+    pub beta: f64,
+    /// Load scaling option.
+    pub scaling: LoadScaling,
+    /// Fixed strain limit `p0` (m) used with `LoadScaling::Stiffness`.
+    pub p0_fixed: f64,
+    /// Strain `p` (m).
+    p: f64,
+    /// Stiffness used at the last sample (N/m).
+    k_used: f64,
+    mode: FrictionMode,
+}
+
+impl ResetIntegrator {
+    /// A model with `Kr` (N/m), `μs`, `μk` and `β` (N·s/m), load scaling `Limit`.
+    pub fn new(kr: f64, mu_s: f64, mu_k: f64, beta: f64) -> Self {
+        Self {
+            kr,
+            mu_s,
+            mu_k,
+            beta,
+            scaling: LoadScaling::Limit,
+            p0_fixed: 1e-4,
+            p: 0.0,
+            k_used: kr,
+            mode: FrictionMode::Stick,
+        }
+    }
+    /// 1-D defaults: `Kr = 4000`, `μs = 0.5`, `μk = 0.45`, `β = 20`.
+    pub fn one_d() -> Self {
+        Self::new(4000.0, 0.5, 0.45, 20.0)
+    }
+    /// Per-contact defaults of the 4-contact 2-D peg: `Kr = 2000`, `β = 10`.
+    pub fn per_contact() -> Self {
+        Self::new(2000.0, 0.5, 0.45, 10.0)
+    }
+    /// The stiction boost `a = μs/μk − 1`.
+    #[inline]
+    pub fn a(&self) -> f64 {
+        self.mu_s / self.mu_k - 1.0
+    }
+    /// The current strain `p` (m).
+    #[inline]
+    pub fn strain(&self) -> f64 {
+        self.p
+    }
+    /// Checks the parameters; the error names the offending one.
+    pub fn validate(&self) -> Result<(), String> {
+        if !(self.kr > 0.0 && self.kr.is_finite()) {
+            return Err(format!(
+                "kr must be a positive stiffness in N/m, got {}",
+                self.kr
+            ));
+        }
+        if !(self.mu_k > 0.0 && self.mu_k.is_finite()) {
+            return Err(format!("mu_k must be positive, got {}", self.mu_k));
+        }
+        if !(self.mu_s >= self.mu_k && self.mu_s.is_finite()) {
+            return Err(format!(
+                "mu_s must be at least mu_k (static ≥ kinetic), got mu_s = {} < mu_k = {}",
+                self.mu_s, self.mu_k
+            ));
+        }
+        if !(self.beta >= 0.0 && self.beta.is_finite()) {
+            return Err(format!(
+                "beta must be a non-negative damping in N·s/m, got {}",
+                self.beta
+            ));
+        }
+        if self.scaling == LoadScaling::Stiffness && !(self.p0_fixed > 0.0) {
+            return Err(format!(
+                "p0 must be a positive strain limit in m, got {}",
+                self.p0_fixed
+            ));
+        }
+        Ok(())
+    }
+}
+
+impl FrictionLaw for ResetIntegrator {
+    fn reset(&mut self) {
+        self.p = 0.0;
+        self.mode = FrictionMode::Stick;
+    }
+
+    fn update(&mut self, i: &FrictionInput) -> f64 {
+        if i.fn_ <= 0.0 {
+            self.reset();
+            return 0.0;
+        }
+        // Load scaling: either the strain limit or the stiffness follows μk·F_n.
+        let (kr, p0) = match self.scaling {
+            LoadScaling::Limit => (self.kr, self.mu_k * i.fn_ / self.kr),
+            LoadScaling::Stiffness => (self.mu_k * i.fn_ / self.p0_fixed, self.p0_fixed),
+        };
+        self.k_used = kr;
+        let a = self.a();
+        let p_star = self.p + i.ds; // candidate: integrate the relative displacement
+        if i.ds > 0.0 && p_star >= p0 {
+            // slip in +t: hold the integrator at the limit
+            self.p = p0;
+            self.mode = FrictionMode::Slip;
+            -kr * self.p
+        } else if i.ds < 0.0 && p_star <= -p0 {
+            // slip in −t
+            self.p = -p0;
+            self.mode = FrictionMode::Slip;
+            -kr * self.p
+        } else {
+            // stick; 'reset' if p0 shrank because F_n fell
+            self.p = p_star.clamp(-p0, p0);
+            self.mode = FrictionMode::Stick;
+            -((1.0 + a) * kr * self.p + self.beta * i.s0)
+        }
+    }
+
+    fn stored_energy(&self) -> f64 {
+        let k = match self.mode {
+            FrictionMode::Stick => (1.0 + self.a()) * self.k_used,
+            FrictionMode::Slip => self.k_used,
+        };
+        0.5 * k * self.p * self.p
+    }
+
+    fn anchor(&self, s: f64) -> Option<f64> {
+        Some(s - self.p)
+    }
+
+    fn mode(&self) -> FrictionMode {
+        self.mode
+    }
+}

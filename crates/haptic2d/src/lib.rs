@@ -1,0 +1,18 @@
+//! # haptic2d
+//!
+//! Passive planar rigid-body simulation for haptic rendering, after Constantinescu et al., *Haptic
+//! Rendering of Planar Rigid-Body Motion using a Redundant Parallel Mechanism* (UBC).
+//!
+//! This core crate is pure computation: no threads, no I/O, `f64` throughout, deterministic. Section
+//! numbers (§) refer to the project's model specification, `spec/MODELS.md`.
+
+#![warn(missing_docs)]
+
+pub mod body;
+pub mod collide;
+pub mod contact;
+pub mod control;
+pub mod device;
+pub mod geom;
+pub mod integrate;
+pub mod laws;
