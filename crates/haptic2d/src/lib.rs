@@ -14,5 +14,6 @@ pub mod contact;
 pub mod control;
 pub mod device;
 pub mod geom;
+pub mod harness;
 pub mod integrate;
 pub mod laws;

@@ -1,1 +1,3 @@
 //! Teleoperation controllers coupling the device to the virtual slave (§11) and passivity tools (§12).
+
+pub mod passivity;

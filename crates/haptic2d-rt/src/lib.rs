@@ -1,0 +1,1 @@
+//! The real-time haptic loop of haptic2d.

@@ -1,0 +1,1 @@
+//! Passivity observer / passivity controller (Hannaford & Ryu 2002), §12.

@@ -1,0 +1,1 @@
+//! The 1-D wall harness (§5.1, §13.1).
