@@ -2,9 +2,23 @@
 //! sort-and-sweep, then GJK distance) and a local stage every tick for proximate pairs
 //! (closest-feature tracking, signed distances, VE candidates).
 
+mod broad;
 mod collider;
+mod gjk;
+mod local;
+mod tracker;
 
+pub use broad::{required_delta_prox, BroadPhase, BroadStats, DEFAULT_DELTA_PROX};
 pub use collider::Collider;
+pub use gjk::{
+    gjk_distance, support_hill_climb, GjkCache, GjkOutput, GjkStats, GJK_EPS_ABS, GJK_EPS_REL,
+    GJK_MAX_ITERATIONS,
+};
+pub use local::{LocalStage, PairState, DEFAULT_DELTA_C, DEFAULT_EPS_S, NEAR_PARALLEL_ANGLE};
+pub use tracker::{
+    ClosestFeatures, Feature, FeatureTracker, TrackStatus, TrackerStats, PARALLEL_TOL,
+    VORONOI_TOL,
+};
 
 /// A vertex–edge candidate produced by the local stage (§9.5): vertex `vertex` of collider
 /// `vertex_collider` against edge `edge` of collider `edge_collider`.

@@ -1,0 +1,372 @@
+//! The local stage (§9.3–9.5): closest-feature tracking and vertex–edge (VE) candidates for every
+//! proximate pair, every control sample.
+//!
+//! # VE candidates
+//!
+//! Every contact is a vertex of one polygon against an edge of the other (§0.4), with signed
+//! distance `d = n·(V − E0)` and edge coordinate `s = t·(V − E0)`; a candidate is recorded only if
+//! `−ε_s ≤ s ≤ L + ε_s`. For a pair `(A, B)` the tracker (§9.3) gives either the closest features or
+//! "penetrating":
+//!
+//! - **Separated, distance ≤ δ_c** (§9.5):
+//!   - vertex–edge `(V_A, E_B)`: one candidate;
+//!   - vertex–vertex `(V_A, V_B)`: two candidates `(V_A, E_B*)` and `(V_B, E_A*)`, where `E_B*` is
+//!     the edge incident to `V_B` whose outward normal is most aligned with `V_A − V_B`, i.e. the
+//!     one with the larger `d = n·(V_A − V_B)` (both edges pass through `V_B`); same on A;
+//!   - parallel edge–edge: the overlap interval of the two edges (in B's edge coordinate) has two
+//!     ends; each is a vertex of A inside `[0, L_B]` or else B's edge end, which then lies inside A's
+//!     edge: `(that vertex, the other polygon's edge)`.
+//!
+//!   **Near-parallel faces** (addition to §9.5): a box resting "flat" is never exactly flat in
+//!   floating point, so the tracker usually reports vertex–edge for it, which alone would give one
+//!   corner. Before the rules above, each edge incident to A's closest feature is therefore tried
+//!   against each edge incident to B's: if the two are antiparallel within [`NEAR_PARALLEL_ANGLE`]
+//!   and their overlap is longer than `ε_s` with *both* ends within `δ_c`, the pair is handled as a
+//!   parallel edge–edge case (two candidates). This is exact for exactly parallel edges and keeps
+//!   the count at 2 for a box tilted by round-off.
+//! - **Penetrating** (§9.4): every vertex `V` of A that is inside B or within `δ_c` of it, i.e.
+//!   `max_j d_j(V) ≤ δ_c` over B's edges `j`, gives one candidate with the edge of least
+//!   penetration depth (largest `d_j`) among the edges whose range contains `V`; the same for B's
+//!   vertices against A. The contact manager (§8.3) picks the edge of a *new* contact by the
+//!   god-object crossing rule and keeps the edge of an existing one; it only needs every touching
+//!   vertex to be proposed.
+//!
+//! Candidates are sorted and deduplicated so that everything downstream is deterministic.
+
+use super::tracker::{ClosestFeatures, Feature, FeatureTracker, TrackStatus};
+use super::{Collider, VeCandidate};
+use crate::geom::Vec2;
+
+/// Default contact distance tolerance `δ_c` (m), §9.5.
+pub const DEFAULT_DELTA_C: f64 = 0.002;
+/// Default edge-range tolerance `ε_s` (m), §0.4.
+pub const DEFAULT_EPS_S: f64 = 1e-4;
+/// Largest angle between two edges (rad, from antiparallel) that the near-parallel face rule treats
+/// as one face contact. A box of length `L` has both corners within `δ_c` only up to a tilt of
+/// `δ_c/L` (0.05 rad for 4 cm), so this only keeps short edges (polygonal circles) out of the rule.
+pub const NEAR_PARALLEL_ANGLE: f64 = 0.1;
+
+/// The tracker result of one proximate pair at the last update.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PairState {
+    /// Collider indices `(a, b)`, `a < b`.
+    pub pair: (u32, u32),
+    /// Closest features (or penetration) of the pair.
+    pub features: ClosestFeatures,
+}
+
+/// Local stage: one closest-feature tracker per proximate pair, and VE candidate generation.
+#[derive(Clone, Debug)]
+pub struct LocalStage {
+    eps_s: f64,
+    cos_parallel: f64,
+    pairs: Vec<(u32, u32)>,
+    trackers: Vec<FeatureTracker>,
+    states: Vec<PairState>,
+    old_pairs: Vec<(u32, u32)>,
+    old_trackers: Vec<FeatureTracker>,
+}
+
+impl Default for LocalStage {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl LocalStage {
+    /// An empty local stage with `ε_s` = [`DEFAULT_EPS_S`].
+    pub fn new() -> Self {
+        Self {
+            eps_s: DEFAULT_EPS_S,
+            cos_parallel: NEAR_PARALLEL_ANGLE.cos(),
+            pairs: Vec::new(),
+            trackers: Vec::new(),
+            states: Vec::new(),
+            old_pairs: Vec::new(),
+            old_trackers: Vec::new(),
+        }
+    }
+
+    /// Sets the edge-range tolerance `ε_s` (m, finite, ≥ 0).
+    pub fn set_edge_tolerance(&mut self, eps_s: f64) -> Result<(), String> {
+        if !(eps_s.is_finite() && eps_s >= 0.0) {
+            return Err(format!(
+                "eps_s (edge-range tolerance) must be a finite distance ≥ 0 m, got {eps_s}"
+            ));
+        }
+        self.eps_s = eps_s;
+        Ok(())
+    }
+
+    /// The edge-range tolerance `ε_s` (m).
+    pub fn edge_tolerance(&self) -> f64 {
+        self.eps_s
+    }
+
+    /// The proximate pairs currently tracked (sorted as given to [`LocalStage::update`]).
+    pub fn pairs(&self) -> &[(u32, u32)] {
+        &self.pairs
+    }
+
+    /// Tracker results of the last update, one per pair, in pair order.
+    pub fn pair_states(&self) -> &[PairState] {
+        &self.states
+    }
+
+    /// The trackers (with their work counters), in pair order.
+    pub fn trackers(&self) -> &[FeatureTracker] {
+        &self.trackers
+    }
+
+    /// Replaces the pair list, keeping the trackers of pairs that persist (capacity is reused).
+    fn rebuild(&mut self, pairs: &[(u32, u32)]) {
+        std::mem::swap(&mut self.pairs, &mut self.old_pairs);
+        std::mem::swap(&mut self.trackers, &mut self.old_trackers);
+        self.pairs.clear();
+        self.trackers.clear();
+        for &p in pairs {
+            let t = match self.old_pairs.binary_search(&p) {
+                Ok(k) => self.old_trackers[k],
+                Err(_) => FeatureTracker::new(),
+            };
+            self.pairs.push(p);
+            self.trackers.push(t);
+        }
+    }
+
+    /// Tracks every proximate pair `pairs` (sorted `(a, b)` collider indices, `a < b`, as produced
+    /// by the global stage) and writes the VE candidates with contact distance tolerance `delta_c`
+    /// (m) into `out` (cleared first), sorted and deduplicated. Pairs naming a collider outside
+    /// `colliders` are skipped. No allocation once the buffers have grown.
+    pub fn update(
+        &mut self,
+        colliders: &[Collider],
+        pairs: &[(u32, u32)],
+        delta_c: f64,
+        out: &mut Vec<VeCandidate>,
+    ) {
+        if self.pairs.as_slice() != pairs {
+            self.rebuild(pairs);
+        }
+        out.clear();
+        self.states.clear();
+        for (k, &(ia, ib)) in pairs.iter().enumerate() {
+            let (Some(a), Some(b)) = (colliders.get(ia as usize), colliders.get(ib as usize)) else {
+                continue;
+            };
+            // Closest features (§9.3).
+            let f = self.trackers[k].update(a, b);
+            self.states.push(PairState {
+                pair: (ia, ib),
+                features: f,
+            });
+            // VE candidates (§9.4–9.5).
+            let ctx = Ctx {
+                delta_c,
+                eps_s: self.eps_s,
+                cos_parallel: self.cos_parallel,
+            };
+            match f.status {
+                TrackStatus::Penetrating => {
+                    ctx.vertices_against(ia, a, ib, b, out);
+                    ctx.vertices_against(ib, b, ia, a, out);
+                }
+                TrackStatus::Separated if f.distance <= delta_c => {
+                    ctx.from_closest_features(ia, a, ib, b, &f, out);
+                }
+                TrackStatus::Separated => {}
+            }
+        }
+        out.sort_unstable();
+        out.dedup();
+    }
+}
+
+/// Tolerances shared by the candidate rules.
+struct Ctx {
+    delta_c: f64,
+    eps_s: f64,
+    cos_parallel: f64,
+}
+
+/// The (up to two) edges incident to a feature: the edge itself, or a vertex's outgoing and
+/// incoming edges.
+fn incident_edges(c: &Collider, f: Feature) -> [Option<usize>; 2] {
+    match f {
+        Feature::Edge(e) => [Some(e as usize), None],
+        Feature::Vertex(v) => [Some(v as usize), Some(c.local.prev(v as usize))],
+    }
+}
+
+impl Ctx {
+    /// Pushes `(vertex v of collider cv, edge e of collider ce)` if `s` is in the edge range and
+    /// `d ≤ δ_c`. Returns whether it was pushed.
+    fn push_if_valid(
+        &self,
+        icv: u32,
+        cv: &Collider,
+        v: usize,
+        ice: u32,
+        ce: &Collider,
+        e: usize,
+        out: &mut Vec<VeCandidate>,
+    ) -> bool {
+        let p = cv.world_vertices[v];
+        let s = ce.edge_coordinate(e, p);
+        let l = ce.local.lengths()[e];
+        if s < -self.eps_s || s > l + self.eps_s || ce.edge_distance(e, p) > self.delta_c {
+            return false;
+        }
+        out.push(VeCandidate {
+            vertex_collider: icv,
+            vertex: v as u32,
+            edge_collider: ice,
+            edge: e as u32,
+        });
+        true
+    }
+
+    /// Separated pair with distance ≤ δ_c: candidates from the closest features (§9.5).
+    fn from_closest_features(
+        &self,
+        ia: u32,
+        a: &Collider,
+        ib: u32,
+        b: &Collider,
+        f: &ClosestFeatures,
+        out: &mut Vec<VeCandidate>,
+    ) {
+        // Near-parallel faces: one edge pair whose overlap ends are both within δ_c.
+        for ea in incident_edges(a, f.feature_a).into_iter().flatten() {
+            for eb in incident_edges(b, f.feature_b).into_iter().flatten() {
+                if self.edge_edge(ia, a, ea, ib, b, eb, true, out) {
+                    return;
+                }
+            }
+        }
+        match (f.feature_a, f.feature_b) {
+            (Feature::Vertex(i), Feature::Edge(j)) => {
+                self.push_if_valid(ia, a, i as usize, ib, b, j as usize, out);
+            }
+            (Feature::Edge(i), Feature::Vertex(j)) => {
+                self.push_if_valid(ib, b, j as usize, ia, a, i as usize, out);
+            }
+            (Feature::Vertex(i), Feature::Vertex(j)) => {
+                let (i, j) = (i as usize, j as usize);
+                let eb = most_aligned_edge(b, j, a.world_vertices[i]);
+                self.push_if_valid(ia, a, i, ib, b, eb, out);
+                let ea = most_aligned_edge(a, i, b.world_vertices[j]);
+                self.push_if_valid(ib, b, j, ia, a, ea, out);
+            }
+            (Feature::Edge(i), Feature::Edge(j)) => {
+                self.edge_edge(ia, a, i as usize, ib, b, j as usize, false, out);
+            }
+        }
+    }
+
+    /// Edge–edge rule for edge `ea` of A and `eb` of B: the two ends of their overlap interval.
+    ///
+    /// In B's edge coordinate `s`, A's edge spans `[s_lo, s_hi]` (its endpoints `V_lo`, `V_hi`) and
+    /// B's spans `[0, L_B]`. The low end of the overlap is `V_lo` (against `E_B`) if `s_lo ≥ 0`,
+    /// else B's start vertex (against `E_A`); the high end is `V_hi` if `s_hi ≤ L_B`, else B's end
+    /// vertex. With `strict`, the edges must be antiparallel within the near-parallel angle, the
+    /// overlap longer than `ε_s` and both ends valid candidates, or nothing is pushed; otherwise
+    /// each valid end is pushed. Returns whether two candidates were pushed.
+    #[allow(clippy::too_many_arguments)]
+    fn edge_edge(
+        &self,
+        ia: u32,
+        a: &Collider,
+        ea: usize,
+        ib: u32,
+        b: &Collider,
+        eb: usize,
+        strict: bool,
+        out: &mut Vec<VeCandidate>,
+    ) -> bool {
+        if strict && a.world_tangents[ea].dot(b.world_tangents[eb]) > -self.cos_parallel {
+            return false;
+        }
+        let ea1 = a.local.next(ea);
+        let eb1 = b.local.next(eb);
+        let s0 = b.edge_coordinate(eb, a.world_vertices[ea]);
+        let s1 = b.edge_coordinate(eb, a.world_vertices[ea1]);
+        let ((v_lo, s_lo), (v_hi, s_hi)) = if s0 <= s1 {
+            ((ea, s0), (ea1, s1))
+        } else {
+            ((ea1, s1), (ea, s0))
+        };
+        let lb = b.local.lengths()[eb];
+        let overlap = s_hi.min(lb) - s_lo.max(0.0);
+        if overlap < 0.0 || (strict && overlap <= self.eps_s) {
+            return false;
+        }
+        // Each end as (vertex collider side, vertex, edge): true = A's vertex on E_B.
+        let lo = if s_lo >= 0.0 { (true, v_lo) } else { (false, eb) };
+        let hi = if s_hi <= lb { (true, v_hi) } else { (false, eb1) };
+        let mark = out.len();
+        let mut pushed = 0;
+        for (on_b, v) in [lo, hi] {
+            let ok = if on_b {
+                self.push_if_valid(ia, a, v, ib, b, eb, out)
+            } else {
+                self.push_if_valid(ib, b, v, ia, a, ea, out)
+            };
+            pushed += ok as usize;
+        }
+        if strict && pushed < 2 {
+            out.truncate(mark);
+            return false;
+        }
+        pushed == 2
+    }
+
+    /// Penetrating pair (§9.4): every vertex of `a` inside `b` or within `δ_c` of it, against the
+    /// edge of `b` of least depth among those whose range contains it.
+    fn vertices_against(
+        &self,
+        ia: u32,
+        a: &Collider,
+        ib: u32,
+        b: &Collider,
+        out: &mut Vec<VeCandidate>,
+    ) {
+        'vertex: for v in 0..a.len() {
+            let p = a.world_vertices[v];
+            let mut best: Option<(usize, f64)> = None;
+            for e in 0..b.len() {
+                let d = b.edge_distance(e, p);
+                if d > self.delta_c {
+                    // Farther than δ_c from B's half-plane, so from B.
+                    continue 'vertex;
+                }
+                let s = b.edge_coordinate(e, p);
+                let in_range = s >= -self.eps_s && s <= b.local.lengths()[e] + self.eps_s;
+                if in_range && best.is_none_or(|(_, bd)| d > bd) {
+                    best = Some((e, d));
+                }
+            }
+            if let Some((e, _)) = best {
+                out.push(VeCandidate {
+                    vertex_collider: ia,
+                    vertex: v as u32,
+                    edge_collider: ib,
+                    edge: e as u32,
+                });
+            }
+        }
+    }
+}
+
+/// Of the two edges of `c` incident to vertex `v`, the one whose outward normal is most aligned
+/// with `p − V` (largest `n·(p − V)`; the outgoing edge on a tie).
+fn most_aligned_edge(c: &Collider, v: usize, p: Vec2) -> usize {
+    let r = p - c.world_vertices[v];
+    let e_out = v;
+    let e_in = c.local.prev(v);
+    if c.world_normals[e_in].dot(r) > c.world_normals[e_out].dot(r) {
+        e_in
+    } else {
+        e_out
+    }
+}
