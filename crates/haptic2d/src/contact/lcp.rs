@@ -13,6 +13,9 @@ pub const PIVOT_MIN: f64 = 1e-12;
 pub const LAMBDA_TOL: f64 = 1e-12;
 /// Enumeration accepts `w_i ≥ −W_TOL` (m/s) (§7.3).
 pub const W_TOL: f64 = 1e-9;
+/// Above [`ENUMERATION_MAX_N`] and up to this size, enumeration is the fallback when projected
+/// Gauss–Seidel stops at its sweep limit (not in §7.3; see [`LcpSolver::solve`]). `2¹⁰` sets.
+pub const ENUMERATION_FALLBACK_MAX_N: usize = 10;
 /// Projected Gauss–Seidel: maximum number of sweeps (§7.3).
 pub const PGS_MAX_SWEEPS: usize = 200;
 /// Projected Gauss–Seidel: stop when the largest `|Δλ|` of a sweep is below this (N·s) (§7.3).
@@ -44,11 +47,15 @@ pub struct LcpReport {
     pub active_mask: u64,
     /// PGS: number of sweeps run. Enumeration: number of index sets tried.
     pub iterations: usize,
-    /// False only when PGS stopped at the sweep limit without meeting its tolerance, or enumeration
-    /// found no index set within tolerance and its PGS fallback did not converge either.
+    /// False when PGS stopped at the sweep limit or stopped with some `w_i < −1e-9` (the `|Δλ|` rule
+    /// met far from the solution), or when enumeration found no index set within tolerance, and no
+    /// fallback (see [`LcpSolver::solve`]) did better.
     pub converged: bool,
     /// True when enumeration found no index set within tolerance and PGS was used instead.
     pub enumeration_failed: bool,
+    /// True when PGS did not converge and the result came from the enumeration fallback
+    /// (`6 < n ≤ 10`).
+    pub pgs_failed: bool,
 }
 
 /// Errors of [`LcpSolver::solve`]: inconsistent input sizes.
@@ -155,9 +162,14 @@ impl LcpSolver {
     }
 
     /// Solves the LCP for the row-major `n × n` matrix `a` and the vector `b` (`n = b.len()`), choosing
-    /// enumeration for `n ≤ 6` and projected Gauss–Seidel otherwise (§7.3). If enumeration finds no
-    /// index set within tolerance (possible only for ill-conditioned or non-PSD `A`), PGS is used and
-    /// the report says so. The result is read with [`Self::lambda`] and [`Self::w`].
+    /// enumeration for `n ≤ 6` and projected Gauss–Seidel otherwise (§7.3). The result is read with
+    /// [`Self::lambda`] and [`Self::w`].
+    ///
+    /// Fallbacks (beyond §7.3, reported in [`LcpReport`]):
+    /// - if enumeration finds no index set within tolerance (ill-conditioned `A`), PGS is used;
+    /// - if PGS does not converge for `6 < n ≤ 10` (sweep limit, or a final `w_i < −1e-9`),
+    ///   enumeration is tried and used if it finds a set. PGS converges very slowly on Delassus matrices of nearly redundant contacts (strongly
+    ///   coupled rows, diagonal spread of 30×); 200 sweeps can leave `w_i ≈ −0.1 m/s`.
     pub fn solve(&mut self, a: &[f64], b: &[f64]) -> Result<LcpReport, LcpError> {
         let n = b.len();
         if n <= ENUMERATION_MAX_N {
@@ -170,7 +182,19 @@ impl LcpSolver {
             p.iterations += r.iterations;
             Ok(p)
         } else {
-            self.solve_pgs(a, b)
+            let p = self.solve_pgs(a, b)?;
+            if p.converged || n > ENUMERATION_FALLBACK_MAX_N {
+                return Ok(p);
+            }
+            let mut e = self.solve_enumeration(a, b)?;
+            if e.converged {
+                e.pgs_failed = true;
+                e.iterations += p.iterations;
+                Ok(e)
+            } else {
+                // Neither converged: restore the PGS iterate.
+                self.solve_pgs(a, b)
+            }
         }
     }
 
@@ -200,6 +224,7 @@ impl LcpSolver {
             iterations: 0,
             converged: true,
             enumeration_failed: false,
+            pgs_failed: false,
         };
         if n == 0 {
             return Ok(report);
@@ -281,6 +306,7 @@ impl LcpSolver {
             iterations: 0,
             converged: true,
             enumeration_failed: false,
+            pgs_failed: false,
         };
         let lam = &mut self.lambda[..n];
         lam.fill(0.0);
@@ -308,7 +334,13 @@ impl LcpSolver {
         }
         for i in 0..n {
             let row = &a[i * n..(i + 1) * n];
-            self.w[i] = row.iter().zip(lam.iter()).map(|(x, l)| x * l).sum::<f64>() + b[i];
+            let wi = row.iter().zip(lam.iter()).map(|(x, l)| x * l).sum::<f64>() + b[i];
+            self.w[i] = wi;
+            // The |Δλ| rule detects stagnation, not optimality: on strongly coupled rows PGS can
+            // creep by < 1e-9 N·s per sweep far from the solution. Check feasibility of w too.
+            if !(wi >= -W_TOL) {
+                report.converged = false;
+            }
         }
         Ok(report)
     }
