@@ -1,1 +1,454 @@
 //! Simultaneous impacts with Poisson restitution (§7): Delassus assembly, compression LCP, restitution, plastic correction.
+//!
+//! The caller (the contact manager, §8.2) builds the impact set `𝒞`: every Colliding contact with
+//! restitution `e`, plus every Continuous contact touching a body of a colliding one with restitution 0.
+//! [`ImpactSolver::solve`] then runs §7.2 and applies the velocity jumps to the bodies. Friction is
+//! ignored during the impulse (§7, [REC]).
+
+use super::lcp::{LcpReport, LcpSolver};
+use crate::body::Body;
+use crate::geom::{cross, Vec2};
+
+/// Constraint-check tolerance `ε_v` (m/s): after restitution, a row with `b⁺_i < −ε_v` triggers the
+/// plastic correction (§7.2 step 3).
+pub const EPS_V: f64 = 1e-6;
+
+/// One row of the impact set `𝒞` (§7.1): a vertex–edge contact.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ImpactRow {
+    /// Index (into the `bodies` slice) of body A, the body that owns the vertex.
+    pub body_a: usize,
+    /// Index (into the `bodies` slice) of body B, the body that owns the edge.
+    pub body_b: usize,
+    /// Unit edge normal `n` (dimensionless), pointing out of B toward A (§0.4).
+    pub n: Vec2,
+    /// Lever arm `r_A = V − c_A` (m) from A's centre of mass to the vertex.
+    pub r_a: Vec2,
+    /// Lever arm `r_B = V − c_B` (m) from B's centre of mass to the vertex.
+    pub r_b: Vec2,
+    /// Restitution `e_i` (dimensionless, in `[0, 1]`): `e` for Colliding rows, 0 for Continuous rows.
+    pub restitution: f64,
+}
+
+impl ImpactRow {
+    /// The Jacobian row `G_i` as two blocks `(n, r_A × n)` for A and `(−n, −(r_B × n))` for B (§7.1).
+    /// A fixed body's block is zero.
+    fn jacobian(&self, bodies: &[Body]) -> [f64; 6] {
+        let mut j = [0.0; 6];
+        if bodies[self.body_a].is_dynamic() {
+            j[0] = self.n.x;
+            j[1] = self.n.y;
+            j[2] = cross(self.r_a, self.n);
+        }
+        if bodies[self.body_b].is_dynamic() {
+            j[3] = -self.n.x;
+            j[4] = -self.n.y;
+            j[5] = -cross(self.r_b, self.n);
+        }
+        j
+    }
+
+    /// Normal relative velocity `C0 = G_i·u = n·(v_A + ω_A·perp(r_A) − v_B − ω_B·perp(r_B))` (m/s),
+    /// positive when separating, from the bodies' current twists. Fixed bodies count as at rest.
+    ///
+    /// # Panics
+    /// If `body_a` or `body_b` is not an index into `bodies`.
+    pub fn normal_velocity(&self, bodies: &[Body]) -> f64 {
+        let j = self.jacobian(bodies);
+        dot_twist(&j[0..3], &bodies[self.body_a]) + dot_twist(&j[3..6], &bodies[self.body_b])
+    }
+}
+
+/// `J·(v_x, v_y, ω)` for one 3-entry Jacobian block.
+#[inline]
+fn dot_twist(j: &[f64], b: &Body) -> f64 {
+    j[0] * b.vel.x + j[1] * b.vel.y + j[2] * b.omega
+}
+
+/// Summary of one [`ImpactSolver::solve`] call. Per-row data (impulses, velocities, the Delassus
+/// matrix) are read from the solver's accessors until the next call.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ImpactOutcome {
+    /// Number of rows `n` in the impact set.
+    pub rows: usize,
+    /// Total kinetic energy of all bodies in the slice before the impact (J).
+    pub kinetic_energy_before: f64,
+    /// Total kinetic energy of all bodies in the slice after the impact (J).
+    pub kinetic_energy_after: f64,
+    /// True if the constraint check found `b⁺_i < −ε_v` and the plastic correction LCP ran (§7.2 step 3).
+    pub plastic_correction: bool,
+    /// Diagnostics of the compression LCP (§7.2 step 1).
+    pub compression: LcpReport,
+    /// Diagnostics of the plastic-correction LCP, if it ran.
+    pub correction: Option<LcpReport>,
+    /// Smallest post-impact normal velocity `min_i b⁺_i` (m/s); `+∞` for an empty set.
+    pub min_post_velocity: f64,
+}
+
+/// Solver for simultaneous frictionless impacts with Poisson restitution (§7.2).
+///
+/// Owns all scratch (the Delassus matrix, velocities, impulses and the LCP solver); buffers grow only
+/// when a larger impact set than any before arrives, so steady-state calls do not allocate.
+#[derive(Clone, Debug)]
+pub struct ImpactSolver {
+    lcp: LcpSolver,
+    cap: usize,
+    n: usize,
+    /// Jacobian rows, two 3-blocks each (A then B).
+    jac: Vec<[f64; 6]>,
+    /// Delassus matrix `A = G M⁻¹ Gᵀ`, row-major `n × n`.
+    a: Vec<f64>,
+    /// Pre-impact normal velocities `b⁻` (m/s).
+    b_pre: Vec<f64>,
+    /// Post-restitution normal velocities, before any plastic correction (m/s).
+    b_mid: Vec<f64>,
+    /// Final post-impact normal velocities `b⁺` (m/s).
+    b_post: Vec<f64>,
+    /// Compression impulses `λ` (N·s).
+    lambda: Vec<f64>,
+    /// Plastic-correction impulses `λ'` (N·s); zero when the correction did not run.
+    correction: Vec<f64>,
+    /// Total impulses `P + λ'` (N·s).
+    impulse: Vec<f64>,
+}
+
+impl Default for ImpactSolver {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl ImpactSolver {
+    /// A solver preallocated for impact sets of up to 8 rows.
+    pub fn new() -> Self {
+        Self::with_capacity(8)
+    }
+
+    /// A solver preallocated for impact sets of up to `rows` rows.
+    pub fn with_capacity(rows: usize) -> Self {
+        let mut s = Self {
+            lcp: LcpSolver::with_capacity(rows),
+            cap: 0,
+            n: 0,
+            jac: Vec::new(),
+            a: Vec::new(),
+            b_pre: Vec::new(),
+            b_mid: Vec::new(),
+            b_post: Vec::new(),
+            lambda: Vec::new(),
+            correction: Vec::new(),
+            impulse: Vec::new(),
+        };
+        s.reserve(rows);
+        s
+    }
+
+    /// Largest impact set solvable without allocating.
+    pub fn capacity(&self) -> usize {
+        self.cap
+    }
+
+    /// Grows the buffers to hold impact sets of `rows` rows (no-op if they already do).
+    pub fn reserve(&mut self, rows: usize) {
+        if rows <= self.cap {
+            return;
+        }
+        self.jac.resize(rows, [0.0; 6]);
+        self.a.resize(rows * rows, 0.0);
+        for v in [
+            &mut self.b_pre,
+            &mut self.b_mid,
+            &mut self.b_post,
+            &mut self.lambda,
+            &mut self.correction,
+            &mut self.impulse,
+        ] {
+            v.resize(rows, 0.0);
+        }
+        self.lcp.reserve(rows);
+        self.cap = rows;
+    }
+
+    /// Number of rows of the last solve.
+    pub fn len(&self) -> usize {
+        self.n
+    }
+
+    /// True if the last solve had no rows.
+    pub fn is_empty(&self) -> bool {
+        self.n == 0
+    }
+
+    /// The Delassus matrix `A = G M⁻¹ Gᵀ` of the last solve, row-major `n × n` (1/kg: (m/s) per N·s).
+    pub fn delassus(&self) -> &[f64] {
+        &self.a[..self.n * self.n]
+    }
+
+    /// Pre-impact normal velocities `b⁻ = G u⁻` of the last solve (m/s).
+    pub fn pre_velocities(&self) -> &[f64] {
+        &self.b_pre[..self.n]
+    }
+
+    /// Normal velocities after restitution and before the plastic correction (m/s).
+    pub fn restitution_velocities(&self) -> &[f64] {
+        &self.b_mid[..self.n]
+    }
+
+    /// Final post-impact normal velocities `b⁺ = G u⁺` of the last solve (m/s).
+    pub fn post_velocities(&self) -> &[f64] {
+        &self.b_post[..self.n]
+    }
+
+    /// Compression impulses `λ_i` of the last solve (N·s).
+    pub fn compression_impulses(&self) -> &[f64] {
+        &self.lambda[..self.n]
+    }
+
+    /// Plastic-correction impulses `λ'_i` of the last solve (N·s); all zero if it did not run.
+    pub fn correction_impulses(&self) -> &[f64] {
+        &self.correction[..self.n]
+    }
+
+    /// Total impulse per row applied by the last solve, `(1 + e_i)·λ_i + λ'_i` (N·s), along `n_i` on
+    /// the vertex body A (and opposite on B).
+    pub fn impulses(&self) -> &[f64] {
+        &self.impulse[..self.n]
+    }
+
+    /// Resolves the impact set `rows` (in the given order) on `bodies` (§7.2) and applies the velocity
+    /// jumps to the bodies' `vel` and `omega`:
+    ///
+    /// 1. compression LCP `λ ≥ 0, A·λ + b⁻ ≥ 0, λ ⟂ (A·λ + b⁻)`;
+    /// 2. Poisson restitution `P_i = (1 + e_i)·λ_i`, `u⁺ = u⁻ + M⁻¹GᵀP`;
+    /// 3. if some `b⁺_i < −ε_v`, a plastic-correction LCP with `b = b⁺`, applied as `M⁻¹Gᵀλ'`.
+    ///
+    /// Fixed bodies have `M⁻¹ = 0` and are treated as at rest; they are never modified.
+    ///
+    /// # Panics
+    /// If a row's `body_a` or `body_b` is not an index into `bodies` (a bug in the caller).
+    pub fn solve(&mut self, rows: &[ImpactRow], bodies: &mut [Body]) -> ImpactOutcome {
+        let n = rows.len();
+        self.reserve(n);
+        self.n = n;
+        let ke_before: f64 = bodies.iter().map(Body::kinetic_energy).sum();
+
+        // Jacobian rows and pre-impact velocities b⁻ = G u⁻.
+        for (i, row) in rows.iter().enumerate() {
+            self.jac[i] = row.jacobian(bodies);
+        }
+        self.normal_velocities(rows, bodies, Buf::Pre);
+
+        // Delassus matrix A_ij = Σ over shared bodies of J_ib · M_b⁻¹ · J_jbᵀ.
+        for i in 0..n {
+            for j in 0..n {
+                let mut s = 0.0;
+                for (pi, bi) in [(0usize, rows[i].body_a), (3, rows[i].body_b)] {
+                    let body = &bodies[bi];
+                    if !body.is_dynamic() {
+                        continue;
+                    }
+                    for (pj, bj) in [(0usize, rows[j].body_a), (3, rows[j].body_b)] {
+                        if bi != bj {
+                            continue;
+                        }
+                        let (ji, jj) = (&self.jac[i], &self.jac[j]);
+                        s += body.inv_mass * (ji[pi] * jj[pj] + ji[pi + 1] * jj[pj + 1])
+                            + body.inv_inertia * ji[pi + 2] * jj[pj + 2];
+                    }
+                }
+                self.a[i * n + j] = s;
+            }
+        }
+
+        // 1. Compression LCP. The sizes are consistent by construction, so the error branch is
+        // unreachable; it degrades to "no impulse" rather than panicking.
+        let compression = match self.lcp.solve(&self.a[..n * n], &self.b_pre[..n]) {
+            Ok(r) => {
+                self.lambda[..n].copy_from_slice(self.lcp.lambda());
+                r
+            }
+            Err(_) => {
+                self.lambda[..n].fill(0.0);
+                empty_report(n)
+            }
+        };
+
+        // 2. Poisson restitution P_i = (1 + e_i)·λ_i, applied as Δu = M⁻¹GᵀP.
+        for i in 0..n {
+            self.impulse[i] = (1.0 + rows[i].restitution) * self.lambda[i];
+            self.correction[i] = 0.0;
+        }
+        self.apply_impulses(rows, bodies, Buf::Impulse);
+        self.normal_velocities(rows, bodies, Buf::Mid);
+
+        // 3. Constraint check and plastic correction.
+        let needs_correction = self.b_mid[..n].iter().any(|&v| v < -EPS_V);
+        let mut correction = None;
+        if needs_correction {
+            if let Ok(r) = self.lcp.solve(&self.a[..n * n], &self.b_mid[..n]) {
+                self.correction[..n].copy_from_slice(self.lcp.lambda());
+                correction = Some(r);
+            }
+            self.apply_impulses(rows, bodies, Buf::Correction);
+            for i in 0..n {
+                self.impulse[i] += self.correction[i];
+            }
+            self.normal_velocities(rows, bodies, Buf::Post);
+        } else {
+            self.b_post[..n].copy_from_slice(&self.b_mid[..n]);
+        }
+
+        let ke_after: f64 = bodies.iter().map(Body::kinetic_energy).sum();
+        ImpactOutcome {
+            rows: n,
+            kinetic_energy_before: ke_before,
+            kinetic_energy_after: ke_after,
+            plastic_correction: needs_correction,
+            compression,
+            correction,
+            min_post_velocity: self.b_post[..n]
+                .iter()
+                .copied()
+                .fold(f64::INFINITY, f64::min),
+        }
+    }
+
+    /// Writes `G u` for the bodies' current twists into the chosen buffer.
+    fn normal_velocities(&mut self, rows: &[ImpactRow], bodies: &[Body], into: Buf) {
+        let out = match into {
+            Buf::Pre => &mut self.b_pre,
+            Buf::Mid => &mut self.b_mid,
+            _ => &mut self.b_post,
+        };
+        for (i, row) in rows.iter().enumerate() {
+            let j = &self.jac[i];
+            out[i] = dot_twist(&j[0..3], &bodies[row.body_a])
+                + dot_twist(&j[3..6], &bodies[row.body_b]);
+        }
+    }
+
+    /// Applies `Δu = M⁻¹Gᵀp` for the impulses `p` in the chosen buffer.
+    fn apply_impulses(&self, rows: &[ImpactRow], bodies: &mut [Body], from: Buf) {
+        let p = match from {
+            Buf::Correction => &self.correction,
+            _ => &self.impulse,
+        };
+        for (i, row) in rows.iter().enumerate() {
+            let pi = p[i];
+            if pi == 0.0 {
+                continue;
+            }
+            let j = &self.jac[i];
+            for (off, bi) in [(0usize, row.body_a), (3, row.body_b)] {
+                let body = &mut bodies[bi];
+                if !body.is_dynamic() {
+                    continue;
+                }
+                body.vel.x += body.inv_mass * j[off] * pi;
+                body.vel.y += body.inv_mass * j[off + 1] * pi;
+                body.omega += body.inv_inertia * j[off + 2] * pi;
+            }
+        }
+    }
+}
+
+/// Internal buffer selector.
+#[derive(Clone, Copy)]
+enum Buf {
+    Pre,
+    Mid,
+    Post,
+    Impulse,
+    Correction,
+}
+
+fn empty_report(n: usize) -> LcpReport {
+    LcpReport {
+        n,
+        method: super::lcp::LcpMethod::Empty,
+        active_mask: 0,
+        iterations: 0,
+        converged: false,
+        enumeration_failed: false,
+        pgs_failed: false,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::Pose;
+
+    #[test]
+    fn fixed_bodies_contribute_nothing_and_are_untouched() {
+        let mut bodies = vec![
+            Body::fixed("wall", Pose::IDENTITY),
+            Body::dynamic("box", 2.0, 0.1, Pose::new(1.0, 0.0, 0.0)),
+        ];
+        bodies[1].vel = Vec2::new(-1.0, 0.0);
+        let row = ImpactRow {
+            body_a: 1,
+            body_b: 0,
+            n: Vec2::new(1.0, 0.0),
+            r_a: Vec2::new(-1.0, 0.0),
+            r_b: Vec2::new(0.0, 0.0),
+            restitution: 1.0,
+        };
+        let mut s = ImpactSolver::with_capacity(1);
+        let out = s.solve(&[row], &mut bodies);
+        assert!((s.delassus()[0] - 0.5).abs() < 1e-15);
+        assert!((bodies[1].vel.x - 1.0).abs() < 1e-15);
+        assert_eq!(bodies[0].vel, Vec2::ZERO);
+        assert_eq!(bodies[0].omega, 0.0);
+        assert!(!out.plastic_correction);
+        assert!((s.impulses()[0] - 4.0).abs() < 1e-14);
+    }
+
+    #[test]
+    fn two_dynamic_bodies_head_on_exchange_velocities() {
+        // Equal masses, e = 1, central impact: velocities are exchanged.
+        let mut bodies = vec![
+            Body::dynamic("a", 1.0, 0.01, Pose::new(0.1, 0.0, 0.0)),
+            Body::dynamic("b", 1.0, 0.01, Pose::new(-0.1, 0.0, 0.0)),
+        ];
+        bodies[0].vel = Vec2::new(-1.0, 0.0);
+        bodies[1].vel = Vec2::new(0.5, 0.0);
+        let row = ImpactRow {
+            body_a: 0,
+            body_b: 1,
+            n: Vec2::new(1.0, 0.0),
+            r_a: Vec2::new(-0.1, 0.0),
+            r_b: Vec2::new(0.1, 0.0),
+            restitution: 1.0,
+        };
+        let mut s = ImpactSolver::new();
+        let out = s.solve(&[row], &mut bodies);
+        assert!((s.delassus()[0] - 2.0).abs() < 1e-15);
+        assert!((bodies[0].vel.x - 0.5).abs() < 1e-14);
+        assert!((bodies[1].vel.x + 1.0).abs() < 1e-14);
+        assert!((out.kinetic_energy_after - out.kinetic_energy_before).abs() < 1e-14);
+    }
+
+    #[test]
+    fn steady_state_does_not_reallocate() {
+        let mut bodies = vec![
+            Body::fixed("wall", Pose::IDENTITY),
+            Body::dynamic("box", 1.0, 0.1, Pose::new(1.0, 0.0, 0.0)),
+        ];
+        let row = ImpactRow {
+            body_a: 1,
+            body_b: 0,
+            n: Vec2::new(1.0, 0.0),
+            r_a: Vec2::new(-1.0, 0.0),
+            r_b: Vec2::ZERO,
+            restitution: 0.5,
+        };
+        let mut s = ImpactSolver::with_capacity(4);
+        let (pa, pb) = (s.a.as_ptr(), s.impulse.as_ptr());
+        for _ in 0..5 {
+            bodies[1].vel = Vec2::new(-1.0, 0.0);
+            s.solve(&[row, row], &mut bodies);
+        }
+        assert_eq!((s.a.as_ptr(), s.impulse.as_ptr()), (pa, pb));
+    }
+}
