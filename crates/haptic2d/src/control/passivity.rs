@@ -48,7 +48,8 @@ pub struct PassivityController {
 
 impl PassivityController {
     /// Valid parameter names for [`PassivityController::set_param`].
-    pub const PARAMS: &'static str = "v_min, alpha_max, control (0 or 1), pairing (0 = zoh, 1 = same-sample)";
+    pub const PARAMS: &'static str =
+        "v_min, alpha_max, control (0 or 1), pairing (0 = zoh, 1 = same-sample)";
 
     /// A controller with threshold `v_min` and bound `alpha_max`, ZOH-consistent pairing, control on.
     pub fn new(v_min: f64, alpha_max: f64) -> Self {

@@ -91,14 +91,18 @@ impl WallConfig {
             if v.is_finite() && v > 0.0 {
                 Ok(())
             } else {
-                Err(format!("wall harness: `{key}` must be finite and > 0, got {v}"))
+                Err(format!(
+                    "wall harness: `{key}` must be finite and > 0, got {v}"
+                ))
             }
         };
         let nonneg = |key: &str, v: f64| {
             if v.is_finite() && v >= 0.0 {
                 Ok(())
             } else {
-                Err(format!("wall harness: `{key}` must be finite and ≥ 0, got {v}"))
+                Err(format!(
+                    "wall harness: `{key}` must be finite and ≥ 0, got {v}"
+                ))
             }
         };
         let finite = |key: &str, v: f64| {
