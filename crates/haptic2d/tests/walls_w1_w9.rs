@@ -3,7 +3,7 @@
 //! `T = 2 ms`, 10 s, exact-ZOH mode unless a test says otherwise.
 
 use haptic2d::harness::wall::{run_wall, EntryImpulse, WallConfig, WallIntegration, WallRun};
-use haptic2d::laws::normal::{colgate_margin, NormalModel, PaperLaw};
+use haptic2d::laws::normal::{colgate_margin, HystereticLaw, NormalModel, PaperLaw};
 
 fn run_law(law: NormalModel, config: WallConfig) -> WallRun {
     run_wall(&config, law).expect("valid run")
@@ -247,6 +247,13 @@ fn fig4_table_report() {
         ("Massie PI", run("pi", cfg)),
         ("Hysteretic", run("hysteretic", cfg)),
         ("Braking pulse", run("pulse", cfg)),
+        (
+            "Hysteretic, 10 g blocks",
+            run_law(
+                NormalModel::Hysteretic(HystereticLaw::one_d().with_block_mass(0.01)),
+                cfg,
+            ),
+        ),
         (
             "Paper e=0.5 + §5.9",
             run_law(NormalModel::Paper(PaperLaw::one_d()), paper),

@@ -320,7 +320,7 @@ fn simulate(
         let inside = x <= 0.0;
         if let Some(imp) = config.impulse {
             if inside && !inside_prev && -v > imp.v_c {
-                v = -imp.e * v;
+                v *= -imp.e;
             }
         }
         inside_prev = inside;
@@ -396,4 +396,37 @@ fn simulate(
         samples,
         metrics,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn free_flight_entry_speed_and_validation() {
+        let cfg = WallConfig::fig4();
+        let r = run_wall(&cfg, NormalModel::from_name("zoh", false).expect("known")).expect("run");
+        assert_eq!(r.samples.len(), 5000);
+        // √(2·F·g0/m) = 0.400 m/s, sampled one step after the crossing at most.
+        let v_in = r.metrics.contacts[0].entry_speed;
+        assert!((v_in - 0.4).abs() < 0.4 * 0.02, "entry speed {v_in}");
+        let bad = WallConfig { mass: 0.0, ..cfg };
+        let e = run_wall(&bad, NormalModel::default()).unwrap_err();
+        assert!(e.contains("mass"), "{e}");
+    }
+
+    #[test]
+    fn exact_zoh_with_damping_matches_the_closed_form() {
+        // No wall in reach: v(t) = v∞ + (v0 − v∞)·e^{−bt/m} with v∞ = −F/b.
+        let cfg = WallConfig {
+            damping: 2.0,
+            gap0: 10.0,
+            duration: 1.0,
+            ..WallConfig::fig4()
+        };
+        let r = run_wall(&cfg, NormalModel::from_name("zoh", false).expect("known")).expect("run");
+        let last = r.samples.last().expect("samples");
+        let v_exact = -1.0 * (1.0 - (-2.0 * last.t / 0.5_f64).exp());
+        assert!((last.v - v_exact).abs() < 1e-12, "{} vs {v_exact}", last.v);
+    }
 }

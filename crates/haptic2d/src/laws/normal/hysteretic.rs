@@ -218,3 +218,46 @@ impl NormalLaw for HystereticLaw {
         self.stored
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn at(delta: f64) -> NormalInput {
+        NormalInput {
+            d: [-delta; 3],
+            hist: 3,
+            c0: 0.0,
+            dt: 0.002,
+            m_eff: 0.5,
+        }
+    }
+
+    #[test]
+    fn blocks_with_mass_follow_the_massless_path_and_stick() {
+        // Blocks of 10 g (k·T²/m = 0.2, well inside the semi-implicit stability bound 4).
+        let mut massless = HystereticLaw::one_d();
+        let mut heavy = HystereticLaw::one_d().with_block_mass(0.01);
+        // Slow ramp to 4 mm over 2 s, then hold 0.4 s.
+        let n = 1000;
+        let (mut f0, mut f1) = (0.0, 0.0);
+        for i in 1..=n + 200 {
+            let delta = 0.004 * (i.min(n) as f64) / n as f64;
+            f0 = massless.force(&at(delta));
+            f1 = heavy.force(&at(delta));
+        }
+        assert!((f0 - 5.5).abs() < 1e-12);
+        assert!((f1 - f0).abs() < 0.05, "massive {f1} vs massless {f0}");
+        // Stuck at rest, each element within its friction bound.
+        for e in &heavy.elements {
+            assert_eq!(e.b_dot, 0.0);
+            assert!(e.k * (0.004 - e.b).abs() <= e.f + 1e-9);
+        }
+        // Unloading by 0.5 mm is elastic for both.
+        let g0 = massless.force(&at(0.0035));
+        let g1 = heavy.force(&at(0.0035));
+        // 3.5 + 500·0.0005 + 500·0.0015 = 4.5 N.
+        assert!((g0 - 4.5).abs() < 1e-12);
+        assert!((g1 - g0).abs() < 0.05, "massive {g1} vs massless {g0}");
+    }
+}

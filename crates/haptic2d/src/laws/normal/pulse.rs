@@ -66,7 +66,8 @@ impl BrakingPulseLaw {
             "k" => self.k = value,
             "e_b" => self.e_b = value,
             "n_p" => {
-                if !(value >= 1.0 && value.fract() == 0.0 && value <= u32::MAX as f64) {
+                let whole = value >= 1.0 && value.fract() == 0.0 && value <= u32::MAX as f64;
+                if !whole {
                     return Err(format!(
                         "pulse: parameter `n_p` must be a positive whole number of samples, got {value}"
                     ));

@@ -103,3 +103,33 @@ impl NormalLaw for SehLaw {
         self.stored
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn input(d: [f64; 3]) -> NormalInput {
+        NormalInput {
+            d,
+            hist: 3,
+            c0: 0.0,
+            dt: 0.002,
+            m_eff: 0.5,
+        }
+    }
+
+    #[test]
+    fn predictor_uses_signed_history_and_corrector_adds_last_error() {
+        let mut seh = SehLaw::new(1000.0, false);
+        // Onset: previous samples outside (positive gaps) enter as negative penetrations.
+        // δ̃ = 2·0.001 − 1.5·(−0.001) + 0.5·(−0.003) = 0.002.
+        assert!((seh.force(&input([-0.001, 0.001, 0.003])) - 2.0).abs() < 1e-12);
+        let mut pc = SehLaw::new(1000.0, true);
+        // First active sample: nothing used before, δ̄ = (0 + 0.001)/2 → +0.0005.
+        assert!((pc.force(&input([-0.001, 0.001, 0.003])) - 2.5).abs() < 1e-12);
+        // Next: δ̃ = 2·0.002 − 1.5·0.001 + 0.5·(−0.001) = 0.002; δ̄ = 0.0015; used 0.0025 → 0.001.
+        assert!((pc.force(&input([-0.002, -0.001, 0.001])) - 1.0).abs() < 1e-12);
+        // Outside: zero and forget.
+        assert_eq!(pc.force(&input([0.001, -0.002, -0.001])), 0.0);
+    }
+}
