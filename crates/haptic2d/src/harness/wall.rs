@@ -426,7 +426,8 @@ mod tests {
         };
         let r = run_wall(&cfg, NormalModel::from_name("zoh", false).expect("known")).expect("run");
         let last = r.samples.last().expect("samples");
-        let v_exact = -1.0 * (1.0 - (-2.0 * last.t / 0.5_f64).exp());
+        let (v_inf, rate) = (-2.0 / 2.0, 2.0 / 0.5);
+        let v_exact = v_inf * (1.0 - (-rate * last.t).exp());
         assert!((last.v - v_exact).abs() < 1e-12, "{} vs {v_exact}", last.v);
     }
 }
