@@ -74,7 +74,7 @@ pub trait NormalLaw {
     fn stored_energy(&self) -> f64;
 }
 
-/// Error for a parameter that must be finite and non-negative; `None` when it is fine.
+/// Checks that a parameter is finite and non-negative; the error names the law and the parameter.
 pub(crate) fn check_nonneg(law: &str, key: &str, value: f64) -> Result<(), String> {
     if value.is_finite() && value >= 0.0 {
         Ok(())
