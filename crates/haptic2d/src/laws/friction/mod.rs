@@ -1,9 +1,17 @@
 //! Friction models per VE contact (§1–§4). Each returns `F_t`, the tangential force on the vertex body A
 //! along `+t`; friction opposes the motion of A relative to B.
 
+mod finger_pad;
+mod hayward_armstrong;
+mod karnopp;
 mod reset_integrator;
+mod salcudean_vlaar;
 
+pub use finger_pad::FingerPad;
+pub use hayward_armstrong::{AdhesionMap, HaywardArmstrong};
+pub use karnopp::Karnopp;
 pub use reset_integrator::{LoadScaling, ResetIntegrator};
+pub use salcudean_vlaar::SalcudeanVlaar;
 
 /// What a friction model sees at one sample (after the normal force of the same sample is known).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -51,7 +59,8 @@ pub trait FrictionLaw {
     fn mode(&self) -> FrictionMode;
 }
 
-/// The selectable friction models. Each variant carries its parameters and per-contact state.
+/// The selectable friction models. Each variant carries its parameters and per-contact state, so a
+/// contact gets its own copy of the scene's prototype (no allocation).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub enum FrictionModel {
     /// No friction.
@@ -59,53 +68,195 @@ pub enum FrictionModel {
     None,
     /// Haessig–Friedland reset integrator (§1), the paper's choice.
     ResetIntegrator(ResetIntegrator),
+    /// Hayward–Armstrong driftless model (§2), or Dahl's model when its map is [`AdhesionMap::Dahl`].
+    HaywardArmstrong(HaywardArmstrong),
+    /// Nahvi et al. finger-pad model (§3).
+    FingerPad(FingerPad),
+    /// Classical velocity-threshold Coulomb model of Karnopp (§4.1).
+    Karnopp(Karnopp),
+    /// Salcudean–Vlaar modified Karnopp model (§4.2).
+    SalcudeanVlaar(SalcudeanVlaar),
 }
 
 impl FrictionModel {
+    /// All names accepted by [`FrictionModel::from_name`], in spec order.
+    pub const NAMES: &'static [&'static str] = &[
+        "none",
+        "reset-integrator",
+        "hayward-armstrong",
+        "dahl",
+        "nahvi",
+        "classical",
+        "salcudean-vlaar",
+    ];
+
     /// The name used in scene files and on the command line.
     pub fn name(&self) -> &'static str {
         match self {
             FrictionModel::None => "none",
             FrictionModel::ResetIntegrator(_) => "reset-integrator",
+            FrictionModel::HaywardArmstrong(m) if m.is_dahl() => "dahl",
+            FrictionModel::HaywardArmstrong(_) => "hayward-armstrong",
+            FrictionModel::FingerPad(_) => "nahvi",
+            FrictionModel::Karnopp(_) => "classical",
+            FrictionModel::SalcudeanVlaar(_) => "salcudean-vlaar",
         }
     }
+
+    /// The model called `name` (see [`FrictionModel::NAMES`]) with its default parameters: the 2-D
+    /// per-contact values of the spec tables when `per_contact` is true (the 4-contact peg), the 1-D
+    /// values otherwise. The error lists the valid names.
+    pub fn from_name(name: &str, per_contact: bool) -> Result<Self, String> {
+        fn pick<T>(per_contact: bool, one_d: T, per: T) -> T {
+            if per_contact {
+                per
+            } else {
+                one_d
+            }
+        }
+        Ok(match name {
+            "none" => FrictionModel::None,
+            "reset-integrator" => FrictionModel::ResetIntegrator(pick(
+                per_contact,
+                ResetIntegrator::one_d(),
+                ResetIntegrator::per_contact(),
+            )),
+            "hayward-armstrong" => FrictionModel::HaywardArmstrong(pick(
+                per_contact,
+                HaywardArmstrong::one_d(),
+                HaywardArmstrong::per_contact(),
+            )),
+            "dahl" => FrictionModel::HaywardArmstrong(
+                pick(
+                    per_contact,
+                    HaywardArmstrong::one_d(),
+                    HaywardArmstrong::per_contact(),
+                )
+                .dahl(),
+            ),
+            "nahvi" => FrictionModel::FingerPad(pick(
+                per_contact,
+                FingerPad::one_d(),
+                FingerPad::per_contact(),
+            )),
+            "classical" => {
+                FrictionModel::Karnopp(pick(per_contact, Karnopp::one_d(), Karnopp::per_contact()))
+            }
+            "salcudean-vlaar" => FrictionModel::SalcudeanVlaar(pick(
+                per_contact,
+                SalcudeanVlaar::one_d(),
+                SalcudeanVlaar::per_contact(),
+            )),
+            _ => {
+                return Err(format!(
+                    "unknown friction model '{name}'; valid: {}",
+                    Self::NAMES.join(", ")
+                ))
+            }
+        })
+    }
+
+    /// The parameter keys that [`FrictionModel::set_param`] accepts for this model.
+    pub fn param_keys(&self) -> &'static [&'static str] {
+        match self {
+            FrictionModel::None => &[],
+            FrictionModel::ResetIntegrator(_) => ResetIntegrator::KEYS,
+            FrictionModel::HaywardArmstrong(_) => HaywardArmstrong::KEYS,
+            FrictionModel::FingerPad(_) => FingerPad::KEYS,
+            FrictionModel::Karnopp(_) => Karnopp::KEYS,
+            FrictionModel::SalcudeanVlaar(_) => SalcudeanVlaar::KEYS,
+        }
+    }
+
+    /// Sets one parameter by its scene-file key. Keys per model: reset-integrator `kr, mu_s, mu_k, beta,
+    /// p0`; hayward-armstrong/dahl `k, mu_k, r_stick, sigma1, sigma2`; nahvi `k_p0, k_p1, b_pad, mu_s,
+    /// mu_k`; classical `v_th, mu_s, mu_k`; salcudean-vlaar `k_p, k_d, b_v, v_th, mu_s, mu_k`. The error
+    /// names the model and lists its valid keys; a non-finite value is refused. Ranges are checked by
+    /// [`FrictionModel::validate`].
+    pub fn set_param(&mut self, key: &str, value: f64) -> Result<(), String> {
+        if !value.is_finite() {
+            return Err(format!(
+                "parameter '{key}' of friction model '{}' must be a finite number, got {value}",
+                self.name()
+            ));
+        }
+        match self {
+            FrictionModel::None => Err(format!(
+                "friction model 'none' has no parameters (got '{key}')"
+            )),
+            FrictionModel::ResetIntegrator(m) => m.set_param(key, value),
+            FrictionModel::HaywardArmstrong(m) => m.set_param(key, value),
+            FrictionModel::FingerPad(m) => m.set_param(key, value),
+            FrictionModel::Karnopp(m) => m.set_param(key, value),
+            FrictionModel::SalcudeanVlaar(m) => m.set_param(key, value),
+        }
+    }
+
+    /// Sets the reset integrator's load scaling (§1); an error for every other model.
+    pub fn set_load_scaling(&mut self, scaling: LoadScaling) -> Result<(), String> {
+        match self {
+            FrictionModel::ResetIntegrator(m) => {
+                m.scaling = scaling;
+                Ok(())
+            }
+            _ => Err(format!(
+                "load_scaling applies only to friction model 'reset-integrator', not '{}'",
+                self.name()
+            )),
+        }
+    }
+
+    /// Checks the parameters; the error names the model and the offending parameter.
+    pub fn validate(&self) -> Result<(), String> {
+        let r = match self {
+            FrictionModel::None => Ok(()),
+            FrictionModel::ResetIntegrator(m) => m.validate(),
+            FrictionModel::HaywardArmstrong(m) => m.validate(),
+            FrictionModel::FingerPad(m) => m.validate(),
+            FrictionModel::Karnopp(m) => m.validate(),
+            FrictionModel::SalcudeanVlaar(m) => m.validate(),
+        };
+        r.map_err(|e| format!("friction model '{}': {e}", self.name()))
+    }
+
+    /// Whether the model reads [`FrictionInput::f_ext_t`] (only the classical model, §4.1); the world
+    /// may skip computing it otherwise.
+    pub fn uses_external_force(&self) -> bool {
+        matches!(self, FrictionModel::Karnopp(_))
+    }
+}
+
+/// Forwards a `FrictionLaw` method to the selected model.
+macro_rules! dispatch {
+    ($self:ident, $m:ident => $e:expr, none => $n:expr) => {
+        match $self {
+            FrictionModel::None => $n,
+            FrictionModel::ResetIntegrator($m) => $e,
+            FrictionModel::HaywardArmstrong($m) => $e,
+            FrictionModel::FingerPad($m) => $e,
+            FrictionModel::Karnopp($m) => $e,
+            FrictionModel::SalcudeanVlaar($m) => $e,
+        }
+    };
 }
 
 impl FrictionLaw for FrictionModel {
     fn reset(&mut self) {
-        match self {
-            FrictionModel::None => {}
-            FrictionModel::ResetIntegrator(m) => m.reset(),
-        }
+        dispatch!(self, m => m.reset(), none => ())
     }
     fn begin(&mut self, s_entry: f64) {
-        match self {
-            FrictionModel::None => {}
-            FrictionModel::ResetIntegrator(m) => m.begin(s_entry),
-        }
+        dispatch!(self, m => m.begin(s_entry), none => ())
     }
     fn update(&mut self, input: &FrictionInput) -> f64 {
-        match self {
-            FrictionModel::None => 0.0,
-            FrictionModel::ResetIntegrator(m) => m.update(input),
-        }
+        dispatch!(self, m => m.update(input), none => 0.0)
     }
     fn stored_energy(&self) -> f64 {
-        match self {
-            FrictionModel::None => 0.0,
-            FrictionModel::ResetIntegrator(m) => m.stored_energy(),
-        }
+        dispatch!(self, m => m.stored_energy(), none => 0.0)
     }
     fn anchor(&self, s: f64) -> Option<f64> {
-        match self {
-            FrictionModel::None => None,
-            FrictionModel::ResetIntegrator(m) => m.anchor(s),
-        }
+        dispatch!(self, m => m.anchor(s), none => None)
     }
     fn mode(&self) -> FrictionMode {
-        match self {
-            FrictionModel::None => FrictionMode::Slip,
-            FrictionModel::ResetIntegrator(m) => m.mode(),
-        }
+        dispatch!(self, m => m.mode(), none => FrictionMode::Slip)
     }
 }

@@ -37,6 +37,29 @@ pub struct ResetIntegrator {
     mode: FrictionMode,
 }
 
+impl LoadScaling {
+    /// The scene-file names of the options.
+    pub const NAMES: &'static [&'static str] = &["limit", "stiffness"];
+    /// The option's scene-file name.
+    pub fn name(&self) -> &'static str {
+        match self {
+            LoadScaling::Limit => "limit",
+            LoadScaling::Stiffness => "stiffness",
+        }
+    }
+    /// Parses a scene-file name (`limit` or `stiffness`); the error lists the valid names.
+    pub fn from_name(name: &str) -> Result<Self, String> {
+        match name {
+            "limit" => Ok(LoadScaling::Limit),
+            "stiffness" => Ok(LoadScaling::Stiffness),
+            _ => Err(format!(
+                "unknown load scaling '{name}'; valid: {}",
+                Self::NAMES.join(", ")
+            )),
+        }
+    }
+}
+
 impl ResetIntegrator {
     /// A model with `Kr` (N/m), `μs`, `μk` and `β` (N·s/m), load scaling `Limit`.
     pub fn new(kr: f64, mu_s: f64, mu_k: f64, beta: f64) -> Self {
@@ -65,10 +88,41 @@ impl ResetIntegrator {
     pub fn a(&self) -> f64 {
         self.mu_s / self.mu_k - 1.0
     }
+    /// The strain limit `p0` (m) at normal force `fn_` (N): `μk·F_n/Kr` with [`LoadScaling::Limit`],
+    /// the fixed `p0` with [`LoadScaling::Stiffness`].
+    #[inline]
+    pub fn p0(&self, fn_: f64) -> f64 {
+        match self.scaling {
+            LoadScaling::Limit => self.mu_k * fn_ / self.kr,
+            LoadScaling::Stiffness => self.p0_fixed,
+        }
+    }
     /// The current strain `p` (m).
     #[inline]
     pub fn strain(&self) -> f64 {
         self.p
+    }
+    /// The parameter keys accepted by [`ResetIntegrator::set_param`] (`p0` is the fixed strain limit of
+    /// [`LoadScaling::Stiffness`]).
+    pub const KEYS: &'static [&'static str] = &["kr", "mu_s", "mu_k", "beta", "p0"];
+    /// Sets one parameter by its scene-file key (see [`ResetIntegrator::KEYS`]); the error lists the valid
+    /// keys. Ranges are checked by [`ResetIntegrator::validate`].
+    pub fn set_param(&mut self, key: &str, value: f64) -> Result<(), String> {
+        match key {
+            "kr" => {
+                self.kr = value;
+                self.k_used = value;
+            }
+            "mu_s" => self.mu_s = value,
+            "mu_k" => self.mu_k = value,
+            "beta" => self.beta = value,
+            "p0" => self.p0_fixed = value,
+            _ => return Err(format!(
+                "unknown parameter '{key}' for friction model 'reset-integrator'; valid keys: {}",
+                Self::KEYS.join(", ")
+            )),
+        }
+        Ok(())
     }
     /// Checks the parameters; the error names the offending one.
     pub fn validate(&self) -> Result<(), String> {
@@ -93,7 +147,9 @@ impl ResetIntegrator {
                 self.beta
             ));
         }
-        if self.scaling == LoadScaling::Stiffness && !(self.p0_fixed > 0.0) {
+        if self.scaling == LoadScaling::Stiffness
+            && !(self.p0_fixed.is_finite() && self.p0_fixed > 0.0)
+        {
             return Err(format!(
                 "p0 must be a positive strain limit in m, got {}",
                 self.p0_fixed

@@ -2,10 +2,34 @@
 //!
 //! In 2-D a law runs per VE contact with `δ = −d` and `v_in = −C0`; in the 1-D harness the wall surface is
 //! at `x = 0`, `d = x` and `C0 = v`.
+//!
+//! Calling convention. In 2-D the world calls [`NormalLaw::force`] only while a contact record exists
+//! (`d ≤ 0`) and gives each contact a fresh copy of the scene's prototype, so "the first sample after
+//! being outside" is the first call after creation or [`NormalLaw::reset`]. In the 1-D harness the law is
+//! called at every sample; every law returns 0 while `δ_k = 0` and resets its own entry state there
+//! (PI integral, pulse counter, hysteretic blocks).
+//!
+//! Per-contact halving (§5, §13.1): when a flat face rests on the wall through two vertex contacts, each
+//! contact uses half the 1-D stiffness, damping, integral gain and friction levels (`per_contact()`),
+//! which reproduces the 1-D numbers (`one_d()`).
 
+mod colgate;
+mod hysteretic;
+mod massie;
+mod minsky;
 mod paper;
+mod pulse;
+mod seh;
+mod zoh;
 
+pub use colgate::{colgate_margin, ColgateLaw};
+pub use hysteretic::{HystereticLaw, SlideElement, BLOCK_STICK_SPEED, MAX_ELEMENTS};
+pub use massie::MassiePiLaw;
+pub use minsky::MinskyLaw;
 pub use paper::PaperLaw;
+pub use pulse::BrakingPulseLaw;
+pub use seh::SehLaw;
+pub use zoh::ZohLaw;
 
 /// What a normal law sees at one sample.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -50,19 +74,162 @@ pub trait NormalLaw {
     fn stored_energy(&self) -> f64;
 }
 
+/// Checks that a parameter is finite and non-negative; the error names the law and the parameter.
+pub(crate) fn check_nonneg(law: &str, key: &str, value: f64) -> Result<(), String> {
+    if value.is_finite() && value >= 0.0 {
+        Ok(())
+    } else {
+        Err(format!(
+            "{law}: parameter `{key}` must be finite and ≥ 0, got {value}"
+        ))
+    }
+}
+
+/// Error for an unknown parameter name, listing the valid ones.
+pub(crate) fn unknown_key(law: &str, key: &str, valid: &str) -> String {
+    format!("{law}: unknown parameter `{key}`; valid parameters: {valid}")
+}
+
 /// The selectable normal laws. Every variant carries its parameters and its per-contact state, so a
 /// contact gets its own copy of the scene's prototype (no allocation).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum NormalModel {
     /// The paper's law, §5.9: `F_n = max(0, −Kc·d̃ − Bc·C0)` with the SEH estimate `d̃`.
     Paper(PaperLaw),
+    /// ZOH pure stiffness, §5.2 (active).
+    Zoh(ZohLaw),
+    /// Minsky et al. stiffness plus damping, §5.3.
+    Minsky(MinskyLaw),
+    /// Colgate–Schenkel wall `K·δ + B·Δδ/T`, §5.4 (passive with enough plant damping).
+    Colgate(ColgateLaw),
+    /// Ellis et al. sample–estimate–hold, §5.5, optionally with the predictor–corrector.
+    Seh(SehLaw),
+    /// Massie PI wall, §5.6.
+    MassiePi(MassiePiLaw),
+    /// Salcudean–Vlaar braking pulse, §5.7.
+    BrakingPulse(BrakingPulseLaw),
+    /// Goldfarb–Wang hysteretic wall, §5.8.
+    Hysteretic(HystereticLaw),
 }
+
+/// Every name accepted by [`NormalModel::from_name`].
+pub const NORMAL_MODEL_NAMES: [&str; 9] = [
+    "paper",
+    "zoh",
+    "minsky",
+    "colgate",
+    "seh",
+    "seh-pc",
+    "pi",
+    "pulse",
+    "hysteretic",
+];
 
 impl NormalModel {
     /// The name used in scene files and on the command line.
     pub fn name(&self) -> &'static str {
         match self {
             NormalModel::Paper(_) => "paper",
+            NormalModel::Zoh(_) => "zoh",
+            NormalModel::Minsky(_) => "minsky",
+            NormalModel::Colgate(_) => "colgate",
+            NormalModel::Seh(l) if l.corrector => "seh-pc",
+            NormalModel::Seh(_) => "seh",
+            NormalModel::MassiePi(_) => "pi",
+            NormalModel::BrakingPulse(_) => "pulse",
+            NormalModel::Hysteretic(_) => "hysteretic",
+        }
+    }
+
+    /// The model called `name` with its spec defaults: the halved per-contact values when
+    /// `per_contact` is true (a face on two contacts in 2-D), the 1-D values otherwise.
+    pub fn from_name(name: &str, per_contact: bool) -> Result<Self, String> {
+        let pick = |one: Self, per: Self| if per_contact { per } else { one };
+        Ok(match name {
+            "paper" => pick(
+                NormalModel::Paper(PaperLaw::one_d()),
+                NormalModel::Paper(PaperLaw::per_contact()),
+            ),
+            "zoh" => pick(
+                NormalModel::Zoh(ZohLaw::one_d()),
+                NormalModel::Zoh(ZohLaw::per_contact()),
+            ),
+            "minsky" => pick(
+                NormalModel::Minsky(MinskyLaw::one_d()),
+                NormalModel::Minsky(MinskyLaw::per_contact()),
+            ),
+            "colgate" => pick(
+                NormalModel::Colgate(ColgateLaw::one_d()),
+                NormalModel::Colgate(ColgateLaw::per_contact()),
+            ),
+            "seh" | "seh-pc" => {
+                let c = name == "seh-pc";
+                pick(
+                    NormalModel::Seh(SehLaw::one_d().with_corrector(c)),
+                    NormalModel::Seh(SehLaw::per_contact().with_corrector(c)),
+                )
+            }
+            "pi" => pick(
+                NormalModel::MassiePi(MassiePiLaw::one_d()),
+                NormalModel::MassiePi(MassiePiLaw::per_contact()),
+            ),
+            "pulse" => pick(
+                NormalModel::BrakingPulse(BrakingPulseLaw::one_d()),
+                NormalModel::BrakingPulse(BrakingPulseLaw::per_contact()),
+            ),
+            "hysteretic" => pick(
+                NormalModel::Hysteretic(HystereticLaw::one_d()),
+                NormalModel::Hysteretic(HystereticLaw::per_contact()),
+            ),
+            _ => {
+                return Err(format!(
+                    "unknown normal law `{name}`; valid names: {}",
+                    NORMAL_MODEL_NAMES.join(", ")
+                ))
+            }
+        })
+    }
+
+    /// Checks the parameters; the error names the law and the bad parameter.
+    pub fn validate(&self) -> Result<(), String> {
+        match self {
+            NormalModel::Paper(l) => l.validate(),
+            NormalModel::Zoh(l) => l.validate(),
+            NormalModel::Minsky(l) => l.validate(),
+            NormalModel::Colgate(l) => l.validate(),
+            NormalModel::Seh(l) => l.validate(),
+            NormalModel::MassiePi(l) => l.validate(),
+            NormalModel::BrakingPulse(l) => l.validate(),
+            NormalModel::Hysteretic(l) => l.validate(),
+        }
+    }
+
+    /// Sets one parameter by name (units as documented on each law); the error lists the valid keys.
+    /// Call [`NormalModel::validate`] after setting all of them.
+    pub fn set_param(&mut self, key: &str, value: f64) -> Result<(), String> {
+        match self {
+            NormalModel::Paper(l) => l.set_param(key, value),
+            NormalModel::Zoh(l) => l.set_param(key, value),
+            NormalModel::Minsky(l) => l.set_param(key, value),
+            NormalModel::Colgate(l) => l.set_param(key, value),
+            NormalModel::Seh(l) => l.set_param(key, value),
+            NormalModel::MassiePi(l) => l.set_param(key, value),
+            NormalModel::BrakingPulse(l) => l.set_param(key, value),
+            NormalModel::Hysteretic(l) => l.set_param(key, value),
+        }
+    }
+
+    /// The valid parameter names of this model, for messages and help text.
+    pub fn param_names(&self) -> &'static str {
+        match self {
+            NormalModel::Paper(_) => PaperLaw::PARAMS,
+            NormalModel::Zoh(_) => ZohLaw::PARAMS,
+            NormalModel::Minsky(_) => MinskyLaw::PARAMS,
+            NormalModel::Colgate(_) => ColgateLaw::PARAMS,
+            NormalModel::Seh(_) => SehLaw::PARAMS,
+            NormalModel::MassiePi(_) => MassiePiLaw::PARAMS,
+            NormalModel::BrakingPulse(_) => BrakingPulseLaw::PARAMS,
+            NormalModel::Hysteretic(_) => HystereticLaw::PARAMS,
         }
     }
 }
@@ -77,16 +244,140 @@ impl NormalLaw for NormalModel {
     fn reset(&mut self) {
         match self {
             NormalModel::Paper(l) => l.reset(),
+            NormalModel::Zoh(l) => l.reset(),
+            NormalModel::Minsky(l) => l.reset(),
+            NormalModel::Colgate(l) => l.reset(),
+            NormalModel::Seh(l) => l.reset(),
+            NormalModel::MassiePi(l) => l.reset(),
+            NormalModel::BrakingPulse(l) => l.reset(),
+            NormalModel::Hysteretic(l) => l.reset(),
         }
     }
     fn force(&mut self, input: &NormalInput) -> f64 {
         match self {
             NormalModel::Paper(l) => l.force(input),
+            NormalModel::Zoh(l) => l.force(input),
+            NormalModel::Minsky(l) => l.force(input),
+            NormalModel::Colgate(l) => l.force(input),
+            NormalModel::Seh(l) => l.force(input),
+            NormalModel::MassiePi(l) => l.force(input),
+            NormalModel::BrakingPulse(l) => l.force(input),
+            NormalModel::Hysteretic(l) => l.force(input),
         }
     }
     fn stored_energy(&self) -> f64 {
         match self {
             NormalModel::Paper(l) => l.stored_energy(),
+            NormalModel::Zoh(l) => l.stored_energy(),
+            NormalModel::Minsky(l) => l.stored_energy(),
+            NormalModel::Colgate(l) => l.stored_energy(),
+            NormalModel::Seh(l) => l.stored_energy(),
+            NormalModel::MassiePi(l) => l.stored_energy(),
+            NormalModel::BrakingPulse(l) => l.stored_energy(),
+            NormalModel::Hysteretic(l) => l.stored_energy(),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn inside(d: f64, c0: f64) -> NormalInput {
+        NormalInput {
+            d: [d, d, d],
+            hist: 3,
+            c0,
+            dt: 0.002,
+            m_eff: 0.5,
+        }
+    }
+
+    #[test]
+    fn names_round_trip_and_unknown_lists_valid() {
+        for name in NORMAL_MODEL_NAMES {
+            for per in [false, true] {
+                let m = NormalModel::from_name(name, per).expect("known name");
+                assert_eq!(m.name(), name);
+                assert!(m.validate().is_ok(), "{name} defaults must validate");
+            }
+        }
+        let e = NormalModel::from_name("spring", false).unwrap_err();
+        assert!(e.contains("hysteretic") && e.contains("seh-pc"), "{e}");
+    }
+
+    #[test]
+    fn set_param_and_validate_name_the_parameter() {
+        let mut m = NormalModel::from_name("minsky", false).expect("known");
+        m.set_param("k", -1.0).expect("known key");
+        assert!(m.validate().unwrap_err().contains("`k`"));
+        let e = m.set_param("stiffness", 1.0).unwrap_err();
+        assert!(e.contains("b_m"), "{e}");
+        let mut h = NormalModel::from_name("hysteretic", true).expect("known");
+        h.set_param("f2", 0.7).expect("element key");
+        h.set_param("m1", -0.1).expect("element key");
+        assert!(h.validate().unwrap_err().contains("`m1`"));
+        assert!(h.set_param("k9", 1.0).is_err());
+        let mut p = NormalModel::from_name("pulse", false).expect("known");
+        assert!(p.set_param("n_p", 2.5).is_err());
+        p.set_param("n_p", 3.0).expect("integer");
+    }
+
+    #[test]
+    fn per_contact_halves_one_d() {
+        for name in NORMAL_MODEL_NAMES {
+            let mut one = NormalModel::from_name(name, false).expect("known");
+            let mut per = NormalModel::from_name(name, true).expect("known");
+            // Two contacts at the same depth and rate give the 1-D force (no pulse: c0 = 0).
+            let f1 = one.force(&inside(-0.001, 0.0));
+            let f2 = per.force(&inside(-0.001, 0.0));
+            assert!((f1 - 2.0 * f2).abs() < 1e-12, "{name}: {f1} vs 2×{f2}");
+        }
+    }
+
+    #[test]
+    fn every_law_is_zero_outside_and_nonnegative() {
+        for name in NORMAL_MODEL_NAMES {
+            let mut m = NormalModel::from_name(name, false).expect("known");
+            assert_eq!(m.force(&inside(0.001, -0.5)), 0.0, "{name} outside");
+            assert!(m.force(&inside(-0.0001, 5.0)) >= 0.0, "{name} clamps");
+        }
+    }
+
+    #[test]
+    fn hysteretic_massless_loading_and_unloading() {
+        let mut h = HystereticLaw::one_d();
+        let at = |d: f64| inside(-d, 0.0);
+        // Elastic below the smallest slip deflection f1/k1 = 1 mm.
+        assert!((h.force(&at(0.0005)) - 1.0).abs() < 1e-12);
+        // Loading to 4 mm: both blocks slip; F = 1000·0.004 + 0.5 + 1.0.
+        assert!((h.force(&at(0.004)) - 5.5).abs() < 1e-12);
+        // Unloading to 3 mm: elements relax elastically by 1 mm each: F = 3 + 0 + 0.5.
+        assert!((h.force(&at(0.003)) - 3.5).abs() < 1e-12);
+        assert!(h.stored_energy() > 0.0);
+        h.force(&at(0.0));
+        assert_eq!(h.block_positions(), [0.0; MAX_ELEMENTS]);
+    }
+
+    #[test]
+    fn pulse_latches_entry_speed_once() {
+        let mut p = BrakingPulseLaw::one_d();
+        let mut inp = inside(-0.0001, -0.4);
+        let fb = 1.3 * 0.5 * 0.4 / (5.0 * 0.002);
+        for _ in 0..5 {
+            assert!((p.force(&inp) - (0.2 + fb)).abs() < 1e-9);
+        }
+        assert!((p.force(&inp) - 0.2).abs() < 1e-9);
+        inp.d[0] = 0.0001;
+        assert_eq!(p.force(&inp), 0.0);
+        inp.d[0] = -0.0001;
+        assert!(p.force(&inp) > 1.0, "pulse re-arms after leaving");
+    }
+
+    #[test]
+    fn colgate_margin_signs() {
+        assert!(colgate_margin(2.4, 2000.0, 0.0, 0.002) > 0.0);
+        assert!(colgate_margin(1.0, 2000.0, 0.0, 0.002) < 0.0);
+        assert!((colgate_margin(3.0, 2000.0, -0.5, 0.002) - 0.5).abs() < 1e-12);
     }
 }

@@ -1,11 +1,14 @@
 //! The paper's continuous-contact law (§5.9): an SEH spring plus damping.
 
-use super::{NormalInput, NormalLaw};
+use super::{check_nonneg, NormalInput, NormalLaw};
 
 /// `F_n,k = max(0, −Kc·d̃_k − Bc·C0,k)` with `d̃_k = 2d_k − 1.5d_{k−1} + 0.5d_{k−2}` (paper eq. 1).
 ///
 /// The clamp keeps the damper from pulling separating bodies together. Collisions faster than `v_c`
 /// are resolved by impulses (§7) before this law applies.
+///
+/// Outside the wall (`d_k > 0`, no contact record in 2-D) the force is 0: in the 1-D harness the law is
+/// called at every sample, and the damper must not act before contact.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PaperLaw {
     /// Contact stiffness `Kc` (N/m).
@@ -17,6 +20,9 @@ pub struct PaperLaw {
 }
 
 impl PaperLaw {
+    /// Valid parameter names for [`PaperLaw::set_param`].
+    pub const PARAMS: &'static str = "kc, bc";
+
     /// A law with stiffness `kc` (N/m) and damping `bc` (N·s/m).
     pub fn new(kc: f64, bc: f64) -> Self {
         Self {
@@ -33,6 +39,20 @@ impl PaperLaw {
     pub fn per_contact() -> Self {
         Self::new(1000.0, 5.0)
     }
+    /// Checks the parameters; the error names the bad one.
+    pub fn validate(&self) -> Result<(), String> {
+        check_nonneg("paper", "kc", self.kc)?;
+        check_nonneg("paper", "bc", self.bc)
+    }
+    /// Sets a parameter by name: `kc` (N/m), `bc` (N·s/m).
+    pub fn set_param(&mut self, key: &str, value: f64) -> Result<(), String> {
+        match key {
+            "kc" | "k" => self.kc = value,
+            "bc" | "b" => self.bc = value,
+            _ => return Err(super::unknown_key("paper", key, Self::PARAMS)),
+        }
+        Ok(())
+    }
 }
 
 impl NormalLaw for PaperLaw {
@@ -42,6 +62,9 @@ impl NormalLaw for PaperLaw {
     fn force(&mut self, input: &NormalInput) -> f64 {
         let delta = input.depth();
         self.stored = 0.5 * self.kc * delta * delta;
+        if input.d[0] > 0.0 {
+            return 0.0;
+        }
         (-self.kc * input.seh_distance() - self.bc * input.c0).max(0.0)
     }
     fn stored_energy(&self) -> f64 {

@@ -1,0 +1,185 @@
+//! Finger-pad friction after Nahvi, Hollerbach, Freier & Nelson (1998), per VE contact (§3) [REC].
+//!
+//! A compliant pad joins the vertex (the "bone") to an anchor `s_a` on the edge (the skin–surface patch).
+//! With deflection `u = s − s_a` and pad stiffness `k_pad = k_p0 + k_p1·F_n`:
+//!
+//! - stick: the anchor is fixed and `F_t = −(k_pad·u + b_pad·S0)`;
+//! - stick → slip when `k_pad·|u| > μs·F_n`;
+//! - slip: the anchor is dragged so that `|u| = μk·F_n/k_pad`, and `F_t = −k_pad·u`;
+//! - slip → stick when the pad force falls below `μk·F_n` (the vertex reverses relative to the anchor).
+//!
+//! The static/kinetic gap is a hysteretic threshold on one spring, not a stiffness boost as in §1.
+
+use super::{FrictionInput, FrictionLaw, FrictionMode};
+
+/// Nahvi finger-pad friction (§3). Parameters are public; the state (`s_a`, mode) is private.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FingerPad {
+    /// Pad tangential stiffness at zero load, `k_p0` (N/m).
+    pub k_p0: f64,
+    /// Load stiffening `k_p1` (1/m): `k_pad = k_p0 + k_p1·F_n`.
+    pub k_p1: f64,
+    /// Pad damping in stick, `b_pad` (N·s/m).
+    pub b_pad: f64,
+    /// Static friction coefficient `μs` (dimensionless).
+    pub mu_s: f64,
+    /// Kinetic friction coefficient `μk` (dimensionless).
+    pub mu_k: f64,
+    /// Anchor edge coordinate `s_a` (m, in the edge body's frame).
+    s_a: f64,
+    /// Whether `s_a` holds a valid anchor; if not, the next loaded update anchors at the current `s`.
+    engaged: bool,
+    /// Stick or slip.
+    mode: FrictionMode,
+    /// Pad stiffness used at the last update (N/m).
+    k_used: f64,
+    /// Deflection `u` after the last update (m).
+    u: f64,
+}
+
+impl FingerPad {
+    /// A linear-pad model (`k_p1 = 0`) with stiffness `k_p0` (N/m), damping `b_pad` (N·s/m), `μs`, `μk`.
+    pub fn new(k_p0: f64, b_pad: f64, mu_s: f64, mu_k: f64) -> Self {
+        Self {
+            k_p0,
+            k_p1: 0.0,
+            b_pad,
+            mu_s,
+            mu_k,
+            s_a: 0.0,
+            engaged: false,
+            mode: FrictionMode::Stick,
+            k_used: k_p0,
+            u: 0.0,
+        }
+    }
+    /// 1-D defaults (§3 table): `k_p0 = 4000 N/m`, `k_p1 = 0`, `b_pad = 10 N·s/m`, `μs = 0.5`, `μk = 0.45`.
+    pub fn one_d() -> Self {
+        Self::new(4000.0, 10.0, 0.5, 0.45)
+    }
+    /// Per-contact defaults of the 4-contact 2-D peg (§3 table): `k_p0 = 2000 N/m`, `b_pad = 5 N·s/m`.
+    pub fn per_contact() -> Self {
+        Self::new(2000.0, 5.0, 0.5, 0.45)
+    }
+    /// The pad stiffness `k_pad = k_p0 + k_p1·F_n` (N/m) at normal force `fn_` (N).
+    #[inline]
+    pub fn k_pad(&self, fn_: f64) -> f64 {
+        self.k_p0 + self.k_p1 * fn_
+    }
+    /// The deflection `u = s − s_a` (m) after the last update.
+    #[inline]
+    pub fn deflection(&self) -> f64 {
+        self.u
+    }
+    /// Checks the parameters; the error names the offending one.
+    pub fn validate(&self) -> Result<(), String> {
+        if !(self.k_p0.is_finite() && self.k_p0 > 0.0) {
+            return Err(format!(
+                "k_p0 must be a positive stiffness in N/m, got {}",
+                self.k_p0
+            ));
+        }
+        if !(self.k_p1.is_finite() && self.k_p1 >= 0.0) {
+            return Err(format!(
+                "k_p1 must be a non-negative load stiffening in 1/m, got {}",
+                self.k_p1
+            ));
+        }
+        if !(self.b_pad.is_finite() && self.b_pad >= 0.0) {
+            return Err(format!(
+                "b_pad must be a non-negative damping in N·s/m, got {}",
+                self.b_pad
+            ));
+        }
+        if !(self.mu_k.is_finite() && self.mu_k > 0.0) {
+            return Err(format!("mu_k must be positive, got {}", self.mu_k));
+        }
+        if !(self.mu_s.is_finite() && self.mu_s >= self.mu_k) {
+            return Err(format!(
+                "mu_s must be at least mu_k (static ≥ kinetic), got mu_s = {} < mu_k = {}",
+                self.mu_s, self.mu_k
+            ));
+        }
+        Ok(())
+    }
+    /// The parameter keys accepted by [`FingerPad::set_param`].
+    pub const KEYS: &'static [&'static str] = &["k_p0", "k_p1", "b_pad", "mu_s", "mu_k"];
+    /// Sets one parameter by its scene-file key (see [`FingerPad::KEYS`]); the error lists the valid keys.
+    /// Ranges are checked by [`FingerPad::validate`].
+    pub fn set_param(&mut self, key: &str, value: f64) -> Result<(), String> {
+        match key {
+            "k_p0" => self.k_p0 = value,
+            "k_p1" => self.k_p1 = value,
+            "b_pad" => self.b_pad = value,
+            "mu_s" => self.mu_s = value,
+            "mu_k" => self.mu_k = value,
+            _ => {
+                return Err(format!(
+                    "unknown parameter '{key}' for friction model 'nahvi'; valid keys: {}",
+                    Self::KEYS.join(", ")
+                ))
+            }
+        }
+        Ok(())
+    }
+}
+
+impl FrictionLaw for FingerPad {
+    fn reset(&mut self) {
+        self.engaged = false;
+        self.mode = FrictionMode::Stick;
+        self.u = 0.0;
+    }
+
+    /// Anchors the pad at the god-object's entry point, so `u ≈ 0` at first contact.
+    fn begin(&mut self, s_entry: f64) {
+        self.reset();
+        self.s_a = s_entry;
+        self.engaged = true;
+    }
+
+    fn update(&mut self, i: &FrictionInput) -> f64 {
+        if i.fn_ <= 0.0 {
+            self.reset(); // delete state
+            return 0.0;
+        }
+        if !self.engaged {
+            // Loaded again after a release (or never begun): anchor where the vertex is now.
+            self.s_a = i.s;
+            self.engaged = true;
+            self.mode = FrictionMode::Stick;
+        }
+        let k = self.k_pad(i.fn_);
+        self.k_used = k;
+        let mut u = i.s - self.s_a;
+        if self.mode == FrictionMode::Stick && k * u.abs() > self.mu_s * i.fn_ {
+            self.mode = FrictionMode::Slip;
+        }
+        if self.mode == FrictionMode::Slip {
+            if k * u.abs() >= self.mu_k * i.fn_ {
+                // Drag the anchor so that the pad force is exactly the kinetic level.
+                self.s_a = i.s - u.signum() * self.mu_k * i.fn_ / k;
+                u = i.s - self.s_a;
+                self.u = u;
+                return -k * u;
+            }
+            self.mode = FrictionMode::Stick;
+        }
+        self.u = u;
+        -(k * u + self.b_pad * i.s0)
+    }
+
+    /// `½·k_pad·u²` (J), the U_f of §13.2 F7-5.
+    fn stored_energy(&self) -> f64 {
+        0.5 * self.k_used * self.u * self.u
+    }
+
+    /// The pad anchor `s_a` (§8.3), once engaged.
+    fn anchor(&self, _s: f64) -> Option<f64> {
+        self.engaged.then_some(self.s_a)
+    }
+
+    fn mode(&self) -> FrictionMode {
+        self.mode
+    }
+}

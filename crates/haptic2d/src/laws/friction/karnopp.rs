@@ -1,0 +1,119 @@
+//! Classical velocity-threshold Coulomb friction (Karnopp 1985), per VE contact (§4.1).
+//!
+//! Inside the band `|S0| ≤ v_th` the contact is declared stuck and the friction force cancels this
+//! contact's share of the other tangential forces, up to `μs·F_n`; outside it, kinetic Coulomb friction
+//! `μk·F_n` opposes the slip velocity. The velocity is not reset on sticking, so a residual
+//! `|S0| < v_th` persists below stiction: the creep that this model is shown to have (Fig. 7).
+
+use super::{FrictionInput, FrictionLaw, FrictionMode};
+
+/// Karnopp's classical stick/slip model (§4.1). Stateless apart from the logged mode.
+///
+/// Needs [`FrictionInput::f_ext_t`]: this contact's share `(t·F_A^nonfric)/n_t` of the non-friction
+/// force on A along `+t` (N); in 1-D, `F_applied/n_contacts`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Karnopp {
+    /// Stick velocity band `v_th` (m/s).
+    pub v_th: f64,
+    /// Static friction coefficient `μs` (dimensionless).
+    pub mu_s: f64,
+    /// Kinetic friction coefficient `μk` (dimensionless).
+    pub mu_k: f64,
+    /// Stick or slip at the last update.
+    mode: FrictionMode,
+}
+
+impl Karnopp {
+    /// A model with band `v_th` (m/s), `μs` and `μk`.
+    pub fn new(v_th: f64, mu_s: f64, mu_k: f64) -> Self {
+        Self {
+            v_th,
+            mu_s,
+            mu_k,
+            mode: FrictionMode::Stick,
+        }
+    }
+    /// Defaults (§4.1): `v_th = 0.01 m/s`, `μs = 0.5`, `μk = 0.45` (the same in 1-D and per 2-D contact).
+    pub fn one_d() -> Self {
+        Self::new(0.01, 0.5, 0.45)
+    }
+    /// Per-contact defaults of the 2-D peg: identical to [`Karnopp::one_d`] (the model has no spring or
+    /// damper to split between contacts).
+    pub fn per_contact() -> Self {
+        Self::one_d()
+    }
+    /// Checks the parameters; the error names the offending one.
+    pub fn validate(&self) -> Result<(), String> {
+        if !(self.v_th.is_finite() && self.v_th > 0.0) {
+            return Err(format!(
+                "v_th must be a positive velocity band in m/s, got {}",
+                self.v_th
+            ));
+        }
+        if !(self.mu_k.is_finite() && self.mu_k > 0.0) {
+            return Err(format!("mu_k must be positive, got {}", self.mu_k));
+        }
+        if !(self.mu_s.is_finite() && self.mu_s >= self.mu_k) {
+            return Err(format!(
+                "mu_s must be at least mu_k (static ≥ kinetic), got mu_s = {} < mu_k = {}",
+                self.mu_s, self.mu_k
+            ));
+        }
+        Ok(())
+    }
+    /// The parameter keys accepted by [`Karnopp::set_param`].
+    pub const KEYS: &'static [&'static str] = &["v_th", "mu_s", "mu_k"];
+    /// Sets one parameter by its scene-file key (see [`Karnopp::KEYS`]); the error lists the valid keys.
+    /// Ranges are checked by [`Karnopp::validate`].
+    pub fn set_param(&mut self, key: &str, value: f64) -> Result<(), String> {
+        match key {
+            "v_th" => self.v_th = value,
+            "mu_s" => self.mu_s = value,
+            "mu_k" => self.mu_k = value,
+            _ => {
+                return Err(format!(
+                    "unknown parameter '{key}' for friction model 'classical'; valid keys: {}",
+                    Self::KEYS.join(", ")
+                ))
+            }
+        }
+        Ok(())
+    }
+}
+
+impl FrictionLaw for Karnopp {
+    fn reset(&mut self) {
+        self.mode = FrictionMode::Stick;
+    }
+
+    fn update(&mut self, i: &FrictionInput) -> f64 {
+        if i.fn_ <= 0.0 {
+            self.reset();
+            return 0.0;
+        }
+        if i.s0.abs() > self.v_th {
+            // slip: kinetic Coulomb friction against the slip velocity
+            self.mode = FrictionMode::Slip;
+            -self.mu_k * i.fn_ * i.s0.signum()
+        } else {
+            // stick: cancel this contact's share of the other tangential forces, up to μs·F_n
+            self.mode = FrictionMode::Stick;
+            let lim = self.mu_s * i.fn_;
+            -i.f_ext_t.clamp(-lim, lim)
+        }
+    }
+
+    /// No spring: 0 J.
+    fn stored_energy(&self) -> f64 {
+        0.0
+    }
+
+    /// No anchor: the god-object tracks the projection (§8.3, frictionless tracking).
+    fn anchor(&self, _s: f64) -> Option<f64> {
+        None
+    }
+
+    fn mode(&self) -> FrictionMode {
+        self.mode
+    }
+}

@@ -1,0 +1,176 @@
+//! Salcudean–Vlaar modified Karnopp friction (1997), per VE contact (§4.2).
+//!
+//! In stick a PD controller holds the vertex at a stick point `s_a`:
+//! `F_t = −K_p·(s − s_a) − K_d·S0`, as long as `|F_t| ≤ μs·F_n`. Beyond that the contact breaks away;
+//! it re-sticks (with a new stick point at the current `s`) as soon as `|S0| < v_th`. In slip the force
+//! is Coulomb plus viscous: `F_t = −μk·F_n·sgn(S0) − b_v·S0`.
+
+use super::{FrictionInput, FrictionLaw, FrictionMode};
+
+/// Salcudean–Vlaar friction (§4.2). Parameters are public; the state (`s_a`, mode) is private.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SalcudeanVlaar {
+    /// Stick-point spring `K_p` (N/m).
+    pub k_p: f64,
+    /// Stick damping `K_d` (N·s/m).
+    pub k_d: f64,
+    /// Viscous friction in slip, `b_v` (N·s/m).
+    pub b_v: f64,
+    /// Re-stick velocity threshold `v_th` (m/s).
+    pub v_th: f64,
+    /// Static friction coefficient `μs` (dimensionless).
+    pub mu_s: f64,
+    /// Kinetic friction coefficient `μk` (dimensionless).
+    pub mu_k: f64,
+    /// Stick-point edge coordinate `s_a` (m, in the edge body's frame).
+    s_a: f64,
+    /// Whether `s_a` holds a valid stick point; if not, the next loaded update sticks at the current `s`.
+    engaged: bool,
+    /// Stick or slip.
+    mode: FrictionMode,
+    /// Stick-spring offset `s − s_a` after the last update (m); 0 in slip.
+    offset: f64,
+}
+
+impl SalcudeanVlaar {
+    /// A model with gains `K_p` (N/m), `K_d` (N·s/m), `b_v` (N·s/m), band `v_th` (m/s), `μs`, `μk`.
+    pub fn new(k_p: f64, k_d: f64, b_v: f64, v_th: f64, mu_s: f64, mu_k: f64) -> Self {
+        Self {
+            k_p,
+            k_d,
+            b_v,
+            v_th,
+            mu_s,
+            mu_k,
+            s_a: 0.0,
+            engaged: false,
+            mode: FrictionMode::Stick,
+            offset: 0.0,
+        }
+    }
+    /// 1-D defaults (§4.2 table): `K_p = 3000 N/m`, `K_d = 15 N·s/m`, `b_v = 2 N·s/m`, `v_th = 0.01 m/s`,
+    /// `μs = 0.5`, `μk = 0.45`.
+    pub fn one_d() -> Self {
+        Self::new(3000.0, 15.0, 2.0, 0.01, 0.5, 0.45)
+    }
+    /// Per-contact defaults of the 2-D peg (§4.2 table): `K_p = 1500`, `K_d = 7.5`, `b_v = 1`, `v_th = 0.01`.
+    pub fn per_contact() -> Self {
+        Self::new(1500.0, 7.5, 1.0, 0.01, 0.5, 0.45)
+    }
+    /// Checks the parameters; the error names the offending one.
+    pub fn validate(&self) -> Result<(), String> {
+        if !(self.k_p.is_finite() && self.k_p > 0.0) {
+            return Err(format!(
+                "k_p must be a positive stiffness in N/m, got {}",
+                self.k_p
+            ));
+        }
+        if !(self.k_d.is_finite() && self.k_d >= 0.0) {
+            return Err(format!(
+                "k_d must be a non-negative damping in N·s/m, got {}",
+                self.k_d
+            ));
+        }
+        if !(self.b_v.is_finite() && self.b_v >= 0.0) {
+            return Err(format!(
+                "b_v must be a non-negative damping in N·s/m, got {}",
+                self.b_v
+            ));
+        }
+        if !(self.v_th.is_finite() && self.v_th > 0.0) {
+            return Err(format!(
+                "v_th must be a positive velocity threshold in m/s, got {}",
+                self.v_th
+            ));
+        }
+        if !(self.mu_k.is_finite() && self.mu_k > 0.0) {
+            return Err(format!("mu_k must be positive, got {}", self.mu_k));
+        }
+        if !(self.mu_s.is_finite() && self.mu_s >= self.mu_k) {
+            return Err(format!(
+                "mu_s must be at least mu_k (static ≥ kinetic), got mu_s = {} < mu_k = {}",
+                self.mu_s, self.mu_k
+            ));
+        }
+        Ok(())
+    }
+    /// The parameter keys accepted by [`SalcudeanVlaar::set_param`].
+    pub const KEYS: &'static [&'static str] = &["k_p", "k_d", "b_v", "v_th", "mu_s", "mu_k"];
+    /// Sets one parameter by its scene-file key (see [`SalcudeanVlaar::KEYS`]); the error lists the valid
+    /// keys. Ranges are checked by [`SalcudeanVlaar::validate`].
+    pub fn set_param(&mut self, key: &str, value: f64) -> Result<(), String> {
+        match key {
+            "k_p" => self.k_p = value,
+            "k_d" => self.k_d = value,
+            "b_v" => self.b_v = value,
+            "v_th" => self.v_th = value,
+            "mu_s" => self.mu_s = value,
+            "mu_k" => self.mu_k = value,
+            _ => return Err(format!(
+                "unknown parameter '{key}' for friction model 'salcudean-vlaar'; valid keys: {}",
+                Self::KEYS.join(", ")
+            )),
+        }
+        Ok(())
+    }
+}
+
+impl FrictionLaw for SalcudeanVlaar {
+    fn reset(&mut self) {
+        self.engaged = false;
+        self.mode = FrictionMode::Stick;
+        self.offset = 0.0;
+    }
+
+    /// Sticks at the god-object's entry point.
+    fn begin(&mut self, s_entry: f64) {
+        self.reset();
+        self.s_a = s_entry;
+        self.engaged = true;
+    }
+
+    fn update(&mut self, i: &FrictionInput) -> f64 {
+        if i.fn_ <= 0.0 {
+            self.reset();
+            return 0.0;
+        }
+        if !self.engaged {
+            // Loaded again after a release (or never begun): stick where the vertex is now.
+            self.s_a = i.s;
+            self.engaged = true;
+            self.mode = FrictionMode::Stick;
+        }
+        if self.mode == FrictionMode::Stick {
+            let offset = i.s - self.s_a;
+            let f = -self.k_p * offset - self.k_d * i.s0;
+            if f.abs() <= self.mu_s * i.fn_ {
+                self.offset = offset;
+                return f;
+            }
+            self.mode = FrictionMode::Slip; // break away; fall through
+        }
+        if i.s0.abs() < self.v_th {
+            // re-stick at the current position
+            self.mode = FrictionMode::Stick;
+            self.s_a = i.s;
+            self.offset = 0.0;
+            return -self.k_d * i.s0;
+        }
+        self.offset = 0.0;
+        -self.mu_k * i.fn_ * i.s0.signum() - self.b_v * i.s0 // Coulomb + viscous
+    }
+
+    /// `½·K_p·(s − s_a)²` in stick, 0 in slip (J): the U_f of §13.2 F7-5.
+    fn stored_energy(&self) -> f64 {
+        0.5 * self.k_p * self.offset * self.offset
+    }
+
+    /// The stick point `s_a` (§8.3), once engaged.
+    fn anchor(&self, _s: f64) -> Option<f64> {
+        self.engaged.then_some(self.s_a)
+    }
+
+    fn mode(&self) -> FrictionMode {
+        self.mode
+    }
+}

@@ -1,0 +1,86 @@
+//! Colgate & Schenkel (1997) wall and passivity condition (§5.4).
+
+use super::{check_nonneg, NormalInput, NormalLaw};
+
+/// Signed Colgate passivity margin `b − (K·T/2 + |B|)` (N·s/m): the sampled wall
+/// `F = K·δ_k + B·(δ_k − δ_{k−1})/T` on a device with physical damping `b` (N·s/m) at period `t` (s)
+/// is passive when the margin is positive.
+///
+/// `b` is the *plant* damping (device or body damping), not part of the law.
+pub fn colgate_margin(b: f64, k: f64, bw: f64, t: f64) -> f64 {
+    b - (k * t / 2.0 + bw.abs())
+}
+
+/// `F_w,k = max(0, K·δ_k + B·(δ_k − δ_{k−1})/T)` while `δ_k > 0`, else 0.
+///
+/// `δ_{k−1} = max(0, −d_{k−1})`; with no history the difference term is zero. The plant damping `b`
+/// that makes this wall passive ([`colgate_margin`]) belongs to the harness (1-D) or the body (2-D).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ColgateLaw {
+    /// Wall stiffness `K` (N/m).
+    pub k: f64,
+    /// Virtual damping `B` (N·s/m), applied to the backward-difference penetration rate.
+    pub b: f64,
+    /// Stored energy `½K·δ²` after the last sample (J).
+    stored: f64,
+}
+
+impl ColgateLaw {
+    /// Valid parameter names for [`ColgateLaw::set_param`].
+    pub const PARAMS: &'static str = "k, b";
+
+    /// A wall of stiffness `k` (N/m) and virtual damping `b` (N·s/m).
+    pub fn new(k: f64, b: f64) -> Self {
+        Self { k, b, stored: 0.0 }
+    }
+    /// 1-D (Fig. 4) defaults: `K = 2000 N/m`, `B = 0`.
+    pub fn one_d() -> Self {
+        Self::new(2000.0, 0.0)
+    }
+    /// Per-contact defaults for a face on two contacts: `K = 1000 N/m`, `B = 0`.
+    pub fn per_contact() -> Self {
+        Self::new(1000.0, 0.0)
+    }
+    /// Checks the parameters; the error names the bad one. `B` may be negative (the condition uses `|B|`).
+    pub fn validate(&self) -> Result<(), String> {
+        check_nonneg("colgate", "k", self.k)?;
+        if !self.b.is_finite() {
+            return Err(format!(
+                "colgate: parameter `b` must be finite, got {}",
+                self.b
+            ));
+        }
+        Ok(())
+    }
+    /// Sets a parameter by name: `k` (N/m), `b` (N·s/m).
+    pub fn set_param(&mut self, key: &str, value: f64) -> Result<(), String> {
+        match key {
+            "k" => self.k = value,
+            "b" => self.b = value,
+            _ => return Err(super::unknown_key("colgate", key, Self::PARAMS)),
+        }
+        Ok(())
+    }
+}
+
+impl NormalLaw for ColgateLaw {
+    fn reset(&mut self) {
+        self.stored = 0.0;
+    }
+    fn force(&mut self, input: &NormalInput) -> f64 {
+        let delta = input.depth();
+        self.stored = 0.5 * self.k * delta * delta;
+        if delta <= 0.0 {
+            return 0.0;
+        }
+        let delta_prev = if input.hist >= 2 {
+            (-input.d[1]).max(0.0)
+        } else {
+            delta
+        };
+        (self.k * delta + self.b * (delta - delta_prev) / input.dt).max(0.0)
+    }
+    fn stored_energy(&self) -> f64 {
+        self.stored
+    }
+}

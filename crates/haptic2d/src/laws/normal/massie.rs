@@ -1,0 +1,92 @@
+//! Massie PI wall (PHANToM rendering, §5.6, [REC] form).
+
+use super::{check_nonneg, NormalInput, NormalLaw};
+
+/// While `δ_k > 0`: `I_k = I_{k−1} + T·δ_k`, `F_w,k = max(0, K·δ_k + K_I·I_k)`; at `δ_k = 0` the
+/// integral resets. Optional anti-windup clamps `0 ≤ I_k ≤ I_max`.
+///
+/// The integral removes the steady-state penetration under a constant push, but its phase lag makes
+/// the wall strongly active.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MassiePiLaw {
+    /// Proportional stiffness `K` (N/m).
+    pub k: f64,
+    /// Integral gain `K_I` (N/(m·s)).
+    pub k_i: f64,
+    /// Anti-windup bound `I_max` (m·s); `f64::INFINITY` disables it.
+    pub i_max: f64,
+    /// Integral of penetration `I_k` (m·s).
+    integral: f64,
+    /// Stored energy `½K·δ²` after the last sample (J).
+    stored: f64,
+}
+
+impl MassiePiLaw {
+    /// Valid parameter names for [`MassiePiLaw::set_param`].
+    pub const PARAMS: &'static str = "k, k_i, i_max";
+
+    /// A PI wall with gains `k` (N/m), `k_i` (N/(m·s)) and anti-windup bound `i_max` (m·s).
+    pub fn new(k: f64, k_i: f64, i_max: f64) -> Self {
+        Self {
+            k,
+            k_i,
+            i_max,
+            integral: 0.0,
+            stored: 0.0,
+        }
+    }
+    /// 1-D defaults: `K = 2000 N/m`, `K_I = 2×10⁴ N/(m·s)`, `I_max = ∞`.
+    pub fn one_d() -> Self {
+        Self::new(2000.0, 2.0e4, f64::INFINITY)
+    }
+    /// Per-contact defaults for a face on two contacts: `K = 1000 N/m`, `K_I = 10⁴ N/(m·s)`, `I_max = ∞`.
+    pub fn per_contact() -> Self {
+        Self::new(1000.0, 1.0e4, f64::INFINITY)
+    }
+    /// The current integral state `I_k` (m·s).
+    pub fn integral(&self) -> f64 {
+        self.integral
+    }
+    /// Checks the parameters; the error names the bad one.
+    pub fn validate(&self) -> Result<(), String> {
+        check_nonneg("pi", "k", self.k)?;
+        check_nonneg("pi", "k_i", self.k_i)?;
+        if self.i_max.is_nan() || self.i_max < 0.0 {
+            return Err(format!(
+                "pi: parameter `i_max` must be ≥ 0 (or infinite), got {}",
+                self.i_max
+            ));
+        }
+        Ok(())
+    }
+    /// Sets a parameter by name: `k` (N/m), `k_i` (N/(m·s)), `i_max` (m·s).
+    pub fn set_param(&mut self, key: &str, value: f64) -> Result<(), String> {
+        match key {
+            "k" => self.k = value,
+            "k_i" => self.k_i = value,
+            "i_max" => self.i_max = value,
+            _ => return Err(super::unknown_key("pi", key, Self::PARAMS)),
+        }
+        Ok(())
+    }
+}
+
+impl NormalLaw for MassiePiLaw {
+    fn reset(&mut self) {
+        self.integral = 0.0;
+        self.stored = 0.0;
+    }
+    fn force(&mut self, input: &NormalInput) -> f64 {
+        let delta = input.depth();
+        self.stored = 0.5 * self.k * delta * delta;
+        if delta <= 0.0 {
+            self.integral = 0.0;
+            return 0.0;
+        }
+        self.integral = (self.integral + input.dt * delta).clamp(0.0, self.i_max);
+        (self.k * delta + self.k_i * self.integral).max(0.0)
+    }
+    fn stored_energy(&self) -> f64 {
+        self.stored
+    }
+}

@@ -1,0 +1,70 @@
+//! Minsky et al. (1990): stabilise the wall by adding damping (§5.3, [REC] form).
+
+use super::{check_nonneg, NormalInput, NormalLaw};
+
+/// `F_w,k = max(0, K·δ_k + B_M·v_in,k)` while `δ_k > 0`, else 0.
+///
+/// Rule of thumb: `B_M ≥ 2·(K·T/2)`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MinskyLaw {
+    /// Wall stiffness `K` (N/m).
+    pub k: f64,
+    /// Wall damping `B_M` (N·s/m).
+    pub b_m: f64,
+    /// Stored energy `½K·δ²` after the last sample (J).
+    stored: f64,
+}
+
+impl MinskyLaw {
+    /// Valid parameter names for [`MinskyLaw::set_param`].
+    pub const PARAMS: &'static str = "k, b_m";
+
+    /// A wall of stiffness `k` (N/m) and damping `b_m` (N·s/m).
+    pub fn new(k: f64, b_m: f64) -> Self {
+        Self {
+            k,
+            b_m,
+            stored: 0.0,
+        }
+    }
+    /// 1-D defaults: `K = 2000 N/m`, `B_M = 10 N·s/m`.
+    pub fn one_d() -> Self {
+        Self::new(2000.0, 10.0)
+    }
+    /// Per-contact defaults for a face on two contacts: `K = 1000 N/m`, `B_M = 5 N·s/m`.
+    pub fn per_contact() -> Self {
+        Self::new(1000.0, 5.0)
+    }
+    /// Checks the parameters; the error names the bad one.
+    pub fn validate(&self) -> Result<(), String> {
+        check_nonneg("minsky", "k", self.k)?;
+        check_nonneg("minsky", "b_m", self.b_m)
+    }
+    /// Sets a parameter by name: `k` (N/m), `b_m` (N·s/m).
+    pub fn set_param(&mut self, key: &str, value: f64) -> Result<(), String> {
+        match key {
+            "k" => self.k = value,
+            "b_m" | "b" => self.b_m = value,
+            _ => return Err(super::unknown_key("minsky", key, Self::PARAMS)),
+        }
+        Ok(())
+    }
+}
+
+impl NormalLaw for MinskyLaw {
+    fn reset(&mut self) {
+        self.stored = 0.0;
+    }
+    fn force(&mut self, input: &NormalInput) -> f64 {
+        let delta = input.depth();
+        self.stored = 0.5 * self.k * delta * delta;
+        if delta <= 0.0 {
+            return 0.0;
+        }
+        let v_in = -input.c0;
+        (self.k * delta + self.b_m * v_in).max(0.0)
+    }
+    fn stored_energy(&self) -> f64 {
+        self.stored
+    }
+}

@@ -1,0 +1,116 @@
+//! Salcudean–Vlaar braking pulse on wall entry (§5.7, [REC] sizing).
+
+use super::{check_nonneg, NormalInput, NormalLaw};
+
+/// Spring `K·δ_k` plus, for the first `N_p` samples inside, a braking pulse
+/// `F_b = (1 + e_b)·m_eff·v_c / (N_p·T)` sized to reverse the latched entry speed `v_c` to `e_b·v_c`.
+///
+/// On the first sample with `δ_k > 0` after being outside (in 2-D: the first call after creation or
+/// reset), the law latches `v_c = max(0, v_in,k)` and `m_eff` from [`NormalInput::m_eff`]. The counter
+/// resets when `δ = 0`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BrakingPulseLaw {
+    /// Wall stiffness `K` (N/m).
+    pub k: f64,
+    /// Pulse restitution target `e_b` (dimensionless, ≥ 0).
+    pub e_b: f64,
+    /// Pulse length `N_p` (samples, ≥ 1).
+    pub n_p: u32,
+    /// Inside the wall at the previous call.
+    inside: bool,
+    /// Samples of the pulse already applied.
+    count: u32,
+    /// Latched pulse force `F_b` (N).
+    pulse: f64,
+    /// Stored energy `½K·δ²` after the last sample (J).
+    stored: f64,
+}
+
+impl BrakingPulseLaw {
+    /// Valid parameter names for [`BrakingPulseLaw::set_param`].
+    pub const PARAMS: &'static str = "k, e_b, n_p";
+
+    /// A wall of stiffness `k` (N/m) with pulse restitution `e_b` and length `n_p` samples.
+    pub fn new(k: f64, e_b: f64, n_p: u32) -> Self {
+        Self {
+            k,
+            e_b,
+            n_p,
+            inside: false,
+            count: 0,
+            pulse: 0.0,
+            stored: 0.0,
+        }
+    }
+    /// 1-D defaults: `K = 2000 N/m`, `e_b = 0.3`, `N_p = 5` (10 ms at 500 Hz).
+    pub fn one_d() -> Self {
+        Self::new(2000.0, 0.3, 5)
+    }
+    /// Per-contact defaults: `K = 1000 N/m`, `e_b = 0.3`, `N_p = 5`; the world splits `m_eff` among
+    /// the contacts that start in the same sample.
+    pub fn per_contact() -> Self {
+        Self::new(1000.0, 0.3, 5)
+    }
+    /// Checks the parameters; the error names the bad one.
+    pub fn validate(&self) -> Result<(), String> {
+        check_nonneg("pulse", "k", self.k)?;
+        check_nonneg("pulse", "e_b", self.e_b)?;
+        if self.n_p == 0 {
+            return Err("pulse: parameter `n_p` must be ≥ 1 sample, got 0".to_string());
+        }
+        Ok(())
+    }
+    /// Sets a parameter by name: `k` (N/m), `e_b` (-), `n_p` (samples, a positive integer).
+    pub fn set_param(&mut self, key: &str, value: f64) -> Result<(), String> {
+        match key {
+            "k" => self.k = value,
+            "e_b" => self.e_b = value,
+            "n_p" => {
+                let whole = value >= 1.0 && value.fract() == 0.0 && value <= u32::MAX as f64;
+                if !whole {
+                    return Err(format!(
+                        "pulse: parameter `n_p` must be a positive whole number of samples, got {value}"
+                    ));
+                }
+                self.n_p = value as u32;
+            }
+            _ => return Err(super::unknown_key("pulse", key, Self::PARAMS)),
+        }
+        Ok(())
+    }
+}
+
+impl NormalLaw for BrakingPulseLaw {
+    fn reset(&mut self) {
+        self.inside = false;
+        self.count = 0;
+        self.pulse = 0.0;
+        self.stored = 0.0;
+    }
+    fn force(&mut self, input: &NormalInput) -> f64 {
+        let delta = input.depth();
+        self.stored = 0.5 * self.k * delta * delta;
+        if delta <= 0.0 {
+            self.inside = false;
+            self.count = 0;
+            return 0.0;
+        }
+        if !self.inside {
+            // First sample inside: latch the entry speed and size the pulse.
+            self.inside = true;
+            self.count = 0;
+            let v_c = (-input.c0).max(0.0);
+            let m_eff = input.m_eff.max(0.0);
+            self.pulse = (1.0 + self.e_b) * m_eff * v_c / (self.n_p as f64 * input.dt);
+        }
+        let mut f = self.k * delta;
+        if self.count < self.n_p {
+            f += self.pulse;
+            self.count += 1;
+        }
+        f.max(0.0)
+    }
+    fn stored_energy(&self) -> f64 {
+        self.stored
+    }
+}

@@ -1,0 +1,60 @@
+//! ZOH pure stiffness, the "active" wall (§5.2).
+
+use super::{check_nonneg, NormalInput, NormalLaw};
+
+/// `F_w,k = K·δ_k`, held over the sample.
+///
+/// Energy [DER]: the held force is `Kδ_k` but the spring energy changes as if the force were the
+/// average `K(δ_k + δ_{k+1})/2`, so the wall returns `½K(δ_{k+1} − δ_k)²` more energy than it absorbed
+/// every sample: it is active.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ZohLaw {
+    /// Wall stiffness `K` (N/m).
+    pub k: f64,
+    /// Stored energy `½K·δ²` after the last sample (J).
+    stored: f64,
+}
+
+impl ZohLaw {
+    /// Valid parameter names for [`ZohLaw::set_param`].
+    pub const PARAMS: &'static str = "k";
+
+    /// A wall of stiffness `k` (N/m).
+    pub fn new(k: f64) -> Self {
+        Self { k, stored: 0.0 }
+    }
+    /// 1-D default: `K = 2000 N/m`.
+    pub fn one_d() -> Self {
+        Self::new(2000.0)
+    }
+    /// Per-contact default for a face on two contacts: `K = 1000 N/m`.
+    pub fn per_contact() -> Self {
+        Self::new(1000.0)
+    }
+    /// Checks the parameters; the error names the bad one.
+    pub fn validate(&self) -> Result<(), String> {
+        check_nonneg("zoh", "k", self.k)
+    }
+    /// Sets a parameter by name (`k`, N/m).
+    pub fn set_param(&mut self, key: &str, value: f64) -> Result<(), String> {
+        match key {
+            "k" => self.k = value,
+            _ => return Err(super::unknown_key("zoh", key, Self::PARAMS)),
+        }
+        Ok(())
+    }
+}
+
+impl NormalLaw for ZohLaw {
+    fn reset(&mut self) {
+        self.stored = 0.0;
+    }
+    fn force(&mut self, input: &NormalInput) -> f64 {
+        let delta = input.depth();
+        self.stored = 0.5 * self.k * delta * delta;
+        (self.k * delta).max(0.0)
+    }
+    fn stored_energy(&self) -> f64 {
+        self.stored
+    }
+}
