@@ -1,1 +1,70 @@
-fn main() {}
+//! `haptic2d`: the command-line tool of the haptic2d project.
+
+mod cmd_check;
+mod cmd_scenes;
+mod cmd_simulate;
+mod csv_out;
+mod scene_arg;
+
+use clap::{Parser, Subcommand};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Haptic rendering of planar rigid-body motion: a passive planar world, contact and friction models,
+/// and a simulated twin-pantograph haptic device.
+#[derive(Parser, Debug)]
+#[command(name = "haptic2d", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Simulate a scene's world alone (no device), headless and as fast as possible, writing a CSV.
+    Simulate {
+        /// A scene file path, or a built-in scene name (see `haptic2d scenes`).
+        scene: String,
+        /// Simulated duration (s).
+        #[arg(long, default_value_t = 10.0)]
+        duration: f64,
+        /// CSV output file (schema in docs/CSV.md). Without it, only a summary is printed.
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Control rate (Hz), overriding the scene's `world.rate`.
+        #[arg(long)]
+        rate: Option<f64>,
+        /// Keep every K-th sample in the CSV.
+        #[arg(long, default_value_t = 1)]
+        every: u64,
+    },
+    /// List the built-in scenes.
+    Scenes,
+    /// Validate a scene file and explain every problem found.
+    Check {
+        /// A scene file path, or a built-in scene name.
+        scene: String,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Simulate {
+            scene,
+            duration,
+            out,
+            rate,
+            every,
+        } => cmd_simulate::run(&scene, duration, out.as_deref(), rate, every),
+        Command::Scenes => cmd_scenes::run(),
+        Command::Check { scene } => cmd_check::run(&scene),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(msg) => {
+            eprintln!("error: {}", msg.trim_end());
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -17,3 +17,7 @@ pub mod geom;
 pub mod harness;
 pub mod integrate;
 pub mod laws;
+pub mod load;
+pub mod metrics;
+pub mod scene;
+pub mod world;

@@ -1,4 +1,13 @@
 //! Contact records, the contact state machine, god-objects and simultaneous impacts (§7, §8).
 
+mod god_object;
 pub mod impact;
 pub mod lcp;
+mod manager;
+mod params;
+mod record;
+
+pub use god_object::entry_point;
+pub use manager::{ContactSet, PastPoses, Wrench2};
+pub use params::ContactParams;
+pub use record::{ContactEvent, ContactState, EventKind, VeContact};

@@ -5,3 +5,4 @@
 
 pub mod friction;
 pub mod normal;
+mod stiffness;

@@ -1,0 +1,30 @@
+//! `haptic2d check`: validates a scene and explains every problem.
+
+use crate::scene_arg;
+
+/// Validates `arg` and prints a summary of the scene, or every problem found.
+pub fn run(arg: &str) -> Result<(), String> {
+    let scene = scene_arg::load(arg, None)?;
+    let w = &scene.world;
+    let dynamic = w.bodies.iter().filter(|b| b.is_dynamic()).count();
+    println!("{}: ok", scene.source);
+    println!(
+        "  {} bodies ({} dynamic, {} fixed), {} convex pieces, {} loads",
+        w.bodies.len(),
+        dynamic,
+        w.bodies.len() - dynamic,
+        w.colliders.len(),
+        w.loads.len()
+    );
+    println!(
+        "  rate {} Hz, proximity every {} samples, normal law \"{}\", friction \"{}\"",
+        1.0 / w.params.dt,
+        w.params.proximity_every,
+        w.normal.name(),
+        w.friction.name()
+    );
+    for warn in &scene.warnings {
+        println!("  warning: {warn}");
+    }
+    Ok(())
+}

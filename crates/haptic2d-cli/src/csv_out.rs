@@ -1,0 +1,64 @@
+//! The world CSV writer (schema: docs/CSV.md).
+
+use haptic2d::world::World;
+use std::fmt::Write as _;
+use std::io::Write;
+
+/// Writes world states as CSV rows; the column set is fixed at construction.
+pub struct WorldCsv<W: Write> {
+    out: W,
+    dynamic: Vec<usize>,
+    line: String,
+}
+
+impl<W: Write> WorldCsv<W> {
+    /// Writes the header for `world`'s dynamic bodies.
+    pub fn new(mut out: W, world: &World) -> std::io::Result<Self> {
+        let dynamic: Vec<usize> = (0..world.bodies.len()).filter(|&i| world.bodies[i].is_dynamic()).collect();
+        let mut header = String::from("t,energy.kinetic,energy.stored,work.applied,contacts");
+        for &i in &dynamic {
+            let n = &world.bodies[i].name;
+            for c in ["x", "y", "theta", "vx", "vy", "omega"] {
+                let _ = write!(header, ",{n}.{c}");
+            }
+        }
+        header.push('\n');
+        out.write_all(header.as_bytes())?;
+        Ok(Self {
+            out,
+            dynamic,
+            line: String::with_capacity(4096),
+        })
+    }
+
+    /// Writes one row for the current state of `world`.
+    pub fn row(&mut self, world: &World) -> std::io::Result<()> {
+        let l = &mut self.line;
+        l.clear();
+        let e = world.ledger();
+        let _ = write!(
+            l,
+            "{},{},{},{},{}",
+            world.time(),
+            e.kinetic,
+            e.stored,
+            e.applied_work,
+            world.contacts().contact_count()
+        );
+        for &i in &self.dynamic {
+            let b = &world.bodies[i];
+            let _ = write!(
+                l,
+                ",{},{},{},{},{},{}",
+                b.pose.pos.x, b.pose.pos.y, b.pose.angle, b.vel.x, b.vel.y, b.omega
+            );
+        }
+        l.push('\n');
+        self.out.write_all(l.as_bytes())
+    }
+
+    /// Flushes the output.
+    pub fn finish(mut self) -> std::io::Result<()> {
+        self.out.flush()
+    }
+}

@@ -1,0 +1,613 @@
+//! The contact set: tracked VE pairs and contact records, their state machine (§8.2), god-objects
+//! (§8.3), simultaneous impacts (§7) and continuous-contact forces (§5.9, §1–§4).
+//!
+//! Entries are kept sorted by `(vertex collider, vertex, edge collider, edge)`; every loop runs in that
+//! order, so the result does not depend on anything but the inputs. After warm-up no step allocates:
+//! the buffers are swapped and reused.
+
+use super::god_object::{crossing_coordinate, entry_point};
+use super::impact::{ImpactRow, ImpactSolver};
+use super::params::ContactParams;
+use super::record::{ContactEvent, ContactState, EventKind, VeContact};
+use crate::body::Body;
+use crate::collide::{Collider, VeCandidate};
+use crate::geom::{cross, Pose, Vec2};
+use crate::laws::friction::{FrictionInput, FrictionLaw, FrictionModel};
+use crate::laws::normal::{NormalInput, NormalLaw, NormalModel};
+
+/// Per-body contact wrench of one sample: force (N) and torque about the COM (N·m).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Wrench2 {
+    /// Force (N).
+    pub force: Vec2,
+    /// Torque about the body's centre of mass (N·m).
+    pub torque: f64,
+}
+
+/// The past body poses the contact set needs for SEH history and god-object entry points.
+pub struct PastPoses<'a> {
+    /// Poses at `k − 1` (empty before the first step).
+    pub prev: &'a [Pose],
+    /// Poses at `k − 2` (empty before the second step).
+    pub prev2: &'a [Pose],
+}
+
+/// All tracked VE pairs and contact records of a world.
+#[derive(Clone, Debug)]
+pub struct ContactSet {
+    /// Thresholds and options.
+    pub params: ContactParams,
+    entries: Vec<VeContact>,
+    merged: Vec<VeContact>,
+    pending: Vec<VeContact>,
+    events: Vec<ContactEvent>,
+    rows: Vec<ImpactRow>,
+    row_entry: Vec<usize>,
+    solver: ImpactSolver,
+    body_flag: Vec<bool>,
+    new_count: Vec<u32>,
+    nonfric: Vec<Vec2>,
+    /// Kinetic energy removed by the impacts of the last sample (J).
+    pub last_impact_loss: f64,
+    /// Number of impact sets solved so far.
+    pub impacts_solved: u64,
+}
+
+impl ContactSet {
+    /// An empty contact set.
+    pub fn new(params: ContactParams) -> Self {
+        Self {
+            params,
+            entries: Vec::with_capacity(64),
+            merged: Vec::with_capacity(64),
+            pending: Vec::with_capacity(16),
+            events: Vec::with_capacity(64),
+            rows: Vec::with_capacity(16),
+            row_entry: Vec::with_capacity(16),
+            solver: ImpactSolver::new(),
+            body_flag: Vec::new(),
+            new_count: Vec::new(),
+            nonfric: Vec::new(),
+            last_impact_loss: 0.0,
+            impacts_solved: 0,
+        }
+    }
+
+    /// Every tracked pair and contact record, sorted by key.
+    #[inline]
+    pub fn entries(&self) -> &[VeContact] {
+        &self.entries
+    }
+
+    /// The contact records (Colliding or Continuous), sorted by key.
+    pub fn records(&self) -> impl Iterator<Item = &VeContact> {
+        self.entries.iter().filter(|e| e.is_contact())
+    }
+
+    /// Number of contact records.
+    pub fn contact_count(&self) -> usize {
+        self.entries.iter().filter(|e| e.is_contact()).count()
+    }
+
+    /// The state transitions of the last sample.
+    #[inline]
+    pub fn events(&self) -> &[ContactEvent] {
+        &self.events
+    }
+
+    /// Energy stored in all contact and friction springs (J).
+    pub fn stored_energy(&self) -> f64 {
+        self.records()
+            .map(|e| e.normal.stored_energy() + e.friction.stored_energy())
+            .sum()
+    }
+
+    /// Steps 4–6 of §0.5 for one sample: merge the local stage's candidates into the tracked set and
+    /// measure every pair, run the state machine, resolve impacts (velocity jumps applied to `bodies`
+    /// now), then compute continuous-contact forces into `wrenches` (one per body, overwritten).
+    #[allow(clippy::too_many_arguments)]
+    pub fn step(
+        &mut self,
+        tick: u64,
+        dt: f64,
+        candidates: &[VeCandidate],
+        colliders: &[Collider],
+        bodies: &mut [Body],
+        past: &PastPoses<'_>,
+        normal: &NormalModel,
+        friction: &FrictionModel,
+        wrenches: &mut [Wrench2],
+    ) {
+        self.events.clear();
+        self.last_impact_loss = 0.0;
+        self.resize_body_buffers(bodies.len());
+        self.sync(tick, candidates, colliders, bodies, past, normal, friction);
+        self.release(tick);
+        let any_colliding = self.create(tick, dt, colliders, bodies, past, normal, friction);
+        if any_colliding {
+            self.resolve_impacts(tick, bodies);
+        }
+        self.forces(dt, bodies, friction, wrenches);
+    }
+
+    fn resize_body_buffers(&mut self, n: usize) {
+        if self.body_flag.len() != n {
+            self.body_flag.resize(n, false);
+            self.new_count.resize(n, 0);
+            self.nonfric.resize(n, Vec2::ZERO);
+        }
+    }
+
+    /// Merges the sorted candidates with the tracked set: existing entries are re-measured (history
+    /// shifted), new candidates get a fresh entry whose history is rebuilt from the past poses, tracked
+    /// pairs that are neither candidates nor records are dropped.
+    #[allow(clippy::too_many_arguments)]
+    fn sync(
+        &mut self,
+        tick: u64,
+        candidates: &[VeCandidate],
+        colliders: &[Collider],
+        bodies: &[Body],
+        past: &PastPoses<'_>,
+        normal: &NormalModel,
+        friction: &FrictionModel,
+    ) {
+        self.merged.clear();
+        let (mut i, mut j) = (0, 0);
+        let old = std::mem::take(&mut self.entries);
+        while i < old.len() || j < candidates.len() {
+            let take_old = j >= candidates.len() || (i < old.len() && old[i].key <= candidates[j]);
+            if take_old {
+                let same = j < candidates.len() && old[i].key == candidates[j];
+                if same || old[i].is_contact() {
+                    let mut e = old[i];
+                    measure(&mut e, colliders, bodies);
+                    self.merged.push(e);
+                }
+                if same {
+                    j += 1;
+                }
+                i += 1;
+            } else {
+                let e = new_entry(tick, candidates[j], colliders, bodies, past, normal, friction);
+                self.merged.push(e);
+                j += 1;
+            }
+        }
+        self.entries = old;
+        std::mem::swap(&mut self.entries, &mut self.merged);
+    }
+
+    /// §8.2 rule 4 (release) and rule 5 (re-collision, optional).
+    fn release(&mut self, tick: u64) {
+        let p = self.params;
+        for e in self.entries.iter_mut() {
+            if e.state != Some(ContactState::Continuous) {
+                continue;
+            }
+            if e.d[0] > p.delta_off || !e.in_range(p.eps_s) {
+                e.state = None;
+                e.normal.reset();
+                e.friction.reset();
+                e.f_n = 0.0;
+                e.f_t = 0.0;
+                self.events.push(ContactEvent {
+                    tick,
+                    key: e.key,
+                    kind: EventKind::Released,
+                });
+            } else if let Some(v_re) = p.v_re {
+                if p.impacts && e.c0 < -v_re {
+                    e.state = Some(ContactState::Colliding);
+                    self.events.push(ContactEvent {
+                        tick,
+                        key: e.key,
+                        kind: EventKind::Recollision,
+                    });
+                }
+            }
+        }
+    }
+
+    /// §8.2 rules 1–2: creation with the crossed-edge rule, then the simultaneity window.
+    /// Returns true if any record is Colliding.
+    #[allow(clippy::too_many_arguments)]
+    fn create(
+        &mut self,
+        tick: u64,
+        dt: f64,
+        colliders: &[Collider],
+        bodies: &[Body],
+        past: &PastPoses<'_>,
+        normal: &NormalModel,
+        friction: &FrictionModel,
+    ) -> bool {
+        let p = self.params;
+        self.pending.clear();
+        for c in self.new_count.iter_mut() {
+            *c = 0;
+        }
+        // Rule 1, one vertex–collider group at a time (entries of a group are adjacent).
+        let mut g = 0;
+        while g < self.entries.len() {
+            let mut h = g + 1;
+            while h < self.entries.len() && same_group(&self.entries[g].key, &self.entries[h].key) {
+                h += 1;
+            }
+            let group_has_record = self.entries[g..h].iter().any(|e| e.is_contact());
+            let touching = self.entries[g..h]
+                .iter()
+                .enumerate()
+                .filter(|(_, e)| e.d[0] <= p.delta_on && e.in_range(p.eps_s))
+                .max_by(|a, b| a.1.d[0].total_cmp(&b.1.d[0]))
+                .map(|(k, _)| g + k);
+            if let (false, Some(fallback)) = (group_has_record, touching) {
+                let key = self.entries[fallback].key;
+                let edge = crossed_edge(key, colliders, past, p.eps_s).unwrap_or(key.edge);
+                let target = self.entries[g..h].iter().position(|e| e.key.edge == edge).map(|k| g + k);
+                match target {
+                    Some(t) => {
+                        let e = &mut self.entries[t];
+                        start_record(e, p, tick, &mut self.events, false);
+                        self.new_count[e.body_a] += 1;
+                    }
+                    None => {
+                        let mut e = new_entry(
+                            tick,
+                            VeCandidate { edge, ..key },
+                            colliders,
+                            bodies,
+                            past,
+                            normal,
+                            friction,
+                        );
+                        start_record(&mut e, p, tick, &mut self.events, false);
+                        self.new_count[e.body_a] += 1;
+                        self.pending.push(e);
+                    }
+                }
+            }
+            g = h;
+        }
+        if !self.pending.is_empty() {
+            self.entries.extend_from_slice(&self.pending);
+            self.entries.sort_unstable_by_key(|e| e.key);
+        }
+
+        // Rule 2: the simultaneity window.
+        let mut any = false;
+        for f in self.body_flag.iter_mut() {
+            *f = false;
+        }
+        for e in &self.entries {
+            if e.state == Some(ContactState::Colliding) {
+                any = true;
+                self.body_flag[e.body_a] |= bodies[e.body_a].is_dynamic();
+                self.body_flag[e.body_b] |= bodies[e.body_b].is_dynamic();
+            }
+        }
+        if any && p.impacts {
+            let mut g = 0;
+            while g < self.entries.len() {
+                let mut h = g + 1;
+                while h < self.entries.len() && same_group(&self.entries[g].key, &self.entries[h].key) {
+                    h += 1;
+                }
+                if !self.entries[g..h].iter().any(|e| e.is_contact()) {
+                    let flag = &self.body_flag;
+                    let pick = self.entries[g..h]
+                        .iter()
+                        .position(|e| {
+                            (flag[e.body_a] || flag[e.body_b])
+                                && e.d[0] > 0.0
+                                && e.c0 < -p.v_c
+                                && e.d[0] + dt * e.c0 <= 0.0
+                                && e.in_range(p.eps_s)
+                        })
+                        .map(|k| g + k);
+                    if let Some(t) = pick {
+                        let e = &mut self.entries[t];
+                        start_record(e, p, tick, &mut self.events, true);
+                        self.new_count[e.body_a] += 1;
+                    }
+                }
+                g = h;
+            }
+        }
+        // Effective masses for the braking pulse: the pair's reduced mass shared by the contacts that
+        // started on the vertex body in this sample.
+        for e in self.entries.iter_mut() {
+            if e.since == tick && e.is_contact() || e.m_eff == 0.0 {
+                let inv = bodies[e.body_a].inv_mass + bodies[e.body_b].inv_mass;
+                let n = self.new_count[e.body_a].max(1) as f64;
+                e.m_eff = if inv > 0.0 { 1.0 / inv / n } else { 0.0 };
+            }
+        }
+        self.entries.iter().any(|e| e.state == Some(ContactState::Colliding))
+    }
+
+    /// §7: every Colliding record (restitution `e`) and every Continuous record touching a body of a
+    /// colliding one (restitution 0) form the impact set; velocity jumps are applied to `bodies` now.
+    fn resolve_impacts(&mut self, tick: u64, bodies: &mut [Body]) {
+        for f in self.body_flag.iter_mut() {
+            *f = false;
+        }
+        for e in &self.entries {
+            if e.state == Some(ContactState::Colliding) {
+                self.body_flag[e.body_a] |= bodies[e.body_a].is_dynamic();
+                self.body_flag[e.body_b] |= bodies[e.body_b].is_dynamic();
+            }
+        }
+        self.rows.clear();
+        self.row_entry.clear();
+        for (idx, e) in self.entries.iter().enumerate() {
+            let restitution = match e.state {
+                Some(ContactState::Colliding) => self.params.restitution,
+                Some(ContactState::Continuous) if self.body_flag[e.body_a] || self.body_flag[e.body_b] => 0.0,
+                _ => continue,
+            };
+            self.rows.push(ImpactRow {
+                body_a: e.body_a,
+                body_b: e.body_b,
+                n: e.n,
+                r_a: e.point - bodies[e.body_a].pose.pos,
+                r_b: e.point - bodies[e.body_b].pose.pos,
+                restitution,
+            });
+            self.row_entry.push(idx);
+        }
+        let before: f64 = bodies.iter().map(|b| b.kinetic_energy()).sum();
+        self.solver.solve(&self.rows, bodies);
+        let after: f64 = bodies.iter().map(|b| b.kinetic_energy()).sum();
+        self.last_impact_loss = before - after;
+        self.impacts_solved += 1;
+        for e in self.entries.iter_mut() {
+            if e.state == Some(ContactState::Colliding) {
+                e.state = Some(ContactState::Continuous);
+                self.events.push(ContactEvent {
+                    tick,
+                    key: e.key,
+                    kind: EventKind::Resolved,
+                });
+            }
+            // Step 5: recompute C0 and S0 with the post-impact velocities.
+            let v_rel = bodies[e.body_a].point_velocity(e.point) - bodies[e.body_b].point_velocity(e.point);
+            e.c0 = e.n.dot(v_rel);
+            e.s0 = e.t.dot(v_rel);
+        }
+    }
+
+    /// Step 6: normal force, then friction, for every Continuous record; god-objects follow.
+    fn forces(&mut self, dt: f64, bodies: &[Body], friction: &FrictionModel, wrenches: &mut [Wrench2]) {
+        for w in wrenches.iter_mut() {
+            *w = Wrench2::default();
+        }
+        for e in self.entries.iter_mut() {
+            if e.state != Some(ContactState::Continuous) {
+                continue;
+            }
+            let input = NormalInput {
+                d: e.d,
+                hist: e.hist,
+                c0: e.c0,
+                dt,
+                m_eff: e.m_eff,
+            };
+            e.f_n = e.normal.force(&input);
+            add_force(wrenches, bodies, e.body_a, e.body_b, e.n * e.f_n, e.point);
+        }
+        let needs_ext = matches!(friction.name(), "classical");
+        if needs_ext {
+            for (i, b) in bodies.iter().enumerate() {
+                self.nonfric[i] = b.force + wrenches[i].force;
+            }
+        }
+        for idx in 0..self.entries.len() {
+            if self.entries[idx].state != Some(ContactState::Continuous) {
+                continue;
+            }
+            let f_ext_t = if needs_ext { self.external_share(idx) } else { 0.0 };
+            let e = &mut self.entries[idx];
+            let input = FrictionInput {
+                ds: e.s - e.s_prev,
+                s: e.s,
+                s0: e.s0,
+                fn_: e.f_n,
+                dt,
+                f_ext_t,
+            };
+            e.f_t = e.friction.update(&input);
+            e.s_g = e.friction.anchor(e.s).unwrap_or(e.s.clamp(0.0, e.len));
+            if e.f_t != 0.0 {
+                add_force(wrenches, bodies, e.body_a, e.body_b, e.t * e.f_t, e.point);
+            }
+        }
+    }
+
+    /// `F_ext,t,i = (t·F_A^nonfric)/n_t` for the classical model (§4.1): the non-friction force on A
+    /// along this contact's tangent, shared by A's contacts with parallel tangents.
+    fn external_share(&self, idx: usize) -> f64 {
+        let e = &self.entries[idx];
+        let n_t = self
+            .entries
+            .iter()
+            .filter(|o| {
+                o.state == Some(ContactState::Continuous) && o.body_a == e.body_a && o.t.dot(e.t).abs() > 0.99
+            })
+            .count()
+            .max(1);
+        e.t.dot(self.nonfric[e.body_a]) / n_t as f64
+    }
+}
+
+#[inline]
+fn same_group(a: &VeCandidate, b: &VeCandidate) -> bool {
+    a.vertex_collider == b.vertex_collider && a.vertex == b.vertex && a.edge_collider == b.edge_collider
+}
+
+fn add_force(w: &mut [Wrench2], bodies: &[Body], a: usize, b: usize, f: Vec2, p: Vec2) {
+    w[a].force += f;
+    w[a].torque += cross(p - bodies[a].pose.pos, f);
+    w[b].force -= f;
+    w[b].torque -= cross(p - bodies[b].pose.pos, f);
+}
+
+/// Turns a tracked pair into a record: Colliding if it approaches faster than `v_c` (and impacts are on),
+/// otherwise Continuous (an invalid impact, §8.2 rule 1). Initialises the god-object and the law states.
+fn start_record(e: &mut VeContact, p: ContactParams, tick: u64, events: &mut Vec<ContactEvent>, simultaneous: bool) {
+    let state = if simultaneous || (p.impacts && e.c0 < -p.v_c) {
+        ContactState::Colliding
+    } else {
+        ContactState::Continuous
+    };
+    e.state = Some(state);
+    e.since = tick;
+    e.m_eff = 0.0;
+    e.s_g = if e.hist >= 2 {
+        entry_point(e.d[1], e.d[0], e.s_prev, e.s, e.len)
+            .map(|(_, s)| s)
+            .unwrap_or(e.s.clamp(0.0, e.len))
+    } else {
+        e.s.clamp(0.0, e.len)
+    };
+    e.s_entry = e.s_g;
+    e.normal.reset();
+    e.friction.begin(e.s_g);
+    events.push(ContactEvent {
+        tick,
+        key: e.key,
+        kind: if simultaneous {
+            EventKind::CreatedSimultaneous
+        } else {
+            EventKind::Created(state)
+        },
+    });
+}
+
+/// World geometry of a VE pair now: `(V, E0, n, t, L)`.
+#[inline]
+fn geometry(key: VeCandidate, colliders: &[Collider]) -> (Vec2, Vec2, Vec2, Vec2, f64) {
+    let ca = &colliders[key.vertex_collider as usize];
+    let cb = &colliders[key.edge_collider as usize];
+    let e = key.edge as usize;
+    (
+        ca.world_vertices[key.vertex as usize],
+        cb.world_vertices[e],
+        cb.world_normals[e],
+        cb.world_tangents[e],
+        cb.local.lengths()[e],
+    )
+}
+
+/// Signed distance and edge coordinate of a VE pair at past poses `pa` (vertex body), `pb` (edge body).
+#[inline]
+fn past_ds(key: VeCandidate, colliders: &[Collider], pa: &Pose, pb: &Pose) -> (f64, f64) {
+    let ca = &colliders[key.vertex_collider as usize];
+    let cb = &colliders[key.edge_collider as usize];
+    let e = key.edge as usize;
+    let v = pa.transform_point(ca.local.vertices()[key.vertex as usize]);
+    let e0 = pb.transform_point(cb.local.vertices()[e]);
+    let rot = pb.rot();
+    let rel = v - e0;
+    (rot.apply(cb.local.normals()[e]).dot(rel), rot.apply(cb.local.tangents()[e]).dot(rel))
+}
+
+/// Re-measures an existing entry: shifts the histories and refreshes geometry and velocities.
+fn measure(e: &mut VeContact, colliders: &[Collider], bodies: &[Body]) {
+    let (v, e0, n, t, len) = geometry(e.key, colliders);
+    let rel = v - e0;
+    e.d = [n.dot(rel), e.d[0], e.d[1]];
+    e.hist = (e.hist + 1).min(3);
+    e.s_prev = e.s;
+    e.s = t.dot(rel);
+    e.len = len;
+    e.point = v;
+    e.n = n;
+    e.t = t;
+    let v_rel = bodies[e.body_a].point_velocity(v) - bodies[e.body_b].point_velocity(v);
+    e.c0 = n.dot(v_rel);
+    e.s0 = t.dot(v_rel);
+}
+
+/// A new tracked entry; its distance history and previous edge coordinate are rebuilt from the past
+/// poses, so the SEH estimate has full history even for a pair first seen in contact.
+fn new_entry(
+    tick: u64,
+    key: VeCandidate,
+    colliders: &[Collider],
+    bodies: &[Body],
+    past: &PastPoses<'_>,
+    normal: &NormalModel,
+    friction: &FrictionModel,
+) -> VeContact {
+    let body_a = colliders[key.vertex_collider as usize].body;
+    let body_b = colliders[key.edge_collider as usize].body;
+    let (v, e0, n, t, len) = geometry(key, colliders);
+    let rel = v - e0;
+    let (d0, s0) = (n.dot(rel), t.dot(rel));
+    let mut d = [d0, 0.0, 0.0];
+    let mut hist = 1;
+    let mut s_prev = s0;
+    if !past.prev.is_empty() {
+        let (d1, s1) = past_ds(key, colliders, &past.prev[body_a], &past.prev[body_b]);
+        d[1] = d1;
+        s_prev = s1;
+        hist = 2;
+        if !past.prev2.is_empty() {
+            d[2] = past_ds(key, colliders, &past.prev2[body_a], &past.prev2[body_b]).0;
+            hist = 3;
+        }
+    }
+    let v_rel = bodies[body_a].point_velocity(v) - bodies[body_b].point_velocity(v);
+    VeContact {
+        key,
+        body_a,
+        body_b,
+        state: None,
+        d,
+        hist,
+        s: s0,
+        s_prev,
+        len,
+        point: v,
+        n,
+        t,
+        c0: n.dot(v_rel),
+        s0: t.dot(v_rel),
+        s_g: s0.clamp(0.0, len),
+        s_entry: s0.clamp(0.0, len),
+        m_eff: 0.0,
+        normal: *normal,
+        friction: *friction,
+        f_n: 0.0,
+        f_t: 0.0,
+        since: tick,
+    }
+}
+
+/// The crossed-edge rule of §8.3: among the edges of the edge collider whose line the vertex crossed
+/// during the last sample, within the edge range, the one crossed first (smallest λ).
+fn crossed_edge(key: VeCandidate, colliders: &[Collider], past: &PastPoses<'_>, eps_s: f64) -> Option<u32> {
+    if past.prev.is_empty() {
+        return None;
+    }
+    let ca = &colliders[key.vertex_collider as usize];
+    let cb = &colliders[key.edge_collider as usize];
+    let (pa, pb) = (&past.prev[ca.body], &past.prev[cb.body]);
+    let mut best: Option<(f64, u32)> = None;
+    for e in 0..cb.len() {
+        let k = VeCandidate { edge: e as u32, ..key };
+        let (_, e0, n, t, len) = geometry(k, colliders);
+        let v = ca.world_vertices[key.vertex as usize];
+        let (d_now, s_now) = (n.dot(v - e0), t.dot(v - e0));
+        let (d_prev, s_prev) = past_ds(k, colliders, pa, pb);
+        if d_prev > 0.0 && d_now <= 0.0 {
+            let lam = d_prev / (d_prev - d_now);
+            let s_cross = crossing_coordinate(d_prev, d_now, s_prev, s_now);
+            if s_cross >= -eps_s && s_cross <= len + eps_s && best.is_none_or(|(l, _)| lam < l) {
+                best = Some((lam, e as u32));
+            }
+        }
+    }
+    best.map(|(_, e)| e)
+}

@@ -1,0 +1,39 @@
+//! Parameters of the contact state machine (§8.2) and of impacts (§7).
+
+/// Thresholds and options of the contact pipeline.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactParams {
+    /// Collision velocity threshold `v_c` (m/s): a new contact approaching faster is Colliding.
+    pub v_c: f64,
+    /// Edge-range tolerance `ε_s` (m).
+    pub eps_s: f64,
+    /// Creation threshold `δ_on` (m): a record is created at `d ≤ δ_on`.
+    pub delta_on: f64,
+    /// Release threshold `δ_off` (m): a record is deleted at `d > δ_off`.
+    pub delta_off: f64,
+    /// Whether collisions are resolved by impulses (§7). When false every contact starts Continuous
+    /// (the pure wall laws of Fig. 4).
+    pub impacts: bool,
+    /// Poisson restitution coefficient `e` for Colliding contacts.
+    pub restitution: f64,
+    /// Re-collision inside contact (§8.2 rule 5): promote a Continuous record approaching faster than this
+    /// (m/s) back to Colliding. `None` = off (default).
+    pub v_re: Option<f64>,
+    /// Plastic-correction threshold `ε_v` (m/s) of the impact solver.
+    pub eps_v: f64,
+}
+
+impl Default for ContactParams {
+    fn default() -> Self {
+        Self {
+            v_c: 0.02,
+            eps_s: 1e-4,
+            delta_on: 0.0,
+            delta_off: 0.0,
+            impacts: true,
+            restitution: 0.5,
+            v_re: None,
+            eps_v: 1e-6,
+        }
+    }
+}

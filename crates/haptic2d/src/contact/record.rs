@@ -1,0 +1,111 @@
+//! The per-VE-pair record (§8.1): distance history, edge coordinate, god-object, law states.
+
+use crate::collide::VeCandidate;
+use crate::geom::Vec2;
+use crate::laws::friction::FrictionModel;
+use crate::laws::normal::NormalModel;
+
+/// The state of a VE pair that is in contact (§8.2). A pair that is only tracked has no state.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ContactState {
+    /// Approaching faster than `v_c` at creation: resolved by an impulse at this sample (§7).
+    Colliding,
+    /// Sticking or sliding contact: forces from the normal law and the friction model.
+    Continuous,
+}
+
+/// A tracked VE pair: a candidate from the local stage, or a contact record when `state` is set.
+///
+/// Geometry fields are refreshed every sample; `n`, `t`, `point` are world quantities of this sample.
+#[derive(Clone, Copy, Debug)]
+pub struct VeContact {
+    /// Identity: (vertex collider, vertex, edge collider, edge).
+    pub key: VeCandidate,
+    /// Body owning the vertex ("A").
+    pub body_a: usize,
+    /// Body owning the edge ("B").
+    pub body_b: usize,
+    /// `None` while only tracked; `Some(state)` for a contact record.
+    pub state: Option<ContactState>,
+    /// Signed-distance history (m): `d[0] = d_k`, `d[1] = d_{k−1}`, `d[2] = d_{k−2}`.
+    pub d: [f64; 3],
+    /// Number of valid entries in `d` (1..=3).
+    pub hist: u8,
+    /// Edge coordinate `s^B_k` (m).
+    pub s: f64,
+    /// Previous edge coordinate `s^B_{k−1}` (m).
+    pub s_prev: f64,
+    /// Edge length `L` (m).
+    pub len: f64,
+    /// World position of the vertex `V` (m).
+    pub point: Vec2,
+    /// Outward edge normal (world).
+    pub n: Vec2,
+    /// Edge tangent (world).
+    pub t: Vec2,
+    /// Normal relative velocity `C0` (m/s), positive when separating.
+    pub c0: f64,
+    /// Tangential slip velocity `S0` (m/s).
+    pub s0: f64,
+    /// God-object edge coordinate `s_g` in B's frame (m), §8.3.
+    pub s_g: f64,
+    /// Entry point: the edge coordinate where the vertex crossed the edge line at creation (m), §8.3.
+    pub s_entry: f64,
+    /// Effective mass behind the contact for the braking pulse (kg).
+    pub m_eff: f64,
+    /// Normal-law state (a copy of the world's prototype).
+    pub normal: NormalModel,
+    /// Friction-model state (a copy of the world's prototype).
+    pub friction: FrictionModel,
+    /// Normal force of the last sample (N).
+    pub f_n: f64,
+    /// Friction force on A along `+t` of the last sample (N).
+    pub f_t: f64,
+    /// Tick at which this entry was first tracked.
+    pub since: u64,
+}
+
+impl VeContact {
+    /// True for a contact record (Colliding or Continuous).
+    #[inline]
+    pub fn is_contact(&self) -> bool {
+        self.state.is_some()
+    }
+    /// True if the vertex lies within the edge range `[−ε_s, L + ε_s]`.
+    #[inline]
+    pub fn in_range(&self, eps_s: f64) -> bool {
+        self.s >= -eps_s && self.s <= self.len + eps_s
+    }
+    /// World position of the god-object (m): the point `E0 + s_g·t` on the edge.
+    #[inline]
+    pub fn god_object(&self) -> Vec2 {
+        // point = E0 + s·t + d·n, so E0 = point − s·t − d·n.
+        self.point - self.t * self.s - self.n * self.d[0] + self.t * self.s_g
+    }
+}
+
+/// One transition of the contact state machine, for the trace that tests assert on (§8.2).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ContactEvent {
+    /// Sample index `k`.
+    pub tick: u64,
+    /// Pair identity.
+    pub key: VeCandidate,
+    /// What happened.
+    pub kind: EventKind,
+}
+
+/// Kinds of contact-state transitions.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EventKind {
+    /// A record was created in this state (Colliding, or Continuous for an invalid impact).
+    Created(ContactState),
+    /// Created as Colliding by the simultaneity window (§8.2 rule 2).
+    CreatedSimultaneous,
+    /// A Colliding record was resolved by the impact solver and became Continuous.
+    Resolved,
+    /// The record was deleted (separation or out of the edge range).
+    Released,
+    /// A Continuous record was promoted back to Colliding (§8.2 rule 5, option).
+    Recollision,
+}

@@ -1,0 +1,433 @@
+//! Validation and construction: a parsed [`SceneFile`] → a [`World`], collecting every problem.
+
+use super::file::{BodySection, SceneFile};
+use super::laws::{friction_from, normal_from};
+use super::{SceneError, SceneErrors};
+use crate::body::Body;
+use crate::contact::ContactParams;
+use crate::geom::{ConvexPolygon, MassProperties, Pose, Rot, Vec2};
+use crate::integrate::{min_mass, IntegrationMode};
+use crate::load::{Load, Profile};
+use crate::world::{World, WorldParams};
+
+/// A validated scene: its world, ready to run, plus any warnings.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// Scene name (from the file, or the built-in name).
+    pub name: String,
+    /// One-line description.
+    pub description: String,
+    /// Where it came from (file path or `built-in:<name>`).
+    pub source: String,
+    /// The world at its initial state.
+    pub world: World,
+    /// Non-fatal remarks (e.g. light bodies accepted with `allow_light_bodies`).
+    pub warnings: Vec<String>,
+}
+
+impl Scene {
+    /// Parses and validates TOML scene text. `source` names the file in messages; `rate` overrides
+    /// `world.rate` (Hz) when given.
+    pub fn from_toml(text: &str, source: &str, rate: Option<f64>) -> Result<Scene, SceneErrors> {
+        let fail = |errors| SceneErrors {
+            source: source.to_string(),
+            errors,
+        };
+        let file: SceneFile = toml::from_str(text).map_err(|e| {
+            let field = e
+                .span()
+                .map(|sp| {
+                    let line = text[..sp.start.min(text.len())].matches('\n').count() + 1;
+                    format!("line {line}")
+                })
+                .unwrap_or_else(|| "file".into());
+            fail(vec![SceneError::new(
+                field,
+                e.message().to_string(),
+                "check the TOML syntax and field names against docs/SCENES.md",
+            )])
+        })?;
+        build(&file, source, rate).map_err(fail)
+    }
+}
+
+fn finite_pos(x: f64) -> bool {
+    x.is_finite() && x > 0.0
+}
+
+fn body_pieces(b: &BodySection, field: &str, errs: &mut Vec<SceneError>) -> Vec<ConvexPolygon> {
+    let pts = |p: &Vec<[f64; 2]>| p.iter().map(|q| Vec2::new(q[0], q[1])).collect::<Vec<_>>();
+    let mut raw: Vec<(String, Vec<Vec2>)> = Vec::new();
+    let given = b.polygon.is_some() as u8 + b.rect.is_some() as u8 + b.pieces.is_some() as u8;
+    if given != 1 {
+        errs.push(SceneError::new(
+            field,
+            if given == 0 {
+                "no shape given".to_string()
+            } else {
+                "more than one shape given".to_string()
+            },
+            "give exactly one of: polygon = [[x, y], ...], box = [width, height], pieces = [[[x, y], ...], ...]",
+        ));
+        return Vec::new();
+    }
+    if let Some(p) = &b.polygon {
+        raw.push((format!("{field}.polygon"), pts(p)));
+    }
+    if let Some([w, h]) = b.rect {
+        if !(finite_pos(w) && finite_pos(h)) {
+            errs.push(SceneError::new(
+                format!("{field}.box"),
+                format!("width and height must be positive, got [{w}, {h}]"),
+                "give box = [width, height] in metres, both > 0",
+            ));
+            return Vec::new();
+        }
+        let (a, c) = (0.5 * w, 0.5 * h);
+        raw.push((
+            format!("{field}.box"),
+            vec![Vec2::new(-a, -c), Vec2::new(a, -c), Vec2::new(a, c), Vec2::new(-a, c)],
+        ));
+    }
+    if let Some(ps) = &b.pieces {
+        for (k, p) in ps.iter().enumerate() {
+            raw.push((format!("{field}.pieces[{k}]"), pts(p)));
+        }
+    }
+    let mut out = Vec::new();
+    for (f, v) in raw {
+        match ConvexPolygon::new(v) {
+            Ok(p) => out.push(p),
+            Err(e) => errs.push(SceneError::new(
+                f,
+                e.to_string(),
+                "vertices must be listed counter-clockwise and form a convex polygon; split non-convex shapes into `pieces`",
+            )),
+        }
+    }
+    out
+}
+
+/// Validates `file` and builds its world.
+pub(super) fn build(file: &SceneFile, source: &str, rate: Option<f64>) -> Result<Scene, Vec<SceneError>> {
+    let mut errs = Vec::new();
+    let mut warnings = Vec::new();
+    let w = &file.world;
+
+    // [world]
+    let rate = rate.or(w.rate).unwrap_or(500.0);
+    if !finite_pos(rate) {
+        errs.push(SceneError::new("world.rate", format!("must be a positive rate in Hz, got {rate}"), "e.g. rate = 1000"));
+    }
+    let dt = 1.0 / rate;
+    let mut params = WorldParams {
+        dt,
+        ..WorldParams::default()
+    };
+    if let Some(n) = w.proximity_every {
+        if n == 0 {
+            errs.push(SceneError::new("world.proximity_every", "must be at least 1", "e.g. proximity_every = 10"));
+        }
+        params.proximity_every = n.max(1);
+    }
+    if let Some(x) = w.delta_prox {
+        if !finite_pos(x) {
+            errs.push(SceneError::new("world.delta_prox", format!("must be a positive distance in m, got {x}"), "e.g. delta_prox = 0.042"));
+        }
+        params.delta_prox = x;
+    }
+    if let Some(x) = w.delta_c {
+        if !(x.is_finite() && x >= 0.0) {
+            errs.push(SceneError::new("world.delta_c", format!("must be a non-negative distance in m, got {x}"), "e.g. delta_c = 0.002"));
+        }
+        params.delta_c = x;
+    }
+    params.mode = match w.integration.as_deref() {
+        None | Some("semi-implicit") => IntegrationMode::SemiImplicit,
+        Some("exact-zoh") => IntegrationMode::ExactZoh,
+        Some("explicit-euler") => IntegrationMode::ExplicitEuler,
+        Some(other) => {
+            errs.push(SceneError::new(
+                "world.integration",
+                format!("unknown integration mode \"{other}\""),
+                "use \"semi-implicit\" (passive, default) or \"exact-zoh\" (lossless, for wall comparisons)",
+            ));
+            IntegrationMode::SemiImplicit
+        }
+    };
+    if let Some(g) = w.guard {
+        if !(g.is_finite() && g >= 0.0) {
+            errs.push(SceneError::new("world.guard", format!("must be a non-negative energy in J, got {g}"), "e.g. guard = 1e-9"));
+        }
+        params.guard = Some(g);
+    }
+    let margin_needed = 2.0 * 1.0 * dt * params.proximity_every as f64 + params.delta_c;
+    if params.delta_prox < margin_needed {
+        warnings.push(format!(
+            "world.delta_prox = {} m is below 2·v_rel,max·T_g + δ_c = {margin_needed:.4} m (v_rel,max = 1 m/s): fast bodies may be missed between proximity updates",
+            params.delta_prox
+        ));
+    }
+
+    // [contact]
+    let c = &file.contact;
+    let mut cp = ContactParams::default();
+    if let Some(x) = c.impacts {
+        cp.impacts = x;
+    }
+    if let Some(e) = c.restitution {
+        if !(0.0..=1.0).contains(&e) {
+            errs.push(SceneError::new("contact.restitution", format!("must be in [0, 1], got {e}"), "e.g. restitution = 0.5"));
+        }
+        cp.restitution = e;
+    }
+    if let Some(v) = c.v_c {
+        if !(v.is_finite() && v >= 0.0) {
+            errs.push(SceneError::new("contact.v_c", format!("must be a non-negative speed in m/s, got {v}"), "e.g. v_c = 0.02"));
+        }
+        cp.v_c = v;
+    }
+    if let Some(x) = c.eps_s {
+        if !(x.is_finite() && x >= 0.0) {
+            errs.push(SceneError::new("contact.eps_s", format!("must be a non-negative distance in m, got {x}"), "e.g. eps_s = 1e-4"));
+        }
+        cp.eps_s = x;
+    }
+    if let Some(v) = c.recollision_speed {
+        if !finite_pos(v) {
+            errs.push(SceneError::new("contact.recollision_speed", format!("must be a positive speed in m/s, got {v}"), "e.g. recollision_speed = 0.1"));
+        }
+        cp.v_re = Some(v);
+    }
+    params.contact = cp;
+
+    // [normal], [friction]
+    let normal = normal_from(&file.normal, &mut errs);
+    let friction = friction_from(&file.friction, &mut errs);
+
+    // [[body]] and [[grid]]
+    let mut bodies = Vec::new();
+    let mut shapes = Vec::new();
+    for (i, b) in file.bodies.iter().enumerate() {
+        let field = match &b.name {
+            Some(n) => format!("body[{i}] \"{n}\""),
+            None => format!("body[{i}]"),
+        };
+        let name = b.name.clone().unwrap_or_else(|| format!("body{i}"));
+        let pieces = body_pieces(b, &field, &mut errs);
+        let fixed = match b.kind.as_deref() {
+            None | Some("dynamic") => false,
+            Some("fixed") => true,
+            Some(k) => {
+                errs.push(SceneError::new(format!("{field}.kind"), format!("unknown kind \"{k}\""), "use \"dynamic\" or \"fixed\""));
+                false
+            }
+        };
+        let pos = b.position.unwrap_or([0.0, 0.0]);
+        let angle = match (b.angle, b.angle_deg) {
+            (Some(_), Some(_)) => {
+                errs.push(SceneError::new(format!("{field}.angle"), "both angle and angle_deg given", "keep one of them"));
+                0.0
+            }
+            (Some(a), None) => a,
+            (None, Some(d)) => d.to_radians(),
+            (None, None) => 0.0,
+        };
+        for (k, v) in [("position", pos[0]), ("position", pos[1]), ("angle", angle)] {
+            if !v.is_finite() {
+                errs.push(SceneError::new(format!("{field}.{k}"), "is NaN or infinite", "give finite numbers"));
+            }
+        }
+        if pieces.is_empty() {
+            continue;
+        }
+        let mp = if fixed {
+            MassProperties::from_density(&pieces, 1.0)
+        } else {
+            match (b.mass, b.density) {
+                (Some(m), None) if finite_pos(m) => MassProperties::from_mass(&pieces, m),
+                (None, Some(d)) if finite_pos(d) => MassProperties::from_density(&pieces, d),
+                (Some(m), None) => {
+                    errs.push(SceneError::new(format!("{field}.mass"), format!("must be a positive mass in kg, got {m}"), "e.g. mass = 0.5"));
+                    continue;
+                }
+                (None, Some(d)) => {
+                    errs.push(SceneError::new(format!("{field}.density"), format!("must be a positive density in kg/m², got {d}"), "e.g. density = 625"));
+                    continue;
+                }
+                (Some(_), Some(_)) => {
+                    errs.push(SceneError::new(format!("{field}.mass"), "both mass and density given", "keep one of them"));
+                    continue;
+                }
+                (None, None) => {
+                    errs.push(SceneError::new(field.clone(), "a dynamic body needs a mass or a density", "add mass = <kg> or density = <kg/m²>, or kind = \"fixed\""));
+                    continue;
+                }
+            }
+        };
+        let inertia = match b.inertia {
+            Some(ii) if !fixed => {
+                if !finite_pos(ii) {
+                    errs.push(SceneError::new(format!("{field}.inertia"), format!("must be positive in kg·m², got {ii}"), "remove it to compute it from the shape"));
+                }
+                ii
+            }
+            _ => mp.inertia,
+        };
+        let pieces: Vec<ConvexPolygon> = pieces.iter().map(|p| p.shifted(mp.com)).collect();
+        let com_world = Vec2::new(pos[0], pos[1]) + Rot::new(angle).apply(mp.com);
+        let pose = Pose {
+            pos: com_world,
+            angle,
+        };
+        let mut body = if fixed {
+            Body::fixed(name, pose)
+        } else {
+            Body::dynamic(name, mp.mass, inertia, pose)
+        };
+        if let Some(v) = b.velocity {
+            body.vel = Vec2::new(v[0], v[1]);
+        }
+        body.omega = b.omega.unwrap_or(0.0);
+        if let Some(d) = b.damping {
+            if !(d.is_finite() && d >= 0.0) {
+                errs.push(SceneError::new(format!("{field}.damping"), format!("must be a non-negative damping in N·s/m, got {d}"), "e.g. damping = 2.4"));
+            }
+            body.damping = d;
+        }
+        bodies.push(body);
+        shapes.push(pieces);
+    }
+    for (gi, g) in file.grids.iter().enumerate() {
+        let field = format!("grid[{gi}]");
+        let prefix = g.name.clone().unwrap_or_else(|| "box".into());
+        if g.columns == 0 || g.count == 0 {
+            errs.push(SceneError::new(field.clone(), "count and columns must be at least 1", "e.g. count = 100, columns = 10"));
+            continue;
+        }
+        if !(finite_pos(g.rect[0]) && finite_pos(g.rect[1]) && finite_pos(g.mass)) {
+            errs.push(SceneError::new(field.clone(), "box sizes and mass must be positive", "e.g. box = [0.05, 0.05], mass = 0.5"));
+            continue;
+        }
+        let Ok(shape) = ConvexPolygon::rectangle(g.rect[0], g.rect[1]) else {
+            continue;
+        };
+        let inertia = MassProperties::from_mass(std::slice::from_ref(&shape), g.mass).inertia;
+        for k in 0..g.count {
+            let (row, col) = (k / g.columns, k % g.columns);
+            let shift = if g.stagger.unwrap_or(false) && row % 2 == 1 { 0.5 * g.spacing[0] } else { 0.0 };
+            let p = Pose::new(
+                g.origin[0] + col as f64 * g.spacing[0] + shift,
+                g.origin[1] + row as f64 * g.spacing[1],
+                0.0,
+            );
+            bodies.push(Body::dynamic(format!("{prefix}{k}"), g.mass, inertia, p));
+            shapes.push(vec![shape.clone()]);
+        }
+    }
+    let mut names = std::collections::BTreeSet::new();
+    for b in &bodies {
+        if !names.insert(b.name.clone()) {
+            errs.push(SceneError::new(format!("body \"{}\"", b.name), "duplicate body name", "give every body a unique name"));
+        }
+    }
+
+    // Minimum mass (§6.4): a flat face rests on two contacts in parallel, so check 2K and 2B.
+    let (k, b) = super::laws::stiffest(&normal, &friction);
+    let (k2, b2) = (2.0 * k, 2.0 * b);
+    for (i, body) in bodies.iter().enumerate() {
+        if !body.is_dynamic() {
+            continue;
+        }
+        let m_min = min_mass(k2, b2, dt);
+        let r2 = shapes[i]
+            .iter()
+            .flat_map(|p| p.vertices().iter().map(|v| v.length_squared()))
+            .fold(0.0, f64::max);
+        let i_min = min_mass(k2 * r2, b2 * r2, dt);
+        for (what, have, need, unit) in [("mass", body.mass, m_min, "kg"), ("inertia", body.inertia, i_min, "kg·m²")] {
+            if have < 1.5 * need {
+                let msg = format!(
+                    "{what} {have:.4e} {unit} is below 1.5 × min_{what} = {:.4e} {unit} for the stiffest contact (K = {k2} N/m, B = {b2} N·s/m for a face on two contacts, T = {dt} s): the simulation would be unstable or nearly so (§6.4)",
+                    1.5 * need
+                );
+                if w.allow_light_bodies.unwrap_or(false) {
+                    warnings.push(format!("body \"{}\": {msg}", body.name));
+                } else {
+                    errs.push(SceneError::new(
+                        format!("body \"{}\".{what}", body.name),
+                        msg,
+                        "increase the mass, lower the contact stiffness/damping, raise world.rate, or set world.allow_light_bodies = true to accept it with a warning",
+                    ));
+                }
+            }
+        }
+    }
+
+    // [[load]]
+    let mut loads = Vec::new();
+    for (li, l) in file.loads.iter().enumerate() {
+        let field = format!("load[{li}]");
+        let profile = match l.profile.as_deref() {
+            None | Some("constant") => Profile::Constant,
+            Some("sine") => match l.frequency {
+                Some(f) if finite_pos(f) => Profile::UnidirectionalSine { frequency: f },
+                _ => {
+                    errs.push(SceneError::new(format!("{field}.frequency"), "the sine profile needs a positive frequency in Hz", "e.g. frequency = 1.0"));
+                    Profile::Constant
+                }
+            },
+            Some(p) => {
+                errs.push(SceneError::new(format!("{field}.profile"), format!("unknown profile \"{p}\""), "use \"constant\" or \"sine\""));
+                Profile::Constant
+            }
+        };
+        let f = l.force.unwrap_or([0.0, 0.0]);
+        let tau = l.torque.unwrap_or(0.0);
+        if !(f[0].is_finite() && f[1].is_finite() && tau.is_finite()) {
+            errs.push(SceneError::new(format!("{field}.force"), "is NaN or infinite", "give finite numbers"));
+        }
+        let targets: Vec<usize> = if l.body == "*" {
+            (0..bodies.len()).filter(|&i| bodies[i].is_dynamic()).collect()
+        } else {
+            match bodies.iter().position(|b| b.name == l.body) {
+                Some(i) if bodies[i].is_dynamic() => vec![i],
+                Some(_) => {
+                    errs.push(SceneError::new(format!("{field}.body"), format!("body \"{}\" is fixed; loads on it have no effect", l.body), "load a dynamic body"));
+                    vec![]
+                }
+                None => {
+                    errs.push(SceneError::new(
+                        format!("{field}.body"),
+                        format!("no body named \"{}\"", l.body),
+                        format!("use one of: {}", bodies.iter().map(|b| b.name.as_str()).take(8).collect::<Vec<_>>().join(", ")),
+                    ));
+                    vec![]
+                }
+            }
+        };
+        for body in targets {
+            loads.push(Load {
+                body,
+                force: Vec2::new(f[0], f[1]),
+                torque: tau,
+                per_mass: l.per_mass.unwrap_or(false),
+                profile,
+            });
+        }
+    }
+    if !bodies.iter().any(|b| b.is_dynamic()) && errs.is_empty() {
+        warnings.push("the scene has no dynamic body: nothing will move".into());
+    }
+    if !errs.is_empty() {
+        return Err(errs);
+    }
+    let name = file.name.clone().unwrap_or_else(|| source.to_string());
+    Ok(Scene {
+        name,
+        description: file.description.clone().unwrap_or_default(),
+        source: source.to_string(),
+        world: World::new(bodies, shapes, loads, normal, friction, params),
+        warnings,
+    })
+}

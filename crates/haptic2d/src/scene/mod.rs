@@ -1,0 +1,16 @@
+//! Scene files (TOML) → [`World`](crate::world::World), with validation that reports every problem with
+//! the field it concerns and the fix.
+//!
+//! The format is documented in `docs/SCENES.md`; built-in scenes live in `scenes/` and are embedded in
+//! the binary.
+
+mod builtin;
+mod error;
+mod file;
+mod laws;
+mod build;
+
+pub use builtin::{builtin, builtin_names, pile_toml, BUILTIN};
+pub use build::Scene;
+pub use error::{SceneError, SceneErrors};
+pub use file::SceneFile;

@@ -1,0 +1,297 @@
+//! The world: bodies, colliders, loads and contact laws, stepped once per haptic sample in the order of
+//! §0.5 (steps 3–6, then 10–11), with an energy ledger.
+//!
+//! For a world-only simulation call [`World::step`]. Inside the haptic loop the controller sits between
+//! contact forces and integration (§0.5 step 7), so the tick calls [`World::begin_step`], reads the slave
+//! state and contact wrench, sets the drive with [`World::set_drive`], then calls [`World::finish_step`].
+
+use crate::body::Body;
+use crate::collide::{BroadPhase, Collider, LocalStage, VeCandidate, DEFAULT_DELTA_PROX};
+use crate::contact::{ContactParams, ContactSet, PastPoses, VeContact, Wrench2};
+use crate::geom::{Pose, Vec2};
+use crate::integrate::{integrate_body, EnergyLedger, IntegrationMode, PassivityGuard};
+use crate::laws::friction::FrictionModel;
+use crate::laws::normal::NormalModel;
+use crate::load::Load;
+
+/// Rates, margins and options of a world.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WorldParams {
+    /// Sample period `T` (s).
+    pub dt: f64,
+    /// Run the global proximity stage every `N_g` samples.
+    pub proximity_every: u32,
+    /// Proximity margin `δ_prox` (m), §9.1.
+    pub delta_prox: f64,
+    /// Contact distance tolerance `δ_c` (m), §9.5.
+    pub delta_c: f64,
+    /// Integration mode (§6; exact-ZOH for harness scenes).
+    pub mode: IntegrationMode,
+    /// Passivity guard tolerance `ε_E` (J); `None` = guard off (default).
+    pub guard: Option<f64>,
+    /// Contact state machine and impact options.
+    pub contact: ContactParams,
+}
+
+impl Default for WorldParams {
+    fn default() -> Self {
+        Self {
+            dt: 0.002,
+            proximity_every: 10,
+            delta_prox: 0.042,
+            delta_c: 0.002,
+            mode: IntegrationMode::SemiImplicit,
+            guard: None,
+            contact: ContactParams::default(),
+        }
+    }
+}
+
+/// A planar world of rigid bodies simulated passively at the control rate.
+#[derive(Clone, Debug)]
+pub struct World {
+    /// Bodies; index = body id.
+    pub bodies: Vec<Body>,
+    /// Convex collision shapes; several may belong to one body.
+    pub colliders: Vec<Collider>,
+    /// Applied loads.
+    pub loads: Vec<Load>,
+    /// Prototype of the normal law; every new contact gets a copy.
+    pub normal: NormalModel,
+    /// Prototype of the friction model; every new contact gets a copy.
+    pub friction: FrictionModel,
+    /// Parameters.
+    pub params: WorldParams,
+    contacts: ContactSet,
+    broad: BroadPhase,
+    local: LocalStage,
+    pairs: Vec<(u32, u32)>,
+    candidates: Vec<VeCandidate>,
+    drive: Vec<Wrench2>,
+    contact_wrench: Vec<Wrench2>,
+    held: Vec<Wrench2>,
+    prev: Vec<Pose>,
+    prev2: Vec<Pose>,
+    ledger: EnergyLedger,
+    guard: Option<PassivityGuard>,
+    ke_before: Vec<f64>,
+    tick: u64,
+}
+
+impl World {
+    /// A world with the given bodies (each with its pieces, in the body frame) and laws.
+    ///
+    /// `shapes[i]` lists the convex pieces of body `i`, expressed in its centre-of-mass frame.
+    pub fn new(
+        bodies: Vec<Body>,
+        shapes: Vec<Vec<crate::geom::ConvexPolygon>>,
+        loads: Vec<Load>,
+        normal: NormalModel,
+        friction: FrictionModel,
+        params: WorldParams,
+    ) -> Self {
+        let mut colliders = Vec::new();
+        for (i, pieces) in shapes.into_iter().enumerate() {
+            for p in pieces {
+                colliders.push(Collider::new(i, bodies[i].is_dynamic(), p, &bodies[i].pose));
+            }
+        }
+        let n = bodies.len();
+        let colliders_len = colliders.len().max(4);
+        let mut w = Self {
+            guard: params.guard.map(|eps| PassivityGuard::new(eps, &bodies)),
+            bodies,
+            colliders,
+            loads,
+            normal,
+            friction,
+            params,
+            contacts: ContactSet::new(params.contact),
+            broad: BroadPhase::new(params.delta_prox)
+                .unwrap_or_else(|_| BroadPhase::new(DEFAULT_DELTA_PROX).expect("the default margin is valid")),
+            local: {
+                let mut l = LocalStage::new();
+                // An invalid tolerance keeps the default; scene validation reports it.
+                let _ = l.set_edge_tolerance(params.contact.eps_s);
+                l
+            },
+            // Room for a typical contact load, so the first contacts do not allocate on the hot path.
+            pairs: Vec::with_capacity(8 * colliders_len),
+            candidates: Vec::with_capacity(16 * colliders_len),
+            drive: vec![Wrench2::default(); n],
+            contact_wrench: vec![Wrench2::default(); n],
+            held: vec![Wrench2::default(); n],
+            prev: Vec::with_capacity(n),
+            prev2: Vec::with_capacity(n),
+            ledger: EnergyLedger::default(),
+            ke_before: vec![0.0; n],
+            tick: 0,
+        };
+        w.ledger.kinetic = w.bodies.iter().map(|b| b.kinetic_energy()).sum();
+        w.ledger.initial = w.ledger.kinetic;
+        w
+    }
+
+    /// The sample index `k` of the next step.
+    #[inline]
+    pub fn tick(&self) -> u64 {
+        self.tick
+    }
+    /// Simulated time `k·T` (s).
+    #[inline]
+    pub fn time(&self) -> f64 {
+        self.tick as f64 * self.params.dt
+    }
+    /// The energy ledger after the last step.
+    #[inline]
+    pub fn ledger(&self) -> &EnergyLedger {
+        &self.ledger
+    }
+    /// The contact set (tracked pairs and records).
+    #[inline]
+    pub fn contacts(&self) -> &ContactSet {
+        &self.contacts
+    }
+    /// Contact records of the last step.
+    pub fn contact_records(&self) -> impl Iterator<Item = &VeContact> {
+        self.contacts.records()
+    }
+    /// The proximate collider pairs of the last global update.
+    #[inline]
+    pub fn proximate_pairs(&self) -> &[(u32, u32)] {
+        &self.pairs
+    }
+    /// The contact wrench on body `i` at the last step (N, N·m): the sum of normal and friction forces.
+    /// The wrench the body applies to the environment, `f_e` of §11, is its negative.
+    #[inline]
+    pub fn contact_wrench(&self, i: usize) -> Wrench2 {
+        self.contact_wrench[i]
+    }
+    /// Number of passivity-guard triggers so far (0 if the guard is off).
+    pub fn guard_triggers(&self) -> u64 {
+        self.guard.as_ref().map_or(0, |g| g.triggers)
+    }
+    /// Looks a body up by name.
+    pub fn body_index(&self, name: &str) -> Option<usize> {
+        self.bodies.iter().position(|b| b.name == name)
+    }
+
+    /// Sets the drive wrench on body `i` (N, N·m at the COM), held until changed: the slave drive
+    /// `f_cs` of the teleoperation controller, or any user force.
+    pub fn set_drive(&mut self, i: usize, force: Vec2, torque: f64) {
+        self.drive[i] = Wrench2 { force, torque };
+    }
+
+    /// One full sample: [`begin_step`](Self::begin_step) then [`finish_step`](Self::finish_step).
+    pub fn step(&mut self) {
+        self.begin_step();
+        self.finish_step();
+    }
+
+    /// §0.5 steps 3–6: proximity (every `N_g` samples), local contacts, contact states, impacts
+    /// (velocities jump now), and continuous-contact forces.
+    pub fn begin_step(&mut self) {
+        let dt = self.params.dt;
+        // 0. World-frame features of every collider at the current poses.
+        for c in self.colliders.iter_mut() {
+            c.update(&self.bodies[c.body].pose);
+        }
+        // 3. Global proximity stage: AABB sort-and-sweep + GJK, every N_g samples.
+        if self.tick % self.params.proximity_every.max(1) as u64 == 0 {
+            self.broad.update(&self.colliders, &mut self.pairs);
+        }
+        // 4. Local stage: closest-feature tracking and VE candidates for proximate pairs.
+        self.local
+            .update(&self.colliders, &self.pairs, self.params.delta_c, &mut self.candidates);
+        // Loads and drives are held over the sample; they enter the bodies' accumulators first so the
+        // classical friction model sees them (§4.1).
+        let t = self.time();
+        for (b, d) in self.bodies.iter_mut().zip(&self.drive) {
+            b.force = d.force;
+            b.torque = d.torque;
+        }
+        for l in &self.loads {
+            let (f, tau) = l.wrench(&self.bodies[l.body], t);
+            self.bodies[l.body].force += f;
+            self.bodies[l.body].torque += tau;
+        }
+        if self.guard.is_some() {
+            for (k, b) in self.ke_before.iter_mut().zip(&self.bodies) {
+                *k = b.kinetic_energy();
+            }
+        }
+        // 4–6. Contact records, state machine, simultaneous impacts, normal and friction forces.
+        let past = PastPoses {
+            prev: &self.prev,
+            prev2: &self.prev2,
+        };
+        self.contacts.step(
+            self.tick,
+            dt,
+            &self.candidates,
+            &self.colliders,
+            &mut self.bodies,
+            &past,
+            &self.normal,
+            &self.friction,
+            &mut self.contact_wrench,
+        );
+        self.ledger.impact_loss += self.contacts.last_impact_loss;
+        if let Some(g) = self.guard.as_mut() {
+            // An impulse changes a body's energy without a held force: count that change as the body's
+            // input, so the guard checks the integrator alone (impacts only lower the total, §7).
+            for (i, b) in self.bodies.iter().enumerate() {
+                g.add_input(i, b.kinetic_energy() - self.ke_before[i]);
+            }
+        }
+        if self.tick == 0 {
+            self.ledger.initial = self.ledger.kinetic + self.contacts.stored_energy();
+        }
+    }
+
+    /// §0.5 steps 10–11: integrate every body with all forces of this sample (contact + loads + drive,
+    /// re-read so a drive set after `begin_step` counts), then update the energy ledger.
+    pub fn finish_step(&mut self) {
+        let dt = self.params.dt;
+        let t = self.time();
+        // Remember the poses of k−1 and k−2 (buffers reused).
+        std::mem::swap(&mut self.prev, &mut self.prev2);
+        self.prev.clear();
+        self.prev.extend(self.bodies.iter().map(|b| b.pose));
+        let mut applied_work = 0.0;
+        for i in 0..self.bodies.len() {
+            // Held applied wrench: loads + drive.
+            let mut applied = self.drive[i];
+            for l in &self.loads {
+                if l.body == i {
+                    let (f, tau) = l.wrench(&self.bodies[i], t);
+                    applied.force += f;
+                    applied.torque += tau;
+                }
+            }
+            let b = &mut self.bodies[i];
+            let cw = self.contact_wrench[i];
+            b.force = applied.force + cw.force;
+            b.torque = applied.torque + cw.torque;
+            self.held[i] = applied;
+            if !b.is_dynamic() {
+                continue;
+            }
+            let before = b.pose;
+            let f_total = b.force - b.vel * b.damping;
+            let tau_total = b.torque;
+            integrate_body(b, dt, self.params.mode);
+            let dx = b.pose.pos - before.pos;
+            let dth = b.pose.angle - before.angle;
+            applied_work += applied.force.dot(dx) + applied.torque * dth;
+            if let Some(g) = self.guard.as_mut() {
+                g.add_input(i, f_total.dot(dx) + tau_total * dth);
+                g.check(i, b);
+            }
+        }
+        self.ledger.applied_work += applied_work;
+        self.ledger.kinetic = self.bodies.iter().map(|b| b.kinetic_energy()).sum();
+        self.ledger.stored = self.contacts.stored_energy();
+        self.tick += 1;
+    }
+}
