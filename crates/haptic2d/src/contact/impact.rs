@@ -307,8 +307,8 @@ impl ImpactSolver {
         };
 
         // 2. Poisson restitution P_i = (1 + e_i)·λ_i, applied as Δu = M⁻¹GᵀP.
-        for i in 0..n {
-            self.impulse[i] = (1.0 + rows[i].restitution) * self.lambda[i];
+        for (i, row) in rows.iter().enumerate() {
+            self.impulse[i] = (1.0 + row.restitution) * self.lambda[i];
             self.correction[i] = 0.0;
         }
         self.apply_impulses(rows, bodies, Buf::Impulse);

@@ -376,7 +376,7 @@ impl LcpSolver {
             self.w[i] = wi;
             // The |Δλ| rule detects stagnation, not optimality: on strongly coupled rows PGS can
             // creep by < 1e-9 N·s per sweep far from the solution. Check feasibility of w too.
-            if !(wi >= -W_TOL) {
+            if wi.is_nan() || wi < -W_TOL {
                 report.converged = false;
             }
         }
@@ -544,9 +544,7 @@ mod tests {
             assert!((w_enum[k] - w_pgs[k]).abs() < 1e-7, "w[{k}]");
         }
         // The body stops in x and rotation about the contact line (all three w are 0).
-        for k in 0..3 {
-            assert!(w_enum[k].abs() < 1e-12);
-        }
+        assert!(w_enum.iter().all(|w| w.abs() < 1e-12), "{w_enum:?}");
         assert!(u_enum[0].abs() < 1e-12 && u_enum[2].abs() < 1e-9);
     }
 
@@ -596,8 +594,8 @@ mod tests {
         // Enumeration on the same problem (n = 10 is still cheap) finds the same unique solution.
         let lp = s.lambda().to_vec();
         s.solve_enumeration(&a, &b).unwrap();
-        for i in 0..n {
-            assert!((lp[i] - s.lambda()[i]).abs() < 1e-8);
+        for (l, le) in lp.iter().zip(s.lambda()) {
+            assert!((l - le).abs() < 1e-8);
         }
     }
 
