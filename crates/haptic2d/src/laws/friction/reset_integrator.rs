@@ -117,10 +117,12 @@ impl ResetIntegrator {
             "mu_k" => self.mu_k = value,
             "beta" => self.beta = value,
             "p0" => self.p0_fixed = value,
-            _ => return Err(format!(
+            _ => {
+                return Err(format!(
                 "unknown parameter '{key}' for friction model 'reset-integrator'; valid keys: {}",
                 Self::KEYS.join(", ")
-            )),
+            ))
+            }
         }
         Ok(())
     }
