@@ -198,6 +198,7 @@ impl FrictionLaw for ResetIntegrator {
         }
     }
 
+    /// `½(1 + a)·Kr·p²` in stick, `½Kr·p²` in slip (J): the U_f of §13.2 F7-5.
     fn stored_energy(&self) -> f64 {
         let k = match self.mode {
             FrictionMode::Stick => (1.0 + self.a()) * self.k_used,
@@ -206,6 +207,7 @@ impl FrictionLaw for ResetIntegrator {
         0.5 * k * self.p * self.p
     }
 
+    /// The stick point `s − p` (§8.3).
     fn anchor(&self, s: f64) -> Option<f64> {
         Some(s - self.p)
     }
