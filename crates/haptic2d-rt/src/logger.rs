@@ -119,9 +119,11 @@ impl CsvLogger {
     pub fn finish(mut self) -> Result<LogReport, String> {
         self.stop.store(true, Ordering::Release);
         match self.thread.take() {
-            Some(t) => t
-                .join()
-                .map_err(|_| "the logger thread panicked".to_string())?,
+            Some(t) => {
+                t.thread().unpark();
+                t.join()
+                    .map_err(|_| "the logger thread panicked".to_string())?
+            }
             None => Err("the logger was already finished".into()),
         }
     }
@@ -133,6 +135,7 @@ impl Drop for CsvLogger {
     fn drop(&mut self) {
         self.stop.store(true, Ordering::Release);
         if let Some(t) = self.thread.take() {
+            t.thread().unpark();
             let _ = t.join();
         }
     }
@@ -174,7 +177,8 @@ fn logger_thread<T: CsvRecord, W: Write>(
         if stopping {
             break;
         }
-        std::thread::sleep(config.poll_interval);
+        // `finish` unparks the thread, so stopping does not wait for a full interval.
+        std::thread::park_timeout(config.poll_interval);
     }
     if let Err(e) = w.flush() {
         first_error.get_or_insert(format!("cannot flush the log {label}: {e}"));
