@@ -43,13 +43,16 @@ pub struct SnapshotRx<T: Copy + Send + 'static> {
     latest: triple_buffer::Output<T>,
 }
 
+/// The three ends of a telemetry channel: producer, ring consumer, snapshot consumer.
+pub type TelemetryEnds<T> = (TelemetryTx<T>, RecordRx<T>, SnapshotRx<T>);
+
 /// Creates a telemetry channel with a ring of `ring_capacity` records
 /// (≥ 1; e.g. 2 s of records at the loop rate) and a snapshot initialised to
 /// `initial`. Errors name the parameter.
 pub fn telemetry_channel<T: Copy + Send + 'static>(
     ring_capacity: usize,
     initial: T,
-) -> Result<(TelemetryTx<T>, RecordRx<T>, SnapshotRx<T>), String> {
+) -> Result<TelemetryEnds<T>, String> {
     if ring_capacity == 0 {
         return Err(
             "ring_capacity = 0: the telemetry ring needs room for at least one record".into(),
