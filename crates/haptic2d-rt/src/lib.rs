@@ -4,7 +4,8 @@
 //!
 //! - [`clock`]: absolute deadlines on `CLOCK_MONOTONIC`, sleep then spin;
 //! - [`rt`]: best-effort `SCHED_FIFO`, `mlockall`, core pinning;
-//! - [`runner`]: [`run_loop`] calls the haptic tick at every deadline;
+//! - [`runner`]: [`run_loop`] (or [`spawn_loop`] on its own thread) calls the
+//!   haptic tick at every deadline;
 //! - [`histogram`], [`stats`]: allocation-free timing statistics and the
 //!   [`TimingSummary`] printed at exit;
 //! - [`telemetry`]: wait-free ring (every record) and triple buffer (latest
@@ -29,7 +30,7 @@ pub mod watchdog;
 pub use io::{DeviceError, DeviceIo, ReplayDevice, ReplayEnd};
 pub use logger::{CsvLogger, CsvRecord, LogReport, LoggerConfig};
 pub use rt::{setup_realtime, CorePin, RtReport, RtRequest};
-pub use runner::{run_loop, LoopConfig, TickControl, TickInfo};
+pub use runner::{run_loop, spawn_loop, LoopConfig, TickControl, TickInfo};
 pub use stats::{Percentiles, TimingStats, TimingSummary};
 pub use telemetry::{telemetry_channel, RecordRx, SnapshotRx, TelemetryTx};
 pub use watchdog::{Fault, FaultKind, SafetyInput, Watchdog, WatchdogConfig};

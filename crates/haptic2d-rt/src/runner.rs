@@ -20,6 +20,8 @@ use crate::clock::{now_ns, period_ns_from_rate, set_timer_slack_ns, FixedRateClo
 use crate::rt::{setup_realtime, RtRequest};
 use crate::stats::{TimingStats, TimingSummary};
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::thread::JoinHandle;
 use std::time::Duration;
 
 /// Settings of [`run_loop`].
@@ -180,4 +182,21 @@ pub fn run_loop(
         stats.record_skipped(skipped);
     }
     Ok(stats.summary(rt_report))
+}
+
+/// Runs [`run_loop`] on a new thread named `haptic2d-rt` (the real-time
+/// setup, if asked for, then applies to that thread) and returns its handle.
+/// Join it to get the summary. Errors if the thread cannot be started.
+pub fn spawn_loop<F>(
+    config: LoopConfig,
+    stop: Arc<AtomicBool>,
+    tick: F,
+) -> Result<JoinHandle<Result<TimingSummary, String>>, String>
+where
+    F: FnMut(TickInfo) -> TickControl + Send + 'static,
+{
+    std::thread::Builder::new()
+        .name("haptic2d-rt".into())
+        .spawn(move || run_loop(&config, &stop, tick))
+        .map_err(|e| format!("cannot start the real-time loop thread: {e}"))
 }

@@ -4,7 +4,9 @@
 //! orderings and invariants that hold however loaded the machine is. The
 //! summaries are printed; run with `--nocapture` to see them.
 
-use haptic2d_rt::{run_loop, LoopConfig, RtRequest, TickControl, TickInfo, TimingSummary};
+use haptic2d_rt::{
+    run_loop, spawn_loop, LoopConfig, RtRequest, TickControl, TickInfo, TimingSummary,
+};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Duration;
@@ -206,4 +208,20 @@ fn real_time_request_degrades_gracefully_and_is_reported() {
     }
     assert!(s.to_string().contains("real-time:"));
     check_summary(&s, &infos);
+}
+
+#[test]
+fn spawned_loop_runs_on_its_own_thread_and_returns_the_summary() {
+    let stop = Arc::new(AtomicBool::new(false));
+    let config = LoopConfig {
+        duration: Some(Duration::from_millis(20)),
+        ..LoopConfig::default()
+    };
+    let handle = spawn_loop(config, stop, |_| {
+        assert_eq!(std::thread::current().name(), Some("haptic2d-rt"));
+        TickControl::Continue
+    })
+    .unwrap();
+    let s = handle.join().unwrap().unwrap();
+    assert_eq!(s.deadlines, 20);
 }
