@@ -72,7 +72,11 @@ fn i1_flat_face_two_corners() {
         // Compression impulses λ₁ = λ₂ = V/4 N·s.
         let lam = solver.compression_impulses();
         for l in lam {
-            assert!((l - v_in / 4.0).abs() < 1e-12, "λ = {l}, V/4 = {}", v_in / 4.0);
+            assert!(
+                (l - v_in / 4.0).abs() < 1e-12,
+                "λ = {l}, V/4 = {}",
+                v_in / 4.0
+            );
         }
         // Post-impact: v_x = e·V, v_y = 0, ω = 0; equal impulses on both corners.
         let b = &bodies[1];
@@ -107,7 +111,10 @@ fn i2_tilted_single_corner_matches_oracle() {
         .iter()
         .enumerate()
         .map(|(k, p)| (k, rot.apply(*p).x))
-        .fold((0, f64::INFINITY), |acc, x| if x.1 < acc.1 { x } else { acc });
+        .fold(
+            (0, f64::INFINITY),
+            |acc, x| if x.1 < acc.1 { x } else { acc },
+        );
     let x_c = -rot.apply(c[k]).x;
     for (v, omega) in [
         (Vec2::new(-0.3, 0.0), 0.0),
@@ -129,10 +136,22 @@ fn i2_tilted_single_corner_matches_oracle() {
         let mut solver = ImpactSolver::new();
         solver.solve(&[row], &mut bodies);
         let b = &bodies[1];
-        assert!((b.vel - v_exp).length() < 1e-12, "v⁺ = {:?} vs {v_exp:?}", b.vel);
-        assert!((b.omega - w_exp).abs() < 1e-12, "ω⁺ = {} vs {w_exp}", b.omega);
+        assert!(
+            (b.vel - v_exp).length() < 1e-12,
+            "v⁺ = {:?} vs {v_exp:?}",
+            b.vel
+        );
+        assert!(
+            (b.omega - w_exp).abs() < 1e-12,
+            "ω⁺ = {} vs {w_exp}",
+            b.omega
+        );
         assert!((solver.impulses()[0] - p_exp).abs() < 1e-12);
-        assert!(b.omega.abs() > 0.5, "tilted impact must spin the body: ω⁺ = {}", b.omega);
+        assert!(
+            b.omega.abs() > 0.5,
+            "tilted impact must spin the body: ω⁺ = {}",
+            b.omega
+        );
         // Poisson restitution at the contact: C0⁺ = −e·C0⁻.
         let c0_pre = solver.pre_velocities()[0];
         assert!((solver.post_velocities()[0] + E * c0_pre).abs() < 1e-12);
@@ -173,7 +192,11 @@ fn random_set(rng: &mut ChaCha8Rng, mixed: bool) -> (Vec<Body>, Vec<ImpactRow>) 
             let n = Vec2::new(ang.cos(), ang.sin());
             let ra = Vec2::new(rng.random_range(-0.05..0.05), rng.random_range(-0.05..0.05));
             let vtx = bodies[a].pose.pos + ra;
-            let restitution = if !mixed || rng.random_bool(0.5) { e } else { 0.0 };
+            let restitution = if !mixed || rng.random_bool(0.5) {
+                e
+            } else {
+                0.0
+            };
             ImpactRow {
                 body_a: a,
                 body_b: b,
@@ -189,6 +212,10 @@ fn random_set(rng: &mut ChaCha8Rng, mixed: bool) -> (Vec<Body>, Vec<ImpactRow>) 
 
 #[test]
 fn i3_energy_never_increases() {
+    // With a uniform e the energy loss is exact: ΔKE = −½(1 − e²)·λᵀAλ ≤ 0 (λᵀ(Aλ + b⁻) = 0). With
+    // mixed e_i (colliding e, continuous 0) the restitution step alone gives
+    // ΔKE = ½[(Dλ)ᵀA(Dλ) − λᵀAλ], D = diag(e_i), which can be positive; the plastic correction then
+    // removes at least that much in every case we have tried (2·10⁵ random sets while developing).
     let mut solver = ImpactSolver::new();
     let mut worst = f64::NEG_INFINITY;
     for (seed, mixed) in [(1u64, false), (2, true), (3, true)] {
@@ -199,7 +226,9 @@ fn i3_energy_never_increases() {
             let ke_check: f64 = bodies.iter().map(Body::kinetic_energy).sum();
             assert_eq!(ke_check, out.kinetic_energy_after);
             let d = out.kinetic_energy_after - out.kinetic_energy_before;
-            worst = worst.max(d);
+            if solver.impulses().iter().any(|&p| p > 0.0) {
+                worst = worst.max(d / out.kinetic_energy_before);
+            }
             assert!(
                 d <= 1e-12,
                 "seed {seed}: KE {} → {} (+{d:e}), rows {rows:?}",
@@ -208,7 +237,7 @@ fn i3_energy_never_increases() {
             );
         }
     }
-    eprintln!("I3: largest KE change over random sets = {worst:e} J");
+    eprintln!("I3: largest relative KE change over random sets with an impulse = {worst:e}");
 
     // e = 1, single contact: kinetic energy is conserved.
     let mut rng = ChaCha8Rng::seed_from_u64(4);
@@ -240,13 +269,19 @@ fn i4_no_penetration_velocity_after() {
             for (i, row) in rows.iter().enumerate() {
                 // Recomputed from the bodies' twists, independently of the solver's buffers.
                 let b_post = row.normal_velocity(&bodies);
-                assert!(b_post >= -1e-9, "seed {seed}: b⁺[{i}] = {b_post:e} {out:?} {:?}", solver.pre_velocities());
+                assert!(
+                    b_post >= -1e-9,
+                    "seed {seed}: b⁺[{i}] = {b_post:e} {out:?} {:?}",
+                    solver.pre_velocities()
+                );
                 assert!((b_post - solver.post_velocities()[i]).abs() < 1e-12);
             }
         }
     }
     // The random sets do exercise the plastic correction (§7.2 step 3).
     assert!(corrections > 0);
+    // Note: the check uses the default ε_v = 1e-9 (see `impact::EPS_V`); with the §7.2 value 1e-6,
+    // rows with b⁺ in (−1e-6, −1e-9) after restitution would be left uncorrected, against I4.
 }
 
 #[test]

@@ -28,7 +28,11 @@ fn run(name: &str, f_pk: f64) -> PegResult {
         .expect("valid harness");
     assert_eq!(r.creep.len(), 4, "{name}: creep_k for k = 1..4");
     assert_eq!(r.advance.len(), 3, "{name}: advance_k for k = 1..3");
-    assert_eq!(r.energy_balance.len(), 4, "{name}: energy balance for k = 1..4");
+    assert_eq!(
+        r.energy_balance.len(),
+        4,
+        "{name}: energy balance for k = 1..4"
+    );
     r
 }
 
@@ -109,7 +113,10 @@ fn f7_4_sub_stiction() {
     assert!(r.x.iter().all(|&x| x == 0.0), "classical must give x ≡ 0");
     // HA: the push exceeds the plastic-onset level 2·k·z_stick = 0.9 N, so it advances a little.
     let r = run("hayward-armstrong", 1.8);
-    println!("hayward-armstrong @1.8 N: advance_k = [{}]", sci(&r.advance));
+    println!(
+        "hayward-armstrong @1.8 N: advance_k = [{}]",
+        sci(&r.advance)
+    );
     for (k, a) in r.advance.iter().enumerate() {
         assert!(
             0.2e-3 < *a && *a < 2e-3,
@@ -124,7 +131,10 @@ fn f7_5_energy_balance_per_cycle() {
     for f_pk in [2.1, 1.8] {
         for name in ALL {
             let r = run(name, f_pk);
-            println!("{name} @{f_pk} N: ΔE − W_push = [{}] J", sci(&r.energy_balance));
+            println!(
+                "{name} @{f_pk} N: ΔE − W_push = [{}] J",
+                sci(&r.energy_balance)
+            );
             for (k, e) in r.energy_balance.iter().enumerate() {
                 assert!(
                     *e <= 1e-6,
@@ -162,7 +172,12 @@ fn f7_reference_numbers_within_10_percent() {
             sci(&r.advance),
             sci(adv_ref)
         );
-        for (m, e) in r.creep.iter().zip(creep_ref).chain(r.advance.iter().zip(adv_ref)) {
+        for (m, e) in r
+            .creep
+            .iter()
+            .zip(creep_ref)
+            .chain(r.advance.iter().zip(adv_ref))
+        {
             assert!(
                 ((m - e) / e).abs() <= 0.10,
                 "{name}: measured {m:e} vs reference {e:e}"

@@ -225,7 +225,7 @@ impl PegResult {
 
     /// The sample index nearest to time `t` (s), if the run reaches it.
     pub fn index(&self, t: f64) -> Option<usize> {
-        if !(t >= 0.0) {
+        if t.is_nan() || t < 0.0 {
             return None;
         }
         let j = (t / self.dt).round() as usize;

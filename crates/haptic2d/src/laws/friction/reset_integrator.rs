@@ -117,10 +117,12 @@ impl ResetIntegrator {
             "mu_k" => self.mu_k = value,
             "beta" => self.beta = value,
             "p0" => self.p0_fixed = value,
-            _ => return Err(format!(
+            _ => {
+                return Err(format!(
                 "unknown parameter '{key}' for friction model 'reset-integrator'; valid keys: {}",
                 Self::KEYS.join(", ")
-            )),
+            ))
+            }
         }
         Ok(())
     }
@@ -196,6 +198,7 @@ impl FrictionLaw for ResetIntegrator {
         }
     }
 
+    /// `½(1 + a)·Kr·p²` in stick, `½Kr·p²` in slip (J): the U_f of §13.2 F7-5.
     fn stored_energy(&self) -> f64 {
         let k = match self.mode {
             FrictionMode::Stick => (1.0 + self.a()) * self.k_used,
@@ -204,6 +207,7 @@ impl FrictionLaw for ResetIntegrator {
         0.5 * k * self.p * self.p
     }
 
+    /// The stick point `s − p` (§8.3).
     fn anchor(&self, s: f64) -> Option<f64> {
         Some(s - self.p)
     }

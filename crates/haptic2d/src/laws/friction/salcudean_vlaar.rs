@@ -106,10 +106,12 @@ impl SalcudeanVlaar {
             "v_th" => self.v_th = value,
             "mu_s" => self.mu_s = value,
             "mu_k" => self.mu_k = value,
-            _ => return Err(format!(
+            _ => {
+                return Err(format!(
                 "unknown parameter '{key}' for friction model 'salcudean-vlaar'; valid keys: {}",
                 Self::KEYS.join(", ")
-            )),
+            ))
+            }
         }
         Ok(())
     }

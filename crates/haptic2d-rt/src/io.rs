@@ -1,0 +1,201 @@
+//! Device I/O: the trait the haptic loop drives, and a replay device.
+//!
+//! A device gives four motor angles (the twin pantograph's encoders, radians,
+//! after the reduction: joint angles `q11, q12, q21, q22` of MODELS §10.3) and
+//! takes four joint torques (N·m). Real drivers, the simulated device and the
+//! [`ReplayDevice`] all implement [`DeviceIo`].
+
+use std::fmt;
+use std::path::Path;
+
+/// A device I/O failure.
+#[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum DeviceError {
+    /// The device stopped answering (unplugged, powered off, timed out).
+    Lost(String),
+    /// A read or write failed (text: the cause).
+    Io(String),
+    /// A replay or recording has no more samples.
+    EndOfData,
+}
+
+impl fmt::Display for DeviceError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            DeviceError::Lost(s) => write!(f, "device lost: {s}"),
+            DeviceError::Io(s) => write!(f, "device I/O error: {s}"),
+            DeviceError::EndOfData => write!(f, "end of the recorded data"),
+        }
+    }
+}
+
+impl std::error::Error for DeviceError {}
+
+/// The device interface of the haptic loop. Every method is called from the
+/// real-time thread, once per tick at most, and must not block longer than
+/// the device's own transfer time.
+pub trait DeviceIo {
+    /// Reads the four joint angles `[q11, q12, q21, q22]`, radians.
+    fn read_encoders(&mut self) -> Result<[f64; 4], DeviceError>;
+
+    /// Commands the four joint torques `[τ11, τ12, τ21, τ22]`, N·m (already
+    /// saturated by the caller).
+    fn write_torques(&mut self, tau: &[f64; 4]) -> Result<(), DeviceError>;
+
+    /// Commands zero torque on every motor. Must not fail (best effort on a
+    /// lost device); called by the watchdog path and on shutdown.
+    fn zero_torques(&mut self);
+
+    /// A short human-readable name, e.g. "sim", "replay:run.csv".
+    fn name(&self) -> &str;
+}
+
+/// What a [`ReplayDevice`] does after its last sample.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ReplayEnd {
+    /// Return [`DeviceError::EndOfData`] (the loop can stop). Default.
+    #[default]
+    Error,
+    /// Keep returning the last sample.
+    Hold,
+    /// Start again from the first sample.
+    Loop,
+}
+
+/// The default encoder columns of a replay CSV.
+pub const DEFAULT_REPLAY_COLUMNS: [&str; 4] = ["q1", "q2", "q3", "q4"];
+
+/// A device that plays back recorded joint angles and discards torques.
+///
+/// The whole file is read at construction, so reading a sample on the RT
+/// thread is an array index. Each [`read_encoders`](DeviceIo::read_encoders)
+/// returns the next row.
+#[derive(Debug, Clone)]
+pub struct ReplayDevice {
+    name: String,
+    samples: Vec<[f64; 4]>,
+    next: usize,
+    end: ReplayEnd,
+    last_torques: [f64; 4],
+}
+
+impl ReplayDevice {
+    /// Loads `path`, taking the four joint angles (radians) from the columns
+    /// named `columns` (e.g. [`DEFAULT_REPLAY_COLUMNS`]); other columns are
+    /// ignored. Errors name the file, the column or the row.
+    pub fn from_path(path: &Path, columns: [&str; 4], end: ReplayEnd) -> Result<Self, String> {
+        let file = std::fs::File::open(path)
+            .map_err(|e| format!("cannot open the replay file {}: {e}", path.display()))?;
+        Self::from_reader(file, &path.display().to_string(), columns, end)
+    }
+
+    /// Like [`from_path`](Self::from_path), from any reader; `label` names the
+    /// source in error messages.
+    pub fn from_reader<R: std::io::Read>(
+        reader: R,
+        label: &str,
+        columns: [&str; 4],
+        end: ReplayEnd,
+    ) -> Result<Self, String> {
+        let mut rdr = csv::ReaderBuilder::new()
+            .trim(csv::Trim::All)
+            .from_reader(reader);
+        let header = rdr
+            .headers()
+            .map_err(|e| format!("{label}: cannot read the CSV header: {e}"))?
+            .clone();
+        let mut idx = [0usize; 4];
+        for (k, col) in columns.iter().enumerate() {
+            idx[k] = header.iter().position(|h| h == *col).ok_or_else(|| {
+                format!(
+                    "{label}: no column named `{col}` (columns found: {}); choose the encoder columns with the replay column option",
+                    header.iter().collect::<Vec<_>>().join(", ")
+                )
+            })?;
+        }
+        let mut samples = Vec::new();
+        for (row, rec) in rdr.records().enumerate() {
+            // Row numbers as a person counts them in the file: header is line 1.
+            let line = row + 2;
+            let rec = rec.map_err(|e| format!("{label}: line {line}: {e}"))?;
+            let mut q = [0.0; 4];
+            for k in 0..4 {
+                let field = rec.get(idx[k]).unwrap_or("");
+                q[k] = field.parse::<f64>().ok().filter(|v| v.is_finite()).ok_or_else(|| {
+                    format!(
+                        "{label}: line {line}, column `{}`: `{field}` is not a finite number (radians)",
+                        columns[k]
+                    )
+                })?;
+            }
+            samples.push(q);
+        }
+        Self::from_samples(samples, end).map(|mut d| {
+            d.name = format!("replay:{label}");
+            d
+        })
+    }
+
+    /// A replay of in-memory samples (radians). Errors if `samples` is empty.
+    pub fn from_samples(samples: Vec<[f64; 4]>, end: ReplayEnd) -> Result<Self, String> {
+        if samples.is_empty() {
+            return Err("the replay has no samples: it needs at least one data row".into());
+        }
+        Ok(Self {
+            name: "replay".into(),
+            samples,
+            next: 0,
+            end,
+            last_torques: [0.0; 4],
+        })
+    }
+
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.samples.len()
+    }
+
+    /// Always false: a replay has at least one sample.
+    pub fn is_empty(&self) -> bool {
+        self.samples.is_empty()
+    }
+
+    /// All samples, radians.
+    pub fn samples(&self) -> &[[f64; 4]] {
+        &self.samples
+    }
+
+    /// The torques last written (N·m), for inspection; they act on nothing.
+    pub fn last_torques(&self) -> [f64; 4] {
+        self.last_torques
+    }
+}
+
+impl DeviceIo for ReplayDevice {
+    fn read_encoders(&mut self) -> Result<[f64; 4], DeviceError> {
+        if self.next >= self.samples.len() {
+            match self.end {
+                ReplayEnd::Error => return Err(DeviceError::EndOfData),
+                ReplayEnd::Hold => return Ok(self.samples[self.samples.len() - 1]),
+                ReplayEnd::Loop => self.next = 0,
+            }
+        }
+        let q = self.samples[self.next];
+        self.next += 1;
+        Ok(q)
+    }
+
+    fn write_torques(&mut self, tau: &[f64; 4]) -> Result<(), DeviceError> {
+        self.last_torques = *tau;
+        Ok(())
+    }
+
+    fn zero_torques(&mut self) {
+        self.last_torques = [0.0; 4];
+    }
+
+    fn name(&self) -> &str {
+        &self.name
+    }
+}

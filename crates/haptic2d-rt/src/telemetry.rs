@@ -1,0 +1,196 @@
+//! Wait-free transport of telemetry records from the real-time thread.
+//!
+//! One producer, [`TelemetryTx`], lives on the RT thread. Each record goes to
+//! two places:
+//!
+//! - a bounded single-producer/single-consumer ring (`rtrb`) for a consumer
+//!   that must see **every** record (the CSV logger). When the ring is full the
+//!   record is dropped and counted — the RT thread never blocks or allocates;
+//! - a triple buffer (`triple_buffer`) holding the **latest** record for a
+//!   consumer that only wants the current state (the display), at its own pace.
+//!
+//! Both are allocated once, by [`telemetry_channel`]. Records are `Copy`, so
+//! pushing is a memory copy plus a few atomic operations.
+
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
+
+/// Counters shared by the producer and the consumers.
+#[derive(Debug, Default)]
+struct Counters {
+    /// Records offered to the ring.
+    offered: AtomicU64,
+    /// Records dropped because the ring was full.
+    dropped: AtomicU64,
+}
+
+/// The RT-side end: publishes records to the ring and to the latest snapshot.
+pub struct TelemetryTx<T: Copy + Send + 'static> {
+    ring: rtrb::Producer<T>,
+    latest: triple_buffer::Input<T>,
+    counters: Arc<Counters>,
+}
+
+/// The ring's consumer end, for a thread that needs every record (the logger).
+pub struct RecordRx<T: Copy + Send + 'static> {
+    ring: rtrb::Consumer<T>,
+    counters: Arc<Counters>,
+}
+
+/// The latest-snapshot consumer end, for a thread that needs only the current
+/// record (the display).
+pub struct SnapshotRx<T: Copy + Send + 'static> {
+    latest: triple_buffer::Output<T>,
+}
+
+/// The three ends of a telemetry channel: producer, ring consumer, snapshot consumer.
+pub type TelemetryEnds<T> = (TelemetryTx<T>, RecordRx<T>, SnapshotRx<T>);
+
+/// Creates a telemetry channel with a ring of `ring_capacity` records
+/// (≥ 1; e.g. 2 s of records at the loop rate) and a snapshot initialised to
+/// `initial`. Errors name the parameter.
+pub fn telemetry_channel<T: Copy + Send + 'static>(
+    ring_capacity: usize,
+    initial: T,
+) -> Result<TelemetryEnds<T>, String> {
+    if ring_capacity == 0 {
+        return Err(
+            "ring_capacity = 0: the telemetry ring needs room for at least one record".into(),
+        );
+    }
+    if ring_capacity > usize::MAX / 2 {
+        return Err(format!("ring_capacity = {ring_capacity} is too large"));
+    }
+    let (producer, consumer) = rtrb::RingBuffer::new(ring_capacity);
+    let (input, output) = triple_buffer::triple_buffer(&initial);
+    let counters = Arc::new(Counters::default());
+    Ok((
+        TelemetryTx {
+            ring: producer,
+            latest: input,
+            counters: counters.clone(),
+        },
+        RecordRx {
+            ring: consumer,
+            counters,
+        },
+        SnapshotRx { latest: output },
+    ))
+}
+
+impl<T: Copy + Send + 'static> TelemetryTx<T> {
+    /// Publishes `record` to both the ring and the snapshot. Wait-free; never
+    /// allocates. Returns `false` if the ring was full and the record was
+    /// dropped from it (the snapshot is updated regardless).
+    #[inline]
+    pub fn publish(&mut self, record: T) -> bool {
+        self.latest.write(record);
+        self.push(record)
+    }
+
+    /// Pushes `record` to the ring only; returns `false` (and counts a drop)
+    /// when the ring is full. Wait-free.
+    #[inline]
+    pub fn push(&mut self, record: T) -> bool {
+        self.counters.offered.fetch_add(1, Ordering::Relaxed);
+        if self.ring.push(record).is_ok() {
+            true
+        } else {
+            self.counters.dropped.fetch_add(1, Ordering::Relaxed);
+            false
+        }
+    }
+
+    /// Updates the latest snapshot only. Wait-free.
+    #[inline]
+    pub fn set_latest(&mut self, record: T) {
+        self.latest.write(record);
+    }
+
+    /// Records offered to the ring so far.
+    pub fn offered(&self) -> u64 {
+        self.counters.offered.load(Ordering::Relaxed)
+    }
+
+    /// Records dropped from the ring so far because it was full.
+    pub fn dropped(&self) -> u64 {
+        self.counters.dropped.load(Ordering::Relaxed)
+    }
+}
+
+impl<T: Copy + Send + 'static> RecordRx<T> {
+    /// Takes the oldest record, if any.
+    #[inline]
+    pub fn pop(&mut self) -> Option<T> {
+        self.ring.pop().ok()
+    }
+
+    /// Number of records waiting in the ring.
+    pub fn len(&self) -> usize {
+        self.ring.slots()
+    }
+
+    /// True when no record is waiting.
+    pub fn is_empty(&self) -> bool {
+        self.ring.is_empty()
+    }
+
+    /// True once the producer ([`TelemetryTx`]) has been dropped: after the
+    /// ring is empty, no more records will come.
+    pub fn is_producer_gone(&self) -> bool {
+        self.ring.is_abandoned()
+    }
+
+    /// Records offered by the producer so far.
+    pub fn offered(&self) -> u64 {
+        self.counters.offered.load(Ordering::Acquire)
+    }
+
+    /// Records the producer dropped so far because the ring was full.
+    pub fn dropped(&self) -> u64 {
+        self.counters.dropped.load(Ordering::Acquire)
+    }
+}
+
+impl<T: Copy + Send + 'static> SnapshotRx<T> {
+    /// The most recent record published (or the initial one).
+    pub fn latest(&mut self) -> T {
+        *self.latest.read()
+    }
+
+    /// True if a record was published since the last [`latest`](Self::latest).
+    pub fn has_new(&self) -> bool {
+        self.latest.updated()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn full_ring_drops_and_counts_without_blocking() {
+        let (mut tx, mut rx, mut snap) = telemetry_channel(4, 0u32).unwrap();
+        for i in 1..=10u32 {
+            tx.publish(i);
+        }
+        assert_eq!(tx.offered(), 10);
+        assert_eq!(tx.dropped(), 6);
+        let got: Vec<u32> = std::iter::from_fn(|| rx.pop()).collect();
+        assert_eq!(got, vec![1, 2, 3, 4]);
+        assert_eq!(snap.latest(), 10);
+        assert!(!snap.has_new());
+        assert!(!rx.is_producer_gone());
+        drop(tx);
+        assert!(rx.is_producer_gone());
+        assert_eq!(rx.offered() - rx.dropped(), 4);
+    }
+
+    #[test]
+    fn zero_capacity_is_an_error_naming_the_parameter() {
+        assert!(telemetry_channel(0, 0u8)
+            .err()
+            .unwrap()
+            .contains("ring_capacity"));
+    }
+}
