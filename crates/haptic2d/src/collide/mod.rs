@@ -16,8 +16,7 @@ pub use gjk::{
 };
 pub use local::{LocalStage, PairState, DEFAULT_DELTA_C, DEFAULT_EPS_S, NEAR_PARALLEL_ANGLE};
 pub use tracker::{
-    ClosestFeatures, Feature, FeatureTracker, TrackStatus, TrackerStats, PARALLEL_TOL,
-    VORONOI_TOL,
+    ClosestFeatures, Feature, FeatureTracker, TrackStatus, TrackerStats, PARALLEL_TOL, VORONOI_TOL,
 };
 
 /// A vertex–edge candidate produced by the local stage (§9.5): vertex `vertex` of collider
