@@ -151,7 +151,8 @@ impl LocalStage {
         out.clear();
         self.states.clear();
         for (k, &(ia, ib)) in pairs.iter().enumerate() {
-            let (Some(a), Some(b)) = (colliders.get(ia as usize), colliders.get(ib as usize)) else {
+            let (Some(a), Some(b)) = (colliders.get(ia as usize), colliders.get(ib as usize))
+            else {
                 continue;
             };
             // Closest features (§9.3).
@@ -166,13 +167,14 @@ impl LocalStage {
                 eps_s: self.eps_s,
                 cos_parallel: self.cos_parallel,
             };
+            let (a, b) = (Side { id: ia, c: a }, Side { id: ib, c: b });
             match f.status {
                 TrackStatus::Penetrating => {
-                    ctx.vertices_against(ia, a, ib, b, out);
-                    ctx.vertices_against(ib, b, ia, a, out);
+                    ctx.vertices_against(a, b, out);
+                    ctx.vertices_against(b, a, out);
                 }
                 TrackStatus::Separated if f.distance <= delta_c => {
-                    ctx.from_closest_features(ia, a, ib, b, &f, out);
+                    ctx.closest_feature_candidates(a, b, &f, out);
                 }
                 TrackStatus::Separated => {}
             }
@@ -189,6 +191,13 @@ struct Ctx {
     cos_parallel: f64,
 }
 
+/// One polygon of a pair: its collider index and its collider.
+#[derive(Clone, Copy)]
+struct Side<'a> {
+    id: u32,
+    c: &'a Collider,
+}
+
 /// The (up to two) edges incident to a feature: the edge itself, or a vertex's outgoing and
 /// incoming edges.
 fn incident_edges(c: &Collider, f: Feature) -> [Option<usize>; 2] {
@@ -199,67 +208,63 @@ fn incident_edges(c: &Collider, f: Feature) -> [Option<usize>; 2] {
 }
 
 impl Ctx {
-    /// Pushes `(vertex v of collider cv, edge e of collider ce)` if `s` is in the edge range and
-    /// `d ≤ δ_c`. Returns whether it was pushed.
+    /// Pushes `(vertex v of pv, edge e of pe)` if `s` is in the edge range and `d ≤ δ_c`. Returns
+    /// whether it was pushed.
     fn push_if_valid(
         &self,
-        icv: u32,
-        cv: &Collider,
+        pv: Side,
         v: usize,
-        ice: u32,
-        ce: &Collider,
+        pe: Side,
         e: usize,
         out: &mut Vec<VeCandidate>,
     ) -> bool {
-        let p = cv.world_vertices[v];
-        let s = ce.edge_coordinate(e, p);
-        let l = ce.local.lengths()[e];
-        if s < -self.eps_s || s > l + self.eps_s || ce.edge_distance(e, p) > self.delta_c {
+        let p = pv.c.world_vertices[v];
+        let s = pe.c.edge_coordinate(e, p);
+        let l = pe.c.local.lengths()[e];
+        if s < -self.eps_s || s > l + self.eps_s || pe.c.edge_distance(e, p) > self.delta_c {
             return false;
         }
         out.push(VeCandidate {
-            vertex_collider: icv,
+            vertex_collider: pv.id,
             vertex: v as u32,
-            edge_collider: ice,
+            edge_collider: pe.id,
             edge: e as u32,
         });
         true
     }
 
     /// Separated pair with distance ≤ δ_c: candidates from the closest features (§9.5).
-    fn from_closest_features(
+    fn closest_feature_candidates(
         &self,
-        ia: u32,
-        a: &Collider,
-        ib: u32,
-        b: &Collider,
+        a: Side,
+        b: Side,
         f: &ClosestFeatures,
         out: &mut Vec<VeCandidate>,
     ) {
         // Near-parallel faces: one edge pair whose overlap ends are both within δ_c.
-        for ea in incident_edges(a, f.feature_a).into_iter().flatten() {
-            for eb in incident_edges(b, f.feature_b).into_iter().flatten() {
-                if self.edge_edge(ia, a, ea, ib, b, eb, true, out) {
+        for ea in incident_edges(a.c, f.feature_a).into_iter().flatten() {
+            for eb in incident_edges(b.c, f.feature_b).into_iter().flatten() {
+                if self.edge_edge(a, ea, b, eb, true, out) {
                     return;
                 }
             }
         }
         match (f.feature_a, f.feature_b) {
             (Feature::Vertex(i), Feature::Edge(j)) => {
-                self.push_if_valid(ia, a, i as usize, ib, b, j as usize, out);
+                self.push_if_valid(a, i as usize, b, j as usize, out);
             }
             (Feature::Edge(i), Feature::Vertex(j)) => {
-                self.push_if_valid(ib, b, j as usize, ia, a, i as usize, out);
+                self.push_if_valid(b, j as usize, a, i as usize, out);
             }
             (Feature::Vertex(i), Feature::Vertex(j)) => {
                 let (i, j) = (i as usize, j as usize);
-                let eb = most_aligned_edge(b, j, a.world_vertices[i]);
-                self.push_if_valid(ia, a, i, ib, b, eb, out);
-                let ea = most_aligned_edge(a, i, b.world_vertices[j]);
-                self.push_if_valid(ib, b, j, ia, a, ea, out);
+                let eb = most_aligned_edge(b.c, j, a.c.world_vertices[i]);
+                self.push_if_valid(a, i, b, eb, out);
+                let ea = most_aligned_edge(a.c, i, b.c.world_vertices[j]);
+                self.push_if_valid(b, j, a, ea, out);
             }
             (Feature::Edge(i), Feature::Edge(j)) => {
-                self.edge_edge(ia, a, i as usize, ib, b, j as usize, false, out);
+                self.edge_edge(a, i as usize, b, j as usize, false, out);
             }
         }
     }
@@ -272,45 +277,50 @@ impl Ctx {
     /// vertex. With `strict`, the edges must be antiparallel within the near-parallel angle, the
     /// overlap longer than `ε_s` and both ends valid candidates, or nothing is pushed; otherwise
     /// each valid end is pushed. Returns whether two candidates were pushed.
-    #[allow(clippy::too_many_arguments)]
     fn edge_edge(
         &self,
-        ia: u32,
-        a: &Collider,
+        a: Side,
         ea: usize,
-        ib: u32,
-        b: &Collider,
+        b: Side,
         eb: usize,
         strict: bool,
         out: &mut Vec<VeCandidate>,
     ) -> bool {
-        if strict && a.world_tangents[ea].dot(b.world_tangents[eb]) > -self.cos_parallel {
+        if strict && a.c.world_tangents[ea].dot(b.c.world_tangents[eb]) > -self.cos_parallel {
             return false;
         }
-        let ea1 = a.local.next(ea);
-        let eb1 = b.local.next(eb);
-        let s0 = b.edge_coordinate(eb, a.world_vertices[ea]);
-        let s1 = b.edge_coordinate(eb, a.world_vertices[ea1]);
+        let ea1 = a.c.local.next(ea);
+        let eb1 = b.c.local.next(eb);
+        let s0 = b.c.edge_coordinate(eb, a.c.world_vertices[ea]);
+        let s1 = b.c.edge_coordinate(eb, a.c.world_vertices[ea1]);
         let ((v_lo, s_lo), (v_hi, s_hi)) = if s0 <= s1 {
             ((ea, s0), (ea1, s1))
         } else {
             ((ea1, s1), (ea, s0))
         };
-        let lb = b.local.lengths()[eb];
+        let lb = b.c.local.lengths()[eb];
         let overlap = s_hi.min(lb) - s_lo.max(0.0);
         if overlap < 0.0 || (strict && overlap <= self.eps_s) {
             return false;
         }
-        // Each end as (vertex collider side, vertex, edge): true = A's vertex on E_B.
-        let lo = if s_lo >= 0.0 { (true, v_lo) } else { (false, eb) };
-        let hi = if s_hi <= lb { (true, v_hi) } else { (false, eb1) };
+        // Each end: (true, vertex of A on E_B) or (false, vertex of B on E_A).
+        let lo = if s_lo >= 0.0 {
+            (true, v_lo)
+        } else {
+            (false, eb)
+        };
+        let hi = if s_hi <= lb {
+            (true, v_hi)
+        } else {
+            (false, eb1)
+        };
         let mark = out.len();
         let mut pushed = 0;
-        for (on_b, v) in [lo, hi] {
-            let ok = if on_b {
-                self.push_if_valid(ia, a, v, ib, b, eb, out)
+        for (a_vertex, v) in [lo, hi] {
+            let ok = if a_vertex {
+                self.push_if_valid(a, v, b, eb, out)
             } else {
-                self.push_if_valid(ib, b, v, ia, a, ea, out)
+                self.push_if_valid(b, v, a, ea, out)
             };
             pushed += ok as usize;
         }
@@ -323,34 +333,27 @@ impl Ctx {
 
     /// Penetrating pair (§9.4): every vertex of `a` inside `b` or within `δ_c` of it, against the
     /// edge of `b` of least depth among those whose range contains it.
-    fn vertices_against(
-        &self,
-        ia: u32,
-        a: &Collider,
-        ib: u32,
-        b: &Collider,
-        out: &mut Vec<VeCandidate>,
-    ) {
-        'vertex: for v in 0..a.len() {
-            let p = a.world_vertices[v];
+    fn vertices_against(&self, a: Side, b: Side, out: &mut Vec<VeCandidate>) {
+        'vertex: for v in 0..a.c.len() {
+            let p = a.c.world_vertices[v];
             let mut best: Option<(usize, f64)> = None;
-            for e in 0..b.len() {
-                let d = b.edge_distance(e, p);
+            for e in 0..b.c.len() {
+                let d = b.c.edge_distance(e, p);
                 if d > self.delta_c {
                     // Farther than δ_c from B's half-plane, so from B.
                     continue 'vertex;
                 }
-                let s = b.edge_coordinate(e, p);
-                let in_range = s >= -self.eps_s && s <= b.local.lengths()[e] + self.eps_s;
+                let s = b.c.edge_coordinate(e, p);
+                let in_range = s >= -self.eps_s && s <= b.c.local.lengths()[e] + self.eps_s;
                 if in_range && best.is_none_or(|(_, bd)| d > bd) {
                     best = Some((e, d));
                 }
             }
             if let Some((e, _)) = best {
                 out.push(VeCandidate {
-                    vertex_collider: ia,
+                    vertex_collider: a.id,
                     vertex: v as u32,
-                    edge_collider: ib,
+                    edge_collider: b.id,
                     edge: e as u32,
                 });
             }

@@ -1,6 +1,18 @@
 //! Two-level collision detection (§9): a global proximity stage every `N_g` ticks (AABBs with
 //! sort-and-sweep, then GJK distance) and a local stage every tick for proximate pairs
 //! (closest-feature tracking, signed distances, VE candidates).
+//!
+//! - [`gjk_distance`] (`gjk.rs`): GJK distance with hill-climbing support and warm start (§9.2);
+//! - [`BroadPhase`] (`broad.rs`): inflated AABBs, sort-and-sweep, GJK → proximity set (§9.1);
+//! - [`FeatureTracker`] (`tracker.rs`): Lin–Canny closest features per pair (§9.3);
+//! - [`LocalStage`] (`local.rs`): one tracker per proximate pair, VE candidates (§9.4–9.5).
+//!
+//! Per tick (§0.5 steps 3–4), after [`Collider::update`] for every collider:
+//!
+//! ```text
+//! if k % N_g == 0 { broad.update(&colliders, &mut pairs) }           // proximity set
+//! local.update(&colliders, &pairs, DEFAULT_DELTA_C, &mut candidates) // sorted VE candidates
+//! ```
 
 mod broad;
 mod collider;
@@ -16,8 +28,7 @@ pub use gjk::{
 };
 pub use local::{LocalStage, PairState, DEFAULT_DELTA_C, DEFAULT_EPS_S, NEAR_PARALLEL_ANGLE};
 pub use tracker::{
-    ClosestFeatures, Feature, FeatureTracker, TrackStatus, TrackerStats, PARALLEL_TOL,
-    VORONOI_TOL,
+    ClosestFeatures, Feature, FeatureTracker, TrackStatus, TrackerStats, PARALLEL_TOL, VORONOI_TOL,
 };
 
 /// A vertex–edge candidate produced by the local stage (§9.5): vertex `vertex` of collider

@@ -41,7 +41,11 @@
 //! [`TrackStatus::Penetrating`] (the local stage then works with vertex signed distances, §9.4).
 //! Otherwise `p_B` is in front of another edge of A and the walk jumps to the edge with the largest
 //! signed distance (O(n), rare). If the walk has not settled after `2·(n_A + n_B)` iterations it
-//! falls back to GJK (warm-started), which always gives the right answer.
+//! falls back to GJK (warm-started), which always gives the right answer; overlapping polygons
+//! have no closest features, so that is how an overlap is found when no interior test fires.
+//! While a pair stays penetrating, each update starts with the warm-started GJK instead (its
+//! triangle simplex re-confirms the overlap in O(1)), and the walk resumes from GJK's features as
+//! soon as the pair separates.
 
 use super::gjk::{gjk_distance, GjkCache, GjkOutput};
 use super::Collider;
@@ -102,8 +106,9 @@ pub struct TrackerStats {
     pub updates: u64,
     /// Total feature-walk iterations.
     pub iterations: u64,
-    /// Number of GJK initialisations (first update or after `reset`).
-    pub gjk_inits: u64,
+    /// Number of updates that started with GJK (first update, after `reset`, or while the pair was
+    /// penetrating at the previous update).
+    pub gjk_starts: u64,
     /// Number of GJK fallbacks after a walk that did not settle.
     pub gjk_fallbacks: u64,
 }
@@ -113,6 +118,7 @@ pub struct TrackerStats {
 pub struct FeatureTracker {
     feature_a: Option<Feature>,
     feature_b: Option<Feature>,
+    penetrating: bool,
     gjk: GjkCache,
     /// Work counters.
     pub stats: TrackerStats,
@@ -165,9 +171,11 @@ fn feature_valid(c: &Collider, f: Feature) -> bool {
 /// Closest points of two features, or the reduction of a non-parallel edge–edge pair.
 fn closest_points(a: &Collider, fa: Feature, b: &Collider, fb: Feature) -> Step {
     match (fa, fb) {
-        (Feature::Vertex(i), Feature::Vertex(j)) => {
-            Step::Points(a.world_vertices[i as usize], b.world_vertices[j as usize], false)
-        }
+        (Feature::Vertex(i), Feature::Vertex(j)) => Step::Points(
+            a.world_vertices[i as usize],
+            b.world_vertices[j as usize],
+            false,
+        ),
         (Feature::Vertex(i), Feature::Edge(j)) => {
             let pa = a.world_vertices[i as usize];
             Step::Points(pa, project_on_edge(b, j as usize, pa), false)
@@ -318,6 +326,7 @@ impl FeatureTracker {
     pub fn reset(&mut self) {
         self.feature_a = None;
         self.feature_b = None;
+        self.penetrating = false;
         self.gjk.reset();
     }
 
@@ -332,13 +341,14 @@ impl FeatureTracker {
     }
 
     /// Runs GJK (warm-started) and takes the features spanned by its simplex.
-    fn from_gjk(&mut self, a: &Collider, b: &Collider, iterations: u32) -> ClosestFeatures {
+    fn start_from_gjk(&mut self, a: &Collider, b: &Collider, iterations: u32) -> ClosestFeatures {
         let g: GjkOutput = gjk_distance(&a.world_vertices, &b.world_vertices, &mut self.gjk);
         let n = g.simplex_count.max(1);
         let fa = feature_from_simplex(a, &g.index_a[..n], &g.weights[..n]);
         let fb = feature_from_simplex(b, &g.index_b[..n], &g.weights[..n]);
         self.feature_a = Some(fa);
         self.feature_b = Some(fb);
+        self.penetrating = g.overlap;
         ClosestFeatures {
             status: if g.overlap {
                 TrackStatus::Penetrating
@@ -350,8 +360,7 @@ impl FeatureTracker {
             point_a: g.point_a,
             point_b: g.point_b,
             distance: g.distance,
-            parallel: !g.overlap
-                && matches!((fa, fb), (Feature::Edge(_), Feature::Edge(_))),
+            parallel: !g.overlap && matches!((fa, fb), (Feature::Edge(_), Feature::Edge(_))),
             iterations,
             used_gjk: true,
         }
@@ -361,12 +370,17 @@ impl FeatureTracker {
     /// O(1) iterations under coherent motion; no allocation.
     pub fn update(&mut self, a: &Collider, b: &Collider) -> ClosestFeatures {
         self.stats.updates += 1;
-        let (mut fa, mut fb) = match (self.feature_a, self.feature_b) {
-            (Some(fa), Some(fb)) if feature_valid(a, fa) && feature_valid(b, fb) => (fa, fb),
+        let cached = match (self.feature_a, self.feature_b) {
+            (Some(fa), Some(fb)) if feature_valid(a, fa) && feature_valid(b, fb) => Some((fa, fb)),
+            _ => None,
+        };
+        let (mut fa, mut fb) = match cached {
+            Some(f) if !self.penetrating => f,
             _ => {
-                // First time: initialise from GJK's simplex; a penetrating start is reported as such.
-                self.stats.gjk_inits += 1;
-                let r = self.from_gjk(a, b, 0);
+                // First time, or still overlapping at the last update: a warm-started GJK decides
+                // (O(1) under coherence); if apart, the walk starts from its simplex features.
+                self.stats.gjk_starts += 1;
+                let r = self.start_from_gjk(a, b, 0);
                 if r.status == TrackStatus::Penetrating {
                     return r;
                 }
@@ -423,6 +437,7 @@ impl FeatureTracker {
             }
             self.feature_a = Some(fa);
             self.feature_b = Some(fb);
+            self.penetrating = false;
             self.stats.iterations += it as u64;
             return ClosestFeatures {
                 status: TrackStatus::Separated,
@@ -439,7 +454,7 @@ impl FeatureTracker {
         // The walk did not settle (degenerate geometry or overlap without a certificate): GJK decides.
         self.stats.iterations += it as u64;
         self.stats.gjk_fallbacks += 1;
-        self.from_gjk(a, b, it)
+        self.start_from_gjk(a, b, it)
     }
 
     fn finish_penetrating(
@@ -452,6 +467,7 @@ impl FeatureTracker {
     ) -> ClosestFeatures {
         self.feature_a = Some(fa);
         self.feature_b = Some(fb);
+        self.penetrating = true;
         self.stats.iterations += it as u64;
         ClosestFeatures {
             status: TrackStatus::Penetrating,
