@@ -4,7 +4,9 @@ use haptic2d::scene::BUILTIN;
 
 /// Prints the built-in scenes with their descriptions.
 pub fn run() -> Result<(), String> {
-    println!("Built-in scenes (use the name wherever a SCENE is expected; `pile:N` gives N boxes):");
+    println!(
+        "Built-in scenes (use the name wherever a SCENE is expected; `pile:N` gives N boxes):"
+    );
     for (name, desc, _) in BUILTIN {
         println!("  {name:<20} {desc}");
     }

@@ -9,9 +9,17 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 /// Runs `scene` for `duration` s, writing every `every`-th sample to `out`.
-pub fn run(scene: &str, duration: f64, out: Option<&Path>, rate: Option<f64>, every: u64) -> Result<(), String> {
+pub fn run(
+    scene: &str,
+    duration: f64,
+    out: Option<&Path>,
+    rate: Option<f64>,
+    every: u64,
+) -> Result<(), String> {
     if !(duration.is_finite() && duration > 0.0) {
-        return Err(format!("--duration must be a positive number of seconds, got {duration}"));
+        return Err(format!(
+            "--duration must be a positive number of seconds, got {duration}"
+        ));
     }
     if every == 0 {
         return Err("--every must be at least 1".into());
@@ -50,11 +58,12 @@ pub fn run(scene: &str, duration: f64, out: Option<&Path>, rate: Option<f64>, ev
         let e = world.ledger();
         max_excess = max_excess.max(e.excess());
         if k % 256 == 0 {
-            if let Some(b) = world
-                .bodies
-                .iter()
-                .find(|b| !(b.pose.pos.is_finite() && b.pose.angle.is_finite() && b.vel.is_finite() && b.omega.is_finite()))
-            {
+            if let Some(b) = world.bodies.iter().find(|b| {
+                !(b.pose.pos.is_finite()
+                    && b.pose.angle.is_finite()
+                    && b.vel.is_finite()
+                    && b.omega.is_finite())
+            }) {
                 return Err(format!(
                     "the simulation diverged at t = {:.4} s: body \"{}\" has a non-finite state\n    fix: lower the contact stiffness or raise the rate (see the minimum-mass rule, docs/SCENES.md)",
                     world.time(),
@@ -70,7 +79,8 @@ pub fn run(scene: &str, duration: f64, out: Option<&Path>, rate: Option<f64>, ev
         }
         if let Some(c) = csv.as_mut() {
             if k % every == 0 {
-                c.row(&world).map_err(|e| format!("cannot write CSV: {e}"))?;
+                c.row(&world)
+                    .map_err(|e| format!("cannot write CSV: {e}"))?;
             }
         }
     }

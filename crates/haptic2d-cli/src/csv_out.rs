@@ -14,7 +14,9 @@ pub struct WorldCsv<W: Write> {
 impl<W: Write> WorldCsv<W> {
     /// Writes the header for `world`'s dynamic bodies.
     pub fn new(mut out: W, world: &World) -> std::io::Result<Self> {
-        let dynamic: Vec<usize> = (0..world.bodies.len()).filter(|&i| world.bodies[i].is_dynamic()).collect();
+        let dynamic: Vec<usize> = (0..world.bodies.len())
+            .filter(|&i| world.bodies[i].is_dynamic())
+            .collect();
         let mut header = String::from("t,energy.kinetic,energy.stored,work.applied,contacts");
         for &i in &dynamic {
             let n = &world.bodies[i].name;

@@ -26,13 +26,13 @@ enum Command {
         /// A scene file path, or a built-in scene name (see `haptic2d scenes`).
         scene: String,
         /// Simulated duration (s).
-        #[arg(long, default_value_t = 10.0)]
+        #[arg(long, default_value_t = 10.0, allow_negative_numbers = true)]
         duration: f64,
         /// CSV output file (schema in docs/CSV.md). Without it, only a summary is printed.
         #[arg(long)]
         out: Option<PathBuf>,
         /// Control rate (Hz), overriding the scene's `world.rate`.
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         rate: Option<f64>,
         /// Keep every K-th sample in the CSV.
         #[arg(long, default_value_t = 1)]

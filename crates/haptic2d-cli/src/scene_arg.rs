@@ -7,12 +7,15 @@ use std::path::Path;
 pub fn load(arg: &str, rate: Option<f64>) -> Result<Scene, String> {
     if let Some(rate) = rate {
         if !(rate.is_finite() && rate > 0.0) {
-            return Err(format!("--rate must be a positive number of Hz, got {rate}"));
+            return Err(format!(
+                "--rate must be a positive number of Hz, got {rate}"
+            ));
         }
     }
     let path = Path::new(arg);
     if path.exists() {
-        let text = std::fs::read_to_string(path).map_err(|e| format!("cannot read scene file {arg}: {e}"))?;
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| format!("cannot read scene file {arg}: {e}"))?;
         return Scene::from_toml(&text, arg, rate).map_err(|e| e.to_string());
     }
     if let Some(s) = builtin(arg, rate) {

@@ -10,7 +10,11 @@ fn haptic2d(args: &[&str]) -> Output {
 }
 
 fn text(o: &Output) -> String {
-    format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
+    format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    )
 }
 
 #[test]
@@ -19,7 +23,14 @@ fn simulate_twice_gives_byte_identical_csv() {
     let a = dir.path().join("a.csv");
     let b = dir.path().join("b.csv");
     for p in [&a, &b] {
-        let o = haptic2d(&["simulate", "box-in-walls-tilt", "--duration", "1.5", "--out", p.to_str().unwrap()]);
+        let o = haptic2d(&[
+            "simulate",
+            "box-in-walls-tilt",
+            "--duration",
+            "1.5",
+            "--out",
+            p.to_str().unwrap(),
+        ]);
         assert!(o.status.success(), "{}", text(&o));
     }
     let (x, y) = (std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
@@ -31,7 +42,16 @@ fn simulate_twice_gives_byte_identical_csv() {
 fn simulate_writes_the_documented_columns() {
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path().join("b.csv");
-    let o = haptic2d(&["simulate", "box-in-walls", "--duration", "1", "--every", "10", "--out", p.to_str().unwrap()]);
+    let o = haptic2d(&[
+        "simulate",
+        "box-in-walls",
+        "--duration",
+        "1",
+        "--every",
+        "10",
+        "--out",
+        p.to_str().unwrap(),
+    ]);
     assert!(o.status.success(), "{}", text(&o));
     let csv = std::fs::read_to_string(&p).unwrap();
     let mut lines = csv.lines();
@@ -57,11 +77,21 @@ fn scenes_lists_the_builtins() {
 fn check_explains_a_bad_scene_and_fails() {
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path().join("bad.toml");
-    std::fs::write(&p, "[[body]]\nname = \"b\"\nmass = 1.0\npolygon = [[0.0, 0.0], [0.0, 0.1], [0.1, 0.0]]\n").unwrap();
+    std::fs::write(
+        &p,
+        "[[body]]\nname = \"b\"\nmass = 1.0\npolygon = [[0.0, 0.0], [0.0, 0.1], [0.1, 0.0]]\n",
+    )
+    .unwrap();
     let o = haptic2d(&["check", p.to_str().unwrap()]);
     assert!(!o.status.success());
     let t = text(&o);
-    assert!(t.contains("bad.toml") && t.contains("body[0] \"b\".polygon") && t.contains("clockwise") && t.contains("fix:"), "{t}");
+    assert!(
+        t.contains("bad.toml")
+            && t.contains("body[0] \"b\".polygon")
+            && t.contains("clockwise")
+            && t.contains("fix:"),
+        "{t}"
+    );
 }
 
 #[test]

@@ -88,7 +88,12 @@ mod tests {
             speed: f64::abs(v_n),
             omega: 0.0,
         };
-        let s = [mk(0.0, 0.01, -0.4), mk(0.1, -0.001, -0.4), mk(0.2, 0.0, 0.2), mk(0.3, 0.01, 0.0)];
+        let s = [
+            mk(0.0, 0.01, -0.4),
+            mk(0.1, -0.001, -0.4),
+            mk(0.2, 0.0, 0.2),
+            mk(0.3, 0.01, 0.0),
+        ];
         let m = BounceMetrics::from_samples(&s);
         assert_eq!(m.separations(), 1);
         assert!((m.contact_ratios[0] - 0.5).abs() < 1e-15);

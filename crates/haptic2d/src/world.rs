@@ -107,8 +107,9 @@ impl World {
             friction,
             params,
             contacts: ContactSet::new(params.contact),
-            broad: BroadPhase::new(params.delta_prox)
-                .unwrap_or_else(|_| BroadPhase::new(DEFAULT_DELTA_PROX).expect("the default margin is valid")),
+            broad: BroadPhase::new(params.delta_prox).unwrap_or_else(|_| {
+                BroadPhase::new(DEFAULT_DELTA_PROX).expect("the default margin is valid")
+            }),
             local: {
                 let mut l = LocalStage::new();
                 // An invalid tolerance keeps the default; scene validation reports it.
@@ -197,12 +198,19 @@ impl World {
             c.update(&self.bodies[c.body].pose);
         }
         // 3. Global proximity stage: AABB sort-and-sweep + GJK, every N_g samples.
-        if self.tick % self.params.proximity_every.max(1) as u64 == 0 {
+        if self
+            .tick
+            .is_multiple_of(self.params.proximity_every.max(1) as u64)
+        {
             self.broad.update(&self.colliders, &mut self.pairs);
         }
         // 4. Local stage: closest-feature tracking and VE candidates for proximate pairs.
-        self.local
-            .update(&self.colliders, &self.pairs, self.params.delta_c, &mut self.candidates);
+        self.local.update(
+            &self.colliders,
+            &self.pairs,
+            self.params.delta_c,
+            &mut self.candidates,
+        );
         // Loads and drives are held over the sample; they enter the bodies' accumulators first so the
         // classical friction model sees them (§4.1).
         let t = self.time();

@@ -21,13 +21,21 @@ pub fn gap(world: &World, body: usize) -> f64 {
         .colliders
         .iter()
         .filter(|c| c.body == body)
-        .flat_map(|c| c.local.vertices().iter().map(|v| world.bodies[body].pose.transform_point(*v).x))
+        .flat_map(|c| {
+            c.local
+                .vertices()
+                .iter()
+                .map(|v| world.bodies[body].pose.transform_point(*v).x)
+        })
         .fold(f64::INFINITY, f64::min)
 }
 
 /// Runs built-in `scene` for `secs` seconds in `mode` (optionally with the passivity guard).
 pub fn run(scene: &str, mode: IntegrationMode, secs: f64, guard: Option<f64>) -> Run {
-    let mut world = builtin(scene, None).expect("built-in").expect("valid").world;
+    let mut world = builtin(scene, None)
+        .expect("built-in")
+        .expect("valid")
+        .world;
     world.params.mode = mode;
     if guard.is_some() {
         world = rebuild_with_guard(world, guard);

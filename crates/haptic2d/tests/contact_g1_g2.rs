@@ -4,7 +4,9 @@ use haptic2d::contact::{ContactState, EventKind};
 use haptic2d::scene::Scene;
 
 fn scene(text: &str) -> haptic2d::world::World {
-    Scene::from_toml(text, "test", None).expect("valid scene").world
+    Scene::from_toml(text, "test", None)
+        .expect("valid scene")
+        .world
 }
 
 #[test]
@@ -36,7 +38,12 @@ velocity = [{v}, {neg}]
             assert_eq!(rec.key.edge, floor_top_edge);
             // The top edge runs from (1, 0) to (−1, 0): s = 1 − x.
             let s_expected = 1.0 - (0.0123 + 0.0031);
-            assert!((rec.s_entry - s_expected).abs() < 1e-9, "entry {} vs {}", rec.s_entry, s_expected);
+            assert!(
+                (rec.s_entry - s_expected).abs() < 1e-9,
+                "entry {} vs {}",
+                rec.s_entry,
+                s_expected
+            );
             return;
         }
     }
@@ -70,9 +77,16 @@ velocity = [0.0, -2.0]
     // inside the triangle's lower edge: that is a separate, legitimate VE contact.)
     for _ in 0..5 {
         w.step();
-        if let Some(rec) = w.contact_records().find(|r| r.key.vertex_collider == 1 && r.key.vertex == 0) {
+        if let Some(rec) = w
+            .contact_records()
+            .find(|r| r.key.vertex_collider == 1 && r.key.vertex == 0)
+        {
             assert_eq!(rec.key.edge_collider, 0);
-            assert_eq!(rec.key.edge, top, "assigned edge {} instead of the top edge", rec.key.edge);
+            assert_eq!(
+                rec.key.edge, top,
+                "assigned edge {} instead of the top edge",
+                rec.key.edge
+            );
             return;
         }
     }
@@ -105,7 +119,9 @@ velocity = [-0.01, 0.0]
         for e in w.contacts().events() {
             match e.kind {
                 EventKind::Created(ContactState::Continuous) => created += 1,
-                EventKind::Created(ContactState::Colliding) | EventKind::CreatedSimultaneous | EventKind::Resolved => {
+                EventKind::Created(ContactState::Colliding)
+                | EventKind::CreatedSimultaneous
+                | EventKind::Resolved => {
                     panic!("an invalid impact produced an impulse: {e:?}")
                 }
                 _ => {}

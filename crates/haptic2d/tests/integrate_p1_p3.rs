@@ -51,7 +51,10 @@ fn p2_zoh_spring_on_semi_implicit_mass_keeps_amplitude() {
             // ½m v_{k-1} v_k + ½K x_{k-1}²
             let h = shadow(xp, vp, v);
             let h0 = *h0.get_or_insert(h);
-            assert!(((h - h0) / h0).abs() < 1e-9, "shadow energy drifted at step {step}: {h} vs {h0}");
+            assert!(
+                ((h - h0) / h0).abs() < 1e-9,
+                "shadow energy drifted at step {step}: {h} vs {h0}"
+            );
         }
         prev = Some((x, v));
         if step < 1000 {
@@ -63,7 +66,10 @@ fn p2_zoh_spring_on_semi_implicit_mass_keeps_amplitude() {
         b.force = Vec2::new(-k * x, 0.0); // ZOH spring on the start-of-interval displacement
         integrate_body(&mut b, dt, IntegrationMode::SemiImplicit);
     }
-    assert!((max_amp_late / max_amp_early - 1.0).abs() < 0.01, "{max_amp_early} → {max_amp_late}");
+    assert!(
+        (max_amp_late / max_amp_early - 1.0).abs() < 0.01,
+        "{max_amp_early} → {max_amp_late}"
+    );
 }
 
 /// Peak |x| over the last 1000 of `n` steps of a semi-implicit mass on a ZOH spring–damper.
@@ -89,6 +95,12 @@ fn p3_min_mass_is_the_stability_boundary() {
     let (k, c, dt) = (2000.0, 10.0, 0.002);
     let m0 = min_mass(k, c, dt);
     assert!((m0 - 0.012).abs() < 1e-15, "worked example of §6.4");
-    assert!(spring_damper_peak(0.99 * m0, k, c, dt, 10_000) > 1.0, "0.99·min_mass must diverge");
-    assert!(spring_damper_peak(1.01 * m0, k, c, dt, 10_000) < 1e-3, "1.01·min_mass must not diverge");
+    assert!(
+        spring_damper_peak(0.99 * m0, k, c, dt, 10_000) > 1.0,
+        "0.99·min_mass must diverge"
+    );
+    assert!(
+        spring_damper_peak(1.01 * m0, k, c, dt, 10_000) < 1e-3,
+        "1.01·min_mass must not diverge"
+    );
 }

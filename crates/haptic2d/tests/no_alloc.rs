@@ -51,7 +51,11 @@ fn world_step_does_not_allocate_once_warm() {
     // One test function: the counter is global, so the scenes run one after the other.
     // box-in-walls: the window covers the later bounces, releases and re-creations of contacts.
     assert_eq!(allocations("box-in-walls", 50, 2500), 0, "box-in-walls");
-    assert_eq!(allocations("box-in-walls-tilt", 50, 2500), 0, "box-in-walls-tilt");
+    assert_eq!(
+        allocations("box-in-walls-tilt", 50, 2500),
+        0,
+        "box-in-walls-tilt"
+    );
     assert_eq!(allocations("peg-in-hole", 50, 2500), 0, "peg-in-hole");
     assert_eq!(allocations("pile:25", 200, 500), 0, "pile:25");
 }

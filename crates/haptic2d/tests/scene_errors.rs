@@ -22,7 +22,9 @@ fn assert_error(text: &str, field: &str, what: &str) {
     let shown = e.to_string();
     assert!(shown.starts_with("test.toml"), "the file is named: {shown}");
     assert!(
-        e.errors.iter().any(|x| x.field.contains(field) && x.message.contains(what) && !x.fix.is_empty()),
+        e.errors
+            .iter()
+            .any(|x| x.field.contains(field) && x.message.contains(what) && !x.fix.is_empty()),
         "no error on `{field}` containing `{what}`:\n{shown}"
     );
 }
@@ -38,13 +40,19 @@ fn toml_syntax_error_names_the_line() {
 
 #[test]
 fn clockwise_polygon() {
-    assert_error(&with_body("mass = 1.0\npolygon = [[0.0, 0.0], [0.0, 0.1], [0.1, 0.0]]"), "body[1] \"b\".polygon", "clockwise");
+    assert_error(
+        &with_body("mass = 1.0\npolygon = [[0.0, 0.0], [0.0, 0.1], [0.1, 0.0]]"),
+        "body[1] \"b\".polygon",
+        "clockwise",
+    );
 }
 
 #[test]
 fn non_convex_polygon() {
     assert_error(
-        &with_body("mass = 1.0\npolygon = [[0.0, 0.0], [0.2, 0.0], [0.1, 0.05], [0.2, 0.2], [0.0, 0.2]]"),
+        &with_body(
+            "mass = 1.0\npolygon = [[0.0, 0.0], [0.2, 0.0], [0.1, 0.05], [0.2, 0.2], [0.0, 0.2]]",
+        ),
         "body[1] \"b\".polygon",
         "not strictly convex",
     );
@@ -52,15 +60,27 @@ fn non_convex_polygon() {
 
 #[test]
 fn fewer_than_three_vertices() {
-    assert_error(&with_body("mass = 1.0\npolygon = [[0.0, 0.0], [0.1, 0.0]]"), "polygon", "at least 3 vertices");
+    assert_error(
+        &with_body("mass = 1.0\npolygon = [[0.0, 0.0], [0.1, 0.0]]"),
+        "polygon",
+        "at least 3 vertices",
+    );
 }
 
 #[test]
 fn zero_negative_and_nan_mass() {
     for m in ["0.0", "-1.0", "nan"] {
-        assert_error(&with_body(&format!("mass = {m}\nbox = [0.1, 0.1]")), "body[1] \"b\".mass", "positive mass");
+        assert_error(
+            &with_body(&format!("mass = {m}\nbox = [0.1, 0.1]")),
+            "body[1] \"b\".mass",
+            "positive mass",
+        );
     }
-    assert_error(&with_body("box = [0.1, 0.1]"), "body[1]", "needs a mass or a density");
+    assert_error(
+        &with_body("box = [0.1, 0.1]"),
+        "body[1]",
+        "needs a mass or a density",
+    );
 }
 
 #[test]
@@ -71,14 +91,25 @@ fn unknown_model_names() {
 
 #[test]
 fn unknown_fields() {
-    assert_error(&format!("{GOOD_BOX}\nmass_kg = 3\n"), "line", "unknown field");
-    assert_error("[normal]\nmodel = \"paper\"\nstiffness = 3.0\n", "normal.stiffness", "");
+    assert_error(
+        &format!("{GOOD_BOX}\nmass_kg = 3\n"),
+        "line",
+        "unknown field",
+    );
+    assert_error(
+        "[normal]\nmodel = \"paper\"\nstiffness = 3.0\n",
+        "normal.stiffness",
+        "",
+    );
 }
 
 #[test]
 fn min_mass_violation_is_refused_and_can_be_downgraded() {
     // Kc = 1e6 N/m per contact at 500 Hz: min_mass = 2e6·4e-6/4 + … ≈ 2 kg, so 0.5 kg is refused.
-    let text = format!("[normal]\nmodel = \"paper\"\nkc = 1.0e6\nbc = 0.0\n{}", with_body("mass = 0.5\nbox = [0.04, 0.02]"));
+    let text = format!(
+        "[normal]\nmodel = \"paper\"\nkc = 1.0e6\nbc = 0.0\n{}",
+        with_body("mass = 0.5\nbox = [0.04, 0.02]")
+    );
     assert_error(&text, "body \"b\".mass", "min_mass");
     let relaxed = format!("[world]\nallow_light_bodies = true\n{text}");
     let s = Scene::from_toml(&relaxed, "test.toml", None).expect("accepted with a warning");

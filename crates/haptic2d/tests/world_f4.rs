@@ -13,7 +13,10 @@ use std::collections::BTreeMap;
 fn creations(events: &[haptic2d::contact::ContactEvent]) -> BTreeMap<u64, usize> {
     let mut m = BTreeMap::new();
     for e in events {
-        if matches!(e.kind, EventKind::Created(ContactState::Colliding) | EventKind::CreatedSimultaneous) {
+        if matches!(
+            e.kind,
+            EventKind::Created(ContactState::Colliding) | EventKind::CreatedSimultaneous
+        ) {
             *m.entry(e.tick).or_insert(0) += 1;
         }
     }
@@ -27,9 +30,16 @@ fn f4_1_flat_impacts_are_simultaneous_and_spin_free() {
         let c = creations(&r.events);
         assert!(!c.is_empty(), "{mode:?}: no impact happened");
         for (tick, n) in &c {
-            assert_eq!(*n, 2, "{mode:?}: impact at tick {tick} involved {n} corner(s), expected both");
+            assert_eq!(
+                *n, 2,
+                "{mode:?}: impact at tick {tick} involved {n} corner(s), expected both"
+            );
         }
-        assert!(r.max_abs_omega < 1e-9, "{mode:?}: |ω| reached {}", r.max_abs_omega);
+        assert!(
+            r.max_abs_omega < 1e-9,
+            "{mode:?}: |ω| reached {}",
+            r.max_abs_omega
+        );
     }
 }
 
@@ -45,7 +55,11 @@ fn f4_flat_reproduces_the_1d_paper_method() {
     let settle = m.settle_time.expect("the paper method settles");
     assert!(settle < 1.5, "settle time {settle}");
     // Final penetration F/K: 2 N on 2 × 1000 N/m.
-    assert!((m.final_penetration - 1e-3).abs() < 5e-5, "final penetration {}", m.final_penetration);
+    assert!(
+        (m.final_penetration - 1e-3).abs() < 5e-5,
+        "final penetration {}",
+        m.final_penetration
+    );
 }
 
 #[test]
@@ -54,18 +68,37 @@ fn f4_2_tilted_first_impact_spins_then_rests_flush() {
         let r = run("box-in-walls-tilt", mode, 10.0, None);
         let c = creations(&r.events);
         let (first_tick, n) = c.iter().next().expect("an impact");
-        assert_eq!(*n, 1, "{mode:?}: the first tilted impact involves one corner");
+        assert_eq!(
+            *n, 1,
+            "{mode:?}: the first tilted impact involves one corner"
+        );
         // |ω| just after the first impact (state after that tick's step).
         let after = r.samples[*first_tick as usize + 1].omega;
-        assert!(after > 5.0, "{mode:?}: |ω| after the first impact = {after}");
+        assert!(
+            after > 5.0,
+            "{mode:?}: |ω| after the first impact = {after}"
+        );
         let box_i = r.world.body_index("box").unwrap();
         let theta = r.world.bodies[box_i].pose.angle;
-        assert!((2.0 * theta).sin().abs() < 0.02, "{mode:?}: not flush, θ = {theta}");
+        assert!(
+            (2.0 * theta).sin().abs() < 0.02,
+            "{mode:?}: not flush, θ = {theta}"
+        );
         let records: Vec<_> = r.world.contact_records().collect();
-        assert_eq!(records.len(), 2, "{mode:?}: {} contacts at rest", records.len());
-        assert!(records.iter().all(|e| e.state == Some(ContactState::Continuous)));
+        assert_eq!(
+            records.len(),
+            2,
+            "{mode:?}: {} contacts at rest",
+            records.len()
+        );
+        assert!(records
+            .iter()
+            .all(|e| e.state == Some(ContactState::Continuous)));
         let total: f64 = records.iter().map(|e| e.f_n).sum();
-        assert!((total - 2.0).abs() <= 0.02, "{mode:?}: total normal force {total}");
+        assert!(
+            (total - 2.0).abs() <= 0.02,
+            "{mode:?}: total normal force {total}"
+        );
     }
 }
 
@@ -79,7 +112,11 @@ fn f4_3_paper_method_loses_energy_at_every_bounce() {
             assert!(w[1] < w[0], "{mode:?}: exit speeds {:?}", m.exit_speeds);
         }
         for ratio in &m.contact_ratios {
-            assert!(*ratio <= 0.5 + 0.02, "{mode:?}: ratios {:?}", m.contact_ratios);
+            assert!(
+                *ratio <= 0.5 + 0.02,
+                "{mode:?}: ratios {:?}",
+                m.contact_ratios
+            );
         }
     }
 }
@@ -91,24 +128,53 @@ fn g3_state_trace_of_the_paper_run() {
     let at_first: Vec<_> = r.events.iter().filter(|e| e.tick == first).collect();
     let created = at_first
         .iter()
-        .filter(|e| matches!(e.kind, EventKind::Created(ContactState::Colliding) | EventKind::CreatedSimultaneous))
+        .filter(|e| {
+            matches!(
+                e.kind,
+                EventKind::Created(ContactState::Colliding) | EventKind::CreatedSimultaneous
+            )
+        })
         .count();
-    let resolved = at_first.iter().filter(|e| e.kind == EventKind::Resolved).count();
-    assert_eq!((created, resolved), (2, 2), "Colliding → Continuous for both corners: {at_first:?}");
-    assert!(r.events.iter().any(|e| e.kind == EventKind::Released), "deletion at separation");
+    let resolved = at_first
+        .iter()
+        .filter(|e| e.kind == EventKind::Resolved)
+        .count();
+    assert_eq!(
+        (created, resolved),
+        (2, 2),
+        "Colliding → Continuous for both corners: {at_first:?}"
+    );
+    assert!(
+        r.events.iter().any(|e| e.kind == EventKind::Released),
+        "deletion at separation"
+    );
     // A final Continuous record persists until the end: the last events are creations, never released.
-    let last_release = r.events.iter().filter(|e| e.kind == EventKind::Released).map(|e| e.tick).max().unwrap();
+    let last_release = r
+        .events
+        .iter()
+        .filter(|e| e.kind == EventKind::Released)
+        .map(|e| e.tick)
+        .max()
+        .unwrap();
     let live: Vec<_> = r.world.contact_records().collect();
     assert_eq!(live.len(), 2);
     for rec in live {
         assert_eq!(rec.state, Some(ContactState::Continuous));
-        assert!(rec.since > last_release, "the final records were created after the last release");
+        assert!(
+            rec.since > last_release,
+            "the final records were created after the last release"
+        );
     }
 }
 
 #[test]
 fn p4_guard_never_triggers_on_the_paper_run() {
-    let r = run("box-in-walls", IntegrationMode::SemiImplicit, 10.0, Some(1e-9));
+    let r = run(
+        "box-in-walls",
+        IntegrationMode::SemiImplicit,
+        10.0,
+        Some(1e-9),
+    );
     assert_eq!(r.world.guard_triggers(), 0);
 }
 

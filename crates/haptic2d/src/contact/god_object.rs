@@ -6,7 +6,13 @@
 ///
 /// Returns `(λ, s_g)`; `None` if the line was not crossed during the sample.
 #[inline]
-pub fn entry_point(d_prev: f64, d_now: f64, s_prev: f64, s_now: f64, len: f64) -> Option<(f64, f64)> {
+pub fn entry_point(
+    d_prev: f64,
+    d_now: f64,
+    s_prev: f64,
+    s_now: f64,
+    len: f64,
+) -> Option<(f64, f64)> {
     if d_prev > 0.0 && d_now <= 0.0 {
         let lam = d_prev / (d_prev - d_now);
         Some((lam, (s_prev + lam * (s_now - s_prev)).clamp(0.0, len)))

@@ -169,7 +169,15 @@ impl ContactSet {
                 }
                 i += 1;
             } else {
-                let e = new_entry(tick, candidates[j], colliders, bodies, past, normal, friction);
+                let e = new_entry(
+                    tick,
+                    candidates[j],
+                    colliders,
+                    bodies,
+                    past,
+                    normal,
+                    friction,
+                );
                 self.merged.push(e);
                 j += 1;
             }
@@ -244,7 +252,10 @@ impl ContactSet {
             if let (false, Some(fallback)) = (group_has_record, touching) {
                 let key = self.entries[fallback].key;
                 let edge = crossed_edge(key, colliders, past, p.eps_s).unwrap_or(key.edge);
-                let target = self.entries[g..h].iter().position(|e| e.key.edge == edge).map(|k| g + k);
+                let target = self.entries[g..h]
+                    .iter()
+                    .position(|e| e.key.edge == edge)
+                    .map(|k| g + k);
                 match target {
                     Some(t) => {
                         let e = &mut self.entries[t];
@@ -290,7 +301,9 @@ impl ContactSet {
             let mut g = 0;
             while g < self.entries.len() {
                 let mut h = g + 1;
-                while h < self.entries.len() && same_group(&self.entries[g].key, &self.entries[h].key) {
+                while h < self.entries.len()
+                    && same_group(&self.entries[g].key, &self.entries[h].key)
+                {
                     h += 1;
                 }
                 if !self.entries[g..h].iter().any(|e| e.is_contact()) {
@@ -323,7 +336,9 @@ impl ContactSet {
                 e.m_eff = if inv > 0.0 { 1.0 / inv / n } else { 0.0 };
             }
         }
-        self.entries.iter().any(|e| e.state == Some(ContactState::Colliding))
+        self.entries
+            .iter()
+            .any(|e| e.state == Some(ContactState::Colliding))
     }
 
     /// §7: every Colliding record (restitution `e`) and every Continuous record touching a body of a
@@ -343,7 +358,11 @@ impl ContactSet {
         for (idx, e) in self.entries.iter().enumerate() {
             let restitution = match e.state {
                 Some(ContactState::Colliding) => self.params.restitution,
-                Some(ContactState::Continuous) if self.body_flag[e.body_a] || self.body_flag[e.body_b] => 0.0,
+                Some(ContactState::Continuous)
+                    if self.body_flag[e.body_a] || self.body_flag[e.body_b] =>
+                {
+                    0.0
+                }
                 _ => continue,
             };
             self.rows.push(ImpactRow {
@@ -371,14 +390,21 @@ impl ContactSet {
                 });
             }
             // Step 5: recompute C0 and S0 with the post-impact velocities.
-            let v_rel = bodies[e.body_a].point_velocity(e.point) - bodies[e.body_b].point_velocity(e.point);
+            let v_rel =
+                bodies[e.body_a].point_velocity(e.point) - bodies[e.body_b].point_velocity(e.point);
             e.c0 = e.n.dot(v_rel);
             e.s0 = e.t.dot(v_rel);
         }
     }
 
     /// Step 6: normal force, then friction, for every Continuous record; god-objects follow.
-    fn forces(&mut self, dt: f64, bodies: &[Body], friction: &FrictionModel, wrenches: &mut [Wrench2]) {
+    fn forces(
+        &mut self,
+        dt: f64,
+        bodies: &[Body],
+        friction: &FrictionModel,
+        wrenches: &mut [Wrench2],
+    ) {
         for w in wrenches.iter_mut() {
             *w = Wrench2::default();
         }
@@ -406,7 +432,11 @@ impl ContactSet {
             if self.entries[idx].state != Some(ContactState::Continuous) {
                 continue;
             }
-            let f_ext_t = if needs_ext { self.external_share(idx) } else { 0.0 };
+            let f_ext_t = if needs_ext {
+                self.external_share(idx)
+            } else {
+                0.0
+            };
             let e = &mut self.entries[idx];
             let input = FrictionInput {
                 ds: e.s - e.s_prev,
@@ -432,7 +462,9 @@ impl ContactSet {
             .entries
             .iter()
             .filter(|o| {
-                o.state == Some(ContactState::Continuous) && o.body_a == e.body_a && o.t.dot(e.t).abs() > 0.99
+                o.state == Some(ContactState::Continuous)
+                    && o.body_a == e.body_a
+                    && o.t.dot(e.t).abs() > 0.99
             })
             .count()
             .max(1);
@@ -442,7 +474,9 @@ impl ContactSet {
 
 #[inline]
 fn same_group(a: &VeCandidate, b: &VeCandidate) -> bool {
-    a.vertex_collider == b.vertex_collider && a.vertex == b.vertex && a.edge_collider == b.edge_collider
+    a.vertex_collider == b.vertex_collider
+        && a.vertex == b.vertex
+        && a.edge_collider == b.edge_collider
 }
 
 fn add_force(w: &mut [Wrench2], bodies: &[Body], a: usize, b: usize, f: Vec2, p: Vec2) {
@@ -454,7 +488,13 @@ fn add_force(w: &mut [Wrench2], bodies: &[Body], a: usize, b: usize, f: Vec2, p:
 
 /// Turns a tracked pair into a record: Colliding if it approaches faster than `v_c` (and impacts are on),
 /// otherwise Continuous (an invalid impact, §8.2 rule 1). Initialises the god-object and the law states.
-fn start_record(e: &mut VeContact, p: ContactParams, tick: u64, events: &mut Vec<ContactEvent>, simultaneous: bool) {
+fn start_record(
+    e: &mut VeContact,
+    p: ContactParams,
+    tick: u64,
+    events: &mut Vec<ContactEvent>,
+    simultaneous: bool,
+) {
     let state = if simultaneous || (p.impacts && e.c0 < -p.v_c) {
         ContactState::Colliding
     } else {
@@ -509,7 +549,10 @@ fn past_ds(key: VeCandidate, colliders: &[Collider], pa: &Pose, pb: &Pose) -> (f
     let e0 = pb.transform_point(cb.local.vertices()[e]);
     let rot = pb.rot();
     let rel = v - e0;
-    (rot.apply(cb.local.normals()[e]).dot(rel), rot.apply(cb.local.tangents()[e]).dot(rel))
+    (
+        rot.apply(cb.local.normals()[e]).dot(rel),
+        rot.apply(cb.local.tangents()[e]).dot(rel),
+    )
 }
 
 /// Re-measures an existing entry: shifts the histories and refreshes geometry and velocities.
@@ -587,7 +630,12 @@ fn new_entry(
 
 /// The crossed-edge rule of §8.3: among the edges of the edge collider whose line the vertex crossed
 /// during the last sample, within the edge range, the one crossed first (smallest λ).
-fn crossed_edge(key: VeCandidate, colliders: &[Collider], past: &PastPoses<'_>, eps_s: f64) -> Option<u32> {
+fn crossed_edge(
+    key: VeCandidate,
+    colliders: &[Collider],
+    past: &PastPoses<'_>,
+    eps_s: f64,
+) -> Option<u32> {
     if past.prev.is_empty() {
         return None;
     }
@@ -596,7 +644,10 @@ fn crossed_edge(key: VeCandidate, colliders: &[Collider], past: &PastPoses<'_>, 
     let (pa, pb) = (&past.prev[ca.body], &past.prev[cb.body]);
     let mut best: Option<(f64, u32)> = None;
     for e in 0..cb.len() {
-        let k = VeCandidate { edge: e as u32, ..key };
+        let k = VeCandidate {
+            edge: e as u32,
+            ..key
+        };
         let (_, e0, n, t, len) = geometry(k, colliders);
         let v = ca.world_vertices[key.vertex as usize];
         let (d_now, s_now) = (n.dot(v - e0), t.dot(v - e0));

@@ -86,7 +86,12 @@ fn body_pieces(b: &BodySection, field: &str, errs: &mut Vec<SceneError>) -> Vec<
         let (a, c) = (0.5 * w, 0.5 * h);
         raw.push((
             format!("{field}.box"),
-            vec![Vec2::new(-a, -c), Vec2::new(a, -c), Vec2::new(a, c), Vec2::new(-a, c)],
+            vec![
+                Vec2::new(-a, -c),
+                Vec2::new(a, -c),
+                Vec2::new(a, c),
+                Vec2::new(-a, c),
+            ],
         ));
     }
     if let Some(ps) = &b.pieces {
@@ -109,7 +114,11 @@ fn body_pieces(b: &BodySection, field: &str, errs: &mut Vec<SceneError>) -> Vec<
 }
 
 /// Validates `file` and builds its world.
-pub(super) fn build(file: &SceneFile, source: &str, rate: Option<f64>) -> Result<Scene, Vec<SceneError>> {
+pub(super) fn build(
+    file: &SceneFile,
+    source: &str,
+    rate: Option<f64>,
+) -> Result<Scene, Vec<SceneError>> {
     let mut errs = Vec::new();
     let mut warnings = Vec::new();
     let w = &file.world;
@@ -117,7 +126,11 @@ pub(super) fn build(file: &SceneFile, source: &str, rate: Option<f64>) -> Result
     // [world]
     let rate = rate.or(w.rate).unwrap_or(500.0);
     if !finite_pos(rate) {
-        errs.push(SceneError::new("world.rate", format!("must be a positive rate in Hz, got {rate}"), "e.g. rate = 1000"));
+        errs.push(SceneError::new(
+            "world.rate",
+            format!("must be a positive rate in Hz, got {rate}"),
+            "e.g. rate = 1000",
+        ));
     }
     let dt = 1.0 / rate;
     let mut params = WorldParams {
@@ -126,19 +139,31 @@ pub(super) fn build(file: &SceneFile, source: &str, rate: Option<f64>) -> Result
     };
     if let Some(n) = w.proximity_every {
         if n == 0 {
-            errs.push(SceneError::new("world.proximity_every", "must be at least 1", "e.g. proximity_every = 10"));
+            errs.push(SceneError::new(
+                "world.proximity_every",
+                "must be at least 1",
+                "e.g. proximity_every = 10",
+            ));
         }
         params.proximity_every = n.max(1);
     }
     if let Some(x) = w.delta_prox {
         if !finite_pos(x) {
-            errs.push(SceneError::new("world.delta_prox", format!("must be a positive distance in m, got {x}"), "e.g. delta_prox = 0.042"));
+            errs.push(SceneError::new(
+                "world.delta_prox",
+                format!("must be a positive distance in m, got {x}"),
+                "e.g. delta_prox = 0.042",
+            ));
         }
         params.delta_prox = x;
     }
     if let Some(x) = w.delta_c {
         if !(x.is_finite() && x >= 0.0) {
-            errs.push(SceneError::new("world.delta_c", format!("must be a non-negative distance in m, got {x}"), "e.g. delta_c = 0.002"));
+            errs.push(SceneError::new(
+                "world.delta_c",
+                format!("must be a non-negative distance in m, got {x}"),
+                "e.g. delta_c = 0.002",
+            ));
         }
         params.delta_c = x;
     }
@@ -157,7 +182,11 @@ pub(super) fn build(file: &SceneFile, source: &str, rate: Option<f64>) -> Result
     };
     if let Some(g) = w.guard {
         if !(g.is_finite() && g >= 0.0) {
-            errs.push(SceneError::new("world.guard", format!("must be a non-negative energy in J, got {g}"), "e.g. guard = 1e-9"));
+            errs.push(SceneError::new(
+                "world.guard",
+                format!("must be a non-negative energy in J, got {g}"),
+                "e.g. guard = 1e-9",
+            ));
         }
         params.guard = Some(g);
     }
@@ -177,25 +206,41 @@ pub(super) fn build(file: &SceneFile, source: &str, rate: Option<f64>) -> Result
     }
     if let Some(e) = c.restitution {
         if !(0.0..=1.0).contains(&e) {
-            errs.push(SceneError::new("contact.restitution", format!("must be in [0, 1], got {e}"), "e.g. restitution = 0.5"));
+            errs.push(SceneError::new(
+                "contact.restitution",
+                format!("must be in [0, 1], got {e}"),
+                "e.g. restitution = 0.5",
+            ));
         }
         cp.restitution = e;
     }
     if let Some(v) = c.v_c {
         if !(v.is_finite() && v >= 0.0) {
-            errs.push(SceneError::new("contact.v_c", format!("must be a non-negative speed in m/s, got {v}"), "e.g. v_c = 0.02"));
+            errs.push(SceneError::new(
+                "contact.v_c",
+                format!("must be a non-negative speed in m/s, got {v}"),
+                "e.g. v_c = 0.02",
+            ));
         }
         cp.v_c = v;
     }
     if let Some(x) = c.eps_s {
         if !(x.is_finite() && x >= 0.0) {
-            errs.push(SceneError::new("contact.eps_s", format!("must be a non-negative distance in m, got {x}"), "e.g. eps_s = 1e-4"));
+            errs.push(SceneError::new(
+                "contact.eps_s",
+                format!("must be a non-negative distance in m, got {x}"),
+                "e.g. eps_s = 1e-4",
+            ));
         }
         cp.eps_s = x;
     }
     if let Some(v) = c.recollision_speed {
         if !finite_pos(v) {
-            errs.push(SceneError::new("contact.recollision_speed", format!("must be a positive speed in m/s, got {v}"), "e.g. recollision_speed = 0.1"));
+            errs.push(SceneError::new(
+                "contact.recollision_speed",
+                format!("must be a positive speed in m/s, got {v}"),
+                "e.g. recollision_speed = 0.1",
+            ));
         }
         cp.v_re = Some(v);
     }
@@ -219,14 +264,22 @@ pub(super) fn build(file: &SceneFile, source: &str, rate: Option<f64>) -> Result
             None | Some("dynamic") => false,
             Some("fixed") => true,
             Some(k) => {
-                errs.push(SceneError::new(format!("{field}.kind"), format!("unknown kind \"{k}\""), "use \"dynamic\" or \"fixed\""));
+                errs.push(SceneError::new(
+                    format!("{field}.kind"),
+                    format!("unknown kind \"{k}\""),
+                    "use \"dynamic\" or \"fixed\"",
+                ));
                 false
             }
         };
         let pos = b.position.unwrap_or([0.0, 0.0]);
         let angle = match (b.angle, b.angle_deg) {
             (Some(_), Some(_)) => {
-                errs.push(SceneError::new(format!("{field}.angle"), "both angle and angle_deg given", "keep one of them"));
+                errs.push(SceneError::new(
+                    format!("{field}.angle"),
+                    "both angle and angle_deg given",
+                    "keep one of them",
+                ));
                 0.0
             }
             (Some(a), None) => a,
@@ -235,7 +288,11 @@ pub(super) fn build(file: &SceneFile, source: &str, rate: Option<f64>) -> Result
         };
         for (k, v) in [("position", pos[0]), ("position", pos[1]), ("angle", angle)] {
             if !v.is_finite() {
-                errs.push(SceneError::new(format!("{field}.{k}"), "is NaN or infinite", "give finite numbers"));
+                errs.push(SceneError::new(
+                    format!("{field}.{k}"),
+                    "is NaN or infinite",
+                    "give finite numbers",
+                ));
             }
         }
         if pieces.is_empty() {
@@ -248,19 +305,35 @@ pub(super) fn build(file: &SceneFile, source: &str, rate: Option<f64>) -> Result
                 (Some(m), None) if finite_pos(m) => MassProperties::from_mass(&pieces, m),
                 (None, Some(d)) if finite_pos(d) => MassProperties::from_density(&pieces, d),
                 (Some(m), None) => {
-                    errs.push(SceneError::new(format!("{field}.mass"), format!("must be a positive mass in kg, got {m}"), "e.g. mass = 0.5"));
+                    errs.push(SceneError::new(
+                        format!("{field}.mass"),
+                        format!("must be a positive mass in kg, got {m}"),
+                        "e.g. mass = 0.5",
+                    ));
                     continue;
                 }
                 (None, Some(d)) => {
-                    errs.push(SceneError::new(format!("{field}.density"), format!("must be a positive density in kg/m², got {d}"), "e.g. density = 625"));
+                    errs.push(SceneError::new(
+                        format!("{field}.density"),
+                        format!("must be a positive density in kg/m², got {d}"),
+                        "e.g. density = 625",
+                    ));
                     continue;
                 }
                 (Some(_), Some(_)) => {
-                    errs.push(SceneError::new(format!("{field}.mass"), "both mass and density given", "keep one of them"));
+                    errs.push(SceneError::new(
+                        format!("{field}.mass"),
+                        "both mass and density given",
+                        "keep one of them",
+                    ));
                     continue;
                 }
                 (None, None) => {
-                    errs.push(SceneError::new(field.clone(), "a dynamic body needs a mass or a density", "add mass = <kg> or density = <kg/m²>, or kind = \"fixed\""));
+                    errs.push(SceneError::new(
+                        field.clone(),
+                        "a dynamic body needs a mass or a density",
+                        "add mass = <kg> or density = <kg/m²>, or kind = \"fixed\"",
+                    ));
                     continue;
                 }
             }
@@ -268,7 +341,11 @@ pub(super) fn build(file: &SceneFile, source: &str, rate: Option<f64>) -> Result
         let inertia = match b.inertia {
             Some(ii) if !fixed => {
                 if !finite_pos(ii) {
-                    errs.push(SceneError::new(format!("{field}.inertia"), format!("must be positive in kg·m², got {ii}"), "remove it to compute it from the shape"));
+                    errs.push(SceneError::new(
+                        format!("{field}.inertia"),
+                        format!("must be positive in kg·m², got {ii}"),
+                        "remove it to compute it from the shape",
+                    ));
                 }
                 ii
             }
@@ -291,7 +368,11 @@ pub(super) fn build(file: &SceneFile, source: &str, rate: Option<f64>) -> Result
         body.omega = b.omega.unwrap_or(0.0);
         if let Some(d) = b.damping {
             if !(d.is_finite() && d >= 0.0) {
-                errs.push(SceneError::new(format!("{field}.damping"), format!("must be a non-negative damping in N·s/m, got {d}"), "e.g. damping = 2.4"));
+                errs.push(SceneError::new(
+                    format!("{field}.damping"),
+                    format!("must be a non-negative damping in N·s/m, got {d}"),
+                    "e.g. damping = 2.4",
+                ));
             }
             body.damping = d;
         }
@@ -302,11 +383,19 @@ pub(super) fn build(file: &SceneFile, source: &str, rate: Option<f64>) -> Result
         let field = format!("grid[{gi}]");
         let prefix = g.name.clone().unwrap_or_else(|| "box".into());
         if g.columns == 0 || g.count == 0 {
-            errs.push(SceneError::new(field.clone(), "count and columns must be at least 1", "e.g. count = 100, columns = 10"));
+            errs.push(SceneError::new(
+                field.clone(),
+                "count and columns must be at least 1",
+                "e.g. count = 100, columns = 10",
+            ));
             continue;
         }
         if !(finite_pos(g.rect[0]) && finite_pos(g.rect[1]) && finite_pos(g.mass)) {
-            errs.push(SceneError::new(field.clone(), "box sizes and mass must be positive", "e.g. box = [0.05, 0.05], mass = 0.5"));
+            errs.push(SceneError::new(
+                field.clone(),
+                "box sizes and mass must be positive",
+                "e.g. box = [0.05, 0.05], mass = 0.5",
+            ));
             continue;
         }
         let Ok(shape) = ConvexPolygon::rectangle(g.rect[0], g.rect[1]) else {
@@ -315,7 +404,11 @@ pub(super) fn build(file: &SceneFile, source: &str, rate: Option<f64>) -> Result
         let inertia = MassProperties::from_mass(std::slice::from_ref(&shape), g.mass).inertia;
         for k in 0..g.count {
             let (row, col) = (k / g.columns, k % g.columns);
-            let shift = if g.stagger.unwrap_or(false) && row % 2 == 1 { 0.5 * g.spacing[0] } else { 0.0 };
+            let shift = if g.stagger.unwrap_or(false) && row % 2 == 1 {
+                0.5 * g.spacing[0]
+            } else {
+                0.0
+            };
             let p = Pose::new(
                 g.origin[0] + col as f64 * g.spacing[0] + shift,
                 g.origin[1] + row as f64 * g.spacing[1],
@@ -328,7 +421,11 @@ pub(super) fn build(file: &SceneFile, source: &str, rate: Option<f64>) -> Result
     let mut names = std::collections::BTreeSet::new();
     for b in &bodies {
         if !names.insert(b.name.clone()) {
-            errs.push(SceneError::new(format!("body \"{}\"", b.name), "duplicate body name", "give every body a unique name"));
+            errs.push(SceneError::new(
+                format!("body \"{}\"", b.name),
+                "duplicate body name",
+                "give every body a unique name",
+            ));
         }
     }
 
@@ -345,7 +442,10 @@ pub(super) fn build(file: &SceneFile, source: &str, rate: Option<f64>) -> Result
             .flat_map(|p| p.vertices().iter().map(|v| v.length_squared()))
             .fold(0.0, f64::max);
         let i_min = min_mass(k2 * r2, b2 * r2, dt);
-        for (what, have, need, unit) in [("mass", body.mass, m_min, "kg"), ("inertia", body.inertia, i_min, "kg·m²")] {
+        for (what, have, need, unit) in [
+            ("mass", body.mass, m_min, "kg"),
+            ("inertia", body.inertia, i_min, "kg·m²"),
+        ] {
             if have < 1.5 * need {
                 let msg = format!(
                     "{what} {have:.4e} {unit} is below 1.5 × min_{what} = {:.4e} {unit} for the stiffest contact (K = {k2} N/m, B = {b2} N·s/m for a face on two contacts, T = {dt} s): the simulation would be unstable or nearly so (§6.4)",
@@ -373,34 +473,60 @@ pub(super) fn build(file: &SceneFile, source: &str, rate: Option<f64>) -> Result
             Some("sine") => match l.frequency {
                 Some(f) if finite_pos(f) => Profile::UnidirectionalSine { frequency: f },
                 _ => {
-                    errs.push(SceneError::new(format!("{field}.frequency"), "the sine profile needs a positive frequency in Hz", "e.g. frequency = 1.0"));
+                    errs.push(SceneError::new(
+                        format!("{field}.frequency"),
+                        "the sine profile needs a positive frequency in Hz",
+                        "e.g. frequency = 1.0",
+                    ));
                     Profile::Constant
                 }
             },
             Some(p) => {
-                errs.push(SceneError::new(format!("{field}.profile"), format!("unknown profile \"{p}\""), "use \"constant\" or \"sine\""));
+                errs.push(SceneError::new(
+                    format!("{field}.profile"),
+                    format!("unknown profile \"{p}\""),
+                    "use \"constant\" or \"sine\"",
+                ));
                 Profile::Constant
             }
         };
         let f = l.force.unwrap_or([0.0, 0.0]);
         let tau = l.torque.unwrap_or(0.0);
         if !(f[0].is_finite() && f[1].is_finite() && tau.is_finite()) {
-            errs.push(SceneError::new(format!("{field}.force"), "is NaN or infinite", "give finite numbers"));
+            errs.push(SceneError::new(
+                format!("{field}.force"),
+                "is NaN or infinite",
+                "give finite numbers",
+            ));
         }
         let targets: Vec<usize> = if l.body == "*" {
-            (0..bodies.len()).filter(|&i| bodies[i].is_dynamic()).collect()
+            (0..bodies.len())
+                .filter(|&i| bodies[i].is_dynamic())
+                .collect()
         } else {
             match bodies.iter().position(|b| b.name == l.body) {
                 Some(i) if bodies[i].is_dynamic() => vec![i],
                 Some(_) => {
-                    errs.push(SceneError::new(format!("{field}.body"), format!("body \"{}\" is fixed; loads on it have no effect", l.body), "load a dynamic body"));
+                    errs.push(SceneError::new(
+                        format!("{field}.body"),
+                        format!("body \"{}\" is fixed; loads on it have no effect", l.body),
+                        "load a dynamic body",
+                    ));
                     vec![]
                 }
                 None => {
                     errs.push(SceneError::new(
                         format!("{field}.body"),
                         format!("no body named \"{}\"", l.body),
-                        format!("use one of: {}", bodies.iter().map(|b| b.name.as_str()).take(8).collect::<Vec<_>>().join(", ")),
+                        format!(
+                            "use one of: {}",
+                            bodies
+                                .iter()
+                                .map(|b| b.name.as_str())
+                                .take(8)
+                                .collect::<Vec<_>>()
+                                .join(", ")
+                        ),
                     ));
                     vec![]
                 }

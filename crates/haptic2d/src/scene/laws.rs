@@ -5,7 +5,12 @@ use crate::laws::friction::FrictionModel;
 use crate::laws::normal::NormalModel;
 use std::collections::BTreeMap;
 
-fn model_name(section: &str, map: &BTreeMap<String, toml::Value>, default: &str, errs: &mut Vec<SceneError>) -> String {
+fn model_name(
+    section: &str,
+    map: &BTreeMap<String, toml::Value>,
+    default: &str,
+    errs: &mut Vec<SceneError>,
+) -> String {
     match map.get("model") {
         None => default.to_string(),
         Some(toml::Value::String(s)) => s.clone(),
@@ -41,7 +46,11 @@ pub fn normal_from(map: &BTreeMap<String, toml::Value>, errs: &mut Vec<SceneErro
     let mut m = match NormalModel::from_name(&name, true) {
         Ok(m) => m,
         Err(e) => {
-            errs.push(SceneError::new("normal.model", e, "pick one of the listed models"));
+            errs.push(SceneError::new(
+                "normal.model",
+                e,
+                "pick one of the listed models",
+            ));
             return NormalModel::default();
         }
     };
@@ -51,23 +60,38 @@ pub fn normal_from(map: &BTreeMap<String, toml::Value>, errs: &mut Vec<SceneErro
         }
         if let Some(x) = number("normal", k, v, errs) {
             if let Err(e) = m.set_param(k, x) {
-                errs.push(SceneError::new(format!("normal.{k}"), e, "remove it or use one of the listed keys"));
+                errs.push(SceneError::new(
+                    format!("normal.{k}"),
+                    e,
+                    "remove it or use one of the listed keys",
+                ));
             }
         }
     }
     if let Err(e) = m.validate() {
-        errs.push(SceneError::new("normal", e, "fix the parameter named above"));
+        errs.push(SceneError::new(
+            "normal",
+            e,
+            "fix the parameter named above",
+        ));
     }
     m
 }
 
 /// Builds the friction-model prototype (per-contact defaults, then the given parameters).
-pub fn friction_from(map: &BTreeMap<String, toml::Value>, errs: &mut Vec<SceneError>) -> FrictionModel {
+pub fn friction_from(
+    map: &BTreeMap<String, toml::Value>,
+    errs: &mut Vec<SceneError>,
+) -> FrictionModel {
     let name = model_name("friction", map, "none", errs);
     let mut m = match FrictionModel::from_name(&name, true) {
         Ok(m) => m,
         Err(e) => {
-            errs.push(SceneError::new("friction.model", e, "pick one of the listed models"));
+            errs.push(SceneError::new(
+                "friction.model",
+                e,
+                "pick one of the listed models",
+            ));
             return FrictionModel::None;
         }
     };
@@ -77,12 +101,20 @@ pub fn friction_from(map: &BTreeMap<String, toml::Value>, errs: &mut Vec<SceneEr
         }
         if let Some(x) = number("friction", k, v, errs) {
             if let Err(e) = m.set_param(k, x) {
-                errs.push(SceneError::new(format!("friction.{k}"), e, "remove it or use one of the listed keys"));
+                errs.push(SceneError::new(
+                    format!("friction.{k}"),
+                    e,
+                    "remove it or use one of the listed keys",
+                ));
             }
         }
     }
     if let Err(e) = m.validate() {
-        errs.push(SceneError::new("friction", e, "fix the parameter named above"));
+        errs.push(SceneError::new(
+            "friction",
+            e,
+            "fix the parameter named above",
+        ));
     }
     m
 }

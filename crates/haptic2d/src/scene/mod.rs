@@ -4,13 +4,13 @@
 //! The format is documented in `docs/SCENES.md`; built-in scenes live in `scenes/` and are embedded in
 //! the binary.
 
+mod build;
 mod builtin;
 mod error;
 mod file;
 mod laws;
-mod build;
 
-pub use builtin::{builtin, builtin_names, pile_toml, BUILTIN};
 pub use build::Scene;
+pub use builtin::{builtin, builtin_names, pile_toml, BUILTIN};
 pub use error::{SceneError, SceneErrors};
 pub use file::SceneFile;
