@@ -32,6 +32,7 @@ const K_O: f64 = 60.0;
 const DURATION: f64 = 4.0;
 
 /// Either architecture behind one call.
+#[allow(clippy::large_enum_variant)]
 enum Controller {
     FourChannel(FourChannel),
     Coupling(VirtualCoupling),

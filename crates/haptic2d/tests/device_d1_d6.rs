@@ -1,5 +1,7 @@
 //! Checkable behaviour of the twin-pantograph device model, spec §10.8 (D1–D6).
 
+#![allow(clippy::needless_range_loop)] // index loops mirror the matrix formulas
+
 use haptic2d::device::dynamics::LumpedDynamics;
 use haptic2d::device::jacobian::{
     condition_number, jacobian, jacobian_at, jacobian_dot_at, singularity_margin,
@@ -279,10 +281,12 @@ fn run_observer_scenario(
     steps: &[(f64, V3)],
     duration: f64,
 ) -> Vec<(f64, V3, V3)> {
-    let mut params = DeviceParams::default();
     // "Model exact": the plant's Coulomb friction sign at rest is unobservable from filtered
     // encoder velocities, so D5 runs with viscous joint friction only (known exactly to the observer).
-    params.f_c = 0.0;
+    let params = DeviceParams {
+        f_c: 0.0,
+        ..DeviceParams::default()
+    };
     let x0 = [0.0, 0.14, 0.2];
     let mut plant = SimDevice::new(&params, x0).expect("valid");
     plant.quantize = quantize;
@@ -413,9 +417,11 @@ fn d5_observers_agree_at_rest_and_with_quantised_encoders() {
 
 #[test]
 fn d6_kinetic_energy_is_conserved_without_inputs() {
-    let mut params = DeviceParams::default();
-    params.f_c = 0.0;
-    params.f_v = 0.0;
+    let params = DeviceParams {
+        f_c: 0.0,
+        f_v: 0.0,
+        ..DeviceParams::default()
+    };
     let mut plant = SimDevice::new(&params, [0.005, 0.14, 0.4]).expect("valid");
     plant.set_state([0.005, 0.14, 0.4], [0.012, -0.008, 6.0]);
     let e0 = plant.kinetic_energy().expect("reachable");

@@ -138,7 +138,7 @@ pub(crate) fn check_min_mass(name: &str, k: &V3, b: &V3, mass: &V3, dt: f64) -> 
     const DOF: [&str; 3] = ["x", "y", "theta"];
     for i in 0..3 {
         let min_mass = k[i] * dt * dt / 4.0 + b[i] * dt / 2.0;
-        if !(mass[i] > 1.5 * min_mass) {
+        if mass[i].is_nan() || mass[i] <= 1.5 * min_mass {
             return Err(format!(
                 "controller.{name}: slave {} mass {} is below 1.5 x min_mass = {} for K = {}, B = {}, T = {} s (lower the gains or raise the mass)",
                 DOF[i],

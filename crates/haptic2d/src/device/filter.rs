@@ -43,9 +43,9 @@ impl VelocityFilter {
             self.v = [0.0; 3];
             return self.v;
         }
-        for i in 0..3 {
-            let raw = (x[i] - self.x_prev[i]) / self.dt;
-            self.v[i] += self.alpha * (raw - self.v[i]);
+        for ((v, xi), xp) in self.v.iter_mut().zip(x).zip(&self.x_prev) {
+            let raw = (xi - xp) / self.dt;
+            *v += self.alpha * (raw - *v);
         }
         self.x_prev = *x;
         self.v

@@ -114,6 +114,7 @@ pub fn solve3(m: &M3, b: &V3) -> Option<V3> {
 
 /// Eigenvalues of a symmetric 3×3 matrix, ascending, by cyclic Jacobi rotations (converges to machine
 /// precision in a handful of sweeps for 3×3).
+#[allow(clippy::needless_range_loop)] // index form mirrors the rotation formulas
 pub fn sym3_eigenvalues(m: &M3) -> V3 {
     let mut a = *m;
     for _sweep in 0..50 {
@@ -157,6 +158,7 @@ mod tests {
     use super::*;
 
     #[test]
+    #[allow(clippy::needless_range_loop)]
     fn inverse_and_eigenvalues() {
         let m = [[4.0, 1.0, 0.5], [1.0, 3.0, 0.2], [0.5, 0.2, 2.0]];
         let mi = inv3(&m).expect("regular");
