@@ -1,0 +1,237 @@
+//! Lawrence's four-channel teleoperation controller with a virtual slave (§11.1), with the local
+//! force-feedback blocks C5 (slave) and C6 (master) and optional acceleration feedforwards.
+//!
+//! With `C_m = B_m + K_m/s`, `C_s = B_s + K_s/s`, the transparency choices `C1 = Z_s + C_s`,
+//! `C2 = 1 + C6`, `C3 = 1 + C5`, `C4 = −(Z_m + C_m)` turn
+//! `f_cm = −C_m·v_m − C4·v_s + C6·f_h − C2·f_e` and `f_cs = −C_s·v_s + C1·v_m + C3·f_h − C5·f_e` into
+//!
+//! ```text
+//! f_cm = K_m·(x_s − x_m) + B_m·(v_s − v_m) + C6·f_h − (1 + C6)·f_e  [+ M̂_x·a_s]
+//! f_cs = K_s·(x_m − x_s) + B_s·(v_m − v_s) + (1 + C5)·f_h − C5·f_e  [+ M_s·â_m]
+//! ```
+//!
+//! which with the default `C5 = C6 = 0` is the spec's discrete law. All gains are diagonal (per DOF
+//! x, y, θ); θ position errors are wrapped to `(−π, π]`.
+
+use serde::{Deserialize, Serialize};
+
+use crate::device::linalg::{m3_mul_v, M3, V3};
+use crate::device::lowpass::LowPass2;
+use crate::geom::wrap_angle;
+
+/// The signals a teleoperation controller sees at sample `k` (3-vectors over x, y, θ).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TeleopSignals {
+    /// Device (master) pose `x_m,k` (m, m, rad).
+    pub x_m: V3,
+    /// Filtered device twist `v̂_m,k` (m/s, m/s, rad/s).
+    pub v_m: V3,
+    /// Estimated hand wrench `Ŵ_h,k` (N, N, N·m).
+    pub f_h: V3,
+    /// Slave pose `x_s,k` (m, m, rad).
+    pub x_s: V3,
+    /// Post-impulse slave twist `v_s,k⁺` (m/s, m/s, rad/s).
+    pub v_s: V3,
+    /// Wrench the slave applies to the environment `f_e,k` (N, N, N·m): minus the sum of contact
+    /// wrenches on the slave, at this sample.
+    pub f_e: V3,
+    /// Device mass matrix estimate `M̂_x` (kg, kg·m, kg·m²); only read by the master feedforward.
+    pub master_mass: M3,
+}
+
+/// Position error `x_a − x_b` with the θ component wrapped.
+#[inline]
+pub fn pose_error(x_a: &V3, x_b: &V3) -> V3 {
+    [
+        x_a[0] - x_b[0],
+        x_a[1] - x_b[1],
+        wrap_angle(x_a[2] - x_b[2]),
+    ]
+}
+
+/// Four-channel gains and options. Defaults are the §11.1 table.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct FourChannelGains {
+    /// Master position gain `K_m` (N/m, N/m, N·m/rad). Default (500, 500, 1.0).
+    pub k_m: V3,
+    /// Master damping `B_m` (N·s/m, N·s/m, N·m·s/rad). Default (5, 5, 0.01).
+    pub b_m: V3,
+    /// Slave position gain `K_s` (N/m, N/m, N·m/rad). Default (2000, 2000, 4).
+    pub k_s: V3,
+    /// Slave damping `B_s` (N·s/m, N·s/m, N·m·s/rad). Default (30, 30, 0.03).
+    pub b_s: V3,
+    /// Slave local force feedback `C5` (dimensionless). Default 0.
+    pub c5: V3,
+    /// Master local force feedback `C6` (dimensionless). Default 0.
+    pub c6: V3,
+    /// Add the master-mass feedforward `M̂_x·a_s` to `f_cm`. Default off.
+    pub master_feedforward: bool,
+    /// Add the slave-mass feedforward `M_s·â_m` to `f_cs` (amplifies encoder noise). Default off.
+    pub slave_feedforward: bool,
+    /// Slave generalized mass `diag(M_s, M_s, I_s)` for the slave feedforward (kg, kg, kg·m²).
+    /// Default (0.5, 0.5, 1e-4).
+    pub slave_mass: V3,
+    /// Cut-off of the 2nd-order low-pass on the backward-difference accelerations (Hz). Default 30.
+    pub accel_cutoff_hz: f64,
+}
+
+impl Default for FourChannelGains {
+    fn default() -> Self {
+        Self {
+            k_m: [500.0, 500.0, 1.0],
+            b_m: [5.0, 5.0, 0.01],
+            k_s: [2000.0, 2000.0, 4.0],
+            b_s: [30.0, 30.0, 0.03],
+            c5: [0.0; 3],
+            c6: [0.0; 3],
+            master_feedforward: false,
+            slave_feedforward: false,
+            slave_mass: [0.5, 0.5, 1e-4],
+            accel_cutoff_hz: 30.0,
+        }
+    }
+}
+
+fn check_finite_nonneg(name: &str, v: &V3) -> Result<(), String> {
+    for (i, x) in v.iter().enumerate() {
+        if !(x.is_finite() && *x >= 0.0) {
+            return Err(format!(
+                "controller.{name}[{i}] must be a finite number >= 0 (got {x})"
+            ));
+        }
+    }
+    Ok(())
+}
+
+impl FourChannelGains {
+    /// Checks that every gain is finite and non-negative (C5, C6 only finite), naming the field.
+    pub fn validate(&self) -> Result<(), String> {
+        check_finite_nonneg("k_m", &self.k_m)?;
+        check_finite_nonneg("b_m", &self.b_m)?;
+        check_finite_nonneg("k_s", &self.k_s)?;
+        check_finite_nonneg("b_s", &self.b_s)?;
+        check_finite_nonneg("slave_mass", &self.slave_mass)?;
+        for (name, c) in [("c5", &self.c5), ("c6", &self.c6)] {
+            if !c.iter().all(|v| v.is_finite()) {
+                return Err(format!("controller.{name} must be finite"));
+            }
+        }
+        if !(self.accel_cutoff_hz.is_finite() && self.accel_cutoff_hz > 0.0) {
+            return Err(format!(
+                "controller.accel_cutoff_hz must be > 0 (got {})",
+                self.accel_cutoff_hz
+            ));
+        }
+        Ok(())
+    }
+
+    /// §6.4 check of the slave coupling `(K_s, B_s)` on a slave of generalized mass `mass` (kg, kg,
+    /// kg·m²) at period `dt` (s): refuses masses below `1.5·(K·T²/4 + B·T/2)`, naming the DOF.
+    pub fn check_slave_mass(&self, mass: &V3, dt: f64) -> Result<(), String> {
+        check_min_mass("k_s/b_s", &self.k_s, &self.b_s, mass, dt)
+    }
+}
+
+/// Refuses any DOF whose mass is below `1.5·min_mass(K, B, T)` (§6.4).
+pub(crate) fn check_min_mass(name: &str, k: &V3, b: &V3, mass: &V3, dt: f64) -> Result<(), String> {
+    const DOF: [&str; 3] = ["x", "y", "theta"];
+    for i in 0..3 {
+        let min_mass = k[i] * dt * dt / 4.0 + b[i] * dt / 2.0;
+        if mass[i].is_nan() || mass[i] <= 1.5 * min_mass {
+            return Err(format!(
+                "controller.{name}: slave {} mass {} is below 1.5 x min_mass = {} for K = {}, B = {}, T = {} s (lower the gains or raise the mass)",
+                DOF[i],
+                mass[i],
+                1.5 * min_mass,
+                k[i],
+                b[i],
+                dt
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The four-channel controller: gains plus the state of the acceleration estimators.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FourChannel {
+    /// Gains and options.
+    pub gains: FourChannelGains,
+    dt: f64,
+    lp_a_s: LowPass2,
+    lp_a_m: LowPass2,
+    v_s_prev: V3,
+    v_m_prev: V3,
+    started: bool,
+}
+
+impl FourChannel {
+    /// A controller with `gains` (validated) at sample period `dt` (s).
+    pub fn new(gains: FourChannelGains, dt: f64) -> Result<Self, String> {
+        gains.validate()?;
+        if !(dt.is_finite() && dt > 0.0) {
+            return Err(format!("controller sample period must be > 0 (got {dt})"));
+        }
+        Ok(Self {
+            gains,
+            dt,
+            lp_a_s: LowPass2::new(gains.accel_cutoff_hz, dt),
+            lp_a_m: LowPass2::new(gains.accel_cutoff_hz, dt),
+            v_s_prev: [0.0; 3],
+            v_m_prev: [0.0; 3],
+            started: false,
+        })
+    }
+
+    /// Clears the acceleration estimators.
+    pub fn reset(&mut self) {
+        self.lp_a_s.reset();
+        self.lp_a_m.reset();
+        self.started = false;
+    }
+
+    /// One sample (§0.5 step 7): returns `(f_cm, f_cs)`, the device command and the slave drive
+    /// (N, N, N·m).
+    pub fn step(&mut self, s: &TeleopSignals) -> (V3, V3) {
+        let g = &self.gains;
+        // Backward-difference accelerations, low-passed (used only by the optional feedforwards).
+        let (raw_a_s, raw_a_m): (V3, V3) = if self.started {
+            (
+                std::array::from_fn(|i| (s.v_s[i] - self.v_s_prev[i]) / self.dt),
+                std::array::from_fn(|i| (s.v_m[i] - self.v_m_prev[i]) / self.dt),
+            )
+        } else {
+            ([0.0; 3], [0.0; 3])
+        };
+        self.started = true;
+        self.v_s_prev = s.v_s;
+        self.v_m_prev = s.v_m;
+        let a_s = self.lp_a_s.update(&raw_a_s);
+        let a_m = self.lp_a_m.update(&raw_a_m);
+        let ff_m = if g.master_feedforward {
+            m3_mul_v(&s.master_mass, &a_s)
+        } else {
+            [0.0; 3]
+        };
+
+        let e = pose_error(&s.x_s, &s.x_m); // x_s − x_m, θ wrapped
+        let mut f_cm = [0.0; 3];
+        let mut f_cs = [0.0; 3];
+        for i in 0..3 {
+            let dv = s.v_s[i] - s.v_m[i];
+            f_cm[i] = g.k_m[i] * e[i] + g.b_m[i] * dv + g.c6[i] * s.f_h[i]
+                - (1.0 + g.c6[i]) * s.f_e[i]
+                + ff_m[i];
+            let ff_s = if g.slave_feedforward {
+                g.slave_mass[i] * a_m[i]
+            } else {
+                0.0
+            };
+            f_cs[i] = -g.k_s[i] * e[i] - g.b_s[i] * dv + (1.0 + g.c5[i]) * s.f_h[i]
+                - g.c5[i] * s.f_e[i]
+                + ff_s;
+        }
+        (f_cm, f_cs)
+    }
+}
