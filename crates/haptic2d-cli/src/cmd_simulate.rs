@@ -53,6 +53,7 @@ pub fn run(
     let mut shown = false;
     let mut max_excess = f64::NEG_INFINITY;
     let mut max_contacts = 0;
+    let mut max_depth = 0.0f64;
     for k in 1..=ticks {
         world.step();
         let e = world.ledger();
@@ -71,6 +72,10 @@ pub fn run(
                 ));
             }
             max_contacts = max_contacts.max(world.contacts().contact_count());
+            max_depth = world
+                .contact_records()
+                .map(|c| -c.d[0])
+                .fold(max_depth, f64::max);
             if !shown && start.elapsed() > Duration::from_secs(1) {
                 bar.set_draw_target(ProgressDrawTarget::stderr());
                 shown = true;
@@ -103,7 +108,13 @@ pub fn run(
     );
     println!(
         "max (kinetic + stored) − (initial + applied work) over the run: {max_excess:.3e} J; contacts now {}, at most {max_contacts}",
-        world.contacts().contact_count()
+        world.contacts().contact_count(),
+    );
+    let depth_now = world.contact_records().map(|c| -c.d[0]).fold(0.0, f64::max);
+    println!(
+        "deepest contact penetration: {:.3} mm at the end, {:.3} mm over the run (sampled every 256 samples)",
+        depth_now * 1e3,
+        max_depth * 1e3
     );
     if let Some(p) = out {
         println!("wrote {}", p.display());

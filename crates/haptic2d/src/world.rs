@@ -69,6 +69,7 @@ pub struct World {
     candidates: Vec<VeCandidate>,
     drive: Vec<Wrench2>,
     contact_wrench: Vec<Wrench2>,
+    /// Load wrench per body of the current sample.
     held: Vec<Wrench2>,
     prev: Vec<Pose>,
     prev2: Vec<Pose>,
@@ -211,17 +212,20 @@ impl World {
             self.params.delta_c,
             &mut self.candidates,
         );
-        // Loads and drives are held over the sample; they enter the bodies' accumulators first so the
-        // classical friction model sees them (§4.1).
+        // Loads are evaluated once per sample (held over it). Loads and drives enter the bodies'
+        // accumulators before the contact forces so the classical friction model sees them (§4.1).
         let t = self.time();
-        for (b, d) in self.bodies.iter_mut().zip(&self.drive) {
-            b.force = d.force;
-            b.torque = d.torque;
+        for h in self.held.iter_mut() {
+            *h = Wrench2::default();
         }
         for l in &self.loads {
             let (f, tau) = l.wrench(&self.bodies[l.body], t);
-            self.bodies[l.body].force += f;
-            self.bodies[l.body].torque += tau;
+            self.held[l.body].force += f;
+            self.held[l.body].torque += tau;
+        }
+        for ((b, d), h) in self.bodies.iter_mut().zip(&self.drive).zip(&self.held) {
+            b.force = d.force + h.force;
+            b.torque = d.torque + h.torque;
         }
         if self.guard.is_some() {
             for (k, b) in self.ke_before.iter_mut().zip(&self.bodies) {
@@ -261,27 +265,21 @@ impl World {
     /// re-read so a drive set after `begin_step` counts), then update the energy ledger.
     pub fn finish_step(&mut self) {
         let dt = self.params.dt;
-        let t = self.time();
         // Remember the poses of k−1 and k−2 (buffers reused).
         std::mem::swap(&mut self.prev, &mut self.prev2);
         self.prev.clear();
         self.prev.extend(self.bodies.iter().map(|b| b.pose));
         let mut applied_work = 0.0;
         for i in 0..self.bodies.len() {
-            // Held applied wrench: loads + drive.
-            let mut applied = self.drive[i];
-            for l in &self.loads {
-                if l.body == i {
-                    let (f, tau) = l.wrench(&self.bodies[i], t);
-                    applied.force += f;
-                    applied.torque += tau;
-                }
-            }
+            // Held applied wrench: loads (evaluated in begin_step) + the drive as it is now.
+            let applied = Wrench2 {
+                force: self.held[i].force + self.drive[i].force,
+                torque: self.held[i].torque + self.drive[i].torque,
+            };
             let b = &mut self.bodies[i];
             let cw = self.contact_wrench[i];
             b.force = applied.force + cw.force;
             b.torque = applied.torque + cw.torque;
-            self.held[i] = applied;
             if !b.is_dynamic() {
                 continue;
             }

@@ -108,8 +108,10 @@ pub struct ImpactSolver {
     n: usize,
     /// Jacobian rows, two 3-blocks each (A then B).
     jac: Vec<[f64; 6]>,
-    /// Delassus matrix `A = G M⁻¹ Gᵀ`, row-major `n × n`.
+    /// Delassus matrix `A = G M⁻¹ Gᵀ`, row-major `n × n` (dense path only).
     a: Vec<f64>,
+    /// Diagonal `A_ii` (sparse path).
+    diag: Vec<f64>,
     /// Pre-impact normal velocities `b⁻` (m/s).
     b_pre: Vec<f64>,
     /// Post-restitution normal velocities, before any plastic correction (m/s).
@@ -148,6 +150,7 @@ impl ImpactSolver {
             n: 0,
             jac: Vec::new(),
             a: Vec::new(),
+            diag: Vec::new(),
             b_pre: Vec::new(),
             b_mid: Vec::new(),
             b_post: Vec::new(),
@@ -186,7 +189,11 @@ impl ImpactSolver {
             return;
         }
         self.jac.resize(rows, [0.0; 6]);
-        self.a.resize(rows * rows, 0.0);
+        let dense = rows.min(DENSE_MAX_ROWS);
+        if self.a.len() < dense * dense {
+            self.a.resize(dense * dense, 0.0);
+        }
+        self.diag.resize(rows, 0.0);
         for v in [
             &mut self.b_pre,
             &mut self.b_mid,
@@ -263,6 +270,9 @@ impl ImpactSolver {
         let n = rows.len();
         self.reserve(n);
         self.n = n;
+        if n > DENSE_MAX_ROWS {
+            return self.solve_sparse(rows, bodies);
+        }
         let ke_before: f64 = bodies.iter().map(Body::kinetic_energy).sum();
 
         // Jacobian rows and pre-impact velocities b⁻ = G u⁻.
@@ -352,6 +362,119 @@ impl ImpactSolver {
         }
     }
 
+    /// The sparse path for large impact sets (`n > DENSE_MAX_ROWS`, e.g. a pile landing): the same
+    /// projected Gauss–Seidel iteration as the dense solver, `λ_i ← max(0, λ_i − (A_i·λ + b_i)/A_ii)`,
+    /// but with `A_i·λ + b_i = G_i·u` read from the bodies' current twists, to which every impulse
+    /// increment is applied at once ("sequential impulses"). Each row update then costs O(1) instead
+    /// of O(n), and no `n × n` matrix is built. Iterates are identical to dense PGS.
+    fn solve_sparse(&mut self, rows: &[ImpactRow], bodies: &mut [Body]) -> ImpactOutcome {
+        let n = rows.len();
+        let ke_before: f64 = bodies.iter().map(Body::kinetic_energy).sum();
+        for (i, row) in rows.iter().enumerate() {
+            self.jac[i] = row.jacobian(bodies);
+            let j = &self.jac[i];
+            let mut d = 0.0;
+            for (off, bi) in [(0usize, row.body_a), (3, row.body_b)] {
+                let b = &bodies[bi];
+                d += b.inv_mass * (j[off] * j[off] + j[off + 1] * j[off + 1])
+                    + b.inv_inertia * j[off + 2] * j[off + 2];
+            }
+            self.diag[i] = d;
+        }
+        self.normal_velocities(rows, bodies, Buf::Pre);
+        // 1. Compression: PGS on the bodies' twists, starting from λ = 0.
+        self.lambda[..n].fill(0.0);
+        let compression = self.pgs_on_bodies(rows, bodies, Buf::Impulse);
+        // 2. Poisson restitution: the bodies already carry λ; add e_i·λ_i.
+        for (i, row) in rows.iter().enumerate() {
+            self.step[i] = row.restitution * self.lambda[i];
+            self.impulse[i] = (1.0 + row.restitution) * self.lambda[i];
+            self.correction[i] = 0.0;
+        }
+        self.apply_impulses(rows, bodies, Buf::Step);
+        self.normal_velocities(rows, bodies, Buf::Mid);
+        self.b_post[..n].copy_from_slice(&self.b_mid[..n]);
+        // 3. Plastic correction: PGS again from the post-restitution twists, λ' from 0.
+        let mut correction = None;
+        let mut passes = 0;
+        if self.b_post[..n].iter().any(|&v| v < -self.eps_v) {
+            passes = 1;
+            self.step[..n].fill(0.0);
+            correction = Some(self.pgs_on_bodies(rows, bodies, Buf::Step));
+            for i in 0..n {
+                self.correction[i] = self.step[i];
+                self.impulse[i] += self.step[i];
+            }
+            self.normal_velocities(rows, bodies, Buf::Post);
+        }
+        let ke_after: f64 = bodies.iter().map(Body::kinetic_energy).sum();
+        ImpactOutcome {
+            rows: n,
+            kinetic_energy_before: ke_before,
+            kinetic_energy_after: ke_after,
+            plastic_correction: passes > 0,
+            correction_passes: passes,
+            compression,
+            correction,
+            min_post_velocity: self.b_post[..n]
+                .iter()
+                .copied()
+                .fold(f64::INFINITY, f64::min),
+        }
+    }
+
+    /// Projected Gauss–Seidel applied directly to the bodies' twists; accumulates the impulses in
+    /// `lambda` (`Buf::Impulse`) or `step` (`Buf::Step`), which must start at zero. Stops when the
+    /// largest increment of a sweep is below 1e-9 N·s, or after `PGS_MAX_SWEEPS` sweeps.
+    fn pgs_on_bodies(&mut self, rows: &[ImpactRow], bodies: &mut [Body], into: Buf) -> LcpReport {
+        let n = rows.len();
+        let mut sweeps = 0;
+        let mut converged = false;
+        while sweeps < PGS_MAX_SWEEPS {
+            sweeps += 1;
+            let mut max_delta = 0.0f64;
+            for (i, row) in rows.iter().enumerate() {
+                if self.diag[i] <= 0.0 {
+                    continue;
+                }
+                let j = self.jac[i];
+                let w = dot_twist(&j[0..3], &bodies[row.body_a])
+                    + dot_twist(&j[3..6], &bodies[row.body_b]);
+                let acc = match into {
+                    Buf::Step => &mut self.step[i],
+                    _ => &mut self.lambda[i],
+                };
+                let new = (*acc - w / self.diag[i]).max(0.0);
+                let delta = new - *acc;
+                *acc = new;
+                if delta != 0.0 {
+                    max_delta = max_delta.max(delta.abs());
+                    for (off, bi) in [(0usize, row.body_a), (3, row.body_b)] {
+                        let b = &mut bodies[bi];
+                        if b.is_dynamic() {
+                            b.vel.x += b.inv_mass * j[off] * delta;
+                            b.vel.y += b.inv_mass * j[off + 1] * delta;
+                            b.omega += b.inv_inertia * j[off + 2] * delta;
+                        }
+                    }
+                }
+            }
+            if max_delta < 1e-9 {
+                converged = true;
+                break;
+            }
+        }
+        LcpReport {
+            n,
+            method: super::lcp::LcpMethod::Pgs,
+            active_mask: 0,
+            iterations: sweeps,
+            converged,
+            enumeration_failed: false,
+            pgs_failed: !converged,
+        }
+    }
+
     /// Writes `G u` for the bodies' current twists into the chosen buffer.
     fn normal_velocities(&mut self, rows: &[ImpactRow], bodies: &[Body], into: Buf) {
         let out = match into {
@@ -390,6 +513,13 @@ impl ImpactSolver {
         }
     }
 }
+
+/// Largest impact set solved with the dense Delassus matrix and the exact/PGS LCP of §7.3; larger
+/// sets use the equivalent sparse PGS on body twists ([`ImpactSolver`]'s `solve_sparse`).
+pub const DENSE_MAX_ROWS: usize = 24;
+
+/// Sweep limit of the sparse PGS (§7.3: 200).
+const PGS_MAX_SWEEPS: usize = 200;
 
 /// Internal buffer selector.
 #[derive(Clone, Copy)]

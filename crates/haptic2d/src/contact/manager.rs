@@ -45,6 +45,10 @@ pub struct ContactSet {
     row_entry: Vec<usize>,
     solver: ImpactSolver,
     body_flag: Vec<bool>,
+    parent: Vec<u32>,
+    row_order: Vec<u32>,
+    row_island: Vec<u32>,
+    island_rows: Vec<ImpactRow>,
     new_count: Vec<u32>,
     nonfric: Vec<Vec2>,
     /// Kinetic energy removed by the impacts of the last sample (J).
@@ -66,6 +70,10 @@ impl ContactSet {
             row_entry: Vec::with_capacity(16),
             solver: ImpactSolver::new(),
             body_flag: Vec::new(),
+            parent: Vec::new(),
+            row_order: Vec::with_capacity(16),
+            row_island: Vec::with_capacity(16),
+            island_rows: Vec::with_capacity(16),
             new_count: Vec::new(),
             nonfric: Vec::new(),
             last_impact_loss: 0.0,
@@ -133,6 +141,7 @@ impl ContactSet {
     fn resize_body_buffers(&mut self, n: usize) {
         if self.body_flag.len() != n {
             self.body_flag.resize(n, false);
+            self.parent.resize(n, 0);
             self.new_count.resize(n, 0);
             self.nonfric.resize(n, Vec2::ZERO);
         }
@@ -376,7 +385,7 @@ impl ContactSet {
             self.row_entry.push(idx);
         }
         let before: f64 = bodies.iter().map(|b| b.kinetic_energy()).sum();
-        self.solver.solve(&self.rows, bodies);
+        self.solve_islands(bodies);
         let after: f64 = bodies.iter().map(|b| b.kinetic_energy()).sum();
         self.last_impact_loss = before - after;
         self.impacts_solved += 1;
@@ -394,6 +403,65 @@ impl ContactSet {
                 bodies[e.body_a].point_velocity(e.point) - bodies[e.body_b].point_velocity(e.point);
             e.c0 = e.n.dot(v_rel);
             e.s0 = e.t.dot(v_rel);
+        }
+    }
+
+    /// Solves the impact set island by island: rows that share no dynamic body are independent (the
+    /// Delassus matrix is block diagonal), so each connected component is its own small LCP. Islands
+    /// are taken in the order of their root body, rows in key order: the result is deterministic and
+    /// identical to solving the whole set at once.
+    fn solve_islands(&mut self, bodies: &mut [Body]) {
+        // Union–find over dynamic bodies (fixed bodies connect nothing).
+        for (i, p) in self.parent.iter_mut().enumerate() {
+            *p = i as u32;
+        }
+        fn find(parent: &mut [u32], mut i: u32) -> u32 {
+            while parent[i as usize] != i {
+                let g = parent[parent[i as usize] as usize];
+                parent[i as usize] = g;
+                i = g;
+            }
+            i
+        }
+        for r in &self.rows {
+            if bodies[r.body_a].is_dynamic() && bodies[r.body_b].is_dynamic() {
+                let (a, b) = (
+                    find(&mut self.parent, r.body_a as u32),
+                    find(&mut self.parent, r.body_b as u32),
+                );
+                if a != b {
+                    let (lo, hi) = if a < b { (a, b) } else { (b, a) };
+                    self.parent[hi as usize] = lo;
+                }
+            }
+        }
+        // Island id of each row: the root of its dynamic body.
+        self.row_island.clear();
+        for r in &self.rows {
+            let b = if bodies[r.body_a].is_dynamic() {
+                r.body_a
+            } else {
+                r.body_b
+            };
+            let root = find(&mut self.parent, b as u32);
+            self.row_island.push(root);
+        }
+        // Group rows by island (stable: rows keep key order inside an island), then solve each run.
+        self.row_order.clear();
+        self.row_order.extend(0..self.rows.len() as u32);
+        let islands = &self.row_island;
+        self.row_order
+            .sort_unstable_by_key(|&r| (islands[r as usize], r));
+        let mut k = 0;
+        while k < self.row_order.len() {
+            let island = self.row_island[self.row_order[k] as usize];
+            self.island_rows.clear();
+            while k < self.row_order.len() && self.row_island[self.row_order[k] as usize] == island
+            {
+                self.island_rows.push(self.rows[self.row_order[k] as usize]);
+                k += 1;
+            }
+            self.solver.solve(&self.island_rows, bodies);
         }
     }
 

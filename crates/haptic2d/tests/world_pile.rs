@@ -1,0 +1,36 @@
+//! The pile scene (scaling): stays finite and bodies do not sink into each other.
+
+use haptic2d::scene::builtin;
+
+#[test]
+fn pile_settles_without_deep_interpenetration() {
+    // 250 boxes (10 staggered rows of 25), 2 kg each, under 9.81 m/s² into a container; Kc = 1e5 N/m.
+    let mut w = builtin("pile:250", None).unwrap().unwrap().world;
+    let steps = (3.0 / w.params.dt) as usize;
+    for _ in 0..steps {
+        w.step();
+    }
+    for b in &w.bodies {
+        assert!(
+            b.pose.pos.is_finite()
+                && b.pose.angle.is_finite()
+                && b.vel.is_finite()
+                && b.omega.is_finite(),
+            "{} is not finite",
+            b.name
+        );
+    }
+    // Equilibrium penetration: the whole weight rests on the 25 bottom boxes' 2 floor corners each:
+    // δ_eq = N·m·g / (50·Kc) = 250·2·9.81 / (50·1e5) ≈ 0.98 mm.
+    let kc = 1.0e5;
+    let delta_eq = 250.0 * 2.0 * 9.81 / (50.0 * kc);
+    let deepest = w.contact_records().map(|c| -c.d[0]).fold(0.0, f64::max);
+    assert!(
+        deepest <= 2.0 * delta_eq,
+        "deepest penetration {deepest} m vs 2·δ_eq = {} m",
+        2.0 * delta_eq
+    );
+    // And the pile has come (nearly) to rest.
+    let ke = w.ledger().kinetic;
+    assert!(ke < 1.0, "kinetic energy after 3 s: {ke} J");
+}
