@@ -225,8 +225,9 @@
     const [bx, by] = [view.w - 20 - 10 * pxPerMm, view.h - 14];
     ctx.strokeStyle = "#444"; ctx.lineWidth = 2;
     ctx.beginPath(); ctx.moveTo(bx, by); ctx.lineTo(bx + 10 * pxPerMm, by); ctx.stroke();
-    ctx.fillStyle = "#444"; ctx.font = "11px system-ui"; ctx.textAlign = "center";
-    ctx.fillText(pxPerMm >= 0.4 ? "10 mm (grid 1 mm)" : "10 mm", bx + 5 * pxPerMm, by - 5);
+    ctx.fillStyle = "#444"; ctx.font = "11px system-ui"; ctx.textAlign = "right";
+    const minor = pxPerMm >= 4 ? "1 mm" : (pxPerMm >= 0.4 ? "10 mm" : "100 mm");
+    ctx.fillText(`10 mm · grid ${minor} · arrows ${forceLegend()}`, view.w - 20, by - 5);
   }
 
   function poly(points) {
@@ -301,8 +302,14 @@
     ctx.closePath(); ctx.fill();
   }
 
-  const PX_PER_N = 25; // force arrows: 25 px per newton
+  // Force arrows: 25 px per newton, shortened so that the largest contact force is at most 90 px.
+  let pxPerN = 25;
+  function forceLegend() { return `${(10 / pxPerN).toPrecision(2)} N per 10 px`; }
   function drawContacts(f) {
+    let fmax = 0;
+    for (const c of f.contacts) fmax = Math.max(fmax, Math.abs(c.f_n), Math.abs(c.f_t));
+    pxPerN = fmax > 0 ? Math.min(25, 90 / fmax) : 25;
+    const PX_PER_N = pxPerN;
     for (const c of f.contacts) {
       // God-object: hollow square on the edge.
       const [gx, gy] = toScreen(c.god_object[0], c.god_object[1]);
