@@ -192,7 +192,7 @@ pub fn parse_client_message(text: &str) -> Result<ClientMessage, String> {
             for (k, v) in [("x", x), ("y", y), ("theta", theta)] {
                 if !(v.is_finite() && v.abs() <= MAX_TARGET_COORDINATE) {
                     return Err(format!(
-                        "set_hand_target.{k} = {v} is out of range (|{k}| ≤ {MAX_TARGET_COORDINATE})"
+                        "set_hand_target.{k} = {v:.3e} is out of range (|{k}| ≤ {MAX_TARGET_COORDINATE})"
                     ));
                 }
             }
@@ -276,7 +276,10 @@ mod tests {
             (r#"{"type":"set_hand_target","x":0,"y":0}"#, "malformed"),
             (r#"{"type":"switch_scene","name":"nope"}"#, "box-in-walls"),
             (r#"{"type":"set_wall_law","name":"nope"}"#, "paper"),
-            (r#"{"type":"set_friction","name":"nope"}"#, "reset-integrator"),
+            (
+                r#"{"type":"set_friction","name":"nope"}"#,
+                "reset-integrator",
+            ),
             (r#"{"type":"set_controller","name":"nope"}"#, "four-channel"),
             ("[]", "malformed"),
         ] {

@@ -33,7 +33,9 @@ pub mod scene_info;
 pub mod server;
 pub mod timing;
 
-pub use command::{parse_client_message, ClientMessage, Command, ControllerKind, MAX_MESSAGE_BYTES};
+pub use command::{
+    parse_client_message, ClientMessage, Command, ControllerKind, MAX_MESSAGE_BYTES,
+};
 pub use frame::{ContactView, DeviceView, Energies, Frame, FrameInputs, LoopTiming};
 pub use hub::{ServerEnd, ViewHub, DEFAULT_FRAME_RATE_HZ};
 pub use scene_info::{BodyShape, DeviceGeometry, SceneInfo};

@@ -13,8 +13,8 @@
 //! [`ViewHandle::token`] (in the WebSocket URL `?token=…` or a first message
 //! `{"type": "hello", "token": "…"}`); viewing never does.
 
-use crate::command::{parse_client_message, scene_names, ClientMessage, Command, ControllerKind};
 use crate::command::MAX_MESSAGE_BYTES;
+use crate::command::{parse_client_message, scene_names, ClientMessage, Command, ControllerKind};
 use crate::frame::Frame;
 use crate::hub::ServerEnd;
 use crate::scene_info::SceneInfo;
@@ -136,7 +136,9 @@ fn to_text(m: &Outgoing<'_>) -> Utf8Bytes {
         Err(e) => {
             // Only non-finite numbers can fail here: serde_json refuses NaN/∞ (as does JSON).
             eprintln!("haptic2d-view: cannot serialise a message: {e}");
-            Utf8Bytes::from_static(r#"{"type":"error","message":"server could not serialise a message"}"#)
+            Utf8Bytes::from_static(
+                r#"{"type":"error","message":"server could not serialise a message"}"#,
+            )
         }
     }
 }
@@ -187,9 +189,7 @@ impl ViewServer {
         let addr = listener
             .local_addr()
             .map_err(|e| format!("cannot start the display on {bind}: {e}"))?;
-        let require = options
-            .require_token
-            .unwrap_or(!addr.ip().is_loopback());
+        let require = options.require_token.unwrap_or(!addr.ip().is_loopback());
         let token = require.then(|| options.token.clone().unwrap_or_else(random_token));
 
         let runtime = tokio::runtime::Builder::new_multi_thread()
@@ -353,7 +353,9 @@ async fn broadcaster(
     mut shutdown: watch::Receiver<bool>,
     counters: Arc<Counters>,
 ) {
-    let mut tick = tokio::time::interval(Duration::from_secs_f64(1.0 / frame_rate_hz));
+    // Poll at 4× the frame rate: the loop publishes on its own clock, and polling at the same rate
+    // would alias (two publications between polls, one lost). Unchanged buffers cost one atomic load.
+    let mut tick = tokio::time::interval(Duration::from_secs_f64(0.25 / frame_rate_hz));
     tick.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Skip);
     loop {
         tokio::select! {
@@ -400,9 +402,7 @@ async fn health() -> &'static str {
 }
 
 fn query_token(query: Option<&str>) -> Option<&str> {
-    query?
-        .split('&')
-        .find_map(|kv| kv.strip_prefix("token="))
+    query?.split('&').find_map(|kv| kv.strip_prefix("token="))
 }
 
 async fn ws_upgrade(
@@ -446,7 +446,10 @@ impl Viewer {
 
     /// Counts, logs (within the budget) and returns the error frame for a rejected message.
     fn reject(&mut self, message: &str) -> Utf8Bytes {
-        self.state.counters.bad_messages.fetch_add(1, Ordering::Relaxed);
+        self.state
+            .counters
+            .bad_messages
+            .fetch_add(1, Ordering::Relaxed);
         if self.log_budget > 0 {
             self.log_budget -= 1;
             let more = if self.log_budget == 0 {
@@ -537,7 +540,15 @@ async fn viewer(mut socket: WebSocket, state: Arc<AppState>, peer: SocketAddr, a
                     }
                 }
                 Some(Err(e)) => {
-                    let _ = v.reject(&format!("connection closed: {e}"));
+                    // A message over the hard limit ends the connection (tungstenite's capacity
+                    // error): count and log it. Other errors are disconnects (a closed tab, a
+                    // reset): not the viewer's fault, not logged.
+                    let text = e.to_string();
+                    if text.contains("Space limit exceeded") || text.contains("too long") {
+                        let _ = v.reject(&format!(
+                            "message over the hard limit of {HARD_MESSAGE_LIMIT} bytes, connection closed: {text}"
+                        ));
+                    }
                     ok = false;
                 }
             },

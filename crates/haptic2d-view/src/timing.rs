@@ -31,7 +31,9 @@ impl LiveTiming {
     /// Allocates its histograms here, once.
     pub fn new(rate_hz: f64, window_s: f64) -> Result<Self, String> {
         if !(rate_hz.is_finite() && rate_hz > 0.0) {
-            return Err(format!("rate_hz = {rate_hz}: must be a positive rate in Hz"));
+            return Err(format!(
+                "rate_hz = {rate_hz}: must be a positive rate in Hz"
+            ));
         }
         if !(window_s.is_finite() && window_s > 0.0) {
             return Err(format!("window_s = {window_s}: must be > 0 s"));
@@ -59,7 +61,12 @@ impl LiveTiming {
     #[inline]
     pub fn record_tick(&mut self, info: &TickInfo, end_ns: u64) {
         let woke = info.deadline_ns + info.lateness_ns;
-        self.record(woke, info.lateness_ns, end_ns.saturating_sub(woke), info.skipped);
+        self.record(
+            woke,
+            info.lateness_ns,
+            end_ns.saturating_sub(woke),
+            info.skipped,
+        );
     }
 
     /// Records one tick that woke at `woke_ns` (monotonic ns), `lateness_ns` after its deadline,
@@ -130,7 +137,10 @@ mod tests {
         assert!((s.achieved_hz - 1000.0).abs() < 1.0, "{s:?}");
         assert!((s.lateness_p50_us - 10.0).abs() < 0.1, "{s:?}");
         assert!((s.compute_p50_us - 5.0).abs() < 0.1, "{s:?}");
-        assert!(s.lateness_max_us <= 11.0, "second window has no spike: {s:?}");
+        assert!(
+            s.lateness_max_us <= 11.0,
+            "second window has no spike: {s:?}"
+        );
         assert!(LiveTiming::new(0.0, 1.0).unwrap_err().contains("rate_hz"));
         assert!(LiveTiming::new(1.0, 0.0).unwrap_err().contains("window_s"));
     }

@@ -27,7 +27,10 @@ fn missing_prerequisites(e2e: &Path) -> Vec<String> {
     if !node_ok {
         missing.push("node".into());
     }
-    if !e2e.join("node_modules/playwright-core/package.json").exists() {
+    if !e2e
+        .join("node_modules/playwright-core/package.json")
+        .exists()
+    {
         missing.push("e2e/node_modules (npm ci)".into());
     }
     missing

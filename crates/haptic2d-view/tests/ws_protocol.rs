@@ -15,7 +15,8 @@ use std::sync::{Arc, Mutex};
 use std::time::Duration;
 use tokio_tungstenite::tungstenite::Message;
 
-type Ws = tokio_tungstenite::WebSocketStream<tokio_tungstenite::MaybeTlsStream<tokio::net::TcpStream>>;
+type Ws =
+    tokio_tungstenite::WebSocketStream<tokio_tungstenite::MaybeTlsStream<tokio::net::TcpStream>>;
 
 fn world() -> (World, SceneInfo) {
     let s = builtin("box-in-walls", Some(1000.0)).unwrap().unwrap();
@@ -145,7 +146,11 @@ async fn viewers_get_welcome_scene_and_frames_and_commands_reach_the_loop() {
     }
     // Commands: parsed, acknowledged (except hand targets), delivered in order.
     let ws = &mut viewers[0];
-    send(ws, r#"{"type":"set_hand_target","x":0.01,"y":0.002,"theta":0.1}"#).await;
+    send(
+        ws,
+        r#"{"type":"set_hand_target","x":0.01,"y":0.002,"theta":0.1}"#,
+    )
+    .await;
     for msg in [
         r#"{"type":"pause"}"#,
         r#"{"type":"set_wall_law","name":"colgate"}"#,
@@ -203,8 +208,14 @@ async fn bad_messages_get_an_error_frame_and_the_stream_goes_on() {
     for (msg, needle) in [
         ("{not json", "malformed"),
         (r#"{"type":"self_destruct"}"#, "malformed"),
-        (r#"{"type":"set_wall_law","name":"rubber"}"#, "unknown wall law"),
-        (r#"{"type":"set_hand_target","x":1e300,"y":0,"theta":0}"#, "out of range"),
+        (
+            r#"{"type":"set_wall_law","name":"rubber"}"#,
+            "unknown wall law",
+        ),
+        (
+            r#"{"type":"set_hand_target","x":1e300,"y":0,"theta":0}"#,
+            "out of range",
+        ),
         (big.as_str(), "limit of 4096 bytes"),
     ] {
         send(&mut ws, msg).await;
@@ -214,7 +225,9 @@ async fn bad_messages_get_an_error_frame_and_the_stream_goes_on() {
             "{msg:.60}: {e}"
         );
     }
-    ws.send(Message::Binary(vec![1u8, 2, 3].into())).await.unwrap();
+    ws.send(Message::Binary(vec![1u8, 2, 3].into()))
+        .await
+        .unwrap();
     let e = next_of(&mut ws, "error").await;
     assert!(e["message"].as_str().unwrap().contains("binary"));
     // Still connected and receiving frames; nothing reached the loop.
@@ -303,8 +316,8 @@ fn http_get(addr: std::net::SocketAddr, path: &str) -> String {
 fn health_page_script_and_port_taken() {
     let (w, _) = world();
     let (_hub, end) = ViewHub::new(&Frame::for_world(&w), 60.0).unwrap();
-    let server = ViewServer::start("127.0.0.1:0".parse().unwrap(), end, ViewOptions::default())
-        .unwrap();
+    let server =
+        ViewServer::start("127.0.0.1:0".parse().unwrap(), end, ViewOptions::default()).unwrap();
     let addr = server.local_addr();
     let health = http_get(addr, "/health");
     assert!(health.starts_with("HTTP/1.1 200"), "{health}");
@@ -319,7 +332,10 @@ fn health_page_script_and_port_taken() {
     let err = ViewServer::start(addr, end2, ViewOptions::default())
         .err()
         .expect("a taken port is an error");
-    assert!(err.contains("already in use") && err.contains(&addr.to_string()), "{err}");
+    assert!(
+        err.contains("already in use") && err.contains(&addr.to_string()),
+        "{err}"
+    );
     assert!(ViewHub::new(&Frame::default(), 0.0)
         .err()
         .unwrap()

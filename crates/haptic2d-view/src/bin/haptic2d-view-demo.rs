@@ -92,7 +92,8 @@ fn parse_args() -> Result<Args, String> {
     Ok(a)
 }
 
-/// The demo's controller.
+/// The demo's controller. Kept inline (not boxed): one instance, switched rarely.
+#[allow(clippy::large_enum_variant)]
 enum Controller {
     Coupling(VirtualCoupling),
     FourChannel(FourChannel),
@@ -281,7 +282,10 @@ impl Demo {
             slave: self.slave,
             hand_target: t,
             drive: self.drive,
-            device: Some((&self.kin, [t[0] - self.offset[0], t[1] - self.offset[1], t[2]])),
+            device: Some((
+                &self.kin,
+                [t[0] - self.offset[0], t[1] - self.offset[1], t[2]],
+            )),
             device_to_world: self.offset,
             passivity_energy: None,
             timing: timing.snapshot(),
