@@ -1,0 +1,183 @@
+// End-to-end test of the haptic2d live display in a real browser (Debian's Chromium, headless).
+//
+// Usage: node view_e2e.mjs URL
+//   URL                      the page served by haptic2d-view-demo (or `haptic2d run`), e.g. http://127.0.0.1:8080/
+//   CHROMIUM_PATH            the browser (default /usr/bin/chromium)
+//   HAPTIC2D_VIEW_SCREENSHOT where to save a PNG of the page after the drag (optional)
+//
+// Checks: the page connects and receives scene + frames; the canvas is not blank (pixel variance
+// of a screenshot); dragging the hand target into the left wall moves the box there and a contact
+// appears (read through window.__haptic2d, fed by the state stream); Q rotates the target; no page
+// errors and no error frames. Prints one JSON line with the measurements; exit code 0 on success.
+
+import { chromium } from "playwright-core";
+import { mkdtempSync, rmSync } from "node:fs";
+import { tmpdir } from "node:os";
+import { join } from "node:path";
+
+const url = process.argv[2];
+if (!url) {
+  console.error("usage: node view_e2e.mjs URL");
+  process.exit(2);
+}
+const executablePath = process.env.CHROMIUM_PATH || "/usr/bin/chromium";
+const screenshotPath = process.env.HAPTIC2D_VIEW_SCREENSHOT;
+
+const watchdog = setTimeout(() => {
+  console.error("FAIL: the e2e script did not finish within 90 s");
+  process.exit(1);
+}, 90_000);
+
+function check(cond, what) {
+  if (!cond) throw new Error(what);
+}
+
+const userDataDir = mkdtempSync(join(tmpdir(), "haptic2d-e2e-"));
+let context;
+const result = {};
+try {
+  context = await chromium.launchPersistentContext(userDataDir, {
+    executablePath,
+    headless: true,
+    viewport: { width: 1400, height: 900 },
+    args: [
+      "--headless",
+      "--no-sandbox",
+      "--disable-gpu",
+      "--disable-quic",
+      "--no-first-run",
+      "--disable-background-networking",
+      "--disable-component-update",
+      "--disable-sync",
+    ],
+  });
+  const page = context.pages()[0] || (await context.newPage());
+  const pageErrors = [];
+  page.on("pageerror", (e) => pageErrors.push(String(e)));
+  page.on("console", (m) => {
+    if (m.type() === "error") pageErrors.push(m.text());
+  });
+
+  // 1. The page loads, connects, gets the scene and frames.
+  await page.goto(url, { waitUntil: "load" });
+  await page.waitForFunction(
+    () => window.__haptic2d && window.__haptic2d.scene && window.__haptic2d.framesForScene >= 10,
+    null,
+    { timeout: 20_000 },
+  );
+  const start = await page.evaluate(() => {
+    const h = window.__haptic2d;
+    const f = h.lastFrame;
+    return { scene: h.scene.name, slave: h.scene.slave, pose: f.bodies[h.scene.slave], control: h.welcome.control };
+  });
+  result.scene = start.scene;
+  result.start_pose = start.pose;
+  check(start.slave !== null, "the scene has no slave body");
+  check(start.control, "the page has no control (token?)");
+
+  // 2. The canvas is not blank: pixel variance of a screenshot of it, decoded by the browser.
+  const canvasShot = await page.locator("#world").screenshot();
+  const stats = await page.evaluate(async (b64) => {
+    const img = new Image();
+    img.src = "data:image/png;base64," + b64;
+    await img.decode();
+    const c = new OffscreenCanvas(img.width, img.height);
+    const g = c.getContext("2d");
+    g.drawImage(img, 0, 0);
+    const d = g.getImageData(0, 0, img.width, img.height).data;
+    let n = 0, sum = 0, sum2 = 0;
+    const colours = new Set();
+    for (let i = 0; i < d.length; i += 4) {
+      const y = 0.299 * d[i] + 0.587 * d[i + 1] + 0.114 * d[i + 2];
+      sum += y; sum2 += y * y; n++;
+      if (i % 64 === 0) colours.add((d[i] << 16) | (d[i + 1] << 8) | d[i + 2]);
+    }
+    const mean = sum / n;
+    return { width: img.width, height: img.height, variance: sum2 / n - mean * mean, colours: colours.size };
+  }, canvasShot.toString("base64"));
+  result.canvas = stats;
+  check(stats.variance > 100 && stats.colours > 8, `the canvas looks blank: ${JSON.stringify(stats)}`);
+
+  // 3. Drag the hand target from the box into the left wall (x = 0): 10 mm inside the wall.
+  const [x0, y0] = start.pose;
+  const from = await page.evaluate(([x, y]) => window.__haptic2d.worldToClient(x, y), [x0, y0]);
+  const to = await page.evaluate(([x, y]) => window.__haptic2d.worldToClient(x, y), [-0.01, y0]);
+  await page.mouse.move(from.x, from.y);
+  await page.mouse.down();
+  await page.mouse.move(to.x, to.y, { steps: 20 });
+  await page.mouse.up();
+  const goal = await page.evaluate(([cx, cy]) => window.__haptic2d.clientToWorld(cx, cy), [to.x, to.y]);
+  result.drag_goal = goal;
+
+  // The loop echoes the target, the box reaches the wall (its left face, 20 mm from its centre,
+  // at x ≈ 0) and the contact manager reports contacts there.
+  await page.waitForFunction(
+    ([gx]) => {
+      const f = window.__haptic2d.lastFrame;
+      if (!f) return false;
+      const p = f.bodies[f.slave];
+      return Math.abs(f.hand_target[0] - gx) < 1e-3 && f.contacts_total > 0 && p[0] < 0.025;
+    },
+    [goal[0]],
+    { timeout: 20_000 },
+  );
+  const hit = await page.evaluate(() => {
+    const f = window.__haptic2d.lastFrame;
+    return {
+      t: f.t,
+      pose: f.bodies[f.slave],
+      contacts_total: f.contacts_total,
+      contacts: f.contacts.map((c) => ({
+        point: c.point, god_object: c.god_object, normal: c.normal, f_n: c.f_n, state: c.state, body_b: c.body_b,
+      })),
+      contact_force_n: f.contact_force_n,
+      hand_target: f.hand_target,
+      device_valid: f.device ? f.device.valid : null,
+    };
+  });
+  result.hit = hit;
+  check(hit.pose[0] < x0 - 0.01, `the box did not move left: ${JSON.stringify(hit.pose)}`);
+  // The box's left corners touch the wall's face: god-objects on the face (x = 0), normal +x, the
+  // vertices inside the wall (x < 0) but not beyond the target (x > −10 mm).
+  check(
+    hit.contacts.some((c) => Math.abs(c.god_object[0]) < 1e-6 && c.normal[0] > 0.99 && c.point[0] < 0 && c.point[0] > -0.01),
+    `no contact on the left wall's face (x = 0, normal +x): ${JSON.stringify(hit.contacts)}`,
+  );
+  // Pressed towards a target 10 mm inside the wall by the coupling: several newtons in steady
+  // contact (coupling 500 N/m in series with 2 × 1000 N/m corner springs: 12 N).
+  await page.waitForFunction(() => window.__haptic2d.lastFrame.contact_force_n > 1.0, null, { timeout: 10_000 });
+  result.contact_force_n = await page.evaluate(() => window.__haptic2d.lastFrame.contact_force_n);
+
+  // 4. Q rotates the hand target by +5°, and the loop echoes it.
+  const theta0 = await page.evaluate(() => window.__haptic2d.lastFrame.hand_target[2]);
+  await page.keyboard.press("q");
+  await page.waitForFunction(
+    (t0) => Math.abs(window.__haptic2d.lastFrame.hand_target[2] - (t0 + (5 * Math.PI) / 180)) < 1e-6,
+    theta0,
+    { timeout: 10_000 },
+  );
+  result.rotated = true;
+
+  // 5. Nothing went wrong on the way.
+  const errors = await page.evaluate(() => window.__haptic2d.errors);
+  check(errors.length === 0, `error frames: ${JSON.stringify(errors)}`);
+  check(pageErrors.length === 0, `page errors: ${JSON.stringify(pageErrors)}`);
+  result.frames_received = await page.evaluate(() => window.__haptic2d.framesReceived);
+
+  if (screenshotPath) {
+    await page.waitForTimeout(300);
+    await page.screenshot({ path: screenshotPath });
+    result.screenshot = screenshotPath;
+  }
+  console.log(JSON.stringify({ ok: true, ...result }));
+  await context.close();
+  clearTimeout(watchdog);
+  rmSync(userDataDir, { recursive: true, force: true });
+  process.exit(0);
+} catch (e) {
+  console.log(JSON.stringify({ ok: false, error: String(e && e.message ? e.message : e), ...result }));
+  console.error(`FAIL: ${e && e.stack ? e.stack : e}`);
+  if (context) await context.close().catch(() => {});
+  rmSync(userDataDir, { recursive: true, force: true });
+  process.exit(1);
+}

@@ -1,0 +1,292 @@
+//! Commands from the page to the haptic loop, and how client messages are parsed and checked.
+//!
+//! The page sends JSON text messages `{"type": "...", ...}` (at most [`MAX_MESSAGE_BYTES`]). The
+//! server parses and validates them on its own thread; only valid commands reach the loop, through a
+//! wait-free ring that the loop drains between ticks with
+//! [`ViewHub::poll_command`](crate::ViewHub::poll_command). A [`Command`] is `Copy` and holds only
+//! `'static` names, so receiving and dropping one on the real-time thread never touches the heap.
+
+use haptic2d::laws::friction::FrictionModel;
+use haptic2d::laws::normal::NORMAL_MODEL_NAMES;
+use haptic2d::scene::BUILTIN;
+use serde::{Deserialize, Serialize};
+
+/// Largest accepted client message (bytes). Longer ones get an error frame.
+pub const MAX_MESSAGE_BYTES: usize = 4096;
+
+/// Largest accepted coordinate of a hand target (m or rad, absolute value).
+pub const MAX_TARGET_COORDINATE: f64 = 1000.0;
+
+/// The controllers the page can select.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub enum ControllerKind {
+    /// The four-channel controller of §11.1 (the default of `haptic2d run`).
+    #[serde(rename = "four-channel")]
+    FourChannel,
+    /// The virtual-coupling (impedance) controller of §11.2.
+    #[serde(rename = "coupling")]
+    Coupling,
+}
+
+impl ControllerKind {
+    /// Every controller, in the order the page lists them.
+    pub const ALL: [ControllerKind; 2] = [ControllerKind::FourChannel, ControllerKind::Coupling];
+
+    /// The name used on the command line and in messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            ControllerKind::FourChannel => "four-channel",
+            ControllerKind::Coupling => "coupling",
+        }
+    }
+
+    /// The controller called `name`; the error lists the valid names.
+    pub fn from_name(name: &str) -> Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|c| c.name() == name)
+            .ok_or_else(|| format!("unknown controller `{name}`; valid: four-channel, coupling"))
+    }
+}
+
+/// What the page asks the loop to do. Delivered through [`ViewHub::poll_command`](crate::ViewHub::poll_command);
+/// the loop applies it between ticks.
+///
+/// Semantics the loop must implement:
+///
+/// - [`SetHandTarget`](Command::SetHandTarget): the new target pose of the (simulated) hand, in the
+///   **world** frame. With a simulated device the simulated hand pulls the handle towards
+///   `target − device_to_world` (device frame); without a device (the demo) the controller's master
+///   pose is the target itself. Clamp it to the device workspace if needed; ignore it with a real
+///   device (the real hand is the input).
+/// - [`SwitchScene`](Command::SwitchScene): load the built-in scene `name` (at the loop's rate),
+///   rebuild the world, re-pick the slave, reset the controller, the passivity observer and the hand
+///   target (to the slave's initial pose); keep the currently selected wall law, friction model and
+///   controller. Then publish a new [`SceneInfo`](crate::SceneInfo) with
+///   [`ViewHub::publish_scene`](crate::ViewHub::publish_scene). Loading allocates: do it between
+///   ticks and accept one late tick, or prepare the scene on another thread.
+/// - [`SetWallLaw`](Command::SetWallLaw): `world.normal = NormalModel::from_name(name, true)`:
+///   every contact created from now on uses it (existing contacts keep their copy until released).
+/// - [`SetFriction`](Command::SetFriction): `world.friction = FrictionModel::from_name(name, true)`,
+///   same rule as the wall law.
+/// - [`SetController`](Command::SetController): switch the teleoperation controller, starting from a
+///   reset state (no stored integrator or filter state carried over).
+/// - [`Pause`](Command::Pause): stop stepping the world and command zero device force; frames keep
+///   flowing with `paused = true`. Idempotent.
+/// - [`Resume`](Command::Resume): step again from the frozen state. Idempotent.
+/// - [`Reset`](Command::Reset): reload the current scene to its initial state (as `SwitchScene` to
+///   the current scene, keeping the selected laws and controller) and publish its `SceneInfo` again;
+///   the paused state is kept.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Command {
+    /// Move the hand target to `(x, y, theta)` (m, m, rad, world frame; θ unwrapped).
+    SetHandTarget {
+        /// x (m).
+        x: f64,
+        /// y (m).
+        y: f64,
+        /// θ (rad).
+        theta: f64,
+    },
+    /// Switch to the built-in scene `name` (one of [`haptic2d::scene::BUILTIN`]).
+    SwitchScene {
+        /// Scene name.
+        name: &'static str,
+    },
+    /// Select the normal (wall) law `name` (one of [`NORMAL_MODEL_NAMES`]).
+    SetWallLaw {
+        /// Law name.
+        name: &'static str,
+    },
+    /// Select the friction model `name` (one of [`FrictionModel::NAMES`]).
+    SetFriction {
+        /// Model name.
+        name: &'static str,
+    },
+    /// Select the controller.
+    SetController {
+        /// Which one.
+        kind: ControllerKind,
+    },
+    /// Freeze the world.
+    Pause,
+    /// Unfreeze the world.
+    Resume,
+    /// Restart the current scene.
+    Reset,
+}
+
+impl Command {
+    /// The message `type` that carries this command.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Command::SetHandTarget { .. } => "set_hand_target",
+            Command::SwitchScene { .. } => "switch_scene",
+            Command::SetWallLaw { .. } => "set_wall_law",
+            Command::SetFriction { .. } => "set_friction",
+            Command::SetController { .. } => "set_controller",
+            Command::Pause => "pause",
+            Command::Resume => "resume",
+            Command::Reset => "reset",
+        }
+    }
+}
+
+/// A message from the page, as parsed (names still owned strings).
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+enum Incoming {
+    Hello { token: String },
+    SetHandTarget { x: f64, y: f64, theta: f64 },
+    SwitchScene { name: String },
+    SetWallLaw { name: String },
+    SetFriction { name: String },
+    SetController { name: String },
+    // Struct variants, so that `deny_unknown_fields` rejects extra fields.
+    Pause {},
+    Resume {},
+    Reset {},
+}
+
+/// A checked client message.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ClientMessage {
+    /// Authentication: the token printed at startup.
+    Hello {
+        /// The token as sent.
+        token: String,
+    },
+    /// A command for the loop.
+    Command(Command),
+}
+
+fn static_name(kind: &str, name: &str, valid: &[&'static str]) -> Result<&'static str, String> {
+    valid
+        .iter()
+        .copied()
+        .find(|v| *v == name)
+        .ok_or_else(|| format!("unknown {kind} `{name}`; valid: {}", valid.join(", ")))
+}
+
+/// The names of the built-in scenes the page may switch to.
+pub fn scene_names() -> Vec<&'static str> {
+    BUILTIN.iter().map(|b| b.0).collect()
+}
+
+/// Parses and checks one text message. Errors are one-line messages for the client and the log.
+pub fn parse_client_message(text: &str) -> Result<ClientMessage, String> {
+    if text.len() > MAX_MESSAGE_BYTES {
+        return Err(format!(
+            "message of {} bytes is larger than the limit of {MAX_MESSAGE_BYTES} bytes",
+            text.len()
+        ));
+    }
+    let msg: Incoming = serde_json::from_str(text).map_err(|e| {
+        let mut s = e.to_string();
+        s.truncate(200);
+        format!("malformed message: {s}")
+    })?;
+    let cmd = match msg {
+        Incoming::Hello { token } => return Ok(ClientMessage::Hello { token }),
+        Incoming::SetHandTarget { x, y, theta } => {
+            for (k, v) in [("x", x), ("y", y), ("theta", theta)] {
+                if !(v.is_finite() && v.abs() <= MAX_TARGET_COORDINATE) {
+                    return Err(format!(
+                        "set_hand_target.{k} = {v:.3e} is out of range (|{k}| ≤ {MAX_TARGET_COORDINATE})"
+                    ));
+                }
+            }
+            Command::SetHandTarget { x, y, theta }
+        }
+        Incoming::SwitchScene { name } => Command::SwitchScene {
+            name: static_name("scene", &name, &scene_names())?,
+        },
+        Incoming::SetWallLaw { name } => Command::SetWallLaw {
+            name: static_name("wall law", &name, &NORMAL_MODEL_NAMES)?,
+        },
+        Incoming::SetFriction { name } => Command::SetFriction {
+            name: static_name("friction model", &name, FrictionModel::NAMES)?,
+        },
+        Incoming::SetController { name } => Command::SetController {
+            kind: ControllerKind::from_name(&name)?,
+        },
+        Incoming::Pause {} => Command::Pause,
+        Incoming::Resume {} => Command::Resume,
+        Incoming::Reset {} => Command::Reset,
+    };
+    Ok(ClientMessage::Command(cmd))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_every_command() {
+        let ok = |s: &str| match parse_client_message(s) {
+            Ok(ClientMessage::Command(c)) => c,
+            other => panic!("{s}: {other:?}"),
+        };
+        assert_eq!(
+            ok(r#"{"type":"set_hand_target","x":0.01,"y":-0.02,"theta":0.5}"#),
+            Command::SetHandTarget {
+                x: 0.01,
+                y: -0.02,
+                theta: 0.5
+            }
+        );
+        assert_eq!(
+            ok(r#"{"type":"switch_scene","name":"peg-in-hole"}"#),
+            Command::SwitchScene {
+                name: "peg-in-hole"
+            }
+        );
+        assert_eq!(
+            ok(r#"{"type":"set_wall_law","name":"seh-pc"}"#),
+            Command::SetWallLaw { name: "seh-pc" }
+        );
+        assert_eq!(
+            ok(r#"{"type":"set_friction","name":"dahl"}"#),
+            Command::SetFriction { name: "dahl" }
+        );
+        assert_eq!(
+            ok(r#"{"type":"set_controller","name":"coupling"}"#),
+            Command::SetController {
+                kind: ControllerKind::Coupling
+            }
+        );
+        assert_eq!(ok(r#"{"type":"pause"}"#), Command::Pause);
+        assert_eq!(ok(r#"{"type":"resume"}"#), Command::Resume);
+        assert_eq!(ok(r#"{"type":"reset"}"#), Command::Reset);
+        assert_eq!(
+            parse_client_message(r#"{"type":"hello","token":"abc"}"#),
+            Ok(ClientMessage::Hello {
+                token: "abc".into()
+            })
+        );
+    }
+
+    #[test]
+    fn rejects_bad_messages_with_a_reason() {
+        for (msg, needle) in [
+            ("not json", "malformed"),
+            (r#"{"type":"launch_rockets"}"#, "malformed"),
+            (r#"{"type":"pause","extra":1}"#, "malformed"),
+            (r#"{"type":"set_hand_target","x":1e9,"y":0,"theta":0}"#, "x"),
+            (r#"{"type":"set_hand_target","x":0,"y":0}"#, "malformed"),
+            (r#"{"type":"switch_scene","name":"nope"}"#, "box-in-walls"),
+            (r#"{"type":"set_wall_law","name":"nope"}"#, "paper"),
+            (
+                r#"{"type":"set_friction","name":"nope"}"#,
+                "reset-integrator",
+            ),
+            (r#"{"type":"set_controller","name":"nope"}"#, "four-channel"),
+            ("[]", "malformed"),
+        ] {
+            let e = parse_client_message(msg).expect_err(msg);
+            assert!(e.contains(needle), "{msg}: {e}");
+        }
+        let big = format!(r#"{{"type":"hello","token":"{}"}}"#, "a".repeat(5000));
+        assert!(parse_client_message(&big).unwrap_err().contains("limit"));
+    }
+}

@@ -1,0 +1,491 @@
+// haptic2d live view: plain JavaScript + canvas, no build step.
+//
+// Protocol (JSON text over /ws): the server sends {type: "welcome" | "scene" | "frame" | "ack" |
+// "error"}; the page sends commands {type: "set_hand_target", x, y, theta} (world frame, m, rad),
+// {type: "switch_scene" | "set_wall_law" | "set_friction" | "set_controller", name},
+// {type: "pause" | "resume" | "reset"} and {type: "hello", token}.
+"use strict";
+
+(function () {
+  const $ = (id) => document.getElementById(id);
+  const params = new URLSearchParams(location.search);
+  const token = params.get("token");
+
+  // State shared with tests through window.__haptic2d.
+  const state = {
+    connected: false,
+    welcome: null,
+    scene: null,
+    lastFrame: null,
+    framesReceived: 0,
+    framesForScene: 0,
+    errors: [],
+    acks: [],
+    commandsSent: 0,
+    target: null, // [x, y, theta] the page last asked for
+  };
+
+  // ---------------------------------------------------------------- connection
+  let ws = null;
+  let retryMs = 500;
+
+  function setStatus(kind, text) {
+    const el = $("status");
+    el.className = kind;
+    $("status-text").textContent = text;
+  }
+
+  function logMessage(text, isError) {
+    const line = `${new Date().toLocaleTimeString()} ${text}`;
+    if (isError) state.errors.push(text);
+    const pre = $("errors");
+    pre.textContent = (line + "\n" + pre.textContent).slice(0, 4000);
+  }
+
+  function connect() {
+    const proto = location.protocol === "https:" ? "wss:" : "ws:";
+    const url = `${proto}//${location.host}/ws${token ? "?token=" + encodeURIComponent(token) : ""}`;
+    setStatus("connecting", "connecting…");
+    ws = new WebSocket(url);
+    ws.onopen = () => {
+      state.connected = true;
+      retryMs = 500;
+      setStatus("open", "connected");
+    };
+    ws.onclose = () => {
+      state.connected = false;
+      setStatus("closed", `disconnected — retrying in ${(retryMs / 1000).toFixed(1)} s`);
+      setTimeout(connect, retryMs);
+      retryMs = Math.min(retryMs * 2, 5000);
+    };
+    ws.onerror = () => {};
+    ws.onmessage = (ev) => {
+      let msg;
+      try {
+        msg = JSON.parse(ev.data);
+      } catch (e) {
+        logMessage("unreadable message from the server", true);
+        return;
+      }
+      switch (msg.type) {
+        case "frame": onFrame(msg); break;
+        case "scene": onScene(msg); break;
+        case "welcome": onWelcome(msg); break;
+        case "ack": state.acks.push(msg.command); logMessage(`ok: ${msg.command}`, false); break;
+        case "error": logMessage(`error: ${msg.message}`, true); break;
+        default: break;
+      }
+    };
+  }
+
+  function send(obj) {
+    if (!ws || ws.readyState !== WebSocket.OPEN) return false;
+    ws.send(JSON.stringify(obj));
+    state.commandsSent += 1;
+    return true;
+  }
+
+  // ---------------------------------------------------------------- messages
+  function fillSelect(sel, names, type) {
+    sel.innerHTML = "";
+    for (const n of names) {
+      const o = document.createElement("option");
+      o.value = n; o.textContent = n;
+      sel.appendChild(o);
+    }
+    sel.onchange = () => send({ type, name: sel.value });
+  }
+
+  function onWelcome(msg) {
+    state.welcome = msg;
+    const o = msg.options;
+    fillSelect($("sel-scene"), o.scenes, "switch_scene");
+    fillSelect($("sel-wall"), o.wall_laws, "set_wall_law");
+    fillSelect($("sel-friction"), o.friction_models, "set_friction");
+    fillSelect($("sel-controller"), o.controllers, "set_controller");
+    const ctl = msg.control;
+    for (const id of ["sel-scene", "sel-wall", "sel-friction", "sel-controller", "btn-pause", "btn-reset"]) {
+      $(id).disabled = !ctl;
+    }
+    $("control-hint").textContent = ctl ? "" :
+      "view only: commands need the token printed at startup (open the page with ?token=…)";
+    if (state.scene) $("sel-scene").value = state.scene.name;
+  }
+
+  function onScene(msg) {
+    state.scene = msg;
+    state.framesForScene = 0;
+    state.target = null;
+    $("scene-name").textContent = msg.name;
+    if ($("sel-scene").options.length) $("sel-scene").value = msg.name;
+    charts.forEach((c) => c.clear());
+    fitView();
+  }
+
+  let frameTimes = [];
+  function onFrame(f) {
+    if (state.scene && f.scene_seq !== state.scene.seq) return; // a frame of another scene
+    state.lastFrame = f;
+    state.framesReceived += 1;
+    state.framesForScene += 1;
+    const now = performance.now();
+    frameTimes.push(now);
+    while (frameTimes.length && now - frameTimes[0] > 2000) frameTimes.shift();
+    if (state.target === null) state.target = f.hand_target.slice();
+    if (!dragging) state.target = f.hand_target.slice();
+    charts[0].push(f.t, [f.contact_force_n, f.contact_force_t]);
+    charts[1].push(f.t, [f.energy.kinetic * 1e3, f.energy.stored * 1e3, f.energy.applied_work * 1e3,
+      f.energy.passivity == null ? NaN : f.energy.passivity * 1e3]);
+    charts[2].push(f.t, [f.timing.lateness_p50_us, f.timing.lateness_p99_us, f.timing.lateness_max_us]);
+    updatePanel(f);
+  }
+
+  function fmt(v, d) { return (v === null || v === undefined || !isFinite(v)) ? "—" : v.toFixed(d); }
+
+  function updatePanel(f) {
+    const t = f.timing;
+    $("sim-time").textContent = f.t.toFixed(3);
+    $("contact-count").textContent = f.contacts_total;
+    $("paused-badge").style.display = f.paused ? "inline" : "none";
+    $("btn-pause").textContent = f.paused ? "Resume" : "Pause";
+    for (const [id, v] of [["sel-wall", f.wall_law], ["sel-friction", f.friction], ["sel-controller", f.controller]]) {
+      const sel = $(id);
+      if (document.activeElement !== sel && sel.value !== v) sel.value = v;
+    }
+    $("tm-rate").textContent = `${fmt(t.rate_hz, 0)} / ${fmt(t.achieved_hz, 1)} Hz`;
+    $("tm-late").textContent = `${fmt(t.lateness_p50_us, 1)} / ${fmt(t.lateness_p99_us, 1)} / ${fmt(t.lateness_max_us, 1)} µs`;
+    $("tm-comp").textContent = `${fmt(t.compute_p50_us, 1)} / ${fmt(t.compute_p99_us, 1)} µs`;
+    $("tm-over").textContent = `${t.overruns} / ${t.skipped}`;
+    $("tm-ticks").textContent = `${t.ticks}`;
+    const fps = frameTimes.length > 1 ? (frameTimes.length - 1) / ((frameTimes[frameTimes.length - 1] - frameTimes[0]) / 1000) : 0;
+    $("tm-frames").textContent = `${state.framesReceived} (${fps.toFixed(0)} /s)`;
+    if (f.slave !== null && f.bodies[f.slave]) {
+      const p = f.bodies[f.slave];
+      $("st-pos").textContent = `${fmt(p[0] * 1e3, 2)}, ${fmt(p[1] * 1e3, 2)}`;
+      $("st-theta").textContent = fmt(p[2] * 180 / Math.PI, 1);
+    }
+    const h = f.hand_target;
+    $("st-target").textContent = `${fmt(h[0] * 1e3, 1)}, ${fmt(h[1] * 1e3, 1)}, ${fmt(h[2] * 180 / Math.PI, 0)}`;
+    $("st-force").textContent = `${fmt(f.contact_force_n, 3)} / ${fmt(f.contact_force_t, 3)}`;
+    $("st-energy").textContent = `${fmt(f.energy.kinetic * 1e3, 3)} / ${fmt(f.energy.stored * 1e3, 3)}`;
+    $("st-excess").textContent = fmt(f.energy.excess * 1e3, 4);
+  }
+
+  // ---------------------------------------------------------------- world view
+  const canvas = $("world");
+  const ctx = canvas.getContext("2d");
+  // World → screen: sx = ox + x·scale, sy = oy − y·scale (CSS pixels, y up in the world).
+  const view = { scale: 1000, ox: 0, oy: 0, w: 0, h: 0, dpr: 1 };
+
+  function resizeCanvas(c) {
+    const dpr = window.devicePixelRatio || 1;
+    const r = c.getBoundingClientRect();
+    const w = Math.max(1, Math.round(r.width * dpr)), h = Math.max(1, Math.round(r.height * dpr));
+    if (c.width !== w || c.height !== h) { c.width = w; c.height = h; }
+    return { w: r.width, h: r.height, dpr };
+  }
+
+  function fitView() {
+    const r = resizeCanvas(canvas);
+    view.w = r.w; view.h = r.h; view.dpr = r.dpr;
+    const s = state.scene;
+    let b = s ? s.bounds.slice() : [-0.1, -0.1, 0.1, 0.1];
+    if (s && s.device) {
+      const m = s.device.motors, ws = s.device.workspace;
+      b = [Math.min(b[0], m[0][0], ws[0]), Math.min(b[1], m[0][1] - 0.01, ws[1]),
+        Math.max(b[2], m[1][0], ws[2]), Math.max(b[3], ws[3])];
+    }
+    const pad = 24;
+    const bw = Math.max(b[2] - b[0], 1e-3), bh = Math.max(b[3] - b[1], 1e-3);
+    view.scale = Math.min((view.w - 2 * pad) / bw, (view.h - 2 * pad) / bh);
+    view.ox = view.w / 2 - view.scale * (b[0] + b[2]) / 2;
+    view.oy = view.h / 2 + view.scale * (b[1] + b[3]) / 2;
+  }
+
+  const toScreen = (x, y) => [view.ox + x * view.scale, view.oy - y * view.scale];
+  const toWorld = (sx, sy) => [(sx - view.ox) / view.scale, (view.oy - sy) / view.scale];
+
+  function drawGrid() {
+    const [x0, y1] = toWorld(0, 0), [x1, y0] = toWorld(view.w, view.h);
+    const pxPerMm = view.scale * 1e-3;
+    const levels = [[0.001, "#efeff2"], [0.01, "#dcdce2"], [0.1, "#c4c4cc"]];
+    for (const [step, color] of levels) {
+      if (step * view.scale < 4) continue; // too dense to draw
+      ctx.strokeStyle = color; ctx.lineWidth = 1;
+      ctx.beginPath();
+      for (let x = Math.ceil(x0 / step) * step; x <= x1; x += step) {
+        const [sx] = toScreen(x, 0); ctx.moveTo(Math.round(sx) + 0.5, 0); ctx.lineTo(Math.round(sx) + 0.5, view.h);
+      }
+      for (let y = Math.ceil(y0 / step) * step; y <= y1; y += step) {
+        const [, sy] = toScreen(0, y); ctx.moveTo(0, Math.round(sy) + 0.5); ctx.lineTo(view.w, Math.round(sy) + 0.5);
+      }
+      ctx.stroke();
+    }
+    // Scale bar: 10 mm.
+    const [bx, by] = [view.w - 20 - 10 * pxPerMm, view.h - 14];
+    ctx.strokeStyle = "#444"; ctx.lineWidth = 2;
+    ctx.beginPath(); ctx.moveTo(bx, by); ctx.lineTo(bx + 10 * pxPerMm, by); ctx.stroke();
+    ctx.fillStyle = "#444"; ctx.font = "11px system-ui"; ctx.textAlign = "right";
+    const minor = pxPerMm >= 4 ? "1 mm" : (pxPerMm >= 0.4 ? "10 mm" : "100 mm");
+    ctx.fillText(`10 mm · grid ${minor} · arrows ${forceLegend()}`, view.w - 20, by - 5);
+  }
+
+  function poly(points) {
+    ctx.beginPath();
+    points.forEach((p, i) => { const [sx, sy] = toScreen(p[0], p[1]); i ? ctx.lineTo(sx, sy) : ctx.moveTo(sx, sy); });
+    ctx.closePath();
+  }
+
+  function drawBodies(f) {
+    const s = state.scene;
+    s.bodies.forEach((b, i) => {
+      const pose = f.bodies[i]; if (!pose) return;
+      const c = Math.cos(pose[2]), sn = Math.sin(pose[2]);
+      const isSlave = s.slave === i;
+      ctx.fillStyle = b.fixed ? "#9a9aa3" : (isSlave ? "rgba(217,72,15,0.75)" : "rgba(54,113,201,0.7)");
+      ctx.strokeStyle = b.fixed ? "#6f6f78" : (isSlave ? "#a33208" : "#244e8f");
+      ctx.lineWidth = 1.2;
+      for (const piece of b.pieces) {
+        poly(piece.map(([x, y]) => [pose[0] + c * x - sn * y, pose[1] + sn * x + c * y]));
+        ctx.fill(); ctx.stroke();
+      }
+      if (!b.fixed) { // centre of mass
+        const [sx, sy] = toScreen(pose[0], pose[1]);
+        ctx.fillStyle = "#fff"; ctx.beginPath(); ctx.arc(sx, sy, 2.5, 0, 2 * Math.PI); ctx.fill();
+      }
+    });
+  }
+
+  function line(a, b) {
+    const [ax, ay] = toScreen(a[0], a[1]), [bx, by] = toScreen(b[0], b[1]);
+    ctx.beginPath(); ctx.moveTo(ax, ay); ctx.lineTo(bx, by); ctx.stroke();
+  }
+
+  function dot(p, r, fill) {
+    const [sx, sy] = toScreen(p[0], p[1]);
+    ctx.fillStyle = fill; ctx.beginPath(); ctx.arc(sx, sy, r, 0, 2 * Math.PI); ctx.fill();
+  }
+
+  function drawDevice(f) {
+    const g = state.scene.device, d = f.device;
+    if (!g) return;
+    const ws = g.workspace;
+    ctx.setLineDash([4, 3]); ctx.strokeStyle = "rgba(90,90,100,0.6)"; ctx.lineWidth = 1;
+    poly([[ws[0], ws[1]], [ws[2], ws[1]], [ws[2], ws[3]], [ws[0], ws[3]]]); ctx.stroke();
+    ctx.setLineDash([]);
+    g.motors.forEach((m) => dot(m, 5, "rgba(40,40,48,0.8)"));
+    if (!d || !d.valid) return;
+    ctx.lineCap = "round";
+    // Pantograph 1 (elbows 0, 1 → P1), pantograph 2 (elbows 2, 3 → P2), then the crank P1 → P2.
+    const links = [[0, 0, 0], [1, 1, 0], [0, 2, 1], [1, 3, 1]];
+    links.forEach(([motor, elbow, end], k) => {
+      ctx.strokeStyle = k < 2 ? "rgba(60,60,70,0.55)" : "rgba(120,80,160,0.5)";
+      ctx.lineWidth = 4; line(g.motors[motor], d.elbows[elbow]);
+      ctx.lineWidth = 2.5; line(d.elbows[elbow], d.endpoints[end]);
+    });
+    ctx.strokeStyle = "rgba(20,20,20,0.8)"; ctx.lineWidth = 3; line(d.endpoints[0], d.endpoints[1]);
+    d.elbows.forEach((e) => dot(e, 2.5, "rgba(40,40,48,0.8)"));
+    dot(d.endpoints[0], 4, "#222"); dot(d.endpoints[1], 3, "#7a4fa3");
+    ctx.lineCap = "butt";
+  }
+
+  function arrow(p, v, color) {
+    const [ax, ay] = toScreen(p[0], p[1]);
+    const bx = ax + v[0], by = ay - v[1];
+    const len = Math.hypot(v[0], v[1]); if (len < 1) return;
+    ctx.strokeStyle = color; ctx.fillStyle = color; ctx.lineWidth = 2;
+    ctx.beginPath(); ctx.moveTo(ax, ay); ctx.lineTo(bx, by); ctx.stroke();
+    const ux = (bx - ax) / len, uy = (by - ay) / len, h = Math.min(8, len * 0.5);
+    ctx.beginPath(); ctx.moveTo(bx, by);
+    ctx.lineTo(bx - h * ux + 0.5 * h * uy, by - h * uy - 0.5 * h * ux);
+    ctx.lineTo(bx - h * ux - 0.5 * h * uy, by - h * uy + 0.5 * h * ux);
+    ctx.closePath(); ctx.fill();
+  }
+
+  // Force arrows: 25 px per newton, shortened so that the largest contact force is at most 90 px.
+  let pxPerN = 25;
+  function forceLegend() { return `${(10 / pxPerN).toPrecision(2)} N per 10 px`; }
+  function drawContacts(f) {
+    let fmax = 0;
+    for (const c of f.contacts) fmax = Math.max(fmax, Math.abs(c.f_n), Math.abs(c.f_t));
+    pxPerN = fmax > 0 ? Math.min(25, 90 / fmax) : 25;
+    const PX_PER_N = pxPerN;
+    for (const c of f.contacts) {
+      // God-object: hollow square on the edge.
+      const [gx, gy] = toScreen(c.god_object[0], c.god_object[1]);
+      ctx.strokeStyle = "#1971c2"; ctx.lineWidth = 1.5; ctx.strokeRect(gx - 3.5, gy - 3.5, 7, 7);
+      arrow(c.point, [c.normal[0] * c.f_n * PX_PER_N, c.normal[1] * c.f_n * PX_PER_N], "#2b8a3e");
+      arrow(c.point, [c.tangent[0] * c.f_t * PX_PER_N, c.tangent[1] * c.f_t * PX_PER_N], "#e67700");
+      dot(c.point, 3.5, c.state === "colliding" ? "#c92a2a" : "#2b8a3e");
+    }
+  }
+
+  function drawTarget() {
+    const t = state.target; if (!t) return;
+    const [sx, sy] = toScreen(t[0], t[1]);
+    ctx.strokeStyle = "#c2255c"; ctx.lineWidth = 1.5;
+    ctx.beginPath(); ctx.arc(sx, sy, 9, 0, 2 * Math.PI); ctx.stroke();
+    ctx.beginPath(); ctx.moveTo(sx - 13, sy); ctx.lineTo(sx + 13, sy); ctx.moveTo(sx, sy - 13); ctx.lineTo(sx, sy + 13); ctx.stroke();
+    ctx.lineWidth = 2.5; ctx.beginPath(); ctx.moveTo(sx, sy);
+    ctx.lineTo(sx + 20 * Math.cos(t[2]), sy - 20 * Math.sin(t[2])); ctx.stroke();
+  }
+
+  function drawWorld() {
+    const r = resizeCanvas(canvas);
+    if (r.w !== view.w || r.h !== view.h) fitView();
+    ctx.setTransform(view.dpr, 0, 0, view.dpr, 0, 0);
+    ctx.fillStyle = "#ffffff"; ctx.fillRect(0, 0, view.w, view.h);
+    drawGrid();
+    const f = state.lastFrame;
+    if (!state.scene || !f) {
+      ctx.fillStyle = "#888"; ctx.font = "14px system-ui"; ctx.textAlign = "center";
+      ctx.fillText(state.connected ? "waiting for the haptic loop…" : "connecting…", view.w / 2, view.h / 2);
+      return;
+    }
+    drawBodies(f);
+    drawDevice(f);
+    drawContacts(f);
+    drawTarget();
+  }
+
+  // ---------------------------------------------------------------- strip charts
+  class StripChart {
+    constructor(canvas, title, unit, names, colors, span) {
+      Object.assign(this, { canvas, title, unit, names, colors, span });
+      this.ctx = canvas.getContext("2d");
+      this.clear();
+    }
+    clear() { this.t = []; this.v = this.names.map(() => []); }
+    push(t, values) {
+      this.t.push(t); values.forEach((x, i) => this.v[i].push(x));
+      while (this.t.length && t - this.t[0] > this.span) { this.t.shift(); this.v.forEach((a) => a.shift()); }
+    }
+    draw() {
+      const r = resizeCanvas(this.canvas), c = this.ctx;
+      c.setTransform(r.dpr, 0, 0, r.dpr, 0, 0);
+      c.fillStyle = "#fff"; c.fillRect(0, 0, r.w, r.h);
+      const L = 44, R = 8, T = 18, B = 16, w = r.w - L - R, h = r.h - T - B;
+      let lo = Infinity, hi = -Infinity;
+      for (const a of this.v) for (const x of a) if (isFinite(x)) { lo = Math.min(lo, x); hi = Math.max(hi, x); }
+      if (!isFinite(lo)) { lo = 0; hi = 1; }
+      lo = Math.min(lo, 0); if (hi - lo < 1e-9) hi = lo + 1;
+      hi += 0.05 * (hi - lo);
+      c.font = "11px system-ui"; c.textAlign = "left"; c.fillStyle = "#333";
+      c.fillText(`${this.title} (${this.unit})`, L, 12);
+      let lx = L + c.measureText(`${this.title} (${this.unit})`).width + 10;
+      this.names.forEach((n, i) => { c.fillStyle = this.colors[i]; c.fillText(n, lx, 12); lx += c.measureText(n).width + 8; });
+      c.strokeStyle = "#e3e3e8"; c.lineWidth = 1; c.fillStyle = "#777"; c.textAlign = "right";
+      for (let k = 0; k <= 2; k++) {
+        const y = T + h - (k / 2) * h, val = lo + (k / 2) * (hi - lo);
+        c.beginPath(); c.moveTo(L, Math.round(y) + 0.5); c.lineTo(L + w, Math.round(y) + 0.5); c.stroke();
+        c.fillText(Math.abs(val) >= 100 ? val.toFixed(0) : val.toPrecision(3), L - 4, y + 4);
+      }
+      if (this.t.length < 2) return;
+      const t1 = this.t[this.t.length - 1], t0 = t1 - this.span;
+      c.textAlign = "right"; c.fillStyle = "#777"; c.fillText(`last ${this.span} s`, L + w, r.h - 3);
+      this.v.forEach((a, i) => {
+        c.strokeStyle = this.colors[i]; c.lineWidth = 1.5; c.beginPath();
+        let pen = false;
+        a.forEach((x, j) => {
+          if (!isFinite(x)) { pen = false; return; }
+          const px = L + ((this.t[j] - t0) / this.span) * w, py = T + h - ((x - lo) / (hi - lo)) * h;
+          pen ? c.lineTo(px, py) : c.moveTo(px, py); pen = true;
+        });
+        c.stroke();
+      });
+    }
+  }
+
+  const charts = [
+    new StripChart($("chart-force"), "contact force", "N", ["Fn", "|Ft|"], ["#2b8a3e", "#e67700"], 10),
+    new StripChart($("chart-energy"), "energy", "mJ", ["kinetic", "stored", "work", "E_obs"], ["#1971c2", "#2b8a3e", "#868e96", "#c2255c"], 10),
+    new StripChart($("chart-timing"), "loop lateness", "µs", ["p50", "p99", "max"], ["#2b8a3e", "#e67700", "#c92a2a"], 10),
+  ];
+
+  // ---------------------------------------------------------------- input
+  let dragging = false;
+  let pendingTarget = null;
+
+  function setTarget(t) {
+    state.target = t;
+    pendingTarget = t;
+  }
+  function flushTarget() {
+    if (pendingTarget) {
+      const [x, y, theta] = pendingTarget;
+      send({ type: "set_hand_target", x, y, theta });
+      pendingTarget = null;
+    }
+  }
+  function pointerWorld(ev) {
+    const r = canvas.getBoundingClientRect();
+    return toWorld(ev.clientX - r.left, ev.clientY - r.top);
+  }
+  canvas.addEventListener("pointerdown", (ev) => {
+    if (!state.lastFrame) return;
+    dragging = true;
+    canvas.setPointerCapture(ev.pointerId);
+    const [x, y] = pointerWorld(ev);
+    setTarget([x, y, state.target ? state.target[2] : 0]);
+  });
+  canvas.addEventListener("pointermove", (ev) => {
+    if (!dragging) return;
+    const [x, y] = pointerWorld(ev);
+    setTarget([x, y, state.target ? state.target[2] : 0]);
+  });
+  const endDrag = () => { dragging = false; flushTarget(); };
+  canvas.addEventListener("pointerup", endDrag);
+  canvas.addEventListener("pointercancel", endDrag);
+
+  const ROTATE_STEP = 5 * Math.PI / 180;
+  function rotate(sign) {
+    if (!state.target) return;
+    setTarget([state.target[0], state.target[1], state.target[2] + sign * ROTATE_STEP]);
+  }
+  canvas.addEventListener("wheel", (ev) => { ev.preventDefault(); rotate(ev.deltaY < 0 ? 1 : -1); }, { passive: false });
+  window.addEventListener("keydown", (ev) => {
+    if (ev.target && ev.target.tagName === "SELECT") return;
+    if (ev.key === "q" || ev.key === "Q") rotate(1);
+    if (ev.key === "e" || ev.key === "E") rotate(-1);
+  });
+
+  $("btn-pause").onclick = () => send({ type: state.lastFrame && state.lastFrame.paused ? "resume" : "pause" });
+  $("btn-reset").onclick = () => send({ type: "reset" });
+  window.addEventListener("resize", fitView);
+
+  // ---------------------------------------------------------------- render loop
+  function render() {
+    flushTarget(); // at most one target command per animation frame
+    drawWorld();
+    charts.forEach((c) => c.draw());
+    requestAnimationFrame(render);
+  }
+
+  window.__haptic2d = {
+    get lastFrame() { return state.lastFrame; },
+    get framesReceived() { return state.framesReceived; },
+    get framesForScene() { return state.framesForScene; },
+    get scene() { return state.scene; },
+    get welcome() { return state.welcome; },
+    get connected() { return state.connected; },
+    get errors() { return state.errors.slice(); },
+    get acks() { return state.acks.slice(); },
+    get target() { return state.target && state.target.slice(); },
+    get commandsSent() { return state.commandsSent; },
+    send,
+    // World point (m) → viewport pixel, for tests that drive the pointer.
+    worldToClient(x, y) {
+      const r = canvas.getBoundingClientRect();
+      const [sx, sy] = toScreen(x, y);
+      return { x: r.left + sx, y: r.top + sy };
+    },
+    clientToWorld(cx, cy) {
+      const r = canvas.getBoundingClientRect();
+      return toWorld(cx - r.left, cy - r.top);
+    },
+  };
+
+  fitView();
+  connect();
+  requestAnimationFrame(render);
+})();

@@ -1,0 +1,88 @@
+//! End-to-end test in a real browser: starts `haptic2d-view-demo` on a free loopback port and runs
+//! `e2e/view_e2e.mjs` (playwright-core driving Debian's headless Chromium) against it.
+//!
+//! Needs `/usr/bin/chromium` (or `CHROMIUM_PATH`), `node` and `e2e/node_modules` (run
+//! `crates/haptic2d-view/e2e/install.sh`). When they are missing the test FAILS if the `CI`
+//! environment variable is set, and otherwise skips with a loud message. Set
+//! `HAPTIC2D_VIEW_SCREENSHOT=/path/shot.png` to keep a screenshot of the page.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+fn missing_prerequisites(e2e: &Path) -> Vec<String> {
+    let mut missing = Vec::new();
+    let chromium = std::env::var("CHROMIUM_PATH").unwrap_or_else(|_| "/usr/bin/chromium".into());
+    if !Path::new(&chromium).exists() {
+        missing.push(format!("chromium ({chromium})"));
+    }
+    let node_ok = Command::new("node")
+        .arg("--version")
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status()
+        .is_ok_and(|s| s.success());
+    if !node_ok {
+        missing.push("node".into());
+    }
+    if !e2e
+        .join("node_modules/playwright-core/package.json")
+        .exists()
+    {
+        missing.push("e2e/node_modules (npm ci)".into());
+    }
+    missing
+}
+
+#[test]
+fn browser_drag_into_wall_shows_box_moving_and_contact() {
+    let e2e = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("e2e");
+    let missing = missing_prerequisites(&e2e);
+    if !missing.is_empty() {
+        let msg = format!(
+            "browser e2e prerequisites missing: {}. Run crates/haptic2d-view/e2e/install.sh",
+            missing.join(", ")
+        );
+        if std::env::var_os("CI").is_some() {
+            panic!("{msg} (CI is set: this test must run)");
+        }
+        eprintln!("\n!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!");
+        eprintln!("!!! SKIPPED browser_e2e: {msg}");
+        eprintln!("!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!!\n");
+        return;
+    }
+
+    let demo = common::Demo::start(&[]);
+    let mut node = Command::new("node")
+        .arg(e2e.join("view_e2e.mjs"))
+        .arg(&demo.url)
+        .current_dir(&e2e)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("node starts");
+    let deadline = Instant::now() + Duration::from_secs(120);
+    let status = loop {
+        if let Some(s) = node.try_wait().expect("wait on node") {
+            break Some(s);
+        }
+        if Instant::now() > deadline {
+            let _ = node.kill();
+            break None;
+        }
+        std::thread::sleep(Duration::from_millis(100));
+    };
+    let out = node.wait_with_output().expect("node output");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    println!("e2e stdout: {stdout}");
+    println!("e2e stderr: {stderr}");
+    let status = status.expect("the e2e script finished within 120 s");
+    assert!(
+        status.success(),
+        "the browser e2e script failed ({status}):\n{stdout}\n{stderr}"
+    );
+    assert!(stdout.contains(r#""ok":true"#), "{stdout}");
+}
