@@ -31,7 +31,11 @@ pub const MODELS: [(&str, &str, &str); 5] = [
     ("classical", "classical", "Classical (Karnopp, v_th = 0.01)"),
     ("salcudean_vlaar", "salcudean-vlaar", "Salcudean–Vlaar"),
     ("reset_integrator", "reset-integrator", "Reset integrator"),
-    ("hayward_armstrong", "hayward-armstrong", "Hayward–Armstrong"),
+    (
+        "hayward_armstrong",
+        "hayward-armstrong",
+        "Hayward–Armstrong",
+    ),
     ("nahvi", "nahvi", "Nahvi finger pad"),
 ];
 /// The two push peaks (N): main and sub-stiction.
@@ -42,7 +46,10 @@ pub const DURATION: f64 = 5.2;
 /// §13.2 reference values at 2.1 N: `(creep_k, advance_k)` as printed in the table.
 pub fn reference(case: &str) -> (&'static str, &'static str) {
     match case {
-        "classical" => ("2.2e-3, 0.9e-3, 1.6e-3, 2.1e-3 (irregular)", "0.042, 0.035, 0.039"),
+        "classical" => (
+            "2.2e-3, 0.9e-3, 1.6e-3, 2.1e-3 (irregular)",
+            "0.042, 0.035, 0.039",
+        ),
         "salcudean_vlaar" => ("7.9e-5 (every cycle)", "0.0125"),
         "reset_integrator" => ("5.4e-5", "0.0407"),
         "hayward_armstrong" => ("5.0e-5", "0.0560"),
@@ -109,7 +116,9 @@ pub fn run_2d(case: &str, f_pk: f64, guard: Option<f64>) -> Result<Run2d, String
         loads += 1;
     }
     if loads != 1 {
-        return Err(format!("peg-in-hole: expected one load on the peg, found {loads}"));
+        return Err(format!(
+            "peg-in-hole: expected one load on the peg, found {loads}"
+        ));
     }
     let mut params = w.params;
     params.guard = guard;
@@ -162,7 +171,10 @@ pub fn run_2d(case: &str, f_pk: f64, guard: Option<f64>) -> Result<Run2d, String
 }
 
 fn sci(v: &[f64]) -> String {
-    v.iter().map(|x| format!("{x:.3e}")).collect::<Vec<_>>().join(", ")
+    v.iter()
+        .map(|x| format!("{x:.3e}"))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 fn measured(r: &PegResult, f_pk: f64, theta: f64, y: f64) -> Fig7Measured {
@@ -186,7 +198,11 @@ pub fn checks_f7_1_to_4(case: &str, m: &Fig7Measured, x_all_zero: bool) -> Vec<C
         c.push(Check::new(
             "F7",
             false,
-            format!("needs 4 creep_k and 3 advance_k, got {} and {}", m.creep_m.len(), m.advance_m.len()),
+            format!(
+                "needs 4 creep_k and 3 advance_k, got {} and {}",
+                m.creep_m.len(),
+                m.advance_m.len()
+            ),
         ));
         return c;
     }
@@ -203,8 +219,16 @@ pub fn checks_f7_1_to_4(case: &str, m: &Fig7Measured, x_all_zero: bool) -> Vec<C
             ));
         } else {
             let hi = max(&m.creep_m);
-            let dc = m.creep_m.windows(2).map(|w| (w[1] - w[0]).abs()).fold(0.0, f64::max);
-            let da = m.advance_m.windows(2).map(|w| (w[1] - w[0]).abs()).fold(0.0, f64::max);
+            let dc = m
+                .creep_m
+                .windows(2)
+                .map(|w| (w[1] - w[0]).abs())
+                .fold(0.0, f64::max);
+            let da = m
+                .advance_m
+                .windows(2)
+                .map(|w| (w[1] - w[0]).abs())
+                .fold(0.0, f64::max);
             c.push(Check::new(
                 "F7-2",
                 hi <= 2e-4 && dc < 1e-5 && da < 1e-5,
@@ -247,7 +271,11 @@ pub fn checks_f7_1_to_4(case: &str, m: &Fig7Measured, x_all_zero: bool) -> Vec<C
 
 /// F7-5: `ΔE − W_push ≤ 1e-6 J` in every cycle.
 pub fn check_f7_5(m: &Fig7Measured) -> Check {
-    let worst = m.energy_balance_j.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+    let worst = m
+        .energy_balance_j
+        .iter()
+        .cloned()
+        .fold(f64::NEG_INFINITY, f64::max);
     Check::new(
         "F7-5",
         m.energy_balance_j.len() == 4 && worst <= 1e-6,
@@ -388,8 +416,18 @@ impl Figure for Fig7 {
                 let mut c2 = checks_f7_1_to_4(case, &two.measured, zero(two));
                 c2.extend(checks_2d(case, &two.measured, &one.measured));
                 c2.push(check_f7_5(&two.measured));
-                cases.push(CaseMetrics::new(case, Dimension::OneD, Measured::Fig7(one.measured.clone()), c1));
-                cases.push(CaseMetrics::new(case, Dimension::TwoD, Measured::Fig7(two.measured.clone()), c2));
+                cases.push(CaseMetrics::new(
+                    case,
+                    Dimension::OneD,
+                    Measured::Fig7(one.measured.clone()),
+                    c1,
+                ));
+                cases.push(CaseMetrics::new(
+                    case,
+                    Dimension::TwoD,
+                    Measured::Fig7(two.measured.clone()),
+                    c2,
+                ));
                 for d in [one, two] {
                     let path = ctx
                         .dir
@@ -422,10 +460,30 @@ impl Figure for Fig7 {
                     x_label: "time (s)".into(),
                     y_label: "peg position x (mm)".into(),
                     series: vec![
-                        Series::new("1-D, F_pk 2.1 N", pts(get(i, 0, Dimension::OneD)), 0, Stroke::Solid),
-                        Series::new("2-D, F_pk 2.1 N", pts(get(i, 0, Dimension::TwoD)), 1, Stroke::Dashed),
-                        Series::new("1-D, F_pk 1.8 N", pts(get(i, 1, Dimension::OneD)), 2, Stroke::Solid),
-                        Series::new("2-D, F_pk 1.8 N", pts(get(i, 1, Dimension::TwoD)), 3, Stroke::Dashed),
+                        Series::new(
+                            "1-D, F_pk 2.1 N",
+                            pts(get(i, 0, Dimension::OneD)),
+                            0,
+                            Stroke::Solid,
+                        ),
+                        Series::new(
+                            "2-D, F_pk 2.1 N",
+                            pts(get(i, 0, Dimension::TwoD)),
+                            1,
+                            Stroke::Dashed,
+                        ),
+                        Series::new(
+                            "1-D, F_pk 1.8 N",
+                            pts(get(i, 1, Dimension::OneD)),
+                            2,
+                            Stroke::Solid,
+                        ),
+                        Series::new(
+                            "2-D, F_pk 1.8 N",
+                            pts(get(i, 1, Dimension::TwoD)),
+                            3,
+                            Stroke::Dashed,
+                        ),
                     ],
                     ..Panel::default()
                 }
@@ -443,11 +501,19 @@ impl Figure for Fig7 {
             let mut s = Vec::new();
             for (i, m) in MODELS.iter().enumerate() {
                 for (d, stroke, label) in [
-                    (Dimension::OneD, Stroke::LineMarkers, format!("{} (1-D)", m.0)),
+                    (
+                        Dimension::OneD,
+                        Stroke::LineMarkers,
+                        format!("{} (1-D)", m.0),
+                    ),
                     (Dimension::TwoD, Stroke::Markers, String::new()),
                 ] {
                     let v = f(&get(i, 0, d).measured);
-                    let pts = v.iter().enumerate().map(|(k, &x)| ((k + 1) as f64, x)).collect();
+                    let pts = v
+                        .iter()
+                        .enumerate()
+                        .map(|(k, &x)| ((k + 1) as f64, x))
+                        .collect();
                     s.push(Series::new(label, pts, i, stroke));
                 }
             }
@@ -513,9 +579,17 @@ fn report(m: &FigureMetrics) -> String {
             let (cr, ad) = reference(&c.model);
             format!("creep {cr}; advance {ad}")
         } else {
-            format!("{}; max|x| here {:.3e} m", reference_sub(&c.model), x.max_abs_x_m)
+            format!(
+                "{}; max|x| here {:.3e} m",
+                reference_sub(&c.model),
+                x.max_abs_x_m
+            )
         };
-        let worst = x.energy_balance_j.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+        let worst = x
+            .energy_balance_j
+            .iter()
+            .cloned()
+            .fold(f64::NEG_INFINITY, f64::max);
         let _ = writeln!(
             s,
             "| {} | {} | {} | {} | {} | {:.2e} | {reference} | {} |",

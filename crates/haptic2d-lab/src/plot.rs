@@ -55,7 +55,12 @@ pub struct Series {
 
 impl Series {
     /// A series with `label`, colour index `color` and `stroke`.
-    pub fn new(label: impl Into<String>, points: Vec<(f64, f64)>, color: usize, stroke: Stroke) -> Self {
+    pub fn new(
+        label: impl Into<String>,
+        points: Vec<(f64, f64)>,
+        color: usize,
+        stroke: Stroke,
+    ) -> Self {
         Self {
             label: label.into(),
             points,
@@ -148,9 +153,7 @@ fn draw_all<DB: DrawingBackend>(
     cols: usize,
 ) -> Result<(), String> {
     root.fill(&WHITE).map_err(err)?;
-    let root = root
-        .titled(title, (FONT_FAMILY, 22))
-        .map_err(err)?;
+    let root = root.titled(title, (FONT_FAMILY, 22)).map_err(err)?;
     let areas = root.split_evenly((rows, cols));
     for (area, p) in areas.iter().zip(panels) {
         draw_panel(area, p)?;
@@ -160,7 +163,12 @@ fn draw_all<DB: DrawingBackend>(
 
 /// Data bounds of a panel, padded; honours log axes and a fixed y range.
 fn bounds(p: &Panel) -> (f64, f64, f64, f64) {
-    let (mut x0, mut x1, mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
+    let (mut x0, mut x1, mut y0, mut y1) = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    );
     for s in &p.series {
         for &(x, y) in &s.points {
             if !(x.is_finite() && y.is_finite()) || (p.log_x && x <= 0.0) || (p.log_y && y <= 0.0) {
@@ -198,8 +206,16 @@ fn bounds(p: &Panel) -> (f64, f64, f64, f64) {
             (a - d, b + d)
         }
     };
-    let (x0, x1) = if p.log_x { pad(x0, x1, true) } else { (x0, if x1 > x0 { x1 } else { x0 + 1.0 }) };
-    let (y0, y1) = if p.y_range.is_some() { (y0, y1) } else { pad(y0, y1, p.log_y) };
+    let (x0, x1) = if p.log_x {
+        pad(x0, x1, true)
+    } else {
+        (x0, if x1 > x0 { x1 } else { x0 + 1.0 })
+    };
+    let (y0, y1) = if p.y_range.is_some() {
+        (y0, y1)
+    } else {
+        pad(y0, y1, p.log_y)
+    };
     (x0, x1, y0, y1)
 }
 
@@ -209,7 +225,13 @@ fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, p: &Panel) -> R
         (false, false) => fill(area, p, x0..x1, y0..y1, (x0, x1)),
         (true, false) => fill(area, p, (x0..x1).log_scale(), y0..y1, (x0, x1)),
         (false, true) => fill(area, p, x0..x1, (y0..y1).log_scale(), (x0, x1)),
-        (true, true) => fill(area, p, (x0..x1).log_scale(), (y0..y1).log_scale(), (x0, x1)),
+        (true, true) => fill(
+            area,
+            p,
+            (x0..x1).log_scale(),
+            (y0..y1).log_scale(),
+            (x0, x1),
+        ),
     }
 }
 
@@ -288,9 +310,10 @@ where
                     .map_err(err)?
             }
             Stroke::Squares => chart
-                .draw_series(pts.into_iter().map(|q| {
-                    EmptyElement::at(q) + Rectangle::new([(-5, -5), (5, 5)], filled)
-                }))
+                .draw_series(
+                    pts.into_iter()
+                        .map(|q| EmptyElement::at(q) + Rectangle::new([(-5, -5), (5, 5)], filled)),
+                )
                 .map_err(err)?,
         };
         if !s.label.is_empty() {

@@ -96,7 +96,9 @@ impl SweepConfig {
             if a.is_finite() && b.is_finite() && a > 0.0 && b > a {
                 Ok(())
             } else {
-                Err(format!("{name} range must satisfy 0 < min < max, got {a} … {b}"))
+                Err(format!(
+                    "{name} range must satisfy 0 < min < max, got {a} … {b}"
+                ))
             }
         };
         range("stiffness", self.k_range)?;
@@ -223,7 +225,10 @@ pub fn sweep_walls(
 ) -> Result<SweepSummary, String> {
     cfg.validate()?;
     if out.exists() && !out.is_dir() {
-        return Err(format!("--out: `{}` exists and is not a folder", out.display()));
+        return Err(format!(
+            "--out: `{}` exists and is not a folder",
+            out.display()
+        ));
     }
     std::fs::create_dir_all(out)
         .map_err(|e| format!("--out: cannot create `{}`: {e}", out.display()))?;
@@ -240,7 +245,9 @@ pub fn sweep_walls(
     }
     let bar = if show_progress {
         let b = ProgressBar::new(grid.len() as u64);
-        if let Ok(s) = ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} sweep") {
+        if let Ok(s) =
+            ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} sweep")
+        {
             b.set_style(s);
         }
         b
@@ -273,7 +280,8 @@ pub fn sweep_walls(
 
     let mut files = Vec::new();
     // CSV (numeric columns; the model and class as indices are awkward, so a text CSV is written).
-    let mut text = String::from("model,k_n_m,damping_n_s_m,damping_kind,separations,mean_ratio,class\n");
+    let mut text =
+        String::from("model,k_n_m,damping_n_s_m,damping_kind,separations,mean_ratio,class\n");
     for p in &points {
         text.push_str(&format!(
             "{},{},{},{},{},{},{}\n",
@@ -325,9 +333,19 @@ pub fn sweep_walls(
                     .collect::<Vec<_>>()
             };
             let mut series = vec![
-                Series::new("dissipative", pick(WallClass::Dissipative), 2, Stroke::Squares),
+                Series::new(
+                    "dissipative",
+                    pick(WallClass::Dissipative),
+                    2,
+                    Stroke::Squares,
+                ),
                 Series::new("marginal", pick(WallClass::Marginal), 3, Stroke::Squares),
-                Series::new("gains energy", pick(WallClass::GainsEnergy), 1, Stroke::Squares),
+                Series::new(
+                    "gains energy",
+                    pick(WallClass::GainsEnergy),
+                    1,
+                    Stroke::Squares,
+                ),
             ];
             if kind == DampingKind::Plant {
                 series.push(Series::new(
