@@ -312,10 +312,11 @@ pub fn checks_2d(case: &str, m2: &Fig7Measured, m1: &Fig7Measured) -> Vec<Check>
     let mut ok = a.len() == b.len();
     for ((name, x2), (_, x1)) in a.iter().zip(&b) {
         let rel = ((x2 - x1) / x1).abs();
-        if !(rel <= 0.10) {
+        // A NaN (e.g. a zero reference) fails the comparison and counts as the worst.
+        if rel.is_nan() || rel > 0.10 {
             ok = false;
         }
-        if !(rel <= worst.1) {
+        if rel.is_nan() || rel > worst.1 {
             worst = (name.clone(), rel);
         }
     }
