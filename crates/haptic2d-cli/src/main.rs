@@ -1,8 +1,10 @@
 //! `haptic2d`: the command-line tool of the haptic2d project.
 
 mod cmd_check;
+mod cmd_reproduce;
 mod cmd_scenes;
 mod cmd_simulate;
+mod cmd_sweep;
 mod csv_out;
 mod scene_arg;
 
@@ -45,6 +47,30 @@ enum Command {
         /// A scene file path, or a built-in scene name.
         scene: String,
     },
+    /// Reproduce the paper's figures (Fig. 4 walls, Fig. 7 peg in hole) as CSV data, SVG/PNG plots,
+    /// metrics.json and REPORT.md.
+    Reproduce {
+        /// Which figure: all, fig4 or fig7.
+        #[arg(default_value = "all")]
+        figure: String,
+        /// Output folder.
+        #[arg(long, default_value = "reproduction")]
+        out: PathBuf,
+    },
+    /// Parameter sweeps; `walls`: stiffness × damping of every wall law, classified by energy gain.
+    Sweep {
+        /// What to sweep: walls.
+        target: String,
+        /// Sample rate (Hz).
+        #[arg(long, default_value_t = 500.0, allow_negative_numbers = true)]
+        rate: f64,
+        /// Grid points per axis (2..=64).
+        #[arg(long, default_value_t = 12)]
+        points: usize,
+        /// Output folder.
+        #[arg(long, default_value = "reproduction/sweep-walls")]
+        out: PathBuf,
+    },
 }
 
 fn main() -> ExitCode {
@@ -59,6 +85,13 @@ fn main() -> ExitCode {
         } => cmd_simulate::run(&scene, duration, out.as_deref(), rate, every),
         Command::Scenes => cmd_scenes::run(),
         Command::Check { scene } => cmd_check::run(&scene),
+        Command::Reproduce { figure, out } => cmd_reproduce::run(&figure, &out),
+        Command::Sweep {
+            target,
+            rate,
+            points,
+            out,
+        } => cmd_sweep::run(&target, rate, points, &out),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

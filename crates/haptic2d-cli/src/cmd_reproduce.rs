@@ -1,0 +1,26 @@
+//! `haptic2d reproduce [all|fig4|fig7] [--out DIR]`: the paper's figures as data, plots, metrics and a
+//! report (see the `haptic2d-lab` crate).
+
+use std::path::Path;
+
+/// Runs the selected figure(s), writes `DIR/<figure>/` and `DIR/REPORT.md`, prints a summary. Fails
+/// (after writing everything) if any case does not pass.
+pub fn run(figure: &str, out: &Path) -> Result<(), String> {
+    let s = haptic2d_lab::reproduce(figure, out, true)?;
+    for f in &s.figures {
+        println!(
+            "{}: {}/{} cases pass ({:.2} s)",
+            f.name, f.passed, f.total, f.seconds
+        );
+        for c in &f.failing {
+            println!("  FAIL {c} (details in {}/metrics.json)", f.name);
+        }
+    }
+    println!("report: {}", s.report.display());
+    println!("total: {:.2} s", s.seconds);
+    if s.all_pass() {
+        Ok(())
+    } else {
+        Err("some cases do not pass; see the report".to_string())
+    }
+}

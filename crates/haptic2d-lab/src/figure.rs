@@ -1,0 +1,205 @@
+//! The [`Figure`] trait, the registry of figures and the `reproduce` driver.
+//!
+//! A figure computes its cases (in parallel with rayon), writes its CSV series and plots into
+//! `DIR/<figure>/`, and returns its metrics and a Markdown section. [`reproduce`] writes
+//! `DIR/<figure>/metrics.json` and `DIR/<figure>/report.md` for each selected figure, then assembles
+//! `DIR/REPORT.md` from the sections of every registered figure found in `DIR`.
+
+use crate::schema::FigureMetrics;
+use indicatif::{ProgressBar, ProgressStyle};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// What a figure gets to run.
+pub struct FigureContext<'a> {
+    /// The figure's output folder `DIR/<figure>/` (exists).
+    pub dir: PathBuf,
+    /// Progress bar; a figure advances it by one per finished job (see [`Figure::jobs`]).
+    pub progress: &'a ProgressBar,
+}
+
+/// What a figure returns.
+#[derive(Clone, Debug)]
+pub struct FigureReport {
+    /// The metrics written to `metrics.json`.
+    pub metrics: FigureMetrics,
+    /// The figure's section of `REPORT.md` (Markdown; image links relative to `DIR`).
+    pub markdown: String,
+    /// Files written into the figure folder (CSV, SVG, PNG).
+    pub files: Vec<PathBuf>,
+}
+
+/// A reproducible experiment of the paper.
+pub trait Figure: Send + Sync {
+    /// Short name, also the output folder and the `reproduce` argument (e.g. `fig4`).
+    fn name(&self) -> &'static str;
+    /// One-line title.
+    fn title(&self) -> &'static str;
+    /// Number of progress units the figure reports (one per simulated case).
+    fn jobs(&self) -> u64;
+    /// Runs every case and writes its files into `ctx.dir`.
+    fn run(&self, ctx: &FigureContext) -> Result<FigureReport, String>;
+}
+
+/// Every registered figure, in report order. Add new figures here.
+pub fn registry() -> Vec<Box<dyn Figure>> {
+    vec![Box::new(crate::fig4::Fig4), Box::new(crate::fig7::Fig7)]
+}
+
+/// Names of the registered figures.
+pub fn figure_names() -> Vec<&'static str> {
+    registry().iter().map(|f| f.name()).collect()
+}
+
+/// Per-figure outcome of a [`reproduce`] run.
+#[derive(Clone, Debug)]
+pub struct FigureSummary {
+    /// Figure name.
+    pub name: String,
+    /// Cases that pass.
+    pub passed: usize,
+    /// Cases in total.
+    pub total: usize,
+    /// Names (`model/dimension`) of the failing cases.
+    pub failing: Vec<String>,
+    /// Wall time of the figure (s).
+    pub seconds: f64,
+}
+
+/// Outcome of a [`reproduce`] run.
+#[derive(Clone, Debug)]
+pub struct ReproduceSummary {
+    /// One entry per figure run.
+    pub figures: Vec<FigureSummary>,
+    /// Path of `REPORT.md`.
+    pub report: PathBuf,
+    /// Total wall time (s).
+    pub seconds: f64,
+}
+
+impl ReproduceSummary {
+    /// Whether every case of every figure passes.
+    pub fn all_pass(&self) -> bool {
+        self.figures.iter().all(|f| f.passed == f.total)
+    }
+}
+
+/// Runs figure `which` (`all` or a registered name) and writes the outputs under `out`. With
+/// `show_progress`, a progress bar is drawn on stderr.
+pub fn reproduce(which: &str, out: &Path, show_progress: bool) -> Result<ReproduceSummary, String> {
+    let all = registry();
+    let selected: Vec<&dyn Figure> = if which == "all" {
+        all.iter().map(|f| f.as_ref()).collect()
+    } else {
+        match all.iter().find(|f| f.name() == which) {
+            Some(f) => vec![f.as_ref()],
+            None => {
+                return Err(format!(
+                    "unknown figure `{which}`; valid: all, {}",
+                    figure_names().join(", ")
+                ))
+            }
+        }
+    };
+    if out.as_os_str().is_empty() {
+        return Err("--out: the output folder must not be empty".to_string());
+    }
+    if out.exists() && !out.is_dir() {
+        return Err(format!(
+            "--out: `{}` exists and is not a folder",
+            out.display()
+        ));
+    }
+    std::fs::create_dir_all(out)
+        .map_err(|e| format!("--out: cannot create `{}`: {e}", out.display()))?;
+
+    let total: u64 = selected.iter().map(|f| f.jobs()).sum();
+    let bar = if show_progress {
+        let b = ProgressBar::new(total);
+        if let Ok(style) =
+            ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} {msg}")
+        {
+            b.set_style(style);
+        }
+        b
+    } else {
+        ProgressBar::hidden()
+    };
+    let start = Instant::now();
+    let mut summaries = Vec::new();
+    for fig in &selected {
+        bar.set_message(fig.name());
+        let t0 = Instant::now();
+        let dir = out.join(fig.name());
+        std::fs::create_dir_all(&dir)
+            .map_err(|e| format!("cannot create `{}`: {e}", dir.display()))?;
+        let ctx = FigureContext {
+            dir: dir.clone(),
+            progress: &bar,
+        };
+        let rep = fig.run(&ctx)?;
+        let json = serde_json::to_string_pretty(&rep.metrics)
+            .map_err(|e| format!("{}: cannot encode metrics: {e}", fig.name()))?;
+        write(&dir.join("metrics.json"), &json)?;
+        write(&dir.join("report.md"), &rep.markdown)?;
+        summaries.push(FigureSummary {
+            name: fig.name().to_string(),
+            passed: rep.metrics.passed(),
+            total: rep.metrics.cases.len(),
+            failing: rep
+                .metrics
+                .cases
+                .iter()
+                .filter(|c| !c.pass)
+                .map(|c| format!("{}/{}", c.model, c.dimension.as_str()))
+                .collect(),
+            seconds: t0.elapsed().as_secs_f64(),
+        });
+    }
+    bar.finish_and_clear();
+    let report = out.join("REPORT.md");
+    write(&report, &assemble_report(out, &all)?)?;
+    Ok(ReproduceSummary {
+        figures: summaries,
+        report,
+        seconds: start.elapsed().as_secs_f64(),
+    })
+}
+
+fn write(path: &Path, text: &str) -> Result<(), String> {
+    std::fs::write(path, text).map_err(|e| format!("cannot write `{}`: {e}", path.display()))
+}
+
+/// `REPORT.md`: a summary table of every figure present under `out`, then each figure's section.
+fn assemble_report(out: &Path, all: &[Box<dyn Figure>]) -> Result<String, String> {
+    let mut head = String::from(
+        "# haptic2d: reproduction of the paper's experiments\n\n\
+         Generated by `haptic2d reproduce`. Each figure folder holds the CSV time series, the plots \
+         (SVG and PNG) and `metrics.json`; the reference values are those of the normative spec \
+         (MODELS.md §5.10, §13).\n\n\
+         | figure | title | cases passing |\n|---|---|---|\n",
+    );
+    let mut body = String::new();
+    for f in all {
+        let dir = out.join(f.name());
+        let (Ok(md), Ok(json)) = (
+            std::fs::read_to_string(dir.join("report.md")),
+            std::fs::read_to_string(dir.join("metrics.json")),
+        ) else {
+            continue;
+        };
+        let m: FigureMetrics = serde_json::from_str(&json)
+            .map_err(|e| format!("{}: unreadable metrics.json: {e}", dir.display()))?;
+        head.push_str(&format!(
+            "| [{}](#{}) | {} | {} / {} |\n",
+            f.name(),
+            f.name(),
+            f.title(),
+            m.passed(),
+            m.cases.len()
+        ));
+        body.push_str(&md);
+        body.push('\n');
+    }
+    Ok(format!("{head}\n{body}"))
+}

@@ -1,0 +1,24 @@
+//! `haptic2d-lab`: reproduction of the paper's experiments as data, plots, metrics and a report, and
+//! parameter sweeps of the virtual walls.
+//!
+//! - [`figure`]: the [`Figure`] trait and the registry of figures; [`reproduce`] runs a selection of
+//!   them, writes `DIR/<figure>/` (CSV series, SVG + PNG plots, `metrics.json`) and `DIR/REPORT.md`.
+//! - [`fig4`]: Fig. 4, a box pushed into undamped walls (§5.10, §13.1), in 1-D and through the 2-D world.
+//! - [`fig7`]: Fig. 7, a peg pushed into a tight hole (§13.2), in 1-D and through the 2-D world.
+//! - [`sweep`]: stiffness × damping sweeps of the wall laws on the 1-D Fig. 4 harness (Z-width chart).
+//!
+//! Adding a figure: implement [`Figure`] in a new file and add it to [`figure::registry`].
+
+#![warn(missing_docs)]
+
+pub mod csv;
+pub mod fig4;
+pub mod fig7;
+pub mod figure;
+pub mod plot;
+pub mod schema;
+pub mod sweep;
+pub mod world2d;
+
+pub use figure::{registry, reproduce, Figure, FigureContext, FigureReport, ReproduceSummary};
+pub use schema::{CaseMetrics, Check, Dimension, FigureMetrics, Measured};

@@ -1,0 +1,140 @@
+//! The `metrics.json` schema: one file per figure,
+//! `{"figure": "fig4", "cases": [{"model", "dimension", <measured metrics>, "pass", "checks"}]}`.
+
+use serde::{Deserialize, Serialize};
+
+/// Which pipeline produced a case.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Dimension {
+    /// The 1-D reduced harness (normative numbers).
+    #[serde(rename = "1d")]
+    OneD,
+    /// The full 2-D world pipeline.
+    #[serde(rename = "2d")]
+    TwoD,
+}
+
+impl Dimension {
+    /// `"1d"` or `"2d"`.
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            Dimension::OneD => "1d",
+            Dimension::TwoD => "2d",
+        }
+    }
+}
+
+/// One spec test evaluated on a case.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Check {
+    /// Spec test ID (e.g. `W1`, `F7-2`, `F4-2D`).
+    pub id: String,
+    /// Whether it holds.
+    pub pass: bool,
+    /// What was measured against what threshold.
+    pub detail: String,
+}
+
+impl Check {
+    /// A check named `id` that holds when `pass`, with a human-readable `detail`.
+    pub fn new(id: &str, pass: bool, detail: impl Into<String>) -> Self {
+        Self {
+            id: id.to_string(),
+            pass,
+            detail: detail.into(),
+        }
+    }
+}
+
+/// Fig. 4 body-level metrics (§13.1).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Fig4Measured {
+    /// Number of separations in the run.
+    pub separations: usize,
+    /// Exit speed / entry speed of every completed contact, in order.
+    pub contact_ratios: Vec<f64>,
+    /// Settle time (s); `null` if the body never settles.
+    pub settle_time_s: Option<f64>,
+    /// Entry speed of every contact (m/s).
+    pub entry_speeds_m_s: Vec<f64>,
+    /// Largest penetration (m).
+    pub max_penetration_m: f64,
+    /// Penetration at the end of the run (m).
+    pub final_penetration_m: f64,
+    /// Largest `|ω|` (rad/s); 0 in 1-D.
+    pub max_abs_omega_rad_s: f64,
+}
+
+/// Fig. 7 metrics (§13.2).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Fig7Measured {
+    /// Peak push `F_pk` (N).
+    pub peak_force_n: f64,
+    /// creep_k (m), k = 1..4.
+    pub creep_m: Vec<f64>,
+    /// advance_k (m), k = 1..3.
+    pub advance_m: Vec<f64>,
+    /// `ΔE − W_push` per cycle (J), k = 1..4.
+    pub energy_balance_j: Vec<f64>,
+    /// `max|x|` of the peg (m).
+    pub max_abs_x_m: f64,
+    /// `max|θ|` of the peg (rad); 0 in 1-D.
+    pub max_abs_theta_rad: f64,
+    /// `max|y|` of the peg (m); 0 in 1-D.
+    pub max_abs_y_m: f64,
+}
+
+/// The measured metrics of a case, by figure (flattened into the case object).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum Measured {
+    /// Fig. 4 metrics.
+    Fig4(Fig4Measured),
+    /// Fig. 7 metrics.
+    Fig7(Fig7Measured),
+}
+
+/// One case of a figure: a model run in one dimension.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CaseMetrics {
+    /// The case name (a wall model or friction model, as listed in the figure).
+    pub model: String,
+    /// Which pipeline.
+    pub dimension: Dimension,
+    /// Measured metrics.
+    #[serde(flatten)]
+    pub measured: Measured,
+    /// Whether every check holds.
+    pub pass: bool,
+    /// The spec tests evaluated on this case.
+    pub checks: Vec<Check>,
+}
+
+impl CaseMetrics {
+    /// A case whose `pass` is the conjunction of `checks` (false if there are none).
+    pub fn new(model: &str, dimension: Dimension, measured: Measured, checks: Vec<Check>) -> Self {
+        Self {
+            model: model.to_string(),
+            dimension,
+            measured,
+            pass: !checks.is_empty() && checks.iter().all(|c| c.pass),
+            checks,
+        }
+    }
+}
+
+/// The contents of one `metrics.json`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FigureMetrics {
+    /// Figure name (`fig4`, `fig7`, …).
+    pub figure: String,
+    /// Every case, in a stable order.
+    pub cases: Vec<CaseMetrics>,
+}
+
+impl FigureMetrics {
+    /// Number of cases that pass.
+    pub fn passed(&self) -> usize {
+        self.cases.iter().filter(|c| c.pass).count()
+    }
+}
