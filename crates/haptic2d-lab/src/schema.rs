@@ -63,6 +63,8 @@ pub struct Fig4Measured {
     pub final_penetration_m: f64,
     /// Largest `|ω|` (rad/s); 0 in 1-D.
     pub max_abs_omega_rad_s: f64,
+    /// Times of the separations (s): samples at which the gap goes from `< 0` to `≥ 0`.
+    pub separation_times_s: Vec<f64>,
 }
 
 /// Fig. 7 metrics (§13.2).

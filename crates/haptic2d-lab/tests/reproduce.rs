@@ -82,35 +82,10 @@ fn reproduce_all_writes_every_output_and_the_cases_pass() {
     for c in &m7.cases {
         assert!(c.pass, "fig7 {} {:?}: {:?}", c.model, c.dimension, c.checks);
     }
-    // Every Fig. 4 case passes except the braking pulse in 2-D. Its chatter after the second impact
-    // (entry speeds < 0.06 m/s, contact ratios jumping between 0.06 and 2.2) is sensitive to round-off:
-    // the 1-D and 2-D runs agree to 1e-12 m for 3.7 s, the difference then grows ~10× per 0.8 s, and
-    // after ≈ 8.7 s the two trajectories part, ending with 58 (1-D) vs 59 (2-D) separations (the spec's
-    // reference prototype also gives 59). The agreement that does hold is asserted instead.
+    // Every Fig. 4 case passes. (The braking pulse chatters after its second impact and its 1-D and
+    // 2-D runs part after ≈ 8.7 s through round-off amplification; the 2-D check compares separation
+    // counts up to that predictability horizon — see `checks_2d`.)
     for c in &m4.cases {
-        if c.model == "pulse" && c.dimension == haptic2d_lab::Dimension::TwoD {
-            let ratios = |d| match &m4
-                .cases
-                .iter()
-                .find(|x| x.model == "pulse" && x.dimension == d)
-                .expect("case")
-                .measured
-            {
-                haptic2d_lab::Measured::Fig4(m) => m.contact_ratios.clone(),
-                _ => panic!("fig4 metrics"),
-            };
-            let (a, b) = (
-                ratios(haptic2d_lab::Dimension::OneD),
-                ratios(haptic2d_lab::Dimension::TwoD),
-            );
-            let agree = a
-                .iter()
-                .zip(&b)
-                .take_while(|(x, y)| (*x - *y).abs() <= 0.02)
-                .count();
-            assert!(agree >= 40, "pulse: ratios agree for only {agree} contacts");
-            continue;
-        }
         assert!(c.pass, "fig4 {} {:?}: {:?}", c.model, c.dimension, c.checks);
     }
 }

@@ -10,7 +10,10 @@ use std::hint::black_box;
 use std::time::Duration;
 
 fn warmed(scene: &str, warm_s: f64) -> haptic2d::world::World {
-    let mut w = builtin(scene, None).expect("built-in").expect("valid").world;
+    let mut w = builtin(scene, None)
+        .expect("built-in")
+        .expect("valid")
+        .world;
     for _ in 0..(warm_s / w.params.dt) as usize {
         w.step();
     }
@@ -19,7 +22,8 @@ fn warmed(scene: &str, warm_s: f64) -> haptic2d::world::World {
 
 fn world_step(c: &mut Criterion) {
     let mut g = c.benchmark_group("world_step");
-    g.warm_up_time(Duration::from_millis(500)).measurement_time(Duration::from_secs(2));
+    g.warm_up_time(Duration::from_millis(500))
+        .measurement_time(Duration::from_secs(2));
     for (scene, warm) in [
         ("box-in-walls", 1.0),
         ("box-in-walls-tilt", 0.05),
