@@ -44,7 +44,8 @@ impl DeviceInTheLoop {
     pub fn step(&mut self) -> Result<TickOutput, DeviceFault> {
         let q = self.plant.encoders()?;
         let out = self.system.tick(&q);
-        self.plant.step(&out.torques, &self.hand, self.system.dt())?;
+        self.plant
+            .step(&out.torques, &self.hand, self.system.dt())?;
         Ok(out)
     }
 

@@ -122,11 +122,11 @@ impl HapticSystem {
         map.validate()?;
         let margin = crate::device::jacobian::singularity_margin(&device.kin, &map.device_origin)
             .map_err(|e| {
-                format!(
-                    "device origin {:?} is not reachable: {e}",
-                    map.device_origin
-                )
-            })?;
+            format!(
+                "device origin {:?} is not reachable: {e}",
+                map.device_origin
+            )
+        })?;
         if margin < config.device.min_singularity_margin {
             return Err(format!(
                 "device origin {:?} is too close to a singularity (margin {margin:.3})",
