@@ -2,10 +2,12 @@
 
 mod cmd_check;
 mod cmd_reproduce;
+mod cmd_run;
 mod cmd_scenes;
 mod cmd_simulate;
 mod cmd_sweep;
 mod csv_out;
+mod hand_arg;
 mod scene_arg;
 
 use clap::{Parser, Subcommand};
@@ -23,6 +25,9 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
+    /// Run the haptic loop: device, controller and world at the control rate (default: box-in-walls,
+    /// simulated device, four-channel controller, 1000 Hz); prints a timing summary at exit.
+    Run(cmd_run::RunArgs),
     /// Simulate a scene's world alone (no device), headless and as fast as possible, writing a CSV.
     Simulate {
         /// A scene file path, or a built-in scene name (see `haptic2d scenes`).
@@ -76,6 +81,7 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
+        Command::Run(args) => cmd_run::run(&args),
         Command::Simulate {
             scene,
             duration,

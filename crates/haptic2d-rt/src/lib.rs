@@ -13,7 +13,9 @@
 //! - [`logger`]: the CSV logger thread draining the ring;
 //! - [`io`]: the [`DeviceIo`] trait the loop drives, and [`ReplayDevice`];
 //! - [`watchdog`]: the latching safety watchdog that zeroes torques;
-//! - [`signal`]: Ctrl-C to a stop flag.
+//! - [`signal`]: Ctrl-C to a stop flag;
+//! - [`sim_io`]: the simulated twin pantograph and hand behind [`DeviceIo`];
+//! - [`tick_log`]: CSV rows of the haptic tick record.
 #![warn(missing_docs)]
 
 pub mod clock;
@@ -23,14 +25,17 @@ pub mod logger;
 pub mod rt;
 pub mod runner;
 pub mod signal;
+pub mod sim_io;
 pub mod stats;
 pub mod telemetry;
+pub mod tick_log;
 pub mod watchdog;
 
 pub use io::{DeviceError, DeviceIo, ReplayDevice, ReplayEnd};
 pub use logger::{CsvLogger, CsvRecord, LogReport, LoggerConfig};
 pub use rt::{setup_realtime, CorePin, RtReport, RtRequest};
 pub use runner::{run_loop, spawn_loop, LoopConfig, TickControl, TickInfo};
+pub use sim_io::{SharedTarget, SimIo};
 pub use stats::{Percentiles, TimingStats, TimingSummary};
 pub use telemetry::{telemetry_channel, RecordRx, SnapshotRx, TelemetryTx};
 pub use watchdog::{Fault, FaultKind, SafetyInput, Watchdog, WatchdogConfig};

@@ -14,6 +14,7 @@ pub mod contact;
 pub mod control;
 pub mod device;
 pub mod geom;
+pub mod haptic;
 pub mod harness;
 pub mod integrate;
 pub mod laws;

@@ -1,0 +1,320 @@
+//! `haptic2d run`: the haptic loop — device, controller and world at the control rate on a real-time
+//! thread, with CSV logging on another thread and a timing summary at exit.
+
+use crate::hand_arg::HandSpec;
+use crate::scene_arg;
+use haptic2d::control::passivity::PlanarPassivity;
+use haptic2d::haptic::{ControllerKind, HapticConfig, HapticSystem, TickRecord};
+use haptic2d_rt::io::DEFAULT_REPLAY_COLUMNS;
+use haptic2d_rt::signal::install_ctrlc_stop;
+use haptic2d_rt::{
+    run_loop, telemetry_channel, CsvLogger, DeviceError, DeviceIo, LoggerConfig, LoopConfig,
+    ReplayDevice, ReplayEnd, SafetyInput, SharedTarget, SimIo, TickControl, Watchdog,
+    WatchdogConfig,
+};
+use std::net::SocketAddr;
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Duration;
+
+/// Options of `haptic2d run`.
+#[derive(clap::Args, Debug)]
+pub struct RunArgs {
+    /// A scene file path, or a built-in scene name (see `haptic2d scenes`).
+    #[arg(default_value = "box-in-walls")]
+    pub scene: String,
+    /// No display (the browser display is not available yet; runs headless either way).
+    #[arg(long)]
+    pub headless: bool,
+    /// Stop after this many seconds (default: run until Ctrl-C).
+    #[arg(long, allow_negative_numbers = true)]
+    pub duration: Option<f64>,
+    /// Control rate (Hz); also the world's rate.
+    #[arg(long, default_value_t = 1000.0, allow_negative_numbers = true)]
+    pub rate: f64,
+    /// Teleoperation controller: four-channel or coupling.
+    #[arg(long, default_value = "four-channel")]
+    pub controller: String,
+    /// Passivity observer/controller on the device port (§12).
+    #[arg(long)]
+    pub passivity: bool,
+    /// Simulated hand (simulated device only): follow | free | constant:FX,FY,TAU |
+    /// sine:FPK,FREQ[,DIRX,DIRY] | script:HOLD,FX,FY,TAU,PUSH[,RFX,RFY,RTAU]. Default: follow.
+    #[arg(long, allow_hyphen_values = true)]
+    pub hand: Option<String>,
+    /// Device: sim (simulated twin pantograph) or replay:FILE.csv (recorded encoders q1..q4, rad).
+    #[arg(long, default_value = "sim")]
+    pub device: String,
+    /// Write every tick's record to this CSV file.
+    #[arg(long)]
+    pub log: Option<PathBuf>,
+    /// Display address (validated; the display itself is not available yet).
+    #[arg(long, default_value = "127.0.0.1:8080")]
+    pub bind: String,
+    /// Ask for real-time scheduling (SCHED_FIFO, mlockall, core pinning); degrades gracefully.
+    #[arg(long, overrides_with = "no_rt")]
+    pub rt: bool,
+    /// Normal scheduling (default).
+    #[arg(long, overrides_with = "rt")]
+    pub no_rt: bool,
+}
+
+/// The device the loop drives.
+enum DeviceChoice {
+    Sim,
+    Replay(PathBuf),
+}
+
+fn parse_device(s: &str) -> Result<DeviceChoice, String> {
+    if s == "sim" {
+        return Ok(DeviceChoice::Sim);
+    }
+    if let Some(f) = s.strip_prefix("replay:") {
+        if f.is_empty() {
+            return Err("--device replay:FILE.csv needs a file name".into());
+        }
+        return Ok(DeviceChoice::Replay(PathBuf::from(f)));
+    }
+    Err(format!(
+        "--device `{s}` is not available\n    fix: use --device sim (the simulated twin pantograph) or --device replay:FILE.csv"
+    ))
+}
+
+/// RK4 sub-steps of the simulated plant per tick: one per 0.5 ms of period (at least one).
+fn plant_substeps(dt: f64) -> u32 {
+    ((dt / 0.0005).ceil() as u32).max(1)
+}
+
+/// Runs the haptic loop.
+pub fn run(a: &RunArgs) -> Result<(), String> {
+    // Validate every option before anything starts.
+    if !(a.rate.is_finite() && a.rate > 0.0) {
+        return Err(format!(
+            "--rate must be a positive number of Hz, got {}",
+            a.rate
+        ));
+    }
+    if let Some(d) = a.duration {
+        if !(d.is_finite() && d > 0.0) {
+            return Err(format!(
+                "--duration must be a positive number of seconds, got {d}"
+            ));
+        }
+    }
+    let bind: SocketAddr = a.bind.parse().map_err(|e| {
+        format!(
+            "--bind `{}` is not an ADDRESS:PORT ({e})\n    fix: e.g. --bind 127.0.0.1:8080 or --bind 0.0.0.0:8080",
+            a.bind
+        )
+    })?;
+    let controller =
+        ControllerKind::from_name(&a.controller).map_err(|e| format!("--controller: {e}"))?;
+    let device = parse_device(&a.device)?;
+    let hand = match (&device, &a.hand) {
+        (DeviceChoice::Replay(_), Some(_)) => {
+            return Err(
+                "--hand applies to the simulated device only (a replay plays recorded motion)"
+                    .into(),
+            )
+        }
+        (_, Some(h)) => HandSpec::parse(h)?,
+        (_, None) => HandSpec::Follow,
+    };
+    let scene = scene_arg::load(&a.scene, Some(a.rate))?;
+    for w in &scene.warnings {
+        eprintln!("warning: {w}");
+    }
+    let config = HapticConfig {
+        controller,
+        passivity: a.passivity.then(PlanarPassivity::default),
+        ..HapticConfig::default()
+    };
+    let scene_name = scene.name.clone();
+    let mut system = HapticSystem::new(scene.world, &config)
+        .map_err(|e| format!("scene {}: {e}", scene.source))?;
+    let dt = system.dt();
+    let start = system.device_start();
+
+    // The device.
+    let mut target = None;
+    let mut io: Box<dyn DeviceIo + Send> = match &device {
+        DeviceChoice::Sim => {
+            let mut sim = SimIo::new(
+                &config.device,
+                start,
+                hand.model(start),
+                dt,
+                plant_substeps(dt),
+            )?;
+            if hand == HandSpec::Follow {
+                let t = Arc::new(SharedTarget::new(start));
+                sim.follow(t.clone());
+                target = Some(t);
+            }
+            Box::new(sim)
+        }
+        DeviceChoice::Replay(p) => Box::new(ReplayDevice::from_path(
+            p,
+            DEFAULT_REPLAY_COLUMNS,
+            ReplayEnd::Error,
+        )?),
+    };
+    // Kept for the display (browser pointer → hand target), which is not available yet.
+    let _hand_target = target;
+    if !a.headless {
+        println!("display: not available yet (would serve http://{bind}); running headless");
+    }
+
+    // Telemetry: every record to the logger (if any), the latest to the display (later).
+    let capacity = ((a.rate * 2.0) as usize).max(4096);
+    let (mut tx, rx, _snapshot) = telemetry_channel(capacity, TickRecord::default())?;
+    let logger = match &a.log {
+        Some(p) => Some(CsvLogger::spawn_file(rx, p, LoggerConfig::default())?),
+        None => {
+            drop(rx);
+            None
+        }
+    };
+    let logging = logger.is_some();
+    let mut watchdog = Watchdog::new(WatchdogConfig {
+        // The tick's own safety latch checks the kinematics and the singularity margin; this one
+        // adds what only the loop sees: a lost device and missed deadlines.
+        // A simulated or replayed device does not move between ticks, so a late tick cannot hurt
+        // anyone: missed deadlines are counted in the summary but do not stop the run. (A hardware
+        // driver will keep the default limit of 10 consecutive misses.)
+        min_singularity_margin: 0.0,
+        max_missed_run: None,
+    })?;
+    let stop = install_ctrlc_stop()?;
+    let loop_config = LoopConfig {
+        rate_hz: a.rate,
+        duration: a.duration.map(Duration::from_secs_f64),
+        rt: a.rt && !a.no_rt,
+        ..LoopConfig::default()
+    };
+    loop_config.validate()?;
+    println!(
+        "running {scene_name}: device {}, controller {}{}, hand {}, {} Hz{}; Ctrl-C stops",
+        io.name(),
+        config.controller.name(),
+        if a.passivity {
+            " + passivity controller"
+        } else {
+            ""
+        },
+        match device {
+            DeviceChoice::Sim => a.hand.as_deref().unwrap_or("follow"),
+            DeviceChoice::Replay(_) => "-",
+        },
+        a.rate,
+        match a.duration {
+            Some(d) => format!(" for {d} s"),
+            None => String::new(),
+        }
+    );
+
+    // The loop, on its own thread; everything it touches is moved in and handed back at the end.
+    let mut ended: Option<String> = None;
+    let summary = std::thread::scope(|s| {
+        let handle = std::thread::Builder::new()
+            .name("haptic2d-rt".into())
+            .spawn_scoped(s, || {
+                run_loop(&loop_config, &stop, |info| {
+                    let (q, lost) = match io.read_encoders() {
+                        Ok(q) => (q, None),
+                        Err(e) => ([f64::NAN; 4], Some(e)),
+                    };
+                    let out = system.tick(&q);
+                    let mut tau = out.torques;
+                    let safety = SafetyInput {
+                        deadline_missed: info.missed_deadline(),
+                        device_lost: lost.is_some(),
+                        pose: if lost.is_some() {
+                            [0.0; 3]
+                        } else {
+                            out.record.x_m
+                        },
+                        ..SafetyInput::nominal(info.index)
+                    };
+                    let guard = watchdog.guard(&safety, &mut tau);
+                    if let Some(e) = lost {
+                        io.zero_torques();
+                        ended = Some(match e {
+                            DeviceError::EndOfData => "the replay ended".to_string(),
+                            e => e.to_string(),
+                        });
+                        return TickControl::Stop;
+                    }
+                    if let Err(e) = io.write_torques(&tau) {
+                        io.zero_torques();
+                        ended = Some(e.to_string());
+                        return TickControl::Stop;
+                    }
+                    let mut rec = out.record;
+                    rec.tau = tau;
+                    if logging {
+                        tx.publish(rec);
+                    } else {
+                        tx.set_latest(rec);
+                    }
+                    if let Err(f) = guard {
+                        io.zero_torques();
+                        ended = Some(f.to_string());
+                        return TickControl::Stop;
+                    }
+                    if out.tripped {
+                        io.zero_torques();
+                        return TickControl::Stop;
+                    }
+                    TickControl::Continue
+                })
+            })
+            .map_err(|e| format!("cannot start the real-time loop thread: {e}"))?;
+        handle
+            .join()
+            .map_err(|_| "the real-time loop thread panicked".to_string())?
+    })?;
+    drop(tx);
+
+    // Report.
+    if let Some(w) = summary.rt.as_ref().and_then(|r| r.warning()) {
+        eprintln!("{w}");
+    }
+    println!("{summary}");
+    println!(
+        "on time: {:.3} % of {} deadlines ({} ticks, {} skipped, {} overruns)",
+        summary.on_time_fraction * 100.0,
+        summary.deadlines,
+        summary.ticks,
+        summary.skipped,
+        summary.overruns
+    );
+    if let Some(trip) = system.safety_trip() {
+        println!("{trip}");
+    }
+    if let Some(msg) = &ended {
+        println!("stopped: {msg}");
+    }
+    let w = system.world();
+    let b = &w.bodies[system.slave()];
+    println!(
+        "final: t = {:.3} s, {} at ({:.5} m, {:.5} m, {:.4} rad), {} contacts, kinetic {:.3e} J",
+        w.time(),
+        b.name,
+        b.pose.pos.x,
+        b.pose.pos.y,
+        b.pose.angle,
+        w.contacts().contact_count(),
+        w.ledger().kinetic
+    );
+    if let Some(l) = logger {
+        let report = l.finish()?;
+        println!(
+            "{report} to {}",
+            a.log
+                .as_ref()
+                .map_or(String::new(), |p| p.display().to_string())
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,89 @@
+//! Settings of a [`HapticSystem`](super::HapticSystem): device, observer, controller, passivity
+//! controller, which body is the slave, and how the device maps onto the world.
+
+use crate::control::coupling::CouplingGains;
+use crate::control::four_channel::FourChannelGains;
+use crate::control::passivity::PlanarPassivity;
+use crate::device::linalg::V3;
+use crate::device::{DeviceParams, ObserverKind};
+
+/// Which teleoperation controller couples the device to the slave (§11).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ControllerKind {
+    /// Lawrence's four-channel controller (§11.1), the default.
+    FourChannel(FourChannelGains),
+    /// The impedance (virtual-coupling) baseline (§11.2).
+    Coupling(CouplingGains),
+}
+
+impl Default for ControllerKind {
+    fn default() -> Self {
+        ControllerKind::FourChannel(FourChannelGains::default())
+    }
+}
+
+impl ControllerKind {
+    /// The controller called `name` (`four-channel` or `coupling`) with default gains. The error lists
+    /// the valid names.
+    pub fn from_name(name: &str) -> Result<Self, String> {
+        match name {
+            "four-channel" | "4ch" => Ok(ControllerKind::FourChannel(FourChannelGains::default())),
+            "coupling" | "virtual-coupling" => {
+                Ok(ControllerKind::Coupling(CouplingGains::default()))
+            }
+            _ => Err(format!(
+                "unknown controller `{name}`; valid: four-channel, coupling"
+            )),
+        }
+    }
+
+    /// The name used on the command line.
+    pub fn name(&self) -> &'static str {
+        match self {
+            ControllerKind::FourChannel(_) => "four-channel",
+            ControllerKind::Coupling(_) => "coupling",
+        }
+    }
+}
+
+/// Everything a [`HapticSystem`](super::HapticSystem) needs besides the world.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HapticConfig {
+    /// Device parameters (§10.2). Default: the spec's twin pantograph.
+    pub device: DeviceParams,
+    /// Hand-wrench observer (§10.6). Default: generalized momentum.
+    pub observer: ObserverKind,
+    /// Teleoperation controller (§11). Default: four-channel with the §11.1 gains.
+    pub controller: ControllerKind,
+    /// Passivity observer/controller on the device port (§12); `None` = off (default).
+    pub passivity: Option<PlanarPassivity>,
+    /// Name of the slave body; `None` = the first dynamic body of the world.
+    pub slave: Option<String>,
+    /// Keep the scene's loads on the slave body. Default false: in the haptic loop the hand drives the
+    /// slave, so loads defined for world-only simulation (e.g. the Fig. 4 push) are dropped. Loads on
+    /// other bodies are always kept.
+    pub keep_slave_loads: bool,
+    /// Handle pose (m, m, rad) that maps to the slave's initial pose; `None` = the workspace centre at
+    /// θ = 0. The device should start here.
+    pub device_origin: Option<V3>,
+    /// Translation scale world/device (dimensionless). Default 1.
+    pub scale: f64,
+    /// Internal preload `ρ` of the redundancy resolution (N·m, §10.5). Default 0.
+    pub preload: f64,
+}
+
+impl Default for HapticConfig {
+    fn default() -> Self {
+        Self {
+            device: DeviceParams::default(),
+            observer: ObserverKind::Momentum,
+            controller: ControllerKind::default(),
+            passivity: None,
+            slave: None,
+            keep_slave_loads: false,
+            device_origin: None,
+            scale: 1.0,
+            preload: 0.0,
+        }
+    }
+}

@@ -1,0 +1,24 @@
+//! The haptic system: the twin-pantograph device, a teleoperation controller, the optional passivity
+//! controller on the device port, and the virtual world, run one sample at a time by
+//! [`HapticSystem::tick`] in the order of §0.5 (steps 1–11).
+//!
+//! The tick is pure computation (no allocation, no locks, no I/O). Where the encoder angles come from
+//! and where the torques go is the caller's business: the real-time loop of `haptic2d-rt` (a real or
+//! simulated device), or [`DeviceInTheLoop`], which closes the loop with a simulated plant and hand in
+//! simulated time for the device-in-the-loop experiments ([`fig5`], [`fig8`]).
+
+pub mod config;
+pub mod experiment;
+pub mod fig5;
+pub mod fig8;
+pub mod mapping;
+pub mod record;
+pub mod safety;
+pub mod system;
+
+pub use config::{ControllerKind, HapticConfig};
+pub use experiment::DeviceInTheLoop;
+pub use mapping::DeviceMap;
+pub use record::{TickRecord, TICK_COLUMNS};
+pub use safety::{Safety, SafetyReason, SafetyTrip};
+pub use system::{HapticSystem, TickOutput};

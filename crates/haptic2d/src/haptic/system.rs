@@ -1,0 +1,347 @@
+//! [`HapticSystem`]: device + controller + passivity controller + world, and the per-sample
+//! [`HapticSystem::tick`] in the order of §0.5.
+
+use crate::control::coupling::VirtualCoupling;
+use crate::control::four_channel::{FourChannel, TeleopSignals};
+use crate::control::passivity::PlanarPassivity;
+use crate::device::linalg::{V3, V4};
+use crate::device::{DeviceEstimate, TwinPantograph};
+use crate::geom::Vec2;
+use crate::world::World;
+
+use super::config::{ControllerKind, HapticConfig};
+use super::mapping::DeviceMap;
+use super::record::{
+    TickRecord, FLAG_NEAR_SINGULAR, FLAG_PASSIVITY_ACTIVE, FLAG_SAFETY, FLAG_SATURATED,
+};
+use super::safety::{Safety, SafetyReason, SafetyTrip};
+
+/// The running controller (one of the §11 architectures).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[allow(clippy::large_enum_variant)]
+enum Controller {
+    FourChannel(FourChannel),
+    Coupling(VirtualCoupling),
+}
+
+impl Controller {
+    #[inline]
+    fn step(&mut self, s: &TeleopSignals) -> (V3, V3) {
+        match self {
+            Controller::FourChannel(c) => c.step(s),
+            Controller::Coupling(c) => c.step(s),
+        }
+    }
+}
+
+/// What one tick hands back to the caller.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TickOutput {
+    /// The four motor torques to write to the amplifiers now and hold for one period (N·m); all zero
+    /// when the safety latch is set.
+    pub torques: V4,
+    /// True when the safety latch is set (this tick or earlier).
+    pub tripped: bool,
+    /// The tick's telemetry record.
+    pub record: TickRecord,
+}
+
+/// The whole haptic system of DESIGN §1: twin-pantograph estimator, teleoperation controller, optional
+/// passivity controller on the device port, and the virtual world with its slave body.
+#[derive(Clone, Debug)]
+pub struct HapticSystem {
+    device: TwinPantograph,
+    controller: Controller,
+    passivity: Option<PlanarPassivity>,
+    world: World,
+    slave: usize,
+    map: DeviceMap,
+    safety: Safety,
+    preload: f64,
+    dt: f64,
+    tau_prev: V4,
+    injected: Option<(usize, f64)>,
+    record: TickRecord,
+}
+
+impl HapticSystem {
+    /// Builds the system around `world` (its sample period is the tick period). Checks the device
+    /// parameters at that period, the controller gains against the slave's mass (§6.4), the passivity
+    /// controller, the mapping and the preload; errors name the setting to fix.
+    pub fn new(mut world: World, config: &HapticConfig) -> Result<Self, String> {
+        let dt = world.params.dt;
+        let slave = match &config.slave {
+            Some(name) => world.body_index(name).ok_or_else(|| {
+                format!(
+                    "slave body `{name}` not found; bodies: {}",
+                    world
+                        .bodies
+                        .iter()
+                        .map(|b| b.name.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )
+            })?,
+            None => world
+                .bodies
+                .iter()
+                .position(|b| b.is_dynamic())
+                .ok_or("the scene has no dynamic body for the device to drive")?,
+        };
+        let body = &world.bodies[slave];
+        if !body.is_dynamic() {
+            return Err(format!(
+                "slave body `{}` is fixed; the device needs a dynamic body",
+                body.name
+            ));
+        }
+        let mass = [body.mass, body.mass, body.inertia];
+        let world_origin = [body.pose.pos.x, body.pose.pos.y, body.pose.angle];
+        let controller = match config.controller {
+            ControllerKind::FourChannel(g) => {
+                g.check_slave_mass(&mass, dt)
+                    .map_err(|e| format!("{e} (slave body `{}`)", body.name))?;
+                Controller::FourChannel(FourChannel::new(g, dt)?)
+            }
+            ControllerKind::Coupling(g) => {
+                let c = VirtualCoupling::new(g)?;
+                c.check_slave_mass(&mass, dt)
+                    .map_err(|e| format!("{e} (slave body `{}`)", body.name))?;
+                Controller::Coupling(c)
+            }
+        };
+        if let Some(p) = &config.passivity {
+            p.validate()?;
+        }
+        let mut device = TwinPantograph::new(config.device, dt, config.observer)?;
+        let mut map = DeviceMap::centred(&config.device, world_origin);
+        if let Some(o) = config.device_origin {
+            map.device_origin = o;
+        }
+        map.scale = config.scale;
+        map.validate()?;
+        let margin = crate::device::jacobian::singularity_margin(&device.kin, &map.device_origin)
+            .map_err(|e| {
+            format!(
+                "device origin {:?} is not reachable: {e}",
+                map.device_origin
+            )
+        })?;
+        if margin < config.device.min_singularity_margin {
+            return Err(format!(
+                "device origin {:?} is too close to a singularity (margin {margin:.3})",
+                map.device_origin
+            ));
+        }
+        let tau_max = config.device.tau_max;
+        if !(config.preload.is_finite() && config.preload.abs() <= 0.1 * tau_max) {
+            return Err(format!(
+                "preload must be finite with |preload| <= 0.1 x tau_max = {} N m (got {})",
+                0.1 * tau_max,
+                config.preload
+            ));
+        }
+        if !config.keep_slave_loads {
+            world.loads.retain(|l| l.body != slave);
+        }
+        device.reset(map.device_origin[2]);
+        Ok(Self {
+            device,
+            controller,
+            passivity: config.passivity,
+            world,
+            slave,
+            map,
+            safety: Safety::new(config.device.min_singularity_margin),
+            preload: config.preload,
+            dt,
+            tau_prev: [0.0; 4],
+            injected: None,
+            record: TickRecord::default(),
+        })
+    }
+
+    /// One haptic sample, §0.5 steps 1–11, from the four encoder angles `q` (rad) to the four motor
+    /// torques (N·m). Never allocates, locks, prints or does I/O.
+    ///
+    /// The caller writes `torques` to the amplifiers right after the call (step 9's output); the world
+    /// integration of step 10 has then already run, which only moves the write by the integration
+    /// time (about a microsecond) and keeps the tick one call.
+    pub fn tick(&mut self, q: &V4) -> TickOutput {
+        let (k, t, dt) = (self.world.tick(), self.world.time(), self.dt);
+        let mut flags = 0u32;
+
+        // 1–2. Device pose by forward kinematics (θ unwrapped, closure monitor), filtered twist, and
+        //      the hand-wrench estimate from the torques of the previous interval (§10.3, §10.6, §10.7).
+        let est: Option<DeviceEstimate> = match self.device.estimate(q, &self.tau_prev) {
+            Ok(e) => Some(e),
+            Err(fault) => {
+                self.safety.trip(k, t, SafetyReason::Device(fault));
+                None
+            }
+        };
+
+        // 3–6. World: proximity every N_g samples, local contacts and god-objects, contact states and
+        //      simultaneous impacts (velocities jump now), then normal and friction forces.
+        self.world.begin_step();
+        let body = &self.world.bodies[self.slave];
+        let x_s = [body.pose.pos.x, body.pose.pos.y, body.pose.angle];
+        let v_s = [body.vel.x, body.vel.y, body.omega];
+        let cw = self.world.contact_wrench(self.slave);
+        let f_e = [-cw.force.x, -cw.force.y, -cw.torque];
+
+        // 7. Teleoperation: device command f_cm and slave drive f_cs (§11), in world coordinates.
+        let (mut f_cm, mut f_cs) = ([0.0; 3], [0.0; 3]);
+        let (mut x_m, mut v_m, mut w_h) = ([0.0; 3], [0.0; 3], [0.0; 3]);
+        if let Some(e) = est {
+            (x_m, v_m, w_h) = (e.pose, e.velocity, e.hand_wrench);
+        }
+        if let (Some(e), false) = (est, self.safety.is_latched()) {
+            let signals = TeleopSignals {
+                x_m: self.map.pose_to_world(&e.pose),
+                v_m: self.map.twist_to_world(&e.velocity),
+                f_h: self.map.wrench_to_world(&e.hand_wrench),
+                x_s,
+                v_s,
+                f_e,
+                master_mass: [[0.0; 3]; 3],
+            };
+            (f_cm, f_cs) = self.controller.step(&signals);
+        }
+
+        // 8. Passivity observer/controller on the device port (§12), in handle coordinates.
+        let mut f_dev = self.map.wrench_to_device(&f_cm);
+        let (mut po_energy, mut alpha) = (0.0, [0.0; 3]);
+        if let (Some(pc), Some(e)) = (self.passivity.as_mut(), est) {
+            f_dev = pc.update(e.pose, e.velocity, f_dev, dt);
+            f_cm = self.map.wrench_to_world(&f_dev);
+            po_energy = pc.e_obs();
+            alpha = [pc.x.alpha(), pc.y.alpha(), pc.theta.alpha()];
+            if alpha.iter().any(|a| *a > 0.0) {
+                flags |= FLAG_PASSIVITY_ACTIVE;
+            }
+        }
+
+        // 9. Redundancy resolution to four motor torques, saturation (§10.5), and the safety gate:
+        //    a fault, a non-finite value or a singular pose zeroes the torques in this same tick.
+        let mut tau = [0.0; 4];
+        if !self.safety.is_latched() {
+            match self.device.torques_for_wrench(&f_dev, self.preload) {
+                Ok(cmd) => {
+                    tau = cmd.tau;
+                    if cmd.saturated {
+                        flags |= FLAG_SATURATED;
+                    }
+                    if cmd.near_singular {
+                        flags |= FLAG_NEAR_SINGULAR;
+                        self.safety.trip(
+                            k,
+                            t,
+                            SafetyReason::Singularity {
+                                margin: cmd.margin,
+                                limit: self.safety.min_margin,
+                            },
+                        );
+                    }
+                }
+                Err(fault) => self.safety.trip(k, t, SafetyReason::Torques(fault)),
+            }
+        }
+        if let Some((i, v)) = self.injected.take() {
+            tau[i] = v;
+        }
+        if self.safety.gate(k, t, &mut tau) {
+            flags |= FLAG_SAFETY;
+            f_cs = [0.0; 3];
+        }
+
+        // 10. Slave drive held over the sample, then passive integration of every body to k+1 (§6).
+        self.world
+            .set_drive(self.slave, Vec2::new(f_cs[0], f_cs[1]), f_cs[2]);
+        self.world.finish_step();
+        self.tau_prev = tau;
+
+        // 11. Log: signals, energies and the contact count into the tick record.
+        let ledger = self.world.ledger();
+        self.record = TickRecord {
+            t,
+            x_m,
+            v_m,
+            w_h,
+            x_s,
+            v_s,
+            f_cm,
+            f_cs,
+            f_e,
+            tau,
+            contacts: self.world.contacts().contact_count() as u32,
+            kinetic: ledger.kinetic,
+            stored: ledger.stored,
+            applied_work: ledger.applied_work,
+            po_energy,
+            alpha,
+            margin: self.device.margin(),
+            closure_error: est.map_or(f64::NAN, |e| e.closure_error),
+            flags,
+        };
+        TickOutput {
+            torques: tau,
+            tripped: self.safety.is_latched(),
+            record: self.record,
+        }
+    }
+
+    /// Fault injection for safety tests and hardware commissioning: at the next tick, torque `index`
+    /// (0–3) is replaced by `value` just before the safety gate (e.g. NaN to check that a non-finite
+    /// torque is zeroed in the same tick). An out-of-range index is ignored.
+    pub fn inject_torque_fault(&mut self, index: usize, value: f64) {
+        if index < 4 {
+            self.injected = Some((index, value));
+        }
+    }
+
+    /// The world (bodies, contacts, ledger).
+    pub fn world(&self) -> &World {
+        &self.world
+    }
+    /// Mutable access to the world (e.g. to move a body between ticks).
+    pub fn world_mut(&mut self) -> &mut World {
+        &mut self.world
+    }
+    /// Index of the slave body in the world.
+    pub fn slave(&self) -> usize {
+        self.slave
+    }
+    /// The device ↔ world mapping.
+    pub fn map(&self) -> &DeviceMap {
+        &self.map
+    }
+    /// The device estimator.
+    pub fn device(&self) -> &TwinPantograph {
+        &self.device
+    }
+    /// The passivity controller, if enabled.
+    pub fn passivity(&self) -> Option<&PlanarPassivity> {
+        self.passivity.as_ref()
+    }
+    /// The latched safety trip, if any.
+    pub fn safety_trip(&self) -> Option<SafetyTrip> {
+        self.safety.trip_info()
+    }
+    /// Re-arms the safety latch (an explicit user action; the next tick recomputes the torques).
+    pub fn reset_safety(&mut self) {
+        self.safety.reset();
+    }
+    /// The record of the last tick.
+    pub fn last_record(&self) -> &TickRecord {
+        &self.record
+    }
+    /// The sample period `T` (s).
+    pub fn dt(&self) -> f64 {
+        self.dt
+    }
+    /// The handle pose the device should start at (m, m, rad): the mapping's device origin.
+    pub fn device_start(&self) -> V3 {
+        self.map.device_origin
+    }
+}
