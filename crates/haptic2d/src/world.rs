@@ -112,7 +112,7 @@ impl World {
                 BroadPhase::new(DEFAULT_DELTA_PROX).expect("the default margin is valid")
             }),
             local: {
-                let mut l = LocalStage::new();
+                let mut l = LocalStage::with_capacity(8 * colliders_len);
                 // An invalid tolerance keeps the default; scene validation reports it.
                 let _ = l.set_edge_tolerance(params.contact.eps_s);
                 l
@@ -233,6 +233,8 @@ impl World {
             }
         }
         // 4–6. Contact records, state machine, simultaneous impacts, normal and friction forces.
+        // (Parameters are re-read every sample, so edits to `params.contact` take effect at once.)
+        self.contacts.params = self.params.contact;
         let past = PastPoses {
             prev: &self.prev,
             prev2: &self.prev2,

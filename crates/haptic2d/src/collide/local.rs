@@ -87,6 +87,18 @@ impl LocalStage {
         }
     }
 
+    /// A local stage with room for `pairs` proximate pairs, so that pair lists up to that size never
+    /// allocate (the pair and tracker buffers are double-buffered across global updates).
+    pub fn with_capacity(pairs: usize) -> Self {
+        let mut s = Self::new();
+        s.pairs.reserve(pairs);
+        s.trackers.reserve(pairs);
+        s.states.reserve(pairs);
+        s.old_pairs.reserve(pairs);
+        s.old_trackers.reserve(pairs);
+        s
+    }
+
     /// Sets the edge-range tolerance `ε_s` (m, finite, ≥ 0).
     pub fn set_edge_tolerance(&mut self, eps_s: f64) -> Result<(), String> {
         if !(eps_s.is_finite() && eps_s >= 0.0) {
