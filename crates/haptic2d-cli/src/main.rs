@@ -17,7 +17,12 @@ use std::process::ExitCode;
 /// Haptic rendering of planar rigid-body motion: a passive planar world, contact and friction models,
 /// and a simulated twin-pantograph haptic device.
 #[derive(Parser, Debug)]
-#[command(name = "haptic2d", version, about, long_about = None)]
+#[command(
+    name = "haptic2d",
+    version,
+    about = "Haptic rendering of planar rigid-body motion: a passive planar world, contact and friction models, and a simulated twin-pantograph haptic device.",
+    long_about = None
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,

@@ -133,3 +133,21 @@ fn builtin_scenes_are_valid() {
         assert!(s.is_ok(), "{name}: {}", s.unwrap_err());
     }
 }
+
+#[test]
+fn friction_load_scaling_option() {
+    let ok = format!("[friction]\nmodel = \"reset-integrator\"\nload_scaling = \"stiffness\"\np0 = 1e-4\n{GOOD_BOX}");
+    assert!(Scene::from_toml(&ok, "test.toml", None).is_ok());
+    assert_error(
+        &format!(
+            "[friction]\nmodel = \"reset-integrator\"\nload_scaling = \"sideways\"\n{GOOD_BOX}"
+        ),
+        "friction.load_scaling",
+        "sideways",
+    );
+    assert_error(
+        &format!("[friction]\nmodel = \"reset-integrator\"\nmu_k = 0.6\nmu_s = 0.5\n{GOOD_BOX}"),
+        "friction",
+        "mu_s",
+    );
+}

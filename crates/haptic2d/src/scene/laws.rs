@@ -1,7 +1,7 @@
 //! `[normal]` and `[friction]` sections → law prototypes.
 
 use super::SceneError;
-use crate::laws::friction::FrictionModel;
+use crate::laws::friction::{FrictionModel, LoadScaling};
 use crate::laws::normal::NormalModel;
 use std::collections::BTreeMap;
 
@@ -97,6 +97,22 @@ pub fn friction_from(
     };
     for (k, v) in map {
         if k == "model" {
+            continue;
+        }
+        if k == "load_scaling" {
+            let r = match v {
+                toml::Value::String(name) => {
+                    LoadScaling::from_name(name).and_then(|ls| m.set_load_scaling(ls))
+                }
+                other => Err(format!("expected \"limit\" or \"stiffness\", got {other}")),
+            };
+            if let Err(e) = r {
+                errs.push(SceneError::new(
+                    "friction.load_scaling",
+                    e,
+                    "load_scaling = \"limit\" (default) or \"stiffness\"",
+                ));
+            }
             continue;
         }
         if let Some(x) = number("friction", k, v, errs) {
