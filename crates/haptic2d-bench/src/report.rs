@@ -137,7 +137,8 @@ pub fn svg(rows: &[Row], path: &Path) -> Result<(), String> {
         .y_desc("step time (µs)")
         .draw()
         .map_err(|e| err(&e))?;
-    let series: [(&str, RGBColor, fn(&Row) -> f64, u32); 4] = [
+    type Series = (&'static str, RGBColor, fn(&Row) -> f64, u32);
+    let series: [Series; 4] = [
         ("haptic2d median", BLUE, |r| r.haptic_median_us, 2),
         ("haptic2d p99", BLUE, |r| r.haptic_p99_us, 1),
         ("rapier2d median", RED, |r| r.rapier_median_us, 2),

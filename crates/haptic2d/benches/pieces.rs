@@ -180,6 +180,15 @@ fn bench_impact(c: &mut Criterion) {
     let mut gl = c.benchmark_group("lcp");
     for (n, a, b) in &lcp_inputs {
         let mut lcp = LcpSolver::with_capacity(*n);
+        // Which method answers matters for the cost (PGS that fails to converge falls back to the
+        // 2ⁿ enumeration for n ≤ 10): say it once.
+        match lcp.solve(a, b) {
+            Ok(r) => eprintln!(
+                "lcp/{n}: {:?}, {} iterations, converged {}, pgs_failed {}",
+                r.method, r.iterations, r.converged, r.pgs_failed
+            ),
+            Err(e) => eprintln!("lcp/{n}: {e}"),
+        }
         gl.bench_function(BenchmarkId::from_parameter(n), |bench| {
             bench.iter(|| black_box(lcp.solve(black_box(a), black_box(b))))
         });
