@@ -1,0 +1,127 @@
+//! The benchmark scenes, defined once as haptic2d scenes; the rapier2d twin of each is built from the
+//! haptic2d world itself (`rapier_world.rs`), so geometry, masses, poses, velocities and loads are
+//! identical by construction.
+
+use haptic2d::scene::{builtin, Scene};
+
+/// Time step of every comparison (s): 1 kHz, the haptic rate.
+pub const DT: f64 = 0.001;
+
+/// One benchmark case: a haptic2d scene plus the few rapier2d settings that cannot be read off it.
+pub struct Case {
+    /// Scene label in the table and JSON (`pile`, `box-in-walls`, `sliding`).
+    pub scene: &'static str,
+    /// Number of dynamic bodies.
+    pub n: usize,
+    /// The haptic2d scene at `DT`.
+    pub haptic: Scene,
+    /// Coulomb friction coefficient given to every rapier2d collider (haptic2d's static μ_s).
+    pub rapier_friction: f64,
+    /// Restitution given to every rapier2d collider (haptic2d's Poisson e).
+    pub rapier_restitution: f64,
+}
+
+/// The sliding scene: `n` boxes of 0.05 m and 2 kg resting on a floor, launched along +x at 1–2 m/s,
+/// 0.2 m apart so they never touch each other; reset-integrator friction μ_s = 0.5, μ_k = 0.45
+/// (they slide for ≈ 0.25–0.45 s, then stick).
+pub fn sliding_toml(n: usize) -> String {
+    let mut s = String::from(
+        r#"name = "sliding"
+description = "boxes sliding on a floor with reset-integrator friction"
+
+[world]
+rate = 1000
+proximity_every = 10
+integration = "semi-implicit"
+
+[contact]
+impacts = true
+restitution = 0.2
+v_c = 0.05
+
+[normal]
+model = "paper"
+kc = 1.0e5
+bc = 40.0
+
+[friction]
+model = "reset-integrator"
+kr = 5.0e4
+mu_s = 0.5
+mu_k = 0.45
+beta = 20.0
+
+[[body]]
+name = "floor"
+kind = "fixed"
+pieces = [[[-1.0, -0.1], [8.0, -0.1], [8.0, 0.0], [-1.0, 0.0]]]
+
+[[load]]
+body = "*"
+force = [0.0, -9.81]
+per_mass = true
+"#,
+    );
+    for k in 0..n {
+        let v = 1.0 + k as f64 / n.max(1) as f64;
+        s.push_str(&format!(
+            "\n[[body]]\nname = \"slider{k}\"\nmass = 2.0\nbox = [0.05, 0.05]\nposition = [{:.3}, 0.025]\nvelocity = [{v:.3}, 0.0]\n",
+            0.2 * k as f64
+        ));
+    }
+    s
+}
+
+fn scene(
+    name: &str,
+    result: Option<Result<Scene, haptic2d::scene::SceneErrors>>,
+) -> Result<Scene, String> {
+    match result {
+        Some(Ok(s)) => Ok(s),
+        Some(Err(e)) => Err(format!("scene {name}: {e}")),
+        None => Err(format!("no built-in scene {name}")),
+    }
+}
+
+/// All cases: `pile` for every `n` in `pile_sizes`, `box-in-walls`, `sliding` (10 boxes); those whose
+/// label contains none of `filter` (when non-empty) are left out.
+pub fn cases(pile_sizes: &[usize], filter: &[String]) -> Result<Vec<Case>, String> {
+    let keep = |label: &str| filter.is_empty() || filter.iter().any(|f| label.contains(f.as_str()));
+    let rate = Some(1.0 / DT);
+    let mut out = Vec::new();
+    if keep("pile") {
+        for &n in pile_sizes {
+            let name = format!("pile:{n}");
+            out.push(Case {
+                scene: "pile",
+                n,
+                haptic: scene(&name, builtin(&name, rate))?,
+                rapier_friction: 0.5,
+                rapier_restitution: 0.2,
+            });
+        }
+    }
+    if keep("box-in-walls") {
+        out.push(Case {
+            scene: "box-in-walls",
+            n: 1,
+            haptic: scene("box-in-walls", builtin("box-in-walls", rate))?,
+            rapier_friction: 0.0,
+            rapier_restitution: 0.5,
+        });
+    }
+    if keep("sliding") {
+        let n = 10;
+        out.push(Case {
+            scene: "sliding",
+            n,
+            haptic: scene(
+                "sliding",
+                Some(Scene::from_toml(&sliding_toml(n), "sliding", rate)),
+            )?,
+            rapier_friction: 0.5,
+            rapier_restitution: 0.2,
+        });
+    }
+    Ok(out)
+}
