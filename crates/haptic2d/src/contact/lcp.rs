@@ -198,6 +198,26 @@ impl LcpSolver {
                 return Ok(p);
             }
             let p_viol = self.violation();
+            // Polish: PGS usually finds the right active set long before its iterate converges (stacked
+            // contacts make A badly conditioned). Solve that index set exactly; accept it if it
+            // satisfies the §7.3 tolerances, before paying for the full enumeration.
+            let support = (0..n).fold(0u64, |m, i| {
+                if self.lambda[i] > LAMBDA_TOL {
+                    m | (1u64 << i)
+                } else {
+                    m
+                }
+            });
+            if let Some((true, _)) = self.eval_set(a, b, n, support) {
+                return Ok(LcpReport {
+                    method: LcpMethod::Enumeration,
+                    active_mask: support,
+                    pgs_failed: true,
+                    iterations: p.iterations + 1,
+                    converged: true,
+                    ..p
+                });
+            }
             let mut e = self.solve_enumeration(a, b)?;
             e.pgs_failed = true;
             e.iterations += p.iterations;
