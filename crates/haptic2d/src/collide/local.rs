@@ -167,6 +167,29 @@ impl LocalStage {
             else {
                 continue;
             };
+            let ctx = Ctx {
+                delta_c,
+                eps_s: self.eps_s,
+                cos_parallel: self.cos_parallel,
+            };
+            let (sa, sb) = (Side { id: ia, c: a }, Side { id: ib, c: b });
+            // A pair that was penetrating and still has a vertex strictly inside the other polygon is
+            // still penetrating: its candidates are exactly the vertex scan (§9.4), and the closest-
+            // feature walk/GJK is skipped (resting contacts, e.g. a pile, stay on this path).
+            if self.trackers[k].is_penetrating() {
+                let mark = out.len();
+                let inside_a = ctx.vertices_against(sa, sb, out);
+                let inside_b = ctx.vertices_against(sb, sa, out);
+                if let Some(at) = inside_a.or(inside_b) {
+                    let f = self.trackers[k].confirm_penetration(at);
+                    self.states.push(PairState {
+                        pair: (ia, ib),
+                        features: f,
+                    });
+                    continue;
+                }
+                out.truncate(mark);
+            }
             // Closest features (§9.3).
             let f = self.trackers[k].update(a, b);
             self.states.push(PairState {
@@ -174,12 +197,7 @@ impl LocalStage {
                 features: f,
             });
             // VE candidates (§9.4–9.5).
-            let ctx = Ctx {
-                delta_c,
-                eps_s: self.eps_s,
-                cos_parallel: self.cos_parallel,
-            };
-            let (a, b) = (Side { id: ia, c: a }, Side { id: ib, c: b });
+            let (a, b) = (sa, sb);
             match f.status {
                 TrackStatus::Penetrating => {
                     ctx.vertices_against(a, b, out);
@@ -345,21 +363,28 @@ impl Ctx {
 
     /// Penetrating pair (§9.4): every vertex of `a` inside `b` or within `δ_c` of it, against the
     /// edge of `b` of least depth among those whose range contains it.
-    fn vertices_against(&self, a: Side, b: Side, out: &mut Vec<VeCandidate>) {
+    /// Returns a vertex of A strictly inside B (all signed distances < 0), if any.
+    fn vertices_against(&self, a: Side, b: Side, out: &mut Vec<VeCandidate>) -> Option<Vec2> {
+        let mut inside = None;
         'vertex: for v in 0..a.c.len() {
             let p = a.c.world_vertices[v];
             let mut best: Option<(usize, f64)> = None;
+            let mut max_d = f64::NEG_INFINITY;
             for e in 0..b.c.len() {
                 let d = b.c.edge_distance(e, p);
                 if d > self.delta_c {
                     // Farther than δ_c from B's half-plane, so from B.
                     continue 'vertex;
                 }
+                max_d = max_d.max(d);
                 let s = b.c.edge_coordinate(e, p);
                 let in_range = s >= -self.eps_s && s <= b.c.local.lengths()[e] + self.eps_s;
                 if in_range && best.is_none_or(|(_, bd)| d > bd) {
                     best = Some((e, d));
                 }
+            }
+            if max_d < 0.0 && inside.is_none() {
+                inside = Some(p);
             }
             if let Some((e, _)) = best {
                 out.push(VeCandidate {
@@ -370,6 +395,7 @@ impl Ctx {
                 });
             }
         }
+        inside
     }
 }
 

@@ -317,6 +317,31 @@ fn feature_from_simplex(c: &Collider, idx: &[u32], w: &[f64]) -> Feature {
 }
 
 impl FeatureTracker {
+    /// True if the last update found the pair overlapping.
+    #[inline]
+    pub fn is_penetrating(&self) -> bool {
+        self.penetrating
+    }
+
+    /// Re-confirms an overlap found by the caller (a vertex of one polygon strictly inside the other)
+    /// without running GJK: the result of [`FeatureTracker::update`] for a pair that is still
+    /// penetrating, with the last features and no closest points (they do not exist).
+    pub fn confirm_penetration(&mut self, at: Vec2) -> ClosestFeatures {
+        self.stats.updates += 1;
+        self.penetrating = true;
+        ClosestFeatures {
+            status: TrackStatus::Penetrating,
+            feature_a: self.feature_a.unwrap_or(Feature::Vertex(0)),
+            feature_b: self.feature_b.unwrap_or(Feature::Vertex(0)),
+            point_a: at,
+            point_b: at,
+            distance: 0.0,
+            parallel: false,
+            iterations: 0,
+            used_gjk: false,
+        }
+    }
+
     /// A tracker with no cached features (the first update runs GJK).
     pub fn new() -> Self {
         Self::default()
