@@ -51,6 +51,10 @@ pub struct Fig8Params {
     pub scale: f64,
     /// Haptic-system settings. Default: the defaults.
     pub haptic: HapticConfig,
+    /// Push the peg in with `push` between `t_hold` and `t_release`. Default false.
+    pub push_in: bool,
+    /// Keep the hand's y/θ grip during the sinusoid. Default false.
+    pub guide_y_theta: bool,
 }
 
 impl Default for Fig8Params {
@@ -66,6 +70,8 @@ impl Default for Fig8Params {
             start_x: -0.03,
             scale: 2.0,
             haptic: HapticConfig::default(),
+            push_in: false,
+            guide_y_theta: false,
         }
     }
 }
@@ -178,11 +184,22 @@ pub fn run_case(
     let mut records = Vec::with_capacity(n);
     let mut stopped = None;
     for k in 0..n {
-        if k == n_hold {
+        if k == n_hold && p.push_in {
             l.hand = pushing;
         }
-        if k == n_release {
-            l.hand = sine;
+        if k >= n_release {
+            if p.guide_y_theta {
+                let x = l.plant.pose();
+                let t = k as f64 * dt;
+                let f = sine.wrench(&x, &[0.0; 3], t)[0];
+                l.hand = HandModel::SpringDamper {
+                    target: [x[0] + f, start[1], start[2]],
+                    stiffness: [1.0, stiffness[1], stiffness[2]],
+                    damping: [0.0, damping[1], damping[2]],
+                };
+            } else {
+                l.hand = sine;
+            }
         }
         let out = l
             .step()
