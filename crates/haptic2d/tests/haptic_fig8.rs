@@ -60,7 +60,13 @@ fn fig8_four_channel_free_handle_rattles_and_stops_safely() {
     for c in &cases {
         let s = c.stopped.as_deref().expect("safety stop");
         assert!(s.contains("singularity"), "{}: {s}", c.name);
-        assert!(c.records.last().expect("records").tau.iter().all(|t| *t == 0.0));
+        assert!(c
+            .records
+            .last()
+            .expect("records")
+            .tau
+            .iter()
+            .all(|t| *t == 0.0));
         assert!(c.metrics.max_abs_y > 1e-3, "{}: corners unload", c.name);
         assert!(!c.metrics.pass);
     }

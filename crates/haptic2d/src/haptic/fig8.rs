@@ -233,7 +233,11 @@ pub fn run_case(
         if k == n_hold && p.push_in {
             l.hand = pushing;
         }
-        let mut f_world = if p.push_in && k >= n_hold { p.push } else { 0.0 };
+        let mut f_world = if p.push_in && k >= n_hold {
+            p.push
+        } else {
+            0.0
+        };
         if k >= n_release {
             let x = l.plant.pose();
             let f = sine.wrench(&x, &[0.0; 3], t)[0];
