@@ -1,5 +1,5 @@
-//! `haptic2d reproduce [all|fig4|fig7] [--out DIR]`: the paper's figures as data, plots, metrics and a
-//! report (see the `haptic2d-lab` crate).
+//! `haptic2d reproduce [all|fig4|fig5|fig7|fig8] [--out DIR]`: the paper's figures as data, plots,
+//! metrics and a report (see the `haptic2d-lab` crate).
 
 use std::path::Path;
 

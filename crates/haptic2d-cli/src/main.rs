@@ -57,10 +57,10 @@ enum Command {
         /// A scene file path, or a built-in scene name.
         scene: String,
     },
-    /// Reproduce the paper's figures (Fig. 4 walls, Fig. 7 peg in hole) as CSV data, SVG/PNG plots,
-    /// metrics.json and REPORT.md.
+    /// Reproduce the paper's figures (Fig. 4 walls, Figs. 5–6 walls with the device, Fig. 7 peg in
+    /// hole, Figs. 8–11 peg with the device) as CSV data, SVG/PNG plots, metrics.json and REPORT.md.
     Reproduce {
-        /// Which figure: all, fig4 or fig7.
+        /// Which figure: all, fig4, fig5, fig7 or fig8.
         #[arg(default_value = "all")]
         figure: String,
         /// Output folder.

@@ -43,7 +43,12 @@ pub trait Figure: Send + Sync {
 
 /// Every registered figure, in report order. Add new figures here.
 pub fn registry() -> Vec<Box<dyn Figure>> {
-    vec![Box::new(crate::fig4::Fig4), Box::new(crate::fig7::Fig7)]
+    vec![
+        Box::new(crate::fig4::Fig4),
+        Box::new(crate::fig5::Fig5),
+        Box::new(crate::fig7::Fig7),
+        Box::new(crate::fig8::Fig8),
+    ]
 }
 
 /// Names of the registered figures.

@@ -4,7 +4,9 @@
 //! - [`figure`]: the [`Figure`] trait and the registry of figures; [`reproduce`] runs a selection of
 //!   them, writes `DIR/<figure>/` (CSV series, SVG + PNG plots, `metrics.json`) and `DIR/REPORT.md`.
 //! - [`fig4`]: Fig. 4, a box pushed into undamped walls (§5.10, §13.1), in 1-D and through the 2-D world.
+//! - [`fig5`]: Figs. 5–6, the walls with the device in the loop (four-channel and virtual coupling).
 //! - [`fig7`]: Fig. 7, a peg pushed into a tight hole (§13.2), in 1-D and through the 2-D world.
+//! - [`fig8`]: Figs. 8–11, the peg in a tight hole with the device in the loop.
 //! - [`sweep`]: stiffness × damping sweeps of the wall laws on the 1-D Fig. 4 harness (Z-width chart).
 //!
 //! Adding a figure: implement [`Figure`] in a new file and add it to [`figure::registry`].
@@ -13,7 +15,9 @@
 
 pub mod csv;
 pub mod fig4;
+pub mod fig5;
 pub mod fig7;
+pub mod fig8;
 pub mod figure;
 pub mod plot;
 pub mod schema;

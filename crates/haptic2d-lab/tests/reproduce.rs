@@ -31,7 +31,7 @@ fn reproduce_all_writes_every_output_and_the_cases_pass() {
     let dir = tempfile::tempdir().expect("temp dir");
     let out = dir.path().join("repro");
     let s = reproduce("all", &out, false).expect("reproduce all");
-    assert_eq!(s.figures.len(), 2);
+    assert_eq!(s.figures.len(), 4);
     for f in [
         "REPORT.md",
         "fig4/metrics.json",
@@ -49,6 +49,16 @@ fn reproduce_all_writes_every_output_and_the_cases_pass() {
         "fig7/creep_advance.png",
         "fig7/nahvi_2.1N_2d.csv",
         "fig7/classical_1.8N_1d.csv",
+        "fig5/metrics.json",
+        "fig5/positions.svg",
+        "fig5/positions.png",
+        "fig5/four-channel_seh.csv",
+        "fig5/coupling_hysteretic.csv",
+        "fig8/metrics.json",
+        "fig8/positions.svg",
+        "fig8/positions.png",
+        "fig8/coupling_classical.csv",
+        "fig8/four-channel_nahvi.csv",
     ] {
         let p = out.join(f);
         let len = std::fs::metadata(&p).map(|m| m.len()).unwrap_or(0);
@@ -59,6 +69,8 @@ fn reproduce_all_writes_every_output_and_the_cases_pass() {
     let report = std::fs::read_to_string(out.join("REPORT.md")).expect("report");
     assert!(report.contains("![positions](fig4/positions.png)"));
     assert!(report.contains("![creep and advance](fig7/creep_advance.png)"));
+    assert!(report.contains("![positions](fig5/positions.png)"));
+    assert!(report.contains("![positions](fig8/positions.png)"));
 
     let v4 = read_json(&out.join("fig4/metrics.json"));
     check_schema(
@@ -88,6 +100,52 @@ fn reproduce_all_writes_every_output_and_the_cases_pass() {
     for c in &m4.cases {
         assert!(c.pass, "fig4 {} {:?}: {:?}", c.model, c.dimension, c.checks);
     }
+
+    // Figs. 5–11 with the device in the loop (see the `fig5`, `fig8` module docs): each controller
+    // reproduces part of Figs. 5–6 — the four-channel loop keeps SEH/ZOH bouncing, the virtual
+    // coupling settles the pulse and hysteretic walls — and the virtual coupling reproduces Figs.
+    // 8–11 while the four-channel loop ends in a safety stop.
+    let v5 = read_json(&out.join("fig5/metrics.json"));
+    check_schema(
+        &v5,
+        "fig5",
+        &["separations", "contact_ratios", "entry_speeds_m_s"],
+    );
+    let v8 = read_json(&out.join("fig8/metrics.json"));
+    check_schema(&v8, "fig8", &["peak_force_n", "creep_m", "advance_m"]);
+    let m5: FigureMetrics = serde_json::from_value(v5).expect("typed fig5");
+    let m8: FigureMetrics = serde_json::from_value(v8).expect("typed fig8");
+    assert_eq!(m5.cases.len(), 8);
+    assert_eq!(m8.cases.len(), 10);
+    let passing = |m: &FigureMetrics| {
+        let mut v: Vec<String> = m
+            .cases
+            .iter()
+            .filter(|c| c.pass)
+            .map(|c| c.model.clone())
+            .collect();
+        v.sort();
+        v
+    };
+    assert_eq!(
+        passing(&m5),
+        [
+            "coupling/hysteretic",
+            "coupling/pulse",
+            "four-channel/seh",
+            "four-channel/zoh"
+        ]
+    );
+    assert_eq!(
+        passing(&m8),
+        [
+            "coupling/classical",
+            "coupling/dahl",
+            "coupling/nahvi",
+            "coupling/reset-integrator",
+            "coupling/salcudean-vlaar"
+        ]
+    );
 }
 
 #[test]

@@ -1,22 +1,21 @@
 //! Figs. 8–11 with the device in the loop (see `haptic2d::haptic::fig8`): the paper's claim is that
-//! classical friction drifts while the other models stick and slip.
+//! classical friction drifts while the other models stick and slip. Thresholds are §13.2's F7-1 (drift:
+//! `min creep_k ≥ 5e-4 m`), F7-2 (stick: `max creep_k ≤ 2e-4 m`) and F7-3 (slip: `advance_k > 5e-3 m`).
 //!
-//! Finding (not yet reproduced; the test documenting the claim is `#[ignore]`d): with the simulated
-//! twin pantograph and the default four-channel controller, every model's first slip carries the peg
-//! 0.1–0.2 m, so the handle reaches the edge of its workspace (singularity margin < 0.1, safety stop)
-//! within 0.6–2.5 s of the release, before the creep/advance windows of later cycles. In the recorded
-//! runs the squeezed peg rattles in y and θ (contact forces of ±5–8 N across the channel, torques at
-//! saturation) once it moves: the coupling's y/θ stiffness (2000 N/m, 4 N·m/rad on the slave) against
-//! 1000 N/m corner springs, with the device's inertial x–y–θ coupling, unloads the corners
-//! intermittently and friction drops, so slips run long. Tried without success: F_pk 2.1–2.3 N,
-//! mapping scale 1 and 2, with and without the push-in phase. Untried: stiffer y/θ grip on the handle,
-//! lower slave y/θ gains, 500 Hz with reduced θ gains.
+//! Measured (1 kHz, scale 2, F_pk = 2.1 N, handle free after the release):
+//!
+//! - Virtual coupling: classical creep 7.1e-4–8.3e-4 m per cycle (drift), the others 3.4e-5–5.3e-5 m
+//!   (elastic presliding, as in the 1-D reference's 5e-5 m); advances 7e-3–2.5e-2 m. Every claim holds.
+//! - Four-channel: the free handle renders the channel's undamped corner springs through the C2 force
+//!   channel at `s²·4000 N/m` with a zero-order hold (Colgate: needs 8 N·s/m of physical damping, the
+//!   device has ~0.01); the y/θ oscillation grows until corners unload (`|y|` up to 7 mm against 1 mm of
+//!   interference), the first slip runs away and every run ends in a singularity safety stop at the
+//!   workspace edge within 0.6–0.9 s of the release.
 
-use haptic2d::haptic::fig8::{run, Fig8Params};
+use haptic2d::haptic::fig8::{run, Fig8Case, Fig8Params};
 
-fn report() -> Vec<haptic2d::haptic::fig8::Fig8Case> {
-    let cases = run(&Fig8Params::default()).expect("runs");
-    for c in &cases {
+fn report(label: &str, cases: &[Fig8Case]) {
+    for c in cases {
         let m = &c.metrics;
         let f = |v: &[f64]| {
             v.iter()
@@ -25,39 +24,50 @@ fn report() -> Vec<haptic2d::haptic::fig8::Fig8Case> {
                 .join(", ")
         };
         println!(
-            "{:<17} creep [{}] m, advance [{}] m, peg x end {:.4} m, pass {}{}",
+            "{label} {:<17} creep [{}] m, advance [{}] m, max|y| {:.1e} m, pass {}{}",
             c.name,
             f(&m.creep),
             f(&m.advance),
-            c.records.last().map_or(f64::NAN, |r| r.x_s[0]),
+            m.max_abs_y,
             m.pass,
             c.stopped
                 .as_deref()
                 .map_or(String::new(), |s| format!(" — {s}"))
         );
     }
-    cases
 }
 
-/// What the loop does today: every case ends in a safety stop at the workspace edge (deterministic).
+/// The paper's claim with the virtual coupling: classical drifts, the others stick and slip.
 #[test]
-fn fig8_runs_and_stops_safely_at_the_workspace_edge() {
-    let cases = report();
+fn fig8_fig11_classical_drifts_others_stick_slip() {
+    let cases = run(&Fig8Params::default()).expect("runs");
+    report("coupling", &cases);
     assert_eq!(cases.len(), 5);
     for c in &cases {
-        let last = c.records.last().expect("records");
-        assert!(last.tau.iter().all(|t| *t == 0.0) || c.stopped.is_none());
-        if let Some(s) = &c.stopped {
-            assert!(s.contains("singularity"), "{}: {s}", c.name);
-        }
+        assert!(c.stopped.is_none(), "{}", c.name);
+        assert!(c.metrics.pass, "{}", c.name);
+        // The peg stays squeezed: no rattle across the 1 mm interference.
+        assert!(c.metrics.max_abs_y < 1e-4, "{}", c.name);
     }
 }
 
-/// The paper's claim (F7-1..F7-3 thresholds): classical drifts, the others stick and slip.
+/// The four-channel loop with the handle released: the y/θ rattle makes every run stop safely at the
+/// workspace edge (deterministic), so the claim cannot be measured there.
 #[test]
-#[ignore = "not reproduced with the device in the loop yet; see the module docs"]
-fn fig8_fig11_classical_drifts_others_stick_slip() {
-    for c in &report() {
-        assert!(c.metrics.pass, "{}", c.name);
+fn fig8_four_channel_free_handle_rattles_and_stops_safely() {
+    let cases = run(&Fig8Params::four_channel()).expect("runs");
+    report("four-channel", &cases);
+    for c in &cases {
+        let s = c.stopped.as_deref().expect("safety stop");
+        assert!(s.contains("singularity"), "{}: {s}", c.name);
+        assert!(c
+            .records
+            .last()
+            .expect("records")
+            .tau
+            .iter()
+            .all(|t| *t == 0.0));
+        assert!(c.metrics.max_abs_y > 1e-3, "{}: corners unload", c.name);
+        assert!(!c.metrics.pass);
     }
 }

@@ -4,14 +4,33 @@
 //! go of the handle and the hand is replaced by a constant force. No wall damping exists." Here: the
 //! box-in-walls scene (0.5 kg box 0.02 m from the left wall) with the wall's normal law replaced by one
 //! of the §5 walls (per-contact defaults, impacts off, so the wall law alone handles the contact), the
-//! simulated twin pantograph and the four-channel controller; the simulated hand grips the handle at
-//! its start pose for `t_hold`, then is replaced by a constant push `F` toward the wall.
+//! simulated twin pantograph and, by default, the four-channel controller (the paper's) at 500 Hz; the
+//! simulated hand grips the handle at its start pose for `t_hold`, then is replaced by a constant push
+//! `F` toward the wall (y and θ keep the grip, see [`Fig5Params::guide_y_theta`]).
 //!
 //! Cases: SEH (marginally passive) and ZOH (active) — Fig. 5: the block keeps bouncing; braking pulse
 //! and hysteretic wall — Fig. 6: contact stability at the first impact with the pulse, soon with the
 //! hysteretic wall. Metrics per case from the slave's trajectory after the release (§13.1 definitions:
-//! separations, entry/exit speeds, contact ratios, settle time).
+//! separations, entry/exit speeds, contact ratios, settle time). Pass criteria (the spec's W6/W7
+//! thresholds, with W7's absolute 0.06 m/s made relative to the 0.40 m/s entry of §5.10), `v1` the
+//! measured first entry speed:
+//!
+//! - keeps bouncing: at least 2 separations in the last 2 s and no settle time;
+//! - settles at the first impact (W7): first contact ratio ≤ 0.4, every entry speed after the second
+//!   impact < 0.15·v1, and no separation in the last 2 s;
+//! - settles soon (W6): each of the first three contact ratios (those that exist) < 0.85 and at most
+//!   6 separations.
+//!
+//! Finding: no single controller meets all four. The four-channel loop is *active* at the wall (SEH
+//! contact ratios 1.25, 1.16, …; the same wall in the world alone gives 0.87, §5.10 VE mode): the device
+//! renders `−f_e` through a zero-order hold with almost no physical damping (Colgate, §5.4:
+//! `K·T/2 = 2 N·s/m` needed), and the hand force reaches the slave only through the observer's lag. So
+//! SEH and ZOH keep bouncing (bounces grow to 0.50–0.57 m/s) but the extra energy also defeats the
+//! pulse (first ratio 0.49) and the hysteretic wall (ratios ≈ 1.0, bouncing to the end). The virtual
+//! coupling (`Fig5Params::coupling`) is *dissipative* (its damper `B_vc` and the device's joint
+//! friction): the pulse and the hysteretic wall settle, but so do SEH and ZOH after one separation.
 
+use crate::control::coupling::CouplingGains;
 use crate::device::dynamics::LumpedDynamics;
 use crate::device::HandModel;
 use crate::device::TwinPantograph;
@@ -19,7 +38,7 @@ use crate::laws::normal::{BrakingPulseLaw, NormalModel};
 use crate::metrics::{BounceMetrics, BounceSample};
 use crate::scene::{Scene, BUILTIN};
 
-use super::config::HapticConfig;
+use super::config::{ControllerKind, HapticConfig};
 use super::experiment::DeviceInTheLoop;
 use super::record::TickRecord;
 use super::system::HapticSystem;
@@ -48,6 +67,19 @@ pub struct Fig5Params {
     /// of §5.7): `e_b` is raised so the pulse removes the device's momentum too. Default false (the box
     /// mass alone): the larger pulse makes the contact chatter (144 separations in 10 s instead of 2).
     pub pulse_device_mass: bool,
+}
+
+impl Fig5Params {
+    /// The defaults with the virtual-coupling controller (§11.2) instead of the four-channel one.
+    pub fn coupling() -> Self {
+        Self {
+            haptic: HapticConfig {
+                controller: ControllerKind::Coupling(CouplingGains::default()),
+                ..HapticConfig::default()
+            },
+            ..Self::default()
+        }
+    }
 }
 
 /// Mass of the box of box-in-walls (kg).
@@ -96,11 +128,12 @@ pub struct Fig5Metrics {
     pub late_separations: usize,
     /// Entry speed of the first impact (m/s).
     pub first_entry_speed: f64,
-    /// Largest entry speed after the first contact (m/s); 0 if none.
+    /// Largest entry speed after the first contact (m/s); 0 if none (for the report; the pulse
+    /// criterion uses the entries after the second contact).
     pub max_later_entry_speed: f64,
     /// Largest `|v|` of the box over the last 2 s (m/s).
     pub late_max_speed: f64,
-    /// Whether the run meets its expectation.
+    /// Whether the run meets its expectation (criteria in the module docs).
     pub pass: bool,
 }
 
@@ -266,16 +299,28 @@ pub fn run_case(
         .skip(1)
         .copied()
         .fold(0.0, f64::max);
+    let ratios = &bounce.contact_ratios;
     let pass = match expectation {
         // Bounces persist to the end of the run: still separating in the last 2 s, never settled.
         Fig5Expectation::KeepsBouncing => late_separations >= 2 && bounce.settle_time.is_none(),
-        // Stable from the first impact: no later impact above 10 % of the first entry speed.
+        // W7: the first impact removes most of the energy, later impacts are slow, none at the end.
         Fig5Expectation::SettlesAtFirstImpact => {
-            first_entry_speed > 0.0 && max_later_entry_speed < 0.1 * first_entry_speed
+            let after_second = bounce
+                .entry_speeds
+                .iter()
+                .skip(2)
+                .copied()
+                .fold(0.0, f64::max);
+            first_entry_speed > 0.0
+                && ratios.first().is_some_and(|r| *r <= 0.4)
+                && after_second < 0.15 * first_entry_speed
+                && late_separations == 0
         }
-        // Stable soon: at most 6 separations, none in the last 2 s, and the box at rest at the end.
+        // W6: the first three contacts lose energy, and the block stops leaving the wall soon.
         Fig5Expectation::SettlesSoon => {
-            bounce.separations() <= 6 && late_separations == 0 && late_max_speed < 1e-2
+            first_entry_speed > 0.0
+                && ratios.iter().take(3).all(|r| *r < 0.85)
+                && bounce.separations() <= 6
         }
     };
     Ok(Fig5Case {
