@@ -8,7 +8,7 @@
 use crate::body::Body;
 use crate::collide::{BroadPhase, Collider, LocalStage, VeCandidate, DEFAULT_DELTA_PROX};
 use crate::contact::{ContactParams, ContactSet, PastPoses, VeContact, Wrench2};
-use crate::geom::{Pose, Vec2};
+use crate::geom::{Pose, Rot, Vec2};
 use crate::integrate::{integrate_body, EnergyLedger, IntegrationMode, PassivityGuard};
 use crate::laws::friction::FrictionModel;
 use crate::laws::normal::NormalModel;
@@ -76,6 +76,7 @@ pub struct World {
     ledger: EnergyLedger,
     guard: Option<PassivityGuard>,
     ke_before: Vec<f64>,
+    rots: Vec<Rot>,
     tick: u64,
 }
 
@@ -127,6 +128,7 @@ impl World {
             prev2: Vec::with_capacity(n),
             ledger: EnergyLedger::default(),
             ke_before: vec![0.0; n],
+            rots: vec![Rot::IDENTITY; n],
             tick: 0,
         };
         w.ledger.kinetic = w.bodies.iter().map(|b| b.kinetic_energy()).sum();
@@ -194,9 +196,12 @@ impl World {
     /// (velocities jump now), and continuous-contact forces.
     pub fn begin_step(&mut self) {
         let dt = self.params.dt;
-        // 0. World-frame features of every collider at the current poses.
+        // 0. Body rotations and the world-frame features of every collider at the current poses.
+        for (r, b) in self.rots.iter_mut().zip(&self.bodies) {
+            *r = b.pose.rot();
+        }
         for c in self.colliders.iter_mut() {
-            c.update(&self.bodies[c.body].pose);
+            c.update_with(&self.bodies[c.body].pose, self.rots[c.body]);
         }
         // 3. Global proximity stage: AABB sort-and-sweep + GJK, every N_g samples.
         if self
@@ -245,6 +250,7 @@ impl World {
             &self.candidates,
             &self.colliders,
             &mut self.bodies,
+            &self.rots,
             &past,
             &self.normal,
             &self.friction,

@@ -1,6 +1,6 @@
 //! A convex collision shape attached to a body, with world-frame features cached once per tick.
 
-use crate::geom::{Aabb, ConvexPolygon, Pose, Vec2};
+use crate::geom::{Aabb, ConvexPolygon, Pose, Rot, Vec2};
 
 /// A convex piece of a body. `local` is expressed in the body frame (origin at the centre of mass);
 /// `world_*` are refreshed by [`Collider::update`] at the start of every tick.
@@ -41,7 +41,11 @@ impl Collider {
 
     /// Recomputes the world-frame features for the body pose `pose` (no allocation).
     pub fn update(&mut self, pose: &Pose) {
-        let rot = pose.rot();
+        self.update_with(pose, pose.rot());
+    }
+
+    /// [`Collider::update`] with the pose's rotation already computed (one `sin_cos` per body).
+    pub fn update_with(&mut self, pose: &Pose, rot: Rot) {
         let mut aabb = Aabb::EMPTY;
         for i in 0..self.local.len() {
             let v = pose.pos + rot.apply(self.local.vertices()[i]);

@@ -8,10 +8,10 @@
 use super::god_object::{crossing_coordinate, entry_point};
 use super::impact::{ImpactRow, ImpactSolver};
 use super::params::ContactParams;
-use super::record::{ContactEvent, ContactState, EventKind, VeContact};
+use super::record::{ContactEvent, ContactState, EventKind, LocalGeom, VeContact};
 use crate::body::Body;
 use crate::collide::{Collider, VeCandidate};
-use crate::geom::{cross, Pose, Vec2};
+use crate::geom::{cross, Pose, Rot, Vec2};
 use crate::laws::friction::{FrictionInput, FrictionLaw, FrictionModel};
 use crate::laws::normal::{NormalInput, NormalLaw, NormalModel};
 
@@ -53,6 +53,8 @@ pub struct ContactSet {
     nonfric: Vec<Vec2>,
     /// Kinetic energy removed by the impacts of the last sample (J).
     pub last_impact_loss: f64,
+    /// Energy stored in contact and friction springs after the last step (J).
+    stored: f64,
     /// Number of impact sets solved so far.
     pub impacts_solved: u64,
 }
@@ -77,6 +79,7 @@ impl ContactSet {
             new_count: Vec::new(),
             nonfric: Vec::new(),
             last_impact_loss: 0.0,
+            stored: 0.0,
             impacts_solved: 0,
         }
     }
@@ -103,11 +106,9 @@ impl ContactSet {
         &self.events
     }
 
-    /// Energy stored in all contact and friction springs (J).
+    /// Energy stored in all contact and friction springs after the last step (J).
     pub fn stored_energy(&self) -> f64 {
-        self.records()
-            .map(|e| e.normal.stored_energy() + e.friction.stored_energy())
-            .sum()
+        self.stored
     }
 
     /// Steps 4–6 of §0.5 for one sample: merge the local stage's candidates into the tracked set and
@@ -121,6 +122,7 @@ impl ContactSet {
         candidates: &[VeCandidate],
         colliders: &[Collider],
         bodies: &mut [Body],
+        rots: &[Rot],
         past: &PastPoses<'_>,
         normal: &NormalModel,
         friction: &FrictionModel,
@@ -129,7 +131,9 @@ impl ContactSet {
         self.events.clear();
         self.last_impact_loss = 0.0;
         self.resize_body_buffers(bodies.len());
-        self.sync(tick, candidates, colliders, bodies, past, normal, friction);
+        self.sync(
+            tick, candidates, colliders, bodies, rots, past, normal, friction,
+        );
         self.release(tick);
         let any_colliding = self.create(tick, dt, colliders, bodies, past, normal, friction);
         if any_colliding {
@@ -157,10 +161,19 @@ impl ContactSet {
         candidates: &[VeCandidate],
         colliders: &[Collider],
         bodies: &[Body],
+        rots: &[Rot],
         past: &PastPoses<'_>,
         normal: &NormalModel,
         friction: &FrictionModel,
     ) {
+        // Fast path (steady contact): the tracked set already is "records ∪ candidates" in order, so
+        // every entry is re-measured in place and nothing is copied.
+        if self.same_keys(candidates) {
+            for e in self.entries.iter_mut() {
+                measure(e, bodies, rots);
+            }
+            return;
+        }
         self.merged.clear();
         let (mut i, mut j) = (0, 0);
         let old = std::mem::take(&mut self.entries);
@@ -170,7 +183,7 @@ impl ContactSet {
                 let same = j < candidates.len() && old[i].key == candidates[j];
                 if same || old[i].is_contact() {
                     let mut e = old[i];
-                    measure(&mut e, colliders, bodies);
+                    measure(&mut e, bodies, rots);
                     self.merged.push(e);
                 }
                 if same {
@@ -193,6 +206,20 @@ impl ContactSet {
         }
         self.entries = old;
         std::mem::swap(&mut self.entries, &mut self.merged);
+    }
+
+    /// True if merging `candidates` would keep exactly the current entries (same keys, same order):
+    /// every candidate is tracked already, and every tracked pair is a candidate or a record.
+    fn same_keys(&self, candidates: &[VeCandidate]) -> bool {
+        let mut j = 0;
+        for e in &self.entries {
+            if j < candidates.len() && e.key == candidates[j] {
+                j += 1;
+            } else if !e.is_contact() || (j < candidates.len() && candidates[j] < e.key) {
+                return false;
+            }
+        }
+        j == candidates.len()
     }
 
     /// §8.2 rule 4 (release) and rule 5 (re-collision, optional).
@@ -294,16 +321,23 @@ impl ContactSet {
             self.entries.sort_unstable_by_key(|e| e.key);
         }
 
-        // Rule 2: the simultaneity window.
-        let mut any = false;
-        for f in self.body_flag.iter_mut() {
-            *f = false;
-        }
-        for e in &self.entries {
-            if e.state == Some(ContactState::Colliding) {
-                any = true;
-                self.body_flag[e.body_a] |= bodies[e.body_a].is_dynamic();
-                self.body_flag[e.body_b] |= bodies[e.body_b].is_dynamic();
+        // Rule 2: the simultaneity window. Records are Colliding only if created (or promoted) in this
+        // sample, so the event list tells whether there is anything to do.
+        let any = self.events.iter().any(|ev| {
+            matches!(
+                ev.kind,
+                EventKind::Created(ContactState::Colliding) | EventKind::Recollision
+            )
+        });
+        if any {
+            for f in self.body_flag.iter_mut() {
+                *f = false;
+            }
+            for e in &self.entries {
+                if e.state == Some(ContactState::Colliding) {
+                    self.body_flag[e.body_a] |= bodies[e.body_a].is_dynamic();
+                    self.body_flag[e.body_b] |= bodies[e.body_b].is_dynamic();
+                }
             }
         }
         if any && p.impacts {
@@ -338,16 +372,23 @@ impl ContactSet {
         }
         // Effective masses for the braking pulse: the pair's reduced mass shared by the contacts that
         // started on the vertex body in this sample.
-        for e in self.entries.iter_mut() {
-            if e.since == tick && e.is_contact() || e.m_eff == 0.0 {
+        let created = self.events.iter().any(|ev| {
+            matches!(
+                ev.kind,
+                EventKind::Created(_) | EventKind::CreatedSimultaneous
+            )
+        });
+        for e in self.entries.iter_mut().filter(|_| created) {
+            if e.since == tick && e.is_contact() {
                 let inv = bodies[e.body_a].inv_mass + bodies[e.body_b].inv_mass;
                 let n = self.new_count[e.body_a].max(1) as f64;
                 e.m_eff = if inv > 0.0 { 1.0 / inv / n } else { 0.0 };
             }
         }
-        self.entries
+        any || self
+            .events
             .iter()
-            .any(|e| e.state == Some(ContactState::Colliding))
+            .any(|ev| ev.kind == EventKind::CreatedSimultaneous)
     }
 
     /// §7: every Colliding record (restitution `e`) and every Continuous record touching a body of a
@@ -476,10 +517,15 @@ impl ContactSet {
         for w in wrenches.iter_mut() {
             *w = Wrench2::default();
         }
-        for e in self.entries.iter_mut() {
-            if e.state != Some(ContactState::Continuous) {
+        // The classical model needs every normal force first (its stick force cancels the other
+        // forces on A); every other model runs normal then friction per contact in one pass.
+        let needs_ext = friction.uses_external_force();
+        let mut stored = 0.0;
+        for idx in 0..self.entries.len() {
+            if self.entries[idx].state != Some(ContactState::Continuous) {
                 continue;
             }
+            let e = &mut self.entries[idx];
             let input = NormalInput {
                 d: e.d,
                 hist: e.hist,
@@ -489,37 +535,26 @@ impl ContactSet {
             };
             e.f_n = e.normal.force(&input);
             add_force(wrenches, bodies, e.body_a, e.body_b, e.n * e.f_n, e.point);
+            if !needs_ext {
+                friction_step(e, dt, 0.0, wrenches, bodies);
+                stored += e.normal.stored_energy() + e.friction.stored_energy();
+            }
         }
-        let needs_ext = matches!(friction.name(), "classical");
         if needs_ext {
             for (i, b) in bodies.iter().enumerate() {
                 self.nonfric[i] = b.force + wrenches[i].force;
             }
-        }
-        for idx in 0..self.entries.len() {
-            if self.entries[idx].state != Some(ContactState::Continuous) {
-                continue;
-            }
-            let f_ext_t = if needs_ext {
-                self.external_share(idx)
-            } else {
-                0.0
-            };
-            let e = &mut self.entries[idx];
-            let input = FrictionInput {
-                ds: e.s - e.s_prev,
-                s: e.s,
-                s0: e.s0,
-                fn_: e.f_n,
-                dt,
-                f_ext_t,
-            };
-            e.f_t = e.friction.update(&input);
-            e.s_g = e.friction.anchor(e.s).unwrap_or(e.s.clamp(0.0, e.len));
-            if e.f_t != 0.0 {
-                add_force(wrenches, bodies, e.body_a, e.body_b, e.t * e.f_t, e.point);
+            for idx in 0..self.entries.len() {
+                if self.entries[idx].state != Some(ContactState::Continuous) {
+                    continue;
+                }
+                let f_ext_t = self.external_share(idx);
+                let e = &mut self.entries[idx];
+                friction_step(e, dt, f_ext_t, wrenches, bodies);
+                stored += e.normal.stored_energy() + e.friction.stored_energy();
             }
         }
+        self.stored = stored;
     }
 
     /// `F_ext,t,i = (t·F_A^nonfric)/n_t` for the classical model (§4.1): the non-friction force on A
@@ -537,6 +572,31 @@ impl ContactSet {
             .count()
             .max(1);
         e.t.dot(self.nonfric[e.body_a]) / n_t as f64
+    }
+}
+
+/// Friction force of one Continuous record for this sample (after its normal force), and its
+/// god-object (§8.3).
+#[inline]
+fn friction_step(
+    e: &mut VeContact,
+    dt: f64,
+    f_ext_t: f64,
+    wrenches: &mut [Wrench2],
+    bodies: &[Body],
+) {
+    let input = FrictionInput {
+        ds: e.s - e.s_prev,
+        s: e.s,
+        s0: e.s0,
+        fn_: e.f_n,
+        dt,
+        f_ext_t,
+    };
+    e.f_t = e.friction.update(&input);
+    e.s_g = e.friction.anchor(e.s).unwrap_or(e.s.clamp(0.0, e.len));
+    if e.f_t != 0.0 {
+        add_force(wrenches, bodies, e.body_a, e.body_b, e.t * e.f_t, e.point);
     }
 }
 
@@ -623,19 +683,25 @@ fn past_ds(key: VeCandidate, colliders: &[Collider], pa: &Pose, pb: &Pose) -> (f
     )
 }
 
-/// Re-measures an existing entry: shifts the histories and refreshes geometry and velocities.
-fn measure(e: &mut VeContact, colliders: &[Collider], bodies: &[Body]) {
-    let (v, e0, n, t, len) = geometry(e.key, colliders);
+/// Re-measures an existing entry: shifts the histories and refreshes geometry and velocities from
+/// the body poses (`rots[i]` is body `i`'s rotation this sample).
+#[inline]
+fn measure(e: &mut VeContact, bodies: &[Body], rots: &[Rot]) {
+    let (ba, bb) = (&bodies[e.body_a], &bodies[e.body_b]);
+    let (ra, rb) = (rots[e.body_a], rots[e.body_b]);
+    let v = ba.pose.pos + ra.apply(e.local.v);
+    let e0 = bb.pose.pos + rb.apply(e.local.e0);
+    let n = rb.apply(e.local.n);
+    let t = rb.apply(e.local.t);
     let rel = v - e0;
     e.d = [n.dot(rel), e.d[0], e.d[1]];
     e.hist = (e.hist + 1).min(3);
     e.s_prev = e.s;
     e.s = t.dot(rel);
-    e.len = len;
     e.point = v;
     e.n = n;
     e.t = t;
-    let v_rel = bodies[e.body_a].point_velocity(v) - bodies[e.body_b].point_velocity(v);
+    let v_rel = ba.point_velocity(v) - bb.point_velocity(v);
     e.c0 = n.dot(v_rel);
     e.s0 = t.dot(v_rel);
 }
@@ -654,6 +720,16 @@ fn new_entry(
     let body_a = colliders[key.vertex_collider as usize].body;
     let body_b = colliders[key.edge_collider as usize].body;
     let (v, e0, n, t, len) = geometry(key, colliders);
+    let (ca, cb) = (
+        &colliders[key.vertex_collider as usize].local,
+        &colliders[key.edge_collider as usize].local,
+    );
+    let local = LocalGeom {
+        v: ca.vertices()[key.vertex as usize],
+        e0: cb.vertices()[key.edge as usize],
+        n: cb.normals()[key.edge as usize],
+        t: cb.tangents()[key.edge as usize],
+    };
     let rel = v - e0;
     let (d0, s0) = (n.dot(rel), t.dot(rel));
     let mut d = [d0, 0.0, 0.0];
@@ -693,6 +769,7 @@ fn new_entry(
         f_n: 0.0,
         f_t: 0.0,
         since: tick,
+        local,
     }
 }
 

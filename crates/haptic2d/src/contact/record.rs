@@ -63,6 +63,22 @@ pub struct VeContact {
     pub f_t: f64,
     /// Tick at which this entry was first tracked.
     pub since: u64,
+    /// The pair's geometry in the bodies' own frames (fixed for the life of the entry).
+    pub local: LocalGeom,
+}
+
+/// Body-frame geometry of a VE pair: the vertex in A's frame, the edge's start, normal and tangent
+/// in B's frame. World quantities follow from the two body poses each sample.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LocalGeom {
+    /// Vertex `V` in A's centre-of-mass frame (m).
+    pub v: Vec2,
+    /// Edge start `E0` in B's centre-of-mass frame (m).
+    pub e0: Vec2,
+    /// Outward edge normal in B's frame.
+    pub n: Vec2,
+    /// Edge tangent in B's frame.
+    pub t: Vec2,
 }
 
 impl VeContact {
