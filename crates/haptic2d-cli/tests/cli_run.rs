@@ -253,7 +253,11 @@ fn run_display_serves_frames_and_applies_commands() {
     let x_min = ws_box[0].as_f64().expect("device workspace");
     let f0 = wait_for(&mut ws, "frame", 5.0, |_| true);
     let start = slave_pose(&f0);
-    assert!(f0["device"]["valid"] == true, "device linkage: {}", f0["device"]);
+    assert!(
+        f0["device"]["valid"] == true,
+        "device linkage: {}",
+        f0["device"]
+    );
     assert_eq!(f0["controller"], "four-channel");
 
     // Hand target 10 mm inside the left wall: clamped to the workspace edge; the box hits the wall.
@@ -265,7 +269,10 @@ fn run_display_serves_frames_and_applies_commands() {
         f["contacts_total"].as_u64().unwrap_or(0) > 0 && slave_pose(f)[0] < 0.025
     });
     let target_x = hit["hand_target"][0].as_f64().unwrap();
-    assert!((target_x - x_min).abs() < 1e-9, "clamped: {target_x} vs {x_min}");
+    assert!(
+        (target_x - x_min).abs() < 1e-9,
+        "clamped: {target_x} vs {x_min}"
+    );
     assert!(slave_pose(&hit)[0] < start[0] - 0.01, "{hit}");
     assert!(hit["contacts"]
         .as_array()
@@ -277,7 +284,9 @@ fn run_display_serves_frames_and_applies_commands() {
     send(&mut ws, r#"{"type":"pause"}"#);
     let p1 = wait_for(&mut ws, "frame", 5.0, |f| f["paused"] == true);
     std::thread::sleep(std::time::Duration::from_millis(200));
-    let p2 = wait_for(&mut ws, "frame", 5.0, |f| f["seq"].as_u64() > p1["seq"].as_u64());
+    let p2 = wait_for(&mut ws, "frame", 5.0, |f| {
+        f["seq"].as_u64() > p1["seq"].as_u64()
+    });
     assert_eq!(p1["t"], p2["t"], "paused world does not advance");
     assert_eq!(p2["drive"], serde_json::json!([0.0, 0.0, 0.0]));
     send(&mut ws, r#"{"type":"resume"}"#);
