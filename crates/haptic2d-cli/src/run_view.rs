@@ -188,3 +188,119 @@ impl LiveView {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::hand_arg::HandSpec;
+    use crate::run_rig::DeviceChoice;
+    use haptic2d::haptic::HapticConfig;
+    use std::alloc::{GlobalAlloc, Layout, System};
+    use std::cell::Cell;
+    use std::time::{Duration, Instant};
+
+    /// Counts the allocations of the current thread.
+    struct Counting;
+
+    thread_local! {
+        static ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
+    }
+
+    unsafe impl GlobalAlloc for Counting {
+        unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+            ALLOCATIONS.with(|a| a.set(a.get() + 1));
+            unsafe { System.alloc(layout) }
+        }
+        unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+            unsafe { System.dealloc(ptr, layout) }
+        }
+        unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+            ALLOCATIONS.with(|a| a.set(a.get() + 1));
+            unsafe { System.realloc(ptr, layout, new_size) }
+        }
+    }
+
+    #[global_allocator]
+    static GLOBAL: Counting = Counting;
+
+    fn allocations() -> u64 {
+        ALLOCATIONS.with(|a| a.get())
+    }
+
+    fn until(what: &str, cond: impl Fn() -> bool) {
+        let end = Instant::now() + Duration::from_secs(10);
+        while !cond() {
+            assert!(Instant::now() < end, "timed out waiting for {what}");
+            std::thread::sleep(Duration::from_millis(10));
+        }
+    }
+
+    /// The loop's side of the display — polling commands, the haptic tick, capturing and publishing
+    /// frames for a connected viewer, recording timing — allocates nothing in steady state, with the
+    /// box held against the wall by the hand target (contacts and the device linkage in every
+    /// frame). Ticks are driven by hand here (simulated time), on this thread.
+    #[test]
+    fn loop_side_of_the_display_does_not_allocate_in_steady_state() {
+        let scene = builtin("box-in-walls", Some(1000.0)).unwrap().unwrap();
+        let loaded = LoadedScene {
+            name: scene.name.clone(),
+            description: scene.description.clone(),
+            world: scene.world.clone(),
+        };
+        let mut rig = Rig::new(
+            scene.world,
+            "box-in-walls",
+            HapticConfig::default(),
+            DeviceChoice::Sim,
+            HandSpec::Follow,
+        )
+        .unwrap();
+        let (server, mut view) =
+            start("127.0.0.1:0".parse().unwrap(), &rig, loaded, 1000.0).unwrap();
+        let addr = server.local_addr();
+        let stream = std::net::TcpStream::connect(addr).unwrap();
+        let (mut ws, _) = tungstenite::client(format!("ws://{addr}/ws"), stream).unwrap();
+        until("the viewer", || server.stats().viewers == 1);
+        ws.send(tungstenite::Message::text(
+            r#"{"type":"set_hand_target","x":-0.01,"y":0.0,"theta":0.0}"#,
+        ))
+        .unwrap();
+        until("the command", || server.stats().commands_forwarded == 1);
+
+        let period_ns = 1_000_000;
+        let mut k = 0u64;
+        let mut pass = |n: u64, view: &mut LiveView, rig: &mut Rig| {
+            let before = allocations();
+            for _ in 0..n {
+                view.apply_commands(rig);
+                let q = rig.io.read_encoders().unwrap();
+                let out = rig.system.tick(&q);
+                rig.io.write_torques(&out.torques).unwrap();
+                let info = TickInfo {
+                    index: k,
+                    deadline_index: k,
+                    t_s: k as f64 * 1e-3,
+                    period_s: 1e-3,
+                    period_ns,
+                    lateness_ns: 0,
+                    skipped: 0,
+                    deadline_ns: k * period_ns,
+                };
+                view.after_tick(&info, rig);
+                k += 1;
+            }
+            allocations() - before
+        };
+        pass(3000, &mut view, &mut rig);
+        let allocs = pass(2000, &mut view, &mut rig);
+        let w = rig.system.world();
+        assert!(
+            w.contacts().contact_count() > 0,
+            "the box is against the wall"
+        );
+        assert!(w.bodies[rig.system.slave()].pose.pos.x < 0.025);
+        assert_eq!(allocs, 0, "allocations in steady state");
+        drop(ws);
+        server.shutdown();
+    }
+}

@@ -348,3 +348,14 @@ fn run_display_port_taken_is_a_clear_error() {
     let o = haptic2d(&["run", "--headless", "--bind", &addr, "--duration", "0.1"]);
     assert!(o.status.success(), "{}", text(&o));
 }
+
+#[test]
+fn run_display_on_a_non_loopback_address_prints_the_token() {
+    let o = haptic2d(&["run", "--bind", "0.0.0.0:0", "--duration", "0.3"]);
+    let out = text(&o);
+    assert!(o.status.success(), "{out}");
+    let banner = out.lines().next().unwrap_or_default();
+    assert!(banner.starts_with("display: http://127.0.0.1:"), "{out}");
+    assert!(banner.contains("?token="), "{out}");
+    assert!(banner.contains("commands need token"), "{out}");
+}
