@@ -1,20 +1,20 @@
 //! `haptic2d run`: the haptic loop — device, controller and world at the control rate on a real-time
-//! thread, with CSV logging on another thread and a timing summary at exit.
+//! thread, with CSV logging on another thread, the live display in the browser (unless
+//! `--headless`), and a timing summary at exit.
 
 use crate::hand_arg::HandSpec;
+use crate::run_rig::{DeviceChoice, Rig};
+use crate::run_view::{self, LoadedScene};
 use crate::scene_arg;
 use haptic2d::control::passivity::PlanarPassivity;
-use haptic2d::haptic::{ControllerKind, HapticConfig, HapticSystem, TickRecord};
-use haptic2d_rt::io::DEFAULT_REPLAY_COLUMNS;
+use haptic2d::haptic::{ControllerKind, HapticConfig, TickRecord};
 use haptic2d_rt::signal::install_ctrlc_stop;
 use haptic2d_rt::{
-    run_loop, telemetry_channel, CsvLogger, DeviceError, DeviceIo, LoggerConfig, LoopConfig,
-    ReplayDevice, ReplayEnd, SafetyInput, SharedTarget, SimIo, TickControl, Watchdog,
-    WatchdogConfig,
+    run_loop, telemetry_channel, CsvLogger, DeviceError, LoggerConfig, LoopConfig, SafetyInput,
+    TickControl, Watchdog, WatchdogConfig,
 };
 use std::net::SocketAddr;
 use std::path::PathBuf;
-use std::sync::Arc;
 use std::time::Duration;
 
 /// Options of `haptic2d run`.
@@ -23,7 +23,7 @@ pub struct RunArgs {
     /// A scene file path, or a built-in scene name (see `haptic2d scenes`).
     #[arg(default_value = "box-in-walls")]
     pub scene: String,
-    /// No display (the browser display is not available yet; runs headless either way).
+    /// No display: do not start the browser display server.
     #[arg(long)]
     pub headless: bool,
     /// Stop after this many seconds (default: run until Ctrl-C).
@@ -48,7 +48,8 @@ pub struct RunArgs {
     /// Write every tick's record to this CSV file.
     #[arg(long)]
     pub log: Option<PathBuf>,
-    /// Display address (validated; the display itself is not available yet).
+    /// Address of the live display (open http://ADDR:PORT/ in a browser). Bound to a non-loopback
+    /// address, commands from the page need the token printed at startup.
     #[arg(long, default_value = "127.0.0.1:8080")]
     pub bind: String,
     /// Ask for real-time scheduling (SCHED_FIFO, mlockall, core pinning); degrades gracefully.
@@ -57,32 +58,6 @@ pub struct RunArgs {
     /// Normal scheduling (default).
     #[arg(long, overrides_with = "rt")]
     pub no_rt: bool,
-}
-
-/// The device the loop drives.
-enum DeviceChoice {
-    Sim,
-    Replay(PathBuf),
-}
-
-fn parse_device(s: &str) -> Result<DeviceChoice, String> {
-    if s == "sim" {
-        return Ok(DeviceChoice::Sim);
-    }
-    if let Some(f) = s.strip_prefix("replay:") {
-        if f.is_empty() {
-            return Err("--device replay:FILE.csv needs a file name".into());
-        }
-        return Ok(DeviceChoice::Replay(PathBuf::from(f)));
-    }
-    Err(format!(
-        "--device `{s}` is not available\n    fix: use --device sim (the simulated twin pantograph) or --device replay:FILE.csv"
-    ))
-}
-
-/// RK4 sub-steps of the simulated plant per tick: one per 0.5 ms of period (at least one).
-fn plant_substeps(dt: f64) -> u32 {
-    ((dt / 0.0005).ceil() as u32).max(1)
 }
 
 /// Runs the haptic loop.
@@ -109,7 +84,7 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
     })?;
     let controller =
         ControllerKind::from_name(&a.controller).map_err(|e| format!("--controller: {e}"))?;
-    let device = parse_device(&a.device)?;
+    let device = DeviceChoice::parse(&a.device)?;
     let hand = match (&device, &a.hand) {
         (DeviceChoice::Replay(_), Some(_)) => {
             return Err(
@@ -130,44 +105,29 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
         ..HapticConfig::default()
     };
     let scene_name = scene.name.clone();
-    let mut system = HapticSystem::new(scene.world, &config)
-        .map_err(|e| format!("scene {}: {e}", scene.source))?;
-    let dt = system.dt();
-    let start = system.device_start();
-
-    // The device.
-    let mut target = None;
-    let mut io: Box<dyn DeviceIo + Send> = match &device {
-        DeviceChoice::Sim => {
-            let mut sim = SimIo::new(
-                &config.device,
-                start,
-                hand.model(start),
-                dt,
-                plant_substeps(dt),
-            )?;
-            if hand == HandSpec::Follow {
-                let t = Arc::new(SharedTarget::new(start));
-                sim.follow(t.clone());
-                target = Some(t);
-            }
-            Box::new(sim)
-        }
-        DeviceChoice::Replay(p) => Box::new(ReplayDevice::from_path(
-            p,
-            DEFAULT_REPLAY_COLUMNS,
-            ReplayEnd::Error,
-        )?),
+    let loaded = LoadedScene {
+        name: scene.name,
+        description: scene.description,
+        world: scene.world.clone(),
     };
-    // Kept for the display (browser pointer → hand target), which is not available yet.
-    let _hand_target = target;
-    if !a.headless {
-        println!("display: not available yet (would serve http://{bind}); running headless");
-    }
+    let hand_name = match device {
+        DeviceChoice::Sim => a.hand.as_deref().unwrap_or("follow").to_string(),
+        DeviceChoice::Replay(_) => "-".to_string(),
+    };
+    let mut rig = Rig::new(scene.world, &scene.source, config, device, hand)?;
 
-    // Telemetry: every record to the logger (if any), the latest to the display (later).
+    // The display: bound before the loop starts, so that a taken port is an error now.
+    let (server, mut view) = if a.headless {
+        (None, None)
+    } else {
+        let (server, view) = run_view::start(bind, &rig, loaded, a.rate)?;
+        println!("{}", server.banner());
+        (Some(server), Some(view))
+    };
+
+    // Telemetry: every record to the logger (if any).
     let capacity = ((a.rate * 2.0) as usize).max(4096);
-    let (mut tx, rx, _snapshot) = telemetry_channel(capacity, TickRecord::default())?;
+    let (mut tx, rx, _latest) = telemetry_channel(capacity, TickRecord::default())?;
     let logger = match &a.log {
         Some(p) => Some(CsvLogger::spawn_file(rx, p, LoggerConfig::default())?),
         None => {
@@ -194,17 +154,13 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
     };
     loop_config.validate()?;
     println!(
-        "running {scene_name}: device {}, controller {}{}, hand {}, {} Hz{}; Ctrl-C stops",
-        io.name(),
-        config.controller.name(),
+        "running {scene_name}: device {}, controller {}{}, hand {hand_name}, {} Hz{}; Ctrl-C stops",
+        rig.io.name(),
+        rig.config.controller.name(),
         if a.passivity {
             " + passivity controller"
         } else {
             ""
-        },
-        match device {
-            DeviceChoice::Sim => a.hand.as_deref().unwrap_or("follow"),
-            DeviceChoice::Replay(_) => "-",
         },
         a.rate,
         match a.duration {
@@ -220,11 +176,20 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
             .name("haptic2d-rt".into())
             .spawn_scoped(s, || {
                 run_loop(&loop_config, &stop, |info| {
+                    // The page's commands, between ticks.
+                    if let Some(v) = view.as_mut() {
+                        v.apply_commands(&mut rig);
+                    }
+                    let Rig { system, io, .. } = &mut rig;
                     let (q, lost) = match io.read_encoders() {
                         Ok(q) => (q, None),
                         Err(e) => ([f64::NAN; 4], Some(e)),
                     };
-                    let out = system.tick(&q);
+                    let out = if view.as_ref().is_some_and(|v| v.paused()) {
+                        system.tick_paused(&q)
+                    } else {
+                        system.tick(&q)
+                    };
                     let mut tau = out.torques;
                     let safety = SafetyInput {
                         deadline_missed: info.missed_deadline(),
@@ -266,6 +231,9 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
                         io.zero_torques();
                         return TickControl::Stop;
                     }
+                    if let Some(v) = view.as_mut() {
+                        v.after_tick(&info, &rig);
+                    }
                     TickControl::Continue
                 })
             })
@@ -275,6 +243,10 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
             .map_err(|_| "the real-time loop thread panicked".to_string())?
     })?;
     drop(tx);
+    drop(view);
+    if let Some(s) = server {
+        s.shutdown();
+    }
 
     // Report.
     if let Some(w) = summary.rt.as_ref().and_then(|r| r.warning()) {
@@ -289,6 +261,7 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
         summary.skipped,
         summary.overruns
     );
+    let system = &rig.system;
     if let Some(trip) = system.safety_trip() {
         println!("{trip}");
     }

@@ -8,6 +8,8 @@ mod cmd_simulate;
 mod cmd_sweep;
 mod csv_out;
 mod hand_arg;
+mod run_rig;
+mod run_view;
 mod scene_arg;
 
 use clap::{Parser, Subcommand};

@@ -136,3 +136,226 @@ fn run_replays_recorded_encoders() {
     assert!(o.status.success(), "{t}");
     assert!(t.contains("the replay ended"), "{t}");
 }
+
+/// A `haptic2d run` with the display on a free loopback port, killed on drop.
+struct Running {
+    child: std::process::Child,
+    /// `host:port` from the banner.
+    addr: String,
+    /// Every stdout line after the banner.
+    lines: std::sync::mpsc::Receiver<String>,
+}
+
+impl Running {
+    fn start(extra: &[&str]) -> Running {
+        use std::io::{BufRead, BufReader};
+        let mut child = Command::new(env!("CARGO_BIN_EXE_haptic2d"))
+            .args(["run", "--bind", "127.0.0.1:0"])
+            .args(extra)
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::inherit())
+            .spawn()
+            .expect("the binary runs");
+        let out = child.stdout.take().expect("piped stdout");
+        let (tx, rx) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            for line in BufReader::new(out).lines() {
+                let Ok(line) = line else { break };
+                if tx.send(line).is_err() {
+                    break;
+                }
+            }
+        });
+        let banner = rx
+            .recv_timeout(std::time::Duration::from_secs(30))
+            .expect("a banner within 30 s");
+        let addr = banner
+            .split_whitespace()
+            .find_map(|w| w.strip_prefix("http://"))
+            .unwrap_or_else(|| panic!("no URL in `{banner}`"))
+            .trim_end_matches('/')
+            .to_string();
+        Running {
+            child,
+            addr,
+            lines: rx,
+        }
+    }
+}
+
+impl Drop for Running {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+type Ws = tungstenite::WebSocket<std::net::TcpStream>;
+
+fn connect(addr: &str) -> Ws {
+    let stream = std::net::TcpStream::connect(addr).expect("TCP connect");
+    stream
+        .set_read_timeout(Some(std::time::Duration::from_secs(5)))
+        .unwrap();
+    let (ws, _) = tungstenite::client(format!("ws://{addr}/ws"), stream).expect("WebSocket");
+    ws
+}
+
+/// The next message of type `ty` for which `pred` holds, within `secs` seconds.
+fn wait_for(
+    ws: &mut Ws,
+    ty: &str,
+    secs: f64,
+    pred: impl Fn(&serde_json::Value) -> bool,
+) -> serde_json::Value {
+    let end = std::time::Instant::now() + std::time::Duration::from_secs_f64(secs);
+    let mut last = serde_json::Value::Null;
+    while std::time::Instant::now() < end {
+        let msg = ws.read().expect("a message");
+        let tungstenite::Message::Text(t) = msg else {
+            continue;
+        };
+        let v: serde_json::Value = serde_json::from_str(t.as_str()).unwrap();
+        assert_ne!(v["type"], "error", "error frame: {v}");
+        if v["type"] == ty {
+            if pred(&v) {
+                return v;
+            }
+            last = v;
+        }
+    }
+    panic!("no `{ty}` message as expected within {secs} s; last one: {last}");
+}
+
+fn send(ws: &mut Ws, json: &str) {
+    ws.send(tungstenite::Message::text(json)).expect("send");
+}
+
+fn slave_pose(f: &serde_json::Value) -> [f64; 3] {
+    let i = f["slave"].as_u64().expect("a slave") as usize;
+    let p = &f["bodies"][i];
+    [0, 1, 2].map(|k| p[k].as_f64().unwrap())
+}
+
+/// `haptic2d run` serves the display and applies the page's commands between ticks: the hand target
+/// (clamped to the device workspace) drags the box into the left wall through the simulated hand,
+/// device and controller; pause freezes the world; the controller, the wall law, reset and scene
+/// switches take effect. At the end of `--duration` it still prints its timing summary.
+#[test]
+fn run_display_serves_frames_and_applies_commands() {
+    let run = Running::start(&["--duration", "8"]);
+    let mut ws = connect(&run.addr);
+    let welcome = wait_for(&mut ws, "welcome", 5.0, |_| true);
+    assert_eq!(welcome["control"], true, "loopback: control without token");
+    let scene = wait_for(&mut ws, "scene", 5.0, |_| true);
+    assert_eq!(scene["name"], "box-in-walls");
+    let ws_box = scene["device"]["workspace"].clone();
+    let x_min = ws_box[0].as_f64().expect("device workspace");
+    let f0 = wait_for(&mut ws, "frame", 5.0, |_| true);
+    let start = slave_pose(&f0);
+    assert!(
+        f0["device"]["valid"] == true,
+        "device linkage: {}",
+        f0["device"]
+    );
+    assert_eq!(f0["controller"], "four-channel");
+
+    // Hand target 10 mm inside the left wall: clamped to the workspace edge; the box hits the wall.
+    send(
+        &mut ws,
+        r#"{"type":"set_hand_target","x":-0.01,"y":0.0,"theta":0.0}"#,
+    );
+    let hit = wait_for(&mut ws, "frame", 5.0, |f| {
+        f["contacts_total"].as_u64().unwrap_or(0) > 0 && slave_pose(f)[0] < 0.025
+    });
+    let target_x = hit["hand_target"][0].as_f64().unwrap();
+    assert!(
+        (target_x - x_min).abs() < 1e-9,
+        "clamped: {target_x} vs {x_min}"
+    );
+    assert!(slave_pose(&hit)[0] < start[0] - 0.01, "{hit}");
+    assert!(hit["contacts"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|c| c["normal"][0].as_f64().unwrap() > 0.99));
+
+    // Pause: the world's time stands still; resume: it runs again.
+    send(&mut ws, r#"{"type":"pause"}"#);
+    let p1 = wait_for(&mut ws, "frame", 5.0, |f| f["paused"] == true);
+    std::thread::sleep(std::time::Duration::from_millis(200));
+    let p2 = wait_for(&mut ws, "frame", 5.0, |f| {
+        f["seq"].as_u64() > p1["seq"].as_u64()
+    });
+    assert_eq!(p1["t"], p2["t"], "paused world does not advance");
+    assert_eq!(p2["drive"], serde_json::json!([0.0, 0.0, 0.0]));
+    send(&mut ws, r#"{"type":"resume"}"#);
+    let t_p = p2["t"].as_f64().unwrap();
+    wait_for(&mut ws, "frame", 5.0, |f| {
+        f["paused"] == false && f["t"].as_f64().unwrap() > t_p + 0.05
+    });
+
+    // Controller and wall law.
+    send(&mut ws, r#"{"type":"set_controller","name":"coupling"}"#);
+    send(&mut ws, r#"{"type":"set_wall_law","name":"zoh"}"#);
+    wait_for(&mut ws, "frame", 5.0, |f| {
+        f["controller"] == "coupling" && f["wall_law"] == "zoh"
+    });
+
+    // Reset: the scene again, the box back at its start, the laws and controller kept.
+    send(&mut ws, r#"{"type":"reset"}"#);
+    let again = wait_for(&mut ws, "scene", 5.0, |_| true);
+    assert_eq!(again["name"], "box-in-walls");
+    assert!(again["seq"].as_u64() > scene["seq"].as_u64());
+    let seq = again["seq"].clone();
+    let f = wait_for(&mut ws, "frame", 5.0, |f| f["scene_seq"] == seq);
+    let p = slave_pose(&f);
+    assert!((p[0] - start[0]).abs() < 2e-3, "{p:?} vs {start:?}");
+    assert_eq!(f["controller"], "coupling");
+    assert_eq!(f["wall_law"], "zoh");
+
+    // Switch scene.
+    send(&mut ws, r#"{"type":"switch_scene","name":"peg-in-hole"}"#);
+    let peg = wait_for(&mut ws, "scene", 5.0, |_| true);
+    assert_eq!(peg["name"], "peg-in-hole");
+    let seq = peg["seq"].clone();
+    let f = wait_for(&mut ws, "frame", 5.0, |f| f["scene_seq"] == seq);
+    assert_eq!(f["wall_law"], "zoh");
+    assert_eq!(f["friction"], "reset-integrator");
+    drop(ws);
+
+    // The run ends by itself and prints its summary.
+    let mut all = Vec::new();
+    while let Ok(l) = run.lines.recv_timeout(std::time::Duration::from_secs(20)) {
+        all.push(l);
+    }
+    let all = all.join("\n");
+    assert!(all.contains("timing: achieved"), "{all}");
+    assert!(all.contains("on time:"), "{all}");
+}
+
+#[test]
+fn run_display_port_taken_is_a_clear_error() {
+    let taken = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+    let addr = taken.local_addr().unwrap().to_string();
+    let o = haptic2d(&["run", "--bind", &addr, "--duration", "1"]);
+    let out = text(&o);
+    assert!(!o.status.success(), "{out}");
+    assert!(out.contains("already in use"), "{out}");
+    assert!(out.contains("--bind"), "{out}");
+    assert!(!out.contains("panicked"), "{out}");
+    // Headless ignores the display address.
+    let o = haptic2d(&["run", "--headless", "--bind", &addr, "--duration", "0.1"]);
+    assert!(o.status.success(), "{}", text(&o));
+}
+
+#[test]
+fn run_display_on_a_non_loopback_address_prints_the_token() {
+    let o = haptic2d(&["run", "--bind", "0.0.0.0:0", "--duration", "0.3"]);
+    let out = text(&o);
+    assert!(o.status.success(), "{out}");
+    let banner = out.lines().next().unwrap_or_default();
+    assert!(banner.starts_with("display: http://127.0.0.1:"), "{out}");
+    assert!(banner.contains("?token="), "{out}");
+    assert!(banner.contains("commands need token"), "{out}");
+}

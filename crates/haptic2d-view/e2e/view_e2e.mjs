@@ -1,14 +1,16 @@
 // End-to-end test of the haptic2d live display in a real browser (Debian's Chromium, headless).
 //
 // Usage: node view_e2e.mjs URL
-//   URL                      the page served by haptic2d-view-demo (or `haptic2d run`), e.g. http://127.0.0.1:8080/
+//   URL                      the page served by `haptic2d run` (box-in-walls, simulated device,
+//                            --hand follow), e.g. http://127.0.0.1:8080/
 //   CHROMIUM_PATH            the browser (default /usr/bin/chromium)
 //   HAPTIC2D_VIEW_SCREENSHOT where to save a PNG of the page after the drag (optional)
 //
 // Checks: the page connects and receives scene + frames; the canvas is not blank (pixel variance
-// of a screenshot); dragging the hand target into the left wall moves the box there and a contact
-// appears (read through window.__haptic2d, fed by the state stream); Q rotates the target; no page
-// errors and no error frames. Prints one JSON line with the measurements; exit code 0 on success.
+// of a screenshot); dragging the hand target into the left wall moves the box there through the
+// simulated hand, the device and the controller, and a contact appears (read through
+// window.__haptic2d, fed by the state stream); Q rotates the target; no page errors and no error
+// frames. Prints one JSON line with the measurements; exit code 0 on success.
 
 import { chromium } from "playwright-core";
 import { mkdtempSync, rmSync } from "node:fs";
@@ -98,7 +100,9 @@ try {
   result.canvas = stats;
   check(stats.variance > 100 && stats.colours > 8, `the canvas looks blank: ${JSON.stringify(stats)}`);
 
-  // 3. Drag the hand target from the box into the left wall (x = 0): 10 mm inside the wall.
+  // 3. Drag the hand target from the box into the left wall (x = 0): 10 mm inside the wall. The loop
+  //    clamps the target to the device workspace (mapped into the world); the simulated hand pulls
+  //    the handle there, and the controller drags the box into the wall.
   const [x0, y0] = start.pose;
   const from = await page.evaluate(([x, y]) => window.__haptic2d.worldToClient(x, y), [x0, y0]);
   const to = await page.evaluate(([x, y]) => window.__haptic2d.worldToClient(x, y), [-0.01, y0]);
@@ -107,18 +111,22 @@ try {
   await page.mouse.move(to.x, to.y, { steps: 20 });
   await page.mouse.up();
   const goal = await page.evaluate(([cx, cy]) => window.__haptic2d.clientToWorld(cx, cy), [to.x, to.y]);
+  const ws = await page.evaluate(() => window.__haptic2d.scene.device.workspace);
+  const expected = [Math.min(Math.max(goal[0], ws[0]), ws[2]), Math.min(Math.max(goal[1], ws[1]), ws[3])];
   result.drag_goal = goal;
+  result.expected_target = expected;
 
-  // The loop echoes the target, the box reaches the wall (its left face, 20 mm from its centre,
-  // at x ≈ 0) and the contact manager reports contacts there.
+  // The loop echoes the (clamped) target, the box reaches the wall (its left face, 20 mm from its
+  // centre, at x ≈ 0) and the contact manager reports contacts there.
   await page.waitForFunction(
-    ([gx]) => {
+    ([ex, ey]) => {
       const f = window.__haptic2d.lastFrame;
       if (!f) return false;
       const p = f.bodies[f.slave];
-      return Math.abs(f.hand_target[0] - gx) < 1e-3 && f.contacts_total > 0 && p[0] < 0.025;
+      return Math.abs(f.hand_target[0] - ex) < 1e-6 && Math.abs(f.hand_target[1] - ey) < 1e-6 &&
+        f.contacts_total > 0 && p[0] < 0.025;
     },
-    [goal[0]],
+    expected,
     { timeout: 20_000 },
   );
   const hit = await page.evaluate(() => {
@@ -137,14 +145,15 @@ try {
   });
   result.hit = hit;
   check(hit.pose[0] < x0 - 0.01, `the box did not move left: ${JSON.stringify(hit.pose)}`);
+  check(hit.device_valid === true, "the device linkage is not in the frames");
   // The box's left corners touch the wall's face: god-objects on the face (x = 0), normal +x, the
   // vertices inside the wall (x < 0) but not beyond the target (x > −10 mm).
   check(
     hit.contacts.some((c) => Math.abs(c.god_object[0]) < 1e-6 && c.normal[0] > 0.99 && c.point[0] < 0 && c.point[0] > -0.01),
     `no contact on the left wall's face (x = 0, normal +x): ${JSON.stringify(hit.contacts)}`,
   );
-  // Pressed towards a target 10 mm inside the wall by the coupling: several newtons in steady
-  // contact (coupling 500 N/m in series with 2 × 1000 N/m corner springs: 12 N).
+  // Held against the wall by the simulated hand (a spring pulling the handle towards a target
+  // beyond the wall): a steady contact force of newtons, rendered back to the hand by the device.
   await page.waitForFunction(() => window.__haptic2d.lastFrame.contact_force_n > 1.0, null, { timeout: 10_000 });
   result.contact_force_n = await page.evaluate(() => window.__haptic2d.lastFrame.contact_force_n);
 

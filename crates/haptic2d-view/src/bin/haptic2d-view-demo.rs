@@ -1,5 +1,6 @@
-//! `haptic2d-view-demo`: a development stand-in for `haptic2d run` that exercises the display end
-//! to end without a device.
+//! `haptic2d-view-demo`: a small stand-in for `haptic2d run` (which serves the same display with
+//! the real haptic loop) that exercises the display without a device and without the CLI; the
+//! display crate's own protocol and load tests run against it.
 //!
 //! A real [`World`] (built-in `box-in-walls`, frictionless) runs in a fixed-rate thread loop
 //! (`haptic2d_rt::run_loop`, 1 kHz by default). The slave box is driven towards the hand target set

@@ -119,13 +119,14 @@
     $("scene-name").textContent = msg.name;
     if ($("sel-scene").options.length) $("sel-scene").value = msg.name;
     charts.forEach((c) => c.clear());
-    fitView();
+    fitView(null);
   }
 
   let frameTimes = [];
   function onFrame(f) {
     if (state.scene && f.scene_seq !== state.scene.seq) return; // a frame of another scene
     state.lastFrame = f;
+    if (!view.fitted) fitView(f);
     state.framesReceived += 1;
     state.framesForScene += 1;
     const now = performance.now();
@@ -175,7 +176,7 @@
   const canvas = $("world");
   const ctx = canvas.getContext("2d");
   // World → screen: sx = ox + x·scale, sy = oy − y·scale (CSS pixels, y up in the world).
-  const view = { scale: 1000, ox: 0, oy: 0, w: 0, h: 0, dpr: 1 };
+  const view = { scale: 1000, ox: 0, oy: 0, w: 0, h: 0, dpr: 1, fitted: false };
 
   function resizeCanvas(c) {
     const dpr = window.devicePixelRatio || 1;
@@ -185,15 +186,38 @@
     return { w: r.width, h: r.height, dpr };
   }
 
-  function fitView() {
+  // Fits the view to the scene. With a device in the loop driving the only dynamic body, and once a
+  // frame is known, the view is fitted to what moves (the slave, the linkage, the device workspace)
+  // rather than to the whole enclosure, so that the slave, the linkage and the force arrows are
+  // large enough to read (the slave cannot leave the workspace by much). Otherwise it shows the
+  // whole scene and the device.
+  function fitView(frame) {
     const r = resizeCanvas(canvas);
     view.w = r.w; view.h = r.h; view.dpr = r.dpr;
     const s = state.scene;
+    view.fitted = !!frame;
+    if (s && s.bodies.filter((body) => !body.fixed).length > 1) frame = null;
     let b = s ? s.bounds.slice() : [-0.1, -0.1, 0.1, 0.1];
+    const grow = (x, y) => { b[0] = Math.min(b[0], x); b[1] = Math.min(b[1], y); b[2] = Math.max(b[2], x); b[3] = Math.max(b[3], y); };
     if (s && s.device) {
       const m = s.device.motors, ws = s.device.workspace;
-      b = [Math.min(b[0], m[0][0], ws[0]), Math.min(b[1], m[0][1] - 0.01, ws[1]),
-        Math.max(b[2], m[1][0], ws[2]), Math.max(b[3], ws[3])];
+      const d = frame && frame.device && frame.device.valid ? frame.device : null;
+      if (frame) {
+        b = [Infinity, Infinity, -Infinity, -Infinity];
+        s.bodies.forEach((body, i) => {
+          const p = frame.bodies[i]; if (body.fixed || !p) return;
+          let rad = 0;
+          for (const piece of body.pieces) for (const [x, y] of piece) rad = Math.max(rad, Math.hypot(x, y));
+          grow(p[0] - rad, p[1] - rad); grow(p[0] + rad, p[1] + rad);
+        });
+        if (d) [...d.elbows, ...d.endpoints].forEach(([x, y]) => grow(x, y));
+      }
+      m.forEach(([x, y]) => grow(x, y - 0.01));
+      grow(ws[0], ws[1]); grow(ws[2], ws[3]);
+      if (frame) { // a margin of 15 % around what moves
+        const mx = 0.15 * (b[2] - b[0]), my = 0.15 * (b[3] - b[1]);
+        b = [b[0] - mx, b[1] - my, b[2] + mx, b[3] + my];
+      }
     }
     const pad = 24;
     const bw = Math.max(b[2] - b[0], 1e-3), bh = Math.max(b[3] - b[1], 1e-3);
@@ -221,13 +245,6 @@
       }
       ctx.stroke();
     }
-    // Scale bar: 10 mm.
-    const [bx, by] = [view.w - 20 - 10 * pxPerMm, view.h - 14];
-    ctx.strokeStyle = "#444"; ctx.lineWidth = 2;
-    ctx.beginPath(); ctx.moveTo(bx, by); ctx.lineTo(bx + 10 * pxPerMm, by); ctx.stroke();
-    ctx.fillStyle = "#444"; ctx.font = "11px system-ui"; ctx.textAlign = "right";
-    const minor = pxPerMm >= 4 ? "1 mm" : (pxPerMm >= 0.4 ? "10 mm" : "100 mm");
-    ctx.fillText(`10 mm · grid ${minor} · arrows ${forceLegend()}`, view.w - 20, by - 5);
   }
 
   function poly(points) {
@@ -293,22 +310,30 @@
     const [ax, ay] = toScreen(p[0], p[1]);
     const bx = ax + v[0], by = ay - v[1];
     const len = Math.hypot(v[0], v[1]); if (len < 1) return;
-    ctx.strokeStyle = color; ctx.fillStyle = color; ctx.lineWidth = 2;
-    ctx.beginPath(); ctx.moveTo(ax, ay); ctx.lineTo(bx, by); ctx.stroke();
-    const ux = (bx - ax) / len, uy = (by - ay) / len, h = Math.min(8, len * 0.5);
-    ctx.beginPath(); ctx.moveTo(bx, by);
-    ctx.lineTo(bx - h * ux + 0.5 * h * uy, by - h * uy - 0.5 * h * ux);
-    ctx.lineTo(bx - h * ux - 0.5 * h * uy, by - h * uy + 0.5 * h * ux);
-    ctx.closePath(); ctx.fill();
+    const ux = (bx - ax) / len, uy = (by - ay) / len, h = Math.min(10, len * 0.5);
+    const head = () => {
+      ctx.beginPath(); ctx.moveTo(bx, by);
+      ctx.lineTo(bx - h * ux + 0.5 * h * uy, by - h * uy - 0.5 * h * ux);
+      ctx.lineTo(bx - h * ux - 0.5 * h * uy, by - h * uy + 0.5 * h * ux);
+      ctx.closePath();
+    };
+    // A white halo first, so that arrows stay readable over the bodies.
+    ctx.strokeStyle = "rgba(255,255,255,0.9)"; ctx.lineWidth = 6; ctx.lineJoin = "round";
+    ctx.beginPath(); ctx.moveTo(ax, ay); ctx.lineTo(bx - h * ux, by - h * uy); ctx.stroke();
+    head(); ctx.lineWidth = 3; ctx.stroke();
+    ctx.strokeStyle = color; ctx.fillStyle = color; ctx.lineWidth = 3;
+    ctx.beginPath(); ctx.moveTo(ax, ay); ctx.lineTo(bx - h * ux, by - h * uy); ctx.stroke();
+    head(); ctx.fill();
   }
 
-  // Force arrows: 25 px per newton, shortened so that the largest contact force is at most 90 px.
+  // Force arrows: 25 px per newton, shortened so that the largest force drawn is at most 110 px.
   let pxPerN = 25;
   function forceLegend() { return `${(10 / pxPerN).toPrecision(2)} N per 10 px`; }
-  function drawContacts(f) {
-    let fmax = 0;
+  function drawForces(f) {
+    const drive = Math.hypot(f.drive[0], f.drive[1]);
+    let fmax = drive;
     for (const c of f.contacts) fmax = Math.max(fmax, Math.abs(c.f_n), Math.abs(c.f_t));
-    pxPerN = fmax > 0 ? Math.min(25, 90 / fmax) : 25;
+    pxPerN = fmax > 0 ? Math.min(25, 110 / fmax) : 25;
     const PX_PER_N = pxPerN;
     for (const c of f.contacts) {
       // God-object: hollow square on the edge.
@@ -317,6 +342,32 @@
       arrow(c.point, [c.normal[0] * c.f_n * PX_PER_N, c.normal[1] * c.f_n * PX_PER_N], "#2b8a3e");
       arrow(c.point, [c.tangent[0] * c.f_t * PX_PER_N, c.tangent[1] * c.f_t * PX_PER_N], "#e67700");
       dot(c.point, 3.5, c.state === "colliding" ? "#c92a2a" : "#2b8a3e");
+    }
+    // The controller's drive on the slave f_cs, at its centre of mass.
+    if (f.slave !== null && f.bodies[f.slave]) {
+      const p = f.bodies[f.slave];
+      arrow(p, [f.drive[0] * PX_PER_N, f.drive[1] * PX_PER_N], "#7048e8");
+    }
+  }
+
+  // The legend strip along the bottom: colours, then the scale bar (10 mm) and the force scale.
+  function drawLegend() {
+    ctx.fillStyle = "rgba(255,255,255,0.85)"; ctx.fillRect(0, view.h - 24, view.w, 24);
+    const pxPerMm = view.scale * 1e-3;
+    const [bx, by] = [view.w - 20 - 10 * pxPerMm, view.h - 7];
+    ctx.strokeStyle = "#444"; ctx.lineWidth = 2;
+    ctx.beginPath(); ctx.moveTo(bx, by); ctx.lineTo(bx + 10 * pxPerMm, by); ctx.stroke();
+    ctx.fillStyle = "#444"; ctx.font = "12px system-ui"; ctx.textAlign = "right";
+    const minor = pxPerMm >= 4 ? "1 mm" : (pxPerMm >= 0.4 ? "10 mm" : "100 mm");
+    ctx.fillText(`10 mm · grid ${minor} · arrows ${forceLegend()}`, bx - 8, by + 3);
+    const items = [["#2b8a3e", "normal force"], ["#e67700", "friction"], ["#7048e8", "drive on slave"],
+      ["#1971c2", "god-object"], ["#c2255c", "hand target"], ["rgba(60,60,70,0.8)", "device linkage"]];
+    ctx.font = "12px system-ui"; ctx.textAlign = "left";
+    let x = 10; const y = view.h - 5;
+    for (const [color, text] of items) {
+      ctx.fillStyle = color; ctx.fillRect(x, y - 8, 14, 4);
+      ctx.fillStyle = "#444"; ctx.fillText(text, x + 18, y - 3);
+      x += 18 + ctx.measureText(text).width + 14;
     }
   }
 
@@ -332,7 +383,7 @@
 
   function drawWorld() {
     const r = resizeCanvas(canvas);
-    if (r.w !== view.w || r.h !== view.h) fitView();
+    if (r.w !== view.w || r.h !== view.h) fitView(state.lastFrame);
     ctx.setTransform(view.dpr, 0, 0, view.dpr, 0, 0);
     ctx.fillStyle = "#ffffff"; ctx.fillRect(0, 0, view.w, view.h);
     drawGrid();
@@ -344,8 +395,9 @@
     }
     drawBodies(f);
     drawDevice(f);
-    drawContacts(f);
+    drawForces(f);
     drawTarget();
+    drawLegend();
   }
 
   // ---------------------------------------------------------------- strip charts
@@ -451,7 +503,7 @@
 
   $("btn-pause").onclick = () => send({ type: state.lastFrame && state.lastFrame.paused ? "resume" : "pause" });
   $("btn-reset").onclick = () => send({ type: "reset" });
-  window.addEventListener("resize", fitView);
+  window.addEventListener("resize", () => fitView(state.lastFrame));
 
   // ---------------------------------------------------------------- render loop
   function render() {
@@ -485,7 +537,7 @@
     },
   };
 
-  fitView();
+  fitView(null);
   connect();
   requestAnimationFrame(render);
 })();

@@ -25,6 +25,26 @@ enum Controller {
 }
 
 impl Controller {
+    /// A controller `kind` in its reset state, its gains checked against the mass of the slave body
+    /// `slave` of `world` at period `dt` (§6.4).
+    fn build(kind: ControllerKind, world: &World, slave: usize, dt: f64) -> Result<Self, String> {
+        let body = &world.bodies[slave];
+        let mass = [body.mass, body.mass, body.inertia];
+        Ok(match kind {
+            ControllerKind::FourChannel(g) => {
+                g.check_slave_mass(&mass, dt)
+                    .map_err(|e| format!("{e} (slave body `{}`)", body.name))?;
+                Controller::FourChannel(FourChannel::new(g, dt)?)
+            }
+            ControllerKind::Coupling(g) => {
+                let c = VirtualCoupling::new(g)?;
+                c.check_slave_mass(&mass, dt)
+                    .map_err(|e| format!("{e} (slave body `{}`)", body.name))?;
+                Controller::Coupling(c)
+            }
+        })
+    }
+
     #[inline]
     fn step(&mut self, s: &TeleopSignals) -> (V3, V3) {
         match self {
@@ -95,21 +115,8 @@ impl HapticSystem {
                 body.name
             ));
         }
-        let mass = [body.mass, body.mass, body.inertia];
         let world_origin = [body.pose.pos.x, body.pose.pos.y, body.pose.angle];
-        let controller = match config.controller {
-            ControllerKind::FourChannel(g) => {
-                g.check_slave_mass(&mass, dt)
-                    .map_err(|e| format!("{e} (slave body `{}`)", body.name))?;
-                Controller::FourChannel(FourChannel::new(g, dt)?)
-            }
-            ControllerKind::Coupling(g) => {
-                let c = VirtualCoupling::new(g)?;
-                c.check_slave_mass(&mass, dt)
-                    .map_err(|e| format!("{e} (slave body `{}`)", body.name))?;
-                Controller::Coupling(c)
-            }
-        };
+        let controller = Controller::build(config.controller, &world, slave, dt)?;
         if let Some(p) = &config.passivity {
             p.validate()?;
         }
@@ -289,6 +296,68 @@ impl HapticSystem {
             tripped: self.safety.is_latched(),
             record: self.record,
         }
+    }
+
+    /// A paused sample (the live display's pause): the device is still estimated from the encoder
+    /// angles `q` (rad; steps 1–2, so the pose unwrapping, the velocity filter and the hand-wrench
+    /// observer keep tracking the handle while the user moves it), but neither controller runs, the
+    /// world is not stepped (its time stands still) and the torques are zero. The record shows the
+    /// device, the frozen slave and zero commands. Never allocates, locks, prints or does I/O.
+    pub fn tick_paused(&mut self, q: &V4) -> TickOutput {
+        let (k, t) = (self.world.tick(), self.world.time());
+        let est = match self.device.estimate(q, &self.tau_prev) {
+            Ok(e) => Some(e),
+            Err(fault) => {
+                self.safety.trip(k, t, SafetyReason::Device(fault));
+                None
+            }
+        };
+        let mut tau = [0.0; 4];
+        let mut flags = 0u32;
+        if self.safety.gate(k, t, &mut tau) {
+            flags |= FLAG_SAFETY;
+        }
+        self.tau_prev = tau;
+        let body = &self.world.bodies[self.slave];
+        let cw = self.world.contact_wrench(self.slave);
+        let ledger = self.world.ledger();
+        let (x_m, v_m, w_h) = est.map_or(([0.0; 3], [0.0; 3], [0.0; 3]), |e| {
+            (e.pose, e.velocity, e.hand_wrench)
+        });
+        self.record = TickRecord {
+            t,
+            x_m,
+            v_m,
+            w_h,
+            x_s: [body.pose.pos.x, body.pose.pos.y, body.pose.angle],
+            v_s: [body.vel.x, body.vel.y, body.omega],
+            f_cm: [0.0; 3],
+            f_cs: [0.0; 3],
+            f_e: [-cw.force.x, -cw.force.y, -cw.torque],
+            tau,
+            contacts: self.world.contacts().contact_count() as u32,
+            kinetic: ledger.kinetic,
+            stored: ledger.stored,
+            applied_work: ledger.applied_work,
+            po_energy: self.passivity.as_ref().map_or(0.0, |p| p.e_obs()),
+            alpha: [0.0; 3],
+            margin: self.device.margin(),
+            closure_error: est.map_or(f64::NAN, |e| e.closure_error),
+            flags,
+        };
+        TickOutput {
+            torques: tau,
+            tripped: self.safety.is_latched(),
+            record: self.record,
+        }
+    }
+
+    /// Switches the teleoperation controller to `kind`, starting from its reset state (no integrator
+    /// or filter state carried over); its gains are checked against the slave's mass as in
+    /// [`Self::new`], and on error the running controller is kept.
+    pub fn set_controller(&mut self, kind: ControllerKind) -> Result<(), String> {
+        self.controller = Controller::build(kind, &self.world, self.slave, self.dt)?;
+        Ok(())
     }
 
     /// Fault injection for safety tests and hardware commissioning: at the next tick, torque `index`

@@ -1,16 +1,77 @@
-//! End-to-end test in a real browser: starts `haptic2d-view-demo` on a free loopback port and runs
-//! `e2e/view_e2e.mjs` (playwright-core driving Debian's headless Chromium) against it.
+//! End-to-end test in a real browser: starts the real `haptic2d run` (default scene box-in-walls,
+//! simulated device, `--hand follow`) with its display on a free loopback port, and runs
+//! `crates/haptic2d-view/e2e/view_e2e.mjs` (playwright-core driving Debian's headless Chromium)
+//! against it: the world is drawn, dragging the hand target pushes the box into the left wall, and
+//! the state stream shows the box moving and the contact.
 //!
 //! Needs `/usr/bin/chromium` (or `CHROMIUM_PATH`), `node` and `e2e/node_modules` (run
-//! `crates/haptic2d-view/e2e/install.sh`). When they are missing the test FAILS if the `CI`
+//! `bash crates/haptic2d-view/e2e/install.sh`). When they are missing the test FAILS if the `CI`
 //! environment variable is set, and otherwise skips with a loud message. Set
 //! `HAPTIC2D_VIEW_SCREENSHOT=/path/shot.png` to keep a screenshot of the page.
 
-mod common;
-
+use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
+
+/// `haptic2d run` with its display on a free loopback port; killed on drop.
+struct Run {
+    child: Child,
+    url: String,
+}
+
+impl Run {
+    fn start() -> Run {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_haptic2d"))
+            .args([
+                "run",
+                "box-in-walls",
+                "--device",
+                "sim",
+                "--hand",
+                "follow",
+                "--bind",
+                "127.0.0.1:0",
+                "--duration",
+                "150",
+            ])
+            .stdout(Stdio::piped())
+            .stderr(Stdio::inherit())
+            .spawn()
+            .expect("haptic2d starts");
+        let out = child.stdout.take().expect("piped stdout");
+        let (tx, rx) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            for line in BufReader::new(out).lines() {
+                let Ok(line) = line else { break };
+                println!("haptic2d: {line}");
+                if tx.send(line).is_err() {
+                    break;
+                }
+            }
+        });
+        let banner = match rx.recv_timeout(Duration::from_secs(30)) {
+            Ok(l) => l,
+            Err(e) => {
+                let _ = child.kill();
+                panic!("haptic2d run printed no banner within 30 s: {e}");
+            }
+        };
+        let url = banner
+            .split_whitespace()
+            .find(|w| w.starts_with("http://"))
+            .unwrap_or_else(|| panic!("no URL in the banner `{banner}`"))
+            .to_string();
+        Run { child, url }
+    }
+}
+
+impl Drop for Run {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
 
 fn missing_prerequisites(e2e: &Path) -> Vec<String> {
     let mut missing = Vec::new();
@@ -37,12 +98,12 @@ fn missing_prerequisites(e2e: &Path) -> Vec<String> {
 }
 
 #[test]
-fn browser_drag_into_wall_shows_box_moving_and_contact() {
-    let e2e = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("e2e");
+fn browser_drag_hand_target_pushes_box_into_left_wall() {
+    let e2e = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../haptic2d-view/e2e");
     let missing = missing_prerequisites(&e2e);
     if !missing.is_empty() {
         let msg = format!(
-            "browser e2e prerequisites missing: {}. Run crates/haptic2d-view/e2e/install.sh",
+            "browser e2e prerequisites missing: {}. Run `bash crates/haptic2d-view/e2e/install.sh`",
             missing.join(", ")
         );
         if std::env::var_os("CI").is_some() {
@@ -54,10 +115,10 @@ fn browser_drag_into_wall_shows_box_moving_and_contact() {
         return;
     }
 
-    let demo = common::Demo::start(&[]);
+    let run = Run::start();
     let mut node = Command::new("node")
         .arg(e2e.join("view_e2e.mjs"))
-        .arg(&demo.url)
+        .arg(&run.url)
         .current_dir(&e2e)
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())

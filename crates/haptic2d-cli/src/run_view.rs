@@ -1,0 +1,306 @@
+//! The live display of `haptic2d run`: the loop's side of `haptic2d-view`.
+//!
+//! [`start`] binds the display server (a taken port is an error here, before the loop starts) and
+//! returns the [`LiveView`] that the loop thread owns. Every tick the loop calls
+//! [`LiveView::apply_commands`] before reading the device (the page's commands take effect between
+//! ticks, with the semantics documented on [`haptic2d_view::Command`]), and
+//! [`LiveView::after_tick`] at the end (a ~60 Hz frame when someone watches, and the tick's
+//! timing). Both are wait-free and allocation-free in steady state; only a scene switch or reset
+//! allocates (a new world), accepting one late tick.
+
+use crate::run_rig::Rig;
+use haptic2d::haptic::ControllerKind as SystemController;
+use haptic2d::laws::friction::FrictionModel;
+use haptic2d::laws::normal::NormalModel;
+use haptic2d::scene::{builtin, BUILTIN};
+use haptic2d::world::World;
+use haptic2d_rt::clock::now_ns;
+use haptic2d_rt::TickInfo;
+use haptic2d_view::{
+    Command, Frame, FrameInputs, LiveTiming, SceneInfo, ViewHandle, ViewHub, ViewOptions,
+    ViewServer, DEFAULT_FRAME_RATE_HZ,
+};
+use std::net::SocketAddr;
+
+/// The scene the loop runs, as loaded (the world at its initial state, kept for resets).
+pub struct LoadedScene {
+    /// Scene name.
+    pub name: String,
+    /// One-line description.
+    pub description: String,
+    /// The world at its initial state.
+    pub world: World,
+}
+
+/// The loop thread's end of the display.
+pub struct LiveView {
+    hub: ViewHub,
+    timing: LiveTiming,
+    rate: f64,
+    scene: LoadedScene,
+    /// Wall law and friction model the page selected (kept across resets and scene switches);
+    /// `None` = the scene's own.
+    wall_law: Option<NormalModel>,
+    friction: Option<FrictionModel>,
+    paused: bool,
+}
+
+/// Starts the display server on `bind` for the rig's current scene `scene` at `rate` (Hz). Returns
+/// the server handle (keep it on the main thread; dropping it stops the server) and the loop's end.
+pub fn start(
+    bind: SocketAddr,
+    rig: &Rig,
+    scene: LoadedScene,
+    rate: f64,
+) -> Result<(ViewHandle, LiveView), String> {
+    // Frames are preallocated for the largest scene the page can switch to, so that capturing never
+    // allocates, not even after a switch.
+    let mut bodies = rig.system.world().bodies.len();
+    for (name, _, _) in BUILTIN {
+        if let Some(Ok(s)) = builtin(name, Some(rate)) {
+            bodies = bodies.max(s.world.bodies.len());
+        }
+    }
+    let prototype = Frame::with_capacity(bodies, haptic2d_view::frame::MAX_FRAME_CONTACTS);
+    let (hub, end) = ViewHub::new(&prototype, DEFAULT_FRAME_RATE_HZ)?;
+    let server = ViewServer::start(bind, end, ViewOptions::default())?;
+    let mut view = LiveView {
+        hub,
+        timing: LiveTiming::new(rate, 1.0)?,
+        rate,
+        scene,
+        wall_law: None,
+        friction: None,
+        paused: false,
+    };
+    view.publish_scene(rig);
+    Ok((server, view))
+}
+
+impl LiveView {
+    /// True while the page has paused the world.
+    #[inline]
+    pub fn paused(&self) -> bool {
+        self.paused
+    }
+
+    /// Applies every command the page sent since the last tick. Wait-free and allocation-free
+    /// except for a scene switch or reset.
+    #[inline]
+    pub fn apply_commands(&mut self, rig: &mut Rig) {
+        while let Some(cmd) = self.hub.poll_command() {
+            if let Err(e) = self.apply(cmd, rig) {
+                eprintln!("display: {} failed: {e}", cmd.kind());
+            }
+        }
+    }
+
+    /// Publishes a frame when one is due and someone watches, then records the tick's timing (call
+    /// it last in the tick). Allocation-free.
+    #[inline]
+    pub fn after_tick(&mut self, info: &TickInfo, rig: &Rig) {
+        if self.hub.frame_due(info.t_s) {
+            let sys = &rig.system;
+            let rec = sys.last_record();
+            let inputs = FrameInputs {
+                paused: self.paused,
+                slave: Some(sys.slave()),
+                hand_target: rig.hand_target_world(),
+                drive: rec.f_cs,
+                device: Some((&sys.device().kin, rec.x_m)),
+                device_to_world: rig.device_to_world(),
+                passivity_energy: sys.passivity().map(|p| p.e_obs()),
+                timing: self.timing.snapshot(),
+                controller: rig.config.controller.name(),
+            };
+            self.hub.publish_frame(info.t_s, sys.world(), &inputs);
+        }
+        self.timing.record_tick(info, now_ns());
+    }
+
+    fn apply(&mut self, cmd: Command, rig: &mut Rig) -> Result<(), String> {
+        match cmd {
+            Command::SetHandTarget { x, y, theta } => {
+                // Ignored without a `follow` hand (a replay, or a scripted/free hand).
+                let _ = rig.set_hand_target([x, y, theta]);
+            }
+            Command::SwitchScene { name } => {
+                let s = builtin(name, Some(self.rate))
+                    .ok_or_else(|| format!("no built-in scene `{name}`"))?
+                    .map_err(|e| e.to_string())?;
+                let scene = LoadedScene {
+                    name: s.name,
+                    description: s.description,
+                    world: s.world,
+                };
+                self.load(scene.world.clone(), rig)?;
+                self.scene = scene;
+                self.publish_scene(rig);
+            }
+            Command::Reset => {
+                self.load(self.scene.world.clone(), rig)?;
+                self.publish_scene(rig);
+            }
+            Command::SetWallLaw { name } => {
+                let m = NormalModel::from_name(name, true)?;
+                rig.system.world_mut().normal = m;
+                self.wall_law = Some(m);
+            }
+            Command::SetFriction { name } => {
+                let m = FrictionModel::from_name(name, true)?;
+                rig.system.world_mut().friction = m;
+                self.friction = Some(m);
+            }
+            Command::SetController { kind } => {
+                let k = SystemController::from_name(kind.name())?;
+                rig.system.set_controller(k)?;
+                rig.config.controller = k;
+            }
+            Command::Pause => self.paused = true,
+            Command::Resume => self.paused = false,
+        }
+        Ok(())
+    }
+
+    /// Rebuilds the rig around `world` with the page's selected laws (and controller, in the rig's
+    /// settings). The paused state is kept.
+    fn load(&self, mut world: World, rig: &mut Rig) -> Result<(), String> {
+        if let Some(m) = self.wall_law {
+            world.normal = m;
+        }
+        if let Some(m) = self.friction {
+            world.friction = m;
+        }
+        rig.rebuild(world)
+    }
+
+    fn publish_scene(&mut self, rig: &Rig) {
+        let sys = &rig.system;
+        let info = SceneInfo::from_world(
+            sys.world(),
+            &self.scene.name,
+            &self.scene.description,
+            Some(sys.slave()),
+            Some((&rig.config.device, rig.device_to_world())),
+        );
+        if let Err(e) = self.hub.publish_scene(info) {
+            eprintln!("display: {e}");
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::hand_arg::HandSpec;
+    use crate::run_rig::DeviceChoice;
+    use haptic2d::haptic::HapticConfig;
+    use std::alloc::{GlobalAlloc, Layout, System};
+    use std::cell::Cell;
+    use std::time::{Duration, Instant};
+
+    /// Counts the allocations of the current thread.
+    struct Counting;
+
+    thread_local! {
+        static ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
+    }
+
+    unsafe impl GlobalAlloc for Counting {
+        unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+            ALLOCATIONS.with(|a| a.set(a.get() + 1));
+            unsafe { System.alloc(layout) }
+        }
+        unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+            unsafe { System.dealloc(ptr, layout) }
+        }
+        unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+            ALLOCATIONS.with(|a| a.set(a.get() + 1));
+            unsafe { System.realloc(ptr, layout, new_size) }
+        }
+    }
+
+    #[global_allocator]
+    static GLOBAL: Counting = Counting;
+
+    fn allocations() -> u64 {
+        ALLOCATIONS.with(|a| a.get())
+    }
+
+    fn until(what: &str, cond: impl Fn() -> bool) {
+        let end = Instant::now() + Duration::from_secs(10);
+        while !cond() {
+            assert!(Instant::now() < end, "timed out waiting for {what}");
+            std::thread::sleep(Duration::from_millis(10));
+        }
+    }
+
+    /// The loop's side of the display — polling commands, the haptic tick, capturing and publishing
+    /// frames for a connected viewer, recording timing — allocates nothing in steady state, with the
+    /// box held against the wall by the hand target (contacts and the device linkage in every
+    /// frame). Ticks are driven by hand here (simulated time), on this thread.
+    #[test]
+    fn loop_side_of_the_display_does_not_allocate_in_steady_state() {
+        let scene = builtin("box-in-walls", Some(1000.0)).unwrap().unwrap();
+        let loaded = LoadedScene {
+            name: scene.name.clone(),
+            description: scene.description.clone(),
+            world: scene.world.clone(),
+        };
+        let mut rig = Rig::new(
+            scene.world,
+            "box-in-walls",
+            HapticConfig::default(),
+            DeviceChoice::Sim,
+            HandSpec::Follow,
+        )
+        .unwrap();
+        let (server, mut view) =
+            start("127.0.0.1:0".parse().unwrap(), &rig, loaded, 1000.0).unwrap();
+        let addr = server.local_addr();
+        let stream = std::net::TcpStream::connect(addr).unwrap();
+        let (mut ws, _) = tungstenite::client(format!("ws://{addr}/ws"), stream).unwrap();
+        until("the viewer", || server.stats().viewers == 1);
+        ws.send(tungstenite::Message::text(
+            r#"{"type":"set_hand_target","x":-0.01,"y":0.0,"theta":0.0}"#,
+        ))
+        .unwrap();
+        until("the command", || server.stats().commands_forwarded == 1);
+
+        let period_ns = 1_000_000;
+        let mut k = 0u64;
+        let mut pass = |n: u64, view: &mut LiveView, rig: &mut Rig| {
+            let before = allocations();
+            for _ in 0..n {
+                view.apply_commands(rig);
+                let q = rig.io.read_encoders().unwrap();
+                let out = rig.system.tick(&q);
+                rig.io.write_torques(&out.torques).unwrap();
+                let info = TickInfo {
+                    index: k,
+                    deadline_index: k,
+                    t_s: k as f64 * 1e-3,
+                    period_s: 1e-3,
+                    period_ns,
+                    lateness_ns: 0,
+                    skipped: 0,
+                    deadline_ns: k * period_ns,
+                };
+                view.after_tick(&info, rig);
+                k += 1;
+            }
+            allocations() - before
+        };
+        pass(3000, &mut view, &mut rig);
+        let allocs = pass(2000, &mut view, &mut rig);
+        let w = rig.system.world();
+        assert!(
+            w.contacts().contact_count() > 0,
+            "the box is against the wall"
+        );
+        assert!(w.bodies[rig.system.slave()].pose.pos.x < 0.025);
+        assert_eq!(allocs, 0, "allocations in steady state");
+        drop(ws);
+        server.shutdown();
+    }
+}
