@@ -3,9 +3,10 @@
 
 use std::path::Path;
 
-/// Runs the selected figure(s), writes `DIR/<figure>/` and `DIR/REPORT.md`, prints a summary. Fails
-/// (after writing everything) if any case does not pass.
-pub fn run(figure: &str, out: &Path) -> Result<(), String> {
+/// Runs the selected figure(s), writes `DIR/<figure>/` and `DIR/REPORT.md`, prints a summary. Every
+/// case's verdict is in its `metrics.json` (`pass`) and in the report; with `strict`, the command also
+/// fails (after writing everything) if any case does not pass.
+pub fn run(figure: &str, out: &Path, strict: bool) -> Result<(), String> {
     let s = haptic2d_lab::reproduce(figure, out, true)?;
     for f in &s.figures {
         println!(
@@ -19,8 +20,12 @@ pub fn run(figure: &str, out: &Path) -> Result<(), String> {
     println!("report: {}", s.report.display());
     println!("total: {:.2} s", s.seconds);
     if s.all_pass() {
+        println!("every case reproduces the paper's claim");
         Ok(())
+    } else if strict {
+        Err("some cases do not pass (--strict); see the report".to_string())
     } else {
-        Err("some cases do not pass; see the report".to_string())
+        println!("some cases do not reproduce the paper's claim: see the report (--strict makes this an error)");
+        Ok(())
     }
 }

@@ -68,6 +68,9 @@ enum Command {
         /// Output folder.
         #[arg(long, default_value = "reproduction")]
         out: PathBuf,
+        /// Exit with an error if any case does not reproduce the paper's claim.
+        #[arg(long)]
+        strict: bool,
     },
     /// Parameter sweeps; `walls`: stiffness × damping of every wall law, classified by energy gain.
     Sweep {
@@ -98,7 +101,11 @@ fn main() -> ExitCode {
         } => cmd_simulate::run(&scene, duration, out.as_deref(), rate, every),
         Command::Scenes => cmd_scenes::run(),
         Command::Check { scene } => cmd_check::run(&scene),
-        Command::Reproduce { figure, out } => cmd_reproduce::run(&figure, &out),
+        Command::Reproduce {
+            figure,
+            out,
+            strict,
+        } => cmd_reproduce::run(&figure, &out, strict),
         Command::Sweep {
             target,
             rate,
