@@ -6,34 +6,9 @@ use haptic2d::control::passivity::PlanarPassivity;
 use haptic2d::device::{HandModel, SimDevice};
 use haptic2d::haptic::{ControllerKind, HapticConfig, HapticSystem};
 use haptic2d::scene::builtin;
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-
-struct Counting;
-
-static COUNTING: AtomicBool = AtomicBool::new(false);
-static ALLOCS: AtomicU64 = AtomicU64::new(0);
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        if COUNTING.load(Ordering::Relaxed) {
-            ALLOCS.fetch_add(1, Ordering::Relaxed);
-        }
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        if COUNTING.load(Ordering::Relaxed) {
-            ALLOCS.fetch_add(1, Ordering::Relaxed);
-        }
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
-
-#[global_allocator]
-static GLOBAL: Counting = Counting;
+#[path = "support/counting_alloc.rs"]
+mod counting_alloc;
+use counting_alloc::allocations;
 
 /// Allocations inside `tick` during `measure` ticks after `warm` ticks. The plant (a test fixture, not
 /// part of the tick) steps outside the counted region.
@@ -51,14 +26,10 @@ fn tick_allocations(
     for k in 0..warm + measure {
         let q = plant.encoders().unwrap();
         let count = k >= warm;
-        if count {
-            ALLOCS.store(0, Ordering::SeqCst);
-            COUNTING.store(true, Ordering::SeqCst);
-        }
+        let before = allocations();
         let out = sys.tick(&q);
         if count {
-            COUNTING.store(false, Ordering::SeqCst);
-            let a = ALLOCS.load(Ordering::SeqCst);
+            let a = allocations() - before;
             if a > 0 {
                 eprintln!(
                     "{scene}: {a} allocations in tick {k} ({} contacts after it)",
