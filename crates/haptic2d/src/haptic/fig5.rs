@@ -29,6 +29,32 @@
 //! pulse (first ratio 0.49) and the hysteretic wall (ratios ≈ 1.0, bouncing to the end). The virtual
 //! coupling (`Fig5Params::coupling`) is *dissipative* (its damper `B_vc` and the device's joint
 //! friction): the pulse and the hysteretic wall settle, but so do SEH and ZOH after one separation.
+//!
+//! Other designs tried (none makes one controller meet all four claims; walls and pass criteria
+//! unchanged; `sep` = separations in 10 s (in the last 2 s), `v` = first entry speeds (m/s), `r` =
+//! contact ratios; ✓/✗ = pass):
+//!
+//! | design (four-channel unless noted) | SEH | ZOH | pulse | hysteretic |
+//! |---|---|---|---|---|
+//! | handle force (this module), 500 Hz | ✓ 32 (7) | ✓ 29 (6) | ✗ r 0.49, 0.34; v3 0.078 > 0.15·v1 | ✗ 48 (10), r 1.02, 0.97, 0.96 |
+//! | same, 1 kHz | ✓ 31 (6) | ✓ 30 (6) | ✗ r 0.98, 0.95, 0.89 | ✗ 48 (10), r 0.99, 0.94, 0.89 |
+//! | same, pulse `e_b` sized for box + device mass (0.945 kg), 500 Hz / 1 kHz | ✓ | ✓ | ✗ chatter, 144 / 262 sep, r 0.82 / 1.11 | — |
+//! | (a) hand-force *signal* `f_h = (−2, 0, 0)` to the controller, handle let go (free), 500 Hz | ✓ 44 (9), v 0.145 | ✗ settles at 9.1 s, 13 sep | ✗ r1 0.07 but later entries 0.065 > 0.15·v1 = 0.022 | ✗ r 0.95, 0.77 (2 sep) |
+//! | (a), 1 kHz | ✓ 37 (6) | ✗ settles at 10.0 s, 20 sep (0 late) | ✗ r1 0.003, later entries 0.056 | ✗ r 0.94, 0.68 |
+//! | (a) + pulse sized for box + device, 500 Hz / 1 kHz | ✓ | ✗ | ✗ r1 0.70 / 0.41, 24 / 25 sep | ✗ |
+//! | handle force *and* exact signal `f_h = (−2, 0, 0)` (ideal force sensor), 500 Hz | ✓ 36 (8) | ✓ 31 (6) | ✗ r 0.46, 0.37; v3 0.071 | ✗ 19 (3), r 0.92, 0.86, 0.76 |
+//! | same, 1 kHz | ✓ 34 (7) | ✓ 32 (6) | ✗ 23 sep, r 0.95, 0.90, 0.83 | ✗ 17 (3), r 0.90, 0.84, 0.72 |
+//! | virtual coupling, handle force, 500 Hz / 1 kHz | ✗ 1 sep, settles | ✗ 2 / 1 sep, settles | ✓ r1 0.20 / 0.09 | ✓ 1 sep, r 0.28 / 0.25 |
+//! | virtual coupling, hand-force signal (a) | ✗ | ✗ | ✗ | ✗ — the coupling has no `f_h` channel (C3 = 0): the box never moves |
+//!
+//! (b) "only the slave pushed (`f_cs`), the device following" is (a) itself: with the spec's
+//! `C5 = C6 = 0` the hand-force signal enters `f_cs` alone (C3 = 1) and never `f_cm`. In (a) the
+//! handle is dragged by `K_m` and its joint friction makes the loop dissipative (first entry 0.145 m/s
+//! instead of √(2·F·g0/(m + M_x)) = 0.29 m/s; after the first impact even ZOH's bounces decay), so the
+//! active walls stop bouncing;
+//! with a force on the handle the loop is active at the wall (SEH ratio 1.25 vs 0.87 world-alone) and
+//! the pulse (sized for the box alone) and the hysteretic wall cannot remove the energy the device
+//! re-injects. Sizing the pulse for the box plus the device's reflected mass overshoots and chatters.
 
 use crate::control::coupling::CouplingGains;
 use crate::device::dynamics::LumpedDynamics;
