@@ -51,9 +51,8 @@
 //! `C5 = C6 = 0` the hand-force signal enters `f_cs` alone (C3 = 1) and never `f_cm`. In (a) the
 //! handle is dragged by `K_m` and its joint friction makes the loop dissipative (first entry 0.145 m/s
 //! instead of √(2·F·g0/(m + M_x)) = 0.29 m/s; after the first impact even ZOH's bounces decay), so the
-//! active walls stop bouncing;
-//! with a force on the handle the loop is active at the wall (SEH ratio 1.25 vs 0.87 world-alone) and
-//! the pulse (sized for the box alone) and the hysteretic wall cannot remove the energy the device
+//! active walls stop bouncing; with a force on the handle the loop is active at the wall (SEH ratio
+//! 1.25 vs 0.87 world-alone) and the pulse (sized for the box alone) and the hysteretic wall cannot remove the energy the device
 //! re-injects. Sizing the pulse for the box plus the device's reflected mass overshoots and chatters.
 
 use crate::control::coupling::CouplingGains;
