@@ -177,12 +177,24 @@ impl ContactSet {
         rots: &[Rot],
         past: &PastPoses<'_>,
     ) {
-        // Fast path (steady contact): the tracked set already is "records ∪ candidates" in order, so
-        // every entry is re-measured in place and nothing is copied.
-        if self.same_keys(candidates) {
-            for e in self.entries.iter_mut() {
-                measure(e, bodies, rots);
+        // Every tracked entry is re-measured in place (one pass over the set), checking on the way
+        // whether merging would keep exactly the current entries: every candidate is tracked already,
+        // and every tracked pair is a candidate or a record. That is the steady-contact case, and then
+        // nothing is copied. (An entry that the merge drops is measured for nothing; that is harmless.)
+        let mut same = true;
+        let mut j = 0;
+        for e in self.entries.iter_mut() {
+            measure(e, bodies, rots);
+            if !same {
+                continue;
             }
+            if j < candidates.len() && e.key == candidates[j] {
+                j += 1;
+            } else if !e.is_contact() || (j < candidates.len() && candidates[j] < e.key) {
+                same = false;
+            }
+        }
+        if same && j == candidates.len() {
             return;
         }
         self.merged.clear();
@@ -193,9 +205,7 @@ impl ContactSet {
             if take_old {
                 let same = j < candidates.len() && old[i].key == candidates[j];
                 if same || old[i].is_contact() {
-                    let mut e = old[i];
-                    measure(&mut e, bodies, rots);
-                    self.merged.push(e);
+                    self.merged.push(old[i]);
                 }
                 if same {
                     j += 1;
@@ -209,20 +219,6 @@ impl ContactSet {
         }
         self.entries = old;
         std::mem::swap(&mut self.entries, &mut self.merged);
-    }
-
-    /// True if merging `candidates` would keep exactly the current entries (same keys, same order):
-    /// every candidate is tracked already, and every tracked pair is a candidate or a record.
-    fn same_keys(&self, candidates: &[VeCandidate]) -> bool {
-        let mut j = 0;
-        for e in &self.entries {
-            if j < candidates.len() && e.key == candidates[j] {
-                j += 1;
-            } else if !e.is_contact() || (j < candidates.len() && candidates[j] < e.key) {
-                return false;
-            }
-        }
-        j == candidates.len()
     }
 
     /// §8.2 rule 4 (release) and rule 5 (re-collision, optional).
