@@ -253,6 +253,7 @@ impl NormalLaw for NormalModel {
             NormalModel::Hysteretic(l) => l.reset(),
         }
     }
+    #[inline]
     fn force(&mut self, input: &NormalInput) -> f64 {
         match self {
             NormalModel::Paper(l) => l.force(input),
