@@ -240,6 +240,10 @@ impl Default for NormalModel {
     }
 }
 
+// The per-sample calls (and every law's own `force` method) are `#[inline]`: the contact set's
+// force pass builds the `NormalInput` on the stack, and a law compiled apart reads it back with loads
+// that straddle the caller's stores (a store-forwarding stall, ~15 % of a pile step). Inlined, the
+// input stays in registers. Behaviour is unchanged.
 impl NormalLaw for NormalModel {
     fn reset(&mut self) {
         match self {
