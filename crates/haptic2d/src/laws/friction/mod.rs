@@ -240,7 +240,7 @@ macro_rules! dispatch {
     };
 }
 
-// Every law's `update` is `#[inline(always)]` (and the dispatch here `#[inline]`): the contact set's
+// Every law's `update`, and its dispatch here, are `#[inline(always)]`: the contact set's
 // force pass builds the `FrictionInput` on the stack, and a `update` compiled apart reads it back with loads
 // that straddle the caller's stores (a store-forwarding stall, ~15 % of a pile step). Inlined, the
 // input stays in registers. A plain `#[inline]` hint was not always followed. Behaviour is unchanged.

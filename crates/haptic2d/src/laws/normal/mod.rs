@@ -240,7 +240,7 @@ impl Default for NormalModel {
     }
 }
 
-// Every law's `force` is `#[inline(always)]` (and the dispatch here `#[inline]`): the contact set's
+// Every law's `force`, and its dispatch here, are `#[inline(always)]`: the contact set's
 // force pass builds the `NormalInput` on the stack, and a `force` compiled apart reads it back with loads
 // that straddle the caller's stores (a store-forwarding stall, ~15 % of a pile step). Inlined, the
 // input stays in registers. A plain `#[inline]` hint was not always followed. Behaviour is unchanged.
