@@ -377,10 +377,12 @@ impl Ctx {
                     continue 'vertex;
                 }
                 max_d = max_d.max(d);
-                let s = b.c.edge_coordinate(e, p);
-                let in_range = s >= -self.eps_s && s <= b.c.local.lengths()[e] + self.eps_s;
-                if in_range && best.is_none_or(|(_, bd)| d > bd) {
-                    best = Some((e, d));
+                // The edge coordinate matters only for an edge that would beat the best so far.
+                if best.is_none_or(|(_, bd)| d > bd) {
+                    let s = b.c.edge_coordinate(e, p);
+                    if s >= -self.eps_s && s <= b.c.local.lengths()[e] + self.eps_s {
+                        best = Some((e, d));
+                    }
                 }
             }
             if max_d < 0.0 && inside.is_none() {

@@ -7,8 +7,11 @@
 
 use super::god_object::{crossing_coordinate, entry_point};
 use super::impact::{ImpactRow, ImpactSolver};
+use super::law_pool::LawPool;
 use super::params::ContactParams;
-use super::record::{ContactEvent, ContactState, EventKind, LocalGeom, VeContact};
+use super::record::{
+    ContactEvent, ContactState, EventKind, LawState, LocalGeom, VeContact, NO_LAW,
+};
 use crate::body::Body;
 use crate::collide::{Collider, VeCandidate};
 use crate::geom::{cross, Pose, Rot, Vec2};
@@ -38,6 +41,8 @@ pub struct ContactSet {
     /// Thresholds and options.
     pub params: ContactParams,
     entries: Vec<VeContact>,
+    /// Law states of the records, addressed by [`VeContact::law`].
+    laws: LawPool,
     merged: Vec<VeContact>,
     pending: Vec<VeContact>,
     events: Vec<ContactEvent>,
@@ -65,6 +70,7 @@ impl ContactSet {
         Self {
             params,
             entries: Vec::with_capacity(64),
+            laws: LawPool::with_capacity(64),
             merged: Vec::with_capacity(64),
             pending: Vec::with_capacity(16),
             events: Vec::with_capacity(64),
@@ -93,6 +99,16 @@ impl ContactSet {
     /// The contact records (Colliding or Continuous), sorted by key.
     pub fn records(&self) -> impl Iterator<Item = &VeContact> {
         self.entries.iter().filter(|e| e.is_contact())
+    }
+
+    /// The law states of record `e` (an entry of [`entries`](Self::entries)); `None` for a pair that
+    /// is only tracked.
+    pub fn laws(&self, e: &VeContact) -> Option<&LawState> {
+        if e.is_contact() {
+            self.laws.get(e.law)
+        } else {
+            None
+        }
     }
 
     /// Number of contact records.
@@ -131,9 +147,7 @@ impl ContactSet {
         self.events.clear();
         self.last_impact_loss = 0.0;
         self.resize_body_buffers(bodies.len());
-        self.sync(
-            tick, candidates, colliders, bodies, rots, past, normal, friction,
-        );
+        self.sync(tick, candidates, colliders, bodies, rots, past);
         self.release(tick);
         let any_colliding = self.create(tick, dt, colliders, bodies, past, normal, friction);
         if any_colliding {
@@ -154,7 +168,6 @@ impl ContactSet {
     /// Merges the sorted candidates with the tracked set: existing entries are re-measured (history
     /// shifted), new candidates get a fresh entry whose history is rebuilt from the past poses, tracked
     /// pairs that are neither candidates nor records are dropped.
-    #[allow(clippy::too_many_arguments)]
     fn sync(
         &mut self,
         tick: u64,
@@ -163,15 +176,25 @@ impl ContactSet {
         bodies: &[Body],
         rots: &[Rot],
         past: &PastPoses<'_>,
-        normal: &NormalModel,
-        friction: &FrictionModel,
     ) {
-        // Fast path (steady contact): the tracked set already is "records ∪ candidates" in order, so
-        // every entry is re-measured in place and nothing is copied.
-        if self.same_keys(candidates) {
-            for e in self.entries.iter_mut() {
-                measure(e, bodies, rots);
+        // Every tracked entry is re-measured in place (one pass over the set), checking on the way
+        // whether merging would keep exactly the current entries: every candidate is tracked already,
+        // and every tracked pair is a candidate or a record. That is the steady-contact case, and then
+        // nothing is copied. (An entry that the merge drops is measured for nothing; that is harmless.)
+        let mut same = true;
+        let mut j = 0;
+        for e in self.entries.iter_mut() {
+            measure(e, bodies, rots);
+            if !same {
+                continue;
             }
+            if j < candidates.len() && e.key == candidates[j] {
+                j += 1;
+            } else if !e.is_contact() || (j < candidates.len() && candidates[j] < e.key) {
+                same = false;
+            }
+        }
+        if same && j == candidates.len() {
             return;
         }
         self.merged.clear();
@@ -182,44 +205,20 @@ impl ContactSet {
             if take_old {
                 let same = j < candidates.len() && old[i].key == candidates[j];
                 if same || old[i].is_contact() {
-                    let mut e = old[i];
-                    measure(&mut e, bodies, rots);
-                    self.merged.push(e);
+                    self.merged.push(old[i]);
                 }
                 if same {
                     j += 1;
                 }
                 i += 1;
             } else {
-                let e = new_entry(
-                    tick,
-                    candidates[j],
-                    colliders,
-                    bodies,
-                    past,
-                    normal,
-                    friction,
-                );
+                let e = new_entry(tick, candidates[j], colliders, bodies, past);
                 self.merged.push(e);
                 j += 1;
             }
         }
         self.entries = old;
         std::mem::swap(&mut self.entries, &mut self.merged);
-    }
-
-    /// True if merging `candidates` would keep exactly the current entries (same keys, same order):
-    /// every candidate is tracked already, and every tracked pair is a candidate or a record.
-    fn same_keys(&self, candidates: &[VeCandidate]) -> bool {
-        let mut j = 0;
-        for e in &self.entries {
-            if j < candidates.len() && e.key == candidates[j] {
-                j += 1;
-            } else if !e.is_contact() || (j < candidates.len() && candidates[j] < e.key) {
-                return false;
-            }
-        }
-        j == candidates.len()
     }
 
     /// §8.2 rule 4 (release) and rule 5 (re-collision, optional).
@@ -231,8 +230,8 @@ impl ContactSet {
             }
             if e.d[0] > p.delta_off || !e.in_range(p.eps_s) {
                 e.state = None;
-                e.normal.reset();
-                e.friction.reset();
+                self.laws.release(e.law);
+                e.law = NO_LAW;
                 e.f_n = 0.0;
                 e.f_t = 0.0;
                 self.events.push(ContactEvent {
@@ -296,19 +295,16 @@ impl ContactSet {
                     Some(t) => {
                         let e = &mut self.entries[t];
                         start_record(e, p, tick, &mut self.events, false);
+                        e.law = self.laws.acquire(normal, friction);
+                        self.laws.get_mut(e.law).begin(e.s_g);
                         self.new_count[e.body_a] += 1;
                     }
                     None => {
-                        let mut e = new_entry(
-                            tick,
-                            VeCandidate { edge, ..key },
-                            colliders,
-                            bodies,
-                            past,
-                            normal,
-                            friction,
-                        );
+                        let key = VeCandidate { edge, ..key };
+                        let mut e = new_entry(tick, key, colliders, bodies, past);
                         start_record(&mut e, p, tick, &mut self.events, false);
+                        e.law = self.laws.acquire(normal, friction);
+                        self.laws.get_mut(e.law).begin(e.s_g);
                         self.new_count[e.body_a] += 1;
                         self.pending.push(e);
                     }
@@ -364,6 +360,8 @@ impl ContactSet {
                     if let Some(t) = pick {
                         let e = &mut self.entries[t];
                         start_record(e, p, tick, &mut self.events, true);
+                        e.law = self.laws.acquire(normal, friction);
+                        self.laws.get_mut(e.law).begin(e.s_g);
                         self.new_count[e.body_a] += 1;
                     }
                 }
@@ -526,6 +524,7 @@ impl ContactSet {
                 continue;
             }
             let e = &mut self.entries[idx];
+            let law = self.laws.get_mut(e.law);
             let input = NormalInput {
                 d: e.d,
                 hist: e.hist,
@@ -533,11 +532,11 @@ impl ContactSet {
                 dt,
                 m_eff: e.m_eff,
             };
-            e.f_n = e.normal.force(&input);
+            e.f_n = law.normal.force(&input);
             add_force(wrenches, bodies, e.body_a, e.body_b, e.n * e.f_n, e.point);
             if !needs_ext {
-                friction_step(e, dt, 0.0, wrenches, bodies);
-                stored += e.normal.stored_energy() + e.friction.stored_energy();
+                friction_step(e, law, dt, 0.0, wrenches, bodies);
+                stored += law.normal.stored_energy() + law.friction.stored_energy();
             }
         }
         if needs_ext {
@@ -550,8 +549,9 @@ impl ContactSet {
                 }
                 let f_ext_t = self.external_share(idx);
                 let e = &mut self.entries[idx];
-                friction_step(e, dt, f_ext_t, wrenches, bodies);
-                stored += e.normal.stored_energy() + e.friction.stored_energy();
+                let law = self.laws.get_mut(e.law);
+                friction_step(e, law, dt, f_ext_t, wrenches, bodies);
+                stored += law.normal.stored_energy() + law.friction.stored_energy();
             }
         }
         self.stored = stored;
@@ -580,6 +580,7 @@ impl ContactSet {
 #[inline]
 fn friction_step(
     e: &mut VeContact,
+    law: &mut LawState,
     dt: f64,
     f_ext_t: f64,
     wrenches: &mut [Wrench2],
@@ -593,8 +594,8 @@ fn friction_step(
         dt,
         f_ext_t,
     };
-    e.f_t = e.friction.update(&input);
-    e.s_g = e.friction.anchor(e.s).unwrap_or(e.s.clamp(0.0, e.len));
+    e.f_t = law.friction.update(&input);
+    e.s_g = law.friction.anchor(e.s).unwrap_or(e.s.clamp(0.0, e.len));
     if e.f_t != 0.0 {
         add_force(wrenches, bodies, e.body_a, e.body_b, e.t * e.f_t, e.point);
     }
@@ -615,7 +616,8 @@ fn add_force(w: &mut [Wrench2], bodies: &[Body], a: usize, b: usize, f: Vec2, p:
 }
 
 /// Turns a tracked pair into a record: Colliding if it approaches faster than `v_c` (and impacts are on),
-/// otherwise Continuous (an invalid impact, §8.2 rule 1). Initialises the god-object and the law states.
+/// otherwise Continuous (an invalid impact, §8.2 rule 1). Initialises the god-object; the caller
+/// gives the record its law states ([`LawState::begin`]).
 fn start_record(
     e: &mut VeContact,
     p: ContactParams,
@@ -639,8 +641,6 @@ fn start_record(
         e.s.clamp(0.0, e.len)
     };
     e.s_entry = e.s_g;
-    e.normal.reset();
-    e.friction.begin(e.s_g);
     events.push(ContactEvent {
         tick,
         key: e.key,
@@ -714,8 +714,6 @@ fn new_entry(
     colliders: &[Collider],
     bodies: &[Body],
     past: &PastPoses<'_>,
-    normal: &NormalModel,
-    friction: &FrictionModel,
 ) -> VeContact {
     let body_a = colliders[key.vertex_collider as usize].body;
     let body_b = colliders[key.edge_collider as usize].body;
@@ -764,8 +762,7 @@ fn new_entry(
         s_g: s0.clamp(0.0, len),
         s_entry: s0.clamp(0.0, len),
         m_eff: 0.0,
-        normal: *normal,
-        friction: *friction,
+        law: NO_LAW,
         f_n: 0.0,
         f_t: 0.0,
         since: tick,

@@ -2,6 +2,7 @@
 
 mod god_object;
 pub mod impact;
+mod law_pool;
 pub mod lcp;
 mod manager;
 mod params;
@@ -10,4 +11,4 @@ mod record;
 pub use god_object::entry_point;
 pub use manager::{ContactSet, PastPoses, Wrench2};
 pub use params::ContactParams;
-pub use record::{ContactEvent, ContactState, EventKind, VeContact};
+pub use record::{ContactEvent, ContactState, EventKind, LawState, VeContact, NO_LAW};

@@ -1,9 +1,26 @@
-//! The per-VE-pair record (§8.1): distance history, edge coordinate, god-object, law states.
+//! The per-VE-pair record (§8.1): distance history, edge coordinate, god-object, and the slot of
+//! its law states.
+//!
+//! The law states ([`LawState`]: a [`NormalModel`] and a [`FrictionModel`], about 270 bytes) live out
+//! of line in the contact set's pool, so the record that every per-sample pass walks stays small
+//! (the tracked pairs that are not contacts, the majority on a pile, need no law state at all).
 
 use crate::collide::VeCandidate;
 use crate::geom::Vec2;
-use crate::laws::friction::FrictionModel;
-use crate::laws::normal::NormalModel;
+use crate::laws::friction::{FrictionLaw, FrictionModel};
+use crate::laws::normal::{NormalLaw, NormalModel};
+
+/// Sentinel of [`VeContact::law`] for an entry without law states (only tracked).
+pub const NO_LAW: u32 = u32::MAX;
+
+/// The per-contact states of the normal law and the friction model of one contact record.
+#[derive(Clone, Copy, Debug)]
+pub struct LawState {
+    /// Normal-law state (a copy of the world's prototype, taken when the record was created).
+    pub normal: NormalModel,
+    /// Friction-model state (a copy of the world's prototype, taken when the record was created).
+    pub friction: FrictionModel,
+}
 
 /// The state of a VE pair that is in contact (§8.2). A pair that is only tracked has no state.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -12,6 +29,16 @@ pub enum ContactState {
     Colliding,
     /// Sticking or sliding contact: forces from the normal law and the friction model.
     Continuous,
+}
+
+impl LawState {
+    /// Starts a new contact whose god-object entry point is at edge coordinate `s_entry` (m): the
+    /// normal law is reset and the friction model begins there (§8.3).
+    #[inline]
+    pub fn begin(&mut self, s_entry: f64) {
+        self.normal.reset();
+        self.friction.begin(s_entry);
+    }
 }
 
 /// A tracked VE pair: a candidate from the local stage, or a contact record when `state` is set.
@@ -53,10 +80,9 @@ pub struct VeContact {
     pub s_entry: f64,
     /// Effective mass behind the contact for the braking pulse (kg).
     pub m_eff: f64,
-    /// Normal-law state (a copy of the world's prototype).
-    pub normal: NormalModel,
-    /// Friction-model state (a copy of the world's prototype).
-    pub friction: FrictionModel,
+    /// Slot of this record's [`LawState`] in the contact set's pool (see
+    /// [`ContactSet::laws`](super::ContactSet::laws)); [`NO_LAW`] while only tracked.
+    pub law: u32,
     /// Normal force of the last sample (N).
     pub f_n: f64,
     /// Friction force on A along `+t` of the last sample (N).

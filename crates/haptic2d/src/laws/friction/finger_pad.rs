@@ -138,6 +138,7 @@ impl FrictionLaw for FingerPad {
         self.engaged = true;
     }
 
+    #[inline(always)]
     fn update(&mut self, i: &FrictionInput) -> f64 {
         if i.fn_ <= 0.0 {
             self.reset(); // delete state

@@ -167,6 +167,7 @@ impl FrictionLaw for ResetIntegrator {
         self.mode = FrictionMode::Stick;
     }
 
+    #[inline(always)]
     fn update(&mut self, i: &FrictionInput) -> f64 {
         if i.fn_ <= 0.0 {
             self.reset();

@@ -197,6 +197,7 @@ impl NormalLaw for HystereticLaw {
         }
         self.stored = 0.0;
     }
+    #[inline(always)]
     fn force(&mut self, input: &NormalInput) -> f64 {
         let delta = input.depth();
         if delta <= 0.0 {

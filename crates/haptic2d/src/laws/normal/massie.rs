@@ -76,6 +76,7 @@ impl NormalLaw for MassiePiLaw {
         self.integral = 0.0;
         self.stored = 0.0;
     }
+    #[inline(always)]
     fn force(&mut self, input: &NormalInput) -> f64 {
         let delta = input.depth();
         self.stored = 0.5 * self.k * delta * delta;

@@ -59,6 +59,7 @@ impl NormalLaw for PaperLaw {
     fn reset(&mut self) {
         self.stored = 0.0;
     }
+    #[inline(always)]
     fn force(&mut self, input: &NormalInput) -> f64 {
         let delta = input.depth();
         self.stored = 0.5 * self.kc * delta * delta;

@@ -87,6 +87,7 @@ impl NormalLaw for BrakingPulseLaw {
         self.pulse = 0.0;
         self.stored = 0.0;
     }
+    #[inline(always)]
     fn force(&mut self, input: &NormalInput) -> f64 {
         let delta = input.depth();
         self.stored = 0.5 * self.k * delta * delta;
