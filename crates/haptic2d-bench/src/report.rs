@@ -99,6 +99,9 @@ pub fn json(rows: &[Row]) -> String {
 
 /// Writes `compare.svg`: median (solid) and p99 (thin) step time vs N for the `pile` rows, log–log.
 pub fn svg(rows: &[Row], path: &Path) -> Result<(), String> {
+    // With the workspace's plotters features unified (the lab enables ab_glyph), text needs a
+    // registered font: use the lab's embedded one.
+    haptic2d_lab::plot::register_font();
     let pile: Vec<&Row> = rows.iter().filter(|r| r.scene == "pile").collect();
     if pile.is_empty() {
         return Ok(());
