@@ -1,21 +1,8 @@
 //! End-to-end tests of the `haptic2d` binary: what a new user types.
 
-use std::process::{Command, Output};
+mod common;
 
-fn haptic2d(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_haptic2d"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
-
-fn text(o: &Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
-}
+use common::{haptic2d, text};
 
 #[test]
 fn simulate_twice_gives_byte_identical_csv() {

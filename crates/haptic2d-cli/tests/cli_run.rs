@@ -1,22 +1,10 @@
 //! `haptic2d run`: a short headless run prints the timing summary and logs one row per tick; bad
 //! options fail with a clear message and a non-zero exit.
 
-use std::process::{Command, Output};
+mod common;
 
-fn haptic2d(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_haptic2d"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
-
-fn text(o: &Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
-}
+use common::{haptic2d, text};
+use std::process::Command;
 
 #[test]
 fn run_headless_one_second_prints_the_summary_and_logs_every_tick() {
