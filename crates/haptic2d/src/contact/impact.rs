@@ -346,20 +346,7 @@ impl ImpactSolver {
             self.normal_velocities(rows, bodies, Buf::Post);
         }
 
-        let ke_after: f64 = bodies.iter().map(Body::kinetic_energy).sum();
-        ImpactOutcome {
-            rows: n,
-            kinetic_energy_before: ke_before,
-            kinetic_energy_after: ke_after,
-            plastic_correction: passes > 0,
-            correction_passes: passes,
-            compression,
-            correction,
-            min_post_velocity: self.b_post[..n]
-                .iter()
-                .copied()
-                .fold(f64::INFINITY, f64::min),
-        }
+        self.outcome(bodies, ke_before, passes, compression, correction)
     }
 
     /// The sparse path for large impact sets (`n > DENSE_MAX_ROWS`, e.g. a pile landing): the same
@@ -407,20 +394,7 @@ impl ImpactSolver {
             }
             self.normal_velocities(rows, bodies, Buf::Post);
         }
-        let ke_after: f64 = bodies.iter().map(Body::kinetic_energy).sum();
-        ImpactOutcome {
-            rows: n,
-            kinetic_energy_before: ke_before,
-            kinetic_energy_after: ke_after,
-            plastic_correction: passes > 0,
-            correction_passes: passes,
-            compression,
-            correction,
-            min_post_velocity: self.b_post[..n]
-                .iter()
-                .copied()
-                .fold(f64::INFINITY, f64::min),
-        }
+        self.outcome(bodies, ke_before, passes, compression, correction)
     }
 
     /// Projected Gauss–Seidel applied directly to the bodies' twists; accumulates the impulses in
@@ -472,6 +446,31 @@ impl ImpactSolver {
             converged,
             enumeration_failed: false,
             pgs_failed: !converged,
+        }
+    }
+
+    /// The summary of the solve just finished (both paths).
+    fn outcome(
+        &self,
+        bodies: &[Body],
+        ke_before: f64,
+        passes: usize,
+        compression: LcpReport,
+        correction: Option<LcpReport>,
+    ) -> ImpactOutcome {
+        let n = self.n;
+        ImpactOutcome {
+            rows: n,
+            kinetic_energy_before: ke_before,
+            kinetic_energy_after: bodies.iter().map(Body::kinetic_energy).sum(),
+            plastic_correction: passes > 0,
+            correction_passes: passes,
+            compression,
+            correction,
+            min_post_velocity: self.b_post[..n]
+                .iter()
+                .copied()
+                .fold(f64::INFINITY, f64::min),
         }
     }
 

@@ -60,6 +60,8 @@ pub struct ContactSet {
     pub last_impact_loss: f64,
     /// Energy stored in contact and friction springs after the last step (J).
     stored: f64,
+    /// Number of contact records after the last step.
+    record_count: usize,
     /// Number of impact sets solved so far.
     pub impacts_solved: u64,
 }
@@ -86,6 +88,7 @@ impl ContactSet {
             nonfric: Vec::new(),
             last_impact_loss: 0.0,
             stored: 0.0,
+            record_count: 0,
             impacts_solved: 0,
         }
     }
@@ -111,9 +114,11 @@ impl ContactSet {
         }
     }
 
-    /// Number of contact records.
+    /// Number of contact records after the last step (counted in the force pass, so reading it
+    /// every tick costs nothing).
+    #[inline]
     pub fn contact_count(&self) -> usize {
-        self.entries.iter().filter(|e| e.is_contact()).count()
+        self.record_count
     }
 
     /// The state transitions of the last sample.
@@ -519,10 +524,13 @@ impl ContactSet {
         // forces on A); every other model runs normal then friction per contact in one pass.
         let needs_ext = friction.uses_external_force();
         let mut stored = 0.0;
+        // Every record is Continuous here (Colliding ones were resolved by the impacts of step 5).
+        let mut records = 0;
         for idx in 0..self.entries.len() {
             if self.entries[idx].state != Some(ContactState::Continuous) {
                 continue;
             }
+            records += 1;
             let e = &mut self.entries[idx];
             let law = self.laws.get_mut(e.law);
             let input = NormalInput {
@@ -555,6 +563,7 @@ impl ContactSet {
             }
         }
         self.stored = stored;
+        self.record_count = records;
     }
 
     /// `F_ext,t,i = (t·F_A^nonfric)/n_t` for the classical model (§4.1): the non-friction force on A
