@@ -9,8 +9,13 @@ use std::path::Path;
 pub fn run(figure: &str, out: &Path, strict: bool) -> Result<(), String> {
     let s = haptic2d_lab::reproduce(figure, out, true)?;
     for f in &s.figures {
+        let extra = if f.comparisons > 0 {
+            format!(", +{} comparison runs", f.comparisons)
+        } else {
+            String::new()
+        };
         println!(
-            "{}: {}/{} cases pass ({:.2} s)",
+            "{}: {}/{} cases pass{extra} ({:.2} s)",
             f.name, f.passed, f.total, f.seconds
         );
         for c in &f.failing {

@@ -16,6 +16,7 @@
 pub mod csv;
 pub mod fig4;
 pub mod fig5;
+pub mod fig5_sweep;
 pub mod fig7;
 pub mod fig8;
 pub mod figure;

@@ -108,6 +108,10 @@ pub struct CaseMetrics {
     pub measured: Measured,
     /// Whether every check holds.
     pub pass: bool,
+    /// A comparison run (another controller or device than the one that carries the paper's claim):
+    /// reported with its verdict, but not counted in the figure's pass count nor by `--strict`.
+    #[serde(default)]
+    pub comparison: bool,
     /// The spec tests evaluated on this case.
     pub checks: Vec<Check>,
 }
@@ -120,8 +124,25 @@ impl CaseMetrics {
             dimension,
             measured,
             pass: !checks.is_empty() && checks.iter().all(|c| c.pass),
+            comparison: false,
             checks,
         }
+    }
+
+    /// The verdict for a report table: `yes` / `**NO**` for a claim case, `yes (comparison)` /
+    /// `no (comparison)` for a comparison run.
+    pub fn verdict(&self) -> &'static str {
+        match (self.pass, self.comparison) {
+            (true, false) => "yes",
+            (false, false) => "**NO**",
+            (true, true) => "yes (comparison)",
+            (false, true) => "no (comparison)",
+        }
+    }
+
+    /// This case marked as a comparison run (`comparison = true`) or not.
+    pub fn with_comparison(self, comparison: bool) -> Self {
+        Self { comparison, ..self }
     }
 }
 
@@ -135,8 +156,34 @@ pub struct FigureMetrics {
 }
 
 impl FigureMetrics {
-    /// Number of cases that pass.
+    /// The cases that carry the figure's claims (every case but the comparison runs).
+    pub fn claims(&self) -> impl Iterator<Item = &CaseMetrics> {
+        self.cases.iter().filter(|c| !c.comparison)
+    }
+
+    /// Number of claim cases (comparison runs excluded).
+    pub fn claim_count(&self) -> usize {
+        self.claims().count()
+    }
+
+    /// Number of claim cases that pass (comparison runs excluded).
     pub fn passed(&self) -> usize {
-        self.cases.iter().filter(|c| c.pass).count()
+        self.claims().filter(|c| c.pass).count()
+    }
+
+    /// Number of comparison runs.
+    pub fn comparisons(&self) -> usize {
+        self.cases.len() - self.claim_count()
+    }
+
+    /// `"P / N"`, with ` (+C comparison runs)` when there are any.
+    pub fn pass_summary(&self) -> String {
+        let c = self.comparisons();
+        let extra = if c > 0 {
+            format!(" (+{c} comparison runs)")
+        } else {
+            String::new()
+        };
+        format!("{} / {}{extra}", self.passed(), self.claim_count())
     }
 }

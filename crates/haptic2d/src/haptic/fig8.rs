@@ -22,7 +22,11 @@
 //! stick–slip models pass, but the classical model does not drift; with the grip at scale 2 it is
 //! unstable again. The virtual coupling sends no force channel to the device: the device only feels
 //! the spring–damper `K_vc, B_vc` to the peg, which is stable with the handle free, and every claim
-//! holds. Both controllers are run by the lab figure (`haptic2d reproduce fig8`).
+//! holds. Both controllers are run by the lab figure (`haptic2d reproduce fig8`); the four-channel runs
+//! are comparison runs there. Raising the device's joint viscous friction does not rescue the
+//! four-channel loop: with `f_v` = 0.03 N·m·s/rad (b_y ≈ 8 N·s/m) every run still ends in a safety
+//! stop; with 0.06 three of five, and with 0.1 none do, but the damped handle no longer lets the peg
+//! stick (creep 4e-3–1.3e-2 m per cycle for every model, F7-2 fails).
 //!
 //! Metrics as §13.2, on the peg's x, for the cycles after the release: `creep_k = x(k + 0.2) −
 //! x(k − 0.1)` (the push is ≤ 0.73 N: any motion is drift or elastic presliding) and `advance_k =
