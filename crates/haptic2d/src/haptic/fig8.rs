@@ -24,7 +24,7 @@
 //! the spring–damper `K_vc, B_vc` to the peg, which is stable with the handle free, and every claim
 //! holds. Both controllers are run by the lab figure (`haptic2d reproduce fig8`); the four-channel runs
 //! are comparison runs there. Raising the device's joint viscous friction does not rescue the
-//! four-channel loop: with `f_v` = 0.03 N·m·s/rad (b_y ≈ 8 N·s/m) every run still ends in a safety
+//! four-channel loop: with `f_v` = 0.03 N·m·s/rad (b_x ≈ 8.3 N·s/m at the workspace centre) every run still ends in a safety
 //! stop; with 0.06 three of five, and with 0.1 none do, but the damped handle no longer lets the peg
 //! stick (creep 4e-3–1.3e-2 m per cycle for every model, F7-2 fails).
 //!
