@@ -23,6 +23,14 @@ pub fn run(arg: &str) -> Result<(), String> {
         w.normal.name(),
         w.friction.name()
     );
+    println!(
+        "  device: {}",
+        if scene.device.is_some() {
+            "the [device] table's parameters (valid; fields left out keep the spec defaults)"
+        } else {
+            "spec defaults (no [device] table)"
+        }
+    );
     for warn in &scene.warnings {
         println!("  warning: {warn}");
     }

@@ -2,6 +2,7 @@
 //! thread, with CSV logging on another thread, the live display in the browser (unless
 //! `--headless`), and a timing summary at exit.
 
+use crate::device_arg;
 use crate::hand_arg::HandSpec;
 use crate::run_rig::{DeviceChoice, Rig};
 use crate::run_view::{self, LoadedScene};
@@ -45,6 +46,11 @@ pub struct RunArgs {
     /// Device: sim (simulated twin pantograph) or replay:FILE.csv (recorded encoders q1..q4, rad).
     #[arg(long, default_value = "sim")]
     pub device: String,
+    /// Device parameters (TOML: top-level fields or a [device] table; template:
+    /// devices/twin-pantograph.toml). Wins over the scene's [device] table; fields left out keep
+    /// the spec defaults. Used by the simulated device and to read a replay's encoders.
+    #[arg(long, value_name = "FILE.toml")]
+    pub device_file: Option<PathBuf>,
     /// Write every tick's record to this CSV file.
     #[arg(long)]
     pub log: Option<PathBuf>,
@@ -105,7 +111,9 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
     for w in &scene.warnings {
         eprintln!("warning: {w}");
     }
+    let device_setting = device_arg::resolve(a.device_file.as_deref(), &scene, 1.0 / a.rate)?;
     let config = HapticConfig {
+        device: device_setting.params,
         controller,
         passivity: a.passivity.then(PlanarPassivity::default),
         ..HapticConfig::default()
@@ -161,8 +169,9 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
     };
     loop_config.validate()?;
     println!(
-        "running {scene_name}: device {}, controller {}{}, hand {hand_name}, {} Hz{}; Ctrl-C stops",
+        "running {scene_name}: device {} (parameters: {}), controller {}{}, hand {hand_name}, {} Hz{}; Ctrl-C stops",
         rig.io.name(),
+        device_setting.origin,
         rig.config.controller.name(),
         if a.passivity {
             " + passivity controller"

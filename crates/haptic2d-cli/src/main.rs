@@ -7,6 +7,7 @@ mod cmd_scenes;
 mod cmd_simulate;
 mod cmd_sweep;
 mod csv_out;
+mod device_arg;
 mod hand_arg;
 mod run_rig;
 mod run_view;

@@ -347,3 +347,127 @@ fn run_display_on_a_non_loopback_address_prints_the_token() {
     assert!(banner.contains("?token="), "{out}");
     assert!(banner.contains("commands need token"), "{out}");
 }
+
+#[test]
+fn run_device_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let template = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../devices/twin-pantograph.toml"
+    );
+    let start_line = |out: &str| -> String {
+        out.lines()
+            .find(|l| l.starts_with("running "))
+            .unwrap_or_else(|| panic!("no start line in:\n{out}"))
+            .to_string()
+    };
+    let run = |extra: &[&str]| {
+        let mut args = vec!["run", "--headless", "--duration", "0.2", "--no-rt"];
+        args.extend_from_slice(extra);
+        haptic2d(&args)
+    };
+
+    // No device file, no [device] table: the spec defaults.
+    let o = run(&[]);
+    let out = text(&o);
+    assert!(o.status.success(), "{out}");
+    assert!(
+        start_line(&out).contains("(parameters: spec defaults)"),
+        "{out}"
+    );
+
+    // The template as a device file.
+    let o = run(&["--device-file", template]);
+    let out = text(&o);
+    assert!(o.status.success(), "{out}");
+    assert!(
+        start_line(&out).contains(&format!("(parameters: device file {template})")),
+        "{out}"
+    );
+
+    // A scene with a [device] table; a device file wins over it.
+    let scene = dir.path().join("scene.toml");
+    let scene_text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../scenes/box-in-walls.toml"
+    ))
+    .unwrap();
+    std::fs::write(&scene, format!("{scene_text}\n[device]\nf_c = 0.002\n")).unwrap();
+    let scene = scene.to_str().unwrap();
+    let o = run(&[scene]);
+    let out = text(&o);
+    assert!(o.status.success(), "{out}");
+    assert!(
+        start_line(&out).contains(&format!("(parameters: scene {scene})")),
+        "{out}"
+    );
+    let subset = dir.path().join("subset.toml");
+    std::fs::write(
+        &subset,
+        "tau_max = 0.4\nm_h = 0.1\nworkspace_center_y = 0.15\n",
+    )
+    .unwrap();
+    let subset = subset.to_str().unwrap();
+    let log = dir.path().join("subset.csv");
+    let o = run(&[
+        scene,
+        "--device-file",
+        subset,
+        "--log",
+        log.to_str().unwrap(),
+    ]);
+    let out = text(&o);
+    assert!(o.status.success(), "{out}");
+    assert!(
+        start_line(&out).contains(&format!("(parameters: device file {subset})")),
+        "{out}"
+    );
+    // The file's parameters reach the device: it starts at the file's workspace centre (the spec
+    // default is y = 0.14 m).
+    let csv = std::fs::read_to_string(&log).unwrap();
+    let first: Vec<f64> = csv
+        .lines()
+        .nth(1)
+        .expect("a logged tick")
+        .split(',')
+        .take(3)
+        .map(|v| v.parse().unwrap())
+        .collect();
+    assert!(
+        (first[2] - 0.15).abs() < 1e-3,
+        "device.y at start {} m, expected 0.15 m",
+        first[2]
+    );
+
+    // Bad device files: non-zero exit, the file and the field named, a fix, no panic.
+    for (name, body, field) in [
+        (
+            "unknown.toml",
+            "[device]\nlink_length = 0.1\n",
+            "device.link_length",
+        ),
+        ("negative.toml", "tau_max = -1\n", "tau_max"),
+        ("type.toml", "l1 = \"long\"\n", "l1"),
+    ] {
+        let bad = dir.path().join(name);
+        std::fs::write(&bad, body).unwrap();
+        let bad = bad.to_str().unwrap();
+        let o = run(&["--device-file", bad]);
+        let out = text(&o);
+        assert!(!o.status.success(), "{name} should fail:\n{out}");
+        assert!(out.contains(bad), "{name}: file not named:\n{out}");
+        assert!(
+            out.contains(&format!("{field}:")),
+            "{name}: `{field}` not named:\n{out}"
+        );
+        assert!(out.contains("fix:"), "{name}: no fix:\n{out}");
+        assert!(!out.contains("running "), "{name}: nothing runs:\n{out}");
+        assert!(!out.contains("panicked"), "{out}");
+    }
+    let missing = dir.path().join("missing.toml");
+    let o = run(&["--device-file", missing.to_str().unwrap()]);
+    let out = text(&o);
+    assert!(!o.status.success(), "{out}");
+    assert!(out.contains("cannot read device file"), "{out}");
+    assert!(!out.contains("panicked"), "{out}");
+}

@@ -96,6 +96,46 @@ impl Default for DeviceParams {
     }
 }
 
+impl DeviceParams {
+    /// Every field, in declaration order, with its unit as written in scene and device files
+    /// (`"-"` for a dimensionless number). Used by file loaders for messages and by the template
+    /// `devices/twin-pantograph.toml`.
+    pub const FIELDS: [(&'static str, &'static str); 24] = [
+        ("s", "m"),
+        ("l1", "m"),
+        ("l2", "m"),
+        ("r_c", "m"),
+        ("workspace_center_x", "m"),
+        ("workspace_center_y", "m"),
+        ("workspace_half_width", "m"),
+        ("n_g", "-"),
+        ("i_rot", "kg·m²"),
+        ("i_p", "kg·m²"),
+        ("m_d", "kg"),
+        ("m_h", "kg"),
+        ("i_h", "kg·m²"),
+        ("m_ee", "kg"),
+        ("tau_max", "N·m"),
+        ("f_c", "N·m"),
+        ("f_v", "N·m·s/rad"),
+        ("encoder_counts", "counts/rev"),
+        ("velocity_cutoff_hz", "Hz"),
+        ("accel_cutoff_hz", "Hz"),
+        ("observer_gain", "1/s"),
+        ("closure_tol", "m"),
+        ("min_singularity_margin", "-"),
+        ("friction_compensation", "-"),
+    ];
+
+    /// The unit of field `name` (see [`DeviceParams::FIELDS`]), or `None` for an unknown name.
+    pub fn unit_of(name: &str) -> Option<&'static str> {
+        Self::FIELDS
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map(|(_, u)| *u)
+    }
+}
+
 fn positive(name: &str, v: f64) -> Result<(), String> {
     if v.is_finite() && v > 0.0 {
         Ok(())

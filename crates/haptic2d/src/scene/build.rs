@@ -1,10 +1,12 @@
 //! Validation and construction: a parsed [`SceneFile`] → a [`World`], collecting every problem.
 
+use super::device::device_from_table;
 use super::file::{BodySection, SceneFile};
 use super::laws::{friction_from, normal_from};
 use super::{SceneError, SceneErrors};
 use crate::body::Body;
 use crate::contact::ContactParams;
+use crate::device::DeviceParams;
 use crate::geom::{ConvexPolygon, MassProperties, Pose, Rot, Vec2};
 use crate::integrate::{min_mass, IntegrationMode};
 use crate::load::{Load, Profile};
@@ -23,6 +25,10 @@ pub struct Scene {
     pub world: World,
     /// Non-fatal remarks (e.g. light bodies accepted with `allow_light_bodies`).
     pub warnings: Vec<String>,
+    /// The device parameters of the file's `[device]` table (the spec defaults with the table's
+    /// fields overriding them), validated at the scene's rate; `None` when the file has no `[device]`
+    /// table. Only `haptic2d run` uses them; the world alone ignores them.
+    pub device: Option<DeviceParams>,
 }
 
 impl Scene {
@@ -245,6 +251,12 @@ pub(super) fn build(
         cp.v_re = Some(v);
     }
     params.contact = cp;
+
+    // [device]
+    let device = file
+        .device
+        .as_ref()
+        .and_then(|t| device_from_table(t, "device.", finite_pos(rate).then_some(dt), &mut errs));
 
     // [normal], [friction]
     let normal = normal_from(&file.normal, &mut errs);
@@ -555,5 +567,6 @@ pub(super) fn build(
         source: source.to_string(),
         world: World::new(bodies, shapes, loads, normal, friction, params),
         warnings,
+        device,
     })
 }

@@ -32,6 +32,10 @@ pub struct SceneFile {
     /// Applied loads.
     #[serde(default, rename = "load")]
     pub loads: Vec<LoadSection>,
+    /// Device parameters overriding the spec defaults (any subset of
+    /// [`DeviceParams`](crate::device::DeviceParams) fields); `None` when the file has no `[device]`
+    /// table. Checked field by field when the scene is built.
+    pub device: Option<toml::Table>,
 }
 
 /// `[world]`.

@@ -6,11 +6,13 @@
 
 mod build;
 mod builtin;
+mod device;
 mod error;
 mod file;
 mod laws;
 
 pub use build::Scene;
 pub use builtin::{builtin, builtin_names, pile_toml, BUILTIN};
+pub use device::{device_params_from_toml, DEVICE_TEMPLATE};
 pub use error::{SceneError, SceneErrors};
 pub use file::SceneFile;
