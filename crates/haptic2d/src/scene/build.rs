@@ -40,16 +40,9 @@ impl Scene {
             errors,
         };
         let file: SceneFile = toml::from_str(text).map_err(|e| {
-            let field = e
-                .span()
-                .map(|sp| {
-                    let line = text[..sp.start.min(text.len())].matches('\n').count() + 1;
-                    format!("line {line}")
-                })
-                .unwrap_or_else(|| "file".into());
-            fail(vec![SceneError::new(
-                field,
-                e.message().to_string(),
+            fail(vec![SceneError::from_toml(
+                text,
+                &e,
                 "check the TOML syntax and field names against docs/SCENES.md",
             )])
         })?;

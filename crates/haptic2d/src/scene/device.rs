@@ -142,16 +142,9 @@ pub fn device_params_from_toml(
         errors,
     };
     let table: toml::Table = toml::from_str(text).map_err(|e| {
-        let field = e
-            .span()
-            .map(|sp| {
-                let line = text[..sp.start.min(text.len())].matches('\n').count() + 1;
-                format!("line {line}")
-            })
-            .unwrap_or_else(|| "file".into());
-        fail(vec![SceneError::new(
-            field,
-            e.message().trim_end().to_string(),
+        fail(vec![SceneError::from_toml(
+            text,
+            &e,
             format!("check the TOML syntax against {DEVICE_TEMPLATE}"),
         )])
     })?;

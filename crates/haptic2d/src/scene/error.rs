@@ -28,6 +28,21 @@ impl SceneError {
     }
 }
 
+impl SceneError {
+    /// The error for TOML text `text` that does not parse (`e`): the field is the line of the
+    /// problem (`line N`, or `file` when the parser gives no position).
+    pub fn from_toml(text: &str, e: &toml::de::Error, fix: impl Into<String>) -> Self {
+        let field = e
+            .span()
+            .map(|sp| {
+                let line = text[..sp.start.min(text.len())].matches('\n').count() + 1;
+                format!("line {line}")
+            })
+            .unwrap_or_else(|| "file".into());
+        Self::new(field, e.message().trim_end(), fix)
+    }
+}
+
 impl fmt::Display for SceneError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(f, "{}: {}", self.field, self.message)?;
