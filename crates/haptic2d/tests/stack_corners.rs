@@ -11,6 +11,8 @@ use haptic2d::contact::EventKind;
 use haptic2d::geom::{ConvexPolygon, Pose, Rot, Vec2};
 use haptic2d::scene::{Scene, BUILTIN};
 use haptic2d::world::World;
+#[path = "support/counting_alloc.rs"]
+mod counting_alloc;
 
 /// The built-in pile with `count` boxes in `columns` columns, rows exactly aligned (`stagger =
 /// false`). Boxes 5 cm, 2 kg, spacing 5.4 cm × 5.6 cm (gaps 4 mm between columns, 6 mm between
@@ -282,4 +284,19 @@ fn aligned_250_box_stacks_stay_passive() {
         r.first_late
     );
     assert_eq!((faces, total), (500, 500), "face records, records");
+}
+
+/// The corner rules add no allocation to the hot path: once the aligned stacks have landed (every
+/// stacked corner then goes through the twin check each sample), `World::step` allocates nothing.
+#[test]
+fn aligned_stacks_step_without_allocation() {
+    let mut w = aligned_pile(100, 25);
+    for _ in 0..1000 {
+        w.step();
+    }
+    let before = counting_alloc::allocations();
+    for _ in 0..1000 {
+        w.step();
+    }
+    assert_eq!(counting_alloc::allocations() - before, 0);
 }
