@@ -393,8 +393,10 @@ impl Ctx {
             let p = a.c.world_vertices[v];
             let mut best: Option<(usize, f64)> = None;
             let mut max_d = f64::NEG_INFINITY;
-            // Edge lines within reach of the vertex (−δ_c ≤ d ≤ δ_c): two or more only near a
-            // corner of B (a box's lines are ≥ its side apart), where least depth is ambiguous.
+            // Edge lines within reach of the vertex (−δ_c ≤ d ≤ δ_c): two or more only within
+            // ~δ_c of a corner of B (or across a part of B thinner than 2·δ_c), where least depth
+            // can be decided by round-off. Counting costs one compare per edge; the corner rule
+            // itself runs only then.
             let mut near_lines = 0u32;
             for e in 0..b.c.len() {
                 let d = b.c.edge_distance(e, p);
