@@ -29,10 +29,21 @@
 //!   penetration depth (largest `d_j`) among the edges whose range contains `V`; the same for B's
 //!   vertices against A. The contact manager (§8.3) picks the edge of a *new* contact by the
 //!   god-object crossing rule and keeps the edge of an existing one; it only needs every touching
-//!   vertex to be proposed.
+//!   vertex to be proposed. The same scan runs for a pair reported apart at a distance below GJK's
+//!   `ε_abs` (1e-9 m): there "apart" is round-off (see below).
+//!
+//!   **Corner on corner** (addition to §9.4): when `V` is within `δ_c` of the lines of two adjacent
+//!   edges of B (it sits at B's corner `W`), least depth is decided by round-off: for equal boxes
+//!   stacked exactly, `V` is `~1e-4 m` below the top line and `±1e-19 m` from the side line. The
+//!   edge is then chosen by orientation only ([`corner_facing_edge`]): the one antiparallel, within
+//!   [`NEAR_PARALLEL_ANGLE`], to an edge of A at `V` (the faces in contact), if exactly one is.
+//!   Such stacks also overlap with every vertex exactly on the other box's edge lines, so no
+//!   vertex is strictly inside and the walk certifies "apart" at ~1e-20 m: hence the vertex scan
+//!   below `ε_abs`.
 //!
 //! Candidates are sorted and deduplicated so that everything downstream is deterministic.
 
+use super::gjk::GJK_EPS_ABS;
 use super::tracker::{ClosestFeatures, Feature, FeatureTracker, TrackStatus};
 use super::{Collider, VeCandidate};
 use crate::geom::Vec2;
@@ -203,6 +214,17 @@ impl LocalStage {
                     ctx.vertices_against(a, b, out);
                     ctx.vertices_against(b, a, out);
                 }
+                // Closer than GJK's ε_abs, "apart" is not a certificate: two equal boxes stacked
+                // corner on corner overlap with every vertex of each exactly on a side line of the
+                // other (signed distance 0 or ±1e-19 m), so no vertex is strictly inside, GJK stops
+                // at |v| ≤ ε_abs and the walk certifies a vertex–side-edge pair at ~1e-20 m, which
+                // would propose one side-edge candidate and let the boxes sink through each other.
+                // The vertex scan (§9.4) proposes every touching vertex instead (at distance 0 it
+                // is exact for touching pairs as well).
+                TrackStatus::Separated if f.distance <= GJK_EPS_ABS => {
+                    ctx.vertices_against(a, b, out);
+                    ctx.vertices_against(b, a, out);
+                }
                 TrackStatus::Separated if f.distance <= delta_c => {
                     ctx.closest_feature_candidates(a, b, &f, out);
                 }
@@ -362,7 +384,8 @@ impl Ctx {
     }
 
     /// Penetrating pair (§9.4): every vertex of `a` inside `b` or within `δ_c` of it, against the
-    /// edge of `b` of least depth among those whose range contains it.
+    /// edge of `b` of least depth among those whose range contains it, or the facing edge when the
+    /// vertex sits at a corner of `b` (corner-on-corner rule, [`corner_facing_edge`]).
     /// Returns a vertex of A strictly inside B (all signed distances < 0), if any.
     fn vertices_against(&self, a: Side, b: Side, out: &mut Vec<VeCandidate>) -> Option<Vec2> {
         let mut inside = None;
@@ -370,6 +393,11 @@ impl Ctx {
             let p = a.c.world_vertices[v];
             let mut best: Option<(usize, f64)> = None;
             let mut max_d = f64::NEG_INFINITY;
+            // Edge lines within reach of the vertex (−δ_c ≤ d ≤ δ_c): two or more only within
+            // ~δ_c of a corner of B (or across a part of B thinner than 2·δ_c), where least depth
+            // can be decided by round-off. Counting costs one compare per edge; the corner rule
+            // itself runs only then.
+            let mut near_lines = 0u32;
             for e in 0..b.c.len() {
                 let d = b.c.edge_distance(e, p);
                 if d > self.delta_c {
@@ -377,6 +405,7 @@ impl Ctx {
                     continue 'vertex;
                 }
                 max_d = max_d.max(d);
+                near_lines += (d >= -self.delta_c) as u32;
                 // The edge coordinate matters only for an edge that would beat the best so far.
                 if best.is_none_or(|(_, bd)| d > bd) {
                     let s = b.c.edge_coordinate(e, p);
@@ -388,7 +417,10 @@ impl Ctx {
             if max_d < 0.0 && inside.is_none() {
                 inside = Some(p);
             }
-            if let Some((e, _)) = best {
+            if let Some((mut e, _)) = best {
+                if near_lines >= 2 {
+                    e = self.corner_edge(a.c, v, b.c, e);
+                }
                 out.push(VeCandidate {
                     vertex_collider: a.id,
                     vertex: v as u32,
@@ -398,6 +430,62 @@ impl Ctx {
             }
         }
         inside
+    }
+
+    /// The edge for vertex `v` of `a`, proposed against edge `e` of `b` by least depth, when two
+    /// edge lines of `b` are within `δ_c` of it: if a neighbour `e'` of `e` (sharing the corner
+    /// `W`) is also within `δ_c` and has the vertex in its range, the vertex is at `W` and the
+    /// choice between `e` and `e'` is the corner-on-corner rule's ([`corner_facing_edge`]);
+    /// otherwise `e`.
+    fn corner_edge(&self, a: &Collider, v: usize, b: &Collider, e: usize) -> usize {
+        let p = a.world_vertices[v];
+        for e2 in [b.local.prev(e), b.local.next(e)] {
+            let d = b.edge_distance(e2, p);
+            let s = b.edge_coordinate(e2, p);
+            let in_range = s >= -self.eps_s && s <= b.local.lengths()[e2] + self.eps_s;
+            if d.abs() <= self.delta_c && in_range {
+                if let Some(f) = corner_facing_edge(a, v, b, e, e2, self.cos_parallel) {
+                    return f;
+                }
+            }
+        }
+        e
+    }
+}
+
+/// Corner-on-corner rule: of two adjacent edges `e1`, `e2` of `b` (meeting at the corner `W`) that
+/// vertex `v` of `a` sits at, the one that *faces* `a`, i.e. whose outward normal is antiparallel,
+/// within [`NEAR_PARALLEL_ANGLE`] (`n_b·n_a < −cos_parallel`), to the normal of an edge of `a`
+/// incident to `v`. `None` if neither or both do (then the position-based rules decide).
+///
+/// Why orientation, not position: at a stacked corner (equal boxes, upper vertex 0 on lower vertex
+/// 3) the vertex is `δ ≈ m·g/(2·K_c) ≈ 1e-4 m` below the top line and on the side line to round-off
+/// (`d = ±1e-19 m`), so the least-depth rule (larger `d`) and the crossed-edge rule (`d_{k−1} > 0 ≥
+/// d_k`) both pick the side edge by round-off, and the record flickers between side edge and
+/// release every tick. The faces in contact are known from the orientations alone: the upper box's
+/// bottom normal `(sin θ, −cos θ)` is antiparallel to the lower box's top normal `(0, 1)`
+/// (`n·n = −cos θ`), while its side normals are at `±90°` or parallel to the lower box's side normal
+/// (`n·n ∈ {±sin θ, cos θ}`): for `|θ| < 0.1 rad` exactly one edge at `W` faces. Two boxes
+/// touching diagonally corner to corner have two facing pairs (top/bottom and side/side) and are
+/// left to the other rules, as is any corner without a face of `a` along an edge of `b` (a wedge
+/// tip entering near a corner: the crossed edge is the constraint there, §8.3).
+pub fn corner_facing_edge(
+    a: &Collider,
+    v: usize,
+    b: &Collider,
+    e1: usize,
+    e2: usize,
+    cos_parallel: f64,
+) -> Option<usize> {
+    let (na_out, na_in) = (a.world_normals[v], a.world_normals[a.local.prev(v)]);
+    let faces = |e: usize| {
+        let n = b.world_normals[e];
+        n.dot(na_out) < -cos_parallel || n.dot(na_in) < -cos_parallel
+    };
+    match (faces(e1), faces(e2)) {
+        (true, false) => Some(e1),
+        (false, true) => Some(e2),
+        _ => None,
     }
 }
 

@@ -26,7 +26,9 @@ pub use gjk::{
     gjk_distance, support_hill_climb, GjkCache, GjkOutput, GjkStats, GJK_EPS_ABS, GJK_EPS_REL,
     GJK_MAX_ITERATIONS,
 };
-pub use local::{LocalStage, PairState, DEFAULT_DELTA_C, DEFAULT_EPS_S, NEAR_PARALLEL_ANGLE};
+pub use local::{
+    corner_facing_edge, LocalStage, PairState, DEFAULT_DELTA_C, DEFAULT_EPS_S, NEAR_PARALLEL_ANGLE,
+};
 pub use tracker::{
     ClosestFeatures, Feature, FeatureTracker, TrackStatus, TrackerStats, PARALLEL_TOL, VORONOI_TOL,
 };
