@@ -66,8 +66,8 @@ pub struct RunArgs {
     #[arg(long, overrides_with = "rt")]
     pub no_rt: bool,
     /// Spin before each deadline (µs): the loop sleeps until this long before the deadline, then
-    /// busy-waits. Longer spins absorb late wake-ups at the cost of CPU time. Default: 20 % of the
-    /// period, at most 200 µs (200 µs at 1 kHz, 20 µs at 10 kHz).
+    /// busy-waits. Longer spins absorb late wake-ups at the cost of CPU time. Default: 40 % of the
+    /// period, at most 400 µs (400 µs at 1 kHz, 40 µs at 10 kHz); see docs/PERFORMANCE.md.
     #[arg(long)]
     pub spin_us: Option<f64>,
 }
@@ -164,7 +164,7 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
         rate_hz: a.rate,
         duration: a.duration.map(Duration::from_secs_f64),
         rt: !a.no_rt,
-        spin_us: a.spin_us.unwrap_or((0.2e6 / a.rate).min(200.0)),
+        spin_us: a.spin_us.unwrap_or((0.4e6 / a.rate).min(400.0)),
         ..LoopConfig::default()
     };
     loop_config.validate()?;
