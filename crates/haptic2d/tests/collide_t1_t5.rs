@@ -7,7 +7,10 @@ use haptic2d::collide::{
 use haptic2d::geom::{ConvexPolygon, Pose, Vec2};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+#[path = "support/ve.rs"]
+mod ve_support;
 use std::f64::consts::{PI, TAU};
+use ve_support::ve;
 
 // ---------------------------------------------------------------------------------------------
 // Helpers
@@ -355,15 +358,6 @@ fn candidates(cols: &[Collider]) -> Vec<VeCandidate> {
     let mut out = Vec::new();
     local.update(cols, &pairs, DEFAULT_DELTA_C, &mut out);
     out
-}
-
-fn ve(vc: u32, v: u32, ec: u32, e: u32) -> VeCandidate {
-    VeCandidate {
-        vertex_collider: vc,
-        vertex: v,
-        edge_collider: ec,
-        edge: e,
-    }
 }
 
 /// T4: a rectangle resting flat on a wall face yields exactly 2 VE contacts (edge–edge case), and a

@@ -13,6 +13,9 @@ use haptic2d::scene::{builtin, Scene, BUILTIN};
 use haptic2d::world::World;
 #[path = "support/counting_alloc.rs"]
 mod counting_alloc;
+#[path = "support/ve.rs"]
+mod ve_support;
+use ve_support::ve;
 
 /// The built-in pile with `count` boxes in `columns` columns, rows exactly aligned (`stagger =
 /// false`). Boxes 5 cm, 2 kg, spacing 5.4 cm × 5.6 cm (gaps 4 mm between columns, 6 mm between
@@ -125,15 +128,6 @@ fn aligned_four_box_stack_is_passive() {
         "records: {:?}",
         w.contact_records().map(|c| c.key).collect::<Vec<_>>()
     );
-}
-
-fn ve(vc: u32, v: u32, ec: u32, e: u32) -> VeCandidate {
-    VeCandidate {
-        vertex_collider: vc,
-        vertex: v,
-        edge_collider: ec,
-        edge: e,
-    }
 }
 
 /// Checks the candidates of a lower box (collider 0) and an upper box (collider 1) stacked corner on
