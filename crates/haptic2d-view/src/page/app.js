@@ -158,8 +158,11 @@
     $("tm-comp").textContent = `${fmt(t.compute_p50_us, 1)} / ${fmt(t.compute_p99_us, 1)} µs`;
     $("tm-over").textContent = `${t.overruns} / ${t.skipped}`;
     $("tm-ticks").textContent = `${t.ticks}`;
-    const fps = frameTimes.length > 1 ? (frameTimes.length - 1) / ((frameTimes[frameTimes.length - 1] - frameTimes[0]) / 1000) : 0;
-    $("tm-frames").textContent = `${state.framesReceived} (${fps.toFixed(0)} /s)`;
+    // Frames per second over the recent frame times; "—" until two frames arrived at distinct times
+    // (a paused or virtual clock gives a zero span).
+    const span = frameTimes.length > 1 ? (frameTimes[frameTimes.length - 1] - frameTimes[0]) / 1000 : 0;
+    const fps = span > 0 ? `${((frameTimes.length - 1) / span).toFixed(0)} /s` : "— /s";
+    $("tm-frames").textContent = `${state.framesReceived} (${fps})`;
     if (f.slave !== null && f.bodies[f.slave]) {
       const p = f.bodies[f.slave];
       $("st-pos").textContent = `${fmt(p[0] * 1e3, 2)}, ${fmt(p[1] * 1e3, 2)}`;
@@ -430,7 +433,7 @@
       for (let k = 0; k <= 2; k++) {
         const y = T + h - (k / 2) * h, val = lo + (k / 2) * (hi - lo);
         c.beginPath(); c.moveTo(L, Math.round(y) + 0.5); c.lineTo(L + w, Math.round(y) + 0.5); c.stroke();
-        c.fillText(Math.abs(val) >= 100 ? val.toFixed(0) : val.toPrecision(3), L - 4, y + 4);
+        c.fillText(axisLabel(val), L - 4, y + 4);
       }
       if (this.t.length < 2) return;
       const t1 = this.t[this.t.length - 1], t0 = t1 - this.span;
@@ -446,6 +449,15 @@
         c.stroke();
       });
     }
+  }
+
+  // An axis value in at most ~6 characters, so it fits the 44 px margin: fixed for ordinary
+  // magnitudes, exponent form for tiny or huge ones (0.000121 → "1.2e-4").
+  function axisLabel(v) {
+    const a = Math.abs(v);
+    if (a === 0) return "0";
+    if (a >= 1e5 || a < 1e-2) return v.toExponential(1).replace("e+", "e");
+    return a >= 100 ? v.toFixed(0) : v.toPrecision(3);
   }
 
   const charts = [
