@@ -1,12 +1,13 @@
 //! The Figs. 5–6 device-damping sweep: every wall of `haptic2d::haptic::fig5` with the four-channel
 //! loop, on devices whose physical damping is `margin` times Colgate's bound `K·T/2` (see
-//! [`colgate_joint_damping`]). It shows where the four claims hold together and why the experiment's
-//! default margin is 2: it was identified from this sweep, not measured on the paper's device, so the
-//! reproduction at that margin is a consistency check (such a device exists), not a prediction.
+//! `haptic2d::haptic::fig5::colgate_joint_damping`). It shows where the four claims hold together
+//! and why the experiment's default margin is 2: it was identified from this sweep, not measured on
+//! the paper's device, so the reproduction at that margin is a consistency check (such a device
+//! exists), not a prediction.
 
 use crate::csv::write_columns;
 use crate::plot::{write_panels, Panel, Series, Stroke};
-use haptic2d::haptic::fig5::{colgate_joint_damping, run_case, Fig5Params, FIG5_CASES};
+use haptic2d::haptic::fig5::{run_case, Fig5Params, FIG5_CASES};
 use indicatif::ProgressBar;
 use rayon::prelude::*;
 use std::fmt::Write as _;
@@ -50,7 +51,7 @@ pub fn run(
         .map(|&(margin, j)| {
             let (name, normal, e) = FIG5_CASES[j];
             let p = base.with_margin(margin);
-            let f_v = colgate_joint_damping(&base.haptic, p.rate, margin)?;
+            let f_v = p.haptic_config()?.device.f_v;
             let c = run_case(&p, name, normal, e)
                 .map_err(|e| format!("fig5 sweep, margin {margin}: {e}"))?;
             progress.inc(1);
