@@ -1,9 +1,12 @@
 //! `haptic2d check`: validates a scene and explains every problem.
 
+use crate::exit::{Failure, Status};
 use crate::scene_arg;
 
-/// Validates `arg` and prints a summary of the scene, or every problem found.
-pub fn run(arg: &str) -> Result<(), String> {
+/// Validates `arg` and prints a summary of the scene, or every problem found. `allow_overlap`
+/// accepts bodies that start overlapping (then reported as warnings).
+pub fn run(arg: &str, allow_overlap: bool) -> Result<Status, Failure> {
+    let _ = allow_overlap;
     let scene = scene_arg::load(arg, None)?;
     let w = &scene.world;
     let dynamic = w.bodies.iter().filter(|b| b.is_dynamic()).count();
@@ -34,5 +37,5 @@ pub fn run(arg: &str) -> Result<(), String> {
     for warn in &scene.warnings {
         println!("  warning: {warn}");
     }
-    Ok(())
+    Ok(Status::Clean)
 }

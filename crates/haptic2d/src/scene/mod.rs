@@ -4,6 +4,7 @@
 //! The format is documented in `docs/SCENES.md`; built-in scenes live in `scenes/` and are embedded in
 //! the binary.
 
+pub mod bounds;
 mod build;
 mod builtin;
 mod device;
@@ -11,6 +12,7 @@ mod error;
 mod file;
 mod laws;
 
+pub use bounds::{divergence, Divergence, MAX_BODIES, MAX_FILE_BYTES, MAX_RATE_HZ, MAX_SAMPLES};
 pub use build::Scene;
 pub use builtin::{builtin, builtin_names, pile_toml, BUILTIN};
 pub use device::{device_params_from_toml, DEVICE_TEMPLATE};
