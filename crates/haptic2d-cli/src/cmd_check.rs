@@ -6,8 +6,7 @@ use crate::scene_arg;
 /// Validates `arg` and prints a summary of the scene, or every problem found. `allow_overlap`
 /// accepts bodies that start overlapping (then reported as warnings).
 pub fn run(arg: &str, allow_overlap: bool) -> Result<Status, Failure> {
-    let _ = allow_overlap;
-    let scene = scene_arg::load(arg, None)?;
+    let scene = scene_arg::load_allowing(arg, None, allow_overlap)?;
     let w = &scene.world;
     let dynamic = w.bodies.iter().filter(|b| b.is_dynamic()).count();
     println!("{}: ok", scene.source);

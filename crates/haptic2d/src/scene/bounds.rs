@@ -43,14 +43,16 @@ pub const MAX_CONTACT_SPEED_M_S: f64 = 1e3;
 pub const MAX_GUARD_J: f64 = 1e6;
 /// Largest `proximity_every` (samples).
 pub const MAX_PROXIMITY_EVERY: u32 = 1_000_000;
+/// Largest |parameter| of a normal law or friction model (stiffness N/m, damping N·s/m, …).
+pub const MAX_LAW_PARAM: f64 = 1e9;
 /// Largest number of vertices of one convex polygon (piece).
 pub const MAX_VERTICES: usize = 128;
 /// Largest number of convex pieces of one body.
 pub const MAX_PIECES_PER_BODY: usize = 64;
 /// Largest number of bodies in a scene (bodies plus every grid's boxes, and `pile:N`).
-pub const MAX_BODIES: usize = 10_000;
+pub const MAX_BODIES: usize = 20_000;
 /// Largest number of loads (after `body = "*"` expands to every dynamic body).
-pub const MAX_LOADS: usize = 20_000;
+pub const MAX_LOADS: usize = 40_000;
 /// Largest scene file read (bytes): 16 MiB, far above any scene (pile.toml is ~1 kB).
 pub const MAX_FILE_BYTES: u64 = 16 << 20;
 /// Largest number of samples one `simulate` may run (duration × rate).
@@ -100,9 +102,17 @@ pub(super) fn check_pos(
     if x.is_finite() && x > 0.0 && x <= max {
         return true;
     }
+    let noun = match unit {
+        "kg" => "mass",
+        "kg/m²" => "density",
+        "kg·m²" => "inertia",
+        "m" => "length",
+        "m/s" => "speed",
+        _ => "value",
+    };
     errs.push(SceneError::new(
         field,
-        format!("must be positive and at most {max:e} {unit}, got {x}"),
+        format!("must be a positive {noun} in {unit}, at most {max:e}, got {x}"),
         format!("give a finite value in (0, {max:e}] {unit} (bounds: docs/SCENES.md)"),
     ));
     false
