@@ -371,6 +371,24 @@ fn run_on_rt_thread(
     })
 }
 
+/// The exit status of a run that stopped for `end` (`None`: the duration ended, or a signal when
+/// `interrupted`), and the "stopped: …" line to print, if any. A stop the tick recorded wins over a
+/// signal that arrived in the same tick.
+fn end_status(end: Option<&LoopEnd>, interrupted: bool) -> (Status, Option<String>) {
+    match end {
+        Some(LoopEnd::ReplayEnded) => (Status::Clean, Some("the replay ended".into())),
+        Some(LoopEnd::DeviceLost(msg)) => (Status::DeviceLost, Some(msg.clone())),
+        Some(LoopEnd::Watchdog(msg)) => (Status::SafetyStop, Some(msg.clone())),
+        // The latch's own report (`system.safety_trip()`) is printed above.
+        Some(LoopEnd::SafetyLatch) => (Status::SafetyStop, None),
+        None if interrupted => (
+            Status::Interrupted,
+            Some("interrupted by a signal (SIGINT or SIGTERM)".into()),
+        ),
+        None => (Status::Clean, None),
+    }
+}
+
 /// Step 7: prints the timing summary, why the loop stopped, the final state and the log report,
 /// and returns the exit status.
 fn report(
@@ -397,26 +415,10 @@ fn report(
     if let Some(trip) = system.safety_trip() {
         println!("{trip}");
     }
-    let status = match &end {
-        Some(LoopEnd::ReplayEnded) => {
-            println!("stopped: the replay ended");
-            Status::Clean
-        }
-        Some(LoopEnd::DeviceLost(msg)) => {
-            println!("stopped: {msg}");
-            Status::DeviceLost
-        }
-        Some(LoopEnd::Watchdog(msg)) => {
-            println!("stopped: {msg}");
-            Status::SafetyStop
-        }
-        Some(LoopEnd::SafetyLatch) => Status::SafetyStop,
-        None if interrupted => {
-            println!("stopped: interrupted by a signal (SIGINT or SIGTERM)");
-            Status::Interrupted
-        }
-        None => Status::Clean,
-    };
+    let (status, why) = end_status(end.as_ref(), interrupted);
+    if let Some(why) = why {
+        println!("stopped: {why}");
+    }
     let w = system.world();
     let b = &w.bodies[system.slave()];
     println!(
@@ -439,4 +441,109 @@ fn report(
         );
     }
     Ok(status)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use haptic2d_rt::DeviceIo;
+
+    /// A device that answers `good` reads, then reports itself lost.
+    struct Flaky {
+        good: u32,
+        q: [f64; 4],
+        zeroed: bool,
+    }
+
+    impl DeviceIo for Flaky {
+        fn read_encoders(&mut self) -> Result<[f64; 4], DeviceError> {
+            if self.good == 0 {
+                return Err(DeviceError::Lost("USB cable pulled".into()));
+            }
+            self.good -= 1;
+            Ok(self.q)
+        }
+        fn write_torques(&mut self, _tau: &[f64; 4]) -> Result<(), DeviceError> {
+            Ok(())
+        }
+        fn zero_torques(&mut self) {
+            self.zeroed = true;
+        }
+        fn name(&self) -> &str {
+            "flaky"
+        }
+    }
+
+    fn state_with(rig: &mut Rig) -> LoopState<'_> {
+        let (tx, _rx, _latest) = telemetry_channel(16, TickRecord::default()).unwrap();
+        LoopState {
+            rig,
+            view: None,
+            watchdog: make_watchdog().unwrap(),
+            tx,
+            logging: false,
+            end: None,
+        }
+    }
+
+    fn info(index: u64) -> TickInfo {
+        TickInfo {
+            index,
+            deadline_index: index,
+            t_s: index as f64 * 1e-3,
+            period_s: 1e-3,
+            period_ns: 1_000_000,
+            lateness_ns: 0,
+            skipped: 0,
+            deadline_ns: 0,
+        }
+    }
+
+    #[test]
+    fn a_lost_device_stops_the_loop_with_exit_status_4() {
+        let scene = scene_arg::load("box-in-walls", Some(1000.0)).unwrap();
+        let config = HapticConfig::default();
+        let mut rig = Rig::new(
+            scene.world,
+            &scene.source,
+            config,
+            DeviceChoice::Sim,
+            HandSpec::Follow,
+        )
+        .unwrap();
+        // The simulated device's own start pose, read twice, then lost.
+        let q = rig.io.read_encoders().unwrap();
+        rig.io = Box::new(Flaky {
+            good: 2,
+            q,
+            zeroed: false,
+        });
+        let mut state = state_with(&mut rig);
+        assert_eq!(state.tick(&info(0)), TickControl::Continue);
+        assert_eq!(state.tick(&info(1)), TickControl::Continue);
+        assert_eq!(state.tick(&info(2)), TickControl::Stop);
+        let end = state.end.take();
+        assert!(matches!(&end, Some(LoopEnd::DeviceLost(m)) if m.contains("USB cable pulled")));
+        let (status, why) = end_status(end.as_ref(), false);
+        assert_eq!(status, Status::DeviceLost);
+        assert_eq!(status.code(), 4);
+        assert!(why.unwrap().contains("device lost"));
+    }
+
+    #[test]
+    fn every_way_a_run_ends_has_its_documented_status() {
+        let cases = [
+            (Some(LoopEnd::ReplayEnded), false, 0),
+            (Some(LoopEnd::DeviceLost("x".into())), false, 4),
+            (Some(LoopEnd::Watchdog("x".into())), false, 3),
+            (Some(LoopEnd::SafetyLatch), false, 3),
+            // A safety stop in the tick the signal arrived is still a safety stop.
+            (Some(LoopEnd::SafetyLatch), true, 3),
+            (None, true, 130),
+            (None, false, 0),
+        ];
+        for (end, interrupted, code) in cases {
+            assert_eq!(end_status(end.as_ref(), interrupted).0.code(), code);
+        }
+    }
 }
