@@ -55,7 +55,7 @@ fn load_unchecked(arg: &str, rate: Option<f64>) -> Result<Scene, String> {
     }
     let path = Path::new(arg);
     if path.exists() {
-        let text = read_bounded(path, MAX_FILE_BYTES)?;
+        let text = read_bounded(path, MAX_FILE_BYTES, "scene file")?;
         return Scene::from_toml(&text, arg, rate).map_err(|e| e.to_string());
     }
     if let Some(s) = builtin(arg, rate) {
@@ -67,22 +67,22 @@ fn load_unchecked(arg: &str, rate: Option<f64>) -> Result<Scene, String> {
     ))
 }
 
-/// Reads the UTF-8 text file at `path`, refusing more than `max` bytes (a device such as /dev/zero
-/// or a huge file is an error, not an unbounded read): at most `max + 1` bytes are ever read.
-pub fn read_bounded(path: &Path, max: u64) -> Result<String, String> {
+/// Reads the UTF-8 text file at `path` (`what` names it in messages, e.g. "scene file"), refusing
+/// more than `max` bytes: a device such as /dev/zero or a huge file is an error, not an unbounded
+/// read; at most `max + 1` bytes are ever read.
+pub fn read_bounded(path: &Path, max: u64, what: &str) -> Result<String, String> {
     let shown = path.display();
-    let file =
-        std::fs::File::open(path).map_err(|e| format!("cannot read scene file {shown}: {e}"))?;
+    let file = std::fs::File::open(path).map_err(|e| format!("cannot read {what} {shown}: {e}"))?;
     let mut bytes = Vec::new();
     file.take(max + 1)
         .read_to_end(&mut bytes)
-        .map_err(|e| format!("cannot read scene file {shown}: {e}"))?;
+        .map_err(|e| format!("cannot read {what} {shown}: {e}"))?;
     if bytes.len() as u64 > max {
         return Err(format!(
-            "scene file {shown} is larger than the documented cap of {max} bytes (16 MiB)\n    fix: give a scene file (TOML text); large piles are built with [[grid]] tables"
+            "{what} {shown} is larger than the documented cap of {max} bytes ({} MiB)\n    fix: give a TOML {what} (scene piles are built with [[grid]] tables)",
+            max >> 20
         ));
     }
-    String::from_utf8(bytes).map_err(|e| {
-        format!("scene file {shown} is not UTF-8 text ({e})\n    fix: give a TOML scene file")
-    })
+    String::from_utf8(bytes)
+        .map_err(|e| format!("{what} {shown} is not UTF-8 text ({e})\n    fix: give a TOML {what}"))
 }
