@@ -210,6 +210,7 @@ mod tests {
     #[test]
     fn ring_capacity_is_bounded_by_the_memory_cap_at_any_rate() {
         #[derive(Clone, Copy)]
+        #[allow(dead_code)] // only its size matters
         struct Big([u8; 312]);
         // `run --rate 1e9` asked for 2e9 records of 312 bytes (624 GB).
         for rate in [1e9, 1e300, f64::INFINITY, f64::NAN, -5.0] {

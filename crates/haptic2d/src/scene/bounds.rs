@@ -173,8 +173,8 @@ pub fn divergence(world: &crate::world::World) -> Option<Divergence> {
             ("omega", b.omega, max_w, "rad/s"),
         ];
         for (name, x, max, unit) in checks {
-            // `!(|x| <= max)` is also true for NaN.
-            if !(x.abs() <= max) {
+            // A NaN fails `is_finite`; ±inf and runaways fail the bound.
+            if !x.is_finite() || x.abs() > max {
                 return Some(Divergence {
                     body: Some(b.name.clone()),
                     what: format!("{name} = {x} {unit} (bound ±{max:e} {unit})"),
