@@ -50,6 +50,9 @@ pub type TelemetryEnds<T> = (TelemetryTx<T>, RecordRx<T>, SnapshotRx<T>);
 /// records are well under 1 MiB; the cap binds only at extreme rates).
 pub const MAX_RING_BYTES: usize = 64 << 20;
 
+/// Hard memory cap of any telemetry ring (1 GiB): [`telemetry_channel`] refuses a larger one.
+pub const MAX_CHANNEL_BYTES: usize = 1 << 30;
+
 /// Ring capacity (records of type `T`) holding `seconds` of records at `rate_hz`, at least
 /// `min_records`, and at most `max_bytes` of memory (and at least 1 record). A non-finite or
 /// negative product counts as the minimum, so no input can size an unbounded allocation.
@@ -79,8 +82,12 @@ pub fn telemetry_channel<T: Copy + Send + 'static>(
             "ring_capacity = 0: the telemetry ring needs room for at least one record".into(),
         );
     }
-    if ring_capacity > usize::MAX / 2 {
-        return Err(format!("ring_capacity = {ring_capacity} is too large"));
+    // However the caller sized it, the ring never takes more than MAX_CHANNEL_BYTES of memory.
+    let bytes = ring_capacity.saturating_mul(std::mem::size_of::<T>());
+    if ring_capacity > usize::MAX / 2 || bytes > MAX_CHANNEL_BYTES {
+        return Err(format!(
+            "ring_capacity = {ring_capacity} records ({bytes} bytes) is above the telemetry ring's cap of {MAX_CHANNEL_BYTES} bytes (1 GiB)"
+        ));
     }
     let (producer, consumer) = rtrb::RingBuffer::new(ring_capacity);
     let (input, output) = triple_buffer::triple_buffer(&initial);
@@ -230,6 +237,14 @@ mod tests {
             ring_capacity::<Big>(10_000.0, 2.0, 4096, MAX_RING_BYTES),
             20_000
         );
+    }
+
+    #[test]
+    fn a_ring_above_the_byte_cap_is_an_error_not_an_allocation() {
+        let too_many = MAX_CHANNEL_BYTES / 8 + 1;
+        let e = telemetry_channel(too_many, 0u64).err().unwrap();
+        assert!(e.contains("ring_capacity") && e.contains("cap"), "{e}");
+        assert!(telemetry_channel(MAX_RING_BYTES / 8, 0u64).is_ok());
     }
 
     #[test]
