@@ -1,10 +1,12 @@
 //! `haptic2d check`: validates a scene and explains every problem.
 
+use crate::exit::{Failure, Status};
 use crate::scene_arg;
 
-/// Validates `arg` and prints a summary of the scene, or every problem found.
-pub fn run(arg: &str) -> Result<(), String> {
-    let scene = scene_arg::load(arg, None)?;
+/// Validates `arg` and prints a summary of the scene, or every problem found. `allow_overlap`
+/// accepts bodies that start overlapping (then reported as warnings).
+pub fn run(arg: &str, allow_overlap: bool) -> Result<Status, Failure> {
+    let scene = scene_arg::load_allowing(arg, None, allow_overlap)?;
     let w = &scene.world;
     let dynamic = w.bodies.iter().filter(|b| b.is_dynamic()).count();
     println!("{}: ok", scene.source);
@@ -34,5 +36,5 @@ pub fn run(arg: &str) -> Result<(), String> {
     for warn in &scene.warnings {
         println!("  warning: {warn}");
     }
-    Ok(())
+    Ok(Status::Clean)
 }

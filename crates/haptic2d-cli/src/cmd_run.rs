@@ -3,19 +3,24 @@
 //! `--headless`), and a timing summary at exit.
 
 use crate::device_arg;
+use crate::exit::{Failure, Status};
 use crate::hand_arg::HandSpec;
 use crate::run_rig::{DeviceChoice, Rig};
-use crate::run_view::{self, LoadedScene};
+use crate::run_view::{self, LiveView, LoadedScene};
 use crate::scene_arg;
 use haptic2d::control::passivity::PlanarPassivity;
 use haptic2d::haptic::{ControllerKind, HapticConfig, TickRecord};
-use haptic2d_rt::signal::install_ctrlc_stop;
+use haptic2d::scene::MAX_RATE_HZ;
+use haptic2d_rt::signal::install_stop_signals;
+use haptic2d_rt::telemetry::{ring_capacity, MAX_RING_BYTES};
 use haptic2d_rt::{
-    run_loop, telemetry_channel, CsvLogger, DeviceError, LoggerConfig, LoopConfig, SafetyInput,
-    TickControl, Watchdog, WatchdogConfig,
+    run_loop, telemetry_channel, CsvLogger, DeviceError, FaultKind, LoggerConfig, LoopConfig,
+    SafetyInput, TelemetryTx, TickControl, TickInfo, TimingSummary, Watchdog, WatchdogConfig,
 };
 use std::net::SocketAddr;
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::Duration;
 
 /// Options of `haptic2d run`.
@@ -72,20 +77,113 @@ pub struct RunArgs {
     pub spin_us: Option<f64>,
 }
 
-/// Runs the haptic loop.
-pub fn run(a: &RunArgs) -> Result<(), String> {
-    // Validate every option before anything starts.
-    if !(a.rate.is_finite() && a.rate > 0.0) {
-        return Err(format!(
-            "--rate must be a positive number of Hz, got {}",
-            a.rate
-        ));
+/// `--duration` upper bound (s): about 116 days, far beyond any session, and small enough that the
+/// deadline count and `Duration` conversions never overflow.
+pub const MAX_RUN_DURATION_S: f64 = 1e7;
+
+/// The options of `haptic2d run`, checked: every number in range, every name resolved.
+struct RunOptions {
+    bind: SocketAddr,
+    controller: ControllerKind,
+    device: DeviceChoice,
+    hand: HandSpec,
+}
+
+/// Why the loop stopped, when the tick stopped it (the loop also stops at the end of `--duration`
+/// or on a signal, with no reason recorded here).
+enum LoopEnd {
+    /// A replay's recorded data ended (a clean end).
+    ReplayEnded,
+    /// The device failed a read or a write, or the watchdog saw it lost.
+    DeviceLost(String),
+    /// The loop's watchdog tripped (other than a lost device).
+    Watchdog(String),
+    /// The haptic tick's own safety latch tripped (reported by `system.safety_trip()`).
+    SafetyLatch,
+}
+
+/// Runs the haptic loop: validate the options, build the rig, start the display and the logger,
+/// run the loop until the duration ends, a signal arrives or the tick stops it, then report.
+pub fn run(a: &RunArgs) -> Result<Status, Failure> {
+    let opts = validate_options(a)?;
+    let scene = scene_arg::load(&a.scene, Some(a.rate))?;
+    for w in &scene.warnings {
+        eprintln!("warning: {w}");
     }
+    let device_setting = device_arg::resolve(a.device_file.as_deref(), &scene, 1.0 / a.rate)?;
+    let config = HapticConfig {
+        device: device_setting.params,
+        controller: opts.controller,
+        passivity: a.passivity.then(PlanarPassivity::default),
+        ..HapticConfig::default()
+    };
+    let scene_name = scene.name.clone();
+    let loaded = LoadedScene {
+        name: scene.name,
+        description: scene.description,
+        world: scene.world.clone(),
+    };
+    let hand_name = match opts.device {
+        DeviceChoice::Sim => a.hand.as_deref().unwrap_or("follow").to_string(),
+        DeviceChoice::Replay(_) => "-".to_string(),
+    };
+    let mut rig = Rig::new(scene.world, &scene.source, config, opts.device, opts.hand)?;
+
+    // The display: bound before the loop starts, so that a taken port is an error now.
+    let (server, view) = if a.headless {
+        (None, None)
+    } else {
+        let (server, view) = run_view::start(opts.bind, &rig, loaded, a.rate)?;
+        println!("{}", server.banner());
+        (Some(server), Some(view))
+    };
+    let (tx, logger) = start_telemetry(a)?;
+    let watchdog = make_watchdog()?;
+    let stop = install_stop()?;
+    let loop_config = make_loop_config(a)?;
+    println!(
+        "running {scene_name}: device {} (parameters: {}), controller {}{}, hand {hand_name}, {} Hz{}; Ctrl-C stops",
+        rig.io.name(),
+        device_setting.origin,
+        rig.config.controller.name(),
+        if a.passivity {
+            " + passivity controller"
+        } else {
+            ""
+        },
+        a.rate,
+        match a.duration {
+            Some(d) => format!(" for {d} s"),
+            None => String::new(),
+        }
+    );
+
+    let mut state = LoopState {
+        rig: &mut rig,
+        view,
+        watchdog,
+        logging: logger.is_some(),
+        tx,
+        end: None,
+    };
+    let summary = run_on_rt_thread(&loop_config, &stop, &mut state)?;
+    let end = state.end.take();
+    drop(state);
+    if let Some(s) = server {
+        s.shutdown();
+    }
+    report(a, &rig, &summary, end, stop.load(Ordering::SeqCst), logger)
+}
+
+/// Step 1: checks every option before anything starts (errors are bad input).
+fn validate_options(a: &RunArgs) -> Result<RunOptions, Failure> {
+    check_rate(a.rate)?;
     if let Some(d) = a.duration {
-        if !(d.is_finite() && d > 0.0) {
+        if !(d.is_finite() && d > 0.0 && d <= MAX_RUN_DURATION_S) {
             return Err(format!(
-                "--duration must be a positive number of seconds, got {d}"
-            ));
+                "--duration must be a positive number of seconds up to {MAX_RUN_DURATION_S:e}, got {d}\n    fix: e.g. --duration 10, or leave it out to run until Ctrl-C"
+            )
+            .into());
         }
     }
     let bind: SocketAddr = a.bind.parse().map_err(|e| {
@@ -107,41 +205,31 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
         (_, Some(h)) => HandSpec::parse(h)?,
         (_, None) => HandSpec::Follow,
     };
-    let scene = scene_arg::load(&a.scene, Some(a.rate))?;
-    for w in &scene.warnings {
-        eprintln!("warning: {w}");
-    }
-    let device_setting = device_arg::resolve(a.device_file.as_deref(), &scene, 1.0 / a.rate)?;
-    let config = HapticConfig {
-        device: device_setting.params,
+    Ok(RunOptions {
+        bind,
         controller,
-        passivity: a.passivity.then(PlanarPassivity::default),
-        ..HapticConfig::default()
-    };
-    let scene_name = scene.name.clone();
-    let loaded = LoadedScene {
-        name: scene.name,
-        description: scene.description,
-        world: scene.world.clone(),
-    };
-    let hand_name = match device {
-        DeviceChoice::Sim => a.hand.as_deref().unwrap_or("follow").to_string(),
-        DeviceChoice::Replay(_) => "-".to_string(),
-    };
-    let mut rig = Rig::new(scene.world, &scene.source, config, device, hand)?;
+        device,
+        hand,
+    })
+}
 
-    // The display: bound before the loop starts, so that a taken port is an error now.
-    let (server, mut view) = if a.headless {
-        (None, None)
-    } else {
-        let (server, view) = run_view::start(bind, &rig, loaded, a.rate)?;
-        println!("{}", server.banner());
-        (Some(server), Some(view))
-    };
+/// `--rate`: positive, finite and at most the world's documented maximum rate.
+fn check_rate(rate: f64) -> Result<(), Failure> {
+    if !(rate.is_finite() && rate > 0.0 && rate <= MAX_RATE_HZ) {
+        return Err(format!(
+            "--rate must be a positive number of Hz up to {MAX_RATE_HZ:e}, got {rate}\n    fix: e.g. --rate 1000"
+        )
+        .into());
+    }
+    Ok(())
+}
 
-    // Telemetry: every record to the logger (if any).
-    let capacity = ((a.rate * 2.0) as usize).max(4096);
-    let (mut tx, rx, _latest) = telemetry_channel(capacity, TickRecord::default())?;
+/// Step 2: the telemetry channel, and the CSV logger draining it when `--log` is given. The ring
+/// holds 2 s of records at the loop rate, at least 4096, and never more than
+/// [`MAX_RING_BYTES`] of memory.
+fn start_telemetry(a: &RunArgs) -> Result<(TelemetryTx<TickRecord>, Option<CsvLogger>), Failure> {
+    let capacity = ring_capacity::<TickRecord>(a.rate, 2.0, 4096, MAX_RING_BYTES);
+    let (tx, rx, _latest) = telemetry_channel(capacity, TickRecord::default())?;
     let logger = match &a.log {
         Some(p) => Some(CsvLogger::spawn_file(rx, p, LoggerConfig::default())?),
         None => {
@@ -149,8 +237,12 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
             None
         }
     };
-    let logging = logger.is_some();
-    let mut watchdog = Watchdog::new(WatchdogConfig {
+    Ok((tx, logger))
+}
+
+/// Step 3: the loop's watchdog.
+fn make_watchdog() -> Result<Watchdog, Failure> {
+    Ok(Watchdog::new(WatchdogConfig {
         // The tick's own safety latch checks the kinematics and the singularity margin; this one
         // adds what only the loop sees: a lost device and missed deadlines.
         // A simulated or replayed device does not move between ticks, so a late tick cannot hurt
@@ -158,8 +250,16 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
         // driver will keep the default limit of 10 consecutive misses.)
         min_singularity_margin: 0.0,
         max_missed_run: None,
-    })?;
-    let stop = install_ctrlc_stop()?;
+    })?)
+}
+
+/// Step 4: SIGINT and SIGTERM set the stop flag; the loop ends after its current tick.
+fn install_stop() -> Result<Arc<AtomicBool>, Failure> {
+    Ok(install_stop_signals()?)
+}
+
+/// Step 5: the loop's timing.
+fn make_loop_config(a: &RunArgs) -> Result<LoopConfig, Failure> {
     let loop_config = LoopConfig {
         rate_hz: a.rate,
         duration: a.duration.map(Duration::from_secs_f64),
@@ -168,103 +268,137 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
         ..LoopConfig::default()
     };
     loop_config.validate()?;
-    println!(
-        "running {scene_name}: device {} (parameters: {}), controller {}{}, hand {hand_name}, {} Hz{}; Ctrl-C stops",
-        rig.io.name(),
-        device_setting.origin,
-        rig.config.controller.name(),
-        if a.passivity {
-            " + passivity controller"
-        } else {
-            ""
-        },
-        a.rate,
-        match a.duration {
-            Some(d) => format!(" for {d} s"),
-            None => String::new(),
-        }
-    );
+    Ok(loop_config)
+}
 
-    // The loop, on its own thread; everything it touches is moved in and handed back at the end.
-    let mut ended: Option<String> = None;
-    let summary = std::thread::scope(|s| {
+/// Everything one tick touches, owned by the loop thread while it runs.
+struct LoopState<'r> {
+    rig: &'r mut Rig,
+    view: Option<LiveView>,
+    watchdog: Watchdog,
+    tx: TelemetryTx<TickRecord>,
+    /// True when a logger drains the ring (else only the latest snapshot is kept).
+    logging: bool,
+    /// Why the tick stopped the loop, if it did.
+    end: Option<LoopEnd>,
+}
+
+impl LoopState<'_> {
+    /// One haptic tick: the page's commands, device read, system tick, watchdog, device write,
+    /// telemetry, then the display. Allocation-free in steady state.
+    fn tick(&mut self, info: &TickInfo) -> TickControl {
+        // The page's commands, between ticks.
+        if let Some(v) = self.view.as_mut() {
+            v.apply_commands(self.rig);
+        }
+        let Rig { system, io, .. } = &mut *self.rig;
+        let (q, lost) = match io.read_encoders() {
+            Ok(q) => (q, None),
+            Err(e) => ([f64::NAN; 4], Some(e)),
+        };
+        let out = if self.view.as_ref().is_some_and(|v| v.paused()) {
+            system.tick_paused(&q)
+        } else {
+            system.tick(&q)
+        };
+        let mut tau = out.torques;
+        let safety = SafetyInput {
+            deadline_missed: info.missed_deadline(),
+            device_lost: lost.is_some(),
+            pose: if lost.is_some() {
+                [0.0; 3]
+            } else {
+                out.record.x_m
+            },
+            ..SafetyInput::nominal(info.index)
+        };
+        let guard = self.watchdog.guard(&safety, &mut tau);
+        if let Some(e) = lost {
+            io.zero_torques();
+            self.end = Some(match e {
+                DeviceError::EndOfData => LoopEnd::ReplayEnded,
+                e => LoopEnd::DeviceLost(e.to_string()),
+            });
+            return TickControl::Stop;
+        }
+        if let Err(e) = io.write_torques(&tau) {
+            io.zero_torques();
+            self.end = Some(LoopEnd::DeviceLost(e.to_string()));
+            return TickControl::Stop;
+        }
+        let mut rec = out.record;
+        rec.tau = tau;
+        if self.logging {
+            self.tx.publish(rec);
+        } else {
+            self.tx.set_latest(rec);
+        }
+        if let Err(f) = guard {
+            io.zero_torques();
+            self.end = Some(match f.kind {
+                FaultKind::DeviceLost => LoopEnd::DeviceLost(f.to_string()),
+                _ => LoopEnd::Watchdog(f.to_string()),
+            });
+            return TickControl::Stop;
+        }
+        if out.tripped {
+            io.zero_torques();
+            self.end = Some(LoopEnd::SafetyLatch);
+            return TickControl::Stop;
+        }
+        if let Some(v) = self.view.as_mut() {
+            v.after_tick(info, self.rig);
+        }
+        TickControl::Continue
+    }
+}
+
+/// Step 6: runs the loop on its own thread; everything it touches is borrowed for the run.
+fn run_on_rt_thread(
+    loop_config: &LoopConfig,
+    stop: &AtomicBool,
+    state: &mut LoopState<'_>,
+) -> Result<TimingSummary, Failure> {
+    std::thread::scope(|s| {
         let handle = std::thread::Builder::new()
             .name("haptic2d-rt".into())
-            .spawn_scoped(s, || {
-                run_loop(&loop_config, &stop, |info| {
-                    // The page's commands, between ticks.
-                    if let Some(v) = view.as_mut() {
-                        v.apply_commands(&mut rig);
-                    }
-                    let Rig { system, io, .. } = &mut rig;
-                    let (q, lost) = match io.read_encoders() {
-                        Ok(q) => (q, None),
-                        Err(e) => ([f64::NAN; 4], Some(e)),
-                    };
-                    let out = if view.as_ref().is_some_and(|v| v.paused()) {
-                        system.tick_paused(&q)
-                    } else {
-                        system.tick(&q)
-                    };
-                    let mut tau = out.torques;
-                    let safety = SafetyInput {
-                        deadline_missed: info.missed_deadline(),
-                        device_lost: lost.is_some(),
-                        pose: if lost.is_some() {
-                            [0.0; 3]
-                        } else {
-                            out.record.x_m
-                        },
-                        ..SafetyInput::nominal(info.index)
-                    };
-                    let guard = watchdog.guard(&safety, &mut tau);
-                    if let Some(e) = lost {
-                        io.zero_torques();
-                        ended = Some(match e {
-                            DeviceError::EndOfData => "the replay ended".to_string(),
-                            e => e.to_string(),
-                        });
-                        return TickControl::Stop;
-                    }
-                    if let Err(e) = io.write_torques(&tau) {
-                        io.zero_torques();
-                        ended = Some(e.to_string());
-                        return TickControl::Stop;
-                    }
-                    let mut rec = out.record;
-                    rec.tau = tau;
-                    if logging {
-                        tx.publish(rec);
-                    } else {
-                        tx.set_latest(rec);
-                    }
-                    if let Err(f) = guard {
-                        io.zero_torques();
-                        ended = Some(f.to_string());
-                        return TickControl::Stop;
-                    }
-                    if out.tripped {
-                        io.zero_torques();
-                        return TickControl::Stop;
-                    }
-                    if let Some(v) = view.as_mut() {
-                        v.after_tick(&info, &rig);
-                    }
-                    TickControl::Continue
-                })
-            })
-            .map_err(|e| format!("cannot start the real-time loop thread: {e}"))?;
+            .spawn_scoped(s, || run_loop(loop_config, stop, |info| state.tick(&info)))
+            .map_err(|e| Failure::error(format!("cannot start the real-time loop thread: {e}")))?;
         handle
             .join()
-            .map_err(|_| "the real-time loop thread panicked".to_string())?
-    })?;
-    drop(tx);
-    drop(view);
-    if let Some(s) = server {
-        s.shutdown();
-    }
+            .map_err(|_| Failure::error("the real-time loop thread panicked"))?
+            .map_err(Failure::from)
+    })
+}
 
-    // Report.
+/// The exit status of a run that stopped for `end` (`None`: the duration ended, or a signal when
+/// `interrupted`), and the "stopped: …" line to print, if any. A stop the tick recorded wins over a
+/// signal that arrived in the same tick.
+fn end_status(end: Option<&LoopEnd>, interrupted: bool) -> (Status, Option<String>) {
+    match end {
+        Some(LoopEnd::ReplayEnded) => (Status::Clean, Some("the replay ended".into())),
+        Some(LoopEnd::DeviceLost(msg)) => (Status::DeviceLost, Some(msg.clone())),
+        Some(LoopEnd::Watchdog(msg)) => (Status::SafetyStop, Some(msg.clone())),
+        // The latch's own report (`system.safety_trip()`) is printed above.
+        Some(LoopEnd::SafetyLatch) => (Status::SafetyStop, None),
+        None if interrupted => (
+            Status::Interrupted,
+            Some("interrupted by a signal (SIGINT or SIGTERM)".into()),
+        ),
+        None => (Status::Clean, None),
+    }
+}
+
+/// Step 7: prints the timing summary, why the loop stopped, the final state and the log report,
+/// and returns the exit status.
+fn report(
+    a: &RunArgs,
+    rig: &Rig,
+    summary: &TimingSummary,
+    end: Option<LoopEnd>,
+    interrupted: bool,
+    logger: Option<CsvLogger>,
+) -> Result<Status, Failure> {
     if let Some(w) = summary.rt.as_ref().and_then(|r| r.warning()) {
         eprintln!("{w}");
     }
@@ -281,8 +415,9 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
     if let Some(trip) = system.safety_trip() {
         println!("{trip}");
     }
-    if let Some(msg) = &ended {
-        println!("stopped: {msg}");
+    let (status, why) = end_status(end.as_ref(), interrupted);
+    if let Some(why) = why {
+        println!("stopped: {why}");
     }
     let w = system.world();
     let b = &w.bodies[system.slave()];
@@ -297,7 +432,7 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
         w.ledger().kinetic
     );
     if let Some(l) = logger {
-        let report = l.finish()?;
+        let report = l.finish().map_err(Failure::error)?;
         println!(
             "{report} to {}",
             a.log
@@ -305,5 +440,110 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
                 .map_or(String::new(), |p| p.display().to_string())
         );
     }
-    Ok(())
+    Ok(status)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use haptic2d_rt::DeviceIo;
+
+    /// A device that answers `good` reads, then reports itself lost.
+    struct Flaky {
+        good: u32,
+        q: [f64; 4],
+        zeroed: bool,
+    }
+
+    impl DeviceIo for Flaky {
+        fn read_encoders(&mut self) -> Result<[f64; 4], DeviceError> {
+            if self.good == 0 {
+                return Err(DeviceError::Lost("USB cable pulled".into()));
+            }
+            self.good -= 1;
+            Ok(self.q)
+        }
+        fn write_torques(&mut self, _tau: &[f64; 4]) -> Result<(), DeviceError> {
+            Ok(())
+        }
+        fn zero_torques(&mut self) {
+            self.zeroed = true;
+        }
+        fn name(&self) -> &str {
+            "flaky"
+        }
+    }
+
+    fn state_with(rig: &mut Rig) -> LoopState<'_> {
+        let (tx, _rx, _latest) = telemetry_channel(16, TickRecord::default()).unwrap();
+        LoopState {
+            rig,
+            view: None,
+            watchdog: make_watchdog().unwrap(),
+            tx,
+            logging: false,
+            end: None,
+        }
+    }
+
+    fn info(index: u64) -> TickInfo {
+        TickInfo {
+            index,
+            deadline_index: index,
+            t_s: index as f64 * 1e-3,
+            period_s: 1e-3,
+            period_ns: 1_000_000,
+            lateness_ns: 0,
+            skipped: 0,
+            deadline_ns: 0,
+        }
+    }
+
+    #[test]
+    fn a_lost_device_stops_the_loop_with_exit_status_4() {
+        let scene = scene_arg::load("box-in-walls", Some(1000.0)).unwrap();
+        let config = HapticConfig::default();
+        let mut rig = Rig::new(
+            scene.world,
+            &scene.source,
+            config,
+            DeviceChoice::Sim,
+            HandSpec::Follow,
+        )
+        .unwrap();
+        // The simulated device's own start pose, read twice, then lost.
+        let q = rig.io.read_encoders().unwrap();
+        rig.io = Box::new(Flaky {
+            good: 2,
+            q,
+            zeroed: false,
+        });
+        let mut state = state_with(&mut rig);
+        assert_eq!(state.tick(&info(0)), TickControl::Continue);
+        assert_eq!(state.tick(&info(1)), TickControl::Continue);
+        assert_eq!(state.tick(&info(2)), TickControl::Stop);
+        let end = state.end.take();
+        assert!(matches!(&end, Some(LoopEnd::DeviceLost(m)) if m.contains("USB cable pulled")));
+        let (status, why) = end_status(end.as_ref(), false);
+        assert_eq!(status, Status::DeviceLost);
+        assert_eq!(status.code(), 4);
+        assert!(why.unwrap().contains("device lost"));
+    }
+
+    #[test]
+    fn every_way_a_run_ends_has_its_documented_status() {
+        let cases = [
+            (Some(LoopEnd::ReplayEnded), false, 0),
+            (Some(LoopEnd::DeviceLost("x".into())), false, 4),
+            (Some(LoopEnd::Watchdog("x".into())), false, 3),
+            (Some(LoopEnd::SafetyLatch), false, 3),
+            // A safety stop in the tick the signal arrived is still a safety stop.
+            (Some(LoopEnd::SafetyLatch), true, 3),
+            (None, true, 130),
+            (None, false, 0),
+        ];
+        for (end, interrupted, code) in cases {
+            assert_eq!(end_status(end.as_ref(), interrupted).0.code(), code);
+        }
+    }
 }

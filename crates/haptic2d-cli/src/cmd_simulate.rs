@@ -1,42 +1,81 @@
 //! `haptic2d simulate`: the world alone, headless, as fast as possible.
+//!
+//! Every sample is checked for divergence ([`divergence`]: a non-finite state or one beyond the
+//! documented magnitudes) *before* its row is written, so a CSV never holds a NaN or runaway row.
+//! SIGINT/SIGTERM stop the run after the current sample: the rows so far are flushed, the summary
+//! printed, and the exit status is 130.
 
 use crate::csv_out::WorldCsv;
+use crate::exit::{Failure, Status};
 use crate::scene_arg;
+use haptic2d::scene::{divergence, MAX_SAMPLES};
+use haptic2d_rt::signal::install_stop_signals;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::fs::File;
 use std::io::BufWriter;
 use std::path::Path;
+use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
 
-/// Runs `scene` for `duration` s, writing every `every`-th sample to `out`.
-pub fn run(
-    scene: &str,
-    duration: f64,
-    out: Option<&Path>,
-    rate: Option<f64>,
-    every: u64,
-) -> Result<(), String> {
+/// The energy-excess bound (J) of the passivity check (§13.1 and issue 10's acceptance): a run whose
+/// `(kinetic + stored) − (initial + applied work)` ever exceeds it generated energy. Reported as a
+/// warning; an error (exit 5) under `--strict`.
+pub const ENERGY_EXCESS_BOUND_J: f64 = 1e-3;
+
+/// Options of `haptic2d simulate`.
+pub struct SimulateArgs<'a> {
+    /// Scene file or built-in name.
+    pub scene: &'a str,
+    /// Simulated duration (s).
+    pub duration: f64,
+    /// CSV output file.
+    pub out: Option<&'a Path>,
+    /// Rate override (Hz).
+    pub rate: Option<f64>,
+    /// Keep every K-th sample.
+    pub every: u64,
+    /// Exit 5 on an energy excess above [`ENERGY_EXCESS_BOUND_J`].
+    pub strict: bool,
+}
+
+/// Runs the scene for `duration` s, writing every `every`-th sample to `out`.
+pub fn run(a: &SimulateArgs) -> Result<Status, Failure> {
+    let duration = a.duration;
     if !(duration.is_finite() && duration > 0.0) {
         return Err(format!(
-            "--duration must be a positive number of seconds, got {duration}"
-        ));
+            "--duration must be a positive number of seconds, got {duration}\n    fix: e.g. --duration 10"
+        )
+        .into());
     }
-    if every == 0 {
+    if a.every == 0 {
         return Err("--every must be at least 1".into());
     }
-    let scene = scene_arg::load(scene, rate)?;
+    let scene = scene_arg::load(a.scene, a.rate)?;
     for w in &scene.warnings {
         eprintln!("warning: {w}");
     }
     let mut world = scene.world;
     let dt = world.params.dt;
-    let ticks = (duration / dt).round() as u64;
-    let mut csv = match out {
+    let samples = (duration / dt).round();
+    if samples > MAX_SAMPLES {
+        return Err(format!(
+            "--duration {duration} s at {} Hz is {samples:e} samples, above the documented cap of {MAX_SAMPLES:e}\n    fix: shorten --duration or lower the rate",
+            1.0 / dt
+        )
+        .into());
+    }
+    let ticks = samples as u64;
+    let stop = install_stop_signals()?;
+    let mut csv = match a.out {
         Some(p) => {
-            let f = File::create(p).map_err(|e| format!("cannot create {}: {e}", p.display()))?;
+            let f = File::create(p)
+                .map_err(|e| Failure::error(format!("cannot create {}: {e}", p.display())))?;
             let mut w = WorldCsv::new(BufWriter::with_capacity(1 << 20, f), &world)
-                .map_err(|e| format!("cannot write {}: {e}", p.display()))?;
-            w.row(&world).map_err(|e| e.to_string())?;
+                .map_err(|e| Failure::error(format!("cannot write {}: {e}", p.display())))?;
+            // TODO(t = 0 row): once the world computes its t = 0 contacts and stored energy (helper
+            // A, issue 10 item 3), this row reports them; today it shows what `World::new` books.
+            w.row(&world)
+                .map_err(|e| Failure::error(format!("cannot write CSV: {e}")))?;
             Some(w)
         }
         None => None,
@@ -46,7 +85,7 @@ pub fn run(
     let bar = ProgressBar::with_draw_target(Some(ticks), ProgressDrawTarget::hidden());
     bar.set_style(
         ProgressStyle::with_template("{spinner} simulating [{bar:40}] {percent}% ({eta} left)")
-            .map_err(|e| e.to_string())?
+            .map_err(|e| Failure::error(e.to_string()))?
             .progress_chars("=> "),
     );
     let start = Instant::now();
@@ -54,28 +93,36 @@ pub fn run(
     let mut max_excess = f64::NEG_INFINITY;
     let mut max_contacts = 0;
     let mut max_depth = 0.0f64;
+    let mut done = 0u64;
+    let mut status = Status::Clean;
     for k in 1..=ticks {
+        if stop.load(Ordering::Relaxed) {
+            status = Status::Interrupted;
+            break;
+        }
         world.step();
+        if let Some(d) = divergence(&world) {
+            // The rows so far are kept (flushed below); this one is not written.
+            if let Some(c) = csv.take() {
+                c.finish()
+                    .map_err(|e| Failure::error(format!("cannot write CSV: {e}")))?;
+            }
+            bar.finish_and_clear();
+            eprintln!(
+                "error: the simulation diverged at t = {:.4} s (sample {k}): {d}\n    fix: lower the contact stiffness or raise the rate (see the minimum-mass rule and the bounds, docs/SCENES.md)",
+                world.time()
+            );
+            return Ok(Status::Diverged);
+        }
+        done = k;
         let e = world.ledger();
         max_excess = max_excess.max(e.excess());
+        max_contacts = max_contacts.max(world.contacts().contact_count());
+        max_depth = world
+            .contact_records()
+            .map(|c| -c.d[0])
+            .fold(max_depth, f64::max);
         if k % 256 == 0 {
-            if let Some(b) = world.bodies.iter().find(|b| {
-                !(b.pose.pos.is_finite()
-                    && b.pose.angle.is_finite()
-                    && b.vel.is_finite()
-                    && b.omega.is_finite())
-            }) {
-                return Err(format!(
-                    "the simulation diverged at t = {:.4} s: body \"{}\" has a non-finite state\n    fix: lower the contact stiffness or raise the rate (see the minimum-mass rule, docs/SCENES.md)",
-                    world.time(),
-                    b.name
-                ));
-            }
-            max_contacts = max_contacts.max(world.contacts().contact_count());
-            max_depth = world
-                .contact_records()
-                .map(|c| -c.d[0])
-                .fold(max_depth, f64::max);
             if !shown && start.elapsed() > Duration::from_secs(1) {
                 bar.set_draw_target(ProgressDrawTarget::stderr());
                 shown = true;
@@ -83,24 +130,29 @@ pub fn run(
             bar.set_position(k);
         }
         if let Some(c) = csv.as_mut() {
-            if k % every == 0 {
+            if k % a.every == 0 {
                 c.row(&world)
-                    .map_err(|e| format!("cannot write CSV: {e}"))?;
+                    .map_err(|e| Failure::error(format!("cannot write CSV: {e}")))?;
             }
         }
     }
     bar.finish_and_clear();
     if let Some(c) = csv {
-        c.finish().map_err(|e| format!("cannot write CSV: {e}"))?;
+        c.finish()
+            .map_err(|e| Failure::error(format!("cannot write CSV: {e}")))?;
     }
     let wall = start.elapsed().as_secs_f64();
     let e = world.ledger();
+    let simulated = done as f64 * dt;
+    if status == Status::Interrupted {
+        println!("interrupted by a signal (SIGINT or SIGTERM) after {done} of {ticks} samples");
+    }
     println!(
-        "{}: {ticks} samples ({duration} s at {} Hz) in {wall:.3} s wall ({:.2} µs/sample, {:.1}× real time)",
+        "{}: {done} samples ({simulated} s at {} Hz) in {wall:.3} s wall ({:.2} µs/sample, {:.1}× real time)",
         scene.name,
         1.0 / dt,
-        wall * 1e6 / ticks as f64,
-        duration / wall
+        wall * 1e6 / done.max(1) as f64,
+        simulated / wall
     );
     println!(
         "energy: initial {:.6} J, final kinetic {:.6} J + stored {:.6} J, applied work {:.6} J, removed by impacts {:.6} J",
@@ -112,12 +164,21 @@ pub fn run(
     );
     let depth_now = world.contact_records().map(|c| -c.d[0]).fold(0.0, f64::max);
     println!(
-        "deepest contact penetration: {:.3} mm at the end, {:.3} mm over the run (sampled every 256 samples)",
+        "deepest contact penetration: {:.3} mm at the end, {:.3} mm over the run",
         depth_now * 1e3,
         max_depth * 1e3
     );
-    if let Some(p) = out {
+    if let Some(p) = a.out {
         println!("wrote {}", p.display());
     }
-    Ok(())
+    if max_excess > ENERGY_EXCESS_BOUND_J {
+        eprintln!(
+            "warning: the world generated energy: excess {max_excess:.3e} J above the bound {ENERGY_EXCESS_BOUND_J:e} J (§13.1){}",
+            if a.strict { "" } else { " (--strict makes this exit 5)" }
+        );
+        if a.strict && status == Status::Clean {
+            status = Status::EnergyExcess;
+        }
+    }
+    Ok(status)
 }

@@ -2,7 +2,7 @@
 //! `[device]` table, which wins over the spec defaults (§10.2).
 
 use haptic2d::device::DeviceParams;
-use haptic2d::scene::{device_params_from_toml, Scene, DEVICE_TEMPLATE};
+use haptic2d::scene::{device_params_from_toml, Scene, DEVICE_TEMPLATE, MAX_FILE_BYTES};
 use std::path::Path;
 
 /// The device parameters in use and where they came from.
@@ -24,11 +24,9 @@ pub fn resolve(
 ) -> Result<DeviceSetting, String> {
     if let Some(path) = device_file {
         let name = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| {
-            format!(
-                "cannot read device file {name}: {e}\n    fix: give the path of a TOML device file; copy {DEVICE_TEMPLATE} and edit it"
-            )
-        })?;
+        // Bounded like scene files (`run --device-file /dev/zero` is an error, not an endless read).
+        let text = crate::scene_arg::read_bounded(path, MAX_FILE_BYTES, "device file")
+            .map_err(|e| format!("{e}\n    fix: give the path of a TOML device file; copy {DEVICE_TEMPLATE} and edit it"))?;
         let params = device_params_from_toml(&text, &format!("device file {name}"), Some(dt))
             .map_err(|e| e.to_string())?;
         return Ok(DeviceSetting {

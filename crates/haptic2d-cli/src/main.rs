@@ -8,12 +8,14 @@ mod cmd_simulate;
 mod cmd_sweep;
 mod csv_out;
 mod device_arg;
+mod exit;
 mod hand_arg;
 mod run_rig;
 mod run_view;
 mod scene_arg;
 
 use clap::{Parser, Subcommand};
+use exit::{Failure, Status};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -24,7 +26,8 @@ use std::process::ExitCode;
     name = "haptic2d",
     version,
     about = "Haptic rendering of planar rigid-body motion: a passive planar world, contact and friction models, and a simulated twin-pantograph haptic device.",
-    long_about = None
+    long_about = None,
+    after_help = exit::EXIT_CODES_HELP
 )]
 struct Cli {
     #[command(subcommand)]
@@ -52,6 +55,9 @@ enum Command {
         /// Keep every K-th sample in the CSV.
         #[arg(long, default_value_t = 1)]
         every: u64,
+        /// Exit with status 5 when the energy excess exceeds the §13.1 bound (always a warning).
+        #[arg(long)]
+        strict: bool,
     },
     /// List the built-in scenes.
     Scenes,
@@ -59,6 +65,10 @@ enum Command {
     Check {
         /// A scene file path, or a built-in scene name.
         scene: String,
+        /// Accept bodies that start overlapping (reported as a warning instead of an error; the
+        /// scene key `world.allow_initial_overlap = true` does the same).
+        #[arg(long)]
+        allow_overlap: bool,
     },
     /// Reproduce the paper's figures (Fig. 4 walls, Figs. 5–6 walls with the device, Fig. 7 peg in
     /// hole, Figs. 8–11 peg with the device) as CSV data, SVG/PNG plots, metrics.json and REPORT.md.
@@ -91,6 +101,8 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    // Commands this module does not own report failures as plain strings: exit 1.
+    let runtime = |r: Result<(), String>| r.map(|()| Status::Clean).map_err(Failure::error);
     let result = match cli.command {
         Command::Run(args) => cmd_run::run(&args),
         Command::Simulate {
@@ -99,26 +111,39 @@ fn main() -> ExitCode {
             out,
             rate,
             every,
-        } => cmd_simulate::run(&scene, duration, out.as_deref(), rate, every),
-        Command::Scenes => cmd_scenes::run(),
-        Command::Check { scene } => cmd_check::run(&scene),
+            strict,
+        } => cmd_simulate::run(&cmd_simulate::SimulateArgs {
+            scene: &scene,
+            duration,
+            out: out.as_deref(),
+            rate,
+            every,
+            strict,
+        }),
+        Command::Scenes => cmd_scenes::run()
+            .map(|()| Status::Clean)
+            .map_err(Failure::from),
+        Command::Check {
+            scene,
+            allow_overlap,
+        } => cmd_check::run(&scene, allow_overlap),
         Command::Reproduce {
             figure,
             out,
             strict,
-        } => cmd_reproduce::run(&figure, &out, strict),
+        } => runtime(cmd_reproduce::run(&figure, &out, strict)),
         Command::Sweep {
             target,
             rate,
             points,
             out,
-        } => cmd_sweep::run(&target, rate, points, &out),
+        } => runtime(cmd_sweep::run(&target, rate, points, &out)),
     };
     match result {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(msg) => {
-            eprintln!("error: {}", msg.trim_end());
-            ExitCode::FAILURE
+        Ok(status) => status.into(),
+        Err(f) => {
+            eprintln!("error: {}", f.message.trim_end());
+            f.status.into()
         }
     }
 }

@@ -46,6 +46,30 @@ pub struct SnapshotRx<T: Copy + Send + 'static> {
 /// The three ends of a telemetry channel: producer, ring consumer, snapshot consumer.
 pub type TelemetryEnds<T> = (TelemetryTx<T>, RecordRx<T>, SnapshotRx<T>);
 
+/// Memory cap of a telemetry ring sized by [`ring_capacity`]: 64 MiB (at 1 kHz the usual 2 s of
+/// records are well under 1 MiB; the cap binds only at extreme rates).
+pub const MAX_RING_BYTES: usize = 64 << 20;
+
+/// Hard memory cap of any telemetry ring (1 GiB): [`telemetry_channel`] refuses a larger one.
+pub const MAX_CHANNEL_BYTES: usize = 1 << 30;
+
+/// Ring capacity (records of type `T`) holding `seconds` of records at `rate_hz`, at least
+/// `min_records`, and at most `max_bytes` of memory (and at least 1 record). A non-finite or
+/// negative product counts as the minimum, so no input can size an unbounded allocation.
+///
+/// Memory = capacity · `size_of::<T>()`; the cap is applied last, so it always holds.
+pub fn ring_capacity<T>(rate_hz: f64, seconds: f64, min_records: usize, max_bytes: usize) -> usize {
+    let want = rate_hz * seconds;
+    let want = if want.is_finite() && want > 0.0 {
+        // `as` saturates: a product above usize::MAX becomes usize::MAX, then the cap applies.
+        want.ceil() as usize
+    } else {
+        0
+    };
+    let cap = max_bytes / std::mem::size_of::<T>().max(1);
+    want.max(min_records).min(cap).max(1)
+}
+
 /// Creates a telemetry channel with a ring of `ring_capacity` records
 /// (≥ 1; e.g. 2 s of records at the loop rate) and a snapshot initialised to
 /// `initial`. Errors name the parameter.
@@ -58,8 +82,12 @@ pub fn telemetry_channel<T: Copy + Send + 'static>(
             "ring_capacity = 0: the telemetry ring needs room for at least one record".into(),
         );
     }
-    if ring_capacity > usize::MAX / 2 {
-        return Err(format!("ring_capacity = {ring_capacity} is too large"));
+    // However the caller sized it, the ring never takes more than MAX_CHANNEL_BYTES of memory.
+    let bytes = ring_capacity.saturating_mul(std::mem::size_of::<T>());
+    if ring_capacity > usize::MAX / 2 || bytes > MAX_CHANNEL_BYTES {
+        return Err(format!(
+            "ring_capacity = {ring_capacity} records ({bytes} bytes) is above the telemetry ring's cap of {MAX_CHANNEL_BYTES} bytes (1 GiB)"
+        ));
     }
     let (producer, consumer) = rtrb::RingBuffer::new(ring_capacity);
     let (input, output) = triple_buffer::triple_buffer(&initial);
@@ -184,6 +212,39 @@ mod tests {
         drop(tx);
         assert!(rx.is_producer_gone());
         assert_eq!(rx.offered() - rx.dropped(), 4);
+    }
+
+    #[test]
+    fn ring_capacity_is_bounded_by_the_memory_cap_at_any_rate() {
+        #[derive(Clone, Copy)]
+        #[allow(dead_code)] // only its size matters
+        struct Big([u8; 312]);
+        // `run --rate 1e9` asked for 2e9 records of 312 bytes (624 GB).
+        for rate in [1e9, 1e300, f64::INFINITY, f64::NAN, -5.0] {
+            let n = ring_capacity::<Big>(rate, 2.0, 4096, MAX_RING_BYTES);
+            assert!(n >= 1);
+            assert!(
+                n * std::mem::size_of::<Big>() <= MAX_RING_BYTES,
+                "rate {rate}: {n}"
+            );
+        }
+        // Ordinary rates get their 2 s, or the minimum.
+        assert_eq!(
+            ring_capacity::<Big>(1000.0, 2.0, 4096, MAX_RING_BYTES),
+            4096
+        );
+        assert_eq!(
+            ring_capacity::<Big>(10_000.0, 2.0, 4096, MAX_RING_BYTES),
+            20_000
+        );
+    }
+
+    #[test]
+    fn a_ring_above_the_byte_cap_is_an_error_not_an_allocation() {
+        let too_many = MAX_CHANNEL_BYTES / 8 + 1;
+        let e = telemetry_channel(too_many, 0u64).err().unwrap();
+        assert!(e.contains("ring_capacity") && e.contains("cap"), "{e}");
+        assert!(telemetry_channel(MAX_RING_BYTES / 8, 0u64).is_ok());
     }
 
     #[test]

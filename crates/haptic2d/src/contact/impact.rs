@@ -205,7 +205,10 @@ impl ImpactSolver {
         ] {
             v.resize(rows, 0.0);
         }
-        self.lcp.reserve(rows);
+        // The dense LCP only ever sees sets of at most DENSE_MAX_ROWS rows: its scratch (and the
+        // Delassus matrix above) stays at DENSE_MAX_ROWS² entries however large the set, so a pile
+        // landing at once (or a 50 000-vertex polygon) costs O(rows) memory, never O(rows²).
+        self.lcp.reserve(rows.min(DENSE_MAX_ROWS));
         self.cap = rows;
     }
 
@@ -219,8 +222,12 @@ impl ImpactSolver {
         self.n == 0
     }
 
-    /// The Delassus matrix `A = G M⁻¹ Gᵀ` of the last solve, row-major `n × n` (1/kg: (m/s) per N·s).
+    /// The Delassus matrix `A = G M⁻¹ Gᵀ` of the last solve, row-major `n × n` (1/kg: (m/s) per N·s);
+    /// empty when the last set took the sparse path (`n > DENSE_MAX_ROWS`: no matrix is built).
     pub fn delassus(&self) -> &[f64] {
+        if self.n > DENSE_MAX_ROWS {
+            return &[];
+        }
         &self.a[..self.n * self.n]
     }
 

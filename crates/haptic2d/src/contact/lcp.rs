@@ -16,6 +16,10 @@ pub const W_TOL: f64 = 1e-9;
 /// Above [`ENUMERATION_MAX_N`] and up to this size, enumeration is the fallback when projected
 /// Gauss–Seidel stops at its sweep limit (not in §7.3; see [`LcpSolver::solve`]). `2¹⁰` sets.
 pub const ENUMERATION_FALLBACK_MAX_N: usize = 10;
+/// Largest problem [`LcpSolver::solve_enumeration`] accepts (`2²⁰` index sets, about a second):
+/// beyond it enumeration would run for ever in practice, and its `k × k` scratch is capped at this
+/// size, so no input sizes an unbounded allocation here.
+pub const ENUMERATION_HARD_MAX_N: usize = 20;
 /// Projected Gauss–Seidel: maximum number of sweeps (§7.3).
 pub const PGS_MAX_SWEEPS: usize = 200;
 /// Projected Gauss–Seidel: stop when the largest `|Δλ|` of a sweep is below this (N·s) (§7.3).
@@ -68,6 +72,11 @@ pub enum LcpError {
         /// `a.len()`.
         a_len: usize,
     },
+    /// Enumeration was asked for `n > ENUMERATION_HARD_MAX_N` rows.
+    TooLargeForEnumeration {
+        /// `b.len()`.
+        n: usize,
+    },
 }
 
 impl std::fmt::Display for LcpError {
@@ -77,6 +86,10 @@ impl std::fmt::Display for LcpError {
                 f,
                 "LCP matrix `a` has {a_len} entries but `b` has {n}, so `a` needs {} (row-major n×n)",
                 n * n
+            ),
+            LcpError::TooLargeForEnumeration { n } => write!(
+                f,
+                "LCP of {n} rows is too large for enumeration (at most {ENUMERATION_HARD_MAX_N}); use projected Gauss–Seidel"
             ),
         }
     }
@@ -145,7 +158,11 @@ impl LcpSolver {
         }
         self.lambda.resize(n, 0.0);
         self.w.resize(n, 0.0);
-        self.m.resize(n * n, 0.0);
+        // Only enumeration uses `m` (its k × k active-set system, k ≤ n ≤ ENUMERATION_HARD_MAX_N).
+        let k = n.min(ENUMERATION_HARD_MAX_N);
+        if self.m.len() < k * k {
+            self.m.resize(k * k, 0.0);
+        }
         self.rhs.resize(n, 0.0);
         self.idx.resize(n, 0);
         self.cap = n;
@@ -251,10 +268,13 @@ impl LcpSolver {
     }
 
     /// Exact enumeration of the `2ⁿ` index sets in increasing bit-mask order (§7.3). Intended for
-    /// `n ≤ 6`; works for any `n < 64` but the cost is `O(2ⁿ n³)`. If no set is accepted (possible
+    /// `n ≤ 6`; works for any `n ≤ ENUMERATION_HARD_MAX_N` (an error beyond) at a cost of `O(2ⁿ n³)`. If no set is accepted (possible
     /// only for ill-conditioned `A`), `converged` is false and the buffers hold the least infeasible
     /// nonsingular set (smallest `max(0, −min w)`, `λ` clamped to `≥ 0`), named by `active_mask`.
     pub fn solve_enumeration(&mut self, a: &[f64], b: &[f64]) -> Result<LcpReport, LcpError> {
+        if b.len() > ENUMERATION_HARD_MAX_N {
+            return Err(LcpError::TooLargeForEnumeration { n: b.len() });
+        }
         let n = self.prepare(a, b)?;
         let mut report = LcpReport {
             n,

@@ -1,5 +1,12 @@
 //! Validation and construction: a parsed [`SceneFile`] → a [`World`], collecting every problem.
 
+use super::bounds::{
+    check_abs, check_count, check_pos, damping_ok, MAX_ANGLE_RAD, MAX_BODIES,
+    MAX_CONTACT_SPEED_M_S, MAX_DAMPING_N_S_M, MAX_DENSITY_KG_M2, MAX_FORCE_N, MAX_FREQUENCY_HZ,
+    MAX_GUARD_J, MAX_INERTIA_KG_M2, MAX_LENGTH_M, MAX_LOADS, MAX_MASS_KG, MAX_OMEGA_RAD_S,
+    MAX_PIECES_PER_BODY, MAX_PROXIMITY_EVERY, MAX_RATE_HZ, MAX_SPEED_M_S, MAX_TORQUE_N_M,
+    MAX_VERTICES, MIN_RATE_HZ,
+};
 use super::device::device_from_table;
 use super::file::{BodySection, SceneFile};
 use super::laws::{friction_from, normal_from};
@@ -29,9 +36,20 @@ pub struct Scene {
     /// fields overriding them), validated at the scene's rate; `None` when the file has no `[device]`
     /// table. Only `haptic2d run` uses them; the world alone ignores them.
     pub device: Option<DeviceParams>,
+    /// `world.allow_initial_overlap`: the file accepts bodies that start overlapping.
+    pub allow_initial_overlap: bool,
 }
 
 impl Scene {
+    /// Bodies that start overlapping deeper than the contact tolerance `δ_c` (`world.delta_c`):
+    /// beyond it a vertex is no resting contact but an interpenetration the contact model was never
+    /// asked to resolve. Shallower overlaps are resting contacts (booked as stored energy at t = 0).
+    /// At most [`overlap::MAX_REPORTED`](super::overlap::MAX_REPORTED) pairs; the flag says the
+    /// list was cut there.
+    pub fn initial_overlaps(&self) -> (Vec<super::Overlap>, bool) {
+        super::overlaps(&self.world, self.world.params.delta_c)
+    }
+
     /// Parses and validates TOML scene text. `source` names the file in messages; `rate` overrides
     /// `world.rate` (Hz) when given.
     pub fn from_toml(text: &str, source: &str, rate: Option<f64>) -> Result<Scene, SceneErrors> {
@@ -70,16 +88,49 @@ fn body_pieces(b: &BodySection, field: &str, errs: &mut Vec<SceneError>) -> Vec<
         ));
         return Vec::new();
     }
+    // Counts first (each piece's vertices are checked before any polygon is built from them).
+    if let Some(ps) = &b.pieces {
+        if !check_count(
+            &format!("{field}.pieces"),
+            ps.len(),
+            MAX_PIECES_PER_BODY,
+            "pieces",
+            errs,
+        ) {
+            return Vec::new();
+        }
+    }
+    let listed: Vec<(String, &Vec<[f64; 2]>)> = match (&b.polygon, &b.pieces) {
+        (Some(p), _) => vec![(format!("{field}.polygon"), p)],
+        (_, Some(ps)) => ps
+            .iter()
+            .enumerate()
+            .map(|(k, p)| (format!("{field}.pieces[{k}]"), p))
+            .collect(),
+        _ => Vec::new(),
+    };
+    let mut bad = false;
+    for (f, p) in &listed {
+        if !check_count(f, p.len(), MAX_VERTICES, "vertices", errs) {
+            bad = true;
+            continue;
+        }
+        for (j, q) in p.iter().enumerate() {
+            for (c, x) in ["x", "y"].iter().zip(q) {
+                bad |= !check_abs(&format!("{f}[{j}].{c}"), *x, MAX_LENGTH_M, "m", errs);
+            }
+        }
+    }
+    if bad {
+        return Vec::new();
+    }
     if let Some(p) = &b.polygon {
         raw.push((format!("{field}.polygon"), pts(p)));
     }
     if let Some([w, h]) = b.rect {
-        if !(finite_pos(w) && finite_pos(h)) {
-            errs.push(SceneError::new(
-                format!("{field}.box"),
-                format!("width and height must be positive, got [{w}, {h}]"),
-                "give box = [width, height] in metres, both > 0",
-            ));
+        if !(check_pos(&format!("{field}.box[0]"), w, MAX_LENGTH_M, "m", errs)
+            & check_pos(&format!("{field}.box[1]"), h, MAX_LENGTH_M, "m", errs))
+        {
             return Vec::new();
         }
         let (a, c) = (0.5 * w, 0.5 * h);
@@ -124,40 +175,37 @@ pub(super) fn build(
 
     // [world]
     let rate = rate.or(w.rate).unwrap_or(500.0);
-    if !finite_pos(rate) {
+    let rate_ok = rate.is_finite() && (MIN_RATE_HZ..=MAX_RATE_HZ).contains(&rate);
+    if !rate_ok {
         errs.push(SceneError::new(
             "world.rate",
-            format!("must be a positive rate in Hz, got {rate}"),
-            "e.g. rate = 1000",
+            format!("must be a rate in Hz within [{MIN_RATE_HZ}, {MAX_RATE_HZ:e}], got {rate}"),
+            "e.g. rate = 1000 (bounds: docs/SCENES.md)",
         ));
     }
+    // An invalid rate has been reported; carry on with the default to find the other problems.
+    let rate = if rate_ok { rate } else { 500.0 };
     let dt = 1.0 / rate;
     let mut params = WorldParams {
         dt,
         ..WorldParams::default()
     };
     if let Some(n) = w.proximity_every {
-        if n == 0 {
+        if n == 0 || n > MAX_PROXIMITY_EVERY {
             errs.push(SceneError::new(
                 "world.proximity_every",
-                "must be at least 1",
+                format!("must be in [1, {MAX_PROXIMITY_EVERY}], got {n}"),
                 "e.g. proximity_every = 10",
             ));
         }
-        params.proximity_every = n.max(1);
+        params.proximity_every = n.clamp(1, MAX_PROXIMITY_EVERY);
     }
     if let Some(x) = w.delta_prox {
-        if !finite_pos(x) {
-            errs.push(SceneError::new(
-                "world.delta_prox",
-                format!("must be a positive distance in m, got {x}"),
-                "e.g. delta_prox = 0.042",
-            ));
-        }
+        check_pos("world.delta_prox", x, MAX_LENGTH_M, "m", &mut errs);
         params.delta_prox = x;
     }
     if let Some(x) = w.delta_c {
-        if !(x.is_finite() && x >= 0.0) {
+        if !(x.is_finite() && (0.0..=MAX_LENGTH_M).contains(&x)) {
             errs.push(SceneError::new(
                 "world.delta_c",
                 format!("must be a non-negative distance in m, got {x}"),
@@ -180,7 +228,7 @@ pub(super) fn build(
         }
     };
     if let Some(g) = w.guard {
-        if !(g.is_finite() && g >= 0.0) {
+        if !(g.is_finite() && (0.0..=MAX_GUARD_J).contains(&g)) {
             errs.push(SceneError::new(
                 "world.guard",
                 format!("must be a non-negative energy in J, got {g}"),
@@ -214,7 +262,7 @@ pub(super) fn build(
         cp.restitution = e;
     }
     if let Some(v) = c.v_c {
-        if !(v.is_finite() && v >= 0.0) {
+        if !(v.is_finite() && (0.0..=MAX_CONTACT_SPEED_M_S).contains(&v)) {
             errs.push(SceneError::new(
                 "contact.v_c",
                 format!("must be a non-negative speed in m/s, got {v}"),
@@ -224,7 +272,7 @@ pub(super) fn build(
         cp.v_c = v;
     }
     if let Some(x) = c.eps_s {
-        if !(x.is_finite() && x >= 0.0) {
+        if !(x.is_finite() && (0.0..=MAX_LENGTH_M).contains(&x)) {
             errs.push(SceneError::new(
                 "contact.eps_s",
                 format!("must be a non-negative distance in m, got {x}"),
@@ -234,13 +282,13 @@ pub(super) fn build(
         cp.eps_s = x;
     }
     if let Some(v) = c.recollision_speed {
-        if !finite_pos(v) {
-            errs.push(SceneError::new(
-                "contact.recollision_speed",
-                format!("must be a positive speed in m/s, got {v}"),
-                "e.g. recollision_speed = 0.1",
-            ));
-        }
+        check_pos(
+            "contact.recollision_speed",
+            v,
+            MAX_CONTACT_SPEED_M_S,
+            "m/s",
+            &mut errs,
+        );
         cp.v_re = Some(v);
     }
     params.contact = cp;
@@ -249,7 +297,7 @@ pub(super) fn build(
     let device = file
         .device
         .as_ref()
-        .and_then(|t| device_from_table(t, "device.", finite_pos(rate).then_some(dt), &mut errs));
+        .and_then(|t| device_from_table(t, "device.", rate_ok.then_some(dt), &mut errs));
 
     // [normal], [friction]
     let normal = normal_from(&file.normal, &mut errs);
@@ -258,7 +306,13 @@ pub(super) fn build(
     // [[body]] and [[grid]]
     let mut bodies = Vec::new();
     let mut shapes = Vec::new();
-    for (i, b) in file.bodies.iter().enumerate() {
+    let body_entries_ok = check_count("body", file.bodies.len(), MAX_BODIES, "bodies", &mut errs);
+    let body_entries = if body_entries_ok {
+        &file.bodies[..]
+    } else {
+        &[]
+    };
+    for (i, b) in body_entries.iter().enumerate() {
         let field = match &b.name {
             Some(n) => format!("body[{i}] \"{n}\""),
             None => format!("body[{i}]"),
@@ -291,15 +345,31 @@ pub(super) fn build(
             (None, Some(d)) => d.to_radians(),
             (None, None) => 0.0,
         };
-        for (k, v) in [("position", pos[0]), ("position", pos[1]), ("angle", angle)] {
-            if !v.is_finite() {
-                errs.push(SceneError::new(
-                    format!("{field}.{k}"),
-                    "is NaN or infinite",
-                    "give finite numbers",
-                ));
-            }
+        let vel = b.velocity.unwrap_or([0.0, 0.0]);
+        let omega = b.omega.unwrap_or(0.0);
+        let mut state_ok = true;
+        for (k, v, max, unit) in [
+            ("position[0]", pos[0], MAX_LENGTH_M, "m"),
+            ("position[1]", pos[1], MAX_LENGTH_M, "m"),
+            (
+                if b.angle_deg.is_some() {
+                    "angle_deg"
+                } else {
+                    "angle"
+                },
+                angle,
+                MAX_ANGLE_RAD,
+                "rad",
+            ),
+            ("velocity[0]", vel[0], MAX_SPEED_M_S, "m/s"),
+            ("velocity[1]", vel[1], MAX_SPEED_M_S, "m/s"),
+            ("omega", omega, MAX_OMEGA_RAD_S, "rad/s"),
+        ] {
+            state_ok &= check_abs(&format!("{field}.{k}"), v, max, unit, &mut errs);
         }
+        // A bad pose or velocity has been reported; the body is still built (with its checked
+        // fields) so that loads naming it do not report a second, misleading problem.
+        let _ = state_ok;
         if pieces.is_empty() {
             continue;
         }
@@ -307,23 +377,34 @@ pub(super) fn build(
             MassProperties::from_density(&pieces, 1.0)
         } else {
             match (b.mass, b.density) {
-                (Some(m), None) if finite_pos(m) => MassProperties::from_mass(&pieces, m),
-                (None, Some(d)) if finite_pos(d) => MassProperties::from_density(&pieces, d),
                 (Some(m), None) => {
-                    errs.push(SceneError::new(
-                        format!("{field}.mass"),
-                        format!("must be a positive mass in kg, got {m}"),
-                        "e.g. mass = 0.5",
-                    ));
-                    continue;
+                    if !check_pos(&format!("{field}.mass"), m, MAX_MASS_KG, "kg", &mut errs) {
+                        continue;
+                    }
+                    MassProperties::from_mass(&pieces, m)
                 }
                 (None, Some(d)) => {
-                    errs.push(SceneError::new(
-                        format!("{field}.density"),
-                        format!("must be a positive density in kg/m², got {d}"),
-                        "e.g. density = 625",
-                    ));
-                    continue;
+                    if !check_pos(
+                        &format!("{field}.density"),
+                        d,
+                        MAX_DENSITY_KG_M2,
+                        "kg/m²",
+                        &mut errs,
+                    ) {
+                        continue;
+                    }
+                    let mp = MassProperties::from_density(&pieces, d);
+                    // density × area can still exceed the mass bound.
+                    if !check_pos(
+                        &format!("{field}.density"),
+                        mp.mass,
+                        MAX_MASS_KG,
+                        "kg (the mass it gives)",
+                        &mut errs,
+                    ) {
+                        continue;
+                    }
+                    mp
                 }
                 (Some(_), Some(_)) => {
                     errs.push(SceneError::new(
@@ -345,12 +426,14 @@ pub(super) fn build(
         };
         let inertia = match b.inertia {
             Some(ii) if !fixed => {
-                if !finite_pos(ii) {
-                    errs.push(SceneError::new(
-                        format!("{field}.inertia"),
-                        format!("must be positive in kg·m², got {ii}"),
-                        "remove it to compute it from the shape",
-                    ));
+                if !check_pos(
+                    &format!("{field}.inertia"),
+                    ii,
+                    MAX_INERTIA_KG_M2,
+                    "kg·m²",
+                    &mut errs,
+                ) {
+                    continue;
                 }
                 ii
             }
@@ -367,16 +450,29 @@ pub(super) fn build(
         } else {
             Body::dynamic(name, mp.mass, inertia, pose)
         };
-        if let Some(v) = b.velocity {
-            body.vel = Vec2::new(v[0], v[1]);
-        }
-        body.omega = b.omega.unwrap_or(0.0);
+        body.vel = Vec2::new(vel[0], vel[1]);
+        body.omega = omega;
         if let Some(d) = b.damping {
-            if !(d.is_finite() && d >= 0.0) {
+            if !(d.is_finite() && (0.0..=MAX_DAMPING_N_S_M).contains(&d)) {
                 errs.push(SceneError::new(
                     format!("{field}.damping"),
-                    format!("must be a non-negative damping in N·s/m, got {d}"),
+                    format!(
+                        "must be a non-negative damping in N·s/m up to {MAX_DAMPING_N_S_M:e}, got {d}"
+                    ),
                     "e.g. damping = 2.4",
+                ));
+            } else if !fixed && !damping_ok(d, body.mass, dt) {
+                errs.push(SceneError::new(
+                    format!("{field}.damping"),
+                    format!(
+                        "b·T/m = {d} N·s/m × {dt} s / {} kg = {:.3} is not below 2: the explicit damping step would diverge",
+                        body.mass,
+                        d * dt / body.mass
+                    ),
+                    format!(
+                        "lower damping below {:.4e} N·s/m, raise the mass, or raise world.rate",
+                        2.0 * body.mass / dt
+                    ),
                 ));
             }
             body.damping = d;
@@ -395,11 +491,55 @@ pub(super) fn build(
             ));
             continue;
         }
-        if !(finite_pos(g.rect[0]) && finite_pos(g.rect[1]) && finite_pos(g.mass)) {
+        // The cap applies to the scene's total, checked before a single box is allocated.
+        if g.count > MAX_BODIES.saturating_sub(bodies.len()) {
+            errs.push(SceneError::new(
+                format!("{field}.count"),
+                format!(
+                    "{} boxes would make the scene {} bodies, above the documented cap of {MAX_BODIES}",
+                    g.count,
+                    bodies.len().saturating_add(g.count)
+                ),
+                format!(
+                    "use at most {} boxes here (bounds: docs/SCENES.md)",
+                    MAX_BODIES.saturating_sub(bodies.len())
+                ),
+            ));
+            continue;
+        }
+        let mut grid_ok = true;
+        for (k, v, max, unit) in [
+            ("origin[0]", g.origin[0], MAX_LENGTH_M, "m"),
+            ("origin[1]", g.origin[1], MAX_LENGTH_M, "m"),
+            ("spacing[0]", g.spacing[0], MAX_LENGTH_M, "m"),
+            ("spacing[1]", g.spacing[1], MAX_LENGTH_M, "m"),
+        ] {
+            grid_ok &= check_abs(&format!("{field}.{k}"), v, max, unit, &mut errs);
+        }
+        for (k, v, max, unit) in [
+            ("box[0]", g.rect[0], MAX_LENGTH_M, "m"),
+            ("box[1]", g.rect[1], MAX_LENGTH_M, "m"),
+            ("mass", g.mass, MAX_MASS_KG, "kg"),
+        ] {
+            grid_ok &= check_pos(&format!("{field}.{k}"), v, max, unit, &mut errs);
+        }
+        if !grid_ok {
+            continue;
+        }
+        // The farthest box centre must stay within the coordinate bound too.
+        let rows = g.count.div_ceil(g.columns.min(g.count));
+        let far = [
+            g.origin[0] + (g.columns.min(g.count) as f64 - 0.5) * g.spacing[0].abs(),
+            g.origin[1] + (rows as f64 - 1.0) * g.spacing[1].abs(),
+        ];
+        if far.iter().any(|x| x.abs() > MAX_LENGTH_M) {
             errs.push(SceneError::new(
                 field.clone(),
-                "box sizes and mass must be positive",
-                "e.g. box = [0.05, 0.05], mass = 0.5",
+                format!(
+                    "the grid reaches ({:.4e} m, {:.4e} m), beyond the documented bound ±{MAX_LENGTH_M:e} m",
+                    far[0], far[1]
+                ),
+                "reduce count, columns or spacing, or move the origin",
             ));
             continue;
         }
@@ -476,11 +616,13 @@ pub(super) fn build(
         let profile = match l.profile.as_deref() {
             None | Some("constant") => Profile::Constant,
             Some("sine") => match l.frequency {
-                Some(f) if finite_pos(f) => Profile::UnidirectionalSine { frequency: f },
+                Some(f) if finite_pos(f) && f <= MAX_FREQUENCY_HZ => {
+                    Profile::UnidirectionalSine { frequency: f }
+                }
                 _ => {
                     errs.push(SceneError::new(
                         format!("{field}.frequency"),
-                        "the sine profile needs a positive frequency in Hz",
+                        format!("the sine profile needs a positive frequency in Hz, at most {MAX_FREQUENCY_HZ:e}"),
                         "e.g. frequency = 1.0",
                     ));
                     Profile::Constant
@@ -497,12 +639,34 @@ pub(super) fn build(
         };
         let f = l.force.unwrap_or([0.0, 0.0]);
         let tau = l.torque.unwrap_or(0.0);
-        if !(f[0].is_finite() && f[1].is_finite() && tau.is_finite()) {
-            errs.push(SceneError::new(
-                format!("{field}.force"),
-                "is NaN or infinite",
-                "give finite numbers",
-            ));
+        let unit = if l.per_mass.unwrap_or(false) {
+            "m/s²"
+        } else {
+            "N"
+        };
+        let mut load_ok = check_abs(
+            &format!("{field}.force[0]"),
+            f[0],
+            MAX_FORCE_N,
+            unit,
+            &mut errs,
+        );
+        load_ok &= check_abs(
+            &format!("{field}.force[1]"),
+            f[1],
+            MAX_FORCE_N,
+            unit,
+            &mut errs,
+        );
+        load_ok &= check_abs(
+            &format!("{field}.torque"),
+            tau,
+            MAX_TORQUE_N_M,
+            "N·m",
+            &mut errs,
+        );
+        if !load_ok {
+            continue;
         }
         let targets: Vec<usize> = if l.body == "*" {
             (0..bodies.len())
@@ -537,6 +701,16 @@ pub(super) fn build(
                 }
             }
         };
+        if loads.len() + targets.len() > MAX_LOADS {
+            check_count(
+                &field,
+                loads.len() + targets.len(),
+                MAX_LOADS,
+                "loads (after body = \"*\" expands)",
+                &mut errs,
+            );
+            break;
+        }
         for body in targets {
             loads.push(Load {
                 body,
@@ -561,5 +735,6 @@ pub(super) fn build(
         world: World::new(bodies, shapes, loads, normal, friction, params),
         warnings,
         device,
+        allow_initial_overlap: w.allow_initial_overlap.unwrap_or(false),
     })
 }

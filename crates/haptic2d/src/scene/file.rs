@@ -56,6 +56,9 @@ pub struct WorldSection {
     pub guard: Option<f64>,
     /// Accept bodies lighter than 1.5 × min_mass with a warning instead of an error.
     pub allow_light_bodies: Option<bool>,
+    /// Accept bodies that start overlapping by more than `delta_c` (reported as warnings instead
+    /// of errors by the CLI).
+    pub allow_initial_overlap: Option<bool>,
 }
 
 /// `[contact]`.

@@ -1,5 +1,6 @@
 //! `[normal]` and `[friction]` sections → law prototypes.
 
+use super::bounds::{check_abs, MAX_LAW_PARAM};
 use super::SceneError;
 use crate::laws::friction::{FrictionModel, LoadScaling};
 use crate::laws::normal::NormalModel;
@@ -26,18 +27,26 @@ fn model_name(
 }
 
 fn number(section: &str, key: &str, v: &toml::Value, errs: &mut Vec<SceneError>) -> Option<f64> {
-    match v {
-        toml::Value::Float(f) => Some(*f),
-        toml::Value::Integer(i) => Some(*i as f64),
+    let x = match v {
+        toml::Value::Float(f) => *f,
+        toml::Value::Integer(i) => *i as f64,
         other => {
             errs.push(SceneError::new(
                 format!("{section}.{key}"),
                 format!("expected a number, got {other}"),
                 "write a plain number in SI units, e.g. 1000.0",
             ));
-            None
+            return None;
         }
-    }
+    };
+    check_abs(
+        &format!("{section}.{key}"),
+        x,
+        MAX_LAW_PARAM,
+        "(SI units)",
+        errs,
+    )
+    .then_some(x)
 }
 
 /// Builds the normal-law prototype (per-contact defaults, then the given parameters).

@@ -4,15 +4,19 @@
 //! The format is documented in `docs/SCENES.md`; built-in scenes live in `scenes/` and are embedded in
 //! the binary.
 
+pub mod bounds;
 mod build;
 mod builtin;
 mod device;
 mod error;
 mod file;
 mod laws;
+pub mod overlap;
 
+pub use bounds::{divergence, Divergence, MAX_BODIES, MAX_FILE_BYTES, MAX_RATE_HZ, MAX_SAMPLES};
 pub use build::Scene;
 pub use builtin::{builtin, builtin_names, pile_toml, BUILTIN};
 pub use device::{device_params_from_toml, DEVICE_TEMPLATE};
 pub use error::{SceneError, SceneErrors};
 pub use file::SceneFile;
+pub use overlap::{overlaps, Overlap};

@@ -1,0 +1,278 @@
+//! Issue 10, items 4–6: every option and scene number bounded with a clear message, and the
+//! documented exit codes (`haptic2d --help`, docs/SCENES.md): 0 clean, 1 runtime failure, 2 bad
+//! input, 3 safety stop, 4 lost device (unit-tested in `cmd_run`), 5 energy excess under `--strict`,
+//! 6 divergence, 130 interrupted (tests/cli_signals.rs).
+
+mod common;
+
+use common::{haptic2d, text};
+use std::process::Output;
+
+fn code(o: &Output) -> i32 {
+    o.status
+        .code()
+        .unwrap_or_else(|| panic!("killed by a signal: {}", text(o)))
+}
+
+/// Asserts exit status `want`, no panic, and that the output contains `needle`.
+fn assert_exit(args: &[&str], want: i32, needle: &str) -> String {
+    let o = haptic2d(args);
+    let out = text(&o);
+    assert_eq!(code(&o), want, "{args:?}:\n{out}");
+    assert!(!out.contains("panicked"), "{args:?}:\n{out}");
+    assert!(
+        out.contains(needle),
+        "{args:?}: missing `{needle}` in:\n{out}"
+    );
+    out
+}
+
+fn write(dir: &tempfile::TempDir, name: &str, text: &str) -> String {
+    let p = dir.path().join(name);
+    std::fs::write(&p, text).unwrap();
+    p.to_str().unwrap().to_string()
+}
+
+const BOX_IN_WALLS: &str = include_str!("../../../scenes/box-in-walls.toml");
+
+#[test]
+fn help_lists_the_exit_codes() {
+    let out = assert_exit(&["--help"], 0, "Exit codes:");
+    for c in ["0 ", "1 ", "2 ", "3 ", "4 ", "5 ", "6 ", "130 "] {
+        assert!(
+            out.contains(&format!("\n  {c}")),
+            "code {c} missing:\n{out}"
+        );
+    }
+}
+
+#[test]
+fn a_clean_simulate_exits_0() {
+    assert_exit(
+        &["simulate", "box-in-walls", "--duration", "0.5"],
+        0,
+        "samples",
+    );
+}
+
+#[test]
+fn bad_scene_exits_2_naming_the_field() {
+    let dir = tempfile::tempdir().unwrap();
+    let r1 = write(
+        &dir,
+        "r1.toml",
+        &BOX_IN_WALLS.replace("angle_deg = 0.0", "angle_deg = 0.0\nvelocity = [nan, 0.0]"),
+    );
+    assert_exit(&["check", &r1], 2, "\"box\".velocity[0]: is NaN");
+    assert_exit(&["simulate", &r1], 2, "velocity[0]");
+}
+
+#[test]
+fn check_dev_zero_is_a_bounded_read_and_a_clear_error() {
+    assert_exit(&["check", "/dev/zero"], 2, "larger than the documented cap");
+}
+
+#[test]
+fn run_rate_above_cap_is_rejected_before_allocating_the_ring() {
+    // Today's `--rate 1e9` sized a 624 GB telemetry ring.
+    assert_exit(
+        &[
+            "run",
+            "--headless",
+            "--no-rt",
+            "--rate",
+            "1e9",
+            "--duration",
+            "1",
+        ],
+        2,
+        "--rate must be a positive number of Hz up to 1e5",
+    );
+}
+
+#[test]
+fn run_duration_1e300_is_a_clear_error_not_a_panic() {
+    assert_exit(
+        &["run", "--headless", "--no-rt", "--duration", "1e300"],
+        2,
+        "--duration must be a positive number of seconds up to 1e7",
+    );
+}
+
+#[test]
+fn simulate_duration_1e300_is_a_clear_error() {
+    assert_exit(
+        &["simulate", "box-in-walls", "--duration", "1e300"],
+        2,
+        "above the documented cap",
+    );
+    assert_exit(
+        &[
+            "simulate",
+            "box-in-walls",
+            "--rate",
+            "1e12",
+            "--duration",
+            "1",
+        ],
+        2,
+        "--rate must be a positive number of Hz up to 1e5",
+    );
+}
+
+#[test]
+fn pile_count_above_cap_exits_2() {
+    assert_exit(
+        &["check", "pile:100000000000"],
+        2,
+        "above the documented cap",
+    );
+}
+
+#[test]
+fn overlapping_bodies_are_an_error_in_check_unless_accepted() {
+    let dir = tempfile::tempdir().unwrap();
+    // The box's face 5 mm inside the left wall (face at x = 0; half width 0.02 m).
+    let text = BOX_IN_WALLS.replace("position = [0.04, 0.0]", "position = [0.015, 0.0]");
+    let p = write(&dir, "overlap.toml", &text);
+    let out = assert_exit(
+        &["check", &p],
+        2,
+        "bodies \"walls\" and \"box\" overlap by 5.000 mm",
+    );
+    assert!(out.contains("allow_initial_overlap"), "{out}");
+    assert_exit(
+        &["check", &p, "--allow-overlap"],
+        0,
+        "warning: bodies \"walls\" and \"box\" overlap by 5.000 mm",
+    );
+    let keyed = write(
+        &dir,
+        "overlap-ok.toml",
+        &text.replace("[world]", "[world]\nallow_initial_overlap = true"),
+    );
+    assert_exit(&["simulate", &keyed, "--duration", "0.1"], 0, "samples");
+    assert_exit(
+        &["simulate", &p, "--duration", "0.1"],
+        2,
+        "overlap by 5.000 mm",
+    );
+}
+
+#[test]
+fn energy_excess_is_a_warning_and_exit_5_with_strict() {
+    let dir = tempfile::tempdir().unwrap();
+    // The pure-stiffness ZOH wall under exact-ZOH integration gains energy at every bounce (§5.10).
+    let zoh = BOX_IN_WALLS
+        .replace(
+            "integration = \"semi-implicit\"",
+            "integration = \"exact-zoh\"",
+        )
+        .replace("impacts = true", "impacts = false");
+    let zoh = zoh
+        .lines()
+        .map(|l| {
+            if l.starts_with("model = \"paper\"") {
+                "model = \"zoh\"".to_string()
+            } else if l.starts_with("kc = ") {
+                "k = 1000.0".to_string()
+            } else if l.starts_with("bc = ") {
+                String::new()
+            } else {
+                l.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    let p = write(&dir, "zoh.toml", &zoh);
+    let out = assert_exit(
+        &["simulate", &p, "--duration", "5"],
+        0,
+        "warning: the world generated energy",
+    );
+    assert!(out.contains("--strict"), "{out}");
+    assert_exit(
+        &["simulate", &p, "--duration", "5", "--strict"],
+        5,
+        "generated energy",
+    );
+    // A passive scene passes --strict.
+    assert_exit(
+        &["simulate", "box-in-walls", "--duration", "2", "--strict"],
+        0,
+        "samples",
+    );
+}
+
+#[test]
+fn divergence_is_detected_before_the_row_is_written_and_exits_6() {
+    let dir = tempfile::tempdir().unwrap();
+    // 1e6 m/s² on a free body: the speed passes the divergence bound (1e6 m/s) after 1 s.
+    let scene = r#"
+[world]
+rate = 1000
+[[body]]
+name = "rocket"
+mass = 1.0
+box = [0.04, 0.04]
+[[load]]
+body = "rocket"
+force = [1.0e6, 0.0]
+per_mass = true
+"#;
+    let p = write(&dir, "rocket.toml", scene);
+    let csv = dir.path().join("rocket.csv");
+    let out = assert_exit(
+        &[
+            "simulate",
+            &p,
+            "--duration",
+            "3",
+            "--out",
+            csv.to_str().unwrap(),
+        ],
+        6,
+        "the simulation diverged at t = 1.0010 s",
+    );
+    assert!(out.contains("\"rocket\": vx = "), "{out}");
+    let rows = std::fs::read_to_string(&csv).unwrap();
+    assert!(rows.ends_with('\n'), "whole rows only");
+    let last = rows.lines().last().unwrap();
+    let vx: f64 = last.split(',').nth(8).unwrap().parse().unwrap();
+    assert!(
+        vx.abs() <= 1e6,
+        "no row beyond the bound was written: {last}"
+    );
+    // One row per sample up to the one before divergence, plus the header and t = 0.
+    assert_eq!(
+        rows.lines().count(),
+        1 + 1 + 1000,
+        "{}",
+        rows.lines().count()
+    );
+}
+
+#[test]
+fn a_safety_stop_in_run_exits_3() {
+    let dir = tempfile::tempdir().unwrap();
+    // Encoder angles of zero are no pose of the device: the closure monitor trips on tick 0.
+    let replay = write(&dir, "zero.csv", "q1,q2,q3,q4\n0,0,0,0\n0,0,0,0\n");
+    assert_exit(
+        &[
+            "run",
+            "--headless",
+            "--no-rt",
+            "--device",
+            &format!("replay:{replay}"),
+            "--duration",
+            "1",
+        ],
+        3,
+        "safety stop at tick 0",
+    );
+}
+
+#[test]
+fn clap_usage_errors_exit_2() {
+    assert_exit(&["simulate", "box-in-walls", "--bogus"], 2, "--bogus");
+}
