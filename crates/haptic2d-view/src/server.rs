@@ -483,7 +483,7 @@ async fn ws_upgrade(
             } else {
                 ""
             };
-            eprintln!("haptic2d-view: connection from {peer} ({who}) is view-only: {why}{more}");
+            eprintln!("haptic2d-view: connection from {peer} ({who}): {why}{more}");
         }
     }
     let viewer = Viewer::new(state, peer, access, failures);

@@ -326,6 +326,7 @@ async fn switch_to_a_scene_too_heavy_for_the_rate_is_refused_with_the_reason() {
     send(&mut ws, r#"{"type":"switch_scene","name":"pile"}"#).await;
     let e = next_of(&mut ws, "error").await;
     let msg = e["message"].as_str().unwrap();
+    println!("refusal: {msg}");
     assert!(
         msg.contains("switch_scene refused")
             && msg.contains("pile")
