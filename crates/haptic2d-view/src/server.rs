@@ -5,7 +5,7 @@
 //!   (JSON text, `{"type": …}`); page → server commands (see [`crate::command`]);
 //! - `GET /health` the plain text `ok`.
 //!
-//! A broadcaster task reads the latest [`Frame`](crate::Frame) from the triple buffer at the frame
+//! A broadcaster task reads the latest [`Frame`] from the triple buffer at the frame
 //! rate, serialises it once and hands the text to every viewer through a `tokio::sync::broadcast`
 //! channel; a viewer that falls behind skips frames (never the loop, never the other viewers).
 //!
@@ -46,7 +46,7 @@ pub const INDEX_HTML: &str = include_str!("page/index.html");
 pub const APP_JS: &str = include_str!("page/app.js");
 
 /// A WebSocket message larger than this closes the connection (bytes); between
-/// [`MAX_MESSAGE_BYTES`] and this, the client gets an error frame and stays connected.
+/// [`MAX_MESSAGE_BYTES`](crate::command::MAX_MESSAGE_BYTES) and this, the client gets an error frame and stays connected.
 pub const HARD_MESSAGE_LIMIT: usize = 64 * 1024;
 /// Refused (view-only) connections logged in all; later ones are counted, not logged.
 const REFUSAL_LOG_BUDGET: u64 = 20;
