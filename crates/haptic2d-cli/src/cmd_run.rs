@@ -59,10 +59,15 @@ pub struct RunArgs {
     /// Write every tick's record to this CSV file.
     #[arg(long)]
     pub log: Option<PathBuf>,
-    /// Address of the live display (open http://ADDR:PORT/ in a browser). Bound to a non-loopback
-    /// address, commands from the page need the token printed at startup.
+    /// Address of the live display (open http://ADDR:PORT/ in a browser). Commands are accepted
+    /// only from the page it serves; bound to a non-loopback address, they also need the token
+    /// printed at startup (see docs/DISPLAY.md).
     #[arg(long, default_value = "127.0.0.1:8080")]
     pub bind: String,
+    /// Commands from the display need the token printed at startup on a loopback --bind too (off
+    /// loopback they always do): for a machine shared with other users.
+    #[arg(long)]
+    pub require_token: bool,
     /// Real-time scheduling (SCHED_FIFO, mlockall, core pinning) — the default; where it is not
     /// permitted the loop says so in one line and runs with normal scheduling.
     #[arg(long, overrides_with = "no_rt")]
@@ -133,7 +138,7 @@ pub fn run(a: &RunArgs) -> Result<Status, Failure> {
     let (server, view) = if a.headless {
         (None, None)
     } else {
-        let (server, view) = run_view::start(opts.bind, &rig, loaded, a.rate)?;
+        let (server, view) = run_view::start(opts.bind, &rig, loaded, a.rate, a.require_token)?;
         println!("{}", server.banner());
         (Some(server), Some(view))
     };

@@ -7,6 +7,12 @@
 //! [`LiveView::after_tick`] at the end (a ~60 Hz frame when someone watches, and the tick's
 //! timing). Both are wait-free and allocation-free in steady state; only a scene switch or reset
 //! allocates (a new world), accepting one late tick.
+//!
+//! Security (docs/DISPLAY.md): the server accepts commands only from the page it served (or a
+//! program, with the token where one is required); the token is required off loopback and, with
+//! `--require-token`, on loopback too. Before the loop starts, every built-in scene is timed at the
+//! loop's rate ([`haptic2d_view::scene_budget`]); a switch to one whose world step does not fit the
+//! period is refused by the server with the reason (greyed out on the page), and again here.
 
 use crate::run_rig::Rig;
 use haptic2d::haptic::ControllerKind as SystemController;
@@ -16,9 +22,10 @@ use haptic2d::scene::{builtin, BUILTIN};
 use haptic2d::world::World;
 use haptic2d_rt::clock::now_ns;
 use haptic2d_rt::TickInfo;
+use haptic2d_view::scene_budget::{estimate_step_s, verdict};
 use haptic2d_view::{
-    Command, Frame, FrameInputs, LiveTiming, SceneInfo, ViewHandle, ViewHub, ViewOptions,
-    ViewServer, DEFAULT_FRAME_RATE_HZ,
+    Command, Frame, FrameInputs, LiveTiming, SceneCost, SceneInfo, ViewHandle, ViewHub,
+    ViewOptions, ViewServer, DEFAULT_FRAME_RATE_HZ, DEFAULT_STEP_FRACTION,
 };
 use std::net::SocketAddr;
 
@@ -43,27 +50,49 @@ pub struct LiveView {
     wall_law: Option<NormalModel>,
     friction: Option<FrictionModel>,
     paused: bool,
+    /// Built-in scenes the loop cannot run at its rate, with the reason (the server refuses them
+    /// first; this is the loop's own check).
+    too_heavy: Vec<(&'static str, String)>,
 }
 
-/// Starts the display server on `bind` for the rig's current scene `scene` at `rate` (Hz). Returns
-/// the server handle (keep it on the main thread; dropping it stops the server) and the loop's end.
+/// Starts the display server on `bind` for the rig's current scene `scene` at `rate` (Hz); with
+/// `require_token`, commands need the token on a loopback bind too. Returns the server handle (keep
+/// it on the main thread; dropping it stops the server) and the loop's end. Call it before the
+/// loop starts: it times a few steps of every built-in scene (a few tenths of a second).
 pub fn start(
     bind: SocketAddr,
     rig: &Rig,
     scene: LoadedScene,
     rate: f64,
+    require_token: bool,
 ) -> Result<(ViewHandle, LiveView), String> {
     // Frames are preallocated for the largest scene the page can switch to, so that capturing never
-    // allocates, not even after a switch.
+    // allocates, not even after a switch. The same worlds are timed: can the loop run them?
     let mut bodies = rig.system.world().bodies.len();
+    let mut costs: Vec<SceneCost> = Vec::new();
     for (name, _, _) in BUILTIN {
         if let Some(Ok(s)) = builtin(name, Some(rate)) {
             bodies = bodies.max(s.world.bodies.len());
+            costs.push(verdict(
+                name,
+                estimate_step_s(&s.world),
+                rate,
+                DEFAULT_STEP_FRACTION,
+            ));
         }
     }
+    let too_heavy = costs
+        .iter()
+        .filter_map(|c| Some((c.name, c.reason.clone()?)))
+        .collect();
     let prototype = Frame::with_capacity(bodies, haptic2d_view::frame::MAX_FRAME_CONTACTS);
     let (hub, end) = ViewHub::new(&prototype, DEFAULT_FRAME_RATE_HZ)?;
-    let server = ViewServer::start(bind, end, ViewOptions::default())?;
+    let options = ViewOptions {
+        require_token,
+        scene_costs: costs,
+        ..ViewOptions::default()
+    };
+    let server = ViewServer::start(bind, end, options)?;
     let mut view = LiveView {
         hub,
         timing: LiveTiming::new(rate, 1.0)?,
@@ -72,6 +101,7 @@ pub fn start(
         wall_law: None,
         friction: None,
         paused: false,
+        too_heavy,
     };
     view.publish_scene(rig);
     Ok((server, view))
@@ -125,6 +155,9 @@ impl LiveView {
                 let _ = rig.set_hand_target([x, y, theta]);
             }
             Command::SwitchScene { name } => {
+                if let Some((_, why)) = self.too_heavy.iter().find(|(n, _)| *n == name) {
+                    return Err(why.clone());
+                }
                 let s = builtin(name, Some(self.rate))
                     .ok_or_else(|| format!("no built-in scene `{name}`"))?
                     .map_err(|e| e.to_string())?;
@@ -256,7 +289,7 @@ mod tests {
         )
         .unwrap();
         let (server, mut view) =
-            start("127.0.0.1:0".parse().unwrap(), &rig, loaded, 1000.0).unwrap();
+            start("127.0.0.1:0".parse().unwrap(), &rig, loaded, 1000.0, false).unwrap();
         let addr = server.local_addr();
         let stream = std::net::TcpStream::connect(addr).unwrap();
         let (mut ws, _) = tungstenite::client(format!("ws://{addr}/ws"), stream).unwrap();
@@ -301,6 +334,80 @@ mod tests {
         assert!(w.bodies[rig.system.slave()].pose.pos.x < 0.025);
         assert_eq!(allocs, 0, "allocations in steady state");
         drop(ws);
+        server.shutdown();
+    }
+
+    /// A WebSocket to the display with the `Origin` header a browser would send for a page there.
+    fn connect_from(addr: SocketAddr, origin: &str) -> tungstenite::WebSocket<std::net::TcpStream> {
+        use tungstenite::client::IntoClientRequest;
+        let mut req = format!("ws://{addr}/ws").into_client_request().unwrap();
+        req.headers_mut().insert("origin", origin.parse().unwrap());
+        let stream = std::net::TcpStream::connect(addr).unwrap();
+        tungstenite::client(req, stream).unwrap().0
+    }
+
+    /// Issue 11: a page from another origin open in the user's browser switched the controller,
+    /// the wall law (to the active `zoh`) and the scene (to `pile`) of `haptic2d run`. Now its
+    /// commands never reach the loop: after the loop drains its commands, the controller, wall law,
+    /// scene and paused state are what they were; the page's own origin still commands it.
+    #[test]
+    fn cross_origin_page_cannot_change_the_running_loop() {
+        let scene = builtin("box-in-walls", Some(1000.0)).unwrap().unwrap();
+        let loaded = LoadedScene {
+            name: scene.name.clone(),
+            description: scene.description.clone(),
+            world: scene.world.clone(),
+        };
+        let mut rig = Rig::new(
+            scene.world,
+            "box-in-walls",
+            HapticConfig::default(),
+            DeviceChoice::Sim,
+            HandSpec::Follow,
+        )
+        .unwrap();
+        let (server, mut view) =
+            start("127.0.0.1:0".parse().unwrap(), &rig, loaded, 1000.0, false).unwrap();
+        let addr = server.local_addr();
+        let before = (
+            rig.config.controller.name(),
+            rig.system.world().normal.name(),
+            view.scene.name.clone(),
+        );
+        let mut evil = connect_from(addr, "http://evil.example");
+        let attack = [
+            r#"{"type":"set_controller","name":"coupling"}"#,
+            r#"{"type":"set_wall_law","name":"zoh"}"#,
+            r#"{"type":"switch_scene","name":"pile"}"#,
+            r#"{"type":"pause"}"#,
+        ];
+        for cmd in attack {
+            evil.send(tungstenite::Message::text(cmd)).unwrap();
+        }
+        until("the refusals", || {
+            server.stats().bad_messages >= attack.len() as u64
+        });
+        view.apply_commands(&mut rig);
+        assert_eq!(server.stats().commands_forwarded, 0);
+        assert_eq!(
+            (
+                rig.config.controller.name(),
+                rig.system.world().normal.name(),
+                view.scene.name.clone(),
+            ),
+            before
+        );
+        assert!(!view.paused());
+
+        let mut page = connect_from(addr, &format!("http://{addr}"));
+        page.send(tungstenite::Message::text(
+            r#"{"type":"set_wall_law","name":"zoh"}"#,
+        ))
+        .unwrap();
+        until("the command", || server.stats().commands_forwarded == 1);
+        view.apply_commands(&mut rig);
+        assert_eq!(rig.system.world().normal.name(), "zoh");
+        drop((evil, page));
         server.shutdown();
     }
 }

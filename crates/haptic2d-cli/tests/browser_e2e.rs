@@ -2,7 +2,9 @@
 //! simulated device, `--hand follow`) with its display on a free loopback port, and runs
 //! `crates/haptic2d-view/e2e/view_e2e.mjs` (playwright-core driving Debian's headless Chromium)
 //! against it: the world is drawn, dragging the hand target pushes the box into the left wall, and
-//! the state stream shows the box moving and the contact.
+//! the state stream shows the box moving and the contact; scenes the loop cannot run at its rate
+//! are greyed out; a page from another origin (`http://evil.example`) gets a view-only WebSocket,
+//! its commands are refused and the loop's state does not change (docs/DISPLAY.md).
 //!
 //! Needs `/usr/bin/chromium` (or `CHROMIUM_PATH`), `node` and `e2e/node_modules` (run
 //! `bash crates/haptic2d-view/e2e/install.sh`). When they are missing the test FAILS if the `CI`

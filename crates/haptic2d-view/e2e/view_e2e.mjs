@@ -9,8 +9,12 @@
 // Checks: the page connects and receives scene + frames; the canvas is not blank (pixel variance
 // of a screenshot); dragging the hand target into the left wall moves the box there through the
 // simulated hand, the device and the controller, and a contact appears (read through
-// window.__haptic2d, fed by the state stream); Q rotates the target; no page errors and no error
-// frames. Prints one JSON line with the measurements; exit code 0 on success.
+// window.__haptic2d, fed by the state stream); Q rotates the target; the scene list greys out
+// exactly the scenes the server says the loop cannot run at its rate; a page from another origin
+// (http://evil.example, served by request interception) opening a WebSocket to the display gets a
+// view-only connection whose commands are refused, and the loop's state does not change; no page
+// errors and no error frames on the page. Prints one JSON line with the measurements; exit code 0
+// on success.
 
 import { chromium } from "playwright-core";
 import { mkdtempSync, rmSync } from "node:fs";
@@ -51,6 +55,10 @@ try {
       "--disable-background-networking",
       "--disable-component-update",
       "--disable-sync",
+      // Recent Chromium blocks a public page's requests to loopback itself (Local Network Access)
+      // unless the user grants a permission; other browsers, older ones and a granted permission do
+      // not. Step 6 tests the display's own defence, so the browser's is turned off.
+      "--disable-features=LocalNetworkAccessChecks,LocalNetworkAccessChecksWebSockets,BlockInsecurePrivateNetworkRequests,PrivateNetworkAccessSendPreflights,PrivateNetworkAccessRespectPreflightResults",
     ],
   });
   const page = context.pages()[0] || (await context.newPage());
@@ -167,7 +175,77 @@ try {
   );
   result.rotated = true;
 
-  // 5. Nothing went wrong on the way.
+  // 5. Scenes the loop cannot run at its rate are greyed out, with the reason as tooltip; the others
+  //    can be chosen.
+  const scenes = await page.evaluate(() => {
+    const costs = window.__haptic2d.welcome.options.scene_costs;
+    const opts = [...document.querySelectorAll("#sel-scene option")].map((o) => ({
+      name: o.value, disabled: o.disabled, title: o.title,
+    }));
+    return { costs, opts };
+  });
+  check(Array.isArray(scenes.costs) && scenes.costs.length === scenes.opts.length,
+    `scene_costs do not cover the scene list: ${JSON.stringify(scenes)}`);
+  for (const c of scenes.costs) {
+    const o = scenes.opts.find((x) => x.name === c.name);
+    check(o && o.disabled === !c.runnable && (c.runnable || o.title === c.reason),
+      `scene ${c.name}: option ${JSON.stringify(o)} does not match ${JSON.stringify(c)}`);
+  }
+  result.scene_costs = scenes.costs.map((c) => ({ name: c.name, step_us: c.step_us, runnable: c.runnable }));
+
+  // 6. A page from another origin cannot command the loop. The page of http://evil.example is
+  //    served by request interception (no network); its WebSocket to the display is real.
+  const before = await page.evaluate(() => {
+    const f = window.__haptic2d.lastFrame;
+    return { wall_law: f.wall_law, controller: f.controller, paused: f.paused, scene: window.__haptic2d.scene.name };
+  });
+  await context.route("http://evil.example/**", (route) =>
+    route.fulfill({ status: 200, contentType: "text/html", body: "<!doctype html><title>elsewhere</title><p>a page from elsewhere" }));
+  const evil = await context.newPage();
+  await evil.goto("http://evil.example/");
+  const wsUrl = `ws://${new URL(url).host}/ws`;
+  const attack = await evil.evaluate((u) => new Promise((resolve) => {
+    const got = { welcome: null, errors: [], acks: [], opened: false };
+    const cmds = [
+      { type: "set_wall_law", name: "zoh" },
+      { type: "set_controller", name: "coupling" },
+      { type: "switch_scene", name: "peg-in-hole" },
+      { type: "pause" },
+    ];
+    const ws = new WebSocket(u);
+    const done = () => { try { ws.close(); } catch (e) {} resolve(got); };
+    ws.onopen = () => { got.opened = true; };
+    ws.onerror = () => { got.errors.push("websocket error"); done(); };
+    ws.onmessage = (ev) => {
+      const m = JSON.parse(ev.data);
+      if (m.type === "welcome") {
+        got.welcome = { control: m.control, reason: m.view_only_reason };
+        for (const c of cmds) ws.send(JSON.stringify(c));
+      } else if (m.type === "error") {
+        got.errors.push(m.message);
+        if (got.errors.length >= cmds.length) done();
+      } else if (m.type === "ack") {
+        got.acks.push(m.command);
+      }
+    };
+    setTimeout(done, 10_000);
+  }), wsUrl);
+  result.cross_origin = attack;
+  check(attack.opened && attack.welcome, `the foreign page's WebSocket did not open: ${JSON.stringify(attack)}`);
+  check(attack.welcome.control === false && /evil\.example/.test(attack.welcome.reason || ""),
+    `the foreign page got control: ${JSON.stringify(attack)}`);
+  check(attack.acks.length === 0 && attack.errors.length === 4 &&
+    attack.errors.every((e) => e.includes("only from the page")), `foreign commands not refused: ${JSON.stringify(attack)}`);
+  await evil.close();
+  await page.waitForTimeout(500);
+  const after = await page.evaluate(() => {
+    const f = window.__haptic2d.lastFrame;
+    return { wall_law: f.wall_law, controller: f.controller, paused: f.paused, scene: window.__haptic2d.scene.name };
+  });
+  check(JSON.stringify(after) === JSON.stringify(before),
+    `the loop changed after the foreign page's commands: ${JSON.stringify({ before, after })}`);
+
+  // 7. Nothing went wrong on the way.
   const errors = await page.evaluate(() => window.__haptic2d.errors);
   check(errors.length === 0, `error frames: ${JSON.stringify(errors)}`);
   check(pageErrors.length === 0, `page errors: ${JSON.stringify(pageErrors)}`);

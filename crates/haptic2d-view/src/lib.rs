@@ -26,9 +26,13 @@
 //! ```
 #![warn(missing_docs)]
 
+pub mod access;
 pub mod command;
+mod connection;
 pub mod frame;
+pub mod http;
 pub mod hub;
+pub mod scene_budget;
 pub mod scene_info;
 pub mod server;
 pub mod timing;
@@ -38,6 +42,7 @@ pub use command::{
 };
 pub use frame::{ContactView, DeviceView, Energies, Frame, FrameInputs, LoopTiming};
 pub use hub::{ServerEnd, ViewHub, DEFAULT_FRAME_RATE_HZ};
+pub use scene_budget::{assess_builtin_scenes, SceneCost, DEFAULT_STEP_FRACTION};
 pub use scene_info::{BodyShape, DeviceGeometry, SceneInfo};
 pub use server::{ServerStats, ViewHandle, ViewOptions, ViewServer};
 pub use timing::LiveTiming;

@@ -5,27 +5,33 @@
 //!   (JSON text, `{"type": …}`); page → server commands (see [`crate::command`]);
 //! - `GET /health` the plain text `ok`.
 //!
-//! A broadcaster task reads the latest [`Frame`](crate::Frame) from the triple buffer at the frame
+//! A broadcaster task reads the latest [`Frame`] from the triple buffer at the frame
 //! rate, serialises it once and hands the text to every viewer through a `tokio::sync::broadcast`
 //! channel; a viewer that falls behind skips frames (never the loop, never the other viewers).
 //!
-//! When the server listens on a non-loopback address, commands need the token of
-//! [`ViewHandle::token`] (in the WebSocket URL `?token=…` or a first message
-//! `{"type": "hello", "token": "…"}`); viewing never does.
+//! Who may command the loop is decided at the upgrade ([`crate::access`], docs/DISPLAY.md): only
+//! the page this server served (its `Origin` is the `Host` it was sent to) or a non-browser client;
+//! any other origin gets a view-only connection and a log line. Off loopback (and on loopback with
+//! [`ViewOptions::require_token`]) commands also need the token of [`ViewHandle::token`] (in the
+//! WebSocket URL `?token=…` or a message `{"type": "hello", "token": "…"}`), compared in constant
+//! time, [`MAX_TOKEN_TRIES`](crate::access::MAX_TOKEN_TRIES) wrong tries per connection. Viewing never
+//! needs it. A request whose headers take longer than [`ViewOptions::header_read_timeout`] is
+//! dropped ([`crate::http`]). A switch to a scene the loop cannot run at its rate
+//! ([`ViewOptions::scene_costs`]) is refused with the reason.
 
-use crate::command::MAX_MESSAGE_BYTES;
-use crate::command::{parse_client_message, scene_names, ClientMessage, Command, ControllerKind};
+use crate::access::{classify, decide, token_eq, Access, Client};
+use crate::command::Command;
+use crate::connection::{self, Viewer};
 use crate::frame::Frame;
 use crate::hub::ServerEnd;
+use crate::scene_budget::SceneCost;
 use crate::scene_info::SceneInfo;
-use axum::extract::ws::{Message, Utf8Bytes, WebSocket, WebSocketUpgrade};
+use axum::extract::ws::{Utf8Bytes, WebSocketUpgrade};
 use axum::extract::{ConnectInfo, RawQuery, State};
-use axum::http::header;
+use axum::http::{header, HeaderMap};
 use axum::response::{Html, IntoResponse, Response};
 use axum::routing::get;
 use axum::Router;
-use haptic2d::laws::friction::FrictionModel;
-use haptic2d::laws::normal::NORMAL_MODEL_NAMES;
 use serde::Serialize;
 use std::net::SocketAddr;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -40,26 +46,48 @@ pub const INDEX_HTML: &str = include_str!("page/index.html");
 pub const APP_JS: &str = include_str!("page/app.js");
 
 /// A WebSocket message larger than this closes the connection (bytes); between
-/// [`MAX_MESSAGE_BYTES`] and this, the client gets an error frame and stays connected.
+/// [`MAX_MESSAGE_BYTES`](crate::command::MAX_MESSAGE_BYTES) and this, the client gets an error frame and stays connected.
 pub const HARD_MESSAGE_LIMIT: usize = 64 * 1024;
-/// Error lines logged per connection before that connection's errors are no longer logged.
-const LOG_BUDGET: u32 = 20;
+/// Refused (view-only) connections logged in all; later ones are counted, not logged.
+const REFUSAL_LOG_BUDGET: u64 = 20;
 
 /// Options of [`ViewServer::start`].
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct ViewOptions {
-    /// Commands need a token: `None` = only when bound to a non-loopback address (default).
-    pub require_token: Option<bool>,
+    /// Commands need the token on a loopback bind too (`haptic2d run --require-token`). Off
+    /// loopback they always do.
+    pub require_token: bool,
     /// The token to use instead of a random one (tests).
     pub token: Option<String>,
+    /// Time a client has to send a request's headers before its connection is dropped (default
+    /// [`DEFAULT_HEADER_READ_TIMEOUT`](crate::http::DEFAULT_HEADER_READ_TIMEOUT), 10 s).
+    pub header_read_timeout: Duration,
+    /// Which built-in scenes the loop can run at its rate (see
+    /// [`assess_builtin_scenes`](crate::scene_budget::assess_builtin_scenes)): a switch to one
+    /// marked not runnable is refused with its reason, and the page greys it out. Empty = no
+    /// assessment, every scene may be switched to.
+    pub scene_costs: Vec<SceneCost>,
+}
+
+impl Default for ViewOptions {
+    fn default() -> Self {
+        Self {
+            require_token: false,
+            token: None,
+            header_read_timeout: crate::http::DEFAULT_HEADER_READ_TIMEOUT,
+            scene_costs: Vec::new(),
+        }
+    }
 }
 
 /// Counters of a running server.
 #[derive(Debug, Default)]
-struct Counters {
-    frames_broadcast: AtomicU64,
-    commands_forwarded: AtomicU64,
-    bad_messages: AtomicU64,
+pub(crate) struct Counters {
+    pub(crate) frames_broadcast: AtomicU64,
+    pub(crate) commands_forwarded: AtomicU64,
+    pub(crate) bad_messages: AtomicU64,
+    pub(crate) view_only: AtomicU64,
+    pub(crate) token_lockouts: AtomicU64,
 }
 
 /// A snapshot of the server's counters.
@@ -73,6 +101,11 @@ pub struct ServerStats {
     pub bad_messages: u64,
     /// Viewers connected now.
     pub viewers: u64,
+    /// Connections made view-only by the origin check so far (foreign origin, browser without
+    /// `Origin`, or a DNS name without a token).
+    pub view_only: u64,
+    /// Connections closed for too many wrong tokens so far.
+    pub token_lockouts: u64,
 }
 
 /// The display server (see the module docs).
@@ -89,36 +122,43 @@ pub struct ViewHandle {
     viewers: Arc<std::sync::atomic::AtomicUsize>,
 }
 
-struct AppState {
-    frames_tx: broadcast::Sender<Utf8Bytes>,
-    scene_rx: watch::Receiver<Option<Utf8Bytes>>,
-    commands: Mutex<rtrb::Producer<Command>>,
-    viewers: Arc<std::sync::atomic::AtomicUsize>,
-    token: Option<String>,
-    frame_rate_hz: f64,
-    shutdown: watch::Receiver<bool>,
-    counters: Arc<Counters>,
+pub(crate) struct AppState {
+    pub(crate) frames_tx: broadcast::Sender<Utf8Bytes>,
+    pub(crate) scene_rx: watch::Receiver<Option<Utf8Bytes>>,
+    pub(crate) commands: Mutex<rtrb::Producer<Command>>,
+    pub(crate) viewers: Arc<std::sync::atomic::AtomicUsize>,
+    /// The token commands need, when they need one.
+    pub(crate) token: Option<String>,
+    pub(crate) scene_costs: Vec<SceneCost>,
+    pub(crate) frame_rate_hz: f64,
+    pub(crate) shutdown: watch::Receiver<bool>,
+    pub(crate) counters: Arc<Counters>,
 }
 
 /// The selectable options, sent in the `welcome` message.
 #[derive(Serialize)]
-struct Options {
-    scenes: Vec<&'static str>,
-    wall_laws: Vec<&'static str>,
-    friction_models: Vec<&'static str>,
-    controllers: Vec<&'static str>,
+pub(crate) struct Options<'a> {
+    pub(crate) scenes: Vec<&'static str>,
+    /// Per built-in scene: its estimated step and whether the loop can run it (empty: not assessed).
+    pub(crate) scene_costs: &'a [SceneCost],
+    pub(crate) wall_laws: Vec<&'static str>,
+    pub(crate) friction_models: Vec<&'static str>,
+    pub(crate) controllers: Vec<&'static str>,
 }
 
 /// Messages from the server to the page.
 #[derive(Serialize)]
 #[serde(tag = "type", rename_all = "snake_case")]
-enum Outgoing<'a> {
+pub(crate) enum Outgoing<'a> {
     Welcome {
         control: bool,
         token_required: bool,
+        /// Why this connection cannot command (absent when it can).
+        #[serde(skip_serializing_if = "Option::is_none")]
+        view_only_reason: Option<&'a str>,
         frame_rate_hz: f64,
         max_message_bytes: usize,
-        options: Options,
+        options: Options<'a>,
     },
     Scene(&'a SceneInfo),
     Frame(&'a Frame),
@@ -130,7 +170,7 @@ enum Outgoing<'a> {
     },
 }
 
-fn to_text(m: &Outgoing<'_>) -> Utf8Bytes {
+pub(crate) fn to_text(m: &Outgoing<'_>) -> Utf8Bytes {
     match serde_json::to_string(m) {
         Ok(s) => s.into(),
         Err(e) => {
@@ -189,8 +229,14 @@ impl ViewServer {
         let addr = listener
             .local_addr()
             .map_err(|e| format!("cannot start the display on {bind}: {e}"))?;
-        let require = options.require_token.unwrap_or(!addr.ip().is_loopback());
+        // Off loopback the token is always required: anyone on the network could reach the port.
+        let require = options.require_token || !addr.ip().is_loopback();
         let token = require.then(|| options.token.clone().unwrap_or_else(random_token));
+        if options.header_read_timeout.is_zero() {
+            return Err(
+                "the display's header_read_timeout must be positive (default 10 s)".to_string(),
+            );
+        }
 
         let runtime = tokio::runtime::Builder::new_multi_thread()
             .worker_threads(2)
@@ -216,6 +262,7 @@ impl ViewServer {
             commands: Mutex::new(commands),
             viewers: viewers.clone(),
             token: token.clone(),
+            scene_costs: options.scene_costs.clone(),
             frame_rate_hz,
             shutdown: shutdown_rx.clone(),
             counters: counters.clone(),
@@ -247,17 +294,8 @@ impl ViewServer {
                         .route("/health", get(health))
                         .route("/ws", get(ws_upgrade))
                         .with_state(state);
-                    let mut stop = shutdown_rx;
-                    let serve = axum::serve(
-                        listener,
-                        app.into_make_service_with_connect_info::<SocketAddr>(),
-                    )
-                    .with_graceful_shutdown(async move {
-                        stopped(&mut stop).await;
-                    });
-                    if let Err(e) = serve.await {
-                        eprintln!("haptic2d-view: server error: {e}");
-                    }
+                    crate::http::serve(listener, app, options.header_read_timeout, shutdown_rx)
+                        .await;
                 });
                 runtime.shutdown_timeout(Duration::from_secs(1));
             })
@@ -321,6 +359,8 @@ impl ViewHandle {
             commands_forwarded: self.counters.commands_forwarded.load(Ordering::Relaxed),
             bad_messages: self.counters.bad_messages.load(Ordering::Relaxed),
             viewers: self.viewers.load(Ordering::Relaxed) as u64,
+            view_only: self.counters.view_only.load(Ordering::Relaxed),
+            token_lockouts: self.counters.token_lockouts.load(Ordering::Relaxed),
         }
     }
 
@@ -381,7 +421,7 @@ async fn broadcaster(
 }
 
 /// Resolves once the shutdown flag is set (or its sender is gone).
-async fn stopped(rx: &mut watch::Receiver<bool>) {
+pub(crate) async fn stopped(rx: &mut watch::Receiver<bool>) {
     let _ = rx.wait_for(|s| *s).await;
 }
 
@@ -405,155 +445,49 @@ fn query_token(query: Option<&str>) -> Option<&str> {
     query?.split('&').find_map(|kv| kv.strip_prefix("token="))
 }
 
+/// The WebSocket upgrade: decides the connection's access from its headers and the URL's token
+/// (see [`crate::access`]), logs a view-only connection (within a budget), then hands the socket
+/// to [`connection::run`].
 async fn ws_upgrade(
     ws: WebSocketUpgrade,
+    headers: HeaderMap,
     RawQuery(query): RawQuery,
     ConnectInfo(peer): ConnectInfo<SocketAddr>,
     State(state): State<Arc<AppState>>,
 ) -> Response {
-    let authorised = match &state.token {
-        None => true,
-        Some(t) => query_token(query.as_deref()) == Some(t.as_str()),
+    let client = classify(&headers);
+    let url_token = query_token(query.as_deref());
+    let url_token_ok = match (&state.token, url_token) {
+        (Some(t), Some(given)) => token_eq(t, given),
+        _ => false,
     };
-    ws.max_message_size(HARD_MESSAGE_LIMIT)
-        .max_frame_size(HARD_MESSAGE_LIMIT)
-        .on_upgrade(move |socket| viewer(socket, state, peer, authorised))
-}
-
-/// One connection to the page: forwards broadcasts, handles the page's messages.
-struct Viewer {
-    state: Arc<AppState>,
-    peer: SocketAddr,
-    authorised: bool,
-    log_budget: u32,
-}
-
-impl Viewer {
-    fn welcome(&self) -> Utf8Bytes {
-        to_text(&Outgoing::Welcome {
-            control: self.authorised,
-            token_required: self.state.token.is_some(),
-            frame_rate_hz: self.state.frame_rate_hz,
-            max_message_bytes: MAX_MESSAGE_BYTES,
-            options: Options {
-                scenes: scene_names(),
-                wall_laws: NORMAL_MODEL_NAMES.to_vec(),
-                friction_models: FrictionModel::NAMES.to_vec(),
-                controllers: ControllerKind::ALL.iter().map(|c| c.name()).collect(),
-            },
-        })
-    }
-
-    /// Counts, logs (within the budget) and returns the error frame for a rejected message.
-    fn reject(&mut self, message: &str) -> Utf8Bytes {
-        self.state
-            .counters
-            .bad_messages
-            .fetch_add(1, Ordering::Relaxed);
-        if self.log_budget > 0 {
-            self.log_budget -= 1;
-            let more = if self.log_budget == 0 {
-                " (further errors from this viewer are not logged)"
+    let access = decide(&client, state.token.is_some(), url_token_ok);
+    // A wrong token in the URL is the connection's first failed try.
+    let failures = u32::from(url_token.is_some() && state.token.is_some() && !url_token_ok);
+    if let Access::ViewOnly(why) = &access {
+        let n = state.counters.view_only.fetch_add(1, Ordering::Relaxed) + 1;
+        if n <= REFUSAL_LOG_BUDGET {
+            let who = match &client {
+                Client::Foreign { origin } => format!("origin `{origin}`"),
+                Client::BrowserWithoutOrigin => "a browser without Origin".to_string(),
+                _ => format!(
+                    "host `{}`",
+                    headers
+                        .get(header::HOST)
+                        .and_then(|h| h.to_str().ok())
+                        .unwrap_or("")
+                ),
+            };
+            let more = if n == REFUSAL_LOG_BUDGET {
+                " (further view-only connections are counted, not logged)"
             } else {
                 ""
             };
-            eprintln!("haptic2d-view: viewer {}: {message}{more}", self.peer);
-        }
-        to_text(&Outgoing::Error { message })
-    }
-
-    /// The reply to one message from the page, if any.
-    fn handle(&mut self, msg: Message) -> Option<Utf8Bytes> {
-        let text = match msg {
-            Message::Text(t) => t,
-            Message::Binary(_) => {
-                return Some(self.reject("binary messages are not supported; send JSON text"))
-            }
-            _ => return None,
-        };
-        match parse_client_message(text.as_str()) {
-            Err(e) => Some(self.reject(&e)),
-            Ok(ClientMessage::Hello { token }) => match &self.state.token {
-                Some(t) if *t != token => Some(self.reject("wrong token")),
-                _ => {
-                    self.authorised = true;
-                    Some(self.welcome())
-                }
-            },
-            Ok(ClientMessage::Command(cmd)) => {
-                if !self.authorised {
-                    return Some(self.reject(
-                        "commands need the token printed at startup (open the page with ?token=…)",
-                    ));
-                }
-                let pushed = match self.state.commands.lock() {
-                    Ok(mut p) => p.push(cmd).is_ok(),
-                    Err(_) => false,
-                };
-                if !pushed {
-                    return Some(
-                        self.reject("command queue full: the haptic loop is not taking commands"),
-                    );
-                }
-                self.state
-                    .counters
-                    .commands_forwarded
-                    .fetch_add(1, Ordering::Relaxed);
-                match cmd {
-                    Command::SetHandTarget { .. } => None,
-                    _ => Some(to_text(&Outgoing::Ack {
-                        command: cmd.kind(),
-                    })),
-                }
-            }
+            eprintln!("haptic2d-view: connection from {peer} ({who}): {why}{more}");
         }
     }
-}
-
-async fn viewer(mut socket: WebSocket, state: Arc<AppState>, peer: SocketAddr, authorised: bool) {
-    state.viewers.fetch_add(1, Ordering::Relaxed);
-    let mut rx = state.frames_tx.subscribe();
-    let mut shutdown = state.shutdown.clone();
-    let mut v = Viewer {
-        state: state.clone(),
-        peer,
-        authorised,
-        log_budget: LOG_BUDGET,
-    };
-    let scene = state.scene_rx.borrow().clone();
-    let mut ok = socket.send(Message::Text(v.welcome())).await.is_ok();
-    if let (true, Some(s)) = (ok, scene) {
-        ok = socket.send(Message::Text(s)).await.is_ok();
-    }
-    while ok {
-        tokio::select! {
-            r = rx.recv() => match r {
-                Ok(text) => ok = socket.send(Message::Text(text)).await.is_ok(),
-                Err(broadcast::error::RecvError::Lagged(_)) => {}
-                Err(broadcast::error::RecvError::Closed) => ok = false,
-            },
-            m = socket.recv() => match m {
-                Some(Ok(Message::Close(_))) | None => ok = false,
-                Some(Ok(msg)) => {
-                    if let Some(reply) = v.handle(msg) {
-                        ok = socket.send(Message::Text(reply)).await.is_ok();
-                    }
-                }
-                Some(Err(e)) => {
-                    // A message over the hard limit ends the connection (tungstenite's capacity
-                    // error): count and log it. Other errors are disconnects (a closed tab, a
-                    // reset): not the viewer's fault, not logged.
-                    let text = e.to_string();
-                    if text.contains("Space limit exceeded") || text.contains("too long") {
-                        let _ = v.reject(&format!(
-                            "message over the hard limit of {HARD_MESSAGE_LIMIT} bytes, connection closed: {text}"
-                        ));
-                    }
-                    ok = false;
-                }
-            },
-            _ = stopped(&mut shutdown) => ok = false,
-        }
-    }
-    state.viewers.fetch_sub(1, Ordering::Relaxed);
+    let viewer = Viewer::new(state, peer, access, failures);
+    ws.max_message_size(HARD_MESSAGE_LIMIT)
+        .max_frame_size(HARD_MESSAGE_LIMIT)
+        .on_upgrade(move |socket| connection::run(socket, viewer))
 }

@@ -29,8 +29,8 @@ use haptic2d::world::World;
 use haptic2d_rt::clock::now_ns;
 use haptic2d_rt::{LoopConfig, TickControl};
 use haptic2d_view::{
-    Command, ControllerKind, Frame, FrameInputs, LiveTiming, SceneInfo, ViewHub, ViewOptions,
-    ViewServer, DEFAULT_FRAME_RATE_HZ,
+    assess_builtin_scenes, Command, ControllerKind, Frame, FrameInputs, LiveTiming, SceneInfo,
+    ViewHub, ViewOptions, ViewServer, DEFAULT_FRAME_RATE_HZ, DEFAULT_STEP_FRACTION,
 };
 use std::io::Write;
 use std::net::SocketAddr;
@@ -41,7 +41,7 @@ struct Args {
     rate: f64,
     duration: Option<f64>,
     token: Option<String>,
-    require_token: Option<bool>,
+    require_token: bool,
 }
 
 fn parse_args() -> Result<Args, String> {
@@ -50,7 +50,7 @@ fn parse_args() -> Result<Args, String> {
         rate: 1000.0,
         duration: None,
         token: None,
-        require_token: None,
+        require_token: false,
     };
     let mut it = std::env::args().skip(1);
     while let Some(k) = it.next() {
@@ -80,7 +80,7 @@ fn parse_args() -> Result<Args, String> {
                 );
             }
             "--token" => a.token = Some(val("--token")?),
-            "--require-token" => a.require_token = Some(true),
+            "--require-token" => a.require_token = true,
             "-h" | "--help" => {
                 println!(
                     "usage: haptic2d-view-demo [--bind ADDR:PORT] [--rate HZ] [--duration S] [--token TOKEN] [--require-token]"
@@ -311,8 +311,11 @@ fn run() -> Result<(), String> {
         args.bind,
         end,
         ViewOptions {
-            require_token: args.require_token.or(args.token.as_ref().map(|_| true)),
+            require_token: args.require_token || args.token.is_some(),
             token: args.token.clone(),
+            // Off the loop's thread, before it starts: which scenes fit the period.
+            scene_costs: assess_builtin_scenes(args.rate, DEFAULT_STEP_FRACTION),
+            ..ViewOptions::default()
         },
     )?;
     println!("{}", server.banner());

@@ -86,11 +86,18 @@
   }
 
   // ---------------------------------------------------------------- messages
-  function fillSelect(sel, names, type) {
+  // `refused` maps a name to the reason it cannot be chosen (greyed out, the reason as tooltip).
+  function fillSelect(sel, names, type, refused) {
     sel.innerHTML = "";
     for (const n of names) {
       const o = document.createElement("option");
       o.value = n; o.textContent = n;
+      const why = refused && refused.get(n);
+      if (why) {
+        o.disabled = true;
+        o.title = why;
+        o.textContent = `${n} (too heavy for this rate)`;
+      }
       sel.appendChild(o);
     }
     sel.onchange = () => send({ type, name: sel.value });
@@ -99,7 +106,9 @@
   function onWelcome(msg) {
     state.welcome = msg;
     const o = msg.options;
-    fillSelect($("sel-scene"), o.scenes, "switch_scene");
+    // Scenes whose world step does not fit the loop's period (the server refuses them too).
+    const heavy = new Map((o.scene_costs || []).filter((c) => !c.runnable).map((c) => [c.name, c.reason]));
+    fillSelect($("sel-scene"), o.scenes, "switch_scene", heavy);
     fillSelect($("sel-wall"), o.wall_laws, "set_wall_law");
     fillSelect($("sel-friction"), o.friction_models, "set_friction");
     fillSelect($("sel-controller"), o.controllers, "set_controller");
@@ -108,7 +117,7 @@
       $(id).disabled = !ctl;
     }
     $("control-hint").textContent = ctl ? "" :
-      "view only: commands need the token printed at startup (open the page with ?token=…)";
+      (msg.view_only_reason || "view only: commands need the token printed at startup (open the page with ?token=…)");
     if (state.scene) $("sel-scene").value = state.scene.name;
   }
 
