@@ -78,6 +78,9 @@ pub struct World {
     ke_before: Vec<f64>,
     rots: Vec<Rot>,
     tick: u64,
+    /// Steps 3–6 of the current tick have run ([`World::begin_step`] or [`World::prime`]) and
+    /// [`World::finish_step`] has not yet.
+    begun: bool,
 }
 
 impl World {
@@ -130,6 +133,7 @@ impl World {
             ke_before: vec![0.0; n],
             rots: vec![Rot::IDENTITY; n],
             tick: 0,
+            begun: false,
         };
         w.ledger.kinetic = w.bodies.iter().map(|b| b.kinetic_energy()).sum();
         w.ledger.initial = w.ledger.kinetic;
@@ -186,6 +190,24 @@ impl World {
         self.drive[i] = Wrench2 { force, torque };
     }
 
+    /// Computes the state at `t = 0` before the first row is written: proximity, contacts (with
+    /// their impacts, if bodies start approaching in contact), contact forces and the stored
+    /// energy, i.e. [`begin_step`](Self::begin_step) of sample 0; the next `begin_step` (or
+    /// [`step`](Self::step)) then goes straight on to its integration. Afterwards the ledger's
+    /// `stored` and `initial` include the energy of bodies that start interpenetrating, and
+    /// [`ContactSet::contact_count`] their records, so a `t = 0` log row reports them (the built-in
+    /// peg-in-hole starts with 1 mm of overlap on 4 contacts: `4·½·K_c·(1 mm)²`).
+    ///
+    /// Call it after the world is set up (bodies, drives, parameters) and before the first row;
+    /// calling it again before a step does nothing more. Idempotent, and a no-op between
+    /// `begin_step` and `finish_step`.
+    pub fn prime(&mut self) {
+        if !self.begun {
+            self.begin_step();
+        }
+        self.ledger.stored = self.contacts.stored_energy();
+    }
+
     /// One full sample: [`begin_step`](Self::begin_step) then [`finish_step`](Self::finish_step).
     pub fn step(&mut self) {
         self.begin_step();
@@ -194,7 +216,13 @@ impl World {
 
     /// §0.5 steps 3–6: proximity (every `N_g` samples), local contacts, contact states, impacts
     /// (velocities jump now), and continuous-contact forces.
+    ///
+    /// Does nothing if steps 3–6 of this sample have run already ([`World::prime`]).
     pub fn begin_step(&mut self) {
+        if self.begun {
+            return;
+        }
+        self.begun = true;
         let dt = self.params.dt;
         // 0. Body rotations and the world-frame features of every collider at the current poses.
         for (r, b) in self.rots.iter_mut().zip(&self.bodies) {
@@ -240,6 +268,7 @@ impl World {
         // 4–6. Contact records, state machine, simultaneous impacts, normal and friction forces.
         // (Parameters are re-read every sample, so edits to `params.contact` take effect at once.)
         self.contacts.params = self.params.contact;
+        self.contacts.set_delta_c(self.params.delta_c);
         let past = PastPoses {
             prev: &self.prev,
             prev2: &self.prev2,
@@ -272,6 +301,7 @@ impl World {
     /// §0.5 steps 10–11: integrate every body with all forces of this sample (contact + loads + drive,
     /// re-read so a drive set after `begin_step` counts), then update the energy ledger.
     pub fn finish_step(&mut self) {
+        self.begun = false;
         let dt = self.params.dt;
         // Remember the poses of k−1 and k−2 (buffers reused).
         std::mem::swap(&mut self.prev, &mut self.prev2);

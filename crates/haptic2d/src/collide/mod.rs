@@ -27,7 +27,8 @@ pub use gjk::{
     GJK_MAX_ITERATIONS,
 };
 pub use local::{
-    corner_facing_edge, LocalStage, PairState, DEFAULT_DELTA_C, DEFAULT_EPS_S, NEAR_PARALLEL_ANGLE,
+    corner_facing_edge, nearest_line, sat_depth, LocalStage, PairState, DEFAULT_DELTA_C,
+    DEFAULT_EPS_S, NEAR_PARALLEL_ANGLE,
 };
 pub use tracker::{
     ClosestFeatures, Feature, FeatureTracker, TrackStatus, TrackerStats, PARALLEL_TOL, VORONOI_TOL,
