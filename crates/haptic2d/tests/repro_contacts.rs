@@ -85,3 +85,37 @@ fn r8_polygon_dropped_on_a_polygon_creates_no_energy() {
         r.max_excess
     );
 }
+
+/// Issue 10, item 3: a primed world reports the state at `t = 0`. The built-in peg-in-hole starts
+/// with 1 mm of interference on 4 corner contacts (`kc = 1000 N/m` each), so its `t = 0` row must
+/// show 4 contacts and `4·½·K_c·(1 mm)² = 2 mJ` stored; unprimed it showed 0 and 0, and an energy
+/// check on the log then failed by exactly that.
+#[test]
+fn t0_primed_peg_in_hole_reports_its_initial_contacts_and_stored_energy() {
+    let mut w = haptic2d::scene::builtin("peg-in-hole", None)
+        .expect("built-in")
+        .expect("valid")
+        .world;
+    assert_eq!(w.contacts().contact_count(), 0, "before prime");
+    w.prime();
+    let expected = 4.0 * 0.5 * 1000.0 * 1e-3f64.powi(2);
+    assert_eq!(w.tick(), 0, "prime does not advance time");
+    assert_eq!(w.contacts().contact_count(), 4);
+    assert!(
+        (w.ledger().stored - expected).abs() < 1e-3 * expected,
+        "stored {} J, expected {expected} J",
+        w.ledger().stored
+    );
+    // The initial energy includes it, so the run's excess starts at 0, not at −2 mJ or +2 mJ.
+    assert!(
+        w.ledger().excess().abs() < 1e-12,
+        "excess {}",
+        w.ledger().excess()
+    );
+    // Priming twice changes nothing; the first step goes on from the primed state.
+    let before = (w.ledger().stored, w.contacts().contact_count());
+    w.prime();
+    assert_eq!(before, (w.ledger().stored, w.contacts().contact_count()));
+    w.step();
+    assert_eq!(w.tick(), 1);
+}
