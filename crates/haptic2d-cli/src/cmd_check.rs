@@ -34,5 +34,9 @@ pub fn run(arg: &str) -> Result<(), String> {
     for warn in &scene.warnings {
         println!("  warning: {warn}");
     }
+    // Speeds beyond what the proximity margin and the swept test guarantee (issue 10).
+    for warn in w.speed_warnings() {
+        println!("  warning: {warn}");
+    }
     Ok(())
 }
