@@ -85,6 +85,8 @@ pub struct World {
     radius: Vec<f64>,
     /// Minimum width of each collider (m), for the swept test.
     thickness: Vec<f64>,
+    /// The smallest of `thickness` (m).
+    thinnest: f64,
     /// Body poses at the last global update.
     global_poses: Vec<Pose>,
     /// Velocities `(v, ω)` before this sample's integration, per body.
@@ -128,7 +130,8 @@ impl World {
         for c in &colliders {
             radius[c.body] = radius[c.body].max(polygon_radius(&c.local));
         }
-        let thickness = colliders.iter().map(|c| body_thickness(&c.local)).collect();
+        let thickness: Vec<f64> = colliders.iter().map(|c| body_thickness(&c.local)).collect();
+        let thinnest = thickness.iter().fold(f64::INFINITY, |a, &t| a.min(t));
         let max_vertices = colliders.iter().map(|c| c.len()).max().unwrap_or(4);
         let global_poses = bodies.iter().map(|b| b.pose).collect();
         let mut w = Self {
@@ -163,6 +166,7 @@ impl World {
             tick: 0,
             radius,
             thickness,
+            thinnest,
             global_poses,
             vel_before: vec![(Vec2::ZERO, 0.0); n],
             guard_force: vec![Wrench2::default(); n],
@@ -411,8 +415,7 @@ impl World {
                 max_motion = max_motion.max(m);
             }
         }
-        let thinnest = self.thickness.iter().fold(f64::INFINITY, |a, &t| a.min(t));
-        if 2.0 * max_motion <= allowed_depth(dc, thinnest, thinnest) {
+        if 2.0 * max_motion <= allowed_depth(dc, self.thinnest, self.thinnest) {
             return;
         }
         for p in self.put_back.iter_mut() {
