@@ -119,3 +119,64 @@ fn t0_primed_peg_in_hole_reports_its_initial_contacts_and_stored_energy() {
     w.step();
     assert_eq!(w.tick(), 1);
 }
+
+/// Issue 10, item 1: a long-lived record whose vertex has come nearer another edge line of the
+/// polygon by more than δ_c is handed to that edge (released, then a Continuous record there), so
+/// its stored energy follows the vertex's real depth down instead of staying that of the far line.
+#[test]
+fn long_lived_record_is_handed_to_the_nearer_edge_and_stores_less() {
+    let text = r#"
+[world]
+rate = 1000
+[contact]
+impacts = false
+[[body]]
+name = "square"
+kind = "fixed"
+box = [0.1, 0.1]
+[[body]]
+name = "tri"
+mass = 0.5
+polygon = [[0.045, 0.0505], [0.065, 0.0705], [0.025, 0.0705]]
+velocity = [0.0, -0.01]
+"#;
+    let mut w = Scene::from_toml(text, "handover", None)
+        .expect("valid")
+        .world;
+    let (top, right) = (2u32, 1u32);
+    let tip = |w: &World| {
+        w.contact_records()
+            .filter(|r| r.key.vertex_collider == 1 && r.key.vertex == 0)
+            .map(|r| (r.key.edge, r.d[0]))
+            .collect::<Vec<_>>()
+    };
+    let mut steps = 0;
+    while tip(&w).is_empty() {
+        w.step();
+        steps += 1;
+        assert!(steps < 200, "the tip never touched the top edge");
+    }
+    assert_eq!(tip(&w)[0].0, top);
+    // Carry the tip to (0.049, 0.039): 11 mm below the top line, 1 mm inside the right one.
+    let tri = w.body_index("tri").unwrap();
+    w.bodies[tri].pose.pos += haptic2d::geom::Vec2::new(0.004, -0.0115);
+    w.bodies[tri].vel = haptic2d::geom::Vec2::ZERO;
+    w.step();
+    let now = tip(&w);
+    assert_eq!(now.len(), 1, "{now:?}");
+    assert_eq!(now[0].0, right, "handed to the right edge: {now:?}");
+    assert!(now[0].1 > -0.002, "depth on the new edge {} m", now[0].1);
+    let kinds: Vec<_> = w
+        .contacts()
+        .events()
+        .iter()
+        .filter(|e| e.key.vertex_collider == 1 && e.key.vertex == 0)
+        .map(|e| (e.key.edge, e.kind))
+        .collect();
+    use haptic2d::contact::{ContactState, EventKind};
+    assert!(kinds.contains(&(top, EventKind::Released)), "{kinds:?}");
+    assert!(
+        kinds.contains(&(right, EventKind::Created(ContactState::Continuous))),
+        "{kinds:?}"
+    );
+}
