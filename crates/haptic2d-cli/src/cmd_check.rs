@@ -36,5 +36,9 @@ pub fn run(arg: &str, allow_overlap: bool) -> Result<Status, Failure> {
     for warn in &scene.warnings {
         println!("  warning: {warn}");
     }
+    // Speeds beyond what the proximity margin and the swept test guarantee (issue 10).
+    for warn in w.speed_warnings() {
+        println!("  warning: {warn}");
+    }
     Ok(Status::Clean)
 }

@@ -6,7 +6,10 @@
 //! state and contact wrench, sets the drive with [`World::set_drive`], then calls [`World::finish_step`].
 
 use crate::body::Body;
-use crate::collide::{BroadPhase, Collider, LocalStage, VeCandidate, DEFAULT_DELTA_PROX};
+use crate::collide::{
+    allowed_depth, body_thickness, polygon_radius, speed_limit, swept_put_back, BroadPhase,
+    Collider, LocalStage, SweepScratch, SweptShape, VeCandidate, DEFAULT_DELTA_PROX,
+};
 use crate::contact::{ContactParams, ContactSet, PastPoses, VeContact, Wrench2};
 use crate::geom::{Pose, Rot, Vec2};
 use crate::integrate::{integrate_body, EnergyLedger, IntegrationMode, PassivityGuard};
@@ -78,6 +81,29 @@ pub struct World {
     ke_before: Vec<f64>,
     rots: Vec<Rot>,
     tick: u64,
+    /// Largest vertex distance from the centre of mass, per body (m).
+    radius: Vec<f64>,
+    /// Minimum width of each collider (m), for the swept test.
+    thickness: Vec<f64>,
+    /// The smallest of `thickness` (m).
+    thinnest: f64,
+    /// Body poses at the last global update.
+    global_poses: Vec<Pose>,
+    /// Velocities `(v, ω)` before this sample's integration, per body.
+    vel_before: Vec<(Vec2, f64)>,
+    /// Force and torque the passivity guard integrates, per body (pre-integration velocity).
+    guard_force: Vec<Wrench2>,
+    /// Fraction of the sample each body keeps after the swept test (1 = all of it).
+    put_back: Vec<f64>,
+    /// Scratch of the swept test.
+    sweep: SweepScratch,
+    /// Number of samples at which the swept test put a body back (see `collide/toi.rs`).
+    swept_hits: u64,
+    /// Number of global updates run early because a body had moved far (see `begin_step`).
+    early_global_updates: u64,
+    /// Steps 3–6 of the current tick have run ([`World::begin_step`] or [`World::prime`]) and
+    /// [`World::finish_step`] has not yet.
+    begun: bool,
 }
 
 impl World {
@@ -100,6 +126,14 @@ impl World {
         }
         let n = bodies.len();
         let colliders_len = colliders.len().max(4);
+        let mut radius = vec![0.0f64; n];
+        for c in &colliders {
+            radius[c.body] = radius[c.body].max(polygon_radius(&c.local));
+        }
+        let thickness: Vec<f64> = colliders.iter().map(|c| body_thickness(&c.local)).collect();
+        let thinnest = thickness.iter().fold(f64::INFINITY, |a, &t| a.min(t));
+        let max_vertices = colliders.iter().map(|c| c.len()).max().unwrap_or(4);
+        let global_poses = bodies.iter().map(|b| b.pose).collect();
         let mut w = Self {
             guard: params.guard.map(|eps| PassivityGuard::new(eps, &bodies)),
             bodies,
@@ -130,6 +164,17 @@ impl World {
             ke_before: vec![0.0; n],
             rots: vec![Rot::IDENTITY; n],
             tick: 0,
+            radius,
+            thickness,
+            thinnest,
+            global_poses,
+            vel_before: vec![(Vec2::ZERO, 0.0); n],
+            guard_force: vec![Wrench2::default(); n],
+            put_back: vec![1.0; n],
+            sweep: SweepScratch::with_capacity(max_vertices),
+            swept_hits: 0,
+            early_global_updates: 0,
+            begun: false,
         };
         w.ledger.kinetic = w.bodies.iter().map(|b| b.kinetic_energy()).sum();
         w.ledger.initial = w.ledger.kinetic;
@@ -186,6 +231,24 @@ impl World {
         self.drive[i] = Wrench2 { force, torque };
     }
 
+    /// Computes the state at `t = 0` before the first row is written: proximity, contacts (with
+    /// their impacts, if bodies start approaching in contact), contact forces and the stored
+    /// energy, i.e. [`begin_step`](Self::begin_step) of sample 0; the next `begin_step` (or
+    /// [`step`](Self::step)) then goes straight on to its integration. Afterwards the ledger's
+    /// `stored` and `initial` include the energy of bodies that start interpenetrating, and
+    /// [`ContactSet::contact_count`] their records, so a `t = 0` log row reports them (the built-in
+    /// peg-in-hole starts with 1 mm of overlap on 4 contacts: `4·½·K_c·(1 mm)²`).
+    ///
+    /// Call it after the world is set up (bodies, drives, parameters) and before the first row;
+    /// calling it again before a step does nothing more. Idempotent, and a no-op between
+    /// `begin_step` and `finish_step`.
+    pub fn prime(&mut self) {
+        if !self.begun {
+            self.begin_step();
+        }
+        self.ledger.stored = self.contacts.stored_energy();
+    }
+
     /// One full sample: [`begin_step`](Self::begin_step) then [`finish_step`](Self::finish_step).
     pub fn step(&mut self) {
         self.begin_step();
@@ -194,7 +257,13 @@ impl World {
 
     /// §0.5 steps 3–6: proximity (every `N_g` samples), local contacts, contact states, impacts
     /// (velocities jump now), and continuous-contact forces.
+    ///
+    /// Does nothing if steps 3–6 of this sample have run already ([`World::prime`]).
     pub fn begin_step(&mut self) {
+        if self.begun {
+            return;
+        }
+        self.begun = true;
         let dt = self.params.dt;
         // 0. Body rotations and the world-frame features of every collider at the current poses.
         for (r, b) in self.rots.iter_mut().zip(&self.bodies) {
@@ -203,12 +272,18 @@ impl World {
         for c in self.colliders.iter_mut() {
             c.update_with(&self.bodies[c.body].pose, self.rots[c.body]);
         }
-        // 3. Global proximity stage: AABB sort-and-sweep + GJK, every N_g samples.
-        if self
+        // 3. Global proximity stage: AABB sort-and-sweep + GJK, every N_g samples, and early when
+        //    a body may have outrun the margin (`moved_past_margin`).
+        let periodic = self
             .tick
-            .is_multiple_of(self.params.proximity_every.max(1) as u64)
-        {
+            .is_multiple_of(self.params.proximity_every.max(1) as u64);
+        let early = !periodic && self.moved_past_margin();
+        if periodic || early {
             self.broad.update(&self.colliders, &mut self.pairs);
+            for (g, b) in self.global_poses.iter_mut().zip(&self.bodies) {
+                *g = b.pose;
+            }
+            self.early_global_updates += early as u64;
         }
         // 4. Local stage: closest-feature tracking and VE candidates for proximate pairs.
         self.local.update(
@@ -240,6 +315,7 @@ impl World {
         // 4–6. Contact records, state machine, simultaneous impacts, normal and friction forces.
         // (Parameters are re-read every sample, so edits to `params.contact` take effect at once.)
         self.contacts.params = self.params.contact;
+        self.contacts.set_delta_c(self.params.delta_c);
         let past = PastPoses {
             prev: &self.prev,
             prev2: &self.prev2,
@@ -269,38 +345,166 @@ impl World {
         }
     }
 
+    /// Whether a body may have moved, by the end of this sample, more than `(δ_prox − δ_c)/2`
+    /// since the last global update, so that the proximity set may miss a pair.
+    ///
+    /// A pair left out at the update was at least `δ_prox` apart (§9.1); its distance shrinks by
+    /// at most the sum of the two bodies' point motions, each at most `D_i = |Δp_i| + |Δθ_i|·ρ_i`
+    /// since the update (`ρ_i` the body's vertex radius). While every `D_i ≤ (δ_prox − δ_c)/2` the
+    /// pair is still more than `δ_c` apart, so it has no VE candidate yet. This sample adds about
+    /// `m_i = (|v_i| + |ω_i|·ρ_i)·T` (the velocity now; the integration changes it by `T·a`), so
+    /// the stage is re-run when `D_i + m_i > (δ_prox − δ_c)/2` for some body. Slow worlds (a
+    /// pile) never trigger it; a body faster than `(δ_prox − δ_c)/(2·T)` re-runs it every sample
+    /// and is beyond the guarantee ([`World::speed_warnings`]). Costs one pass over the bodies.
+    fn moved_past_margin(&self) -> bool {
+        let limit = speed_limit(self.broad.delta_prox(), self.params.delta_c);
+        let dt = self.params.dt;
+        self.bodies
+            .iter()
+            .zip(&self.global_poses)
+            .zip(&self.radius)
+            .any(|((b, g), &r)| {
+                b.is_dynamic() && {
+                    let d = (b.pose.pos - g.pos).length() + (b.pose.angle - g.angle).abs() * r;
+                    let m = (b.vel.length() + b.omega.abs() * r) * dt;
+                    d + m > limit
+                }
+            })
+    }
+
+    /// Initial speeds beyond what the settings guarantee, one message per body (empty if none):
+    /// a body whose rim speed `|v| + |ω|·ρ` (m/s) moves it more than `(δ_prox − δ_c)/2` per
+    /// sample can reach a pair the proximity set does not hold, and pass through it
+    /// (`moved_past_margin`, `collide/toi.rs`). Loads can still accelerate a body past the limit
+    /// later; this checks the state the scene starts in.
+    pub fn speed_warnings(&self) -> Vec<String> {
+        let dt = self.params.dt;
+        let (dp, dc) = (self.broad.delta_prox(), self.params.delta_c);
+        let limit = speed_limit(dp, dc) / dt;
+        let mut out = Vec::new();
+        for (b, &r) in self.bodies.iter().zip(&self.radius) {
+            let speed = b.vel.length() + b.omega.abs() * r;
+            if b.is_dynamic() && speed > limit {
+                out.push(format!(
+                    "body \"{}\" starts at {speed:.3} m/s (|v| + |ω|·ρ), faster than the {limit:.3} m/s that \
+                     rate {:.0} Hz, delta_prox {dp} m and delta_c {dc} m guarantee against tunnelling \
+                     ((delta_prox − delta_c)/2 per sample); fix: raise world.rate or world.delta_prox",
+                    b.name,
+                    1.0 / dt
+                ));
+            }
+        }
+        out
+    }
+
+    /// Samples at which the swept test put a body back, and global updates run early, so far.
+    pub fn continuous_stats(&self) -> (u64, u64) {
+        (self.swept_hits, self.early_global_updates)
+    }
+
+    /// The swept test (time of impact, `collide/toi.rs`) for every proximate pair whose motion
+    /// this sample could carry it past the allowed depth: bodies are put back to the fraction
+    /// `λ_t` of the sample (pose and velocity interpolated), the smallest over their pairs. A
+    /// cheap bound skips the pass when no body moved more than half the smallest allowed depth.
+    fn sweep_fast_bodies(&mut self) {
+        let dc = self.params.delta_c;
+        let mut max_motion = 0.0f64;
+        for ((b, p), &r) in self.bodies.iter().zip(&self.prev).zip(&self.radius) {
+            if b.is_dynamic() {
+                let m = (b.pose.pos - p.pos).length() + (b.pose.angle - p.angle).abs() * r;
+                max_motion = max_motion.max(m);
+            }
+        }
+        if 2.0 * max_motion <= allowed_depth(dc, self.thinnest, self.thinnest) {
+            return;
+        }
+        for p in self.put_back.iter_mut() {
+            *p = 1.0;
+        }
+        let mut hit = false;
+        for &(ca, cb) in &self.pairs {
+            let (ca, cb) = (ca as usize, cb as usize);
+            let (ia, ib) = (self.colliders[ca].body, self.colliders[cb].body);
+            let side = |c: usize, i: usize| SweptShape {
+                shape: &self.colliders[c].local,
+                start: self.prev[i],
+                end: self.bodies[i].pose,
+                radius: self.radius[i],
+            };
+            let allowed = allowed_depth(dc, self.thickness[ca], self.thickness[cb]);
+            if let Some(l) = swept_put_back(&side(ca, ia), &side(cb, ib), allowed, &mut self.sweep)
+            {
+                self.put_back[ia] = self.put_back[ia].min(l);
+                self.put_back[ib] = self.put_back[ib].min(l);
+                hit = true;
+            }
+        }
+        if !hit {
+            return;
+        }
+        self.swept_hits += 1;
+        for i in 0..self.bodies.len() {
+            let lam = self.put_back[i];
+            let b = &mut self.bodies[i];
+            if lam >= 1.0 || !b.is_dynamic() {
+                continue;
+            }
+            let (p0, (v0, w0)) = (self.prev[i], self.vel_before[i]);
+            b.pose.pos = p0.pos + (b.pose.pos - p0.pos) * lam;
+            b.pose.angle = p0.angle + (b.pose.angle - p0.angle) * lam;
+            b.vel = v0 + (b.vel - v0) * lam;
+            b.omega = w0 + (b.omega - w0) * lam;
+        }
+    }
+
     /// §0.5 steps 10–11: integrate every body with all forces of this sample (contact + loads + drive,
-    /// re-read so a drive set after `begin_step` counts), then update the energy ledger.
+    /// re-read so a drive set after `begin_step` counts), put fast bodies back to their time of
+    /// impact (the swept test, `collide/toi.rs`), then update the energy ledger.
     pub fn finish_step(&mut self) {
+        self.begun = false;
         let dt = self.params.dt;
         // Remember the poses of k−1 and k−2 (buffers reused).
         std::mem::swap(&mut self.prev, &mut self.prev2);
         self.prev.clear();
         self.prev.extend(self.bodies.iter().map(|b| b.pose));
-        let mut applied_work = 0.0;
+        // 10. Integration.
         for i in 0..self.bodies.len() {
             // Held applied wrench: loads (evaluated in begin_step) + the drive as it is now.
+            let b = &mut self.bodies[i];
+            let cw = self.contact_wrench[i];
+            b.force = self.held[i].force + self.drive[i].force + cw.force;
+            b.torque = self.held[i].torque + self.drive[i].torque + cw.torque;
+            if !b.is_dynamic() {
+                continue;
+            }
+            self.vel_before[i] = (b.vel, b.omega);
+            self.guard_force[i] = Wrench2 {
+                force: b.force - b.vel * b.damping,
+                torque: b.torque,
+            };
+            integrate_body(b, dt, self.params.mode);
+        }
+        // Swept test: fast bodies that would pass a thin part are put back to their impact.
+        self.sweep_fast_bodies();
+        // 11. Energy ledger: the applied work over each body's actual motion.
+        let mut applied_work = 0.0;
+        for i in 0..self.bodies.len() {
+            let b = &self.bodies[i];
+            if !b.is_dynamic() {
+                continue;
+            }
+            let before = self.prev[i];
+            let dx = b.pose.pos - before.pos;
+            let dth = b.pose.angle - before.angle;
             let applied = Wrench2 {
                 force: self.held[i].force + self.drive[i].force,
                 torque: self.held[i].torque + self.drive[i].torque,
             };
-            let b = &mut self.bodies[i];
-            let cw = self.contact_wrench[i];
-            b.force = applied.force + cw.force;
-            b.torque = applied.torque + cw.torque;
-            if !b.is_dynamic() {
-                continue;
-            }
-            let before = b.pose;
-            let f_total = b.force - b.vel * b.damping;
-            let tau_total = b.torque;
-            integrate_body(b, dt, self.params.mode);
-            let dx = b.pose.pos - before.pos;
-            let dth = b.pose.angle - before.angle;
             applied_work += applied.force.dot(dx) + applied.torque * dth;
             if let Some(g) = self.guard.as_mut() {
-                g.add_input(i, f_total.dot(dx) + tau_total * dth);
-                g.check(i, b);
+                let f = self.guard_force[i];
+                g.add_input(i, f.force.dot(dx) + f.torque * dth);
+                g.check(i, &mut self.bodies[i]);
             }
         }
         self.ledger.applied_work += applied_work;

@@ -384,14 +384,38 @@ impl Ctx {
     }
 
     /// Penetrating pair (§9.4): every vertex of `a` inside `b` or within `δ_c` of it, against the
-    /// edge of `b` of least depth among those whose range contains it, or the facing edge when the
-    /// vertex sits at a corner of `b` (corner-on-corner rule, [`corner_facing_edge`]).
-    /// Returns a vertex of A strictly inside B (all signed distances < 0), if any.
+    /// edge of `b` whose *line is nearest* (largest `d_j`), provided that edge's range holds the
+    /// vertex; or the facing edge when the vertex sits at a corner of `b` (corner-on-corner rule,
+    /// [`corner_facing_edge`]). Returns a vertex of A strictly inside B (all `d_j < 0`), if any.
+    ///
+    /// # Why the nearest line, and why a corner vertex outside B gets nothing
+    ///
+    /// A record on edge `e` stores `½·K_c·d_e²` (§5.9), so its depth `−d_e` must not exceed the
+    /// vertex's real depth in B, or energy appears from nothing when the record is created (the
+    /// defect of issue 10: a far edge, `d = −23.5 mm`, proposed for a vertex 1.5 mm *outside* B).
+    ///
+    /// - *V inside B* (`d_j < 0` for all `j`): its depth is `dist(V, ∂B) = −max_j d_j`, attained
+    ///   on the nearest line `j*`, and the foot of the perpendicular lies on the edge `j*` itself:
+    ///   were the foot `F` outside the segment, it would be outside B (a supporting line meets B
+    ///   only in its edge), so the segment `V→F` would leave B through another edge `k` at a point
+    ///   `Q` with `−d_k ≤ |V − Q| < |V − F| = −d_{j*}`, contradicting `j*` nearest. So the nearest
+    ///   edge always holds `V` in its range, and `d_{j*} = max_j d_j` is exactly the real depth.
+    /// - *V outside B within `δ_c`* (`max_j d_j > 0`): either V is in the outer Voronoi region of
+    ///   an edge `j`, whose range holds V and whose line is then the nearest (`d_j = dist(V, B) ≥
+    ///   d_k` for every `k`, since B lies in each half-plane); or V is in the region of a corner
+    ///   `W`, outside the range of both edges at `W` (up to `ε_s`). There no edge describes the
+    ///   contact — every in-range edge is a far one, `d ≪ max_j d_j` — so no candidate is made; the
+    ///   vertex gets one as soon as it reaches an edge region or enters B.
+    ///
+    /// The corner-on-corner rule may choose the neighbour of the nearest edge at the corner; it is
+    /// limited to a neighbour whose line is within `δ_c` of the nearest one, so every candidate
+    /// satisfies `d_e ≥ max_j d_j − δ_c` (the invariant the contact manager checks,
+    /// [`nearest_line`]).
     fn vertices_against(&self, a: Side, b: Side, out: &mut Vec<VeCandidate>) -> Option<Vec2> {
         let mut inside = None;
         'vertex: for v in 0..a.c.len() {
             let p = a.c.world_vertices[v];
-            let mut best: Option<(usize, f64)> = None;
+            let mut nearest = 0usize;
             let mut max_d = f64::NEG_INFINITY;
             // Edge lines within reach of the vertex (−δ_c ≤ d ≤ δ_c): two or more only within
             // ~δ_c of a corner of B (or across a part of B thinner than 2·δ_c), where least depth
@@ -404,46 +428,48 @@ impl Ctx {
                     // Farther than δ_c from B's half-plane, so from B.
                     continue 'vertex;
                 }
-                max_d = max_d.max(d);
-                near_lines += (d >= -self.delta_c) as u32;
-                // The edge coordinate matters only for an edge that would beat the best so far.
-                if best.is_none_or(|(_, bd)| d > bd) {
-                    let s = b.c.edge_coordinate(e, p);
-                    if s >= -self.eps_s && s <= b.c.local.lengths()[e] + self.eps_s {
-                        best = Some((e, d));
-                    }
+                if d > max_d {
+                    max_d = d;
+                    nearest = e;
                 }
+                near_lines += (d >= -self.delta_c) as u32;
             }
             if max_d < 0.0 && inside.is_none() {
                 inside = Some(p);
             }
-            if let Some((mut e, _)) = best {
-                if near_lines >= 2 {
-                    e = self.corner_edge(a.c, v, b.c, e);
-                }
-                out.push(VeCandidate {
-                    vertex_collider: a.id,
-                    vertex: v as u32,
-                    edge_collider: b.id,
-                    edge: e as u32,
-                });
+            // Nearest line first: its edge must hold the vertex (always so inside B, see above);
+            // otherwise the vertex is in a corner region outside B and gets no candidate.
+            let s = b.c.edge_coordinate(nearest, p);
+            if s < -self.eps_s || s > b.c.local.lengths()[nearest] + self.eps_s {
+                continue;
             }
+            let mut e = nearest;
+            if near_lines >= 2 {
+                e = self.corner_edge(a.c, v, b.c, e, max_d);
+            }
+            out.push(VeCandidate {
+                vertex_collider: a.id,
+                vertex: v as u32,
+                edge_collider: b.id,
+                edge: e as u32,
+            });
         }
         inside
     }
 
-    /// The edge for vertex `v` of `a`, proposed against edge `e` of `b` by least depth, when two
-    /// edge lines of `b` are within `δ_c` of it: if a neighbour `e'` of `e` (sharing the corner
-    /// `W`) is also within `δ_c` and has the vertex in its range, the vertex is at `W` and the
-    /// choice between `e` and `e'` is the corner-on-corner rule's ([`corner_facing_edge`]);
-    /// otherwise `e`.
-    fn corner_edge(&self, a: &Collider, v: usize, b: &Collider, e: usize) -> usize {
+    /// The edge for vertex `v` of `a`, proposed against the nearest edge `e` of `b` (line
+    /// distance `max_d`), when two edge lines of `b` are within `δ_c` of it: if a neighbour `e'`
+    /// of `e` (sharing the corner `W`) is also within `δ_c`, no more than `δ_c` deeper than the
+    /// nearest line (`d' ≥ max_d − δ_c`), and has the vertex in its range, the vertex is at `W`
+    /// and the choice between `e` and `e'` is the corner-on-corner rule's
+    /// ([`corner_facing_edge`]); otherwise `e`.
+    fn corner_edge(&self, a: &Collider, v: usize, b: &Collider, e: usize, max_d: f64) -> usize {
         let p = a.world_vertices[v];
         for e2 in [b.local.prev(e), b.local.next(e)] {
             let d = b.edge_distance(e2, p);
             let s = b.edge_coordinate(e2, p);
             let in_range = s >= -self.eps_s && s <= b.local.lengths()[e2] + self.eps_s;
-            if d.abs() <= self.delta_c && in_range {
+            if d.abs() <= self.delta_c && d >= max_d - self.delta_c && in_range {
                 if let Some(f) = corner_facing_edge(a, v, b, e, e2, self.cos_parallel) {
                     return f;
                 }
@@ -499,5 +525,48 @@ fn most_aligned_edge(c: &Collider, v: usize, p: Vec2) -> usize {
         e_in
     } else {
         e_out
+    }
+}
+
+/// The nearest edge line of `b` to the world point `p`: `(j*, d_{j*})` with `d_{j*} = max_j d_j`
+/// over all of `b`'s edge lines (m, positive outside). For `p` inside `b`, `−d_{j*}` is its depth
+/// (distance to the boundary) and edge `j*` holds `p` in its range (see `vertices_against`).
+///
+/// The invariant of every VE record `(V, e)` (issue 10): `d_e ≥ d_{j*} − δ_c`, so its stored
+/// energy `½·K_c·d_e²` never exceeds that of the vertex's real depth by more than the corner
+/// tolerance allows.
+#[inline]
+pub fn nearest_line(b: &Collider, p: Vec2) -> (usize, f64) {
+    let mut best = (0usize, f64::NEG_INFINITY);
+    for e in 0..b.len() {
+        let d = b.edge_distance(e, p);
+        if d > best.1 {
+            best = (e, d);
+        }
+    }
+    best
+}
+
+/// Penetration depth of two convex polygons by separating axes (m): the smallest overlap of their
+/// projections over every edge normal of both, `0` if some axis separates them. No vertex of one
+/// can be deeper in the other than this (translating by the minimum separating vector clears
+/// every vertex). Costs `O((n_a + n_b)²)`: for checks, not the hot path.
+pub fn sat_depth(a: &Collider, b: &Collider) -> f64 {
+    let mut depth = f64::INFINITY;
+    for (p, q) in [(a, b), (b, a)] {
+        for e in 0..p.len() {
+            // Overlap along n_e: how far q's deepest vertex is behind p's edge line e.
+            let min_d = q
+                .world_vertices
+                .iter()
+                .map(|&v| p.edge_distance(e, v))
+                .fold(f64::INFINITY, f64::min);
+            depth = depth.min((-min_d).max(0.0));
+        }
+    }
+    if depth.is_finite() {
+        depth
+    } else {
+        0.0
     }
 }

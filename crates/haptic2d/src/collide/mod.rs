@@ -5,7 +5,9 @@
 //! - [`gjk_distance`] (`gjk.rs`): GJK distance with hill-climbing support and warm start (§9.2);
 //! - [`BroadPhase`] (`broad.rs`): inflated AABBs, sort-and-sweep, GJK → proximity set (§9.1);
 //! - [`FeatureTracker`] (`tracker.rs`): Lin–Canny closest features per pair (§9.3);
-//! - [`LocalStage`] (`local.rs`): one tracker per proximate pair, VE candidates (§9.4–9.5).
+//! - [`LocalStage`] (`local.rs`): one tracker per proximate pair, VE candidates (§9.4–9.5);
+//! - [`swept_put_back`] (`toi.rs`): the swept test (time of impact) for bodies too fast for one
+//!   sample, and the speed limits the world guarantees ([`speed_limit`], [`allowed_depth`]).
 //!
 //! Per tick (§0.5 steps 3–4), after [`Collider::update`] for every collider:
 //!
@@ -18,6 +20,7 @@ mod broad;
 mod collider;
 mod gjk;
 mod local;
+mod toi;
 mod tracker;
 
 pub use broad::{required_delta_prox, BroadPhase, BroadStats, DEFAULT_DELTA_PROX};
@@ -27,7 +30,12 @@ pub use gjk::{
     GJK_MAX_ITERATIONS,
 };
 pub use local::{
-    corner_facing_edge, LocalStage, PairState, DEFAULT_DELTA_C, DEFAULT_EPS_S, NEAR_PARALLEL_ANGLE,
+    corner_facing_edge, nearest_line, sat_depth, LocalStage, PairState, DEFAULT_DELTA_C,
+    DEFAULT_EPS_S, NEAR_PARALLEL_ANGLE,
+};
+pub use toi::{
+    allowed_depth, radius as polygon_radius, speed_limit, swept_put_back,
+    thickness as body_thickness, SweepScratch, SweptShape, TOI_MAX_SAMPLES,
 };
 pub use tracker::{
     ClosestFeatures, Feature, FeatureTracker, TrackStatus, TrackerStats, PARALLEL_TOL, VORONOI_TOL,

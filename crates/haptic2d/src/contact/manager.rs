@@ -13,7 +13,10 @@ use super::record::{
     ContactEvent, ContactState, EventKind, LawState, LocalGeom, VeContact, NO_LAW,
 };
 use crate::body::Body;
-use crate::collide::{corner_facing_edge, Collider, VeCandidate, NEAR_PARALLEL_ANGLE};
+use crate::collide::{
+    corner_facing_edge, nearest_line, sat_depth, Collider, VeCandidate, DEFAULT_DELTA_C,
+    NEAR_PARALLEL_ANGLE,
+};
 use crate::geom::{cross, Pose, Rot, Vec2};
 use crate::laws::friction::{FrictionInput, FrictionLaw, FrictionModel};
 use crate::laws::normal::{NormalInput, NormalLaw, NormalModel};
@@ -66,6 +69,8 @@ pub struct ContactSet {
     pub impacts_solved: u64,
     /// `cos(NEAR_PARALLEL_ANGLE)`: edges with `n·n < −cos_parallel` face each other.
     cos_parallel: f64,
+    /// Contact distance tolerance `δ_c` (m): also the tolerance of the depth invariant.
+    delta_c: f64,
 }
 
 impl ContactSet {
@@ -93,6 +98,16 @@ impl ContactSet {
             record_count: 0,
             impacts_solved: 0,
             cos_parallel: NEAR_PARALLEL_ANGLE.cos(),
+            delta_c: DEFAULT_DELTA_C,
+        }
+    }
+
+    /// Sets the contact distance tolerance `δ_c` (m, the local stage's; default
+    /// [`DEFAULT_DELTA_C`]), which is also the tolerance of the depth invariant
+    /// ([`ContactSet::step`]). A non-finite or negative value is ignored.
+    pub fn set_delta_c(&mut self, delta_c: f64) {
+        if delta_c.is_finite() && delta_c >= 0.0 {
+            self.delta_c = delta_c;
         }
     }
 
@@ -138,6 +153,29 @@ impl ContactSet {
     /// Steps 4–6 of §0.5 for one sample: merge the local stage's candidates into the tracked set and
     /// measure every pair, run the state machine, resolve impacts (velocity jumps applied to `bodies`
     /// now), then compute continuous-contact forces into `wrenches` (one per body, overwritten).
+    ///
+    /// **Depth invariant** (issue 10). A record `(V, e)` stores `½·K_c·d_e²`, a function of the
+    /// poses while its key is fixed, so the stored energy is continuous over its life; it can only
+    /// jump where a record is created or changes edge. There its depth must be the vertex's real
+    /// depth in the edge polygon B, up to the corner tolerance `δ_c`:
+    ///
+    /// ```text
+    /// d_e ≥ max_j d_j(V) − δ_c      (j over B's edge lines; −max_j d_j = depth of V inside B)
+    /// ```
+    ///
+    /// which also bounds `−d_e` by the pair's separating-axis depth `+ δ_c` (no vertex is deeper
+    /// in B than the pair's penetration depth). One exception, face on face: where `V` sits at a
+    /// corner of B on its side line (coincident corners of an aligned stack) and `e` *faces* an
+    /// edge of A at `V` (antiparallel within [`NEAR_PARALLEL_ANGLE`], the corner-on-corner rule),
+    /// the faces overlap by the pair's separating-axis depth while `V` is on B's boundary: the
+    /// record is then valid up to that depth, `−d_e ≤ depth_SAT + δ_c` (a landing 10-box stack
+    /// compresses its faces by 2.02 mm with `V` at `±1e-19 m` from the side line). A far edge
+    /// never faces A (its normal points away from A). Candidates satisfy it where they are made (the
+    /// local stage's nearest-line rule); `create` checks it for the edge it picks (the crossed-edge
+    /// rule may pick another one); `hand_over` moves a record whose vertex has come nearer to
+    /// another line of B by more than `δ_c` to that edge (or releases it if the vertex is outside
+    /// B): its stored energy then drops, never rises. Debug builds assert the invariant for every
+    /// record at the end of every sample.
     #[allow(clippy::too_many_arguments)]
     pub fn step(
         &mut self,
@@ -157,11 +195,122 @@ impl ContactSet {
         self.resize_body_buffers(bodies.len());
         self.sync(tick, candidates, colliders, bodies, rots, past);
         self.release(tick);
+        self.hand_over(tick, colliders, bodies, past, normal, friction);
         let any_colliding = self.create(tick, dt, colliders, bodies, past, normal, friction);
         if any_colliding {
             self.resolve_impacts(tick, bodies);
         }
         self.forces(dt, bodies, friction, wrenches);
+        #[cfg(debug_assertions)]
+        self.assert_depth_invariant(colliders);
+    }
+
+    /// Debug builds: every record satisfies the depth invariant of [`ContactSet::step`], and is no
+    /// deeper than its pair's separating-axis depth plus `δ_c`.
+    #[cfg(debug_assertions)]
+    fn assert_depth_invariant(&self, colliders: &[Collider]) {
+        // Round-off allowance on distances of a few metres at most.
+        const TOL: f64 = 1e-9;
+        for e in self.entries.iter().filter(|e| e.is_contact()) {
+            let ca = &colliders[e.key.vertex_collider as usize];
+            let cb = &colliders[e.key.edge_collider as usize];
+            let p = ca.world_vertices[e.key.vertex as usize];
+            let d_e = cb.edge_distance(e.key.edge as usize, p);
+            let (j, max_d) = nearest_line(cb, p);
+            let face = face_on_face_ok(e.key, colliders, self.delta_c, self.cos_parallel);
+            debug_assert!(
+                d_e >= max_d - self.delta_c - TOL || face,
+                "VE record {:?}: d = {d_e:e} m on its edge, but edge {j}'s line is at {max_d:e} m \
+                 (more than δ_c = {} m nearer): its stored energy exceeds the vertex's real depth",
+                e.key,
+                self.delta_c
+            );
+            let sat = sat_depth(ca, cb);
+            debug_assert!(
+                -d_e <= sat + self.delta_c + TOL,
+                "VE record {:?}: depth {:e} m exceeds the pair's separating-axis depth {sat:e} m + δ_c",
+                e.key,
+                -d_e
+            );
+        }
+    }
+
+    /// Hands a Continuous record over to the nearer edge where the depth invariant of
+    /// [`ContactSet::step`] would break: when some other line `j` of B is nearer to the vertex
+    /// than the record's edge line by more than `δ_c` (`d_e < max_j d_j − δ_c`; a long-lived
+    /// record of a vertex that slid or rotated deep past a corner of B). The record is released
+    /// and, if the vertex is inside B (`max_j d_j ≤ δ_off`) and in the range of `j` (always so
+    /// inside B), a Continuous record is started on `j` (events `Released`, then
+    /// `Created(Continuous)`: it is not an impact). Its stored energy drops from `½·K_c·d_e²` to
+    /// `½·K_c·d_j²`, so the hand-over dissipates and never creates energy. The `δ_c` hysteresis is
+    /// the corner tolerance: at a stacked corner the vertex is equally near both lines up to
+    /// round-off, and the corner-on-corner rule, not the distances, decides the edge there.
+    fn hand_over(
+        &mut self,
+        tick: u64,
+        colliders: &[Collider],
+        bodies: &[Body],
+        past: &PastPoses<'_>,
+        normal: &NormalModel,
+        friction: &FrictionModel,
+    ) {
+        let p = self.params;
+        self.pending.clear();
+        for idx in 0..self.entries.len() {
+            let e = &self.entries[idx];
+            if e.state != Some(ContactState::Continuous) {
+                continue;
+            }
+            let cb = &colliders[e.key.edge_collider as usize];
+            let (j, max_d) = nearest_line(cb, e.point);
+            if e.d[0] >= max_d - self.delta_c
+                || face_on_face_ok(e.key, colliders, self.delta_c, self.cos_parallel)
+            {
+                continue;
+            }
+            let key = VeCandidate {
+                edge: j as u32,
+                ..e.key
+            };
+            let s_j = cb.edge_coordinate(j, e.point);
+            let holds =
+                max_d <= p.delta_off && s_j >= -p.eps_s && s_j <= cb.local.lengths()[j] + p.eps_s;
+            let e = &mut self.entries[idx];
+            e.state = None;
+            self.laws.release(e.law);
+            e.law = NO_LAW;
+            e.f_n = 0.0;
+            e.f_t = 0.0;
+            self.events.push(ContactEvent {
+                tick,
+                key: e.key,
+                kind: EventKind::Released,
+            });
+            if !holds {
+                continue;
+            }
+            match self.entries.binary_search_by(|x| x.key.cmp(&key)) {
+                Ok(t) if !self.entries[t].is_contact() => {
+                    let n = &mut self.entries[t];
+                    start_handed_over(n, tick, &mut self.events);
+                    n.law = self.laws.acquire(normal, friction);
+                    self.laws.get_mut(n.law).begin(n.s_g);
+                }
+                Ok(_) => {}
+                Err(_) => {
+                    let mut n = new_entry(tick, key, colliders, bodies, past);
+                    start_handed_over(&mut n, tick, &mut self.events);
+                    n.law = self.laws.acquire(normal, friction);
+                    self.laws.get_mut(n.law).begin(n.s_g);
+                    self.pending.push(n);
+                }
+            }
+        }
+        if !self.pending.is_empty() {
+            self.entries.extend_from_slice(&self.pending);
+            self.entries.sort_unstable_by_key(|e| e.key);
+            self.pending.clear();
+        }
     }
 
     fn resize_body_buffers(&mut self, n: usize) {
@@ -308,6 +457,19 @@ impl ContactSet {
             if let (false, Some(fallback)) = (group_has_record, touching) {
                 let key = self.entries[fallback].key;
                 let edge = creation_edge(key, colliders, past, p.eps_s, cos);
+                // The depth invariant (see `step`): the crossed edge of a fast vertex may be one
+                // whose line is far deeper than the vertex's real depth (a vertex that went past
+                // the middle of a thin part of B); then the proposed edge, which satisfies it by
+                // construction in the local stage, is used, and if neither does, no record.
+                let (dc, cos) = (self.delta_c, self.cos_parallel);
+                let edge = if depth_ok(VeCandidate { edge, ..key }, colliders, dc, cos) {
+                    edge
+                } else if depth_ok(key, colliders, dc, cos) {
+                    key.edge
+                } else {
+                    g = h;
+                    continue;
+                };
                 if edge != key.edge
                     && twin_has_record(
                         &self.entries,
@@ -689,6 +851,53 @@ fn start_record(
         } else {
             EventKind::Created(state)
         },
+    });
+}
+
+/// The depth invariant of [`ContactSet::step`] for the pair `key` at the current poses:
+/// `d_e ≥ max_j d_j − δ_c` over the edge collider's lines `j`, or the face-on-face case
+/// ([`face_on_face_ok`]).
+#[inline]
+fn depth_ok(key: VeCandidate, colliders: &[Collider], delta_c: f64, cos_parallel: f64) -> bool {
+    let ca = &colliders[key.vertex_collider as usize];
+    let cb = &colliders[key.edge_collider as usize];
+    let p = ca.world_vertices[key.vertex as usize];
+    cb.edge_distance(key.edge as usize, p) >= nearest_line(cb, p).1 - delta_c
+        || face_on_face_ok(key, colliders, delta_c, cos_parallel)
+}
+
+/// The face-on-face exception of the depth invariant ([`ContactSet::step`]): edge `e` faces an
+/// edge of A at the vertex (`n_e·n_A < −cos_parallel`) and the record is no deeper than the
+/// pair's separating-axis depth plus `δ_c`. The SAT depth costs `O((n_a + n_b)²)`, so this runs
+/// only where the nearest-line test has failed (a stack compressed past `δ_c`).
+fn face_on_face_ok(
+    key: VeCandidate,
+    colliders: &[Collider],
+    delta_c: f64,
+    cos_parallel: f64,
+) -> bool {
+    let ca = &colliders[key.vertex_collider as usize];
+    let cb = &colliders[key.edge_collider as usize];
+    let (v, e) = (key.vertex as usize, key.edge as usize);
+    let n = cb.world_normals[e];
+    let faces = n.dot(ca.world_normals[v]) < -cos_parallel
+        || n.dot(ca.world_normals[ca.local.prev(v)]) < -cos_parallel;
+    faces && -cb.edge_distance(e, ca.world_vertices[v]) <= sat_depth(ca, cb) + delta_c
+}
+
+/// Starts the record a hand-over moves to (see `ContactSet::hand_over`): Continuous (the vertex
+/// is already in contact, so this is no impact), god-object at the projection. The caller gives it
+/// its law states.
+fn start_handed_over(e: &mut VeContact, tick: u64, events: &mut Vec<ContactEvent>) {
+    e.state = Some(ContactState::Continuous);
+    e.since = tick;
+    e.m_eff = 0.0;
+    e.s_g = e.s.clamp(0.0, e.len);
+    e.s_entry = e.s_g;
+    events.push(ContactEvent {
+        tick,
+        key: e.key,
+        kind: EventKind::Created(ContactState::Continuous),
     });
 }
 
