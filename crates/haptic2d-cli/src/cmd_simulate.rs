@@ -55,6 +55,8 @@ pub fn run(a: &SimulateArgs) -> Result<Status, Failure> {
         eprintln!("warning: {w}");
     }
     let mut world = scene.world;
+    // The t = 0 state (contacts, stored energy of bodies that start in contact) before the first row.
+    world.prime();
     let dt = world.params.dt;
     let samples = (duration / dt).round();
     if samples > MAX_SAMPLES {
@@ -72,8 +74,7 @@ pub fn run(a: &SimulateArgs) -> Result<Status, Failure> {
                 .map_err(|e| Failure::error(format!("cannot create {}: {e}", p.display())))?;
             let mut w = WorldCsv::new(BufWriter::with_capacity(1 << 20, f), &world)
                 .map_err(|e| Failure::error(format!("cannot write {}: {e}", p.display())))?;
-            // TODO(t = 0 row): once the world computes its t = 0 contacts and stored energy (helper
-            // A, issue 10 item 3), this row reports them; today it shows what `World::new` books.
+            // The t = 0 row: primed above, so it reports the contacts and stored energy at t = 0.
             w.row(&world)
                 .map_err(|e| Failure::error(format!("cannot write CSV: {e}")))?;
             Some(w)
