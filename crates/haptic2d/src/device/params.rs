@@ -63,6 +63,16 @@ pub struct DeviceParams {
     /// Friction-compensation fraction applied by the low-level controller, `0..=1` (§11.2). Default 0
     /// (the spec's option uses 0.5).
     pub friction_compensation: f64,
+    /// Stiffness of the workspace bound (N/m): past the edge of the workspace square the handle feels
+    /// a wall `F = −K·(penetration) − B·v` (never pulling inward). Default 2000; 0 = no wall (the trip
+    /// still applies).
+    pub workspace_wall_stiffness: f64,
+    /// Damping of the workspace bound `B` (N·s/m). Default 5; must be at least Colgate's `K·T/2` at
+    /// the loop's period, so that the sampled wall is passive (§5.4).
+    pub workspace_wall_damping: f64,
+    /// Trip distance (m): the safety latch trips when the handle is more than this far past the edge of
+    /// the workspace square. Default 0.01.
+    pub workspace_trip_distance: f64,
 }
 
 impl Default for DeviceParams {
@@ -92,6 +102,9 @@ impl Default for DeviceParams {
             closure_tol: 1e-3,
             min_singularity_margin: 0.1,
             friction_compensation: 0.0,
+            workspace_wall_stiffness: 2000.0,
+            workspace_wall_damping: 5.0,
+            workspace_trip_distance: 0.01,
         }
     }
 }
@@ -100,7 +113,7 @@ impl DeviceParams {
     /// Every field, in declaration order, with its unit as written in scene and device files
     /// (`"-"` for a dimensionless number). Used by file loaders for messages and by the template
     /// `devices/twin-pantograph.toml`.
-    pub const FIELDS: [(&'static str, &'static str); 24] = [
+    pub const FIELDS: [(&'static str, &'static str); 27] = [
         ("s", "m"),
         ("l1", "m"),
         ("l2", "m"),
@@ -125,6 +138,9 @@ impl DeviceParams {
         ("closure_tol", "m"),
         ("min_singularity_margin", "-"),
         ("friction_compensation", "-"),
+        ("workspace_wall_stiffness", "N/m"),
+        ("workspace_wall_damping", "N·s/m"),
+        ("workspace_trip_distance", "m"),
     ];
 
     /// The unit of field `name` (see [`DeviceParams::FIELDS`]), or `None` for an unknown name.
@@ -213,6 +229,9 @@ impl DeviceParams {
                 self.friction_compensation
             ));
         }
+        non_negative("workspace_wall_stiffness", self.workspace_wall_stiffness)?;
+        non_negative("workspace_wall_damping", self.workspace_wall_damping)?;
+        positive("workspace_trip_distance", self.workspace_trip_distance)?;
         if self.l2 <= self.s / 2.0 {
             return Err(format!(
                 "device.l2 ({}) must exceed s/2 ({}) for the distal links to meet",
@@ -255,9 +274,16 @@ impl DeviceParams {
     }
 
     /// Checks the parameters that depend on the sample period `dt` (s): `K_O·T < 1` for the momentum
-    /// observer (§10.6).
+    /// observer (§10.6), and Colgate's `B ≥ K·T/2` for the workspace wall (§5.4).
     pub fn validate_for_period(&self, dt: f64) -> Result<(), String> {
         positive("sample period", dt)?;
+        let b_min = 0.5 * self.workspace_wall_stiffness * dt;
+        if self.workspace_wall_damping < b_min {
+            return Err(format!(
+                "device.workspace_wall_damping = {} N s/m is below K·T/2 = {b_min} N s/m for workspace_wall_stiffness = {} N/m at the period {dt} s: the sampled wall would be active; raise the damping or lower the stiffness",
+                self.workspace_wall_damping, self.workspace_wall_stiffness
+            ));
+        }
         for (i, k) in self.observer_gain.iter().enumerate() {
             if k * dt >= 1.0 {
                 return Err(format!(

@@ -20,5 +20,5 @@ pub use config::{ControllerKind, HapticConfig};
 pub use experiment::DeviceInTheLoop;
 pub use mapping::DeviceMap;
 pub use record::{TickRecord, TICK_COLUMNS};
-pub use safety::{Safety, SafetyReason, SafetyTrip};
+pub use safety::{Safety, SafetyConfig, SafetyReason, SafetyTrip};
 pub use system::{HapticSystem, TickOutput};
