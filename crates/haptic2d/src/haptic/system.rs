@@ -460,11 +460,9 @@ impl HapticSystem {
     #[inline]
     fn workspace_wall(&mut self, k: u64, t: f64, x: &V3, v: &V3) -> V3 {
         let p = &self.device.params;
-        let (kw, bw, hw) = (
-            p.workspace_wall_stiffness,
-            p.workspace_wall_damping,
-            p.workspace_half_width,
-        );
+        // Colgate (§5.4): a ZOH wall K, B is passive for B ≥ K·T/2, so render at most K = 2·B/T.
+        let (bw, hw) = (p.workspace_wall_damping, p.workspace_half_width);
+        let kw = p.workspace_wall_stiffness.min(2.0 * bw / self.dt);
         let centre = [p.workspace_center_x, p.workspace_center_y];
         let mut f = [0.0; 3];
         for axis in 0..2 {
