@@ -57,7 +57,10 @@ impl VelocityFilter {
         } else {
             // α_v = 1 − exp(−2π f_v T) with T → elapsed: the cut-off f_v = −ln(1 − α)/(2π T).
             let f_v = -(1.0 - self.alpha).ln() / (std::f64::consts::TAU * self.dt);
-            (elapsed, 1.0 - (-std::f64::consts::TAU * f_v * elapsed).exp())
+            (
+                elapsed,
+                1.0 - (-std::f64::consts::TAU * f_v * elapsed).exp(),
+            )
         };
         for ((v, xi), xp) in self.v.iter_mut().zip(x).zip(&self.x_prev) {
             let raw = (xi - xp) / h;

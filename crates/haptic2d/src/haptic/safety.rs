@@ -249,7 +249,15 @@ impl Safety {
             let limit = self.tau_max * (1.0 + self.torque_trip_margin);
             if peak > limit {
                 let value = tau[index];
-                self.trip(tick, t, SafetyReason::TorqueLimit { index, value, limit });
+                self.trip(
+                    tick,
+                    t,
+                    SafetyReason::TorqueLimit {
+                        index,
+                        value,
+                        limit,
+                    },
+                );
             } else if peak > self.tau_max {
                 let s = self.tau_max / peak;
                 tau.iter_mut().for_each(|v| *v *= s);

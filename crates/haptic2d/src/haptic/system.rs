@@ -608,6 +608,13 @@ impl HapticSystem {
     /// handle's measured pose and ramps the torques in again from zero, as at start-up.
     pub fn reset_safety(&mut self) {
         self.safety.reset();
+        // The estimates are stale after a fault (a stall, lost readings): restart the velocity filter
+        // and the observer, keeping the θ unwrapping reference.
+        let theta = self
+            .device
+            .pose()
+            .map_or(self.map.device_origin[2], |p| p[2]);
+        self.device.reset(theta);
         self.aligned = false;
         self.started = false;
     }
