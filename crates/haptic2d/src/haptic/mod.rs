@@ -15,6 +15,7 @@ pub mod mapping;
 pub mod record;
 pub mod safety;
 pub mod system;
+pub mod workspace;
 
 pub use config::{ControllerKind, HapticConfig};
 pub use experiment::DeviceInTheLoop;
@@ -22,3 +23,4 @@ pub use mapping::DeviceMap;
 pub use record::{TickRecord, TICK_COLUMNS};
 pub use safety::{Safety, SafetyConfig, SafetyReason, SafetyTrip};
 pub use system::{HapticSystem, TickOutput};
+pub use workspace::WorkspaceBound;

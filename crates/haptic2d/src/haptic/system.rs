@@ -15,6 +15,7 @@ use super::record::{
     TickRecord, FLAG_NEAR_SINGULAR, FLAG_PASSIVITY_ACTIVE, FLAG_SAFETY, FLAG_SATURATED,
 };
 use super::safety::{Safety, SafetyConfig, SafetyReason, SafetyTrip};
+use super::workspace::WorkspaceBound;
 
 /// The running controller (one of the §11 architectures).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -87,6 +88,7 @@ pub struct HapticSystem {
     world: World,
     slave: usize,
     map: DeviceMap,
+    workspace: WorkspaceBound,
     safety: Safety,
     safety_config: SafetyConfig,
     preload: f64,
@@ -190,6 +192,7 @@ impl HapticSystem {
             world,
             slave,
             map,
+            workspace: WorkspaceBound::new(&config.device, dt),
             safety: Safety::new(
                 config.device.min_singularity_margin,
                 tau_max,
@@ -331,9 +334,18 @@ impl HapticSystem {
         //     square, and a trip beyond it.
         let mut f_dev = f_port;
         if let Some(e) = est {
-            let wall = self.workspace_wall(k, t, &e.pose, &e.velocity);
+            let (wall, excursion) = self.workspace.wrench(&e.pose, &e.velocity);
             f_dev[0] += wall[0];
             f_dev[1] += wall[1];
+            if let Some(x) = excursion {
+                let reason = SafetyReason::Workspace {
+                    axis: x.axis,
+                    position: x.position,
+                    edge: x.edge,
+                    trip: self.workspace.trip_distance,
+                };
+                self.safety.trip(k, t, reason);
+            }
         }
         f_cm = self.map.wrench_to_world(&f_dev);
 
@@ -449,48 +461,6 @@ impl HapticSystem {
         }
     }
 
-    /// The workspace-bound wrench (N, N, 0; handle coordinates) at handle pose `x`, twist `v`, and the
-    /// trip beyond it. Per axis with edges `c ± h` (centre `c`, half-width `h`), penetration
-    /// `p = |x − edge|` outside the square and outward unit `n = ±1`:
-    ///
-    /// ```text
-    /// F = −n·max(0, K·p + B·n·ẋ)      (spring–damper that only pushes back: passive, B ≥ K·T/2)
-    /// p > trip distance  → safety trip
-    /// ```
-    #[inline]
-    fn workspace_wall(&mut self, k: u64, t: f64, x: &V3, v: &V3) -> V3 {
-        let p = &self.device.params;
-        // Colgate (§5.4): a ZOH wall K, B is passive for B ≥ K·T/2, so render at most K = 2·B/T.
-        let (bw, hw) = (p.workspace_wall_damping, p.workspace_half_width);
-        let kw = p.workspace_wall_stiffness.min(2.0 * bw / self.dt);
-        let centre = [p.workspace_center_x, p.workspace_center_y];
-        let mut f = [0.0; 3];
-        for axis in 0..2 {
-            let (lo, hi) = (centre[axis] - hw, centre[axis] + hw);
-            let (pen, edge, n) = if x[axis] > hi {
-                (x[axis] - hi, hi, 1.0)
-            } else if x[axis] < lo {
-                (lo - x[axis], lo, -1.0)
-            } else {
-                continue;
-            };
-            f[axis] = -n * (kw * pen + bw * n * v[axis]).max(0.0);
-            if pen > p.workspace_trip_distance {
-                self.safety.trip(
-                    k,
-                    t,
-                    SafetyReason::Workspace {
-                        axis,
-                        position: x[axis],
-                        edge,
-                        trip: p.workspace_trip_distance,
-                    },
-                );
-            }
-        }
-        f
-    }
-
     /// A paused sample (the live display's pause): the device is still estimated from the encoder
     /// angles `q` (rad; steps 1–2, so the pose unwrapping, the velocity filter and the hand-wrench
     /// observer keep tracking the handle while the user moves it), but neither controller runs, the
@@ -591,6 +561,10 @@ impl HapticSystem {
     /// The device ↔ world mapping.
     pub fn map(&self) -> &DeviceMap {
         &self.map
+    }
+    /// The workspace bound rendered from the device file.
+    pub fn workspace(&self) -> &WorkspaceBound {
+        &self.workspace
     }
     /// The device estimator.
     pub fn device(&self) -> &TwinPantograph {
