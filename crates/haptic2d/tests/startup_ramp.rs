@@ -91,12 +91,10 @@ fn startup_torques_ramp_in_linearly_from_exactly_zero() {
                 (k as f64 / n_ramp as f64).min(1.0)
             };
             assert!((ramp - expect).abs() < 1e-12, "tick {k}: ramp {ramp}");
-            for i in 0..4 {
+            for (i, (got, f)) in out.torques.iter().zip(full).enumerate() {
                 assert!(
-                    (out.torques[i] - expect * full[i]).abs() <= 1e-12 * (1.0 + full[i].abs()),
-                    "tick {k}, motor {i}: {} vs {expect} x {}",
-                    out.torques[i],
-                    full[i]
+                    (got - expect * f).abs() <= 1e-12 * (1.0 + f.abs()),
+                    "tick {k}, motor {i}: {got} vs {expect} x {f}"
                 );
             }
             if k == 0 {

@@ -237,7 +237,8 @@ impl HapticSystem {
 
         // 0. Stall: the device held the previous torques for `elapsed` seconds, unsupervised.
         let stall_limit = self.safety_config.max_stall_periods * dt;
-        if self.started && !(elapsed <= stall_limit) {
+        // (A NaN interval counts as a stall: a broken clock must not pass.)
+        if self.started && (elapsed.is_nan() || elapsed > stall_limit) {
             self.safety.trip(
                 k,
                 t,
