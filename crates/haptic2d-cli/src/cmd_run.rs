@@ -11,8 +11,8 @@ use haptic2d::control::passivity::PlanarPassivity;
 use haptic2d::haptic::{ControllerKind, HapticConfig, TickRecord};
 use haptic2d_rt::signal::install_ctrlc_stop;
 use haptic2d_rt::{
-    run_loop, telemetry_channel, CsvLogger, DeviceError, LoggerConfig, LoopConfig, SafetyInput,
-    TickControl, Watchdog, WatchdogConfig,
+    run_loop, telemetry_channel, CsvLogger, DeviceError, LoggerConfig, LoopConfig, TickControl,
+    Watchdog,
 };
 use std::net::SocketAddr;
 use std::path::PathBuf;
@@ -150,15 +150,10 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
         }
     };
     let logging = logger.is_some();
-    let mut watchdog = Watchdog::new(WatchdogConfig {
-        // The tick's own safety latch checks the kinematics and the singularity margin; this one
-        // adds what only the loop sees: a lost device and missed deadlines.
-        // A simulated or replayed device does not move between ticks, so a late tick cannot hurt
-        // anyone: missed deadlines are counted in the summary but do not stop the run. (A hardware
-        // driver will keep the default limit of 10 consecutive misses.)
-        min_singularity_margin: 0.0,
-        max_missed_run: None,
-    })?;
+    // The tick's own latch checks the kinematics, the singularity margin, the workspace bound and
+    // stalls; the watchdog adds what only the loop sees (a lost device, missed deadlines) and gets
+    // the tick's real margin and closure status (Rig::safety_input).
+    let mut watchdog = Watchdog::new(rig.watchdog_config())?;
     let stop = install_ctrlc_stop()?;
     let loop_config = LoopConfig {
         rate_hz: a.rate,
@@ -196,27 +191,15 @@ pub fn run(a: &RunArgs) -> Result<(), String> {
                     if let Some(v) = view.as_mut() {
                         v.apply_commands(&mut rig);
                     }
-                    let Rig { system, io, .. } = &mut rig;
-                    let (q, lost) = match io.read_encoders() {
+                    let paused = view.as_ref().is_some_and(|v| v.paused());
+                    let (q, lost) = match rig.io.read_encoders() {
                         Ok(q) => (q, None),
                         Err(e) => ([f64::NAN; 4], Some(e)),
                     };
-                    let out = if view.as_ref().is_some_and(|v| v.paused()) {
-                        system.tick_paused(&q)
-                    } else {
-                        system.tick(&q)
-                    };
+                    let out = rig.tick_system(&q, &info, paused);
                     let mut tau = out.torques;
-                    let safety = SafetyInput {
-                        deadline_missed: info.missed_deadline(),
-                        device_lost: lost.is_some(),
-                        pose: if lost.is_some() {
-                            [0.0; 3]
-                        } else {
-                            out.record.x_m
-                        },
-                        ..SafetyInput::nominal(info.index)
-                    };
+                    let safety = rig.safety_input(&info, &out, lost.is_some());
+                    let io = &mut rig.io;
                     let guard = watchdog.guard(&safety, &mut tau);
                     if let Some(e) = lost {
                         io.zero_torques();
