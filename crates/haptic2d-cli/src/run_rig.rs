@@ -121,7 +121,7 @@ impl Rig {
     /// on a stall); a device paced by the ticks gets one period. Never allocates.
     pub fn tick_system(&mut self, q: &V4, info: &TickInfo, paused: bool) -> TickOutput {
         let elapsed_ns = self.interval.update(info);
-        let out = if paused {
+        if paused {
             self.elapsed_periods = 1.0;
             self.system.tick_paused(q)
         } else if self.io.paced_by_ticks() {
@@ -131,8 +131,7 @@ impl Rig {
             self.elapsed_periods = elapsed_ns as f64 / info.period_ns as f64;
             let elapsed_s = elapsed_ns as f64 * 1e-9;
             self.system.tick_elapsed(q, elapsed_s)
-        };
-        out
+        }
     }
 
     /// The watchdog's input for the tick `info` whose output is `out`: the real singularity margin
