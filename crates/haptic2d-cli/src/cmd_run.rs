@@ -15,7 +15,7 @@ use haptic2d_rt::signal::install_stop_signals;
 use haptic2d_rt::telemetry::{ring_capacity, MAX_RING_BYTES};
 use haptic2d_rt::{
     run_loop, telemetry_channel, CsvLogger, DeviceError, FaultKind, LoggerConfig, LoopConfig,
-    SafetyInput, TelemetryTx, TickControl, TickInfo, TimingSummary, Watchdog, WatchdogConfig,
+    TelemetryTx, TickControl, TickInfo, TimingSummary, Watchdog,
 };
 use std::net::SocketAddr;
 use std::path::PathBuf;
@@ -143,7 +143,7 @@ pub fn run(a: &RunArgs) -> Result<Status, Failure> {
         (Some(server), Some(view))
     };
     let (tx, logger) = start_telemetry(a)?;
-    let watchdog = make_watchdog()?;
+    let watchdog = make_watchdog(&rig)?;
     let stop = install_stop()?;
     let loop_config = make_loop_config(a)?;
     println!(
@@ -246,16 +246,11 @@ fn start_telemetry(a: &RunArgs) -> Result<(TelemetryTx<TickRecord>, Option<CsvLo
 }
 
 /// Step 3: the loop's watchdog.
-fn make_watchdog() -> Result<Watchdog, Failure> {
-    Ok(Watchdog::new(WatchdogConfig {
-        // The tick's own safety latch checks the kinematics and the singularity margin; this one
-        // adds what only the loop sees: a lost device and missed deadlines.
-        // A simulated or replayed device does not move between ticks, so a late tick cannot hurt
-        // anyone: missed deadlines are counted in the summary but do not stop the run. (A hardware
-        // driver will keep the default limit of 10 consecutive misses.)
-        min_singularity_margin: 0.0,
-        max_missed_run: None,
-    })?)
+fn make_watchdog(rig: &Rig) -> Result<Watchdog, Failure> {
+    // The tick's own latch checks the kinematics, the singularity margin, the workspace bound and
+    // stalls; the watchdog adds what only the loop sees (a lost device, missed deadlines) and gets
+    // the tick's real margin and closure status (Rig::safety_input).
+    Ok(Watchdog::new(rig.watchdog_config())?)
 }
 
 /// Step 4: SIGINT and SIGTERM set the stop flag; the loop ends after its current tick.
@@ -296,27 +291,15 @@ impl LoopState<'_> {
         if let Some(v) = self.view.as_mut() {
             v.apply_commands(self.rig);
         }
-        let Rig { system, io, .. } = &mut *self.rig;
-        let (q, lost) = match io.read_encoders() {
+        let paused = self.view.as_ref().is_some_and(|v| v.paused());
+        let (q, lost) = match self.rig.io.read_encoders() {
             Ok(q) => (q, None),
             Err(e) => ([f64::NAN; 4], Some(e)),
         };
-        let out = if self.view.as_ref().is_some_and(|v| v.paused()) {
-            system.tick_paused(&q)
-        } else {
-            system.tick(&q)
-        };
+        let out = self.rig.tick_system(&q, info, paused);
         let mut tau = out.torques;
-        let safety = SafetyInput {
-            deadline_missed: info.missed_deadline(),
-            device_lost: lost.is_some(),
-            pose: if lost.is_some() {
-                [0.0; 3]
-            } else {
-                out.record.x_m
-            },
-            ..SafetyInput::nominal(info.index)
-        };
+        let safety = self.rig.safety_input(info, &out, lost.is_some());
+        let io = &mut self.rig.io;
         let guard = self.watchdog.guard(&safety, &mut tau);
         if let Some(e) = lost {
             io.zero_torques();
@@ -481,10 +464,11 @@ mod tests {
 
     fn state_with(rig: &mut Rig) -> LoopState<'_> {
         let (tx, _rx, _latest) = telemetry_channel(16, TickRecord::default()).unwrap();
+        let watchdog = make_watchdog(rig).unwrap();
         LoopState {
             rig,
             view: None,
-            watchdog: make_watchdog().unwrap(),
+            watchdog,
             tx,
             logging: false,
             end: None,

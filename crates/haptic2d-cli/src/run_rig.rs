@@ -3,11 +3,14 @@
 //! world and rebuilt when the live display resets or switches the scene.
 
 use crate::hand_arg::HandSpec;
-use haptic2d::device::linalg::V3;
-use haptic2d::haptic::{HapticConfig, HapticSystem};
+use haptic2d::device::linalg::{V3, V4};
+use haptic2d::haptic::{HapticConfig, HapticSystem, TickOutput};
 use haptic2d::world::World;
 use haptic2d_rt::io::DEFAULT_REPLAY_COLUMNS;
-use haptic2d_rt::{DeviceIo, ReplayDevice, ReplayEnd, SharedTarget, SimIo};
+use haptic2d_rt::{
+    DeviceIo, ReplayDevice, ReplayEnd, SafetyInput, SharedTarget, SimIo, TickInfo, TickInterval,
+    WatchdogConfig,
+};
 use std::path::PathBuf;
 use std::sync::Arc;
 
@@ -58,6 +61,10 @@ pub struct Rig {
     /// The target a `follow` hand pulls the handle towards (m, m, rad, handle coordinates): set by
     /// the page's pointer. `None` for any other hand or device.
     pub target: Option<Arc<SharedTarget>>,
+    /// Measures the interval between ticks (wake to wake).
+    interval: TickInterval,
+    /// The last tick's interval, in periods (1 for a device paced by the ticks).
+    elapsed_periods: f64,
 }
 
 impl Rig {
@@ -90,7 +97,61 @@ impl Rig {
             device,
             hand,
             target,
+            interval: TickInterval::new(),
+            elapsed_periods: 1.0,
         })
+    }
+
+    /// The watchdog's thresholds for this rig: the device file's singularity margin always; for a
+    /// real device also the stall limit of the tick's safety settings and 10 consecutive missed
+    /// deadlines. A device paced by the ticks (the simulated plant, a replay) does not move between
+    /// ticks, so a late tick cannot hurt anyone: stalls and misses are counted in the timing summary
+    /// but do not stop the run.
+    pub fn watchdog_config(&self) -> WatchdogConfig {
+        let real = !self.io.paced_by_ticks();
+        WatchdogConfig {
+            min_singularity_margin: self.config.device.min_singularity_margin,
+            max_missed_run: real.then_some(10),
+            max_stall_periods: real.then_some(self.system.safety_config().max_stall_periods),
+        }
+    }
+
+    /// One tick of the system on encoder angles `q` (rad), `paused` or running. A real device gets
+    /// the measured interval since the previous tick (the system differentiates over it and trips
+    /// on a stall); a device paced by the ticks gets one period. Never allocates.
+    pub fn tick_system(&mut self, q: &V4, info: &TickInfo, paused: bool) -> TickOutput {
+        let elapsed_ns = self.interval.update(info);
+        if paused {
+            self.elapsed_periods = 1.0;
+            self.system.tick_paused(q)
+        } else if self.io.paced_by_ticks() {
+            self.elapsed_periods = 1.0;
+            self.system.tick(q)
+        } else {
+            self.elapsed_periods = elapsed_ns as f64 / info.period_ns as f64;
+            let elapsed_s = elapsed_ns as f64 * 1e-9;
+            self.system.tick_elapsed(q, elapsed_s)
+        }
+    }
+
+    /// The watchdog's input for the tick `info` whose output is `out`: the real singularity margin
+    /// and closure status of the tick, the interval in periods, the deadline flag and whether the
+    /// device was lost (`lost`; the pose is then unknown and reported as zeros).
+    pub fn safety_input(
+        &self,
+        info: &TickInfo,
+        out: &TickOutput,
+        lost: bool,
+    ) -> SafetyInput<'static> {
+        SafetyInput {
+            deadline_missed: info.missed_deadline(),
+            device_lost: lost,
+            pose: if lost { [0.0; 3] } else { out.record.x_m },
+            closure_fault: out.closure_fault,
+            singularity_margin: if lost { 1.0 } else { out.margin },
+            elapsed_periods: self.elapsed_periods,
+            ..SafetyInput::nominal(info.index)
+        }
     }
 
     fn sim(
@@ -129,6 +190,7 @@ impl Rig {
             )?);
         }
         self.system = system;
+        self.interval.reset();
         Ok(())
     }
 
@@ -165,5 +227,80 @@ impl Rig {
             Some(t) => map.pose_to_world(&t.get()),
             None => map.pose_to_world(&self.system.last_record().x_m),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use haptic2d::scene::builtin;
+    use haptic2d_rt::Watchdog;
+
+    fn rig() -> Rig {
+        let scene = builtin("box-in-walls", Some(1000.0)).unwrap().unwrap();
+        Rig::new(
+            scene.world,
+            "box-in-walls",
+            HapticConfig::default(),
+            DeviceChoice::Sim,
+            HandSpec::Follow,
+        )
+        .unwrap()
+    }
+
+    fn info(k: u64) -> TickInfo {
+        TickInfo {
+            index: k,
+            deadline_index: k,
+            t_s: k as f64 * 1e-3,
+            period_s: 1e-3,
+            period_ns: 1_000_000,
+            lateness_ns: 0,
+            skipped: 0,
+            deadline_ns: k * 1_000_000,
+        }
+    }
+
+    /// Issue 11: `run` gave the watchdog a nominal singularity margin (1) and no closure fault.
+    #[test]
+    fn the_watchdog_gets_the_real_margin_and_closure_status() {
+        let mut rig = rig();
+        let mut dog = Watchdog::new(rig.watchdog_config()).unwrap();
+        assert_eq!(rig.watchdog_config().min_singularity_margin, 0.1);
+        let q = rig.io.read_encoders().unwrap();
+        let out = rig.tick_system(&q, &info(0), false);
+        let input = rig.safety_input(&info(0), &out, false);
+        assert!(input.singularity_margin < 1.0 && input.singularity_margin > 0.1);
+        assert_eq!(input.singularity_margin, rig.system.device().margin());
+        assert!(!input.closure_fault);
+        let mut tau = out.torques;
+        assert!(dog.guard(&input, &mut tau).is_ok());
+        // A slipped cable on pantograph 2: the closure monitor fails, and the watchdog hears it.
+        let mut bad = q;
+        bad[2] += 0.05;
+        let out = rig.tick_system(&bad, &info(1), false);
+        let input = rig.safety_input(&info(1), &out, false);
+        assert!(input.closure_fault);
+        let f = dog.guard(&input, &mut tau).unwrap_err();
+        assert_eq!(f.kind, haptic2d_rt::FaultKind::ClosureFault);
+        assert_eq!(tau, [0.0; 4]);
+    }
+
+    #[test]
+    fn a_simulated_device_is_paced_by_the_ticks() {
+        let mut rig = rig();
+        let cfg = rig.watchdog_config();
+        assert_eq!(cfg.max_stall_periods, None);
+        assert_eq!(cfg.max_missed_run, None);
+        // A 50 ms gap: the simulated plant advanced one period, so the tick uses one period and
+        // neither the system nor the watchdog sees a stall.
+        let q = rig.io.read_encoders().unwrap();
+        rig.tick_system(&q, &info(0), false);
+        let out = rig.tick_system(&q, &info(50), false);
+        assert!(!out.tripped);
+        assert_eq!(
+            rig.safety_input(&info(50), &out, false).elapsed_periods,
+            1.0
+        );
     }
 }

@@ -49,6 +49,15 @@ pub trait DeviceIo {
 
     /// A short human-readable name, e.g. "sim", "replay:run.csv".
     fn name(&self) -> &str;
+
+    /// True for a device whose motion advances one period per tick whatever the wall clock says (a
+    /// simulated plant stepped in `write_torques`, a replay that plays one row per read): a late tick
+    /// cannot hurt anyone there, so the loop neither measures the interval for it nor trips on
+    /// stalls. Default false: a real device moves in real time, and a stall leaves its last torques
+    /// applied unsupervised.
+    fn paced_by_ticks(&self) -> bool {
+        false
+    }
 }
 
 /// What a [`ReplayDevice`] does after its last sample.
@@ -197,5 +206,9 @@ impl DeviceIo for ReplayDevice {
 
     fn name(&self) -> &str {
         &self.name
+    }
+
+    fn paced_by_ticks(&self) -> bool {
+        true
     }
 }

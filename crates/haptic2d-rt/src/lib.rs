@@ -34,7 +34,7 @@ pub mod watchdog;
 pub use io::{DeviceError, DeviceIo, ReplayDevice, ReplayEnd};
 pub use logger::{CsvLogger, CsvRecord, LogReport, LoggerConfig};
 pub use rt::{setup_realtime, CorePin, RtReport, RtRequest};
-pub use runner::{run_loop, spawn_loop, LoopConfig, TickControl, TickInfo};
+pub use runner::{run_loop, spawn_loop, LoopConfig, TickControl, TickInfo, TickInterval};
 pub use sim_io::{SharedTarget, SimIo};
 pub use stats::{Percentiles, TimingStats, TimingSummary};
 pub use telemetry::{telemetry_channel, RecordRx, SnapshotRx, TelemetryTx};

@@ -108,6 +108,38 @@ impl TickInfo {
     }
 }
 
+/// Measures the time between consecutive ticks (wake to wake), for the stall check of the watchdog
+/// and for a tick that must differentiate over the real interval. No allocation.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct TickInterval {
+    prev_wake_ns: Option<u64>,
+}
+
+impl TickInterval {
+    /// A meter that has seen no tick yet.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Time since the previous tick's wake-up (ns), from this tick's `info`; one period for the
+    /// first tick. A wake-up is `deadline + lateness`.
+    #[inline]
+    pub fn update(&mut self, info: &TickInfo) -> u64 {
+        let wake = info.deadline_ns.saturating_add(info.lateness_ns);
+        let elapsed = match self.prev_wake_ns {
+            Some(p) => wake.saturating_sub(p),
+            None => info.period_ns,
+        };
+        self.prev_wake_ns = Some(wake);
+        elapsed
+    }
+
+    /// Forgets the previous tick (e.g. after a pause): the next update returns one period.
+    pub fn reset(&mut self) {
+        self.prev_wake_ns = None;
+    }
+}
+
 /// What the tick function wants next.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum TickControl {

@@ -127,4 +127,8 @@ impl DeviceIo for SimIo {
     fn name(&self) -> &str {
         &self.name
     }
+
+    fn paced_by_ticks(&self) -> bool {
+        true
+    }
 }

@@ -12,7 +12,11 @@
 //! 2. a non-finite torque, pose component or extra monitored value;
 //! 3. a kinematic closure fault (MODELS §10.3: `| |P₂ − P₁| − r_c | ≥ 1e-3 m`);
 //! 4. singularity margin below the limit (MODELS §10.4: 0.1);
-//! 5. `N` consecutive ticks that missed their deadline.
+//! 5. a stall: this tick came more than `max_stall_periods` periods after the previous one (the
+//!    device held its last torques, unsupervised, for that long) — one such tick is enough;
+//! 6. `N` consecutive ticks that missed their deadline.
+//!
+//! [`TickInterval`](crate::runner::TickInterval) measures the time between ticks for item 5.
 
 use std::fmt;
 
@@ -25,6 +29,10 @@ pub struct WatchdogConfig {
     /// Fault after this many consecutive ticks that missed their deadline;
     /// `None` disables the check. Default `Some(10)` (10 ms at 1 kHz).
     pub max_missed_run: Option<u32>,
+    /// Fault on a single tick that comes more than this many periods after the previous one
+    /// ([`SafetyInput::elapsed_periods`]); `None` disables the check. Default `Some(5.0)` (5 ms at
+    /// 1 kHz): a few periods, so that ordinary scheduling jitter passes and a stall does not.
+    pub max_stall_periods: Option<f64>,
 }
 
 impl Default for WatchdogConfig {
@@ -32,6 +40,7 @@ impl Default for WatchdogConfig {
         Self {
             min_singularity_margin: 0.1,
             max_missed_run: Some(10),
+            max_stall_periods: Some(5.0),
         }
     }
 }
@@ -44,6 +53,13 @@ impl WatchdogConfig {
                 "min_singularity_margin = {}: must be a number ≥ 0 (default 0.1)",
                 self.min_singularity_margin
             ));
+        }
+        if let Some(p) = self.max_stall_periods {
+            if !(p.is_finite() && p >= 1.0) {
+                return Err(format!(
+                    "max_stall_periods = {p}: must be a number ≥ 1 (periods; default 5), or none to disable the check"
+                ));
+            }
         }
         if self.max_missed_run == Some(0) {
             return Err("max_missed_run = 0: must be ≥ 1, or none to disable the check".into());
@@ -67,6 +83,9 @@ pub struct SafetyInput<'a> {
     /// it, or it started more than a period late; see
     /// [`TickInfo::missed_deadline`](crate::runner::TickInfo::missed_deadline)).
     pub deadline_missed: bool,
+    /// Time since the previous tick started, in periods (1 = on time; see
+    /// [`TickInterval`](crate::runner::TickInterval)). A non-finite value counts as a stall.
+    pub elapsed_periods: f64,
     /// True when device I/O reported the device lost.
     pub device_lost: bool,
     /// Any other values that must be finite (velocities, wrenches, …).
@@ -74,7 +93,7 @@ pub struct SafetyInput<'a> {
 }
 
 impl SafetyInput<'_> {
-    /// A nominal input at tick `tick`: pose at the origin, margin 1, no flags.
+    /// A nominal input at tick `tick`: pose at the origin, margin 1, on time, no flags.
     pub fn nominal(tick: u64) -> SafetyInput<'static> {
         SafetyInput {
             tick,
@@ -82,6 +101,7 @@ impl SafetyInput<'_> {
             closure_fault: false,
             singularity_margin: 1.0,
             deadline_missed: false,
+            elapsed_periods: 1.0,
             device_lost: false,
             extra: &[],
         }
@@ -126,6 +146,13 @@ pub enum FaultKind {
         /// Margin measured.
         margin: f64,
         /// Limit configured.
+        limit: f64,
+    },
+    /// One tick came too long after the previous one.
+    Stall {
+        /// Time since the previous tick, in periods.
+        periods: f64,
+        /// Limit configured, in periods.
         limit: f64,
     },
     /// Too many consecutive ticks missed their deadline.
@@ -183,6 +210,10 @@ impl fmt::Display for Fault {
             FaultKind::Singularity { margin, limit } => write!(
                 f,
                 "singularity margin {margin:.3} below the limit {limit:.3} (handle near the workspace boundary)"
+            ),
+            FaultKind::Stall { periods, limit } => write!(
+                f,
+                "the loop stalled: this tick came {periods:.1} periods after the previous one (limit {limit}); the device held its torques unsupervised (machine overloaded, or the device blocked)"
             ),
             FaultKind::MissedDeadlines { run, limit } => write!(
                 f,
@@ -275,6 +306,13 @@ impl Watchdog {
                 margin: input.singularity_margin,
                 limit: self.config.min_singularity_margin,
             });
+        }
+        if let Some(limit) = self.config.max_stall_periods {
+            // (NaN is a stall: a broken clock must not pass.)
+            let p = input.elapsed_periods;
+            if p.is_nan() || p > limit {
+                return Some(FaultKind::Stall { periods: p, limit });
+            }
         }
         if let Some(limit) = self.config.max_missed_run {
             if self.missed_run >= limit {

@@ -190,3 +190,82 @@ fn invalid_config_names_the_parameter() {
     .unwrap_err();
     assert!(e.contains("max_missed_run"));
 }
+
+/// Issue 11: a stall of any length used to count as one missed deadline (10 in a row needed). Now a
+/// single tick more than `max_stall_periods` periods after the previous one trips, in that tick.
+#[test]
+fn one_stalled_tick_longer_than_the_limit_trips_at_once() {
+    let mut w = dog();
+    let mut tau = TAU;
+    for k in 0..5 {
+        assert!(w.guard(&SafetyInput::nominal(k), &mut tau).is_ok());
+    }
+    // 4.9 periods late is jitter; 50 periods (50 ms at 1 kHz) is a stall.
+    let late = SafetyInput {
+        elapsed_periods: 4.9,
+        deadline_missed: true,
+        ..SafetyInput::nominal(5)
+    };
+    assert!(w.guard(&late, &mut tau).is_ok());
+    let stall = SafetyInput {
+        elapsed_periods: 50.0,
+        deadline_missed: true,
+        ..SafetyInput::nominal(6)
+    };
+    let f = w.guard(&stall, &mut tau).unwrap_err();
+    assert_eq!(tau, [0.0; 4]);
+    assert_eq!(
+        f.kind,
+        FaultKind::Stall {
+            periods: 50.0,
+            limit: 5.0
+        }
+    );
+    assert!(f.reason().contains("stalled"), "{}", f.reason());
+    // A broken interval (NaN) is a stall too; disabled, nothing trips.
+    let mut w = dog();
+    let nan = SafetyInput {
+        elapsed_periods: f64::NAN,
+        ..SafetyInput::nominal(0)
+    };
+    assert!(w.guard(&nan, &mut TAU.clone()).is_err());
+    let mut off = Watchdog::new(WatchdogConfig {
+        max_stall_periods: None,
+        ..WatchdogConfig::default()
+    })
+    .unwrap();
+    assert!(off.guard(&stall, &mut TAU.clone()).is_ok());
+    // The limit is checked.
+    let bad = WatchdogConfig {
+        max_stall_periods: Some(0.5),
+        ..WatchdogConfig::default()
+    };
+    assert!(bad.validate().unwrap_err().contains("max_stall_periods"));
+}
+
+#[test]
+fn tick_interval_measures_wake_to_wake() {
+    use haptic2d_rt::{TickInfo, TickInterval};
+    let period_ns = 1_000_000;
+    let info = |k: u64, lateness_ns: u64| TickInfo {
+        index: k,
+        deadline_index: k,
+        t_s: k as f64 * 1e-3,
+        period_s: 1e-3,
+        period_ns,
+        lateness_ns,
+        skipped: 0,
+        deadline_ns: 5_000_000 + k * period_ns,
+    };
+    let mut m = TickInterval::new();
+    assert_eq!(
+        m.update(&info(0, 20_000)),
+        period_ns,
+        "first tick: one period"
+    );
+    assert_eq!(m.update(&info(1, 20_000)), period_ns);
+    // Deadlines 2..49 skipped, tick 50 woke 0.3 ms late.
+    assert_eq!(m.update(&info(50, 300_000)), 49 * period_ns + 280_000);
+    m.reset();
+    assert_eq!(m.update(&info(51, 0)), period_ns);
+}

@@ -52,14 +52,16 @@ fn fig8_fig11_classical_drifts_others_stick_slip() {
 }
 
 /// The four-channel loop with the handle released: the y/θ rattle makes every run stop safely at the
-/// workspace edge (deterministic), so the claim cannot be measured there.
+/// workspace bound (deterministic), so the claim cannot be measured there.
 #[test]
 fn fig8_four_channel_free_handle_rattles_and_stops_safely() {
     let cases = run(&Fig8Params::four_channel()).expect("runs");
     report("four-channel", &cases);
     for c in &cases {
         let s = c.stopped.as_deref().expect("safety stop");
-        assert!(s.contains("singularity"), "{}: {s}", c.name);
+        // The workspace bound of the device file (10 mm past the ±32 mm square) catches the rattle
+        // before the singularity margin does.
+        assert!(s.contains("workspace edge"), "{}: {s}", c.name);
         assert!(c
             .records
             .last()

@@ -20,7 +20,8 @@ use haptic2d::control::four_channel::FourChannelGains;
 use haptic2d::control::passivity::PlanarPassivity;
 use haptic2d::device::{DeviceParams, HandModel};
 use haptic2d::haptic::{
-    ControllerKind, DeviceInTheLoop, HapticConfig, HapticSystem, SafetyReason, TickRecord,
+    ControllerKind, DeviceInTheLoop, HapticConfig, HapticSystem, SafetyConfig, SafetyReason,
+    TickRecord,
 };
 use haptic2d::scene::builtin;
 
@@ -260,15 +261,35 @@ fn safety_closure_fault_is_zeroed_in_the_same_tick_and_latched() {
         let q = l.plant.encoders().unwrap();
         assert_eq!(l.system.tick(&q).torques, [0.0; 4]);
     }
+    // Re-armed: the first tick re-aligns and starts the ramp at exactly zero, then the torques
+    // come back.
     l.system.reset_safety();
-    let q = l.plant.encoders().unwrap();
-    let out = l.system.tick(&q);
-    assert!(!out.tripped && out.torques.iter().any(|t| *t != 0.0));
+    let out = l.step().unwrap();
+    assert!(!out.tripped);
+    assert_eq!(out.torques, [0.0; 4], "the ramp starts at zero");
+    let mut back = false;
+    for _ in 0..50 {
+        let out = l.step().unwrap();
+        assert!(!out.tripped, "{:?}", l.system.safety_trip());
+        back |= out.torques.iter().any(|t| *t != 0.0);
+    }
+    assert!(back, "the torques ramp back in");
 }
 
 #[test]
 fn safety_singularity_margin_trips() {
-    let mut l = held_loop();
+    // The workspace bound would trip first out there (tests/workspace_bound.rs): move it out of the
+    // way, so that this test sees the singularity check itself.
+    let config = HapticConfig {
+        device: DeviceParams {
+            workspace_trip_distance: 1.0,
+            workspace_wall_stiffness: 0.0,
+            ..DeviceParams::default()
+        },
+        ..HapticConfig::default()
+    };
+    let mut l = closed_loop(&config, box_world(0.01, None), HandModel::Free, true);
+    l.hand = HandModel::grip(l.plant.pose());
     l.step().unwrap();
     // Encoders of a handle pose far outside the workspace, next to the reach boundary.
     let kin = l.system.device().kin;
@@ -297,7 +318,8 @@ fn safety_singularity_margin_trips() {
 
 /// PC on the device port in a passive scenario: the hand pushes the box into the damped wall of the
 /// paper's law through the virtual coupling; the observed energy never goes (meaningfully) negative
-/// and the controller never acts.
+/// and the controller never acts. No start-up ramp here: the hand pushes from the first tick, and a
+/// gain that grows while the coupling is stretched is not passive (the PC rightly answers it).
 #[test]
 fn pc2_pc4_passivity_controller_on_the_device_port() {
     for (name, controller) in [
@@ -310,7 +332,16 @@ fn pc2_pc4_passivity_controller_on_the_device_port() {
             passivity: Some(PlanarPassivity::default()),
             ..HapticConfig::default()
         };
-        let mut l = closed_loop(&config, box_world(0.001, None), push(), false);
+        let sys = HapticSystem::with_safety(
+            box_world(0.001, None),
+            &config,
+            SafetyConfig {
+                ramp_time: 0.0,
+                ..SafetyConfig::default()
+            },
+        )
+        .expect("valid system");
+        let mut l = DeviceInTheLoop::new(sys, push(), 10, false).expect("plant");
         l.hand = reference_hand(l.plant.pose());
         let (mut min_e, mut max_alpha) = (f64::INFINITY, 0.0f64);
         let (mut min_dof, mut max_alpha_dof) = ([f64::INFINITY; 3], [0.0f64; 3]);

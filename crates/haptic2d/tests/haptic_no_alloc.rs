@@ -4,7 +4,7 @@
 
 use haptic2d::control::passivity::PlanarPassivity;
 use haptic2d::device::{HandModel, SimDevice};
-use haptic2d::haptic::{ControllerKind, HapticConfig, HapticSystem};
+use haptic2d::haptic::{ControllerKind, HapticConfig, HapticSystem, SafetyConfig};
 use haptic2d::scene::builtin;
 #[path = "support/counting_alloc.rs"]
 mod counting_alloc;
@@ -20,7 +20,14 @@ fn tick_allocations(
     measure: usize,
 ) -> u64 {
     let world = builtin(scene, Some(1000.0)).unwrap().unwrap().world;
-    let mut sys = HapticSystem::new(world, config).unwrap();
+    // The hands here push from the first tick; with the start-up ramp the handle would give way and
+    // reach the workspace bound (a safety stop, by design). The ramp's own path is counted in
+    // `safety_paths_of_the_tick_do_not_allocate`.
+    let safety = SafetyConfig {
+        ramp_time: 0.0,
+        ..SafetyConfig::default()
+    };
+    let mut sys = HapticSystem::with_safety(world, config, safety).unwrap();
     let mut plant = SimDevice::new(&config.device, sys.device_start()).unwrap();
     let mut total = 0;
     for k in 0..warm + measure {
@@ -77,4 +84,48 @@ fn tick_does_not_allocate_once_warm() {
         0,
         "peg-in-hole"
     );
+}
+
+/// The safety paths of the tick (the start-up ramp, late ticks over the measured interval, the
+/// workspace wall, the final clamp, the passivity controller's booking) allocate nothing either.
+#[test]
+fn safety_paths_of_the_tick_do_not_allocate() {
+    let world = builtin("box-in-walls", Some(1000.0))
+        .unwrap()
+        .unwrap()
+        .world;
+    let config = HapticConfig {
+        passivity: Some(PlanarPassivity::default()),
+        keep_slave_loads: true,
+        ..HapticConfig::default()
+    };
+    let mut sys = HapticSystem::new(world, &config).unwrap();
+    let p = config.device;
+    let c = sys.device_start();
+    let edge = p.workspace_center_x + p.workspace_half_width;
+    // Warm up inside, then walk out past the edge (wall active) with every third tick 3 periods
+    // late, and a torque request just above τ_max (clamped) now and then.
+    let q0 = sys.device().kin.ik(&c).unwrap();
+    for _ in 0..50 {
+        sys.tick(&q0);
+    }
+    let mut total = 0;
+    let mut x = c[0];
+    for k in 0..1500 {
+        x = (x + 0.00003).min(edge + 0.005);
+        let q = sys.device().kin.ik(&[x, c[1], c[2]]).unwrap();
+        if k % 97 == 0 {
+            sys.inject_torque_fault(1, 0.51);
+        }
+        let before = allocations();
+        let out = if k % 3 == 0 {
+            sys.tick_elapsed(&q, 0.003)
+        } else {
+            sys.tick(&q)
+        };
+        total += allocations() - before;
+        assert!(!out.tripped, "tick {k}: {:?}", sys.safety_trip());
+    }
+    assert!(sys.last_record().x_m[0] > edge, "the wall was reached");
+    assert_eq!(total, 0);
 }

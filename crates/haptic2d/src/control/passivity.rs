@@ -5,6 +5,26 @@
 //! observer tracks the energy that has flowed **into** the environment, which must stay ≥ 0; the
 //! controller (impedance causality: velocity in, force out) adds damping `α_k` whenever the observed
 //! energy is negative.
+//!
+//! Two things the textbook form leaves to the integrator, done here:
+//!
+//! - **Book what was applied.** The observer must pair the displacement with the force the device
+//!   actually produced, which after saturation, the start-up ramp or a safety stop is not `F_out`.
+//!   [`PassivityController::book_applied`] replaces the held force by the applied one (ZOH pairing).
+//! - **Bound α by the explicit-damping limit.** The added damping `−α·v̂_k` is computed from the
+//!   state at `k` and held over the sample: on a mass `M` that is the explicit-Euler update
+//!   `v_{k+1} = (1 − α·T/M)·v_k`, which is stable only for `|1 − α·T/M| < 1`, i.e. `α < 2·M/T`
+//!   ([`explicit_damping_limit`]). Above it the "damping" injects energy: each sample reverses the
+//!   velocity and grows it. [`PassivityController::update_limited`] caps α at
+//!   `min(α_max, 2·M/T)` for the axis's inertia `M`.
+
+/// The explicit-damping limit `2·M/T` (N·s/m, or N·m·s/rad for an inertia in kg·m²): the largest
+/// damping a sampled controller can add to mass `M` (kg or kg·m²) at period `dt` (s) without making
+/// the sampled velocity update unstable (see the module doc).
+#[inline]
+pub fn explicit_damping_limit(mass: f64, dt: f64) -> f64 {
+    2.0 * mass / dt
+}
 
 /// How the observer pairs force and motion.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -151,6 +171,19 @@ impl PassivityController {
     /// uncorrected environment force `f_env` (N) and the period `dt` (s). Returns `F_out,k` (N), which
     /// the caller must hold over the sample.
     pub fn update(&mut self, x: f64, v_hat: f64, f_env: f64, dt: f64) -> f64 {
+        self.update_limited(x, v_hat, f_env, dt, f64::INFINITY)
+    }
+
+    /// [`update`](Self::update) with α capped at `min(α_max, alpha_cap)`; pass
+    /// [`explicit_damping_limit`] of the axis's inertia as `alpha_cap` (N·s/m or N·m·s/rad).
+    pub fn update_limited(
+        &mut self,
+        x: f64,
+        v_hat: f64,
+        f_env: f64,
+        dt: f64,
+        alpha_cap: f64,
+    ) -> f64 {
         // Observer.
         match self.pairing {
             EnergyPairing::ZohConsistent => {
@@ -165,7 +198,9 @@ impl PassivityController {
         }
         // Controller.
         self.alpha = if self.control && self.e_obs < 0.0 && v_hat.abs() > self.v_min {
-            (-self.e_obs / (dt * v_hat * v_hat)).min(self.alpha_max)
+            (-self.e_obs / (dt * v_hat * v_hat))
+                .min(self.alpha_max)
+                .min(alpha_cap.max(0.0))
         } else {
             0.0
         };
@@ -176,6 +211,23 @@ impl PassivityController {
         self.v_prev = v_hat;
         self.alpha_prev = self.alpha;
         f_out
+    }
+}
+
+impl PassivityController {
+    /// Books `f_applied` (N or N·m), the force the device actually produced over this sample (after
+    /// saturation, ramp or a safety stop), as the held force the next sample pairs with its
+    /// displacement (ZOH pairing). With the same-sample pairing (a comparison option) this only
+    /// records the value; that pairing books `F_env` by definition.
+    pub fn book_applied(&mut self, f_applied: f64) {
+        if self.started {
+            self.f_prev = f_applied;
+        }
+    }
+
+    /// The force booked for the last sample (N or N·m): `F_out` or what [`Self::book_applied`] set.
+    pub fn booked_force(&self) -> f64 {
+        self.f_prev
     }
 }
 
@@ -228,6 +280,38 @@ impl PlanarPassivity {
             self.theta.update(pose[2], vel[2], wrench[2], dt),
         ]
     }
+    /// [`update`](Self::update) with each axis's α capped at `alpha_cap[i]` (see
+    /// [`PassivityController::update_limited`]).
+    pub fn update_limited(
+        &mut self,
+        pose: [f64; 3],
+        vel: [f64; 3],
+        wrench: [f64; 3],
+        dt: f64,
+        alpha_cap: [f64; 3],
+    ) -> [f64; 3] {
+        [
+            self.x
+                .update_limited(pose[0], vel[0], wrench[0], dt, alpha_cap[0]),
+            self.y
+                .update_limited(pose[1], vel[1], wrench[1], dt, alpha_cap[1]),
+            self.theta
+                .update_limited(pose[2], vel[2], wrench[2], dt, alpha_cap[2]),
+        ]
+    }
+    /// Books the wrench the device actually produced this sample (see
+    /// [`PassivityController::book_applied`]).
+    pub fn book_applied(&mut self, wrench: [f64; 3]) {
+        self.x.book_applied(wrench[0]);
+        self.y.book_applied(wrench[1]);
+        self.theta.book_applied(wrench[2]);
+    }
+    /// Zeroes α on every axis (the loop is stopped: nothing is added).
+    pub fn idle(&mut self) {
+        self.x.alpha = 0.0;
+        self.y.alpha = 0.0;
+        self.theta.alpha = 0.0;
+    }
     /// Total observed energy over the three DOFs (J).
     pub fn e_obs(&self) -> f64 {
         self.x.e_obs() + self.y.e_obs() + self.theta.e_obs()
@@ -260,6 +344,28 @@ mod tests {
         capped.update(0.0, 0.0, 2.0, 0.002);
         capped.update(0.001, 0.5, 0.0, 0.002);
         assert_eq!(capped.alpha(), 1.0);
+    }
+
+    #[test]
+    fn alpha_is_capped_by_the_explicit_damping_limit() {
+        // A 4 N·s/m request on a 1 g mass at T = 2 ms: the limit 2·M/T = 1 N·s/m wins.
+        let cap = explicit_damping_limit(0.001, 0.002);
+        assert!((cap - 1.0).abs() < 1e-12);
+        let mut pc = PassivityController::linear();
+        pc.update_limited(0.0, 0.0, 2.0, 0.002, cap);
+        pc.update_limited(0.001, 0.5, 0.0, 0.002, cap);
+        assert_eq!(pc.alpha(), 1.0);
+    }
+
+    #[test]
+    fn booked_force_replaces_the_commanded_one() {
+        // Commanded 2 N, but only 0.5 N was applied (saturation): the 1 mm that followed took
+        // 0.5 mJ out of the environment, not 2 mJ.
+        let mut pc = PassivityController::linear().observer_only();
+        pc.update(0.0, 0.0, 2.0, 0.002);
+        pc.book_applied(0.5);
+        pc.update(0.001, 0.5, 0.0, 0.002);
+        assert!((pc.e_obs() + 0.0005).abs() < 1e-15);
     }
 
     #[test]

@@ -37,15 +37,34 @@ impl VelocityFilter {
     /// Feeds pose `x_k` (m, m, rad with θ unwrapped) and returns `v̂_k` (m/s, m/s, rad/s). The first
     /// sample after construction or [`reset`](Self::reset) returns zero.
     pub fn update(&mut self, x: &V3) -> V3 {
+        self.update_elapsed(x, self.dt)
+    }
+
+    /// Like [`update`](Self::update), for a sample taken `elapsed` seconds after the previous one
+    /// (a late tick): the difference is divided by the measured interval and the filter coefficient
+    /// is that of the interval, `α = 1 − exp(−2π·f_v·elapsed)`, so a handle moving steadily reads the
+    /// same speed whether the tick came on time or late. `elapsed == T` is exactly [`update`]; a
+    /// non-finite or non-positive `elapsed` is taken as `T`.
+    pub fn update_elapsed(&mut self, x: &V3, elapsed: f64) -> V3 {
         if !self.initialized {
             self.initialized = true;
             self.x_prev = *x;
             self.v = [0.0; 3];
             return self.v;
         }
+        let (h, alpha) = if elapsed == self.dt || !(elapsed.is_finite() && elapsed > 0.0) {
+            (self.dt, self.alpha)
+        } else {
+            // α_v = 1 − exp(−2π f_v T) with T → elapsed: the cut-off f_v = −ln(1 − α)/(2π T).
+            let f_v = -(1.0 - self.alpha).ln() / (std::f64::consts::TAU * self.dt);
+            (
+                elapsed,
+                1.0 - (-std::f64::consts::TAU * f_v * elapsed).exp(),
+            )
+        };
         for ((v, xi), xp) in self.v.iter_mut().zip(x).zip(&self.x_prev) {
-            let raw = (xi - xp) / self.dt;
-            *v += self.alpha * (raw - *v);
+            let raw = (xi - xp) / h;
+            *v += alpha * (raw - *v);
         }
         self.x_prev = *x;
         self.v

@@ -86,6 +86,27 @@ impl HandWrenchObserver {
     ///
     /// The friction estimate is `τ̂_f = f_c·sgn(q̇) + f_v·q̇` at `q̇ = J_a·v̂` (the model's friction).
     pub fn update(&mut self, x: &V3, v: &V3, tau_prev: &V4) -> Result<V3, DeviceFault> {
+        self.update_elapsed(x, v, tau_prev, self.dt)
+    }
+
+    /// Like [`update`](Self::update) for a sample taken `elapsed` seconds after the previous one (a
+    /// late tick; `elapsed == T` is exactly `update`). The momentum observer integrates the held
+    /// torques over the measured interval (they were held that long); the inverse-dynamics observer
+    /// cannot difference twice over unequal intervals, so it holds its estimate for that sample; the
+    /// static observer needs no time.
+    pub fn update_elapsed(
+        &mut self,
+        x: &V3,
+        v: &V3,
+        tau_prev: &V4,
+        elapsed: f64,
+    ) -> Result<V3, DeviceFault> {
+        let h = if elapsed.is_finite() && elapsed > 0.0 {
+            elapsed
+        } else {
+            self.dt
+        };
+        let late = h != self.dt;
         let terms = self.model.terms(x, v)?;
         let first = self.k == 0;
         let w = match self.kind {
@@ -98,7 +119,16 @@ impl HandWrenchObserver {
                 let tf = self.model.joint_friction(&terms.qd);
                 let net: V4 = std::array::from_fn(|i| tau_prev[i] - tf[i]);
                 let drive = jt_mul_v(&terms.j, &net);
-                let raw: V3 = if self.k >= 2 {
+                let raw: V3 = if late {
+                    // Hold: restart the difference history at this sample.
+                    self.x1 = *x;
+                    self.x2 = *x;
+                    self.prev_j = terms.j;
+                    self.prev_qd = terms.qd;
+                    self.prev_bias = terms.momentum_bias;
+                    self.k += 1;
+                    return Ok(self.r);
+                } else if self.k >= 2 {
                     let t2 = self.dt * self.dt;
                     std::array::from_fn(|i| (x[i] - 2.0 * self.x1[i] + self.x2[i]) / t2)
                 } else {
@@ -122,7 +152,7 @@ impl HandWrenchObserver {
                     let drive = jt_mul_v(&self.prev_j, &net);
                     let mut r = [0.0; 3];
                     for i in 0..3 {
-                        self.integral[i] += self.dt * (drive[i] + self.prev_bias[i] + self.r[i]);
+                        self.integral[i] += h * (drive[i] + self.prev_bias[i] + self.r[i]);
                         r[i] = self.k_o[i] * (p[i] - self.p0[i] - self.integral[i]);
                     }
                     r

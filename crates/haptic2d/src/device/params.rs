@@ -63,6 +63,17 @@ pub struct DeviceParams {
     /// Friction-compensation fraction applied by the low-level controller, `0..=1` (§11.2). Default 0
     /// (the spec's option uses 0.5).
     pub friction_compensation: f64,
+    /// Stiffness of the workspace bound (N/m): past the edge of the workspace square the handle feels
+    /// a wall `F = −K·(penetration) − B·v` (never pulling inward). Default 2000; 0 = no wall (the trip
+    /// still applies).
+    pub workspace_wall_stiffness: f64,
+    /// Damping of the workspace bound `B` (N·s/m). Default 5. The loop renders the wall with stiffness
+    /// `min(K, 2·B/T)`, so that Colgate's condition `B ≥ K·T/2` (§5.4) holds at its period `T` and the
+    /// sampled wall stays passive (at 1 kHz the default 2000 N/m is rendered in full down to 200 Hz).
+    pub workspace_wall_damping: f64,
+    /// Trip distance (m): the safety latch trips when the handle is more than this far past the edge of
+    /// the workspace square. Default 0.01.
+    pub workspace_trip_distance: f64,
 }
 
 impl Default for DeviceParams {
@@ -92,6 +103,9 @@ impl Default for DeviceParams {
             closure_tol: 1e-3,
             min_singularity_margin: 0.1,
             friction_compensation: 0.0,
+            workspace_wall_stiffness: 2000.0,
+            workspace_wall_damping: 5.0,
+            workspace_trip_distance: 0.01,
         }
     }
 }
@@ -100,7 +114,7 @@ impl DeviceParams {
     /// Every field, in declaration order, with its unit as written in scene and device files
     /// (`"-"` for a dimensionless number). Used by file loaders for messages and by the template
     /// `devices/twin-pantograph.toml`.
-    pub const FIELDS: [(&'static str, &'static str); 24] = [
+    pub const FIELDS: [(&'static str, &'static str); 27] = [
         ("s", "m"),
         ("l1", "m"),
         ("l2", "m"),
@@ -125,6 +139,9 @@ impl DeviceParams {
         ("closure_tol", "m"),
         ("min_singularity_margin", "-"),
         ("friction_compensation", "-"),
+        ("workspace_wall_stiffness", "N/m"),
+        ("workspace_wall_damping", "N·s/m"),
+        ("workspace_trip_distance", "m"),
     ];
 
     /// The unit of field `name` (see [`DeviceParams::FIELDS`]), or `None` for an unknown name.
@@ -213,6 +230,9 @@ impl DeviceParams {
                 self.friction_compensation
             ));
         }
+        non_negative("workspace_wall_stiffness", self.workspace_wall_stiffness)?;
+        non_negative("workspace_wall_damping", self.workspace_wall_damping)?;
+        positive("workspace_trip_distance", self.workspace_trip_distance)?;
         if self.l2 <= self.s / 2.0 {
             return Err(format!(
                 "device.l2 ({}) must exceed s/2 ({}) for the distal links to meet",

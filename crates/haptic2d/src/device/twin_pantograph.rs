@@ -6,7 +6,7 @@ use super::dynamics::LumpedDynamics;
 use super::fault::DeviceFault;
 use super::filter::VelocityFilter;
 use super::jacobian::{jacobian, jacobian_at, singularity_margin_at};
-use super::linalg::{j_mul_v, M43, V3, V4};
+use super::linalg::{j_mul_v, M3, M43, V3, V4};
 use super::observer::{HandWrenchObserver, ObserverKind};
 use super::params::DeviceParams;
 use super::redundancy::{min_norm_torques, null_vector, saturate};
@@ -107,9 +107,24 @@ impl TwinPantograph {
     /// Steps 1–2 in one call: pose from encoders, filtered velocity, and the hand-wrench estimate using
     /// the torques `tau_prev` (N·m) applied during the previous interval.
     pub fn estimate(&mut self, q: &V4, tau_prev: &V4) -> Result<DeviceEstimate, DeviceFault> {
+        self.estimate_elapsed(q, tau_prev, self.filter.dt)
+    }
+
+    /// [`estimate`](Self::estimate) for a reading taken `elapsed` seconds (measured) after the
+    /// previous one: the velocity filter differentiates over, and the momentum observer integrates
+    /// the held torques over, the measured interval (§10.6, §10.7), so a late tick does not read a
+    /// normal motion as a jump. `elapsed == T` is exactly `estimate`.
+    pub fn estimate_elapsed(
+        &mut self,
+        q: &V4,
+        tau_prev: &V4,
+        elapsed: f64,
+    ) -> Result<DeviceEstimate, DeviceFault> {
         let pose = self.pose_from_encoders(q)?;
-        self.velocity = self.filter.update(&pose);
-        let hand_wrench = self.observer.update(&pose, &self.velocity, tau_prev)?;
+        self.velocity = self.filter.update_elapsed(&pose, elapsed);
+        let hand_wrench = self
+            .observer
+            .update_elapsed(&pose, &self.velocity, tau_prev, elapsed)?;
         Ok(DeviceEstimate {
             pose,
             velocity: self.velocity,
@@ -171,5 +186,14 @@ impl TwinPantograph {
     /// The singularity margin at the last measured pose (dimensionless).
     pub fn margin(&self) -> f64 {
         self.margin
+    }
+
+    /// The mass matrix `M_x` (kg, kg·m, kg·m², §10.6) at the last measured pose; zero before the first
+    /// reading.
+    pub fn mass_matrix(&self) -> M3 {
+        match self.pose {
+            Some(p) => self.model.mass_matrix(&self.jac, p[2]),
+            None => [[0.0; 3]; 3],
+        }
     }
 }

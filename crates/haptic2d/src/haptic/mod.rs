@@ -15,10 +15,12 @@ pub mod mapping;
 pub mod record;
 pub mod safety;
 pub mod system;
+pub mod workspace;
 
 pub use config::{ControllerKind, HapticConfig};
 pub use experiment::DeviceInTheLoop;
 pub use mapping::DeviceMap;
 pub use record::{TickRecord, TICK_COLUMNS};
-pub use safety::{Safety, SafetyReason, SafetyTrip};
+pub use safety::{Safety, SafetyConfig, SafetyReason, SafetyTrip};
 pub use system::{HapticSystem, TickOutput};
+pub use workspace::WorkspaceBound;

@@ -3,9 +3,9 @@
 
 use crate::control::coupling::VirtualCoupling;
 use crate::control::four_channel::{FourChannel, TeleopSignals};
-use crate::control::passivity::PlanarPassivity;
-use crate::device::linalg::{V3, V4};
-use crate::device::{DeviceEstimate, TwinPantograph};
+use crate::control::passivity::{explicit_damping_limit, PlanarPassivity};
+use crate::device::linalg::{M3, V3, V4};
+use crate::device::{DeviceEstimate, DeviceFault, TwinPantograph};
 use crate::geom::Vec2;
 use crate::world::World;
 
@@ -14,7 +14,8 @@ use super::mapping::DeviceMap;
 use super::record::{
     TickRecord, FLAG_NEAR_SINGULAR, FLAG_PASSIVITY_ACTIVE, FLAG_SAFETY, FLAG_SATURATED,
 };
-use super::safety::{Safety, SafetyReason, SafetyTrip};
+use super::safety::{Safety, SafetyConfig, SafetyReason, SafetyTrip};
+use super::workspace::WorkspaceBound;
 
 /// The running controller (one of the §11 architectures).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -62,12 +63,23 @@ pub struct TickOutput {
     pub torques: V4,
     /// True when the safety latch is set (this tick or earlier).
     pub tripped: bool,
+    /// The singularity margin at the measured pose (dimensionless, §10.4); 0 when the device could
+    /// not be read this tick. For a watchdog downstream.
+    pub margin: f64,
+    /// True when the kinematic consistency (closure) monitor of §10.3 failed this tick.
+    pub closure_fault: bool,
     /// The tick's telemetry record.
     pub record: TickRecord,
 }
 
 /// The whole haptic system of DESIGN §1: twin-pantograph estimator, teleoperation controller, optional
 /// passivity controller on the device port, and the virtual world with its slave body.
+///
+/// Safety (DESIGN §7) is part of the system, so every device gets it: the torques are exactly zero
+/// until the first valid device reading; at that reading the mapping is re-anchored so that the
+/// measured handle pose lands on the slave's pose (no coupling force on the first tick), and the
+/// torques ramp in over [`SafetyConfig::ramp_time`]; the workspace bound of the device file is a
+/// passive wall with a trip beyond it; a stall trips; the final gate clamps to `τ_max`.
 #[derive(Clone, Debug)]
 pub struct HapticSystem {
     device: TwinPantograph,
@@ -76,19 +88,40 @@ pub struct HapticSystem {
     world: World,
     slave: usize,
     map: DeviceMap,
+    workspace: WorkspaceBound,
     safety: Safety,
+    safety_config: SafetyConfig,
     preload: f64,
     dt: f64,
     tau_prev: V4,
     injected: Option<(usize, f64)>,
+    /// False until the first valid reading after construction, a re-arm or a pause.
+    aligned: bool,
+    /// Ticks since the alignment (the ramp's clock).
+    ramp_ticks: u64,
+    /// Ticks of the ramp, `round(ramp_time / T)` (0 = no ramp).
+    ramp_len: u64,
+    /// True once any tick has read the device (the stall check needs a previous tick).
+    started: bool,
     record: TickRecord,
 }
 
 impl HapticSystem {
-    /// Builds the system around `world` (its sample period is the tick period). Checks the device
-    /// parameters at that period, the controller gains against the slave's mass (§6.4), the passivity
-    /// controller, the mapping and the preload; errors name the setting to fix.
-    pub fn new(mut world: World, config: &HapticConfig) -> Result<Self, String> {
+    /// Builds the system around `world` (its sample period is the tick period) with the default
+    /// [`SafetyConfig`]. Checks the device parameters at that period, the controller gains against
+    /// the slave's mass (§6.4), the passivity controller, the mapping and the preload; errors name
+    /// the setting to fix.
+    pub fn new(world: World, config: &HapticConfig) -> Result<Self, String> {
+        Self::with_safety(world, config, SafetyConfig::default())
+    }
+
+    /// [`Self::new`] with the safety settings `safety` (ramp time, stall limit, torque trip margin).
+    pub fn with_safety(
+        mut world: World,
+        config: &HapticConfig,
+        safety: SafetyConfig,
+    ) -> Result<Self, String> {
+        safety.validate()?;
         let dt = world.params.dt;
         let slave = match &config.slave {
             Some(name) => world.body_index(name).ok_or_else(|| {
@@ -159,34 +192,89 @@ impl HapticSystem {
             world,
             slave,
             map,
-            safety: Safety::new(config.device.min_singularity_margin),
+            workspace: WorkspaceBound::new(&config.device, dt),
+            safety: Safety::new(
+                config.device.min_singularity_margin,
+                tau_max,
+                safety.torque_trip_margin,
+            ),
+            safety_config: safety,
             preload: config.preload,
             dt,
             tau_prev: [0.0; 4],
             injected: None,
+            aligned: false,
+            ramp_ticks: 0,
+            ramp_len: (safety.ramp_time / dt).round() as u64,
+            started: false,
             record: TickRecord::default(),
         })
     }
 
-    /// One haptic sample, §0.5 steps 1–11, from the four encoder angles `q` (rad) to the four motor
-    /// torques (N·m). Never allocates, locks, prints or does I/O.
+    /// One haptic sample taken on time (one period after the previous one): see
+    /// [`Self::tick_elapsed`].
+    pub fn tick(&mut self, q: &V4) -> TickOutput {
+        self.tick_elapsed(q, self.dt)
+    }
+
+    /// One haptic sample, §0.5 steps 1–11, from the four encoder angles `q` (rad) read `elapsed`
+    /// seconds (measured) after the previous tick's reading, to the four motor torques (N·m). Never
+    /// allocates, locks, prints or does I/O.
+    ///
+    /// `elapsed` is what the real-time loop measured; a device paced by the ticks themselves (a
+    /// simulated plant that advances one period per tick, a replay) passes `T` (or calls
+    /// [`Self::tick`]). A late tick differentiates and integrates the device signals over the measured
+    /// interval; one more than `max_stall_periods` periods late trips the latch, because the device
+    /// held its last torques unsupervised for that long. The world still steps by `T`: its
+    /// integrator is passive for that step (§6).
     ///
     /// The caller writes `torques` to the amplifiers right after the call (step 9's output); the world
     /// integration of step 10 has then already run, which only moves the write by the integration
     /// time (about a microsecond) and keeps the tick one call.
-    pub fn tick(&mut self, q: &V4) -> TickOutput {
+    pub fn tick_elapsed(&mut self, q: &V4, elapsed: f64) -> TickOutput {
         let (k, t, dt) = (self.world.tick(), self.world.time(), self.dt);
         let mut flags = 0u32;
 
+        // 0. Stall: the device held the previous torques for `elapsed` seconds, unsupervised.
+        let stall_limit = self.safety_config.max_stall_periods * dt;
+        // (A NaN interval counts as a stall: a broken clock must not pass.)
+        if self.started && (elapsed.is_nan() || elapsed > stall_limit) {
+            self.safety.trip(
+                k,
+                t,
+                SafetyReason::Stall {
+                    elapsed,
+                    limit: stall_limit,
+                },
+            );
+        }
+        self.started = true;
+
         // 1–2. Device pose by forward kinematics (θ unwrapped, closure monitor), filtered twist, and
-        //      the hand-wrench estimate from the torques of the previous interval (§10.3, §10.6, §10.7).
-        let est: Option<DeviceEstimate> = match self.device.estimate(q, &self.tau_prev) {
-            Ok(e) => Some(e),
-            Err(fault) => {
-                self.safety.trip(k, t, SafetyReason::Device(fault));
-                None
-            }
-        };
+        //      the hand-wrench estimate from the torques of the previous interval (§10.3, §10.6,
+        //      §10.7), both over the measured interval.
+        let mut closure_fault = false;
+        let est: Option<DeviceEstimate> =
+            match self.device.estimate_elapsed(q, &self.tau_prev, elapsed) {
+                Ok(e) => Some(e),
+                Err(fault) => {
+                    closure_fault = matches!(fault, DeviceFault::ClosureViolation { .. });
+                    self.safety.trip(k, t, SafetyReason::Device(fault));
+                    None
+                }
+            };
+
+        // 1b. Start-up alignment, at the first valid reading (and after a re-arm or a pause): anchor
+        //     the mapping so that the measured handle pose maps onto the slave's current pose. The
+        //     coupling then starts with zero pose error wherever the handle was, and the slave is not
+        //     moved (moving it could put it inside a wall). The torque ramp restarts here.
+        if let (Some(e), false) = (est, self.aligned) {
+            let body = &self.world.bodies[self.slave];
+            self.map.device_origin = e.pose;
+            self.map.world_origin = [body.pose.pos.x, body.pose.pos.y, body.pose.angle];
+            self.aligned = true;
+            self.ramp_ticks = 0;
+        }
 
         // 3–6. World: proximity every N_g samples, local contacts and god-objects, contact states and
         //      simultaneous impacts (velocities jump now), then normal and friction forces.
@@ -198,12 +286,19 @@ impl HapticSystem {
         let f_e = [-cw.force.x, -cw.force.y, -cw.torque];
 
         // 7. Teleoperation: device command f_cm and slave drive f_cs (§11), in world coordinates.
+        //    The master-mass feed-forward (off by default) gets the device's mass matrix at the
+        //    measured pose, in world coordinates: with the twist map v_w = S·v_d and the wrench map
+        //    f_d = S·f_w (S = diag(s, s, 1)), f_d = M_d·a_d gives f_w = S⁻¹·M_d·S⁻¹·a_w.
+        let m_dev = self.device.mass_matrix();
         let (mut f_cm, mut f_cs) = ([0.0; 3], [0.0; 3]);
         let (mut x_m, mut v_m, mut w_h) = ([0.0; 3], [0.0; 3], [0.0; 3]);
         if let Some(e) = est {
             (x_m, v_m, w_h) = (e.pose, e.velocity, e.hand_wrench);
         }
         if let (Some(e), false) = (est, self.safety.is_latched()) {
+            let sc = [self.map.scale, self.map.scale, 1.0];
+            let master_mass: M3 =
+                std::array::from_fn(|i| std::array::from_fn(|j| m_dev[i][j] / (sc[i] * sc[j])));
             let signals = TeleopSignals {
                 x_m: self.map.pose_to_world(&e.pose),
                 v_m: self.map.twist_to_world(&e.velocity),
@@ -211,31 +306,61 @@ impl HapticSystem {
                 x_s,
                 v_s,
                 f_e,
-                master_mass: [[0.0; 3]; 3],
+                master_mass,
             };
             (f_cm, f_cs) = self.controller.step(&signals);
         }
 
-        // 8. Passivity observer/controller on the device port (§12), in handle coordinates.
-        let mut f_dev = self.map.wrench_to_device(&f_cm);
+        // 8. Passivity observer/controller on the device port (§12), in handle coordinates, with α
+        //    per axis capped at the explicit-damping limit 2·M_ii/T of the device's inertia on that
+        //    axis. It stops (α = 0, nothing booked but the zero applied) while latched.
+        let mut f_port = self.map.wrench_to_device(&f_cm);
         let (mut po_energy, mut alpha) = (0.0, [0.0; 3]);
-        if let (Some(pc), Some(e)) = (self.passivity.as_mut(), est) {
-            f_dev = pc.update(e.pose, e.velocity, f_dev, dt);
-            f_cm = self.map.wrench_to_world(&f_dev);
-            po_energy = pc.e_obs();
-            alpha = [pc.x.alpha(), pc.y.alpha(), pc.theta.alpha()];
-            if alpha.iter().any(|a| *a > 0.0) {
-                flags |= FLAG_PASSIVITY_ACTIVE;
+        if let Some(pc) = self.passivity.as_mut() {
+            match (est, self.safety.is_latched()) {
+                (Some(e), false) => {
+                    let cap = std::array::from_fn(|i| explicit_damping_limit(m_dev[i][i], dt));
+                    f_port = pc.update_limited(e.pose, e.velocity, f_port, dt, cap);
+                    alpha = [pc.x.alpha(), pc.y.alpha(), pc.theta.alpha()];
+                    if alpha.iter().any(|a| *a > 0.0) {
+                        flags |= FLAG_PASSIVITY_ACTIVE;
+                    }
+                }
+                _ => pc.idle(),
             }
+            po_energy = pc.e_obs();
         }
 
-        // 9. Redundancy resolution to four motor torques, saturation (§10.5), and the safety gate:
-        //    a fault, a non-finite value or a singular pose zeroes the torques in this same tick.
+        // 8b. Workspace bound (device file): a passive wall just past the edge of the workspace
+        //     square, and a trip beyond it.
+        let mut f_dev = f_port;
+        if let Some(e) = est {
+            let (wall, excursion) = self.workspace.wrench(&e.pose, &e.velocity);
+            f_dev[0] += wall[0];
+            f_dev[1] += wall[1];
+            if let Some(x) = excursion {
+                let reason = SafetyReason::Workspace {
+                    axis: x.axis,
+                    position: x.position,
+                    edge: x.edge,
+                    trip: self.workspace.trip_distance,
+                };
+                self.safety.trip(k, t, reason);
+            }
+        }
+        f_cm = self.map.wrench_to_world(&f_dev);
+
+        // 9. Redundancy resolution to four motor torques, saturation (§10.5), the start-up ramp, and
+        //    the final gate: a fault, a non-finite value, a singular pose or a request above τ_max
+        //    by more than the margin zeroes the torques in this same tick; a request just above τ_max
+        //    is clamped to it.
         let mut tau = [0.0; 4];
+        let mut wrench_scale = 0.0;
         if !self.safety.is_latched() {
             match self.device.torques_for_wrench(&f_dev, self.preload) {
                 Ok(cmd) => {
                     tau = cmd.tau;
+                    wrench_scale = cmd.wrench_scale;
                     if cmd.saturated {
                         flags |= FLAG_SATURATED;
                     }
@@ -254,12 +379,34 @@ impl HapticSystem {
                 Err(fault) => self.safety.trip(k, t, SafetyReason::Torques(fault)),
             }
         }
+        let ramp = self.ramp_factor();
+        tau.iter_mut().for_each(|v| *v *= ramp);
         if let Some((i, v)) = self.injected.take() {
             tau[i] = v;
         }
-        if self.safety.gate(k, t, &mut tau) {
+        let peak_before = tau.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let gated = self.safety.gate(k, t, &mut tau);
+        let peak_after = tau.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        if gated {
             flags |= FLAG_SAFETY;
             f_cs = [0.0; 3];
+        } else if self.aligned {
+            self.ramp_ticks = self.ramp_ticks.saturating_add(1);
+        }
+
+        // 9b. The passivity observer books the wrench the port actually produced: the controller's
+        //     output scaled by the saturation, the ramp and the final clamp (zero when gated).
+        if let Some(pc) = self.passivity.as_mut() {
+            let applied = if gated || peak_before == 0.0 {
+                0.0
+            } else {
+                wrench_scale * ramp * (peak_after / peak_before)
+            };
+            pc.book_applied([
+                applied * f_port[0],
+                applied * f_port[1],
+                applied * f_port[2],
+            ]);
         }
 
         // 10. Slave drive held over the sample, then passive integration of every body to k+1 (§6).
@@ -270,6 +417,11 @@ impl HapticSystem {
 
         // 11. Log: signals, energies and the contact count into the tick record.
         let ledger = self.world.ledger();
+        let margin = if est.is_some() {
+            self.device.margin()
+        } else {
+            0.0
+        };
         self.record = TickRecord {
             t,
             x_m,
@@ -294,7 +446,19 @@ impl HapticSystem {
         TickOutput {
             torques: tau,
             tripped: self.safety.is_latched(),
+            margin,
+            closure_fault,
             record: self.record,
+        }
+    }
+
+    /// The start-up ramp factor of this tick, `min(1, n / N)` (exactly 0 at the alignment tick).
+    #[inline]
+    fn ramp_factor(&self) -> f64 {
+        if self.ramp_len == 0 {
+            1.0
+        } else {
+            (self.ramp_ticks as f64 / self.ramp_len as f64).min(1.0)
         }
     }
 
@@ -305,9 +469,11 @@ impl HapticSystem {
     /// device, the frozen slave and zero commands. Never allocates, locks, prints or does I/O.
     pub fn tick_paused(&mut self, q: &V4) -> TickOutput {
         let (k, t) = (self.world.tick(), self.world.time());
+        let mut closure_fault = false;
         let est = match self.device.estimate(q, &self.tau_prev) {
             Ok(e) => Some(e),
             Err(fault) => {
+                closure_fault = matches!(fault, DeviceFault::ClosureViolation { .. });
                 self.safety.trip(k, t, SafetyReason::Device(fault));
                 None
             }
@@ -318,6 +484,12 @@ impl HapticSystem {
             flags |= FLAG_SAFETY;
         }
         self.tau_prev = tau;
+        // The handle moves while the slave is frozen: the next running tick re-aligns and ramps in.
+        self.aligned = false;
+        self.started = false;
+        if let Some(pc) = self.passivity.as_mut() {
+            pc.idle();
+        }
         let body = &self.world.bodies[self.slave];
         let cw = self.world.contact_wrench(self.slave);
         let ledger = self.world.ledger();
@@ -348,6 +520,12 @@ impl HapticSystem {
         TickOutput {
             torques: tau,
             tripped: self.safety.is_latched(),
+            margin: if est.is_some() {
+                self.device.margin()
+            } else {
+                0.0
+            },
+            closure_fault,
             record: self.record,
         }
     }
@@ -385,6 +563,10 @@ impl HapticSystem {
     pub fn map(&self) -> &DeviceMap {
         &self.map
     }
+    /// The workspace bound rendered from the device file.
+    pub fn workspace(&self) -> &WorkspaceBound {
+        &self.workspace
+    }
     /// The device estimator.
     pub fn device(&self) -> &TwinPantograph {
         &self.device
@@ -397,9 +579,31 @@ impl HapticSystem {
     pub fn safety_trip(&self) -> Option<SafetyTrip> {
         self.safety.trip_info()
     }
-    /// Re-arms the safety latch (an explicit user action; the next tick recomputes the torques).
+    /// Re-arms the safety latch (an explicit user action). The next tick re-aligns the mapping to the
+    /// handle's measured pose and ramps the torques in again from zero, as at start-up.
     pub fn reset_safety(&mut self) {
         self.safety.reset();
+        // The estimates are stale after a fault (a stall, lost readings): restart the velocity filter
+        // and the observer, keeping the θ unwrapping reference.
+        let theta = self
+            .device
+            .pose()
+            .map_or(self.map.device_origin[2], |p| p[2]);
+        self.device.reset(theta);
+        self.aligned = false;
+        self.started = false;
+    }
+    /// The safety settings (ramp, stall limit, torque trip margin).
+    pub fn safety_config(&self) -> &SafetyConfig {
+        &self.safety_config
+    }
+    /// The start-up ramp factor the next tick applies (0 at the first valid reading, 1 once ramped in).
+    pub fn ramp(&self) -> f64 {
+        if self.aligned {
+            self.ramp_factor()
+        } else {
+            0.0
+        }
     }
     /// The record of the last tick.
     pub fn last_record(&self) -> &TickRecord {
@@ -409,7 +613,8 @@ impl HapticSystem {
     pub fn dt(&self) -> f64 {
         self.dt
     }
-    /// The handle pose the device should start at (m, m, rad): the mapping's device origin.
+    /// The handle pose the device should start at (m, m, rad): the mapping's device origin (before
+    /// the first tick; from then on, the handle pose the start-up alignment anchored).
     pub fn device_start(&self) -> V3 {
         self.map.device_origin
     }
