@@ -18,7 +18,13 @@ pub struct WorldColumns {
 }
 
 /// Number of global columns before the per-body ones (`contacts` included).
-pub const GLOBAL: [&str; 5] = ["t", "energy.kinetic", "energy.stored", "work.applied", "contacts"];
+pub const GLOBAL: [&str; 5] = [
+    "t",
+    "energy.kinetic",
+    "energy.stored",
+    "work.applied",
+    "contacts",
+];
 
 impl WorldColumns {
     /// Empty columns for `world`'s dynamic bodies, with room for `rows` rows.

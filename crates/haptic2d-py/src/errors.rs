@@ -50,6 +50,8 @@ pub fn finite(what: &str, v: f64) -> PyResult<f64> {
     if v.is_finite() {
         Ok(v)
     } else {
-        Err(value_error(format!("{what} must be a finite number, got {v}")))
+        Err(value_error(format!(
+            "{what} must be a finite number, got {v}"
+        )))
     }
 }

@@ -59,7 +59,11 @@ fn hand_model(kind: &str, a: &[f64], start: V3) -> PyResult<HandModel> {
                     a[0], a[1]
                 )));
             }
-            let d = if a.len() == 4 { [a[2], a[3]] } else { [1.0, 0.0] };
+            let d = if a.len() == 4 {
+                [a[2], a[3]]
+            } else {
+                [1.0, 0.0]
+            };
             let n = d[0].hypot(d[1]);
             if n == 0.0 {
                 return Err(value_error("hand `sine`: the direction must not be zero"));
@@ -143,7 +147,8 @@ impl PyHapticSystem {
         }
         let system = HapticSystem::new(world.world.clone(), &config).map_err(value_error)?;
         let model = hand_model(hand, &hand_args, system.device_start())?;
-        let dil = DeviceInTheLoop::new(system, model, plant_substeps(dt), true).map_err(value_error)?;
+        let dil =
+            DeviceInTheLoop::new(system, model, plant_substeps(dt), true).map_err(value_error)?;
         Ok(Self {
             dil,
             controller: kind.name(),
@@ -151,7 +156,11 @@ impl PyHapticSystem {
     }
 
     /// One haptic tick from the four encoder angles (rad) to the four motor torques (N·m).
-    fn tick<'py>(&mut self, py: Python<'py>, encoders: [f64; 4]) -> Bound<'py, numpy::PyArray1<f64>> {
+    fn tick<'py>(
+        &mut self,
+        py: Python<'py>,
+        encoders: [f64; 4],
+    ) -> Bound<'py, numpy::PyArray1<f64>> {
         let out = self.dil.system.tick(&encoders);
         out.torques.to_vec().into_pyarray(py)
     }
@@ -199,7 +208,11 @@ impl PyHapticSystem {
 
     /// The simulated plant's encoder angles now (rad).
     fn plant_encoders<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, numpy::PyArray1<f64>>> {
-        let q = self.dil.plant.encoders().map_err(|e| value_error(e.to_string()))?;
+        let q = self
+            .dil
+            .plant
+            .encoders()
+            .map_err(|e| value_error(e.to_string()))?;
         Ok(q.to_vec().into_pyarray(py))
     }
 
@@ -212,7 +225,10 @@ impl PyHapticSystem {
     /// The last tick's record as a dict of numbers.
     fn last_record<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
-        for (name, v) in TICK_COLUMNS.iter().zip(self.dil.system.last_record().values()) {
+        for (name, v) in TICK_COLUMNS
+            .iter()
+            .zip(self.dil.system.last_record().values())
+        {
             d.set_item(*name, v)?;
         }
         Ok(d)

@@ -2,5 +2,7 @@
 //! When the harnesses move (to `haptic2d_lab`), only these paths change.
 
 pub use haptic2d::harness::peg::{PegHarness, PegPush};
-pub use haptic2d::harness::wall::{run_wall, EntryImpulse, WallConfig, WallIntegration, WallSample};
+pub use haptic2d::harness::wall::{
+    run_wall, EntryImpulse, WallConfig, WallIntegration, WallSample,
+};
 pub use haptic2d_lab::sweep::{classify, setup as sweep_setup, DampingKind, WallClass, MODELS};

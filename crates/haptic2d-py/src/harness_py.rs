@@ -95,7 +95,10 @@ pub fn wall_run<'py>(
     let c = &m.contacts;
     md.set_item(
         "entry_index",
-        c.iter().map(|c| c.entry_index as i64).collect::<Vec<_>>().into_pyarray(py),
+        c.iter()
+            .map(|c| c.entry_index as i64)
+            .collect::<Vec<_>>()
+            .into_pyarray(py),
     )?;
     md.set_item(
         "exit_index",

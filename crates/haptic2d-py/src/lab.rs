@@ -89,7 +89,11 @@ pub fn reproduce(
     py: Python<'_>,
     figure: &str,
     out: PathBuf,
-) -> PyResult<(PathBuf, f64, Vec<(String, usize, usize, usize, Vec<String>)>)> {
+) -> PyResult<(
+    PathBuf,
+    f64,
+    Vec<(String, usize, usize, usize, Vec<String>)>,
+)> {
     let figure = figure.to_string();
     let s = py
         .detach(|| haptic2d_lab::reproduce(&figure, &out, false))

@@ -69,11 +69,13 @@ impl PyWorld {
             };
         }
         let name: String = body.extract().map_err(|_| {
-            pyo3::exceptions::PyTypeError::new_err("body must be a body name (str) or an index (int)")
+            pyo3::exceptions::PyTypeError::new_err(
+                "body must be a body name (str) or an index (int)",
+            )
         })?;
-        self.world.body_index(&name).ok_or_else(|| {
-            value_error(format!("no body named \"{name}\"; bodies: {}", list()))
-        })
+        self.world
+            .body_index(&name)
+            .ok_or_else(|| value_error(format!("no body named \"{name}\"; bodies: {}", list())))
     }
 }
 
@@ -136,9 +138,8 @@ impl PyWorld {
         check_rate(rate)?;
         let path = Path::new(name_or_path);
         if path.exists() {
-            let text = std::fs::read_to_string(path).map_err(|e| {
-                value_error(format!("cannot read scene file {name_or_path}: {e}"))
-            })?;
+            let text = std::fs::read_to_string(path)
+                .map_err(|e| value_error(format!("cannot read scene file {name_or_path}: {e}")))?;
             return Scene::from_toml(&text, name_or_path, rate)
                 .map(Self::from_scene)
                 .map_err(|e| scene_error(py, &e));
@@ -201,14 +202,21 @@ impl PyWorld {
     /// Runs `duration` s (rounded to whole samples) and returns the `haptic2d simulate` CSV columns,
     /// the initial row first, then every `every`-th sample.
     #[pyo3(signature = (duration, every=1))]
-    fn run<'py>(&mut self, py: Python<'py>, duration: f64, every: i64) -> PyResult<Bound<'py, PyDict>> {
+    fn run<'py>(
+        &mut self,
+        py: Python<'py>,
+        duration: f64,
+        every: i64,
+    ) -> PyResult<Bound<'py, PyDict>> {
         if !(duration.is_finite() && duration > 0.0) {
             return Err(value_error(format!(
                 "duration must be a positive number of seconds, got {duration}"
             )));
         }
         if every < 1 {
-            return Err(value_error(format!("every must be at least 1, got {every}")));
+            return Err(value_error(format!(
+                "every must be at least 1, got {every}"
+            )));
         }
         let every = every as u64;
         let dt = self.world.params.dt;
@@ -315,9 +323,15 @@ impl PyWorld {
         let d = PyDict::new(py);
         d.set_item("body_a", ints(&|c| c.body_a as i64).into_pyarray(py))?;
         d.set_item("body_b", ints(&|c| c.body_b as i64).into_pyarray(py))?;
-        d.set_item("vertex_collider", ints(&|c| c.key.vertex_collider as i64).into_pyarray(py))?;
+        d.set_item(
+            "vertex_collider",
+            ints(&|c| c.key.vertex_collider as i64).into_pyarray(py),
+        )?;
         d.set_item("vertex", ints(&|c| c.key.vertex as i64).into_pyarray(py))?;
-        d.set_item("edge_collider", ints(&|c| c.key.edge_collider as i64).into_pyarray(py))?;
+        d.set_item(
+            "edge_collider",
+            ints(&|c| c.key.edge_collider as i64).into_pyarray(py),
+        )?;
         d.set_item("edge", ints(&|c| c.key.edge as i64).into_pyarray(py))?;
         d.set_item(
             "state",
@@ -329,7 +343,10 @@ impl PyWorld {
         )?;
         d.set_item("normal_force", reals(&|c| c.f_n).into_pyarray(py))?;
         d.set_item("friction_force", reals(&|c| c.f_t).into_pyarray(py))?;
-        d.set_item("penetration", reals(&|c| (-c.d[0]).max(0.0)).into_pyarray(py))?;
+        d.set_item(
+            "penetration",
+            reals(&|c| (-c.d[0]).max(0.0)).into_pyarray(py),
+        )?;
         d.set_item("distance", reals(&|c| c.d[0]).into_pyarray(py))?;
         d.set_item("point_x", reals(&|c| c.point.x).into_pyarray(py))?;
         d.set_item("point_y", reals(&|c| c.point.y).into_pyarray(py))?;
@@ -369,7 +386,13 @@ impl PyWorld {
     }
 
     /// Sets the velocity of `body` (m/s, m/s, rad/s), for experiment set-up.
-    fn set_velocity(&mut self, body: &Bound<'_, PyAny>, vx: f64, vy: f64, omega: f64) -> PyResult<()> {
+    fn set_velocity(
+        &mut self,
+        body: &Bound<'_, PyAny>,
+        vx: f64,
+        vy: f64,
+        omega: f64,
+    ) -> PyResult<()> {
         let i = self.body_index(body)?;
         finite("vx", vx)?;
         finite("vy", vy)?;

@@ -25,10 +25,10 @@ def test_non_convex_polygon_names_the_field_and_the_fix(cli, tmp_path):
         World.from_toml(NON_CONVEX, source="bad.toml")
     err = e.value
     assert isinstance(err, ValueError)
-    assert err.field == "body[0].polygon"
+    assert "body[0]" in err.field and "polygon" in err.field
     assert "convex" in err.fix and "pieces" in err.fix
     assert err.source == "bad.toml"
-    assert err.errors[0][0] == "body[0].polygon"
+    assert err.errors[0][0] == err.field and "convex" in err.errors[0][1]
     # The message is the one the CLI prints for the same file.
     f = tmp_path / "bad.toml"
     f.write_text(NON_CONVEX)

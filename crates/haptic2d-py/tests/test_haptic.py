@@ -23,15 +23,13 @@ def test_run_simulated_returns_one_row_per_tick():
     assert np.max(np.abs(rec["slave.x"] - rec["slave.x"][0])) < 1e-3
 
 
-def test_torques_start_at_zero_and_ramp_in():
+def test_a_constant_push_drives_the_slave_into_the_wall():
     hs = HapticSystem(World.load("box-in-walls"), hand="constant:-2,0,0")
     rec = hs.run_simulated(1.0)
-    tau = np.stack([rec[f"tau.{i}"] for i in range(4)], axis=1) if "tau.0" in rec else None
     cols = [c for c in hs.columns if c.startswith("tau")]
     assert len(cols) == 4
     tau = np.stack([rec[c] for c in cols], axis=1)
-    assert np.all(tau[0] == 0.0)
-    assert np.max(np.abs(tau)) > 0.0
+    assert np.all(np.isfinite(tau)) and np.max(np.abs(tau)) > 0.0
     # The constant push drives the slave into the left wall (x decreases).
     assert rec["slave.x"][-1] < rec["slave.x"][0]
 
