@@ -32,16 +32,16 @@ def main() -> int:
     models = ["zoh", "seh", "minsky", "colgate", "paper"]
     s = haptic2d.sweep_walls(models, rate=args.rate, points=args.points)
     T = 1.0 / args.rate
-    for m in models:
-        sel = s["model"] == m
-        classes = s["class"][sel]
-        counts = {c: int(np.sum(classes == c)) for c in haptic2d.SWEEP_CLASSES}
-        stable_k = s["k_n_m"][sel][classes == "dissipative"]
-        print(
-            f"{m:8s} damping={s['damping_kind'][sel][0]:5s} "
-            + " ".join(f"{c}={n:3d}" for c, n in counts.items())
-            + (f"  largest dissipative K = {stable_k.max():8.0f} N/m" if len(stable_k) else "")
-        )
+    # Z-width table: for each stiffness, the least damping on the grid that keeps the wall dissipative.
+    ks = np.unique(s["k_n_m"])
+    print(f"least dissipative damping (N s/m) at {args.rate:g} Hz; '-' = none on the grid")
+    print("K (N/m)   " + "".join(f"{m + ' (' + s['damping_kind'][s['model'] == m][0] + ')':>18s}" for m in models))
+    for k in ks:
+        cells = []
+        for m in models:
+            sel = (s["model"] == m) & (s["k_n_m"] == k) & (s["class"] == "dissipative")
+            cells.append(f"{s['damping_n_s_m'][sel].min():18.3g}" if sel.any() else f"{'-':>18s}")
+        print(f"{k:9.0f} " + "".join(cells))
 
     # The SEH wall alone: contact ratio of the first bounce against stiffness (no damping).
     ks = np.geomspace(200, 20000, 15)
