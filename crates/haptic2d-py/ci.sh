@@ -20,7 +20,7 @@ echo "== python: fresh venv at $venv"
 python3 -m venv --clear "$venv"
 echo "== python: pip install ./$crate"
 "$venv/bin/python" -m pip install --quiet --disable-pip-version-check "./$crate"
-"$venv/bin/python" -m pip install --quiet --disable-pip-version-check pytest "dask[distributed]"
+"$venv/bin/python" -m pip install --quiet --disable-pip-version-check pytest "dask[distributed]" mypy
 
 # The equality tests compare with the `haptic2d` binary's own output.
 echo "== python: the haptic2d CLI the tests compare against"
@@ -28,8 +28,11 @@ cargo build --quiet -p haptic2d-cli
 export HAPTIC2D_BIN="$CARGO_TARGET_DIR/debug/haptic2d"
 export HAPTIC2D_REQUIRE_CLI=1
 
-echo "== python: pytest $crate/tests"
 cd "$root/$crate"
+echo "== python: stubtest (the .pyi stubs match the installed package)"
+"$venv/bin/python" -m mypy.stubtest haptic2d
+
+echo "== python: pytest $crate/tests"
 status=0
 "$venv/bin/python" -m pytest tests -q -p no:cacheprovider || status=$?
 echo "== python: done in $(( $(date +%s) - start )) s (pytest exit $status)"

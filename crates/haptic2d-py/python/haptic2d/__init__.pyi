@@ -8,6 +8,19 @@ import numpy as np
 from . import harness as harness
 from ._haptic2d import SceneError as SceneError
 
+__all__ = [
+    "World",
+    "SceneError",
+    "CONTACT_DTYPE",
+    "HapticSystem",
+    "sweep_walls",
+    "reproduce",
+    "read_log",
+    "SWEEP_CLASSES",
+    "harness",
+    "__version__",
+]
+
 __version__: str
 
 CONTACT_DTYPE: np.dtype

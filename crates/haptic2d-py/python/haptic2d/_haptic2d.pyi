@@ -1,8 +1,21 @@
 # Stubs of the compiled module haptic2d._haptic2d (src/*.rs). Private: use the haptic2d package.
 import os
-from typing import Any, Dict, List, Optional, Tuple, Union
+from typing import Any, Dict, List, Optional, Tuple, Union, final
 
 import numpy as np
+
+__all__ = [
+    "SceneError",
+    "World",
+    "HapticSystem",
+    "wall_run",
+    "peg_run",
+    "model_names",
+    "sweep_task",
+    "sweep_models",
+    "reproduce",
+    "__version__",
+]
 
 __version__: str
 
@@ -12,6 +25,7 @@ class SceneError(ValueError):
     source: str
     errors: List[Tuple[str, str, str]]
 
+@final
 class World:
     name: str
     description: str
@@ -45,9 +59,10 @@ class World:
     def set_pose(self, body: Union[str, int], x: float, y: float, theta: float) -> None: ...
     def set_velocity(self, body: Union[str, int], vx: float, vy: float, omega: float) -> None: ...
 
+@final
 class HapticSystem:
-    def __init__(
-        self,
+    def __new__(
+        cls,
         world: World,
         controller: str,
         device_toml: Optional[str],
@@ -56,7 +71,7 @@ class HapticSystem:
         hand_args: List[float],
         passivity: bool,
         slave: Optional[str],
-    ) -> None: ...
+    ) -> HapticSystem: ...
     def tick(self, encoders: Tuple[float, float, float, float]) -> np.ndarray: ...
     def run_simulated(self, n: int) -> Tuple[Dict[str, np.ndarray], Optional[str]]: ...
     def set_hand(self, hand: str, hand_args: List[float]) -> None: ...
