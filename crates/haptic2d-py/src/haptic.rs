@@ -6,8 +6,8 @@ use crate::errors::{scene_error, value_error};
 use crate::world::PyWorld;
 use haptic2d::control::passivity::PlanarPassivity;
 use haptic2d::device::linalg::V3;
-use haptic2d::device::HandModel;
-use haptic2d::haptic::{ControllerKind, DeviceInTheLoop, HapticConfig, HapticSystem, TICK_COLUMNS};
+use haptic2d::device::{DeviceFault, HandModel, SimDevice};
+use haptic2d::haptic::{ControllerKind, HapticConfig, HapticSystem, TickOutput, TICK_COLUMNS};
 use haptic2d::scene::device_params_from_toml;
 use numpy::IntoPyArray;
 use pyo3::prelude::*;
@@ -109,10 +109,29 @@ fn hand_model(kind: &str, a: &[f64], start: V3) -> PyResult<HandModel> {
     })
 }
 
+/// A haptic system, the simulated twin-pantograph plant and the simulated hand acting on it.
+struct Loop {
+    system: HapticSystem,
+    plant: SimDevice,
+    hand: HandModel,
+}
+
+impl Loop {
+    /// One tick closed around the plant: read its encoders, run the haptic tick, then advance the
+    /// plant by `T` under the held torques and the hand. Errors if the plant leaves its reachable set.
+    fn step(&mut self) -> Result<TickOutput, DeviceFault> {
+        let q = self.plant.encoders()?;
+        let out = self.system.tick(&q);
+        self.plant
+            .step(&out.torques, &self.hand, self.system.dt())?;
+        Ok(out)
+    }
+}
+
 /// A haptic system closed around a simulated plant and hand.
 #[pyclass(module = "haptic2d._haptic2d", name = "HapticSystem")]
 pub struct PyHapticSystem {
-    dil: DeviceInTheLoop,
+    dil: Loop,
     controller: &'static str,
 }
 
@@ -147,8 +166,16 @@ impl PyHapticSystem {
         }
         let system = HapticSystem::new(world.world.clone(), &config).map_err(value_error)?;
         let model = hand_model(hand, &hand_args, system.device_start())?;
-        let dil =
-            DeviceInTheLoop::new(system, model, plant_substeps(dt), true).map_err(value_error)?;
+        // The plant starts at rest at the device origin, with encoder quantisation.
+        let mut plant =
+            SimDevice::new(&system.device().params, system.device_start()).map_err(value_error)?;
+        plant.substeps = plant_substeps(dt);
+        plant.quantize = true;
+        let dil = Loop {
+            system,
+            plant,
+            hand: model,
+        };
         Ok(Self {
             dil,
             controller: kind.name(),
