@@ -11,29 +11,30 @@ export CARGO_TERM_COLOR=never
 crate=crates/haptic2d-py
 venv="$CARGO_TARGET_DIR/py-venv"
 start=$(date +%s)
+stage() { echo "== python [$(( $(date +%s) - start )) s]: $*"; }
 
-echo "== python: cargo fmt --check and clippy (crates/haptic2d-py is its own workspace)"
+stage "cargo fmt --check and clippy (crates/haptic2d-py is its own workspace)"
 cargo fmt --manifest-path "$crate/Cargo.toml" -- --check
 cargo clippy --manifest-path "$crate/Cargo.toml" --all-targets -- -D warnings
 
-echo "== python: fresh venv at $venv"
+stage "fresh venv at $venv"
 python3 -m venv --clear "$venv"
-echo "== python: pip install ./$crate"
+stage "pip install ./$crate"
 "$venv/bin/python" -m pip install --quiet --disable-pip-version-check "./$crate"
 "$venv/bin/python" -m pip install --quiet --disable-pip-version-check pytest "dask[distributed]" mypy
 
 # The equality tests compare with the `haptic2d` binary's own output.
-echo "== python: the haptic2d CLI the tests compare against"
+stage "the haptic2d CLI the tests compare against"
 cargo build --quiet -p haptic2d-cli
 export HAPTIC2D_BIN="$CARGO_TARGET_DIR/debug/haptic2d"
 export HAPTIC2D_REQUIRE_CLI=1
 
 cd "$root/$crate"
-echo "== python: stubtest (the .pyi stubs match the installed package)"
+stage "stubtest (the .pyi stubs match the installed package)"
 "$venv/bin/python" -m mypy.stubtest haptic2d
 
-echo "== python: pytest $crate/tests"
+stage "pytest $crate/tests"
 status=0
 "$venv/bin/python" -m pytest tests -q -p no:cacheprovider || status=$?
-echo "== python: done in $(( $(date +%s) - start )) s (pytest exit $status)"
+stage "done in $(( $(date +%s) - start )) s (pytest exit $status)"
 exit "$status"
