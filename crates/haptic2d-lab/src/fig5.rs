@@ -1,4 +1,4 @@
-//! Figs. 5–6: the walls with the device in the loop (`haptic2d::haptic::fig5`): a 0.5 kg box held on
+//! Figs. 5–6: the walls with the device in the loop (`crate::experiments::fig5`): a 0.5 kg box held on
 //! the simulated twin pantograph, released 0.02 m from the left wall and pushed into it by a constant
 //! 2 N, 500 Hz, 10 s, one case per wall (SEH, ZOH, braking pulse, hysteretic). The claims are carried
 //! by the paper's four-channel controller on a device damped at twice Colgate's bound; comparison runs:
@@ -15,11 +15,11 @@
 //! - hysteretic (Fig. 6, "stable soon"): the first three contact ratios < 0.85 and ≤ 6 separations.
 
 use crate::csv::write_columns;
+use crate::experiments::fig5::{run_case, Fig5Case, Fig5Expectation, Fig5Params, FIG5_CASES};
 use crate::fig5_sweep;
 use crate::figure::{Figure, FigureContext, FigureReport};
 use crate::plot::{write_panels, Panel, Series, Stroke};
 use crate::schema::{CaseMetrics, Check, Dimension, Fig4Measured, FigureMetrics, Measured};
-use haptic2d::haptic::fig5::{run_case, Fig5Case, Fig5Expectation, Fig5Params, FIG5_CASES};
 use rayon::prelude::*;
 use std::fmt::Write as _;
 

@@ -1,4 +1,4 @@
-//! Figs. 8–11: the peg in a tight hole with the device in the loop (`haptic2d::haptic::fig8`): the
+//! Figs. 8–11: the peg in a tight hole with the device in the loop (`crate::experiments::fig8`): the
 //! 0.2 kg peg of `peg-in-hole` (1 mm interference, 1 N per corner), one friction model per case, the
 //! simulated twin pantograph at 1 kHz with mapping scale 2; the hand grips the handle for 1 s, then
 //! lets go and `F_pk (1 − cos 2πt)/2` with `F_pk = 2.1 N` (world) pushes the handle along x; y and θ
@@ -11,10 +11,10 @@
 //! is an energy port the ledger does not close).
 
 use crate::csv::write_columns;
+use crate::experiments::fig8::{run_case, Fig8Case, Fig8Params, FIG8_CASES};
 use crate::figure::{Figure, FigureContext, FigureReport};
 use crate::plot::{write_panels, Panel, Series, Stroke};
 use crate::schema::{CaseMetrics, Check, Dimension, Fig7Measured, FigureMetrics, Measured};
-use haptic2d::haptic::fig8::{run_case, Fig8Case, Fig8Params, FIG8_CASES};
 use rayon::prelude::*;
 use std::fmt::Write as _;
 

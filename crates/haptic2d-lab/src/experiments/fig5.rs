@@ -64,18 +64,18 @@
 //! 1.25 vs 0.87 world-alone) and the pulse (sized for the box alone) and the hysteretic wall cannot remove the energy the device
 //! re-injects. Sizing the pulse for the box plus the device's reflected mass overshoots and chatters.
 
-use crate::control::coupling::CouplingGains;
-use crate::device::dynamics::LumpedDynamics;
-use crate::device::HandModel;
-use crate::device::TwinPantograph;
-use crate::laws::normal::{BrakingPulseLaw, NormalModel};
-use crate::metrics::{BounceMetrics, BounceSample};
-use crate::scene::{Scene, BUILTIN};
+use haptic2d::control::coupling::CouplingGains;
+use haptic2d::device::dynamics::LumpedDynamics;
+use haptic2d::device::HandModel;
+use haptic2d::device::TwinPantograph;
+use haptic2d::laws::normal::{BrakingPulseLaw, NormalModel};
+use haptic2d::metrics::{BounceMetrics, BounceSample};
+use haptic2d::scene::{Scene, BUILTIN};
 
-use super::config::{ControllerKind, HapticConfig};
-use super::experiment::DeviceInTheLoop;
-use super::record::TickRecord;
-use super::system::HapticSystem;
+use haptic2d::haptic::config::{ControllerKind, HapticConfig};
+use haptic2d::haptic::experiment::DeviceInTheLoop;
+use haptic2d::haptic::record::TickRecord;
+use haptic2d::haptic::system::HapticSystem;
 
 /// Settings of the Fig. 5–6 experiment.
 #[derive(Clone, Debug, PartialEq)]

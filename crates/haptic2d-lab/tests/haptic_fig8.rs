@@ -1,4 +1,4 @@
-//! Figs. 8–11 with the device in the loop (see `haptic2d::haptic::fig8`): the paper's claim is that
+//! Figs. 8–11 with the device in the loop (see `haptic2d_lab::experiments::fig8`): the paper's claim is that
 //! classical friction drifts while the other models stick and slip. Thresholds are §13.2's F7-1 (drift:
 //! `min creep_k ≥ 5e-4 m`), F7-2 (stick: `max creep_k ≤ 2e-4 m`) and F7-3 (slip: `advance_k > 5e-3 m`).
 //!
@@ -12,7 +12,7 @@
 //!   interference), the first slip runs away and every run ends in a singularity safety stop at the
 //!   workspace edge within 0.6–0.9 s of the release.
 
-use haptic2d::haptic::fig8::{run, Fig8Case, Fig8Params};
+use haptic2d_lab::experiments::fig8::{run, Fig8Case, Fig8Params};
 
 fn report(label: &str, cases: &[Fig8Case]) {
     for c in cases {

@@ -36,15 +36,15 @@
 //! cycle differences < 1e-5 m) is not required: the device's joint friction, encoder quantisation and
 //! coupling make the staircase vary by about 1e-3 m per cycle.
 
-use crate::control::coupling::CouplingGains;
-use crate::device::HandModel;
-use crate::laws::friction::FrictionModel;
-use crate::scene::{Scene, BUILTIN};
+use haptic2d::control::coupling::CouplingGains;
+use haptic2d::device::HandModel;
+use haptic2d::laws::friction::FrictionModel;
+use haptic2d::scene::{Scene, BUILTIN};
 
-use super::config::{ControllerKind, HapticConfig};
-use super::experiment::DeviceInTheLoop;
-use super::record::TickRecord;
-use super::system::HapticSystem;
+use haptic2d::haptic::config::{ControllerKind, HapticConfig};
+use haptic2d::haptic::experiment::DeviceInTheLoop;
+use haptic2d::haptic::record::TickRecord;
+use haptic2d::haptic::system::HapticSystem;
 
 /// Settings of the Figs. 8–11 experiment.
 #[derive(Clone, Debug, PartialEq)]
@@ -67,7 +67,7 @@ pub struct Fig8Params {
     pub cycles: usize,
     /// Handle x at the start (m), left of the workspace centre so the peg can advance. Default −0.03.
     pub start_x: f64,
-    /// Translation scale world/device of the mapping (§ [`DeviceMap`](super::DeviceMap)). Default 2,
+    /// Translation scale world/device of the mapping (§ [`DeviceMap`](haptic2d::haptic::DeviceMap)). Default 2,
     /// so four slips fit in the device's reach. The mapping preserves power, so a world force `F`
     /// needs `scale·F` at the handle; the forces above are world forces and the hand applies them times
     /// `scale`.
