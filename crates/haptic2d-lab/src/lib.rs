@@ -26,6 +26,7 @@ pub mod figure;
 pub mod harness;
 pub mod plot;
 pub mod schema;
+pub mod stability;
 pub mod sweep;
 pub mod world2d;
 
