@@ -1,6 +1,9 @@
 //! A small dense real matrix (row-major `Vec<f64>`), with just what the loop analysis needs: products
 //! and the matrix exponential (for the zero-order-hold discretisation of the device plant).
 
+// Index loops on purpose: the algorithms read like their textbook statements.
+#![allow(clippy::needless_range_loop)]
+
 /// A dense `n × n` real matrix, row-major.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Mat {

@@ -12,6 +12,9 @@
 //!
 //! Cost O(n³); the loop matrices are at most 9 × 9.
 
+// Index loops on purpose: the algorithms read like their textbook statements.
+#![allow(clippy::needless_range_loop)]
+
 use super::dense::Mat;
 
 /// A complex number `(re, im)`.
