@@ -238,3 +238,82 @@ fn released_handle_default_on_the_real_device_model_is_bounded() {
         }
     }
 }
+
+/// The 1-DOF loop of §11.4 in the time domain, with the tick's own pieces: the device (0.445 kg,
+/// 0.028 N·s/m: the spec device's x axis) integrated exactly under the held command, the 50 Hz
+/// velocity filter and a 1-DOF momentum observer (`K_O = 60 1/s`), the four-channel controller of
+/// `haptic2d::control`, and the 0.5 kg slave (semi-implicit Euler) on a one-sided 2000 N/m wall at
+/// x = 0. The handle is released: a force source pushes it toward the wall (rising smoothly to 2 N
+/// over 0.3 s, then constant), no hand impedance. Returns the slave's x range over the last second
+/// (infinite if the contact was lost, i.e. the slave left the wall, or a value became non-finite).
+fn one_dof(gains: FourChannelGains, rate: f64) -> f64 {
+    use haptic2d::control::four_channel::{FourChannel, TeleopSignals};
+    use haptic2d::device::filter::VelocityFilter;
+    let (m, b, m_s, k_e, k_o) = (0.445, 0.028, 0.5, 2000.0, 60.0);
+    let dt = 1.0 / rate;
+    let mut ctrl = FourChannel::new(gains, dt).expect("gains");
+    let mut filter = VelocityFilter::new(50.0, dt);
+    let (mut x_m, mut v_m, mut x_s, mut v_s) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    let (mut p0, mut integral, mut r, mut u_prev, mut v_prev) = (0.0, 0.0, 0.0, 0.0, 0.0);
+    let n = (SECONDS * rate) as usize;
+    let (mut lo, mut hi) = (f64::MAX, f64::MIN);
+    for k in 0..n {
+        let t = k as f64 * dt;
+        let push = if t < 0.3 {
+            1.0 - (std::f64::consts::PI * t / 0.3).cos()
+        } else {
+            2.0
+        };
+        let v_hat = filter.update(&[x_m, 0.0, 0.0])[0];
+        let p = m * v_hat;
+        if k == 0 {
+            p0 = p;
+        } else {
+            integral += dt * (u_prev - b * v_prev + r);
+            r = k_o * (p - p0 - integral);
+        }
+        // The wall pushes the slave out (+x) when x_s < 0; f_e is what the slave applies to it.
+        let f_contact = if x_s < 0.0 { -k_e * x_s } else { 0.0 };
+        let (f_cm, f_cs) = ctrl.step(&TeleopSignals {
+            x_m: [x_m, 0.0, 0.0],
+            v_m: [v_hat, 0.0, 0.0],
+            f_h: [r, 0.0, 0.0],
+            x_s: [x_s, 0.0, 0.0],
+            v_s: [v_s, 0.0, 0.0],
+            f_e: [-f_contact, 0.0, 0.0],
+            ..Default::default()
+        });
+        v_s += dt * (f_cs[0] + f_contact) / m_s;
+        x_s += dt * v_s;
+        // Device under the held force u = f_cm − push: m·v̇ = u − b·v, exactly over dt.
+        let u = f_cm[0] - push;
+        let decay = (-b * dt / m).exp();
+        let v_inf = u / b;
+        x_m += v_inf * dt + (v_m - v_inf) * (m / b) * (1.0 - decay);
+        v_m = v_inf + (v_m - v_inf) * decay;
+        u_prev = f_cm[0];
+        v_prev = v_hat;
+        if !(x_s.is_finite() && x_m.is_finite()) || (t > 0.3 && x_s > 0.0) {
+            return f64::INFINITY;
+        }
+        if k + rate as usize >= n {
+            lo = lo.min(x_s);
+            hi = hi.max(x_s);
+        }
+    }
+    hi - lo
+}
+
+/// The 1-DOF released-handle regression at 0.5, 1, 2 and 10 kHz: the default settles on the wall
+/// (x range over the last second below 1 µm); the §11.1 table loses the contact (the slave is thrown
+/// off the wall by the growing oscillation) or keeps oscillating above 0.1 mm.
+#[test]
+fn released_handle_one_dof_default_settles_spec_grows() {
+    for rate in RATES {
+        let ok = one_dof(FourChannelGains::default(), rate);
+        let bad = one_dof(FourChannelGains::spec(), rate);
+        println!("1-DOF {rate} Hz: default late range {ok:e} m, spec {bad:e} m");
+        assert!(ok < 1e-6, "{rate} Hz default: {ok:e}");
+        assert!(bad > 1e-4, "{rate} Hz spec: {bad:e}");
+    }
+}

@@ -294,3 +294,29 @@ fn default_configuration_is_stable_released_and_the_spec_is_not() {
         }
     }
 }
+
+/// The gate `run` applies before a real device: the spec table is refused with the axis and the fix
+/// named; the default and the virtual coupling pass.
+#[test]
+fn check_released_stability_refuses_the_spec_table_and_names_the_axis_and_fix() {
+    use haptic2d_lab::stability::check_released_stability;
+    let text = BUILTIN.iter().find(|b| b.0 == "box-in-walls").unwrap().2;
+    let world = Scene::from_toml(text, "box-in-walls", Some(1000.0))
+        .unwrap()
+        .world;
+    let spec = HapticConfig {
+        controller: ControllerKind::FourChannel(FourChannelGains::spec()),
+        ..HapticConfig::default()
+    };
+    let e = check_released_stability(&spec, &world).unwrap_err();
+    println!("{e}");
+    assert!(e.contains("axis x") || e.contains("axis y"), "{e}");
+    assert!(e.contains("--controller four-channel"), "{e}");
+    assert!(e.contains("--allow-unstable"), "{e}");
+    assert!(check_released_stability(&HapticConfig::default(), &world).is_ok());
+    let coupling = HapticConfig {
+        controller: ControllerKind::from_name("coupling").unwrap(),
+        ..HapticConfig::default()
+    };
+    assert!(check_released_stability(&coupling, &world).is_ok());
+}
