@@ -26,7 +26,7 @@ impl Default for ControllerKind {
 impl ControllerKind {
     /// Names accepted by [`Self::from_name`].
     pub const NAMES: &'static str =
-        "four-channel, four-channel-spec, four-channel-damped, coupling";
+        "four-channel, coupling, four-channel-spec, four-channel-damped";
 
     /// The controller called `name` with its named gains: `four-channel` (default: local force
     /// feedback C6 = −1 and a small damping injection, stable with the hand released),
