@@ -361,7 +361,7 @@ mod tests {
     #[test]
     fn roots_of_a_quartic_with_two_complex_pairs() {
         // (s² + 2s + 5)(s² − 4s + 13): roots −1 ± 2j, 2 ± 3j.
-        let c = [1.0, -2.0, 10.0, -6.0, 65.0];
+        let c = [1.0, -2.0, 10.0, 6.0, 65.0];
         let r = sorted(poly_roots(&c).unwrap());
         let want = [(-1.0, -2.0), (-1.0, 2.0), (2.0, -3.0), (2.0, 3.0)];
         for (got, w) in r.iter().zip(want) {
