@@ -38,7 +38,8 @@ pub struct RunArgs {
     /// Control rate (Hz); also the world's rate.
     #[arg(long, default_value_t = 1000.0, allow_negative_numbers = true)]
     pub rate: f64,
-    /// Teleoperation controller: four-channel or coupling.
+    /// Teleoperation controller: four-channel (default: stable with the hand released),
+    /// four-channel-spec (the paper's gains, unstable released), four-channel-damped or coupling.
     #[arg(long, default_value = "four-channel")]
     pub controller: String,
     /// Passivity observer/controller on the device port (§12).
@@ -80,6 +81,10 @@ pub struct RunArgs {
     /// period, at most 400 µs (400 µs at 1 kHz, 40 µs at 10 kHz); see docs/PERFORMANCE.md.
     #[arg(long)]
     pub spin_us: Option<f64>,
+    /// Drive a real device even if `haptic2d stability` finds the configuration unstable with the
+    /// hand released.
+    #[arg(long)]
+    pub allow_unstable: bool,
 }
 
 /// `--duration` upper bound (s): about 116 days, far beyond any session, and small enough that the
@@ -122,6 +127,11 @@ pub fn run(a: &RunArgs) -> Result<Status, Failure> {
         passivity: a.passivity.then(PlanarPassivity::default),
         ..HapticConfig::default()
     };
+    // A real device only starts with a configuration that is stable with the hand released (§11.4).
+    let simulated = matches!(opts.device, DeviceChoice::Sim | DeviceChoice::Replay(_));
+    if !simulated && !a.allow_unstable {
+        haptic2d_lab::stability::check_released_stability(&config, &scene.world)?;
+    }
     let scene_name = scene.name.clone();
     let loaded = LoadedScene {
         name: scene.name,

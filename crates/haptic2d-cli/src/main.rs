@@ -5,6 +5,7 @@ mod cmd_reproduce;
 mod cmd_run;
 mod cmd_scenes;
 mod cmd_simulate;
+mod cmd_stability;
 mod cmd_sweep;
 mod csv_out;
 mod device_arg;
@@ -83,6 +84,9 @@ enum Command {
         #[arg(long)]
         strict: bool,
     },
+    /// The loop's stability per axis with the hand held and released: right-most poles, sampled-data
+    /// growth rate and a verdict, plus a plot of the poles against the hand's impedance.
+    Stability(cmd_stability::StabilityArgs),
     /// Parameter sweeps; `walls`: stiffness × damping of every wall law, classified by energy gain.
     Sweep {
         /// What to sweep: walls.
@@ -123,6 +127,7 @@ fn main() -> ExitCode {
         Command::Scenes => cmd_scenes::run()
             .map(|()| Status::Clean)
             .map_err(Failure::from),
+        Command::Stability(args) => runtime(cmd_stability::run(&args)),
         Command::Check {
             scene,
             allow_overlap,

@@ -15,11 +15,11 @@
 
 use crate::csv::write_columns;
 use crate::figure::{Figure, FigureContext, FigureReport};
+use crate::harness::wall::{run_wall, EntryImpulse, WallConfig};
 use crate::plot::{write_panels, Panel, Series, Stroke};
 use crate::schema::{CaseMetrics, Check, Dimension, Fig4Measured, FigureMetrics, Measured};
 use crate::world2d::{body, load_builtin, min_vertex_x};
 use haptic2d::geom::ConvexPolygon;
-use haptic2d::harness::wall::{run_wall, EntryImpulse, WallConfig};
 use haptic2d::integrate::IntegrationMode;
 use haptic2d::laws::friction::FrictionModel;
 use haptic2d::laws::normal::{colgate_margin, NormalModel};

@@ -17,11 +17,11 @@
 
 use crate::csv::write_columns;
 use crate::figure::{Figure, FigureContext, FigureReport};
+use crate::harness::peg::{PegHarness, PegPush, PegResult};
 use crate::plot::{write_panels, Panel, Series, Stroke};
 use crate::schema::{CaseMetrics, Check, Dimension, Fig7Measured, FigureMetrics, Measured};
 use crate::world2d::{body, load_builtin, rebuild};
 use haptic2d::geom::Vec2;
-use haptic2d::harness::peg::{PegHarness, PegPush, PegResult};
 use haptic2d::laws::friction::FrictionModel;
 use rayon::prelude::*;
 use std::fmt::Write as _;

@@ -7,6 +7,8 @@
 //! - [`fig5`]: Figs. 5–6, the walls with the device in the loop (four-channel and virtual coupling).
 //! - [`fig7`]: Fig. 7, a peg pushed into a tight hole (§13.2), in 1-D and through the 2-D world.
 //! - [`fig8`]: Figs. 8–11, the peg in a tight hole with the device in the loop.
+//! - [`experiments`]: the device-in-the-loop runs of Figs. 5–6 and 8–11 (library code the figures call).
+//! - [`harness`]: the 1-D reduced harnesses of Figs. 4 and 7 (§5.1, §13).
 //! - [`sweep`]: stiffness × damping sweeps of the wall laws on the 1-D Fig. 4 harness (Z-width chart).
 //!
 //! Adding a figure: implement [`Figure`] in a new file and add it to [`figure::registry`].
@@ -14,14 +16,17 @@
 #![warn(missing_docs)]
 
 pub mod csv;
+pub mod experiments;
 pub mod fig4;
 pub mod fig5;
 pub mod fig5_sweep;
 pub mod fig7;
 pub mod fig8;
 pub mod figure;
+pub mod harness;
 pub mod plot;
 pub mod schema;
+pub mod stability;
 pub mod sweep;
 pub mod world2d;
 

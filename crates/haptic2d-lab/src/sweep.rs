@@ -15,8 +15,8 @@
 //! state becomes non-finite gains energy.
 
 use crate::csv::write_columns;
+use crate::harness::wall::{run_wall, EntryImpulse, WallConfig};
 use crate::plot::{write_panels, Panel, Series, Stroke};
-use haptic2d::harness::wall::{run_wall, EntryImpulse, WallConfig};
 use haptic2d::laws::normal::NormalModel;
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;

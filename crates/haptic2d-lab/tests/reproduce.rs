@@ -2,7 +2,7 @@
 //! option validation.
 
 use haptic2d_lab::sweep::{sweep_walls, SweepConfig};
-use haptic2d_lab::{reproduce, FigureMetrics};
+use haptic2d_lab::{reproduce, CaseMetrics, FigureMetrics};
 use serde_json::Value;
 use std::path::Path;
 
@@ -101,9 +101,11 @@ fn reproduce_all_writes_every_output_and_the_cases_pass() {
         assert!(c.pass, "fig4 {} {:?}: {:?}", c.model, c.dimension, c.checks);
     }
 
-    // Figs. 5–11 with the device in the loop (see the `fig5`, `fig8` module docs): the four-channel
-    // loop on the damped device reproduces every wall of Figs. 5–6, the virtual coupling reproduces
-    // Figs. 8–11; the other runs are comparison runs, reported but not counted.
+    // Figs. 5–11 with the device in the loop (see the `experiments::fig5`, `fig8` module docs): the
+    // claim cases are the four-channel runs with the released-stable default gains on the spec's
+    // device; the §11.1 table, the calibrated-damping device and the virtual coupling are comparison
+    // runs, reported but not counted. The claim runs have no safety stop; the claims they cannot meet
+    // (Fig. 5's bouncing, Figs. 8–11's slips and classical drift) are pinned here as measured.
     let v5 = read_json(&out.join("fig5/metrics.json"));
     check_schema(
         &v5,
@@ -114,8 +116,8 @@ fn reproduce_all_writes_every_output_and_the_cases_pass() {
     check_schema(&v8, "fig8", &["peak_force_n", "creep_m", "advance_m"]);
     let m5: FigureMetrics = serde_json::from_value(v5).expect("typed fig5");
     let m8: FigureMetrics = serde_json::from_value(v8).expect("typed fig8");
-    assert_eq!(m5.cases.len(), 12);
-    assert_eq!(m8.cases.len(), 10);
+    assert_eq!(m5.cases.len(), 16);
+    assert_eq!(m8.cases.len(), 15);
     let names = |m: &FigureMetrics, pass: bool, comparison: bool| {
         let mut v: Vec<String> = m
             .cases
@@ -126,29 +128,36 @@ fn reproduce_all_writes_every_output_and_the_cases_pass() {
         v.sort();
         v
     };
-    // Every claim case passes; the comparison runs show what the other designs do.
     assert_eq!(
         names(&m5, true, false),
-        [
-            "four-channel/hysteretic",
-            "four-channel/pulse",
-            "four-channel/seh",
-            "four-channel/zoh"
-        ]
+        ["four-channel/hysteretic", "four-channel/pulse"]
     );
-    assert!(names(&m5, false, false).is_empty());
+    assert_eq!(
+        names(&m5, false, false),
+        ["four-channel/seh", "four-channel/zoh"]
+    );
     assert_eq!(
         names(&m5, false, true),
         [
             "coupling/seh",
             "coupling/zoh",
-            "four-channel-spec-device/hysteretic",
-            "four-channel-spec-device/pulse"
+            "four-channel-spec/hysteretic",
+            "four-channel-spec/pulse"
         ]
     );
-    assert_eq!((m5.passed(), m5.claim_count(), m5.comparisons()), (4, 4, 8));
     assert_eq!(
-        names(&m8, true, false),
+        (m5.passed(), m5.claim_count(), m5.comparisons()),
+        (2, 4, 12)
+    );
+    let claim8: Vec<&CaseMetrics> = m8.cases.iter().filter(|c| !c.comparison).collect();
+    assert_eq!(claim8.len(), 5);
+    for c in &claim8 {
+        assert!(c.model.starts_with("four-channel/"), "{}", c.model);
+        let run = c.checks.iter().find(|k| k.id == "F8-run").expect("F8-run");
+        assert!(run.pass, "{}: no safety stop", c.model);
+    }
+    assert_eq!(
+        names(&m8, true, true),
         [
             "coupling/classical",
             "coupling/dahl",
@@ -157,14 +166,13 @@ fn reproduce_all_writes_every_output_and_the_cases_pass() {
             "coupling/salcudean-vlaar"
         ]
     );
-    assert!(names(&m8, false, false).is_empty());
-    assert_eq!(m8.comparisons(), 5);
+    assert_eq!(m8.comparisons(), 10);
     for f in ["fig5/sweep.csv", "fig5/sweep.png", "fig5/sweep.svg"] {
         assert!(out.join(f).is_file(), "{f}");
     }
     assert!(report.contains("![sweep](fig5/sweep.png)"));
-    assert!(report.contains("4 / 4 (+8 comparison runs)"), "{report}");
-    assert!(s.all_pass());
+    assert!(report.contains("2 / 4 (+12 comparison runs)"), "{report}");
+    assert!(!s.all_pass());
 }
 
 #[test]

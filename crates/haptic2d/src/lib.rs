@@ -15,7 +15,6 @@ pub mod control;
 pub mod device;
 pub mod geom;
 pub mod haptic;
-pub mod harness;
 pub mod integrate;
 pub mod laws;
 pub mod load;

@@ -3,6 +3,9 @@
 //! constant 2 N toward a virtual wall (`K_e = 2000 N/m`, `B_e = 5 N·s/m`, surface at x = 0) at the slave
 //! (0.5 kg, semi-implicit Euler); `T = 2 ms`, 4 s. The device + hand is a continuous plant integrated
 //! exactly under the zero-order-held command `f_cm`. The controllers run on 3-vectors; only x is used.
+//! The §11.3 references are for the §11.1 table ([`FourChannelGains::spec`]); the default
+//! configuration (local force feedback `C6 = −1`, damping injection) is checked by
+//! `x1_x3_default_configuration`.
 //!
 //! The device velocity is estimated by the §10.7 filter. The hand-force signal `f_h` fed to the
 //! four-channel controller is selectable ([`HandForce`]):
@@ -149,7 +152,7 @@ fn four_channel_with(k_m: f64, slave_feedforward: bool) -> Controller {
     let gains = FourChannelGains {
         k_m: [k_m, k_m, 1.0],
         slave_feedforward,
-        ..FourChannelGains::default()
+        ..FourChannelGains::spec()
     };
     gains
         .check_slave_mass(&[M_S, M_S, 1e-4], T)
@@ -293,4 +296,41 @@ fn x2_with_observer_estimated_hand_force() {
         late > 1e-5,
         "documents the lightly damped mode; if this fails, the loop improved"
     );
+}
+
+/// X1 and X3 (and X2 at the default `K_m`) for the default configuration, local force feedback
+/// `C6 = −1` plus damping injection (§11.4): in steady contact the master cancels the hand force and
+/// the slave carries it (`f_e = f_h`, `x_s = x_m`), so the perceived stiffness is still `K_e` and
+/// `f_cm = −f_h`, of the magnitude of `f_e` (the injection adds nothing at rest).
+#[test]
+fn x1_x3_default_configuration() {
+    let gains = FourChannelGains::default();
+    assert_eq!(gains.c6, [-1.0; 3]);
+    let tr = run(
+        Controller::FourChannel(FourChannel::new(gains, T).expect("valid gains")),
+        HandForce::Applied,
+    );
+    let (xm, xs) = (
+        *tr.x_m.last().unwrap_or(&0.0),
+        *tr.x_s.last().unwrap_or(&0.0),
+    );
+    let k_hat = 2.0 / (-xm);
+    println!(
+        "X1 default four-channel: device {:.4} mm, slave {:.4} mm, k_hat = {k_hat:.1} N/m",
+        xm * 1e3,
+        xs * 1e3
+    );
+    assert!((k_hat - K_E).abs() <= 0.1 * K_E, "k_hat = {k_hat}");
+    let pp = window_pp(&tr.x_m, DURATION - 1.0);
+    println!("X2 default four-channel: device p-p over the last 1 s = {pp:.3e} m");
+    assert!(pp < 1e-5, "p-p {pp:e} m");
+    let (f_cm, f_e) = (
+        *tr.f_cm.last().unwrap_or(&0.0),
+        *tr.f_e.last().unwrap_or(&0.0),
+    );
+    // With C6 = −1 the device command is −f_h (the hand push is 2 N): |f_cm| = |f_e| in steady contact.
+    let rel = (f_cm.abs() - f_e.abs()).abs() / f_e.abs();
+    println!("X3 default four-channel: f_cm = {f_cm:.5} N, f_e = {f_e:.5} N");
+    assert!(f_e < -1.9, "steady contact reached (f_e = {f_e})");
+    assert!(rel < 0.01, "rel {rel}");
 }

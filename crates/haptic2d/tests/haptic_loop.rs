@@ -66,10 +66,11 @@ fn push() -> HandModel {
     }
 }
 
+/// The §11.1 table (the X1–X3 references of §11.3 are for it) with `K_m` set.
 fn four_channel(k_m: f64) -> ControllerKind {
     ControllerKind::FourChannel(FourChannelGains {
         k_m: [k_m, k_m, 1.0],
-        ..FourChannelGains::default()
+        ..FourChannelGains::spec()
     })
 }
 

@@ -6,11 +6,13 @@
 //! `f_cm = −C_m·v_m − C4·v_s + C6·f_h − C2·f_e` and `f_cs = −C_s·v_s + C1·v_m + C3·f_h − C5·f_e` into
 //!
 //! ```text
-//! f_cm = K_m·(x_s − x_m) + B_m·(v_s − v_m) + C6·f_h − (1 + C6)·f_e  [+ M̂_x·a_s]
+//! f_cm = K_m·(x_s − x_m) + B_m·(v_s − v_m) + C6·f_h − (1 + C6)·f_e − D_m·v_m  [+ M̂_x·a_s]
 //! f_cs = K_s·(x_m − x_s) + B_s·(v_m − v_s) + (1 + C5)·f_h − C5·f_e  [+ M_s·â_m]
 //! ```
 //!
-//! which with the default `C5 = C6 = 0` is the spec's discrete law. All gains are diagonal (per DOF
+//! which with `C5 = C6 = 0`, `D_m = 0` is the spec's discrete law ([`FourChannelGains::spec`]). The
+//! default is [`FourChannelGains::local_force_feedback`] (`C6 = −1` plus a small damping injection),
+//! stable with the hand released (§11.4; see its derivation). All gains are diagonal (per DOF
 //! x, y, θ); θ position errors are wrapped to `(−π, π]`.
 
 use serde::{Deserialize, Serialize};
@@ -49,7 +51,8 @@ pub fn pose_error(x_a: &V3, x_b: &V3) -> V3 {
     ]
 }
 
-/// Four-channel gains and options. Defaults are the §11.1 table.
+/// Four-channel gains and options. The default is [`FourChannelGains::local_force_feedback`]; the
+/// §11.1 table is [`FourChannelGains::spec`].
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct FourChannelGains {
@@ -63,8 +66,11 @@ pub struct FourChannelGains {
     pub b_s: V3,
     /// Slave local force feedback `C5` (dimensionless). Default 0.
     pub c5: V3,
-    /// Master local force feedback `C6` (dimensionless). Default 0.
+    /// Master local force feedback `C6` (dimensionless). Default −1 (spec: 0).
     pub c6: V3,
+    /// Master damping injection `D_m` (N·s/m, N·s/m, N·m·s/rad): a local damper `−D_m·v̂_m` on the
+    /// device command, on top of `B_m` (which acts on the velocity error). Default (2, 2, 0.002) (spec: 0).
+    pub d_m: V3,
     /// Add the master-mass feedforward `M̂_x·a_s` to `f_cm`. Default off.
     pub master_feedforward: bool,
     /// Add the slave-mass feedforward `M_s·â_m` to `f_cs` (amplifies encoder noise). Default off.
@@ -77,7 +83,29 @@ pub struct FourChannelGains {
 }
 
 impl Default for FourChannelGains {
+    /// The default configuration of `run` and `reproduce`: [`FourChannelGains::local_force_feedback`].
     fn default() -> Self {
+        Self::local_force_feedback()
+    }
+}
+
+/// Master damping injection of the default configuration in world units (N·s/m, N·s/m, N·m·s/rad);
+/// see [`FourChannelGains::local_force_feedback`].
+pub const DEFAULT_DAMPING_INJECTION: V3 = [2.0, 2.0, 0.002];
+
+/// Master damping injection of [`FourChannelGains::damped`] (N·s/m, N·s/m, N·m·s/rad).
+pub const SPEC_DAMPING_INJECTION: V3 = [40.0, 40.0, 0.04];
+
+impl FourChannelGains {
+    /// The §11.1 table exactly (`C5 = C6 = 0`, direct force reflection, no damping injection): the
+    /// paper's configuration, kept as the named comparison `four-channel-spec`. **Unstable with the
+    /// hand released** against a stiff contact (§11.4): with the handle let go, the master (inertia
+    /// `m`, almost no physical damping) and the slave on the contact spring `K_e` close a loop through
+    /// `C2 = 1` whose released characteristic polynomial has right-half-plane roots in continuous
+    /// time — `+2.5 ± 67j` for the spec device on the Fig. 4 box (2000 N/m), `+30 ± 185j` for the
+    /// peg's y axis at world scale 2 — so no sampling rate fixes it (`haptic2d stability
+    /// --controller four-channel-spec`).
+    pub fn spec() -> Self {
         Self {
             k_m: [500.0, 500.0, 1.0],
             b_m: [5.0, 5.0, 0.01],
@@ -85,10 +113,54 @@ impl Default for FourChannelGains {
             b_s: [30.0, 30.0, 0.03],
             c5: [0.0; 3],
             c6: [0.0; 3],
+            d_m: [0.0; 3],
             master_feedforward: false,
             slave_feedforward: false,
             slave_mass: [0.5, 0.5, 1e-4],
             accel_cutoff_hz: 30.0,
+        }
+    }
+
+    /// The default (`four-channel`): the §11.1 gains with **local force feedback `C6 = −1`** at the
+    /// master and a small master damping injection `D_m` = [`DEFAULT_DAMPING_INJECTION`].
+    ///
+    /// Derivation. With `C6 = −1` the transparency conditions of §11.1 give `C2 = 1 + C6 = 0`: the
+    /// environment force no longer reaches the device directly, and the hand-force estimate is
+    /// cancelled at the master (`f_cm = K_m·e + B_m·ė − Ŵ_h`) and passed to the slave (`C3 = 1`) —
+    /// Hashtrudi-Zaad and Salcudean's three-channel form, still transparent in steady contact
+    /// (`f_e = f_h`, `x_s = x_m`, so X1 and X3 hold). With the handle released, the loop is then a
+    /// master on the PD `(K_m, B_m)` to a slave held by `K_s + K_e`, whose released poles are all in
+    /// the left half plane; but the master's mode is lightly damped (for the spec device on the Fig. 4
+    /// box: right-most pole `−1.3 ± 23j`, sampled growth `−0.9 1/s` at 500 Hz, below the
+    /// 2 1/s margin of the stability verdict). `D_m = 2 N·s/m` (world units) moves it to a decay of
+    /// `≥ 2.6 1/s` on every axis, hand held or released, at 0.5, 1, 2 and 10 kHz with or without one
+    /// sample of output delay, on box-in-walls (Fig. 4 walls, 2000 N/m) and peg-in-hole at scale 2
+    /// (1 kHz and up; the peg's 3.3e-5 kg·m² is below the θ minimum mass at 500 Hz), and costs
+    /// `D_m·v` of drag in free motion (0.2 N at 0.1 m/s). The θ injection follows the ratio `B_m,θ /
+    /// B_m,x`. Figures from `haptic2d_lab::stability` (test `stability_defaults.rs`).
+    pub fn local_force_feedback() -> Self {
+        Self {
+            c6: [-1.0; 3],
+            d_m: DEFAULT_DAMPING_INJECTION,
+            ..Self::spec()
+        }
+    }
+
+    /// `four-channel-damped`: the §11.1 gains (`C5 = C6 = 0`, full force reflection) made stable
+    /// released by master damping injection alone, `D_m` = [`SPEC_DAMPING_INJECTION`].
+    ///
+    /// Derivation. In the §11.4 polynomial the injection adds to the device's damping `b`; the Fig. 4
+    /// box needs `b + D_m ≳ 2.65 N·s/m`, but the peg's y axis at scale 2 (world inertia 0.0625 kg on
+    /// 4000–8900 N/m) needs far more: `D_m = 20` still grows at `+8 1/s` (2 kHz); `D_m = 40` decays at
+    /// `≥ 9 1/s` on the box and `≥ 24 1/s` on the peg at 1 kHz and up with no output delay, but grows
+    /// again with one sample of delay (`+24 1/s` on the peg at 1 kHz): the damper is a derivative
+    /// action the delay turns active. A comparison configuration, not a default: it is refused for a
+    /// real device by `run`'s released-stability gate (which assumes one sample of delay) at 1 kHz,
+    /// and the operator feels 40 N·s/m of drag (4 N at 0.1 m/s).
+    pub fn damped() -> Self {
+        Self {
+            d_m: SPEC_DAMPING_INJECTION,
+            ..Self::spec()
         }
     }
 }
@@ -105,12 +177,31 @@ fn check_finite_nonneg(name: &str, v: &V3) -> Result<(), String> {
 }
 
 impl FourChannelGains {
+    /// The named configuration of the command line: `four-channel` (default), `four-channel-spec`,
+    /// `four-channel-damped`; `None` for another name.
+    pub fn named(name: &str) -> Option<Self> {
+        match name {
+            "four-channel" | "4ch" => Some(Self::local_force_feedback()),
+            "four-channel-spec" => Some(Self::spec()),
+            "four-channel-damped" => Some(Self::damped()),
+            _ => None,
+        }
+    }
+
+    /// The name of these gains if they are one of the named configurations.
+    pub fn name(&self) -> Option<&'static str> {
+        ["four-channel", "four-channel-spec", "four-channel-damped"]
+            .into_iter()
+            .find(|n| Self::named(n).as_ref() == Some(self))
+    }
+
     /// Checks that every gain is finite and non-negative (C5, C6 only finite), naming the field.
     pub fn validate(&self) -> Result<(), String> {
         check_finite_nonneg("k_m", &self.k_m)?;
         check_finite_nonneg("b_m", &self.b_m)?;
         check_finite_nonneg("k_s", &self.k_s)?;
         check_finite_nonneg("b_s", &self.b_s)?;
+        check_finite_nonneg("d_m", &self.d_m)?;
         check_finite_nonneg("slave_mass", &self.slave_mass)?;
         for (name, c) in [("c5", &self.c5), ("c6", &self.c6)] {
             if !c.iter().all(|v| v.is_finite()) {
@@ -222,6 +313,7 @@ impl FourChannel {
             let dv = s.v_s[i] - s.v_m[i];
             f_cm[i] = g.k_m[i] * e[i] + g.b_m[i] * dv + g.c6[i] * s.f_h[i]
                 - (1.0 + g.c6[i]) * s.f_e[i]
+                - g.d_m[i] * s.v_m[i]
                 + ff_m[i];
             let ff_s = if g.slave_feedforward {
                 g.slave_mass[i] * a_m[i]

@@ -10,7 +10,8 @@ use crate::device::{DeviceParams, ObserverKind};
 /// Which teleoperation controller couples the device to the slave (§11).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ControllerKind {
-    /// Lawrence's four-channel controller (§11.1), the default.
+    /// Lawrence's four-channel controller (§11.1), the default (with the released-stable gains of
+    /// [`FourChannelGains::local_force_feedback`]).
     FourChannel(FourChannelGains),
     /// The impedance (virtual-coupling) baseline (§11.2).
     Coupling(CouplingGains),
@@ -23,24 +24,34 @@ impl Default for ControllerKind {
 }
 
 impl ControllerKind {
-    /// The controller called `name` (`four-channel` or `coupling`) with default gains. The error lists
-    /// the valid names.
+    /// Names accepted by [`Self::from_name`].
+    pub const NAMES: &'static str =
+        "four-channel, coupling, four-channel-spec, four-channel-damped";
+
+    /// The controller called `name` with its named gains: `four-channel` (default: local force
+    /// feedback C6 = −1 and a small damping injection, stable with the hand released),
+    /// `four-channel-spec` (the §11.1 table, unstable released), `four-channel-damped` (the §11.1
+    /// table plus master damping injection) or `coupling`. The error lists the valid names.
     pub fn from_name(name: &str) -> Result<Self, String> {
+        if let Some(g) = FourChannelGains::named(name) {
+            return Ok(ControllerKind::FourChannel(g));
+        }
         match name {
-            "four-channel" | "4ch" => Ok(ControllerKind::FourChannel(FourChannelGains::default())),
             "coupling" | "virtual-coupling" => {
                 Ok(ControllerKind::Coupling(CouplingGains::default()))
             }
             _ => Err(format!(
-                "unknown controller `{name}`; valid: four-channel, coupling"
+                "unknown controller `{name}`; valid: {}",
+                Self::NAMES
             )),
         }
     }
 
-    /// The name used on the command line.
+    /// The name used on the command line (`four-channel` for four-channel gains that are not one
+    /// of the named configurations).
     pub fn name(&self) -> &'static str {
         match self {
-            ControllerKind::FourChannel(_) => "four-channel",
+            ControllerKind::FourChannel(g) => g.name().unwrap_or("four-channel"),
             ControllerKind::Coupling(_) => "coupling",
         }
     }
@@ -53,7 +64,8 @@ pub struct HapticConfig {
     pub device: DeviceParams,
     /// Hand-wrench observer (§10.6). Default: generalized momentum.
     pub observer: ObserverKind,
-    /// Teleoperation controller (§11). Default: four-channel with the §11.1 gains.
+    /// Teleoperation controller (§11). Default: four-channel with the released-stable gains
+    /// ([`FourChannelGains::local_force_feedback`]).
     pub controller: ControllerKind,
     /// Passivity observer/controller on the device port (§12); `None` = off (default).
     pub passivity: Option<PlanarPassivity>,

@@ -5,12 +5,10 @@
 //! The tick is pure computation (no allocation, no locks, no I/O). Where the encoder angles come from
 //! and where the torques go is the caller's business: the real-time loop of `haptic2d-rt` (a real or
 //! simulated device), or [`DeviceInTheLoop`], which closes the loop with a simulated plant and hand in
-//! simulated time for the device-in-the-loop experiments ([`fig5`], [`fig8`]).
+//! simulated time for tests and for the device-in-the-loop experiments of `haptic2d-lab`.
 
 pub mod config;
 pub mod experiment;
-pub mod fig5;
-pub mod fig8;
 pub mod mapping;
 pub mod record;
 pub mod safety;

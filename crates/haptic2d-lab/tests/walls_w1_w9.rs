@@ -2,8 +2,8 @@
 //! constant push 2 N toward the wall, at rest 0.02 m from it (entry speed 0.400 m/s), `K = 2000 N/m`,
 //! `T = 2 ms`, 10 s, exact-ZOH mode unless a test says otherwise.
 
-use haptic2d::harness::wall::{run_wall, EntryImpulse, WallConfig, WallIntegration, WallRun};
 use haptic2d::laws::normal::{colgate_margin, HystereticLaw, NormalModel, PaperLaw};
+use haptic2d_lab::harness::wall::{run_wall, EntryImpulse, WallConfig, WallIntegration, WallRun};
 
 fn run_law(law: NormalModel, config: WallConfig) -> WallRun {
     run_wall(&config, law).expect("valid run")

@@ -2,8 +2,8 @@
 //! `F(t) = F_pk·(1 − cos 2πt)/2`, point mass 0.2 kg on two contacts with `F_n = 2 N` each, semi-implicit
 //! Euler at `T = 0.002 s` for 5.2 s, every model with its 1-D defaults. Tests F7-1 … F7-5.
 
-use haptic2d::harness::peg::{PegHarness, PegPush, PegResult};
 use haptic2d::laws::friction::FrictionModel;
+use haptic2d_lab::harness::peg::{PegHarness, PegPush, PegResult};
 
 /// The four models that must show clean stick/slip (F7-2).
 const STICKY: [&str; 4] = [

@@ -6,8 +6,8 @@
 //! of §12 or a user hook, holds the result over the sample and advances the mass in one of three
 //! integration modes. It records the time series and computes the body-level metrics of §13.1.
 
-use crate::control::passivity::PassivityController;
-use crate::laws::normal::{NormalInput, NormalLaw, NormalModel};
+use haptic2d::control::passivity::PassivityController;
+use haptic2d::laws::normal::{NormalInput, NormalLaw, NormalModel};
 
 /// Speed below which the body counts as settled (m/s), §13.1.
 pub const SETTLE_SPEED: f64 = 1e-3;

@@ -3,8 +3,8 @@
 //! observed port carries the wall force only; the push is an external input.
 
 use haptic2d::control::passivity::{EnergyPairing, PassivityController};
-use haptic2d::harness::wall::{run_wall, WallConfig, WallRun};
 use haptic2d::laws::normal::NormalModel;
+use haptic2d_lab::harness::wall::{run_wall, WallConfig, WallRun};
 
 fn run(name: &str, pc: Option<PassivityController>) -> WallRun {
     let cfg = WallConfig {

@@ -8,10 +8,10 @@
 //! variant (ZOH, SEH, predictor–corrector) gives the same 1 N per corner.
 
 use haptic2d::geom::{ConvexPolygon, Vec2};
-use haptic2d::harness::peg::{PegHarness, PegPush, PegResult};
 use haptic2d::laws::friction::FrictionModel;
 use haptic2d::scene::builtin;
 use haptic2d::world::World;
+use haptic2d_lab::harness::peg::{PegHarness, PegPush, PegResult};
 
 const MODELS: [&str; 5] = [
     "classical",

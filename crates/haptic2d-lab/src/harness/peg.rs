@@ -12,7 +12,7 @@
 //! The result holds the trace and the Fig. 7 metrics: creep_k, advance_k, the per-cycle energy balance
 //! `ΔE − W_push` (F7-5) and `max|x|`.
 
-use crate::laws::friction::{FrictionInput, FrictionLaw, FrictionMode, FrictionModel};
+use haptic2d::laws::friction::{FrictionInput, FrictionLaw, FrictionMode, FrictionModel};
 
 /// The push `F(t)` (N) along the hole axis.
 #[derive(Clone, Copy, Debug, PartialEq)]

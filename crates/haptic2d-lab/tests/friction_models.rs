@@ -5,11 +5,11 @@
 //! "Harness" tests use the 1-D peg harness of §13.2 (point mass, semi-implicit Euler, `T = 0.002 s`);
 //! "kinematic" tests drive one model instance directly with a prescribed motion.
 
-use haptic2d::harness::peg::{PegHarness, PegPush, PegResult};
 use haptic2d::laws::friction::{
     FingerPad, FrictionInput, FrictionLaw, FrictionMode, FrictionModel, HaywardArmstrong, Karnopp,
     LoadScaling, ResetIntegrator, SalcudeanVlaar,
 };
+use haptic2d_lab::harness::peg::{PegHarness, PegPush, PegResult};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
