@@ -12,6 +12,7 @@ pub mod experiment;
 pub mod fig5;
 pub mod fig8;
 pub mod mapping;
+pub mod planar2;
 pub mod record;
 pub mod safety;
 pub mod system;
