@@ -217,6 +217,9 @@ pub struct EmulatorConfig {
     pub service_time: Duration,
     /// Linkage time. Default real time.
     pub clock: EmulatorClock,
+    /// The hand's own damping at the handle (N·s/m), on top of the hand model: a hand that holds a
+    /// handle is never undamped. Default 2 N·s/m.
+    pub hand_damping: f64,
 }
 
 impl Default for EmulatorConfig {
@@ -225,6 +228,7 @@ impl Default for EmulatorConfig {
             hand: HandModel::Free,
             service_time: Duration::from_micros(50),
             clock: EmulatorClock::RealTime,
+            hand_damping: 2.0,
         }
     }
 }
@@ -246,14 +250,18 @@ pub struct EmulatorReport {
 
 /// The plant for device file `file`, at rest at `start` (2DIY: end point `(x, y)` in the board
 /// frame, m; twin: handle pose `(x, y, θ)`, m, m, rad); `None` = the workspace centre.
-pub fn plant_for(file: &HaplyDeviceFile, start: Option<[f64; 3]>) -> Result<Plant, String> {
+pub fn plant_for(
+    file: &HaplyDeviceFile,
+    start: Option<[f64; 3]>,
+    config: &EmulatorConfig,
+) -> Result<Plant, String> {
     let s = start.unwrap_or_else(|| file.workspace_center());
     match &file.kind {
         HaplyKind::TwoDiy { linkage, .. } => Ok(Plant::TwoDiy(Plant2::new(
             *linkage,
             haptic2d::geom::Vec2::new(s[0], s[1]),
         )?)),
-        HaplyKind::Twin(p) => Plant::twin(p, s),
+        HaplyKind::Twin(p) => Plant::twin(p, s, config.hand_damping),
     }
 }
 
@@ -273,6 +281,11 @@ pub fn serve<S: Read + Write>(
     let mut last_service = Instant::now();
     let mut last_step = Instant::now();
     let mut reason = "stopped".to_string();
+    // Folded into the twin's joint friction by `plant_for`.
+    let b_h = match plant {
+        Plant::TwoDiy(_) => config.hand_damping,
+        Plant::Twin(_) => 0.0,
+    };
     'outer: while !stop.load(Ordering::Relaxed) {
         match stream.read(&mut rx) {
             Ok(0) => {}
@@ -297,7 +310,7 @@ pub fn serve<S: Read + Write>(
                     EmulatorClock::PerWrite(dt) => dt,
                 };
                 last_step = now;
-                if let Err(e) = plant.step(&fw.joint_torques(), &config.hand, dt.min(0.1)) {
+                if let Err(e) = plant.step(&fw.joint_torques(), &config.hand, b_h, dt.min(0.1)) {
                     reason = format!("the simulated linkage failed: {e}");
                     break 'outer;
                 }

@@ -7,6 +7,7 @@ pub mod driver;
 pub mod emulator;
 pub mod plant;
 pub mod serial;
+pub mod system;
 pub mod transport;
 
 pub use codec::{BoardSetup, CodecError, Reply, Rotation};
@@ -15,3 +16,4 @@ pub use driver::HaplyDevice;
 pub use emulator::{serve, EmulatorClock, EmulatorConfig, EmulatorReport, Firmware};
 pub use plant::{Plant, Plant2};
 pub use transport::{HaplyError, Transport};
+pub use system::{HaplySystem, HaplyTick};

@@ -63,6 +63,17 @@ impl Plant2 {
     /// Advances `dt` (s) under joint torques `tau` (N·m) and the hand. Errors (the state is kept)
     /// when the linkage reaches a singular pose.
     pub fn step(&mut self, tau: [f64; 2], hand: &HandModel, dt: f64) -> Result<(), String> {
+        self.step_damped(tau, hand, 0.0, dt)
+    }
+
+    /// [`step`](Self::step) with an extra hand damping `b_h` (N·s/m) on the end point.
+    pub fn step_damped(
+        &mut self,
+        tau: [f64; 2],
+        hand: &HandModel,
+        b_h: f64,
+        dt: f64,
+    ) -> Result<(), String> {
         let n = (dt / 1e-4).ceil().max(1.0) as usize;
         let h = dt / n as f64;
         for _ in 0..n {
@@ -77,7 +88,7 @@ impl Plant2 {
                 }
                 Err(_) => [0.0; 2],
             };
-            let fh = jt_mul(&s.j, [w[0], w[1]]);
+            let fh = jt_mul(&s.j, [w[0] - b_h * ed[0], w[1] - b_h * ed[1]]);
             let cor = jt_mul(&s.j, jdqd);
             let rhs: [f64; 2] = std::array::from_fn(|i| {
                 tau[i] + fh[i] - self.b * self.qd[i] - self.m_e * cor[i]
@@ -121,9 +132,13 @@ pub enum Plant {
 }
 
 impl Plant {
-    /// A twin-pantograph plant for `params` at rest at handle pose `x0` (m, m, rad).
-    pub fn twin(params: &DeviceParams, x0: [f64; 3]) -> Result<Self, String> {
-        let mut sim = SimDevice::new(params, x0)?;
+    /// A twin-pantograph plant for `params` at rest at handle pose `x0` (m, m, rad). A hand damping
+    /// `b_h` (N·s/m) at the handle is approximated by joint viscous friction `b_h·l1²/2` per joint
+    /// (four joints share it), added to `f_v`.
+    pub fn twin(params: &DeviceParams, x0: [f64; 3], b_h: f64) -> Result<Self, String> {
+        let mut p = *params;
+        p.f_v += 0.5 * b_h * p.l1 * p.l1;
+        let mut sim = SimDevice::new(&p, x0)?;
         sim.quantize = false; // the emulated board's encoders quantise
         sim.substeps = 4;
         Ok(Plant::Twin(Box::new(sim)))
@@ -137,10 +152,12 @@ impl Plant {
         }
     }
 
-    /// Advances `dt` (s) under joint torques `tau` (N·m) and `hand`.
-    pub fn step(&mut self, tau: &V4, hand: &HandModel, dt: f64) -> Result<(), String> {
+    /// Advances `dt` (s) under joint torques `tau` (N·m) and `hand`, plus the hand's own damping
+    /// `b_h` (N·s/m at the end point; for the twin it was folded into the joint friction at
+    /// construction, see [`Plant::twin`]).
+    pub fn step(&mut self, tau: &V4, hand: &HandModel, b_h: f64, dt: f64) -> Result<(), String> {
         match self {
-            Plant::TwoDiy(p) => p.step([tau[0], tau[1]], hand, dt),
+            Plant::TwoDiy(p) => p.step_damped([tau[0], tau[1]], hand, b_h, dt),
             Plant::Twin(s) => {
                 // SimDevice steps at most 10 ms at a time (long gaps are split).
                 let n = (dt / 0.002).ceil().max(1.0) as usize;
@@ -152,3 +169,4 @@ impl Plant {
         }
     }
 }
+

@@ -51,13 +51,14 @@ pub fn make_raw(port: &TTYPort) -> Result<(), String> {
 }
 
 /// A pseudo-terminal pair for an emulated board: the emulator serves `master`; a host opens
-/// `path` (the slave side) like a serial port. `slave` is kept open so that the master never sees
-/// a hang-up while no host is connected.
+/// `path` (the slave side) like a serial port. The slave side is kept open through a plain file
+/// (without the advisory lock `serialport` takes, so that a host can still open it), so the master
+/// never sees a hang-up while no host is connected.
 pub struct Pty {
     /// The emulator's end.
     pub master: TTYPort,
-    /// The slave end, held open.
-    pub slave: TTYPort,
+    /// The slave end, held open (no lock).
+    pub keep: std::fs::File,
     /// Path of the slave device (e.g. `/dev/pts/5`).
     pub path: String,
 }
@@ -65,25 +66,24 @@ pub struct Pty {
 impl Pty {
     /// A new pair in raw mode with short read timeouts.
     pub fn new() -> Result<Self, String> {
-        let (mut master, mut slave) =
+        let (mut master, slave) =
             TTYPort::pair().map_err(|e| format!("cannot create a pseudo-terminal pair: {e}"))?;
         let path = slave
             .name()
             .ok_or("the pseudo-terminal has no name")?
             .to_string();
         make_raw(&slave)?;
+        let keep = std::fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .open(&path)
+            .map_err(|e| format!("cannot open the pseudo-terminal {path}: {e}"))?;
+        // Dropping the serialport handle releases its lock; `keep` holds the tty open.
+        drop(slave);
         master
             .set_timeout(STREAM_TIMEOUT)
             .map_err(|e| e.to_string())?;
-        slave
-            .set_timeout(STREAM_TIMEOUT)
-            .map_err(|e| e.to_string())?;
-        let _ = slave.set_exclusive(false);
-        Ok(Self {
-            master,
-            slave,
-            path,
-        })
+        Ok(Self { master, keep, path })
     }
 }
 
