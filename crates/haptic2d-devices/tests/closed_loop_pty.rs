@@ -19,10 +19,19 @@ fn check_wall(samples: &[(f64, f64, u32)], label: &str) {
     let tail = &samples[samples.len() - 1000..];
     let handle = tail.iter().map(|s| s.0).sum::<f64>() / tail.len() as f64;
     let slave = tail.iter().map(|s| s.1).sum::<f64>() / tail.len() as f64;
-    assert!(tail.iter().all(|s| s.2 > 0), "{label}: the box is not touching the wall");
-    assert!((slave - 0.02).abs() < 1e-3, "{label}: box centre at {slave} m, not at the wall");
+    assert!(
+        tail.iter().all(|s| s.2 > 0),
+        "{label}: the box is not touching the wall"
+    );
+    assert!(
+        (slave - 0.02).abs() < 1e-3,
+        "{label}: box centre at {slave} m, not at the wall"
+    );
     let var = tail.iter().map(|s| (s.0 - handle).powi(2)).sum::<f64>() / tail.len() as f64;
-    eprintln!("{label}: handle x {handle:.5} m (rms {:.2e}), slave x {slave:.5} m", var.sqrt());
+    eprintln!(
+        "{label}: handle x {handle:.5} m (rms {:.2e}), slave x {slave:.5} m",
+        var.sqrt()
+    );
     let displacement = 0.02 - handle;
     let expected = PUSH / K_R;
     let err = (displacement - expected).abs() / expected;
@@ -32,7 +41,10 @@ fn check_wall(samples: &[(f64, f64, u32)], label: &str) {
         expected * 1e3,
         err * 100.0
     );
-    assert!(err < 0.2, "{label}: displacement {displacement} m vs {expected} m");
+    assert!(
+        err < 0.2,
+        "{label}: displacement {displacement} m vs {expected} m"
+    );
 }
 
 #[test]
@@ -41,9 +53,13 @@ fn two_diy_box_reaches_the_wall_and_handle_feels_its_stiffness() {
     let start = file.workspace_center();
     let mut emu = start_emulator(&file, hold_then_push(start, 0.8, -PUSH), 1.0 / RATE);
     let mut dev = open_driver(&emu, &file, 1.0 / RATE);
-    let mut system =
-        haptic2d_devices::haply::HaplySystem::new(box_world(RATE, 0.04), &file, coupling(), [0.0; 2])
-            .unwrap();
+    let mut system = haptic2d_devices::haply::HaplySystem::new(
+        box_world(RATE, 0.04),
+        &file,
+        coupling(),
+        [0.0; 2],
+    )
+    .unwrap();
     let samples = run(&mut system, &mut dev, 4000);
     check_wall(&samples, "2DIY gen 3");
     drop(dev);
@@ -64,9 +80,13 @@ fn twin_box_reaches_the_wall_and_handle_feels_its_stiffness() {
     let mut emu = start_emulator(&file, hold_then_push(start, 0.8, -PUSH), 1.0 / RATE);
     let mut dev = open_driver(&emu, &file, 1.0 / RATE);
     // The twin's workspace is ±15 mm: start the box 8 mm from the wall.
-    let mut system =
-        haptic2d_devices::haply::HaplySystem::new(box_world(RATE, 0.028), &file, coupling(), [0.0; 2])
-            .unwrap();
+    let mut system = haptic2d_devices::haply::HaplySystem::new(
+        box_world(RATE, 0.028),
+        &file,
+        coupling(),
+        [0.0; 2],
+    )
+    .unwrap();
     let samples = run(&mut system, &mut dev, 4000);
     check_wall(&samples, "twin");
     drop(dev);

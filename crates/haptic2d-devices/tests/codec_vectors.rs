@@ -7,7 +7,12 @@ fn gen2_setup() -> BoardSetup {
     let mut s = BoardSetup::empty(1);
     s.motor_mask = 0b0011;
     s.enc_mask = 0b0011;
-    s.motor_dir = [Rotation::Clockwise, Rotation::CounterClockwise, Rotation::Clockwise, Rotation::Clockwise];
+    s.motor_dir = [
+        Rotation::Clockwise,
+        Rotation::CounterClockwise,
+        Rotation::Clockwise,
+        Rotation::Clockwise,
+    ];
     s.enc_dir = s.motor_dir;
     s.enc_offset_deg = [-61.0, 241.0, 0.0, 0.0];
     s.enc_resolution = [10752.0, 10752.0, 0.0, 0.0];
@@ -80,7 +85,10 @@ fn wrong_id_is_out_of_step() {
     let bytes = [0x05, 0, 0, 0, 0, 0, 0, 0, 0];
     assert_eq!(
         decode_reply(1, 0, 2, &bytes),
-        Err(CodecError::WrongId { expected: 1, got: 5 })
+        Err(CodecError::WrongId {
+            expected: 1,
+            got: 5
+        })
     );
 }
 
@@ -89,7 +97,10 @@ fn short_reply_is_detected() {
     let bytes = [0x01, 0, 0, 0x48, 0x41, 0];
     assert_eq!(
         decode_reply(1, 0, 2, &bytes),
-        Err(CodecError::Short { expected: 9, got: 6 })
+        Err(CodecError::Short {
+            expected: 9,
+            got: 6
+        })
     );
 }
 
@@ -97,14 +108,23 @@ fn short_reply_is_detected() {
 fn nan_in_reply_is_garbage() {
     let mut bytes = [0x01, 0, 0, 0, 0, 0, 0, 0, 0];
     bytes[5..9].copy_from_slice(&f32::NAN.to_le_bytes());
-    assert_eq!(decode_reply(1, 0, 2, &bytes), Err(CodecError::NonFinite { offset: 5 }));
+    assert_eq!(
+        decode_reply(1, 0, 2, &bytes),
+        Err(CodecError::NonFinite { offset: 5 })
+    );
 }
 
 #[test]
 fn buffer_too_small_is_an_error_not_a_panic() {
     let mut b = [0u8; 5];
-    assert!(matches!(encode_setup(&gen2_setup(), &mut b), Err(CodecError::BufferTooSmall(26))));
-    assert!(matches!(encode_write(1, &[], &[0.0, 0.0], &mut b), Err(CodecError::BufferTooSmall(10))));
+    assert!(matches!(
+        encode_setup(&gen2_setup(), &mut b),
+        Err(CodecError::BufferTooSmall(26))
+    ));
+    assert!(matches!(
+        encode_write(1, &[], &[0.0, 0.0], &mut b),
+        Err(CodecError::BufferTooSmall(10))
+    ));
 }
 
 #[test]
@@ -113,13 +133,22 @@ fn direction_quirk_shifts_directions_for_a_mask_not_starting_at_port_1() {
     // and byte 1 to port 2, so port 3 falls back to CW.
     let mut s = BoardSetup::empty(1);
     s.motor_mask = 0b0110;
-    s.motor_dir = [Rotation::Clockwise, Rotation::CounterClockwise, Rotation::CounterClockwise, Rotation::Clockwise];
+    s.motor_dir = [
+        Rotation::Clockwise,
+        Rotation::CounterClockwise,
+        Rotation::CounterClockwise,
+        Rotation::Clockwise,
+    ];
     let mut b = [0u8; SETUP_MAX_LEN];
     let n = encode_setup(&s, &mut b).unwrap();
     assert_eq!(&b[..n], &[0x01, 0x01, 0x06, 0x01, 0x01, 0x00, 0x00, 0x00]);
     let fw = decode_setup(&b[..n]).unwrap();
     assert_eq!(fw.motor_dir[1], Rotation::CounterClockwise);
-    assert_eq!(fw.motor_dir[2], Rotation::Clockwise, "port 3 lost its direction");
+    assert_eq!(
+        fw.motor_dir[2],
+        Rotation::Clockwise,
+        "port 3 lost its direction"
+    );
 }
 
 #[test]
@@ -139,5 +168,8 @@ fn host_frames_decode_incrementally() {
         }
         f => panic!("not a write: {f:?}"),
     }
-    assert_eq!(decode_host_frame(&[0x09], &setup), Err(CodecError::UnknownCommand(9)));
+    assert_eq!(
+        decode_host_frame(&[0x09], &setup),
+        Err(CodecError::UnknownCommand(9))
+    );
 }

@@ -31,7 +31,9 @@ fn shipped_files_parse() {
 }
 
 fn err(text: &str) -> String {
-    HaplyDeviceFile::from_toml(text, "test.toml").unwrap_err().to_string()
+    HaplyDeviceFile::from_toml(text, "test.toml")
+        .unwrap_err()
+        .to_string()
 }
 
 const GOOD: &str = r#"
@@ -65,7 +67,10 @@ fn good_text_parses() {
 #[test]
 fn torque_limit_above_the_firmware_clamp_is_refused() {
     let e = err(&GOOD.replace("id = 1", "id = 1\ntorque_limit = 0.5"));
-    assert!(e.contains("board.torque_limit") && e.contains("N·m") && e.contains("0.123"), "{e}");
+    assert!(
+        e.contains("board.torque_limit") && e.contains("N·m") && e.contains("0.123"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -89,7 +94,10 @@ fn unknown_field_and_syntax_errors_point_at_the_line() {
 #[test]
 fn unreachable_workspace_is_refused() {
     let e = err(&GOOD.replace("half_width = 0.03", "half_width = 0.09"));
-    assert!(e.contains("workspace.half_width") && e.contains("shrink"), "{e}");
+    assert!(
+        e.contains("workspace.half_width") && e.contains("shrink"),
+        "{e}"
+    );
 }
 
 #[test]

@@ -113,7 +113,10 @@ fn non_finite_torque_sends_zeros_and_fails() {
     let mut dev = open_mock(&board, 0.123).unwrap();
     dev.read_encoders().unwrap();
     let e = dev.write_torques(&[f64::NAN, 0.1, 0.0, 0.0]).unwrap_err();
-    assert!(matches!(e, DeviceError::Io(ref m) if m.contains("non-finite") && m.contains("zero")), "{e}");
+    assert!(
+        matches!(e, DeviceError::Io(ref m) if m.contains("non-finite") && m.contains("zero")),
+        "{e}"
+    );
     assert_eq!(board.writes().last().unwrap()[..2], [0.0, 0.0]);
 }
 
@@ -160,7 +163,10 @@ fn truncated_replies_twice_stop_with_a_clear_error() {
     let e = dev.read_encoders().unwrap_err();
     let msg = e.to_string();
     assert!(matches!(e, DeviceError::Lost(_)), "{msg}");
-    assert!(msg.contains("out of step") && msg.contains("haply:mock") && msg.contains("check"), "{msg}");
+    assert!(
+        msg.contains("out of step") && msg.contains("haply:mock") && msg.contains("check"),
+        "{msg}"
+    );
     assert_eq!(dev.resyncs(), 1);
 }
 
@@ -178,7 +184,10 @@ fn random_garbage_never_panics_and_is_an_error() {
         }
         let soup = Arc::new(soup);
         let mut t = Transport::from_stream(
-            Garbage { soup: soup.clone(), at: 0 },
+            Garbage {
+                soup: soup.clone(),
+                at: 0,
+            },
             device_file("haply-2diy-gen3.toml").board_setup(),
             Duration::from_millis(2),
         )

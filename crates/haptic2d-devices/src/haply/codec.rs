@@ -144,7 +144,9 @@ impl BoardSetup {
             .iter()
             .any(|p| !(ANALOG_PIN_MIN..=ANALOG_PIN_MAX).contains(p))
         {
-            return Err(CodecError::Invalid("analog pins are numbered 54–65 (A0–A11)"));
+            return Err(CodecError::Invalid(
+                "analog pins are numbered 54–65 (A0–A11)",
+            ));
         }
         for port in used_ports(self.enc_mask) {
             let (o, r) = (self.enc_offset_deg[port], self.enc_resolution[port]);
@@ -316,7 +318,10 @@ pub fn decode_reply(
     let expected = 1 + 4 * (n_sensors + n_enc);
     if let Some(&b) = bytes.first() {
         if b != id {
-            return Err(CodecError::WrongId { expected: id, got: b });
+            return Err(CodecError::WrongId {
+                expected: id,
+                got: b,
+            });
         }
     }
     if bytes.len() < expected {

@@ -10,6 +10,7 @@
 //! usb_ids = ["2341:804d"]       # vendor:product (hex) for --device haply:auto
 //! torque_limit = 0.123          # N·m, ≤ the firmware's 0.123
 //! timeout_periods = 3           # a reply later than this many periods = device lost
+//! max_missed_deadlines = 10     # watchdog: consecutive missed deadlines (0 = off)
 //! [linkage]                     # 2diy only (the twin's geometry is its [device] table)
 //! d = 0.038                     # m
 //! l1 = 0.07                     # m
@@ -78,6 +79,9 @@ pub struct HaplyDeviceFile {
     pub torque_limit: f64,
     /// A reply later than this many periods means the device is lost. Default 3.
     pub timeout_periods: f64,
+    /// The watchdog trips after this many consecutive missed deadlines; `None` (0 in the file)
+    /// turns the check off. Default 10.
+    pub max_missed_deadlines: Option<u32>,
     /// Motors in joint order.
     pub motors: Vec<MotorSpec>,
     /// 2DIY or twin.
@@ -112,6 +116,8 @@ struct RawBoard {
     torque_limit: f64,
     #[serde(default = "three")]
     timeout_periods: f64,
+    #[serde(default = "ten")]
+    max_missed_deadlines: i64,
 }
 
 #[derive(Deserialize)]
@@ -145,6 +151,9 @@ fn one() -> i64 {
 }
 fn three() -> f64 {
     3.0
+}
+fn ten() -> i64 {
+    10
 }
 fn firmware_limit() -> f64 {
     FIRMWARE_TORQUE_LIMIT as f64
@@ -234,6 +243,13 @@ impl HaplyDeviceFile {
                 "board.timeout_periods",
                 format!("{} periods is too short", b.timeout_periods),
                 "give a number of control periods ≥ 1 (default 3)",
+            ));
+        }
+        if !(0..=100_000).contains(&b.max_missed_deadlines) {
+            errs.push(SceneError::new(
+                "board.max_missed_deadlines",
+                format!("{} is not a count of periods", b.max_missed_deadlines),
+                "give a number of consecutive missed deadlines ≥ 1 (default 10), or 0 to turn the check off",
             ));
         }
         let n_expected = match raw.kind.as_str() {
@@ -378,6 +394,9 @@ impl HaplyDeviceFile {
                 usb_ids,
                 torque_limit: b.torque_limit,
                 timeout_periods: b.timeout_periods,
+                max_missed_deadlines: u32::try_from(b.max_missed_deadlines)
+                    .ok()
+                    .filter(|n| *n > 0),
                 motors,
                 kind,
             }),

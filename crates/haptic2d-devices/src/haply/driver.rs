@@ -123,7 +123,10 @@ impl<S: Read + Write> HaplyDevice<S> {
 impl<S: Read + Write> DeviceIo for HaplyDevice<S> {
     fn read_encoders(&mut self) -> Result<[f64; 4], DeviceError> {
         if self.lost {
-            return Err(DeviceError::Lost(format!("Haply board {}: already lost", self.name)));
+            return Err(DeviceError::Lost(format!(
+                "Haply board {}: already lost",
+                self.name
+            )));
         }
         if !self.transport.pending() {
             self.send(&[0.0; PORTS])?;
@@ -146,7 +149,10 @@ impl<S: Read + Write> DeviceIo for HaplyDevice<S> {
 
     fn write_torques(&mut self, tau: &[f64; 4]) -> Result<(), DeviceError> {
         if self.lost {
-            return Err(DeviceError::Lost(format!("Haply board {}: already lost", self.name)));
+            return Err(DeviceError::Lost(format!(
+                "Haply board {}: already lost",
+                self.name
+            )));
         }
         let mut wire = [0f32; PORTS];
         let mut bad = None;

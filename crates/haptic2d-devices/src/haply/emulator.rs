@@ -113,9 +113,7 @@ impl Firmware {
 
     /// True when a complete write frame is next in the input.
     pub fn next_is_write(&self) -> bool {
-        self.len > 0
-            && self.buf[0] == CMD_WRITE
-            && self.len >= self.setup.write_len()
+        self.len > 0 && self.buf[0] == CMD_WRITE && self.len >= self.setup.write_len()
     }
 
     /// Appends received bytes (dropping what does not fit: a flooded board loses bytes).
@@ -169,9 +167,17 @@ impl Firmware {
                 let w = &self.wiring;
                 self.torques = [0.0; PORTS];
                 for (k, p) in used_ports(self.setup.motor_mask).enumerate() {
-                    let t = if torques[k].is_finite() { torques[k] } else { 0.0 };
+                    let t = if torques[k].is_finite() {
+                        torques[k]
+                    } else {
+                        0.0
+                    };
                     let t = t.clamp(-FIRMWARE_TORQUE_LIMIT, FIRMWARE_TORQUE_LIMIT) as f64;
-                    let sign = if self.setup.motor_dir[p] == w.motor_dir[p] { 1.0 } else { -1.0 };
+                    let sign = if self.setup.motor_dir[p] == w.motor_dir[p] {
+                        1.0
+                    } else {
+                        -1.0
+                    };
                     self.torques[p] = sign * t;
                 }
                 // Encoder angles, in port order of the encoder mask.
@@ -186,13 +192,21 @@ impl Firmware {
                     let count0 = (o * r / 360.0).round();
                     let count = match joint {
                         Some(j) => {
-                            let sign = if self.setup.enc_dir[p] == w.enc_dir[p] { 1.0 } else { -1.0 };
+                            let sign = if self.setup.enc_dir[p] == w.enc_dir[p] {
+                                1.0
+                            } else {
+                                -1.0
+                            };
                             let moved = q[j].to_degrees() - w.offset_deg[p];
                             count0 + sign * (moved * w.resolution[p] / 360.0).round()
                         }
                         None => count0,
                     };
-                    angles[k] = if r > 0.0 { (360.0 * count / r) as f32 } else { 0.0 };
+                    angles[k] = if r > 0.0 {
+                        (360.0 * count / r) as f32
+                    } else {
+                        0.0
+                    };
                 }
                 let analog = [0f32; 12];
                 self.replies += 1;
@@ -290,7 +304,11 @@ pub fn serve<S: Read + Write>(
         match stream.read(&mut rx) {
             Ok(0) => {}
             Ok(n) => fw.receive(&rx[..n]),
-            Err(e) if matches!(e.kind(), ErrorKind::TimedOut | ErrorKind::WouldBlock | ErrorKind::Interrupted) => {}
+            Err(e)
+                if matches!(
+                    e.kind(),
+                    ErrorKind::TimedOut | ErrorKind::WouldBlock | ErrorKind::Interrupted
+                ) => {}
             Err(e) => {
                 reason = format!("the port failed: {e}");
                 break;
@@ -321,7 +339,12 @@ pub fn serve<S: Read + Write>(
                 break;
             };
             last_service = Instant::now();
-            if n > 0 && stream.write_all(&out[..n]).and_then(|_| stream.flush()).is_err() {
+            if n > 0
+                && stream
+                    .write_all(&out[..n])
+                    .and_then(|_| stream.flush())
+                    .is_err()
+            {
                 reason = "the host closed the port".into();
                 break 'outer;
             }

@@ -15,5 +15,5 @@ pub use device_file::{HaplyDeviceFile, HaplyKind, MotorSpec};
 pub use driver::HaplyDevice;
 pub use emulator::{serve, EmulatorClock, EmulatorConfig, EmulatorReport, Firmware};
 pub use plant::{Plant, Plant2};
-pub use transport::{HaplyError, Transport};
 pub use system::{HaplySystem, HaplyTick};
+pub use transport::{HaplyError, Transport};

@@ -90,9 +90,8 @@ impl Plant2 {
             };
             let fh = jt_mul(&s.j, [w[0] - b_h * ed[0], w[1] - b_h * ed[1]]);
             let cor = jt_mul(&s.j, jdqd);
-            let rhs: [f64; 2] = std::array::from_fn(|i| {
-                tau[i] + fh[i] - self.b * self.qd[i] - self.m_e * cor[i]
-            });
+            let rhs: [f64; 2] =
+                std::array::from_fn(|i| tau[i] + fh[i] - self.b * self.qd[i] - self.m_e * cor[i]);
             // M = I_j·1 + m_e·JᵀJ (symmetric positive definite).
             let j = &s.j;
             let jtj = [
@@ -162,11 +161,11 @@ impl Plant {
                 // SimDevice steps at most 10 ms at a time (long gaps are split).
                 let n = (dt / 0.002).ceil().max(1.0) as usize;
                 for _ in 0..n {
-                    s.step(tau, hand, dt / n as f64).map_err(|e| e.to_string())?;
+                    s.step(tau, hand, dt / n as f64)
+                        .map_err(|e| e.to_string())?;
                 }
                 Ok(())
             }
         }
     }
 }
-

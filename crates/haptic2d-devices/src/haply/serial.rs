@@ -101,7 +101,8 @@ pub struct PortInfo {
 /// The serial ports of this machine with their USB ids. Without libudev `serialport` may not know
 /// the ids, so they are read from `/sys/class/tty/NAME/device/../idVendor` (Linux) as well.
 pub fn list_ports() -> Result<Vec<PortInfo>, String> {
-    let ports = serialport::available_ports().map_err(|e| format!("cannot list serial ports: {e}"))?;
+    let ports =
+        serialport::available_ports().map_err(|e| format!("cannot list serial ports: {e}"))?;
     let mut out = Vec::new();
     for p in ports {
         let (mut usb, mut description) = match &p.port_type {
@@ -148,7 +149,10 @@ fn sysfs_usb(path: &str) -> Option<((u16, u16), Option<String>)> {
 /// The first port whose USB ids are in `ids`, or an error listing the ports found.
 pub fn find_board(ids: &[(u16, u16)]) -> Result<String, String> {
     let ports = list_ports()?;
-    if let Some(p) = ports.iter().find(|p| p.usb.is_some_and(|u| ids.contains(&u))) {
+    if let Some(p) = ports
+        .iter()
+        .find(|p| p.usb.is_some_and(|u| ids.contains(&u)))
+    {
         return Ok(p.path.clone());
     }
     let listed = if ports.is_empty() {

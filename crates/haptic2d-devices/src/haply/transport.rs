@@ -69,7 +69,11 @@ impl<S: Read + Write> Transport<S> {
     /// A transport to the board configured by `setup` over `stream`, waiting at most `timeout` for
     /// each reply (from the moment its write was sent). Nothing is sent yet: call
     /// [`handshake`](Self::handshake).
-    pub fn from_stream(stream: S, setup: BoardSetup, timeout: Duration) -> Result<Self, HaplyError> {
+    pub fn from_stream(
+        stream: S,
+        setup: BoardSetup,
+        timeout: Duration,
+    ) -> Result<Self, HaplyError> {
         setup
             .validate()
             .map_err(|e| HaplyError::Config(e.to_string()))?;
@@ -241,7 +245,9 @@ fn cfg(e: CodecError) -> HaplyError {
 }
 
 fn write_all<S: Write>(s: &mut S, b: &[u8]) -> Result<(), HaplyError> {
-    s.write_all(b)
-        .and_then(|_| s.flush())
-        .map_err(|e| HaplyError::Lost(format!("cannot write to the port ({e}): unplugged or closed")))
+    s.write_all(b).and_then(|_| s.flush()).map_err(|e| {
+        HaplyError::Lost(format!(
+            "cannot write to the port ({e}): unplugged or closed"
+        ))
+    })
 }

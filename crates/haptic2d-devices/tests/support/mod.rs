@@ -82,13 +82,20 @@ pub fn start_emulator_damped(file: &HaplyDeviceFile, hand: HandModel, dt: f64, b
 /// Opens the driver on the emulator's port at period `dt` (s).
 pub fn open_driver(emu: &Emu, file: &HaplyDeviceFile, dt: f64) -> HaplyDevice<TTYPort> {
     let port = open_port(&emu.path).unwrap();
-    HaplyDevice::open(port, file, Duration::from_secs_f64(dt), &format!("haply:{}", emu.path))
-        .unwrap()
+    HaplyDevice::open(
+        port,
+        file,
+        Duration::from_secs_f64(dt),
+        &format!("haply:{}", emu.path),
+    )
+    .unwrap()
 }
 
 /// The box-in-walls scene at `rate` Hz with the box's centre moved to `box_x` (m).
 pub fn box_world(rate: f64, box_x: f64) -> World {
-    let scene = haptic2d::scene::builtin("box-in-walls", Some(rate)).unwrap().unwrap();
+    let scene = haptic2d::scene::builtin("box-in-walls", Some(rate))
+        .unwrap()
+        .unwrap();
     let mut w = scene.world;
     let i = w.body_index("box").unwrap();
     w.bodies[i].pose.pos.x = box_x;
@@ -132,7 +139,11 @@ pub fn run(
         let t = system.tick(&q);
         assert!(!t.tripped, "safety trip: {:?}", system.trip());
         dev.write_torques(&t.torques).unwrap();
-        out.push((system.handle_world(&t.record)[0], t.record.x_s[0], t.record.contacts));
+        out.push((
+            system.handle_world(&t.record)[0],
+            t.record.x_s[0],
+            t.record.contacts,
+        ));
     }
     out
 }

@@ -47,7 +47,9 @@ impl Pantograph2 {
     /// The linkage `d`, `l1`, `l2` (m). Errors name the bad value.
     pub fn new(d: f64, l1: f64, l2: f64) -> Result<Self, String> {
         if !(d.is_finite() && d >= 0.0) {
-            return Err(format!("d = {d} m: the motor spacing must be a finite number ≥ 0"));
+            return Err(format!(
+                "d = {d} m: the motor spacing must be a finite number ≥ 0"
+            ));
         }
         if !(l1.is_finite() && l1 > 0.0 && l2.is_finite() && l2 > 0.0) {
             return Err(format!(
@@ -145,7 +147,11 @@ mod tests {
     #[test]
     fn ik_fk_round_trip_with_d() {
         let p = gen3();
-        for e in [Vec2::new(0.019, 0.10), Vec2::new(0.0, 0.08), Vec2::new(0.04, 0.12)] {
+        for e in [
+            Vec2::new(0.019, 0.10),
+            Vec2::new(0.0, 0.08),
+            Vec2::new(0.04, 0.12),
+        ] {
             let q = p.ik(e).unwrap();
             let e2 = p.fk(q).unwrap();
             assert!((e2 - e).length() < 1e-12, "{e:?} -> {e2:?}");
@@ -164,8 +170,16 @@ mod tests {
                 qp[c] += h;
                 qm[c] -= h;
                 let d = (p.fk(qp).unwrap() - p.fk(qm).unwrap()) / (2.0 * h);
-                assert!((d.x - s.j[0][c]).abs() < 1e-6, "col {c}: {d:?} vs {:?}", s.j);
-                assert!((d.y - s.j[1][c]).abs() < 1e-6, "col {c}: {d:?} vs {:?}", s.j);
+                assert!(
+                    (d.x - s.j[0][c]).abs() < 1e-6,
+                    "col {c}: {d:?} vs {:?}",
+                    s.j
+                );
+                assert!(
+                    (d.y - s.j[1][c]).abs() < 1e-6,
+                    "col {c}: {d:?} vs {:?}",
+                    s.j
+                );
             }
             assert!(s.margin > 0.1 && s.margin <= 1.0);
         }
@@ -177,7 +191,9 @@ mod tests {
         let g2 = Pantograph2::new(0.0, 0.07, 0.09).unwrap();
         let e = g2.fk([241f64.to_radians(), (-61f64).to_radians()]).unwrap();
         assert!(e.x.abs() < 1e-9 && e.y > 0.0, "{e:?}");
-        let e3 = gen3().fk([168f64.to_radians(), 12f64.to_radians()]).unwrap();
+        let e3 = gen3()
+            .fk([168f64.to_radians(), 12f64.to_radians()])
+            .unwrap();
         assert!((e3.x - 0.019).abs() < 1e-9 && e3.y > 0.0, "{e3:?}");
     }
 

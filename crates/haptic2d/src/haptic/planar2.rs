@@ -117,7 +117,9 @@ impl Planar2System {
         let dt = world.params.dt;
         for (i, t) in config.tau_max.iter().enumerate() {
             if !(t.is_finite() && *t > 0.0) {
-                return Err(format!("tau_max[{i}] = {t} N·m: must be a finite number > 0"));
+                return Err(format!(
+                    "tau_max[{i}] = {t} N·m: must be a finite number > 0"
+                ));
             }
         }
         if !config.grasp.iter().all(|v| v.is_finite()) {
