@@ -150,7 +150,7 @@ impl BoardSetup {
         }
         for port in used_ports(self.enc_mask) {
             let (o, r) = (self.enc_offset_deg[port], self.enc_resolution[port]);
-            if !o.is_finite() || !(r.is_finite() && r > 0.0) {
+            if !(o.is_finite() && r.is_finite() && r > 0.0) {
                 return Err(CodecError::Invalid(
                     "encoder offsets must be finite and resolutions > 0",
                 ));

@@ -445,8 +445,7 @@ impl HaplyDeviceFile {
 }
 
 fn check_workspace(l: &Pantograph2, w: &RawWorkspace, errs: &mut Vec<SceneError>) {
-    if !(w.half_width.is_finite() && w.half_width > 0.0) || !w.center.iter().all(|c| c.is_finite())
-    {
+    if !(w.half_width.is_finite() && w.half_width > 0.0 && w.center.iter().all(|c| c.is_finite())) {
         errs.push(SceneError::new(
             "workspace",
             "center must be finite and half_width > 0",

@@ -111,9 +111,9 @@ impl Plant2 {
                 (m11 * rhs[0] - m01 * rhs[1]) / det,
                 (m00 * rhs[1] - m01 * rhs[0]) / det,
             ];
-            for i in 0..2 {
-                self.qd[i] += h * qdd[i];
-                self.q[i] += h * self.qd[i];
+            for ((q, qd), a) in self.q.iter_mut().zip(self.qd.iter_mut()).zip(qdd) {
+                *qd += h * a;
+                *q += h * *qd;
             }
             self.t += h;
         }

@@ -104,7 +104,7 @@ impl Pantograph2 {
         let (u1, u2) = (e - a, e - b);
         let det = cross(u1, u2);
         let margin = det.abs() / (self.l2 * self.l2);
-        if !(det.abs() > 1e-12) {
+        if det.is_nan() || det.abs() <= 1e-12 {
             return Err(DeviceFault::Singular);
         }
         let d1 = self.l1 * u1.dot(perp(e_of(q[0])));

@@ -246,9 +246,9 @@ impl Planar2System {
         if let (Some(s), false) = (st, self.safety.is_latched()) {
             let tau = jt_mul(&s.j, [f_cm[0], f_cm[1]]);
             let mut scale: f64 = 1.0;
-            for i in 0..2 {
-                if tau[i].abs() > self.config.tau_max[i] {
-                    scale = scale.min(self.config.tau_max[i] / tau[i].abs());
+            for (t, max) in tau.iter().zip(self.config.tau_max) {
+                if t.abs() > max {
+                    scale = scale.min(max / t.abs());
                 }
             }
             if scale < 1.0 {
