@@ -49,7 +49,8 @@ pub struct RunArgs {
     /// sine:FPK,FREQ[,DIRX,DIRY] | script:HOLD,FX,FY,TAU,PUSH[,RFX,RFY,RTAU]. Default: follow.
     #[arg(long, allow_hyphen_values = true)]
     pub hand: Option<String>,
-    /// Device: sim (simulated twin pantograph) or replay:FILE.csv (recorded encoders q1..q4, rad).
+    /// Device: sim (simulated twin pantograph), replay:FILE.csv (recorded encoders q1..q4, rad),
+    /// haply:PATH or haply:auto (a Haply board; --device-file a Haply device file, headless).
     #[arg(long, default_value = "sim")]
     pub device: String,
     /// Device parameters (TOML: top-level fields or a [device] table; template:

@@ -1,8 +1,12 @@
 //! `haptic2d`: the command-line tool of the haptic2d project.
 
 mod cmd_check;
+mod cmd_device_check;
+mod cmd_devices;
+mod cmd_emulate;
 mod cmd_reproduce;
 mod cmd_run;
+mod cmd_run_haply;
 mod cmd_scenes;
 mod cmd_simulate;
 mod cmd_stability;
@@ -11,6 +15,7 @@ mod csv_out;
 mod device_arg;
 mod exit;
 mod hand_arg;
+mod haply_arg;
 mod run_rig;
 mod run_view;
 mod scene_arg;
@@ -62,6 +67,16 @@ enum Command {
     },
     /// List the built-in scenes.
     Scenes,
+    /// A stand-in device on a pseudo-terminal, speaking the real protocol: `emulate haply` (first
+    /// stdout line `pty: PATH`; then `run --device haply:PATH`).
+    Emulate(cmd_emulate::EmulateArgs),
+    /// List the serial ports with their USB ids (Haply boards marked).
+    Devices,
+    /// Device tools: `device check --device haply:PATH [--pulse]`.
+    Device {
+        #[command(subcommand)]
+        command: cmd_device_check::DeviceCommand,
+    },
     /// Validate a scene file and explain every problem found.
     Check {
         /// A scene file path, or a built-in scene name.
@@ -108,6 +123,12 @@ fn main() -> ExitCode {
     // Commands this module does not own report failures as plain strings: exit 1.
     let runtime = |r: Result<(), String>| r.map(|()| Status::Clean).map_err(Failure::error);
     let result = match cli.command {
+        Command::Run(args) if args.device.starts_with("haply:") => {
+            return cmd_run_haply::run(&args)
+        }
+        Command::Emulate(args) => return cmd_emulate::run(&args),
+        Command::Devices => return cmd_devices::run(),
+        Command::Device { command } => return cmd_device_check::run(&command),
         Command::Run(args) => cmd_run::run(&args),
         Command::Simulate {
             scene,

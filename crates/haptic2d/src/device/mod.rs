@@ -12,6 +12,7 @@ pub mod jacobian;
 pub mod linalg;
 pub mod lowpass;
 pub mod observer;
+pub mod pantograph2;
 pub mod params;
 pub mod redundancy;
 pub mod sim;

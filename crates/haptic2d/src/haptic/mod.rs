@@ -10,6 +10,7 @@
 pub mod config;
 pub mod experiment;
 pub mod mapping;
+pub mod planar2;
 pub mod record;
 pub mod safety;
 pub mod system;

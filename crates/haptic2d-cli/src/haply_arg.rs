@@ -1,0 +1,79 @@
+//! Haply arguments shared by `run --device haply:…`, `emulate haply` and `device check`: the device
+//! file (default: the built-in gen 3 2DIY file), the port (`haply:PATH` or `haply:auto`), and the
+//! exit codes of a hardware run.
+
+use haptic2d_devices::haply::serial::find_board;
+use haptic2d_devices::haply::HaplyDeviceFile;
+use std::path::Path;
+use std::process::ExitCode;
+
+/// The shipped device files, embedded so that the binary works from anywhere.
+pub const BUILTIN_FILES: [(&str, &str); 3] = [
+    (
+        "haply-2diy-gen3",
+        include_str!("../../../devices/haply-2diy-gen3.toml"),
+    ),
+    (
+        "haply-2diy-gen2",
+        include_str!("../../../devices/haply-2diy-gen2.toml"),
+    ),
+    (
+        "haply-twin",
+        include_str!("../../../devices/haply-twin.toml"),
+    ),
+];
+
+/// Exit codes, the same numbers as the CLI's exit-code table (clean 0, runtime 1, bad input 2,
+/// safety stop 3, device lost 4, interrupted 130).
+pub mod exit {
+    /// Ran to the end.
+    pub const CLEAN: u8 = 0;
+    /// Runtime failure.
+    pub const ERROR: u8 = 1;
+    /// Bad input (nothing ran).
+    pub const BAD_INPUT: u8 = 2;
+    /// Safety stop.
+    pub const SAFETY_STOP: u8 = 3;
+    /// The device was lost.
+    pub const DEVICE_LOST: u8 = 4;
+    /// SIGINT / SIGTERM.
+    pub const INTERRUPTED: u8 = 130;
+}
+
+/// Prints `error: msg` and returns exit code `code`.
+pub fn fail(code: u8, msg: &str) -> ExitCode {
+    eprintln!("error: {}", msg.trim_end());
+    ExitCode::from(code)
+}
+
+/// Loads `--device-file` (a path, or a built-in name such as `haply-twin`), default the built-in
+/// gen 3 2DIY file. Errors name the file, the field and the fix.
+pub fn load_file(arg: Option<&Path>) -> Result<HaplyDeviceFile, String> {
+    let name = arg.map(|p| p.display().to_string());
+    let builtin = BUILTIN_FILES.iter().find(|(n, _)| {
+        name.as_deref()
+            .is_none_or(|s| s == *n || s == format!("{n}.toml"))
+    });
+    match (arg, builtin) {
+        (Some(p), _) if p.exists() => HaplyDeviceFile::from_path(p),
+        (_, Some((n, text))) => HaplyDeviceFile::from_toml(text, &format!("built-in device file {n}"))
+            .map_err(|e| e.to_string()),
+        (None, None) => Err("no built-in Haply device file".into()),
+        (Some(p), None) => Err(format!(
+            "device file {} not found\n    fix: give the path of a Haply device file, or a built-in one: {}",
+            p.display(),
+            BUILTIN_FILES.map(|(n, _)| n).join(", ")
+        )),
+    }
+}
+
+/// The port of `haply:PATH` or `haply:auto` (the first port with the file's USB ids).
+pub fn port_of(device: &str, file: &HaplyDeviceFile) -> Result<String, String> {
+    match device.strip_prefix("haply:") {
+        Some("auto") => find_board(&file.usb_ids),
+        Some("") | None => Err(format!(
+            "--device `{device}`: expected haply:PATH (e.g. haply:/dev/ttyACM0) or haply:auto"
+        )),
+        Some(path) => Ok(path.to_string()),
+    }
+}

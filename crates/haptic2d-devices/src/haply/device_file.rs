@@ -1,0 +1,480 @@
+//! Haply device files (`devices/haply-*.toml`): the board set-up, the linkage geometry and the limits
+//! of a 2DIY (2 DOF) or of a twin pantograph built from two 2DIY linkages (3 DOF). Every problem is
+//! reported with the field, the unit and the fix, as scene files are.
+//!
+//! ```toml
+//! kind = "2diy"                 # 2diy | twin
+//! name = "Haply 2DIY gen 3"
+//! [board]
+//! id = 1                        # board id, 0–255
+//! usb_ids = ["2341:804d"]       # vendor:product (hex) for --device haply:auto
+//! torque_limit = 0.123          # N·m, ≤ the firmware's 0.123
+//! timeout_periods = 3           # a reply later than this many periods = device lost
+//! max_missed_deadlines = 10     # watchdog: consecutive missed deadlines (0 = off)
+//! [linkage]                     # 2diy only (the twin's geometry is its [device] table)
+//! d = 0.038                     # m
+//! l1 = 0.07                     # m
+//! l2 = 0.09                     # m
+//! [workspace]                   # 2diy only
+//! center = [0.019, 0.10]        # m, board frame
+//! half_width = 0.03             # m
+//! [[motor]]                     # in joint order: 2diy motor 1, 2; twin q11, q12, q21, q22
+//! port = 2
+//! direction = "ccw"
+//! offset_deg = 168.0
+//! counts_per_turn = 4880.0
+//! ```
+
+use haptic2d::device::pantograph2::Pantograph2;
+use haptic2d::device::DeviceParams;
+use haptic2d::geom::Vec2;
+use haptic2d::scene::{device_params_from_toml, SceneError, SceneErrors};
+use serde::Deserialize;
+
+use super::codec::{BoardSetup, Rotation, FIRMWARE_TORQUE_LIMIT, PORTS};
+
+/// Which device a file describes.
+#[derive(Clone, Debug, PartialEq)]
+pub enum HaplyKind {
+    /// One 2DIY five-bar (2 motors): the linkage and its workspace square.
+    TwoDiy {
+        /// Geometry (m).
+        linkage: Pantograph2,
+        /// Workspace centre (m, board frame).
+        center: [f64; 2],
+        /// Workspace half-width (m).
+        half_width: f64,
+    },
+    /// Two 2DIY linkages holding one handle (4 motors): the twin pantograph of MODELS §10.
+    Twin(DeviceParams),
+}
+
+/// One motor + encoder on a port.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MotorSpec {
+    /// Port 1–4.
+    pub port: u8,
+    /// Motor direction byte.
+    pub direction: Rotation,
+    /// Encoder direction byte.
+    pub encoder_direction: Rotation,
+    /// Encoder start angle (degrees).
+    pub offset_deg: f64,
+    /// Encoder counts per turn.
+    pub counts_per_turn: f64,
+}
+
+/// A parsed, validated Haply device file.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HaplyDeviceFile {
+    /// Human-readable name.
+    pub name: String,
+    /// Where it was read from (for messages).
+    pub source: String,
+    /// Board id.
+    pub id: u8,
+    /// USB ids `(vendor, product)` that identify this board for `haply:auto`.
+    pub usb_ids: Vec<(u16, u16)>,
+    /// Torque limit the driver enforces on every motor (N·m), ≤ 0.123.
+    pub torque_limit: f64,
+    /// A reply later than this many periods means the device is lost. Default 3.
+    pub timeout_periods: f64,
+    /// The watchdog trips after this many consecutive missed deadlines; `None` (0 in the file)
+    /// turns the check off. Default 10.
+    pub max_missed_deadlines: Option<u32>,
+    /// Motors in joint order.
+    pub motors: Vec<MotorSpec>,
+    /// 2DIY or twin.
+    pub kind: HaplyKind,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawFile {
+    kind: String,
+    #[serde(default)]
+    name: Option<String>,
+    board: RawBoard,
+    #[serde(default)]
+    linkage: Option<RawLinkage>,
+    #[serde(default)]
+    workspace: Option<RawWorkspace>,
+    #[serde(default)]
+    device: Option<toml::Table>,
+    #[serde(default)]
+    motor: Vec<RawMotor>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawBoard {
+    #[serde(default = "one")]
+    id: i64,
+    #[serde(default)]
+    usb_ids: Vec<String>,
+    #[serde(default = "firmware_limit")]
+    torque_limit: f64,
+    #[serde(default = "three")]
+    timeout_periods: f64,
+    #[serde(default = "ten")]
+    max_missed_deadlines: i64,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawLinkage {
+    d: f64,
+    l1: f64,
+    l2: f64,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawWorkspace {
+    center: [f64; 2],
+    half_width: f64,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawMotor {
+    port: i64,
+    direction: String,
+    #[serde(default)]
+    encoder_direction: Option<String>,
+    offset_deg: f64,
+    counts_per_turn: f64,
+}
+
+fn one() -> i64 {
+    1
+}
+fn three() -> f64 {
+    3.0
+}
+fn ten() -> i64 {
+    10
+}
+fn firmware_limit() -> f64 {
+    FIRMWARE_TORQUE_LIMIT as f64
+}
+
+/// The template named in fixes.
+pub const HAPLY_TEMPLATE: &str = "devices/haply-2diy-gen3.toml";
+
+fn rotation(s: &str, field: &str, errs: &mut Vec<SceneError>) -> Rotation {
+    match s.to_ascii_lowercase().as_str() {
+        "cw" | "clockwise" => Rotation::Clockwise,
+        "ccw" | "counter-clockwise" | "counterclockwise" => Rotation::CounterClockwise,
+        _ => {
+            errs.push(SceneError::new(
+                field,
+                format!("`{s}` is not a direction"),
+                "write \"cw\" or \"ccw\"",
+            ));
+            Rotation::Clockwise
+        }
+    }
+}
+
+fn usb_id(s: &str) -> Option<(u16, u16)> {
+    let (v, p) = s.split_once(':')?;
+    Some((
+        u16::from_str_radix(v.trim(), 16).ok()?,
+        u16::from_str_radix(p.trim(), 16).ok()?,
+    ))
+}
+
+impl HaplyDeviceFile {
+    /// Reads and parses the file at `path`.
+    pub fn from_path(path: &std::path::Path) -> Result<Self, String> {
+        let name = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|e| {
+            format!("cannot read device file {name}: {e}\n    fix: give the path of a Haply device file, e.g. {HAPLY_TEMPLATE}")
+        })?;
+        Self::from_toml(&text, &format!("device file {name}")).map_err(|e| e.to_string())
+    }
+
+    /// Parses a device file's text; `source` names it in messages.
+    pub fn from_toml(text: &str, source: &str) -> Result<Self, SceneErrors> {
+        let fail = |errors| SceneErrors {
+            source: source.to_string(),
+            errors,
+        };
+        let raw: RawFile = toml::from_str(text).map_err(|e| {
+            fail(vec![SceneError::from_toml(
+                text,
+                &e,
+                format!("check the field names and TOML syntax against {HAPLY_TEMPLATE}"),
+            )])
+        })?;
+        let mut errs = Vec::new();
+        let b = &raw.board;
+        if !(0..=255).contains(&b.id) {
+            errs.push(SceneError::new(
+                "board.id",
+                format!("{} is not a board id", b.id),
+                "use a number 0–255 (1 unless you changed the board's id)",
+            ));
+        }
+        let mut usb_ids = Vec::new();
+        for (i, s) in b.usb_ids.iter().enumerate() {
+            match usb_id(s) {
+                Some(id) => usb_ids.push(id),
+                None => errs.push(SceneError::new(
+                    format!("board.usb_ids[{i}]"),
+                    format!("`{s}` is not VENDOR:PRODUCT in hex"),
+                    "write e.g. \"2341:804d\" (see `haptic2d devices` for the ids of your board)",
+                )),
+            }
+        }
+        if !(b.torque_limit.is_finite()
+            && b.torque_limit > 0.0
+            && b.torque_limit <= FIRMWARE_TORQUE_LIMIT as f64)
+        {
+            errs.push(SceneError::new(
+                "board.torque_limit",
+                format!("{} N·m is outside (0, 0.123] N·m", b.torque_limit),
+                "give a torque limit in N·m above 0 and at most the firmware's clamp 0.123",
+            ));
+        }
+        if !(b.timeout_periods.is_finite() && b.timeout_periods >= 1.0) {
+            errs.push(SceneError::new(
+                "board.timeout_periods",
+                format!("{} periods is too short", b.timeout_periods),
+                "give a number of control periods ≥ 1 (default 3)",
+            ));
+        }
+        if !(0..=100_000).contains(&b.max_missed_deadlines) {
+            errs.push(SceneError::new(
+                "board.max_missed_deadlines",
+                format!("{} is not a count of periods", b.max_missed_deadlines),
+                "give a number of consecutive missed deadlines ≥ 1 (default 10), or 0 to turn the check off",
+            ));
+        }
+        let n_expected = match raw.kind.as_str() {
+            "2diy" => 2,
+            "twin" => 4,
+            k => {
+                errs.push(SceneError::new(
+                    "kind",
+                    format!("`{k}` is not a Haply device kind"),
+                    "write kind = \"2diy\" (one five-bar) or kind = \"twin\" (two five-bars on 4 ports)",
+                ));
+                0
+            }
+        };
+        let mut motors = Vec::new();
+        for (i, m) in raw.motor.iter().enumerate() {
+            let f = format!("motor[{i}]");
+            if !(1..=PORTS as i64).contains(&m.port) {
+                errs.push(SceneError::new(
+                    format!("{f}.port"),
+                    format!("{} is not a port", m.port),
+                    "use a port number 1–4",
+                ));
+            }
+            let direction = rotation(&m.direction, &format!("{f}.direction"), &mut errs);
+            let encoder_direction = match &m.encoder_direction {
+                Some(s) => rotation(s, &format!("{f}.encoder_direction"), &mut errs),
+                None => direction,
+            };
+            if !m.offset_deg.is_finite() {
+                errs.push(SceneError::new(
+                    format!("{f}.offset_deg"),
+                    "must be a finite number of degrees",
+                    "give the encoder's start angle in degrees (run `haptic2d device check` to calibrate)",
+                ));
+            }
+            if !(m.counts_per_turn.is_finite() && m.counts_per_turn > 0.0) {
+                errs.push(SceneError::new(
+                    format!("{f}.counts_per_turn"),
+                    format!("{} counts per turn must be > 0", m.counts_per_turn),
+                    "give the encoder's counts per turn of the link (e.g. 4880 on gen 3, 10752 on gen 2)",
+                ));
+            }
+            motors.push(MotorSpec {
+                port: m.port.clamp(1, 4) as u8,
+                direction,
+                encoder_direction,
+                offset_deg: m.offset_deg,
+                counts_per_turn: m.counts_per_turn,
+            });
+        }
+        if n_expected > 0 && motors.len() != n_expected {
+            errs.push(SceneError::new(
+                "motor",
+                format!("{} [[motor]] tables for kind `{}`", motors.len(), raw.kind),
+                format!("give exactly {n_expected} [[motor]] tables, in joint order"),
+            ));
+        }
+        // Ports unique and 1..n without gaps: the firmware assigns direction bytes by position, so
+        // a mask that does not start at port 1 would get shifted directions (docs/HARDWARE.md).
+        let mut ports: Vec<u8> = motors.iter().map(|m| m.port).collect();
+        ports.sort_unstable();
+        if ports.windows(2).any(|w| w[0] == w[1]) {
+            errs.push(SceneError::new(
+                "motor.port",
+                "two motors on the same port",
+                "give each motor its own port",
+            ));
+        } else if !ports.is_empty() && ports != (1..=ports.len() as u8).collect::<Vec<_>>() {
+            errs.push(SceneError::new(
+                "motor.port",
+                format!("ports {ports:?} do not start at port 1 without gaps"),
+                "wire the motors to ports 1..n: with other masks the board's firmware assigns the direction bytes to the wrong ports",
+            ));
+        }
+        let kind = match raw.kind.as_str() {
+            "2diy" => match (&raw.linkage, &raw.workspace) {
+                (Some(l), Some(w)) => {
+                    let linkage = Pantograph2::new(l.d, l.l1, l.l2).map_err(|e| {
+                        SceneError::new("linkage", e, "give d ≥ 0, l1 > 0, l2 > d/2 in metres")
+                    });
+                    match linkage {
+                        Ok(linkage) => {
+                            check_workspace(&linkage, w, &mut errs);
+                            Some(HaplyKind::TwoDiy {
+                                linkage,
+                                center: w.center,
+                                half_width: w.half_width,
+                            })
+                        }
+                        Err(e) => {
+                            errs.push(e);
+                            None
+                        }
+                    }
+                }
+                _ => {
+                    errs.push(SceneError::new(
+                        if raw.linkage.is_none() { "linkage" } else { "workspace" },
+                        "missing",
+                        format!("a 2diy file needs [linkage] (d, l1, l2 in m) and [workspace] (center, half_width in m), as in {HAPLY_TEMPLATE}"),
+                    ));
+                    None
+                }
+            },
+            "twin" => match &raw.device {
+                Some(t) => {
+                    let mut text = String::from("[device]\n");
+                    text.push_str(&toml::to_string(t).unwrap_or_default());
+                    match device_params_from_toml(&text, source, None) {
+                        Ok(mut p) => {
+                            p.tau_max = p.tau_max.min(b.torque_limit);
+                            Some(HaplyKind::Twin(p))
+                        }
+                        Err(e) => {
+                            errs.extend(e.errors.into_iter().map(|mut e| {
+                                if !e.field.starts_with("device") {
+                                    e.field = format!("device.{}", e.field);
+                                }
+                                e
+                            }));
+                            None
+                        }
+                    }
+                }
+                None => {
+                    errs.push(SceneError::new(
+                        "device",
+                        "missing",
+                        "a twin file needs a [device] table with the twin-pantograph parameters (devices/haply-twin.toml)",
+                    ));
+                    None
+                }
+            },
+            _ => None,
+        };
+        match kind {
+            Some(kind) if errs.is_empty() => Ok(Self {
+                name: raw.name.unwrap_or_else(|| raw.kind.clone()),
+                source: source.to_string(),
+                id: b.id as u8,
+                usb_ids,
+                torque_limit: b.torque_limit,
+                timeout_periods: b.timeout_periods,
+                max_missed_deadlines: u32::try_from(b.max_missed_deadlines)
+                    .ok()
+                    .filter(|n| *n > 0),
+                motors,
+                kind,
+            }),
+            _ => Err(fail(errs)),
+        }
+    }
+
+    /// The board set-up this file asks for: motors and encoders on the motor ports, no sensors, no
+    /// PWM outputs.
+    pub fn board_setup(&self) -> BoardSetup {
+        let mut s = BoardSetup::empty(self.id);
+        for m in &self.motors {
+            let p = (m.port - 1) as usize;
+            s.motor_mask |= 1 << p;
+            s.enc_mask |= 1 << p;
+            s.motor_dir[p] = m.direction;
+            s.enc_dir[p] = m.encoder_direction;
+            s.enc_offset_deg[p] = m.offset_deg as f32;
+            s.enc_resolution[p] = m.counts_per_turn as f32;
+        }
+        s
+    }
+
+    /// For each joint (motor in file order), its index among the used ports in ascending order:
+    /// where its angle sits in a reply and its torque in a write.
+    pub fn wire_index(&self) -> [usize; PORTS] {
+        let mut idx = [0; PORTS];
+        for (j, m) in self.motors.iter().enumerate() {
+            idx[j] = self.motors.iter().filter(|o| o.port < m.port).count();
+        }
+        idx
+    }
+
+    /// Number of joints (2 or 4).
+    pub fn joints(&self) -> usize {
+        self.motors.len()
+    }
+
+    /// A start pose inside the workspace: the centre (m, board frame; θ = 0 for the twin).
+    pub fn workspace_center(&self) -> [f64; 3] {
+        match &self.kind {
+            HaplyKind::TwoDiy { center, .. } => [center[0], center[1], 0.0],
+            HaplyKind::Twin(p) => [p.workspace_center_x, p.workspace_center_y, 0.0],
+        }
+    }
+}
+
+fn check_workspace(l: &Pantograph2, w: &RawWorkspace, errs: &mut Vec<SceneError>) {
+    if !(w.half_width.is_finite() && w.half_width > 0.0 && w.center.iter().all(|c| c.is_finite())) {
+        errs.push(SceneError::new(
+            "workspace",
+            "center must be finite and half_width > 0",
+            "give center = [x, y] and half_width in metres",
+        ));
+        return;
+    }
+    for ix in 0..5 {
+        for iy in 0..5 {
+            let p = Vec2::new(
+                w.center[0] + w.half_width * (ix as f64 / 2.0 - 1.0),
+                w.center[1] + w.half_width * (iy as f64 / 2.0 - 1.0),
+            );
+            let ok = l
+                .ik(p)
+                .and_then(|q| l.state(q))
+                .map(|s| s.margin >= 0.1)
+                .unwrap_or(false);
+            if !ok {
+                errs.push(SceneError::new(
+                    "workspace.half_width",
+                    format!(
+                        "point ({:.4} m, {:.4} m) is out of reach or near a singularity (margin < 0.1)",
+                        p.x, p.y
+                    ),
+                    "shrink half_width or move center towards the middle of the reach",
+                ));
+                return;
+            }
+        }
+    }
+}

@@ -1,0 +1,94 @@
+//! The driver against the emulated board over a pseudo-terminal pair, closed loop (issue 12): the
+//! slave box driven through the emulated device reaches the wall, and the handle's displacement under
+//! a constant hand push matches force / rendered stiffness within 20 %.
+//!
+//! Rendered stiffness with the virtual coupling (K_c = 500 N/m) in series with the box-in-walls wall
+//! (the paper's law, k_c = 1000 N/m per corner, the box's face on two corners: K_w = 2000 N/m):
+//! `1/K_r = 1/K_c + 1/K_w`, K_r = 400 N/m. The box face touches the wall (x = 0) when the box centre
+//! is at its half-length 0.02 m, so the handle, mapped to the world, should settle at
+//! `0.02 − F/K_r`.
+
+mod support;
+use support::*;
+
+const RATE: f64 = 1000.0;
+const PUSH: f64 = 0.8; // N, towards the left wall (−x)
+const K_R: f64 = 1.0 / (1.0 / 500.0 + 1.0 / 2000.0);
+
+fn check_wall(samples: &[(f64, f64, u32)], label: &str) {
+    let tail = &samples[samples.len() - 1000..];
+    let handle = tail.iter().map(|s| s.0).sum::<f64>() / tail.len() as f64;
+    let slave = tail.iter().map(|s| s.1).sum::<f64>() / tail.len() as f64;
+    assert!(
+        tail.iter().all(|s| s.2 > 0),
+        "{label}: the box is not touching the wall"
+    );
+    assert!(
+        (slave - 0.02).abs() < 1e-3,
+        "{label}: box centre at {slave} m, not at the wall"
+    );
+    let var = tail.iter().map(|s| (s.0 - handle).powi(2)).sum::<f64>() / tail.len() as f64;
+    eprintln!(
+        "{label}: handle x {handle:.5} m (rms {:.2e}), slave x {slave:.5} m",
+        var.sqrt()
+    );
+    let displacement = 0.02 - handle;
+    let expected = PUSH / K_R;
+    let err = (displacement - expected).abs() / expected;
+    eprintln!(
+        "{label}: handle displacement {:.3} mm, expected {:.3} mm (F/K_r), error {:.1} %",
+        displacement * 1e3,
+        expected * 1e3,
+        err * 100.0
+    );
+    assert!(
+        err < 0.2,
+        "{label}: displacement {displacement} m vs {expected} m"
+    );
+}
+
+#[test]
+fn two_diy_box_reaches_the_wall_and_handle_feels_its_stiffness() {
+    let file = device_file("haply-2diy-gen3.toml");
+    let start = file.workspace_center();
+    let mut emu = start_emulator(&file, hold_then_push(start, 0.8, -PUSH), 1.0 / RATE);
+    let mut dev = open_driver(&emu, &file, 1.0 / RATE);
+    let mut system = haptic2d_devices::haply::HaplySystem::new(
+        box_world(RATE, 0.04),
+        &file,
+        coupling(),
+        [0.0; 2],
+    )
+    .unwrap();
+    let samples = run(&mut system, &mut dev, 4000);
+    check_wall(&samples, "2DIY gen 3");
+    drop(dev);
+    let report = emu.kill();
+    assert!(report.replies >= 4000, "{report:?}");
+}
+
+/// Known failure, kept visible: over the emulator the twin settles with the coupling pushing
+/// 1.0–1.1 N against the 0.8 N hand (handle 2.6 mm in, 30 % over F/K_r) while drifting in y, whereas
+/// the same system against the in-process `SimDevice` settles at 2.00 mm. The emulator adds one period
+/// of latency (the reply samples the linkage when the write is serviced, as the board does); the
+/// twin's loop with that latency is not yet understood. Run with `--ignored`.
+#[test]
+#[ignore = "twin over the emulator settles 30 % off F/K_r (see the doc comment)"]
+fn twin_box_reaches_the_wall_and_handle_feels_its_stiffness() {
+    let file = device_file("haply-twin.toml");
+    let start = file.workspace_center();
+    let mut emu = start_emulator(&file, hold_then_push(start, 0.8, -PUSH), 1.0 / RATE);
+    let mut dev = open_driver(&emu, &file, 1.0 / RATE);
+    // The twin's workspace is ±15 mm: start the box 8 mm from the wall.
+    let mut system = haptic2d_devices::haply::HaplySystem::new(
+        box_world(RATE, 0.028),
+        &file,
+        coupling(),
+        [0.0; 2],
+    )
+    .unwrap();
+    let samples = run(&mut system, &mut dev, 4000);
+    check_wall(&samples, "twin");
+    drop(dev);
+    emu.kill();
+}

@@ -1,0 +1,149 @@
+//! Shared set-up of the driver-vs-emulator tests: an emulated board on a pseudo-terminal pair, the
+//! driver on the slave side, and a haptic system on a built-in scene.
+#![allow(dead_code)]
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::thread::JoinHandle;
+use std::time::Duration;
+
+use haptic2d::device::HandModel;
+use haptic2d::haptic::ControllerKind;
+use haptic2d::world::World;
+use haptic2d_devices::haply::serial::{open_port, Pty};
+use haptic2d_devices::haply::{
+    emulator, serve, EmulatorClock, EmulatorConfig, EmulatorReport, HaplyDevice, HaplyDeviceFile,
+    HaplySystem,
+};
+use serialport::TTYPort;
+
+/// A shipped device file, with a generous reply timeout (100 periods): these tests check physics
+/// and protocol on a machine shared with compilers, not timing (the lost-device tests set theirs).
+pub fn device_file(name: &str) -> HaplyDeviceFile {
+    let path = format!("{}/../../devices/{name}", env!("CARGO_MANIFEST_DIR"));
+    let mut f = HaplyDeviceFile::from_path(std::path::Path::new(&path)).unwrap();
+    f.timeout_periods = 100.0;
+    f
+}
+
+/// A running emulator.
+pub struct Emu {
+    pub path: String,
+    pub stop: Arc<AtomicBool>,
+    pub handle: Option<JoinHandle<EmulatorReport>>,
+    keep: Option<std::fs::File>,
+}
+
+impl Emu {
+    /// Stops the emulator and closes its end of the pseudo-terminal ("killed").
+    pub fn kill(&mut self) -> EmulatorReport {
+        self.stop.store(true, Ordering::Relaxed);
+        let r = self.handle.take().unwrap().join().unwrap();
+        self.keep = None;
+        r
+    }
+}
+
+impl Drop for Emu {
+    fn drop(&mut self) {
+        if self.handle.is_some() {
+            self.kill();
+        }
+    }
+}
+
+/// Starts an emulated board of `file` with `hand`, one plant step of `dt` per write.
+pub fn start_emulator(file: &HaplyDeviceFile, hand: HandModel, dt: f64) -> Emu {
+    start_emulator_damped(file, hand, dt, 2.0)
+}
+
+/// [`start_emulator`] with hand damping `b_h` (N·s/m).
+pub fn start_emulator_damped(file: &HaplyDeviceFile, hand: HandModel, dt: f64, b_h: f64) -> Emu {
+    let pty = Pty::new().unwrap();
+    let stop = Arc::new(AtomicBool::new(false));
+    let config = EmulatorConfig {
+        hand,
+        clock: EmulatorClock::PerWrite(dt),
+        hand_damping: b_h,
+        ..EmulatorConfig::default()
+    };
+    let plant = emulator::plant_for(file, None, &config).unwrap();
+    let (s2, f2) = (stop.clone(), file.clone());
+    let master = pty.master;
+    let handle = std::thread::spawn(move || serve(master, &f2, plant, &config, &s2));
+    Emu {
+        path: pty.path,
+        stop,
+        handle: Some(handle),
+        keep: Some(pty.keep),
+    }
+}
+
+/// Opens the driver on the emulator's port at period `dt` (s).
+pub fn open_driver(emu: &Emu, file: &HaplyDeviceFile, dt: f64) -> HaplyDevice<TTYPort> {
+    let port = open_port(&emu.path).unwrap();
+    HaplyDevice::open(
+        port,
+        file,
+        Duration::from_secs_f64(dt),
+        &format!("haply:{}", emu.path),
+    )
+    .unwrap()
+}
+
+/// The box-in-walls scene at `rate` Hz with the box's centre moved to `box_x` (m).
+pub fn box_world(rate: f64, box_x: f64) -> World {
+    let scene = haptic2d::scene::builtin("box-in-walls", Some(rate))
+        .unwrap()
+        .unwrap();
+    let mut w = scene.world;
+    let i = w.body_index("box").unwrap();
+    w.bodies[i].pose.pos.x = box_x;
+    w
+}
+
+/// A hand that holds the handle at its start pose (in the emulator's plant frame) for `hold` s,
+/// then pushes with the constant force `(fx, 0)` N.
+pub fn hold_then_push(start: [f64; 3], hold: f64, fx: f64) -> HandModel {
+    HandModel::Scripted {
+        pose: start,
+        stiffness: [300.0, 300.0, 0.5],
+        damping: [5.0, 5.0, 0.005],
+        t_hold: hold,
+        push: [fx, 0.0, 0.0],
+        t_push: 1e9,
+        release: [0.0; 3],
+    }
+}
+
+/// The virtual coupling with its default gains (500 N/m, 5 N·s/m).
+pub fn coupling() -> ControllerKind {
+    ControllerKind::from_name("coupling").unwrap()
+}
+
+/// Runs `ticks` ticks of `system` against `dev` as fast as the exchanges go (the emulator's plant
+/// steps one period per write). Returns every record's handle x (world, m), the slave's x (m) and
+/// the contact count.
+pub fn run(
+    system: &mut HaplySystem,
+    dev: &mut HaplyDevice<TTYPort>,
+    ticks: usize,
+) -> Vec<(f64, f64, u32)> {
+    use haptic2d_rt::DeviceIo;
+    let mut out = Vec::with_capacity(ticks);
+    for k in 0..ticks {
+        let q = match dev.read_encoders() {
+            Ok(q) => q,
+            Err(e) => panic!("tick {k}: {e}"),
+        };
+        let t = system.tick(&q);
+        assert!(!t.tripped, "safety trip: {:?}", system.trip());
+        dev.write_torques(&t.torques).unwrap();
+        out.push((
+            system.handle_world(&t.record)[0],
+            t.record.x_s[0],
+            t.record.contacts,
+        ));
+    }
+    out
+}

@@ -1,0 +1,355 @@
+//! [`Planar2System`]: a 2-DOF device (a Haply 2DIY five-bar) in the 3-DOF world (issue 12 item 3).
+//!
+//! The device holds the slave body at a **grasp point** `r_g` (body frame, m; default the centre). The
+//! controllers of §11 act on x and y only: the master pose is `(E_world, θ_s)` and its twist
+//! `(Ė_world, ω_s)`, i.e. the θ channel always sees zero error, so the body's rotation is left to the
+//! world (contacts turn it about the grasp point). The translational drive `f_cs` acts at the grasp
+//! point, so the slave receives the force `f_cs` and the torque `(R·r_g) × f_cs` about its centre.
+//!
+//! One tick, in the order of §0.5:
+//!
+//! ```text
+//! 1–2. q (rad) → E, J, margin (five-bar)           ⇒ handle point, filtered velocity
+//! 3–6. world.begin_step                              ⇒ slave pose, contact wrench
+//! 7.   controller on (x, y) of the grasp point      ⇒ f_cm (device), f_cs (slave)
+//! 9.   τ = Jᵀ f_cm, direction-preserving saturation, start-up ramp, safety gate
+//! 10.  f_cs at the grasp point, world.finish_step
+//! 11.  record
+//! ```
+//!
+//! There is no hand-wrench observer on a 2DIY (no model of its dynamics): `f_h = 0` is given to the
+//! controller, so the four-channel controller runs without its C2 channel. The device↔world mapping is
+//! a translation set at the **first measured handle position** (the slave starts aligned with the
+//! handle wherever the user holds it). Never allocates, locks or does I/O in [`Planar2System::tick`].
+
+use crate::control::coupling::VirtualCoupling;
+use crate::control::four_channel::{FourChannel, TeleopSignals};
+use crate::device::filter::VelocityFilter;
+use crate::device::pantograph2::{jt_mul, Pantograph2};
+use crate::device::DeviceFault;
+use crate::geom::{cross, Vec2};
+use crate::world::World;
+
+use super::config::ControllerKind;
+use super::record::{TickRecord, FLAG_NEAR_SINGULAR, FLAG_SAFETY, FLAG_SATURATED};
+use super::safety::{Safety, SafetyReason, SafetyTrip};
+
+/// Settings of a [`Planar2System`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct Planar2Config {
+    /// The linkage (m).
+    pub linkage: Pantograph2,
+    /// Motor torque limits `(τ_1, τ_2)` (N·m), each > 0.
+    pub tau_max: [f64; 2],
+    /// Teleoperation controller (§11), acting on x and y.
+    pub controller: ControllerKind,
+    /// Name of the slave body; `None` = the first dynamic body.
+    pub slave: Option<String>,
+    /// Grasp point in the slave's body frame (m). Default `(0, 0)`, the centre.
+    pub grasp: [f64; 2],
+    /// Velocity low-pass cut-off (Hz), §10.7. Default 50.
+    pub velocity_cutoff_hz: f64,
+    /// Start-up ramp (s): device torques scale linearly from 0 to 1 over this time after the first
+    /// tick. Default 0.5 s; 0 disables it.
+    pub ramp_s: f64,
+    /// Trip below this singularity margin (dimensionless `|sin|` of the distal links). Default 0.1.
+    pub min_singularity_margin: f64,
+    /// Keep the scene's loads on the slave body. Default false (the hand drives it).
+    pub keep_slave_loads: bool,
+}
+
+impl Planar2Config {
+    /// A configuration for `linkage` with torque limit `tau_max` (N·m) on both motors and the
+    /// defaults above.
+    pub fn new(linkage: Pantograph2, tau_max: f64) -> Self {
+        Self {
+            linkage,
+            tau_max: [tau_max; 2],
+            controller: ControllerKind::default(),
+            slave: None,
+            grasp: [0.0; 2],
+            velocity_cutoff_hz: 50.0,
+            ramp_s: 0.5,
+            min_singularity_margin: 0.1,
+            keep_slave_loads: false,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[allow(clippy::large_enum_variant)]
+enum Controller2 {
+    FourChannel(FourChannel),
+    Coupling(VirtualCoupling),
+}
+
+/// What one 2-DOF tick hands back.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Planar2Output {
+    /// Motor torques `(τ_1, τ_2)` (N·m) to write now; zero when latched.
+    pub torques: [f64; 2],
+    /// True when the safety latch is set.
+    pub tripped: bool,
+    /// The tick's record (`tau[2..4]` zero; `x_m` the handle point in world coordinates).
+    pub record: TickRecord,
+}
+
+/// A 2-DOF device coupled to the slave body of a world.
+#[derive(Clone, Debug)]
+pub struct Planar2System {
+    config: Planar2Config,
+    controller: Controller2,
+    world: World,
+    slave: usize,
+    filter: VelocityFilter,
+    safety: Safety,
+    /// World point of the grasp at start (m): the first handle position maps here.
+    world_origin: Vec2,
+    device_origin: Option<Vec2>,
+    ticks: u64,
+    dt: f64,
+    record: TickRecord,
+}
+
+impl Planar2System {
+    /// Builds the system around `world` (its period is the tick period). Errors name the setting.
+    pub fn new(mut world: World, config: Planar2Config) -> Result<Self, String> {
+        let dt = world.params.dt;
+        for (i, t) in config.tau_max.iter().enumerate() {
+            if !(t.is_finite() && *t > 0.0) {
+                return Err(format!(
+                    "tau_max[{i}] = {t} N·m: must be a finite number > 0"
+                ));
+            }
+        }
+        if !config.grasp.iter().all(|v| v.is_finite()) {
+            return Err(format!("grasp = {:?} m: must be finite", config.grasp));
+        }
+        if !(config.velocity_cutoff_hz.is_finite() && config.velocity_cutoff_hz > 0.0) {
+            return Err("velocity_cutoff_hz must be > 0 Hz (default 50)".into());
+        }
+        if !(config.ramp_s.is_finite() && config.ramp_s >= 0.0) {
+            return Err("ramp_s must be ≥ 0 s (default 0.5)".into());
+        }
+        let slave = match &config.slave {
+            Some(name) => world
+                .body_index(name)
+                .ok_or_else(|| format!("slave body `{name}` not found"))?,
+            None => world
+                .bodies
+                .iter()
+                .position(|b| b.is_dynamic())
+                .ok_or("the scene has no dynamic body for the device to drive")?,
+        };
+        let body = &world.bodies[slave];
+        if !body.is_dynamic() {
+            return Err(format!("slave body `{}` is fixed", body.name));
+        }
+        let mass = [body.mass, body.mass, body.inertia];
+        let controller = match config.controller {
+            ControllerKind::FourChannel(g) => {
+                g.check_slave_mass(&mass, dt)?;
+                Controller2::FourChannel(FourChannel::new(g, dt)?)
+            }
+            ControllerKind::Coupling(g) => {
+                let c = VirtualCoupling::new(g)?;
+                c.check_slave_mass(&mass, dt)?;
+                Controller2::Coupling(c)
+            }
+        };
+        let world_origin = grasp_world(&world, slave, config.grasp);
+        if !config.keep_slave_loads {
+            world.loads.retain(|l| l.body != slave);
+        }
+        Ok(Self {
+            filter: VelocityFilter::new(config.velocity_cutoff_hz, dt),
+            safety: Safety::new(config.min_singularity_margin),
+            config,
+            controller,
+            world,
+            slave,
+            world_origin,
+            device_origin: None,
+            ticks: 0,
+            dt,
+            record: TickRecord::default(),
+        })
+    }
+
+    /// One sample from the motor angles `q` (rad) to the motor torques (N·m).
+    pub fn tick(&mut self, q: &[f64; 2]) -> Planar2Output {
+        let (k, t, dt) = (self.world.tick(), self.world.time(), self.dt);
+        let mut flags = 0u32;
+
+        // 1–2. Handle point, Jacobian, margin; filtered velocity; device → world translation.
+        let st = match self.config.linkage.state(*q) {
+            Ok(s) => Some(s),
+            Err(f) => {
+                self.safety.trip(k, t, SafetyReason::Device(f));
+                None
+            }
+        };
+        let mut x_m = [f64::NAN; 3];
+        let mut v_m = [0.0; 3];
+        if let Some(s) = st {
+            let origin = *self.device_origin.get_or_insert(s.e);
+            let p = s.e - origin + self.world_origin;
+            let v = self.filter.update(&[p.x, p.y, 0.0]);
+            x_m = [p.x, p.y, 0.0];
+            v_m = [v[0], v[1], 0.0];
+            if s.margin < self.config.min_singularity_margin {
+                flags |= FLAG_NEAR_SINGULAR;
+                self.safety.trip(
+                    k,
+                    t,
+                    SafetyReason::Singularity {
+                        margin: s.margin,
+                        limit: self.config.min_singularity_margin,
+                    },
+                );
+            }
+        }
+
+        // 3–6. World contacts; slave state at the grasp point.
+        self.world.begin_step();
+        let body = &self.world.bodies[self.slave];
+        let (c, theta, omega) = (body.pose.pos, body.pose.angle, body.omega);
+        let r = rotate(theta, self.config.grasp);
+        let pg = c + r;
+        let vg = body.vel + omega * crate::geom::perp(r);
+        let cw = self.world.contact_wrench(self.slave);
+        x_m[2] = theta;
+        v_m[2] = omega;
+
+        // 7. Controller on x and y (θ channel sees no error: rotation is left to the world).
+        let (mut f_cm, mut f_cs) = ([0.0; 3], [0.0; 3]);
+        if st.is_some() && !self.safety.is_latched() {
+            let s = TeleopSignals {
+                x_m,
+                v_m,
+                f_h: [0.0; 3],
+                x_s: [pg.x, pg.y, theta],
+                v_s: [vg.x, vg.y, omega],
+                f_e: [-cw.force.x, -cw.force.y, 0.0],
+                master_mass: [[0.0; 3]; 3],
+            };
+            (f_cm, f_cs) = match &mut self.controller {
+                Controller2::FourChannel(c) => c.step(&s),
+                Controller2::Coupling(c) => c.step(&s),
+            };
+            f_cm[2] = 0.0;
+            f_cs[2] = 0.0;
+        }
+
+        // 9. τ = Jᵀ f_cm, direction-preserving saturation, start-up ramp, safety gate.
+        let mut tau4 = [0.0; 4];
+        if let (Some(s), false) = (st, self.safety.is_latched()) {
+            let tau = jt_mul(&s.j, [f_cm[0], f_cm[1]]);
+            let mut scale: f64 = 1.0;
+            for (t, max) in tau.iter().zip(self.config.tau_max) {
+                if t.abs() > max {
+                    scale = scale.min(max / t.abs());
+                }
+            }
+            if scale < 1.0 {
+                flags |= FLAG_SATURATED;
+            }
+            let ramp = if self.config.ramp_s > 0.0 {
+                (self.ticks as f64 * dt / self.config.ramp_s).min(1.0)
+            } else {
+                1.0
+            };
+            tau4[0] = tau[0] * scale * ramp;
+            tau4[1] = tau[1] * scale * ramp;
+        }
+        if self.safety.gate(k, t, &mut tau4) {
+            flags |= FLAG_SAFETY;
+            f_cs = [0.0; 3];
+            f_cm = [0.0; 3];
+        }
+
+        // 10. Slave drive at the grasp point, integration.
+        let f = Vec2::new(f_cs[0], f_cs[1]);
+        self.world.set_drive(self.slave, f, cross(r, f));
+        self.world.finish_step();
+        self.ticks += 1;
+
+        // 11. Record.
+        let body = &self.world.bodies[self.slave];
+        let ledger = self.world.ledger();
+        self.record = TickRecord {
+            t,
+            x_m,
+            v_m,
+            w_h: [0.0; 3],
+            x_s: [c.x, c.y, theta],
+            v_s: [body.vel.x, body.vel.y, body.omega],
+            f_cm,
+            f_cs,
+            f_e: [-cw.force.x, -cw.force.y, -cw.torque],
+            tau: tau4,
+            contacts: self.world.contacts().contact_count() as u32,
+            kinetic: ledger.kinetic,
+            stored: ledger.stored,
+            applied_work: ledger.applied_work,
+            po_energy: 0.0,
+            alpha: [0.0; 3],
+            margin: st.map_or(f64::NAN, |s| s.margin),
+            closure_error: 0.0,
+            flags,
+        };
+        Planar2Output {
+            torques: [tau4[0], tau4[1]],
+            tripped: self.safety.is_latched(),
+            record: self.record,
+        }
+    }
+
+    /// Latches the safety stop from outside (e.g. the device was lost): zero torques from now on.
+    pub fn trip_device(&mut self, fault: DeviceFault) {
+        let (k, t) = (self.world.tick(), self.world.time());
+        self.safety.trip(k, t, SafetyReason::Device(fault));
+    }
+
+    /// The world.
+    pub fn world(&self) -> &World {
+        &self.world
+    }
+    /// Index of the slave body.
+    pub fn slave(&self) -> usize {
+        self.slave
+    }
+    /// The latched safety trip, if any.
+    pub fn safety_trip(&self) -> Option<SafetyTrip> {
+        self.safety.trip_info()
+    }
+    /// The record of the last tick.
+    pub fn last_record(&self) -> &TickRecord {
+        &self.record
+    }
+    /// The configuration.
+    pub fn config(&self) -> &Planar2Config {
+        &self.config
+    }
+    /// Handle position (m, board frame) that maps to the slave's grasp point at start, once measured.
+    pub fn device_origin(&self) -> Option<Vec2> {
+        self.device_origin
+    }
+    /// World point of the grasp at start (m).
+    pub fn world_origin(&self) -> Vec2 {
+        self.world_origin
+    }
+}
+
+/// `R(θ)·r` (m).
+#[inline]
+fn rotate(theta: f64, r: [f64; 2]) -> Vec2 {
+    let (s, c) = theta.sin_cos();
+    Vec2::new(c * r[0] - s * r[1], s * r[0] + c * r[1])
+}
+
+/// The grasp point of body `i` in world coordinates (m).
+fn grasp_world(world: &World, i: usize, grasp: [f64; 2]) -> Vec2 {
+    let b = &world.bodies[i];
+    b.pose.pos + rotate(b.pose.angle, grasp)
+}
