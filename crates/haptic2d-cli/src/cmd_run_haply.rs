@@ -14,7 +14,7 @@ use haptic2d_devices::haply::{HaplyDevice, HaplyKind, HaplySystem};
 use haptic2d_rt::signal::install_ctrlc_stop;
 use haptic2d_rt::{
     run_loop, telemetry_channel, CsvLogger, DeviceIo, LoggerConfig, LoopConfig, SafetyInput,
-    TickControl, Watchdog, WatchdogConfig,
+    TickControl, TickInterval, Watchdog, WatchdogConfig,
 };
 use std::process::ExitCode;
 use std::sync::atomic::Ordering;
@@ -101,6 +101,8 @@ fn run_inner(a: &RunArgs) -> Result<u8, (u8, String)> {
     let mut watchdog = Watchdog::new(WatchdogConfig {
         min_singularity_margin: 0.0,
         max_missed_run: file.max_missed_deadlines,
+        // A tick more than 5 periods after the previous one (a stalled loop) trips at once.
+        ..WatchdogConfig::default()
     })
     .map_err(|e| (exit::ERROR, e))?;
     let stop = install_ctrlc_stop().map_err(|e| (exit::ERROR, e))?;
@@ -126,7 +128,10 @@ fn run_inner(a: &RunArgs) -> Result<u8, (u8, String)> {
     );
 
     let mut ended: Option<End> = None;
+    let mut interval = TickInterval::new();
     let summary = run_loop(&loop_config, &stop, |info| {
+        // Wake-to-wake interval: the watchdog trips on a stall longer than max_stall_periods.
+        let elapsed_periods = interval.update(&info) as f64 / info.period_ns as f64;
         let q = match dev.read_encoders() {
             Ok(q) => q,
             Err(e) => {
@@ -149,6 +154,7 @@ fn run_inner(a: &RunArgs) -> Result<u8, (u8, String)> {
             &SafetyInput {
                 deadline_missed: info.missed_deadline(),
                 pose: out.record.x_m,
+                elapsed_periods,
                 ..SafetyInput::nominal(info.index)
             },
             &mut tau,

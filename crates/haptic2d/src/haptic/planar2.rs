@@ -32,7 +32,7 @@ use crate::world::World;
 
 use super::config::ControllerKind;
 use super::record::{TickRecord, FLAG_NEAR_SINGULAR, FLAG_SAFETY, FLAG_SATURATED};
-use super::safety::{Safety, SafetyReason, SafetyTrip};
+use super::safety::{Safety, SafetyConfig, SafetyReason, SafetyTrip};
 
 /// Settings of a [`Planar2System`].
 #[derive(Clone, Debug, PartialEq)]
@@ -163,7 +163,13 @@ impl Planar2System {
         }
         Ok(Self {
             filter: VelocityFilter::new(config.velocity_cutoff_hz, dt),
-            safety: Safety::new(config.min_singularity_margin),
+            // The final gate clamps to the smaller motor limit (the saturation above already scales
+            // each motor to its own) and trips above it by the default margin.
+            safety: Safety::new(
+                config.min_singularity_margin,
+                config.tau_max[0].min(config.tau_max[1]),
+                SafetyConfig::default().torque_trip_margin,
+            ),
             config,
             controller,
             world,
