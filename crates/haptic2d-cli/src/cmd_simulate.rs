@@ -5,14 +5,12 @@
 //! SIGINT/SIGTERM stop the run after the current sample: the rows so far are flushed, the summary
 //! printed, and the exit status is 130.
 
-use crate::csv_out::WorldCsv;
+use crate::world_mcap::WorldOut;
 use crate::exit::{Failure, Status};
 use crate::scene_arg;
 use haptic2d::scene::{divergence, MAX_SAMPLES};
 use haptic2d_rt::signal::install_stop_signals;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use std::fs::File;
-use std::io::BufWriter;
 use std::path::Path;
 use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
@@ -28,7 +26,7 @@ pub struct SimulateArgs<'a> {
     pub scene: &'a str,
     /// Simulated duration (s).
     pub duration: f64,
-    /// CSV output file.
+    /// Output file: MCAP when it ends in .mcap (docs/LOGS.md), else CSV (docs/CSV.md).
     pub out: Option<&'a Path>,
     /// Rate override (Hz).
     pub rate: Option<f64>,
@@ -68,9 +66,7 @@ pub fn run(a: &SimulateArgs) -> Result<Status, Failure> {
     let stop = install_stop_signals()?;
     let mut csv = match a.out {
         Some(p) => {
-            let f = File::create(p)
-                .map_err(|e| Failure::error(format!("cannot create {}: {e}", p.display())))?;
-            let mut w = WorldCsv::new(BufWriter::with_capacity(1 << 20, f), &world)
+            let mut w = WorldOut::create(p, &world, a.scene, &scene.name)
                 .map_err(|e| Failure::error(format!("cannot write {}: {e}", p.display())))?;
             // TODO(t = 0 row): once the world computes its t = 0 contacts and stored energy (helper
             // A, issue 10 item 3), this row reports them; today it shows what `World::new` books.
