@@ -50,7 +50,11 @@ fn info(path: &Path) -> Result<Status, Failure> {
     let label = path.display().to_string();
     if !is_mcap(path) {
         let rows = read_csv(path)?;
-        println!("{label}: CSV tick log, {} rows, {} columns", rows.1.len(), rows.0.len());
+        println!(
+            "{label}: CSV tick log, {} rows, {} columns",
+            rows.1.len(),
+            rows.0.len()
+        );
         let t = column_index("t").and_then(|k| rows.0.iter().position(|&c| c == k));
         if let (Some(t), Some(first), Some(last)) = (t, rows.1.first(), rows.1.last()) {
             let (a, b) = (first[t].as_f64(), last[t].as_f64());
@@ -152,10 +156,18 @@ fn read_csv(path: &Path) -> Result<(Vec<usize>, Vec<Vec<Val>>), Failure> {
         let rec = rec.map_err(|e| format!("{label}: line {line}: {e}"))?;
         let mut row = Vec::with_capacity(cols.len());
         for (&k, field) in cols.iter().zip(rec.iter()) {
-            row.push(parse_cell(&TICK_TABLE[k], field).map_err(|e| format!("{label}: line {line}: {e}"))?);
+            row.push(
+                parse_cell(&TICK_TABLE[k], field)
+                    .map_err(|e| format!("{label}: line {line}: {e}"))?,
+            );
         }
         if row.len() != cols.len() {
-            return Err(format!("{label}: line {line} has {} fields, the header {}", row.len(), cols.len()).into());
+            return Err(format!(
+                "{label}: line {line} has {} fields, the header {}",
+                row.len(),
+                cols.len()
+            )
+            .into());
         }
         rows.push(row);
     }

@@ -4,6 +4,7 @@
 
 use crate::device_arg;
 use crate::exit::{Failure, Status};
+use crate::foxglove_live::FoxgloveServer;
 use crate::hand_arg::HandSpec;
 use crate::run_log::{self, RunLogger};
 use crate::run_rig::{DeviceChoice, Rig};
@@ -12,10 +13,9 @@ use crate::scene_arg;
 use haptic2d::control::passivity::PlanarPassivity;
 use haptic2d::haptic::{ControllerKind, HapticConfig};
 use haptic2d::scene::MAX_RATE_HZ;
+use haptic2d_rt::mcap::{LoggedTick, McapSetup};
 use haptic2d_rt::signal::install_stop_signals;
 use haptic2d_rt::telemetry::{ring_capacity, MAX_RING_BYTES};
-use crate::foxglove_live::FoxgloveServer;
-use haptic2d_rt::mcap::{LoggedTick, McapSetup};
 use haptic2d_rt::{
     run_loop, telemetry_channel, DeviceError, FaultKind, LoopConfig, SafetyInput, SnapshotRx,
     TelemetryTx, TickControl, TickInfo, TimingSummary, Watchdog, WatchdogConfig,
@@ -198,8 +198,7 @@ pub fn run(a: &RunArgs) -> Result<Status, Failure> {
         view,
         watchdog,
         logging: logger.is_some(),
-        capture_world: logger.as_ref().is_some_and(RunLogger::captures_world)
-            || foxglove.is_some(),
+        capture_world: logger.as_ref().is_some_and(RunLogger::captures_world) || foxglove.is_some(),
         logged: LoggedTick::default(),
         tx,
         end: None,

@@ -5,9 +5,9 @@
 //! SIGINT/SIGTERM stop the run after the current sample: the rows so far are flushed, the summary
 //! printed, and the exit status is 130.
 
-use crate::world_mcap::WorldOut;
 use crate::exit::{Failure, Status};
 use crate::scene_arg;
+use crate::world_mcap::WorldOut;
 use haptic2d::scene::{divergence, MAX_SAMPLES};
 use haptic2d_rt::signal::install_stop_signals;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};

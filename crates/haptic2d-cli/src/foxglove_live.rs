@@ -93,11 +93,6 @@ impl FoxgloveServer {
         })
     }
 
-    /// The address bound (with the actual port when 0 was asked).
-    pub fn addr(&self) -> SocketAddr {
-        self.addr
-    }
-
     /// The line printed at startup.
     pub fn banner(&self) -> String {
         format!(
@@ -226,7 +221,9 @@ impl Server {
     fn handshake(&self, stream: TcpStream) -> Option<Client> {
         stream.set_nonblocking(false).ok()?;
         stream.set_read_timeout(Some(Duration::from_secs(2))).ok()?;
-        stream.set_write_timeout(Some(Duration::from_secs(2))).ok()?;
+        stream
+            .set_write_timeout(Some(Duration::from_secs(2)))
+            .ok()?;
         let _ = stream.set_nodelay(true);
         let cb = |req: &Request, mut resp: Response| -> Result<Response, ErrorResponse> {
             let offered = req
@@ -281,7 +278,11 @@ impl Server {
                 Ok(Message::Close(_)) => break false,
                 Ok(_) => {}
                 Err(tungstenite::Error::Io(e)) if e.kind() == ErrorKind::WouldBlock => {
-                    break c.ws.flush().is_ok() || would_block(&c.ws);
+                    break match c.ws.flush() {
+                        Ok(()) => true,
+                        Err(tungstenite::Error::Io(e)) if e.kind() == ErrorKind::WouldBlock => true,
+                        Err(_) => false,
+                    };
                 }
                 Err(_) => break false,
             }
@@ -294,7 +295,11 @@ impl Server {
         }
         let t = snap.deadline_ns;
         for ch in 1..=CHANNELS.len() as u32 {
-            if !self.clients.iter().any(|c| c.subs.values().any(|&v| v == ch)) {
+            if !self
+                .clients
+                .iter()
+                .any(|c| c.subs.values().any(|&v| v == ch))
+            {
                 continue;
             }
             let world = snap.world.body_count > 0;
@@ -333,10 +338,6 @@ impl Server {
             });
         }
     }
-}
-
-fn would_block(_ws: &WebSocket<TcpStream>) -> bool {
-    true
 }
 
 /// Handles one client text message; an error is the text of the `status` reply.

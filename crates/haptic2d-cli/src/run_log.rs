@@ -97,9 +97,7 @@ impl RunLogger {
     pub fn finish(self, summary: &TimingSummary) -> Result<String, String> {
         match self {
             Self::Csv(l) => Ok(l.finish()?.to_string()),
-            Self::Mcap(l) => {
-                Ok(l.finish(vec![timing_metadata(summary)])?.to_string())
-            }
+            Self::Mcap(l) => Ok(l.finish(vec![timing_metadata(summary)])?.to_string()),
         }
     }
 }
@@ -122,7 +120,10 @@ pub fn timing_metadata(s: &TimingSummary) -> Metadata {
     put("on_time_limit_us", s.on_time_limit_us.to_string());
     put("elapsed_s", s.elapsed_s.to_string());
     put("achieved_rate_hz", s.achieved_rate_hz.to_string());
-    for (name, p) in [("lateness_us", &s.lateness_us), ("compute_us", &s.compute_us)] {
+    for (name, p) in [
+        ("lateness_us", &s.lateness_us),
+        ("compute_us", &s.compute_us),
+    ] {
         put(&format!("{name}.p50"), p.p50.to_string());
         put(&format!("{name}.p99"), p.p99.to_string());
         put(&format!("{name}.p999"), p.p999.to_string());

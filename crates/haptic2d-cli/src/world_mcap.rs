@@ -31,7 +31,12 @@ fn other(e: impl std::fmt::Display) -> std::io::Error {
 
 impl WorldOut {
     /// Creates `path` for `world` (of the scene `scene_arg`, named `scene_name`, at `rate_hz`).
-    pub fn create(path: &Path, world: &World, scene_arg: &str, scene_name: &str) -> std::io::Result<Self> {
+    pub fn create(
+        path: &Path,
+        world: &World,
+        scene_arg: &str,
+        scene_name: &str,
+    ) -> std::io::Result<Self> {
         let file = BufWriter::with_capacity(1 << 20, File::create(path)?);
         if !crate::run_log::is_mcap(path) {
             return Ok(Self::Csv(WorldCsv::new(file, world)?));

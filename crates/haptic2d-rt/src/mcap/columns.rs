@@ -64,7 +64,11 @@ pub const TICK_TABLE: [Column; TICK_TABLE_LEN] = [
         "ns",
         "the tick's deadline, CLOCK_MONOTONIC (= the message's log_time)",
     ),
-    u("lateness_ns", "ns", "how late the tick started, wake − deadline"),
+    u(
+        "lateness_ns",
+        "ns",
+        "how late the tick started, wake − deadline",
+    ),
     f("encoders.q1", "rad", "joint angle q11 read this tick"),
     f("encoders.q2", "rad", "joint angle q12 read this tick"),
     f("encoders.q3", "rad", "joint angle q21 read this tick"),
@@ -76,17 +80,37 @@ pub const TICK_TABLE: [Column; TICK_TABLE_LEN] = [
     f("device.vx", "m/s", "filtered device twist vx"),
     f("device.vy", "m/s", "filtered device twist vy"),
     f("device.omega", "rad/s", "filtered device twist ω"),
-    f("hand.fx", "N", "hand-wrench estimate fx (handle coordinates)"),
-    f("hand.fy", "N", "hand-wrench estimate fy (handle coordinates)"),
-    f("hand.tau", "N·m", "hand-wrench estimate τ (handle coordinates)"),
+    f(
+        "hand.fx",
+        "N",
+        "hand-wrench estimate fx (handle coordinates)",
+    ),
+    f(
+        "hand.fy",
+        "N",
+        "hand-wrench estimate fy (handle coordinates)",
+    ),
+    f(
+        "hand.tau",
+        "N·m",
+        "hand-wrench estimate τ (handle coordinates)",
+    ),
     f("slave.x", "m", "slave pose x after impacts"),
     f("slave.y", "m", "slave pose y after impacts"),
     f("slave.theta", "rad", "slave pose θ after impacts"),
     f("slave.vx", "m/s", "post-impulse slave twist vx"),
     f("slave.vy", "m/s", "post-impulse slave twist vy"),
     f("slave.omega", "rad/s", "post-impulse slave twist ω"),
-    f("f_cm.x", "N", "device command after the passivity controller, x (world)"),
-    f("f_cm.y", "N", "device command after the passivity controller, y (world)"),
+    f(
+        "f_cm.x",
+        "N",
+        "device command after the passivity controller, x (world)",
+    ),
+    f(
+        "f_cm.y",
+        "N",
+        "device command after the passivity controller, y (world)",
+    ),
     f(
         "f_cm.tau",
         "N·m",
@@ -97,15 +121,27 @@ pub const TICK_TABLE: [Column; TICK_TABLE_LEN] = [
     f("f_cs.tau", "N·m", "slave drive τ"),
     f("f_e.x", "N", "wrench of the slave on the environment, x"),
     f("f_e.y", "N", "wrench of the slave on the environment, y"),
-    f("f_e.tau", "N·m", "wrench of the slave on the environment, τ"),
+    f(
+        "f_e.tau",
+        "N·m",
+        "wrench of the slave on the environment, τ",
+    ),
     f("tau1", "N·m", "motor torque 1 sent to the amplifiers"),
     f("tau2", "N·m", "motor torque 2 sent to the amplifiers"),
     f("tau3", "N·m", "motor torque 3 sent to the amplifiers"),
     f("tau4", "N·m", "motor torque 4 sent to the amplifiers"),
     f("contacts", "1", "number of contact records"),
     f("energy.kinetic", "J", "world kinetic energy after the step"),
-    f("energy.stored", "J", "energy stored in contact springs after the step"),
-    f("work.applied", "J", "work done on the world by loads and drives so far"),
+    f(
+        "energy.stored",
+        "J",
+        "energy stored in contact springs after the step",
+    ),
+    f(
+        "work.applied",
+        "J",
+        "work done on the world by loads and drives so far",
+    ),
     f(
         "po.energy",
         "J",
@@ -113,11 +149,19 @@ pub const TICK_TABLE: [Column; TICK_TABLE_LEN] = [
     ),
     f("po.alpha_x", "N·s/m", "passivity-controller damping, x"),
     f("po.alpha_y", "N·s/m", "passivity-controller damping, y"),
-    f("po.alpha_theta", "N·m·s/rad", "passivity-controller damping, θ"),
+    f(
+        "po.alpha_theta",
+        "N·m·s/rad",
+        "passivity-controller damping, θ",
+    ),
     f("margin", "1", "singularity margin at the device pose"),
     f("closure_error", "m", "closure error |P2 − P1| − r_c"),
     f("flag.saturated", "1", "saturation scaled the torques (0/1)"),
-    f("flag.near_singular", "1", "below the singularity margin (0/1)"),
+    f(
+        "flag.near_singular",
+        "1",
+        "below the singularity margin (0/1)",
+    ),
     f("flag.safety", "1", "safety latch set (0/1)"),
     f("flag.passivity", "1", "passivity controller active (0/1)"),
 ];
@@ -170,7 +214,13 @@ pub fn column_index(name: &str) -> Option<usize> {
 }
 
 /// The full row of a tick: loop fields and record.
-pub fn tick_row(index: u64, deadline_ns: u64, lateness_ns: u64, q: &[f64; 4], rec: &TickRecord) -> TickRow {
+pub fn tick_row(
+    index: u64,
+    deadline_ns: u64,
+    lateness_ns: u64,
+    q: &[f64; 4],
+    rec: &TickRecord,
+) -> TickRow {
     let mut row: TickRow = [None; TICK_TABLE_LEN];
     row[0] = Some(Val::U(index));
     row[1] = Some(Val::U(deadline_ns));
@@ -214,7 +264,11 @@ pub fn json_f64(v: &serde_json::Value) -> Option<f64> {
 /// Writes the fields of `row` (present cells only) as the members of a JSON object, nested per
 /// [`TICK_TABLE`]: `"t":0.001,"device":{"x":…},…` (no surrounding braces; `first` = no member
 /// written yet). Returns whether a member was written.
-pub fn write_row_members<W: Write>(out: &mut W, row: &TickRow, mut first: bool) -> std::io::Result<bool> {
+pub fn write_row_members<W: Write>(
+    out: &mut W,
+    row: &TickRow,
+    mut first: bool,
+) -> std::io::Result<bool> {
     let mut open: Option<&str> = None;
     for (c, cell) in TICK_TABLE.iter().zip(row.iter()) {
         let Some(v) = cell else { continue };
@@ -260,10 +314,16 @@ pub fn row_from_json(msg: &serde_json::Value) -> Result<TickRow, String> {
         let Some(v) = v else { continue };
         row[k] = Some(match (c.kind, v) {
             (Kind::U64, v) => Val::U(v.as_u64().ok_or_else(|| {
-                format!("field `{}` is `{v}`, expected an unsigned integer ({})", c.name, c.unit)
+                format!(
+                    "field `{}` is `{v}`, expected an unsigned integer ({})",
+                    c.name, c.unit
+                )
             })?),
             (Kind::F64, v) => Val::F(json_f64(v).ok_or_else(|| {
-                format!("field `{}` is `{v}`, expected a number ({})", c.name, c.unit)
+                format!(
+                    "field `{}` is `{v}`, expected a number ({})",
+                    c.name, c.unit
+                )
             })?),
         });
     }
@@ -275,12 +335,17 @@ pub fn parse_cell(col: &Column, text: &str) -> Result<Val, String> {
     let t = text.trim();
     match col.kind {
         Kind::U64 => t.parse::<u64>().map(Val::U).map_err(|_| {
-            format!("column `{}`: `{t}` is not an unsigned integer ({})", col.name, col.unit)
+            format!(
+                "column `{}`: `{t}` is not an unsigned integer ({})",
+                col.name, col.unit
+            )
         }),
-        Kind::F64 => t
-            .parse::<f64>()
-            .map(Val::F)
-            .map_err(|_| format!("column `{}`: `{t}` is not a number ({})", col.name, col.unit)),
+        Kind::F64 => t.parse::<f64>().map(Val::F).map_err(|_| {
+            format!(
+                "column `{}`: `{t}` is not a number ({})",
+                col.name, col.unit
+            )
+        }),
     }
 }
 
@@ -354,9 +419,18 @@ mod tests {
 
     #[test]
     fn row_json_round_trip_is_exact() {
+        // -1.0408340855860843e-14 and 4.163336342344337e-14 came back one ULP off with serde_json's
+        // default float parser (a CSV ↔ MCAP comparison caught it): the `float_roundtrip` feature
+        // is required.
         let rec = TickRecord {
             t: 0.1 + 0.2,
+            f_cm: [
+                -1.0408340855860843e-14,
+                4.163336342344337e-14,
+                0.005443417929809624,
+            ],
             x_m: [1e-300, -0.0, f64::NAN],
+            v_m: [f64::INFINITY, f64::NEG_INFINITY, 5e-324],
             contacts: 3,
             flags: 5,
             ..TickRecord::default()
@@ -384,7 +458,11 @@ mod tests {
                 Some(o) => &p[o]["properties"][f],
                 None => &p[f],
             };
-            assert!(node["description"].as_str().unwrap().contains(c.unit), "{}", c.name);
+            assert!(
+                node["description"].as_str().unwrap().contains(c.unit),
+                "{}",
+                c.name
+            );
         }
     }
 }

@@ -20,36 +20,38 @@ pub fn encode_tick_row(b: &mut Vec<u8>, row: &TickRow) -> std::io::Result<()> {
 
 /// Writes the `/haptic2d/tick` message of `t`.
 pub fn encode_tick(b: &mut Vec<u8>, t: &LoggedTick) -> std::io::Result<()> {
-    encode_tick_row(b, &tick_row(t.index, t.deadline_ns, t.lateness_ns, &t.q, &t.rec))
+    encode_tick_row(
+        b,
+        &tick_row(t.index, t.deadline_ns, t.lateness_ns, &t.q, &t.rec),
+    )
 }
-
 
 /// Writes a `/haptic2d/bodies` message (`names`: the bodies' names as JSON strings).
 pub fn encode_bodies(b: &mut Vec<u8>, names: &[String], s: &WorldSample) -> std::io::Result<()> {
-        b.extend_from_slice(b"{\"t\":");
-        write_json_f64(b, s.t)?;
-        write!(b, ",\"count\":{},\"bodies\":[", s.body_count)?;
-        for (i, body) in s.bodies().iter().enumerate() {
-            if i > 0 {
-                b.push(b',');
-            }
-            match names.get(i) {
-                Some(n) => write!(b, "{{\"name\":{n}")?,
-                None => write!(b, "{{\"name\":\"body{i}\"")?,
-            }
-            for (k, v) in ["x", "y", "theta"].iter().zip(body.pose) {
-                write!(b, ",\"{k}\":")?;
-                write_json_f64(b, v)?;
-            }
-            for (k, v) in ["vx", "vy", "omega"].iter().zip(body.twist) {
-                write!(b, ",\"{k}\":")?;
-                write_json_f64(b, v)?;
-            }
-            b.push(b'}');
+    b.extend_from_slice(b"{\"t\":");
+    write_json_f64(b, s.t)?;
+    write!(b, ",\"count\":{},\"bodies\":[", s.body_count)?;
+    for (i, body) in s.bodies().iter().enumerate() {
+        if i > 0 {
+            b.push(b',');
         }
-        b.extend_from_slice(b"]}");
-        Ok(())
+        match names.get(i) {
+            Some(n) => write!(b, "{{\"name\":{n}")?,
+            None => write!(b, "{{\"name\":\"body{i}\"")?,
+        }
+        for (k, v) in ["x", "y", "theta"].iter().zip(body.pose) {
+            write!(b, ",\"{k}\":")?;
+            write_json_f64(b, v)?;
+        }
+        for (k, v) in ["vx", "vy", "omega"].iter().zip(body.twist) {
+            write!(b, ",\"{k}\":")?;
+            write_json_f64(b, v)?;
+        }
+        b.push(b'}');
     }
+    b.extend_from_slice(b"]}");
+    Ok(())
+}
 
 /// Writes a `/haptic2d/contacts` message (`names`: the bodies' names as JSON strings).
 pub fn encode_contacts(b: &mut Vec<u8>, names: &[String], s: &WorldSample) -> std::io::Result<()> {
@@ -59,59 +61,62 @@ pub fn encode_contacts(b: &mut Vec<u8>, names: &[String], s: &WorldSample) -> st
             .cloned()
             .unwrap_or_else(|| format!("\"body{i}\""))
     };
-        b.extend_from_slice(b"{\"t\":");
-        write_json_f64(b, s.t)?;
-        write!(b, ",\"count\":{},\"contacts\":[", s.contact_count)?;
-        for (i, c) in s.contacts().iter().enumerate() {
-            if i > 0 {
-                b.push(b',');
-            }
-            write!(
-                b,
-                "{{\"body_a\":{},\"body_b\":{},\"state\":\"{}\"",
-                name(c.body_a),
-                name(c.body_b),
-                if c.colliding { "colliding" } else { "continuous" }
-            )?;
-            for (k, v) in [
-                ("x", c.point[0]),
-                ("y", c.point[1]),
-                ("nx", c.normal[0]),
-                ("ny", c.normal[1]),
-                ("penetration", c.penetration),
-                ("f_n", c.f_n),
-                ("f_t", c.f_t),
-                ("slip", c.slip),
-            ] {
-                write!(b, ",\"{k}\":")?;
-                write_json_f64(b, v)?;
-            }
-            b.push(b'}');
+    b.extend_from_slice(b"{\"t\":");
+    write_json_f64(b, s.t)?;
+    write!(b, ",\"count\":{},\"contacts\":[", s.contact_count)?;
+    for (i, c) in s.contacts().iter().enumerate() {
+        if i > 0 {
+            b.push(b',');
         }
-        b.extend_from_slice(b"]}");
-        Ok(())
-    }
-
-/// Writes a `/haptic2d/energy` message.
-pub fn encode_energy(b: &mut Vec<u8>, s: &WorldSample) -> std::io::Result<()> {
-        let l = &s.ledger;
-        b.extend_from_slice(b"{\"t\":");
-        write_json_f64(b, s.t)?;
+        write!(
+            b,
+            "{{\"body_a\":{},\"body_b\":{},\"state\":\"{}\"",
+            name(c.body_a),
+            name(c.body_b),
+            if c.colliding {
+                "colliding"
+            } else {
+                "continuous"
+            }
+        )?;
         for (k, v) in [
-            ("kinetic", l.kinetic),
-            ("stored", l.stored),
-            ("applied_work", l.applied_work),
-            ("initial", l.initial),
-            ("impact_loss", l.impact_loss),
-            ("excess", l.excess()),
+            ("x", c.point[0]),
+            ("y", c.point[1]),
+            ("nx", c.normal[0]),
+            ("ny", c.normal[1]),
+            ("penetration", c.penetration),
+            ("f_n", c.f_n),
+            ("f_t", c.f_t),
+            ("slip", c.slip),
         ] {
             write!(b, ",\"{k}\":")?;
             write_json_f64(b, v)?;
         }
         b.push(b'}');
-        Ok(())
     }
+    b.extend_from_slice(b"]}");
+    Ok(())
+}
 
+/// Writes a `/haptic2d/energy` message.
+pub fn encode_energy(b: &mut Vec<u8>, s: &WorldSample) -> std::io::Result<()> {
+    let l = &s.ledger;
+    b.extend_from_slice(b"{\"t\":");
+    write_json_f64(b, s.t)?;
+    for (k, v) in [
+        ("kinetic", l.kinetic),
+        ("stored", l.stored),
+        ("applied_work", l.applied_work),
+        ("initial", l.initial),
+        ("impact_loss", l.impact_loss),
+        ("excess", l.excess()),
+    ] {
+        write!(b, ",\"{k}\":")?;
+        write_json_f64(b, v)?;
+    }
+    b.push(b'}');
+    Ok(())
+}
 
 /// Writes a Foxglove `SceneUpdate` (JSON): one entity per body (its outlines as `LINE_LOOP`s, posed
 /// at the body's pose; dynamic bodies blue, fixed grey) and one `contacts` entity with a line per
@@ -185,7 +190,10 @@ pub fn encode_scene_update<B: Write>(
             b.write_all(b",")?;
         }
         let len = c.f_n * FORCE_LINE_M_PER_N;
-        let tip = [c.point[0] + c.normal[0] * len, c.point[1] + c.normal[1] * len];
+        let tip = [
+            c.point[0] + c.normal[0] * len,
+            c.point[1] + c.normal[1] * len,
+        ];
         for (k, p) in [c.point, tip].iter().enumerate() {
             if k > 0 {
                 b.write_all(b",")?;
@@ -197,6 +205,8 @@ pub fn encode_scene_update<B: Write>(
             b.write_all(b",\"z\":0}")?;
         }
     }
-    b.write_all(b"],\"color\":{\"r\":0.9,\"g\":0.2,\"b\":0.2,\"a\":1},\"colors\":[],\"indices\":[]}]}]}")?;
+    b.write_all(
+        b"],\"color\":{\"r\":0.9,\"g\":0.2,\"b\":0.2,\"a\":1},\"colors\":[],\"indices\":[]}]}]}",
+    )?;
     Ok(())
 }

@@ -13,8 +13,8 @@ pub mod columns;
 pub mod encode;
 pub mod logger;
 pub mod reader;
-pub mod replay;
 pub mod record;
+pub mod replay;
 pub mod schemas;
 pub mod writer;
 

@@ -154,10 +154,13 @@ pub fn read_ticks(bytes: &[u8], label: &str) -> Result<(Vec<TickRow>, LogInfo), 
             return Ok(());
         }
         let v: serde_json::Value = serde_json::from_slice(data).map_err(|e| {
-            format!("{label}: tick message {} (log_time {t} ns) is not JSON: {e}", rows.len())
+            format!(
+                "{label}: tick message {} (log_time {t} ns) is not JSON: {e}",
+                rows.len()
+            )
         })?;
-        let row = row_from_json(&v)
-            .map_err(|e| format!("{label}: tick message {}: {e}", rows.len()))?;
+        let row =
+            row_from_json(&v).map_err(|e| format!("{label}: tick message {}: {e}", rows.len()))?;
         rows.push(row);
         Ok(())
     })?;

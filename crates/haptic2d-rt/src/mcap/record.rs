@@ -144,7 +144,13 @@ impl LoggedTick {
     /// Fills `self` for the tick `info` (allocation-free): the loop fields, `q`, `rec`, and — when
     /// `world` is given — the world sample.
     #[inline]
-    pub fn capture(&mut self, info: &TickInfo, q: &[f64; 4], rec: &TickRecord, world: Option<&World>) {
+    pub fn capture(
+        &mut self,
+        info: &TickInfo,
+        q: &[f64; 4],
+        rec: &TickRecord,
+        world: Option<&World>,
+    ) {
         self.index = info.index;
         self.deadline_ns = info.deadline_ns;
         self.lateness_ns = info.lateness_ns;

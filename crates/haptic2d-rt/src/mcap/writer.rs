@@ -14,9 +14,9 @@ use crate::mcap::encode::{
 };
 use crate::mcap::record::{LoggedTick, WorldSample};
 use crate::mcap::schemas::*;
-use haptic2d::world::World;
 use ::mcap::records::{MessageHeader, Metadata};
 use ::mcap::{WriteOptions, Writer};
+use haptic2d::world::World;
 use std::collections::BTreeMap;
 use std::io::{Seek, Write};
 
@@ -162,7 +162,12 @@ impl<W: Write + Seek> McapSink<W> {
         let (bodies, contacts, energy) = if setup.world {
             (
                 Some(add(&mut w, SCHEMA_BODIES, BODIES_SCHEMA, TOPIC_BODIES)?),
-                Some(add(&mut w, SCHEMA_CONTACTS, CONTACTS_SCHEMA, TOPIC_CONTACTS)?),
+                Some(add(
+                    &mut w,
+                    SCHEMA_CONTACTS,
+                    CONTACTS_SCHEMA,
+                    TOPIC_CONTACTS,
+                )?),
                 Some(add(&mut w, SCHEMA_ENERGY, ENERGY_SCHEMA, TOPIC_ENERGY)?),
             )
         } else {
@@ -248,7 +253,12 @@ impl<W: Write + Seek> McapSink<W> {
 
     /// Writes one `/haptic2d/tick` message from a row (present cells only) at `log_time` (ns);
     /// nothing without a tick channel.
-    pub fn write_tick_row(&mut self, seq: u64, log_time: u64, row: &TickRow) -> ::mcap::McapResult<()> {
+    pub fn write_tick_row(
+        &mut self,
+        seq: u64,
+        log_time: u64,
+        row: &TickRow,
+    ) -> ::mcap::McapResult<()> {
         self.scene_once(log_time)?;
         if let Some(id) = self.ch.tick {
             self.buf.clear();
@@ -260,7 +270,12 @@ impl<W: Write + Seek> McapSink<W> {
     }
 
     /// Writes one world sample (bodies, contacts, energy, decimated `SceneUpdate`) at `log_time` (ns).
-    pub fn write_world(&mut self, seq: u64, log_time: u64, s: &WorldSample) -> ::mcap::McapResult<()> {
+    pub fn write_world(
+        &mut self,
+        seq: u64,
+        log_time: u64,
+        s: &WorldSample,
+    ) -> ::mcap::McapResult<()> {
         self.scene_once(log_time)?;
         let (Some(bodies), Some(contacts), Some(energy)) =
             (self.ch.bodies, self.ch.contacts, self.ch.energy)
@@ -280,8 +295,14 @@ impl<W: Write + Seek> McapSink<W> {
             if log_time >= self.next_scene_update_ns {
                 self.next_scene_update_ns = log_time.saturating_add(self.scene_update_period_ns);
                 self.buf.clear();
-                encode_scene_update(&mut self.buf, &self.setup.bodies, &self.names_json, s, log_time)
-                    .map_err(io_err)?;
+                encode_scene_update(
+                    &mut self.buf,
+                    &self.setup.bodies,
+                    &self.names_json,
+                    s,
+                    log_time,
+                )
+                .map_err(io_err)?;
                 self.emit(id, seq, log_time)?;
             }
         }
@@ -318,4 +339,3 @@ impl<W: Write + Seek> McapSink<W> {
         })
     }
 }
-
