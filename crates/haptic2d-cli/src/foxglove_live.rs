@@ -225,6 +225,8 @@ impl Server {
             .set_write_timeout(Some(Duration::from_secs(2)))
             .ok()?;
         let _ = stream.set_nodelay(true);
+        // The error type is tungstenite's (its `Callback` trait), not ours to shrink.
+        #[allow(clippy::result_large_err)]
         let cb = |req: &Request, mut resp: Response| -> Result<Response, ErrorResponse> {
             let offered = req
                 .headers()

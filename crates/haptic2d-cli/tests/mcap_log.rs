@@ -131,7 +131,7 @@ fn mcap_log_of_a_2s_run_has_every_tick_and_matches_the_csv_log_of_the_same_run()
 fn sigint_mid_run_leaves_a_complete_readable_mcap() {
     let dir = tempfile::tempdir().unwrap();
     let mcap = dir.path().join("int.mcap");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_haptic2d"))
+    let child = Command::new(env!("CARGO_BIN_EXE_haptic2d"))
         .args([
             "run",
             "--headless",
