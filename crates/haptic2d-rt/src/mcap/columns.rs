@@ -242,15 +242,25 @@ fn split(name: &str) -> (Option<&str>, &str) {
     }
 }
 
-/// Writes a JSON number in shortest round-trip form; a non-finite value (JSON has none) as the
-/// string `"NaN"`, `"inf"` or `"-inf"`, so that every `f64` survives a round trip.
+/// Writes a JSON number in shortest round-trip form (`ryu`: e.g. `0.001`, `2.3702731755658497e-17`;
+/// exact, and short for tiny values); a non-finite value (JSON has none) as the string `"NaN"`,
+/// `"inf"` or `"-inf"`, so that every `f64` survives a round trip.
 #[inline]
 pub fn write_json_f64<W: Write>(out: &mut W, v: f64) -> std::io::Result<()> {
     if v.is_finite() {
-        write!(out, "{v}")
+        let mut b = ryu::Buffer::new();
+        out.write_all(b.format_finite(v).as_bytes())
     } else {
         write!(out, "\"{v}\"")
     }
+}
+
+/// Writes `"key":`.
+#[inline]
+pub fn write_key<W: Write>(out: &mut W, key: &str) -> std::io::Result<()> {
+    out.write_all(b"\"")?;
+    out.write_all(key.as_bytes())?;
+    out.write_all(b"\":")
 }
 
 /// Reads a float written by [`write_json_f64`] (a number, or `"NaN"`/`"inf"`/`"-inf"`).
@@ -289,7 +299,7 @@ pub fn write_row_members<W: Write>(
         } else {
             out.write_all(b",")?;
         }
-        write!(out, "\"{field}\":")?;
+        write_key(out, field)?;
         match v {
             Val::U(x) => write!(out, "{x}")?,
             Val::F(x) => write_json_f64(out, *x)?,

@@ -2,7 +2,7 @@
 //! the MCAP writer and the Foxglove live server, so a live view and a recording carry the same
 //! bytes. Floats: [`write_json_f64`].
 
-use crate::mcap::columns::{tick_row, write_json_f64, write_row_members, TickRow};
+use crate::mcap::columns::{tick_row, write_json_f64, write_key, write_row_members, TickRow};
 use crate::mcap::record::{LoggedTick, WorldSample};
 use crate::mcap::writer::BodyGeom;
 use std::io::Write;
@@ -40,11 +40,13 @@ pub fn encode_bodies(b: &mut Vec<u8>, names: &[String], s: &WorldSample) -> std:
             None => write!(b, "{{\"name\":\"body{i}\"")?,
         }
         for (k, v) in ["x", "y", "theta"].iter().zip(body.pose) {
-            write!(b, ",\"{k}\":")?;
+            b.push(b',');
+            write_key(b, k)?;
             write_json_f64(b, v)?;
         }
         for (k, v) in ["vx", "vy", "omega"].iter().zip(body.twist) {
-            write!(b, ",\"{k}\":")?;
+            b.push(b',');
+            write_key(b, k)?;
             write_json_f64(b, v)?;
         }
         b.push(b'}');
@@ -89,7 +91,8 @@ pub fn encode_contacts(b: &mut Vec<u8>, names: &[String], s: &WorldSample) -> st
             ("f_t", c.f_t),
             ("slip", c.slip),
         ] {
-            write!(b, ",\"{k}\":")?;
+            b.push(b',');
+            write_key(b, k)?;
             write_json_f64(b, v)?;
         }
         b.push(b'}');
@@ -111,7 +114,8 @@ pub fn encode_energy(b: &mut Vec<u8>, s: &WorldSample) -> std::io::Result<()> {
         ("impact_loss", l.impact_loss),
         ("excess", l.excess()),
     ] {
-        write!(b, ",\"{k}\":")?;
+        b.push(b',');
+            write_key(b, k)?;
         write_json_f64(b, v)?;
     }
     b.push(b'}');
