@@ -115,7 +115,7 @@ pub fn encode_energy(b: &mut Vec<u8>, s: &WorldSample) -> std::io::Result<()> {
         ("excess", l.excess()),
     ] {
         b.push(b',');
-            write_key(b, k)?;
+        write_key(b, k)?;
         write_json_f64(b, v)?;
     }
     b.push(b'}');

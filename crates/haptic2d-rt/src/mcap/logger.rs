@@ -142,7 +142,9 @@ fn logger_thread<W: Write + Seek>(
     let mut written = 0u64;
     loop {
         // Read the stop flag before draining: every record pushed before it was set is drained.
-        let stopping = stop.load(Ordering::Acquire) || rx.is_producer_gone();
+        // Only `finish` (or drop) ends the thread — not the producer going away, which happens
+        // first, before `finish` has handed over the final metadata.
+        let stopping = stop.load(Ordering::Acquire);
         while let Some(rec) = rx.pop() {
             if first_error.is_some() {
                 continue; // keep draining so the RT thread never sees a full ring
@@ -175,4 +177,50 @@ fn logger_thread<W: Write + Seek>(
         },
         stats: stats?,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mcap::reader::{read_file, read_info};
+    use crate::telemetry::telemetry_channel;
+    use std::collections::BTreeMap;
+
+    /// The loop drops the producer before `finish` hands over the timing summary; the logger used
+    /// to end on "producer gone" and lose it (seen as "no timing summary" in `log info`).
+    #[test]
+    fn final_metadata_is_written_when_the_producer_is_gone_before_finish() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("m.mcap");
+        let (mut tx, rx, _) = telemetry_channel(64, LoggedTick::default()).unwrap();
+        let setup = McapSetup {
+            ticks: true,
+            ..McapSetup::default()
+        };
+        let logger = McapLogger::spawn_file(rx, &path, setup).unwrap();
+        for i in 0..10 {
+            let t = LoggedTick {
+                index: i,
+                deadline_ns: 1000 + i,
+                ..LoggedTick::default()
+            };
+            assert!(tx.push(t));
+        }
+        drop(tx);
+        std::thread::sleep(Duration::from_millis(50));
+        let mut m = BTreeMap::new();
+        m.insert("ticks".to_string(), "10".to_string());
+        let report = logger
+            .finish(vec![Metadata {
+                name: "haptic2d.timing".into(),
+                metadata: m,
+            }])
+            .unwrap();
+        assert_eq!(report.log.written, 10);
+        let bytes = read_file(&path).unwrap();
+        let info = read_info(&bytes, "m.mcap").unwrap();
+        assert!(info.complete);
+        assert_eq!(info.count(crate::mcap::schemas::TOPIC_TICK), 10);
+        assert_eq!(info.metadata("haptic2d.timing").unwrap()["ticks"], "10");
+    }
 }
