@@ -4,19 +4,23 @@
 
 use crate::device_arg;
 use crate::exit::{Failure, Status};
+use crate::foxglove_live::FoxgloveServer;
 use crate::hand_arg::HandSpec;
+use crate::run_log::{self, RunLogger};
 use crate::run_rig::{DeviceChoice, Rig};
 use crate::run_view::{self, LiveView, LoadedScene};
 use crate::scene_arg;
 use haptic2d::control::passivity::PlanarPassivity;
-use haptic2d::haptic::{ControllerKind, HapticConfig, TickRecord};
+use haptic2d::haptic::{ControllerKind, HapticConfig};
 use haptic2d::scene::MAX_RATE_HZ;
+use haptic2d_rt::mcap::{LoggedTick, McapSetup};
 use haptic2d_rt::signal::install_stop_signals;
 use haptic2d_rt::telemetry::{ring_capacity, MAX_RING_BYTES};
 use haptic2d_rt::{
-    run_loop, telemetry_channel, CsvLogger, DeviceError, FaultKind, LoggerConfig, LoopConfig,
-    TelemetryTx, TickControl, TickInfo, TimingSummary, Watchdog,
+    run_loop, telemetry_channel, DeviceError, FaultKind, LoopConfig, SnapshotRx, TelemetryTx,
+    TickControl, TickInfo, TimingSummary, Watchdog,
 };
+use std::collections::BTreeMap;
 use std::net::SocketAddr;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -50,7 +54,8 @@ pub struct RunArgs {
     #[arg(long, allow_hyphen_values = true)]
     pub hand: Option<String>,
     /// Device: sim (simulated twin pantograph), replay:FILE.csv (recorded encoders q1..q4, rad),
-    /// haply:PATH or haply:auto (a Haply board; --device-file a Haply device file, headless).
+    /// replay:FILE.mcap (the encoders of a `--log FILE.mcap` recording), haply:PATH or haply:auto
+    /// (a Haply board; --device-file a Haply device file, headless).
     #[arg(long, default_value = "sim")]
     pub device: String,
     /// Device parameters (TOML: top-level fields or a [device] table; template:
@@ -58,7 +63,8 @@ pub struct RunArgs {
     /// the spec defaults. Used by the simulated device and to read a replay's encoders.
     #[arg(long, value_name = "FILE.toml")]
     pub device_file: Option<PathBuf>,
-    /// Write every tick's record to this CSV file.
+    /// Write every tick's record to this file: MCAP when it ends in .mcap (every tick, plus bodies,
+    /// contacts, energy and a Foxglove scene; docs/LOGS.md), else CSV.
     #[arg(long)]
     pub log: Option<PathBuf>,
     /// Address of the live display (open http://ADDR:PORT/ in a browser). Commands are accepted
@@ -77,6 +83,13 @@ pub struct RunArgs {
     /// Normal scheduling: do not ask for real-time privileges.
     #[arg(long, overrides_with = "rt")]
     pub no_rt: bool,
+    /// Foxglove live view: serve the Foxglove WebSocket protocol on ADDR:PORT (or PORT, on
+    /// loopback; alone: 127.0.0.1:8765), decimated to --foxglove-rate. See docs/LOGS.md.
+    #[arg(long, value_name = "ADDR:PORT", num_args = 0..=1, default_missing_value = "127.0.0.1:8765")]
+    pub foxglove: Option<String>,
+    /// Rate of the Foxglove live view (Hz, at most 1000).
+    #[arg(long, default_value_t = crate::foxglove_live::DEFAULT_LIVE_RATE_HZ, allow_negative_numbers = true)]
+    pub foxglove_rate: f64,
     /// Spin before each deadline (µs): the loop sleeps until this long before the deadline, then
     /// busy-waits. Longer spins absorb late wake-ups at the cost of CPU time. Default: 40 % of the
     /// period, at most 400 µs (400 µs at 1 kHz, 40 µs at 10 kHz); see docs/PERFORMANCE.md.
@@ -95,6 +108,7 @@ pub const MAX_RUN_DURATION_S: f64 = 1e7;
 /// The options of `haptic2d run`, checked: every number in range, every name resolved.
 struct RunOptions {
     bind: SocketAddr,
+    foxglove: Option<SocketAddr>,
     controller: ControllerKind,
     device: DeviceChoice,
     hand: HandSpec,
@@ -153,7 +167,28 @@ pub fn run(a: &RunArgs) -> Result<Status, Failure> {
         println!("{}", server.banner());
         (Some(server), Some(view))
     };
-    let (tx, logger) = start_telemetry(a)?;
+    let scene_meta = run_log::scene_strings(
+        &a.scene,
+        &scene_name,
+        a.device_file.as_deref(),
+        &[
+            ("rate_hz", a.rate.to_string()),
+            ("controller", rig.config.controller.name().to_string()),
+            ("device", rig.io.name().to_string()),
+            ("hand", hand_name.clone()),
+            ("passivity", a.passivity.to_string()),
+        ],
+    );
+    let live_setup = McapSetup::for_world(rig.system.world(), scene_meta.clone(), true);
+    let (tx, logger, latest) = start_telemetry(a, rig.system.world(), scene_meta)?;
+    let foxglove = match opts.foxglove {
+        Some(addr) => {
+            let f = FoxgloveServer::start(addr, latest, live_setup, a.foxglove_rate)?;
+            println!("{}", f.banner());
+            Some(f)
+        }
+        None => None,
+    };
     let watchdog = make_watchdog(&rig)?;
     let stop = install_stop()?;
     let loop_config = make_loop_config(a)?;
@@ -179,6 +214,8 @@ pub fn run(a: &RunArgs) -> Result<Status, Failure> {
         view,
         watchdog,
         logging: logger.is_some(),
+        capture_world: logger.as_ref().is_some_and(RunLogger::captures_world) || foxglove.is_some(),
+        logged: LoggedTick::default(),
         tx,
         end: None,
     };
@@ -187,6 +224,9 @@ pub fn run(a: &RunArgs) -> Result<Status, Failure> {
     drop(state);
     if let Some(s) = server {
         s.shutdown();
+    }
+    if let Some(f) = foxglove {
+        f.shutdown();
     }
     report(a, &rig, &summary, end, stop.load(Ordering::SeqCst), logger)
 }
@@ -208,6 +248,7 @@ fn validate_options(a: &RunArgs) -> Result<RunOptions, Failure> {
             a.bind
         )
     })?;
+    let foxglove = a.foxglove.as_deref().map(parse_foxglove).transpose()?;
     let controller =
         ControllerKind::from_name(&a.controller).map_err(|e| format!("--controller: {e}"))?;
     let device = DeviceChoice::parse(&a.device)?;
@@ -223,9 +264,21 @@ fn validate_options(a: &RunArgs) -> Result<RunOptions, Failure> {
     };
     Ok(RunOptions {
         bind,
+        foxglove,
         controller,
         device,
         hand,
+    })
+}
+
+/// `--foxglove`: `ADDR:PORT`, or a bare `PORT` on loopback.
+fn parse_foxglove(s: &str) -> Result<SocketAddr, Failure> {
+    if let Ok(port) = s.parse::<u16>() {
+        return Ok(SocketAddr::from(([127, 0, 0, 1], port)));
+    }
+    s.parse().map_err(|e| {
+        format!("--foxglove `{s}` is not an ADDRESS:PORT or a PORT ({e})\n    fix: e.g. --foxglove 127.0.0.1:8765")
+            .into()
     })
 }
 
@@ -240,20 +293,31 @@ fn check_rate(rate: f64) -> Result<(), Failure> {
     Ok(())
 }
 
-/// Step 2: the telemetry channel, and the CSV logger draining it when `--log` is given. The ring
-/// holds 2 s of records at the loop rate, at least 4096, and never more than
-/// [`MAX_RING_BYTES`] of memory.
-fn start_telemetry(a: &RunArgs) -> Result<(TelemetryTx<TickRecord>, Option<CsvLogger>), Failure> {
-    let capacity = ring_capacity::<TickRecord>(a.rate, 2.0, 4096, MAX_RING_BYTES);
-    let (tx, rx, _latest) = telemetry_channel(capacity, TickRecord::default())?;
+/// The telemetry ends of a run: producer, logger, latest snapshot.
+type Telemetry = (
+    TelemetryTx<LoggedTick>,
+    Option<RunLogger>,
+    SnapshotRx<LoggedTick>,
+);
+
+/// Step 2: the telemetry channel, and the logger draining it when `--log` is given (CSV, or MCAP
+/// for a `.mcap` file, which also describes `world` and `scene`). The ring holds 2 s of records at
+/// the loop rate, at least 4096, and never more than [`MAX_RING_BYTES`] of memory.
+fn start_telemetry(
+    a: &RunArgs,
+    world: &haptic2d::world::World,
+    scene: BTreeMap<String, String>,
+) -> Result<Telemetry, Failure> {
+    let capacity = ring_capacity::<LoggedTick>(a.rate, 2.0, 4096, MAX_RING_BYTES);
+    let (tx, rx, latest) = telemetry_channel(capacity, LoggedTick::default())?;
     let logger = match &a.log {
-        Some(p) => Some(CsvLogger::spawn_file(rx, p, LoggerConfig::default())?),
+        Some(p) => Some(RunLogger::start(p, rx, world, scene)?),
         None => {
             drop(rx);
             None
         }
     };
-    Ok((tx, logger))
+    Ok((tx, logger, latest))
 }
 
 /// Step 3: the loop's watchdog.
@@ -287,9 +351,13 @@ struct LoopState<'r> {
     rig: &'r mut Rig,
     view: Option<LiveView>,
     watchdog: Watchdog,
-    tx: TelemetryTx<TickRecord>,
+    tx: TelemetryTx<LoggedTick>,
     /// True when a logger drains the ring (else only the latest snapshot is kept).
     logging: bool,
+    /// True when the telemetry carries the world (bodies, contacts): an MCAP log.
+    capture_world: bool,
+    /// The record being filled, reused every tick.
+    logged: LoggedTick,
     /// Why the tick stopped the loop, if it did.
     end: Option<LoopEnd>,
 }
@@ -310,7 +378,7 @@ impl LoopState<'_> {
         let out = self.rig.tick_system(&q, info, paused);
         let mut tau = out.torques;
         let safety = self.rig.safety_input(info, &out, lost.is_some());
-        let io = &mut self.rig.io;
+        let Rig { system, io, .. } = &mut *self.rig;
         let guard = self.watchdog.guard(&safety, &mut tau);
         if let Some(e) = lost {
             io.zero_torques();
@@ -327,10 +395,12 @@ impl LoopState<'_> {
         }
         let mut rec = out.record;
         rec.tau = tau;
+        let world = self.capture_world.then(|| system.world());
+        self.logged.capture(info, &q, &rec, world);
         if self.logging {
-            self.tx.publish(rec);
+            self.tx.publish(self.logged);
         } else {
-            self.tx.set_latest(rec);
+            self.tx.set_latest(self.logged);
         }
         if let Err(f) = guard {
             io.zero_torques();
@@ -396,7 +466,7 @@ fn report(
     summary: &TimingSummary,
     end: Option<LoopEnd>,
     interrupted: bool,
-    logger: Option<CsvLogger>,
+    logger: Option<RunLogger>,
 ) -> Result<Status, Failure> {
     if let Some(w) = summary.rt.as_ref().and_then(|r| r.warning()) {
         eprintln!("{w}");
@@ -431,7 +501,7 @@ fn report(
         w.ledger().kinetic
     );
     if let Some(l) = logger {
-        let report = l.finish().map_err(Failure::error)?;
+        let report = l.finish(summary).map_err(Failure::error)?;
         println!(
             "{report} to {}",
             a.log
@@ -474,7 +544,7 @@ mod tests {
     }
 
     fn state_with(rig: &mut Rig) -> LoopState<'_> {
-        let (tx, _rx, _latest) = telemetry_channel(16, TickRecord::default()).unwrap();
+        let (tx, _rx, _latest) = telemetry_channel(16, LoggedTick::default()).unwrap();
         let watchdog = make_watchdog(rig).unwrap();
         LoopState {
             rig,
@@ -482,6 +552,8 @@ mod tests {
             watchdog,
             tx,
             logging: false,
+            capture_world: false,
+            logged: LoggedTick::default(),
             end: None,
         }
     }

@@ -5,14 +5,12 @@
 //! SIGINT/SIGTERM stop the run after the current sample: the rows so far are flushed, the summary
 //! printed, and the exit status is 130.
 
-use crate::csv_out::WorldCsv;
 use crate::exit::{Failure, Status};
 use crate::scene_arg;
+use crate::world_mcap::WorldOut;
 use haptic2d::scene::{divergence, MAX_SAMPLES};
 use haptic2d_rt::signal::install_stop_signals;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use std::fs::File;
-use std::io::BufWriter;
 use std::path::Path;
 use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
@@ -28,7 +26,7 @@ pub struct SimulateArgs<'a> {
     pub scene: &'a str,
     /// Simulated duration (s).
     pub duration: f64,
-    /// CSV output file.
+    /// Output file: MCAP when it ends in .mcap (docs/LOGS.md), else CSV (docs/CSV.md).
     pub out: Option<&'a Path>,
     /// Rate override (Hz).
     pub rate: Option<f64>,
@@ -70,9 +68,7 @@ pub fn run(a: &SimulateArgs) -> Result<Status, Failure> {
     let stop = install_stop_signals()?;
     let mut csv = match a.out {
         Some(p) => {
-            let f = File::create(p)
-                .map_err(|e| Failure::error(format!("cannot create {}: {e}", p.display())))?;
-            let mut w = WorldCsv::new(BufWriter::with_capacity(1 << 20, f), &world)
+            let mut w = WorldOut::create(p, &world, a.scene, &scene.name)
                 .map_err(|e| Failure::error(format!("cannot write {}: {e}", p.display())))?;
             // The t = 0 row: primed above, so it reports the contacts and stored energy at t = 0.
             w.row(&world)

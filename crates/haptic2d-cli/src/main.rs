@@ -4,6 +4,7 @@ mod cmd_check;
 mod cmd_device_check;
 mod cmd_devices;
 mod cmd_emulate;
+mod cmd_log;
 mod cmd_reproduce;
 mod cmd_run;
 mod cmd_run_haply;
@@ -14,11 +15,14 @@ mod cmd_sweep;
 mod csv_out;
 mod device_arg;
 mod exit;
+mod foxglove_live;
 mod hand_arg;
 mod haply_arg;
+mod run_log;
 mod run_rig;
 mod run_view;
 mod scene_arg;
+mod world_mcap;
 
 use clap::{Parser, Subcommand};
 use exit::{Failure, Status};
@@ -52,7 +56,8 @@ enum Command {
         /// Simulated duration (s).
         #[arg(long, default_value_t = 10.0, allow_negative_numbers = true)]
         duration: f64,
-        /// CSV output file (schema in docs/CSV.md). Without it, only a summary is printed.
+        /// Output file: MCAP when it ends in .mcap (docs/LOGS.md), else CSV (docs/CSV.md). Without
+        /// it, only a summary is printed.
         #[arg(long)]
         out: Option<PathBuf>,
         /// Control rate (Hz), overriding the scene's `world.rate`.
@@ -102,6 +107,10 @@ enum Command {
     /// The loop's stability per axis with the hand held and released: right-most poles, sampled-data
     /// growth rate and a verdict, plus a plot of the poles against the hand's impedance.
     Stability(cmd_stability::StabilityArgs),
+    /// Logs: `log info FILE` (channels, counts, duration, timing summary), `log convert IN OUT`
+    /// (tick logs between CSV and MCAP, by extension).
+    #[command(subcommand)]
+    Log(cmd_log::LogCmd),
     /// Parameter sweeps; `walls`: stiffness × damping of every wall law, classified by energy gain.
     Sweep {
         /// What to sweep: walls.
@@ -158,6 +167,7 @@ fn main() -> ExitCode {
             out,
             strict,
         } => runtime(cmd_reproduce::run(&figure, &out, strict)),
+        Command::Log(cmd) => cmd_log::run(&cmd),
         Command::Sweep {
             target,
             rate,

@@ -19,7 +19,8 @@ use std::sync::Arc;
 pub enum DeviceChoice {
     /// The simulated twin pantograph, pushed by the simulated hand.
     Sim,
-    /// Recorded encoder angles `q1..q4` (rad) played back from a CSV file.
+    /// Recorded encoder angles `q1..q4` (rad) played back from a CSV file, or the encoders of an
+    /// MCAP tick log (`.mcap`).
     Replay(PathBuf),
 }
 
@@ -84,6 +85,9 @@ impl Rig {
             .then(|| Arc::new(SharedTarget::new(system.device_start())));
         let io: Box<dyn DeviceIo + Send> = match &device {
             DeviceChoice::Sim => Box::new(Self::sim(&system, &config, &hand, target.as_ref())?),
+            DeviceChoice::Replay(p) if crate::run_log::is_mcap(p) => Box::new(
+                haptic2d_rt::mcap::McapReplay::from_path(p, ReplayEnd::Error)?,
+            ),
             DeviceChoice::Replay(p) => Box::new(ReplayDevice::from_path(
                 p,
                 DEFAULT_REPLAY_COLUMNS,

@@ -15,13 +15,15 @@
 //! - [`watchdog`]: the latching safety watchdog that zeroes torques;
 //! - [`signal`]: Ctrl-C to a stop flag;
 //! - [`sim_io`]: the simulated twin pantograph and hand behind [`DeviceIo`];
-//! - [`tick_log`]: CSV rows of the haptic tick record.
+//! - [`tick_log`]: CSV rows of the haptic tick record;
+//! - [`mcap`]: MCAP logs (logger thread, schemas, reader).
 #![warn(missing_docs)]
 
 pub mod clock;
 pub mod histogram;
 pub mod io;
 pub mod logger;
+pub mod mcap;
 pub mod rt;
 pub mod runner;
 pub mod signal;

@@ -1,0 +1,83 @@
+//! `haptic2d simulate --out FILE.mcap`: the world's samples as an MCAP log (bodies, contacts,
+//! energy, Foxglove scene; no tick channel, there is no haptic loop). Same calls as the world CSV
+//! writer ([`WorldCsv`](crate::csv_out::WorldCsv)), so `cmd_simulate` picks one by extension.
+
+use crate::csv_out::WorldCsv;
+use haptic2d::world::World;
+use haptic2d_rt::mcap::{McapSetup, McapSink, WorldSample};
+use std::collections::BTreeMap;
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::Path;
+
+/// The world output of `simulate`: CSV (docs/CSV.md) or MCAP (docs/LOGS.md).
+pub enum WorldOut {
+    /// `--out FILE.csv` (any extension but `.mcap`).
+    Csv(WorldCsv<BufWriter<File>>),
+    /// `--out FILE.mcap`.
+    Mcap {
+        /// The file being written.
+        sink: Box<McapSink<BufWriter<File>>>,
+        /// The sample being filled, reused.
+        sample: Box<WorldSample>,
+        /// Samples written so far.
+        seq: u64,
+    },
+}
+
+fn other(e: impl std::fmt::Display) -> std::io::Error {
+    std::io::Error::other(e.to_string())
+}
+
+impl WorldOut {
+    /// Creates `path` for `world` (of the scene `scene_arg`, named `scene_name`, at `rate_hz`).
+    pub fn create(
+        path: &Path,
+        world: &World,
+        scene_arg: &str,
+        scene_name: &str,
+    ) -> std::io::Result<Self> {
+        let file = BufWriter::with_capacity(1 << 20, File::create(path)?);
+        if !crate::run_log::is_mcap(path) {
+            return Ok(Self::Csv(WorldCsv::new(file, world)?));
+        }
+        let scene: BTreeMap<String, String> = crate::run_log::scene_strings(
+            scene_arg,
+            scene_name,
+            None,
+            &[
+                ("rate_hz", (1.0 / world.params.dt).to_string()),
+                ("command", "simulate".to_string()),
+            ],
+        );
+        let sink = McapSink::new(file, McapSetup::for_world(world, scene, false)).map_err(other)?;
+        Ok(Self::Mcap {
+            sink: Box::new(sink),
+            sample: Box::default(),
+            seq: 0,
+        })
+    }
+
+    /// Writes the current state of `world` (log_time = round(t · 10⁹) ns).
+    pub fn row(&mut self, world: &World) -> std::io::Result<()> {
+        match self {
+            Self::Csv(c) => c.row(world),
+            Self::Mcap { sink, sample, seq } => {
+                sample.capture(world);
+                let t = world.time().max(0.0);
+                sink.write_world(*seq, (t * 1e9).round() as u64, sample)
+                    .map_err(other)?;
+                *seq += 1;
+                Ok(())
+            }
+        }
+    }
+
+    /// Finishes the file (flush; an MCAP log gets its summary and index).
+    pub fn finish(self) -> std::io::Result<()> {
+        match self {
+            Self::Csv(c) => c.finish(),
+            Self::Mcap { sink, .. } => sink.finish(&[]).map(|_| ()).map_err(other),
+        }
+    }
+}

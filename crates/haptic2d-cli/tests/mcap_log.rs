@@ -1,0 +1,365 @@
+//! MCAP logs (issue 14): `run --log x.mcap` records every tick, read back by our reader and equal
+//! to the CSV log of the same (deterministic) run; Ctrl-C leaves a complete file; CSV ↔ MCAP
+//! conversion is lossless; `--device replay:x.mcap` replays a recording; `simulate --out x.mcap`;
+//! the Foxglove live server serves a loopback client and survives a malformed message.
+
+mod common;
+
+use common::{haptic2d, text};
+use haptic2d_rt::mcap::columns::{TickRow, LOOP_COLUMN_COUNT, TICK_TABLE};
+use haptic2d_rt::mcap::reader::{read_file, read_info, read_ticks};
+use haptic2d_rt::mcap::schemas::*;
+use std::path::Path;
+use std::process::{Command, Stdio};
+use std::time::Duration;
+
+/// "N ticks" of the timing summary.
+fn summary_ticks(out: &str) -> u64 {
+    out.split_whitespace()
+        .collect::<Vec<_>>()
+        .windows(2)
+        .find(|w| w[1] == "ticks")
+        .and_then(|w| w[0].parse().ok())
+        .unwrap_or_else(|| panic!("no tick count in:\n{out}"))
+}
+
+fn run_logged(log: &Path, extra: &[&str]) -> String {
+    let mut args = vec![
+        "run",
+        "--headless",
+        "--no-rt",
+        "--log",
+        log.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    let o = haptic2d(&args);
+    let out = text(&o);
+    assert!(o.status.success(), "{out}");
+    out
+}
+
+fn ticks_of(path: &Path) -> Vec<TickRow> {
+    let bytes = read_file(path).unwrap();
+    read_ticks(&bytes, "test").unwrap().0
+}
+
+/// The CSV row of a tick row's record columns, as the CSV logger writes them.
+fn record_text(row: &TickRow) -> Vec<String> {
+    row[LOOP_COLUMN_COUNT..]
+        .iter()
+        .map(|v| v.expect("record column").to_string())
+        .collect()
+}
+
+fn csv_rows(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
+    let mut r = csv::Reader::from_path(path).unwrap();
+    let h = r.headers().unwrap().iter().map(str::to_string).collect();
+    let rows = r
+        .records()
+        .map(|x| x.unwrap().iter().map(str::to_string).collect())
+        .collect();
+    (h, rows)
+}
+
+#[test]
+fn mcap_log_of_a_2s_run_has_every_tick_and_matches_the_csv_log_of_the_same_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let mcap = dir.path().join("x.mcap");
+    let out = run_logged(&mcap, &["--duration", "2"]);
+    let ticks = summary_ticks(&out);
+    assert!(
+        out.contains(&format!("log: {ticks} ticks written")),
+        "{out}"
+    );
+    let bytes = read_file(&mcap).unwrap();
+    let info = read_info(&bytes, "x.mcap").unwrap();
+    assert!(info.complete, "{info:?}");
+    assert_eq!(info.count(TOPIC_TICK), ticks, "one tick message per tick");
+    for topic in [TOPIC_BODIES, TOPIC_CONTACTS, TOPIC_ENERGY] {
+        assert_eq!(info.count(topic), ticks, "{topic}");
+    }
+    assert_eq!(info.count(TOPIC_SCENE), 1);
+    // SceneUpdates at 60 Hz over ~2 s.
+    let su = info.count(TOPIC_SCENE_UPDATE);
+    assert!((100..=125).contains(&su), "{su} scene updates");
+    for c in &info.channels {
+        assert_eq!(
+            (c.schema_encoding.as_str(), c.message_encoding.as_str()),
+            ("jsonschema", "json")
+        );
+        let s: serde_json::Value = serde_json::from_slice(&c.schema_data)
+            .unwrap_or_else(|e| panic!("schema of {}: {e}", c.topic));
+        assert_eq!(s["type"], "object", "{}", c.topic);
+    }
+    let timing = info.metadata("haptic2d.timing").expect("timing summary");
+    assert_eq!(timing["ticks"], ticks.to_string());
+    let scene = info.metadata("haptic2d.scene").expect("scene metadata");
+    assert!(
+        scene["scene_toml"].contains("[world]") || scene["scene_toml"].contains("[["),
+        "{scene:?}"
+    );
+
+    let rows = ticks_of(&mcap);
+    assert_eq!(rows.len() as u64, ticks);
+    for (k, r) in rows.iter().enumerate() {
+        assert_eq!(
+            r[0].unwrap().as_f64() as usize,
+            k,
+            "tick indices 0, 1, 2, … without a gap"
+        );
+    }
+
+    // The same run logged as CSV: the simulated device and hand make every tick's record depend
+    // only on its index, so the two logs agree on every tick both have.
+    let csv = dir.path().join("x.csv");
+    run_logged(&csv, &["--duration", "2"]);
+    let (header, csv) = csv_rows(&csv);
+    let names: Vec<&str> = TICK_TABLE[LOOP_COLUMN_COUNT..]
+        .iter()
+        .map(|c| c.name)
+        .collect();
+    assert_eq!(header, names);
+    let n = csv.len().min(rows.len());
+    // (A loaded machine skips deadlines, so the two runs may differ in length.)
+    assert!(n > 100, "{n} shared ticks");
+    for k in [0, n - 1] {
+        assert_eq!(record_text(&rows[k]), csv[k], "tick {k}");
+    }
+}
+
+#[test]
+fn sigint_mid_run_leaves_a_complete_readable_mcap() {
+    let dir = tempfile::tempdir().unwrap();
+    let mcap = dir.path().join("int.mcap");
+    let child = Command::new(env!("CARGO_BIN_EXE_haptic2d"))
+        .args([
+            "run",
+            "--headless",
+            "--no-rt",
+            "--log",
+            mcap.to_str().unwrap(),
+        ])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(1500));
+    let st = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(st.success());
+    let o = child.wait_with_output().unwrap();
+    let out = text(&o);
+    assert_eq!(o.status.code(), Some(130), "{out}");
+    let ticks = summary_ticks(&out);
+    let bytes = read_file(&mcap).unwrap();
+    let info = read_info(&bytes, "int.mcap").unwrap();
+    assert!(info.complete, "summary and footer written: {info:?}");
+    assert!(ticks > 100, "{out}");
+    assert_eq!(info.count(TOPIC_TICK), ticks);
+    assert_eq!(
+        info.metadata("haptic2d.timing").unwrap()["ticks"],
+        ticks.to_string()
+    );
+}
+
+#[test]
+fn csv_to_mcap_to_csv_is_lossless_and_mcap_to_csv_keeps_every_tick_column() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b, c) = (
+        dir.path().join("a.csv"),
+        dir.path().join("b.mcap"),
+        dir.path().join("c.csv"),
+    );
+    run_logged(&a, &["--duration", "0.3", "--hand", "sine:0.3,2"]);
+    for (i, o) in [(&a, &b), (&b, &c)] {
+        let r = haptic2d(&["log", "convert", i.to_str().unwrap(), o.to_str().unwrap()]);
+        assert!(r.status.success(), "{}", text(&r));
+    }
+    let (ta, tc) = (
+        std::fs::read_to_string(&a).unwrap(),
+        std::fs::read_to_string(&c).unwrap(),
+    );
+    assert!(ta.lines().count() > 50);
+    assert_eq!(ta, tc, "CSV → MCAP → CSV is the same text");
+
+    // MCAP → CSV → MCAP keeps every tick column of the recording, the loop columns too.
+    let (m, d, e) = (
+        dir.path().join("m.mcap"),
+        dir.path().join("d.csv"),
+        dir.path().join("e.mcap"),
+    );
+    run_logged(&m, &["--duration", "0.3"]);
+    for (i, o) in [(&m, &d), (&d, &e)] {
+        let r = haptic2d(&["log", "convert", i.to_str().unwrap(), o.to_str().unwrap()]);
+        assert!(r.status.success(), "{}", text(&r));
+    }
+    let (rm, re) = (ticks_of(&m), ticks_of(&e));
+    assert_eq!(rm.len(), re.len());
+    for (x, y) in rm.iter().zip(&re) {
+        let sx: Vec<String> = x.iter().map(|v| v.unwrap().to_string()).collect();
+        let sy: Vec<String> = y.iter().map(|v| v.unwrap().to_string()).collect();
+        assert_eq!(sx, sy);
+    }
+    let bad = haptic2d(&["log", "convert", a.to_str().unwrap(), c.to_str().unwrap()]);
+    assert_eq!(bad.status.code(), Some(2), "{}", text(&bad));
+    assert!(text(&bad).contains("one of the two must end in .mcap"));
+}
+
+#[test]
+fn log_info_prints_channels_counts_duration_and_the_timing_summary() {
+    let dir = tempfile::tempdir().unwrap();
+    let m = dir.path().join("run.mcap");
+    let out = run_logged(&m, &["--duration", "0.5"]);
+    let ticks = summary_ticks(&out);
+    let o = haptic2d(&["log", "info", m.to_str().unwrap()]);
+    let t = text(&o);
+    assert!(o.status.success(), "{t}");
+    assert!(t.contains("complete (summary and index written)"), "{t}");
+    let line = t
+        .lines()
+        .find(|l| l.trim_start().starts_with(TOPIC_TICK))
+        .expect("tick channel");
+    assert!(line.contains(&format!("{ticks} messages")), "{line}");
+    assert!(t.contains("timing: achieved"), "{t}");
+    assert!(t.contains("scene: box-in-walls"), "{t}");
+    let bad = dir.path().join("bad.mcap");
+    std::fs::write(&bad, "not an mcap").unwrap();
+    let o = haptic2d(&["log", "info", bad.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o).contains("is not an MCAP file"), "{}", text(&o));
+}
+
+#[test]
+fn replay_of_an_mcap_recording_reproduces_its_device_motion() {
+    let dir = tempfile::tempdir().unwrap();
+    let (rec, rep) = (dir.path().join("rec.mcap"), dir.path().join("rep.mcap"));
+    run_logged(&rec, &["--duration", "0.5", "--hand", "sine:0.3,2"]);
+    let out = run_logged(&rep, &["--device", &format!("replay:{}", rec.display())]);
+    assert!(out.contains("the replay ended"), "{out}");
+    let (a, b) = (ticks_of(&rec), ticks_of(&rep));
+    assert_eq!(a.len(), b.len(), "one replayed tick per recorded tick");
+    // Same encoder angles in → same device pose (forward kinematics) out, every tick.
+    for (k, (x, y)) in a.iter().zip(&b).enumerate() {
+        for col in 3..11 {
+            assert_eq!(x[col], y[col], "tick {k}, {}", TICK_TABLE[col].name);
+        }
+    }
+}
+
+#[test]
+fn simulate_out_mcap_writes_every_sample_of_the_world() {
+    let dir = tempfile::tempdir().unwrap();
+    let m = dir.path().join("sim.mcap");
+    let o = haptic2d(&[
+        "simulate",
+        "box-in-walls",
+        "--duration",
+        "0.5",
+        "--out",
+        m.to_str().unwrap(),
+    ]);
+    let out = text(&o);
+    assert!(o.status.success(), "{out}");
+    let samples: u64 = out
+        .split_whitespace()
+        .collect::<Vec<_>>()
+        .windows(2)
+        .find(|w| w[1] == "samples")
+        .and_then(|w| w[0].parse().ok())
+        .unwrap_or_else(|| panic!("no sample count in {out}"));
+    assert!(samples > 100, "{out}");
+    let bytes = read_file(&m).unwrap();
+    let info = read_info(&bytes, "sim.mcap").unwrap();
+    assert!(info.complete);
+    assert_eq!(info.count(TOPIC_TICK), 0);
+    // Every sample plus the t = 0 row.
+    for topic in [TOPIC_BODIES, TOPIC_CONTACTS, TOPIC_ENERGY] {
+        assert_eq!(info.count(topic), samples + 1, "{topic}");
+    }
+}
+
+#[test]
+fn foxglove_live_server_serves_a_loopback_client_and_survives_a_malformed_message() {
+    use std::io::{BufRead, BufReader};
+    use tungstenite::client::IntoClientRequest;
+    use tungstenite::Message;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_haptic2d"))
+        .args([
+            "run",
+            "--headless",
+            "--no-rt",
+            "--duration",
+            "20",
+            "--foxglove",
+            "127.0.0.1:0",
+        ])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::inherit())
+        .spawn()
+        .unwrap();
+    let mut lines = BufReader::new(child.stdout.take().unwrap()).lines();
+    let addr = loop {
+        let l = lines.next().expect("a banner").unwrap();
+        if let Some(a) = l.split_whitespace().find_map(|w| w.strip_prefix("ws://")) {
+            break a.to_string();
+        }
+    };
+    let mut req = format!("ws://{addr}").into_client_request().unwrap();
+    req.headers_mut().insert(
+        "Sec-WebSocket-Protocol",
+        "foxglove.websocket.v1".parse().unwrap(),
+    );
+    let stream = std::net::TcpStream::connect(&addr).unwrap();
+    stream
+        .set_read_timeout(Some(Duration::from_secs(10)))
+        .unwrap();
+    let (mut ws, resp) = tungstenite::client(req, stream).unwrap();
+    assert_eq!(
+        resp.headers()["Sec-WebSocket-Protocol"],
+        "foxglove.websocket.v1"
+    );
+    let text_msg = |ws: &mut tungstenite::WebSocket<std::net::TcpStream>| loop {
+        if let Message::Text(t) = ws.read().unwrap() {
+            break serde_json::from_str::<serde_json::Value>(t.as_str()).unwrap();
+        }
+    };
+    assert_eq!(text_msg(&mut ws)["op"], "serverInfo");
+    let adv = text_msg(&mut ws);
+    assert_eq!(adv["op"], "advertise");
+    let tick_ch = adv["channels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["topic"] == TOPIC_TICK)
+        .expect("tick channel advertised")["id"]
+        .clone();
+    // A malformed message gets a status reply; the server and the loop go on.
+    ws.send(Message::text("{this is not json")).unwrap();
+    let st = text_msg(&mut ws);
+    assert_eq!(st["op"], "status", "{st}");
+    ws.send(Message::text(
+        serde_json::json!({"op": "subscribe", "subscriptions": [{"id": 7, "channelId": tick_ch}]})
+            .to_string(),
+    ))
+    .unwrap();
+    let mut indices = Vec::new();
+    while indices.len() < 10 {
+        if let Message::Binary(b) = ws.read().unwrap() {
+            assert_eq!(b[0], 1, "message data opcode");
+            assert_eq!(u32::from_le_bytes(b[1..5].try_into().unwrap()), 7);
+            let v: serde_json::Value = serde_json::from_slice(&b[13..]).unwrap();
+            indices.push(v["index"].as_u64().unwrap());
+        }
+    }
+    assert!(indices.windows(2).all(|w| w[1] > w[0]), "{indices:?}");
+    // About 60 frames per second of a 1 kHz loop: consecutive frames ~16 ticks apart.
+    let gap = (indices[9] - indices[1]) as f64 / 8.0;
+    assert!((8.0..40.0).contains(&gap), "{indices:?}");
+    let _ = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status();
+    let st = child.wait().unwrap();
+    assert_eq!(st.code(), Some(130));
+}

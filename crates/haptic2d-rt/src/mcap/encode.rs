@@ -1,0 +1,216 @@
+//! JSON encoders of the channels' messages, into a caller's reused buffer (appending). Shared by
+//! the MCAP writer and the Foxglove live server, so a live view and a recording carry the same
+//! bytes. Floats: [`write_json_f64`].
+
+use crate::mcap::columns::{tick_row, write_json_f64, write_key, write_row_members, TickRow};
+use crate::mcap::record::{LoggedTick, WorldSample};
+use crate::mcap::writer::BodyGeom;
+use std::io::Write;
+
+/// Scale of the contact-force lines drawn in the `SceneUpdate` (m per N): 1 N draws 1 mm.
+pub const FORCE_LINE_M_PER_N: f64 = 1e-3;
+
+/// Writes a `/haptic2d/tick` message of the present cells of `row`.
+pub fn encode_tick_row(b: &mut Vec<u8>, row: &TickRow) -> std::io::Result<()> {
+    b.push(b'{');
+    write_row_members(b, row, true)?;
+    b.push(b'}');
+    Ok(())
+}
+
+/// Writes the `/haptic2d/tick` message of `t`.
+pub fn encode_tick(b: &mut Vec<u8>, t: &LoggedTick) -> std::io::Result<()> {
+    encode_tick_row(
+        b,
+        &tick_row(t.index, t.deadline_ns, t.lateness_ns, &t.q, &t.rec),
+    )
+}
+
+/// Writes a `/haptic2d/bodies` message (`names`: the bodies' names as JSON strings).
+pub fn encode_bodies(b: &mut Vec<u8>, names: &[String], s: &WorldSample) -> std::io::Result<()> {
+    b.extend_from_slice(b"{\"t\":");
+    write_json_f64(b, s.t)?;
+    write!(b, ",\"count\":{},\"bodies\":[", s.body_count)?;
+    for (i, body) in s.bodies().iter().enumerate() {
+        if i > 0 {
+            b.push(b',');
+        }
+        match names.get(i) {
+            Some(n) => write!(b, "{{\"name\":{n}")?,
+            None => write!(b, "{{\"name\":\"body{i}\"")?,
+        }
+        for (k, v) in ["x", "y", "theta"].iter().zip(body.pose) {
+            b.push(b',');
+            write_key(b, k)?;
+            write_json_f64(b, v)?;
+        }
+        for (k, v) in ["vx", "vy", "omega"].iter().zip(body.twist) {
+            b.push(b',');
+            write_key(b, k)?;
+            write_json_f64(b, v)?;
+        }
+        b.push(b'}');
+    }
+    b.extend_from_slice(b"]}");
+    Ok(())
+}
+
+/// Writes a `/haptic2d/contacts` message (`names`: the bodies' names as JSON strings).
+pub fn encode_contacts(b: &mut Vec<u8>, names: &[String], s: &WorldSample) -> std::io::Result<()> {
+    let name = |i: u32| {
+        names
+            .get(i as usize)
+            .cloned()
+            .unwrap_or_else(|| format!("\"body{i}\""))
+    };
+    b.extend_from_slice(b"{\"t\":");
+    write_json_f64(b, s.t)?;
+    write!(b, ",\"count\":{},\"contacts\":[", s.contact_count)?;
+    for (i, c) in s.contacts().iter().enumerate() {
+        if i > 0 {
+            b.push(b',');
+        }
+        write!(
+            b,
+            "{{\"body_a\":{},\"body_b\":{},\"state\":\"{}\"",
+            name(c.body_a),
+            name(c.body_b),
+            if c.colliding {
+                "colliding"
+            } else {
+                "continuous"
+            }
+        )?;
+        for (k, v) in [
+            ("x", c.point[0]),
+            ("y", c.point[1]),
+            ("nx", c.normal[0]),
+            ("ny", c.normal[1]),
+            ("penetration", c.penetration),
+            ("f_n", c.f_n),
+            ("f_t", c.f_t),
+            ("slip", c.slip),
+        ] {
+            b.push(b',');
+            write_key(b, k)?;
+            write_json_f64(b, v)?;
+        }
+        b.push(b'}');
+    }
+    b.extend_from_slice(b"]}");
+    Ok(())
+}
+
+/// Writes a `/haptic2d/energy` message.
+pub fn encode_energy(b: &mut Vec<u8>, s: &WorldSample) -> std::io::Result<()> {
+    let l = &s.ledger;
+    b.extend_from_slice(b"{\"t\":");
+    write_json_f64(b, s.t)?;
+    for (k, v) in [
+        ("kinetic", l.kinetic),
+        ("stored", l.stored),
+        ("applied_work", l.applied_work),
+        ("initial", l.initial),
+        ("impact_loss", l.impact_loss),
+        ("excess", l.excess()),
+    ] {
+        b.push(b',');
+        write_key(b, k)?;
+        write_json_f64(b, v)?;
+    }
+    b.push(b'}');
+    Ok(())
+}
+
+/// Writes a Foxglove `SceneUpdate` (JSON): one entity per body (its outlines as `LINE_LOOP`s, posed
+/// at the body's pose; dynamic bodies blue, fixed grey) and one `contacts` entity with a line per
+/// contact along the normal, `f_n · FORCE_LINE_M_PER_N` long. Planar: z = 0, rotation about z.
+pub fn encode_scene_update<B: Write>(
+    b: &mut B,
+    geom: &[BodyGeom],
+    names: &[String],
+    s: &WorldSample,
+    log_time: u64,
+) -> std::io::Result<()> {
+    let (sec, nsec) = (log_time / 1_000_000_000, log_time % 1_000_000_000);
+    let empty = "\"arrows\":[],\"cubes\":[],\"spheres\":[],\"cylinders\":[],\"triangles\":[],\"texts\":[],\"models\":[]";
+    b.write_all(b"{\"deletions\":[],\"entities\":[")?;
+    let mut first = true;
+    for (i, body) in s.bodies().iter().enumerate() {
+        let Some(g) = geom.get(i) else { continue };
+        if !first {
+            b.write_all(b",")?;
+        }
+        first = false;
+        let name = names.get(i).map_or("\"?\"", |n| n.as_str());
+        // Rotation by θ about z as a unit quaternion: (0, 0, sin(θ/2), cos(θ/2)).
+        let half = 0.5 * body.pose[2];
+        let (qz, qw) = (half.sin(), half.cos());
+        write!(
+            b,
+            "{{\"timestamp\":{{\"sec\":{sec},\"nsec\":{nsec}}},\"frame_id\":\"world\",\"id\":{name},\"lifetime\":{{\"sec\":0,\"nsec\":0}},\"frame_locked\":false,\"metadata\":[],{empty},\"lines\":["
+        )?;
+        let color = if g.dynamic {
+            "{\"r\":0.2,\"g\":0.45,\"b\":0.9,\"a\":1}"
+        } else {
+            "{\"r\":0.55,\"g\":0.55,\"b\":0.55,\"a\":1}"
+        };
+        for (k, outline) in g.outlines.iter().enumerate() {
+            if k > 0 {
+                b.write_all(b",")?;
+            }
+            b.write_all(b"{\"type\":1,\"pose\":{\"position\":{\"x\":")?;
+            write_json_f64(b, body.pose[0])?;
+            b.write_all(b",\"y\":")?;
+            write_json_f64(b, body.pose[1])?;
+            b.write_all(b",\"z\":0},\"orientation\":{\"x\":0,\"y\":0,\"z\":")?;
+            write_json_f64(b, qz)?;
+            b.write_all(b",\"w\":")?;
+            write_json_f64(b, qw)?;
+            b.write_all(b"}},\"thickness\":0.002,\"scale_invariant\":false,\"points\":[")?;
+            for (j, p) in outline.iter().enumerate() {
+                if j > 0 {
+                    b.write_all(b",")?;
+                }
+                b.write_all(b"{\"x\":")?;
+                write_json_f64(b, p[0])?;
+                b.write_all(b",\"y\":")?;
+                write_json_f64(b, p[1])?;
+                b.write_all(b",\"z\":0}")?;
+            }
+            write!(b, "],\"color\":{color},\"colors\":[],\"indices\":[]}}")?;
+        }
+        b.write_all(b"]}")?;
+    }
+    if !first {
+        b.write_all(b",")?;
+    }
+    write!(
+        b,
+        "{{\"timestamp\":{{\"sec\":{sec},\"nsec\":{nsec}}},\"frame_id\":\"world\",\"id\":\"contacts\",\"lifetime\":{{\"sec\":0,\"nsec\":0}},\"frame_locked\":false,\"metadata\":[],{empty},\"lines\":[{{\"type\":2,\"pose\":{{\"position\":{{\"x\":0,\"y\":0,\"z\":0}},\"orientation\":{{\"x\":0,\"y\":0,\"z\":0,\"w\":1}}}},\"thickness\":0.002,\"scale_invariant\":false,\"points\":["
+    )?;
+    for (j, c) in s.contacts().iter().enumerate() {
+        if j > 0 {
+            b.write_all(b",")?;
+        }
+        let len = c.f_n * FORCE_LINE_M_PER_N;
+        let tip = [
+            c.point[0] + c.normal[0] * len,
+            c.point[1] + c.normal[1] * len,
+        ];
+        for (k, p) in [c.point, tip].iter().enumerate() {
+            if k > 0 {
+                b.write_all(b",")?;
+            }
+            b.write_all(b"{\"x\":")?;
+            write_json_f64(b, p[0])?;
+            b.write_all(b",\"y\":")?;
+            write_json_f64(b, p[1])?;
+            b.write_all(b",\"z\":0}")?;
+        }
+    }
+    b.write_all(
+        b"],\"color\":{\"r\":0.9,\"g\":0.2,\"b\":0.2,\"a\":1},\"colors\":[],\"indices\":[]}]}]}",
+    )?;
+    Ok(())
+}

@@ -1,0 +1,27 @@
+//! MCAP logs of the haptic loop and the world (issue 14; channels and schemas: docs/LOGS.md).
+//!
+//! - [`columns`]: the one table of tick columns with units (CSV header, JSON Schema, JSON rows);
+//! - [`record`]: [`LoggedTick`], the fixed-size record the loop pushes into the telemetry ring;
+//! - [`encode`]: the JSON encoders of the messages (shared with the Foxglove live server);
+//! - [`schemas`]: topics and JSON Schemas of the other channels (Foxglove `SceneUpdate` included);
+//! - [`writer`]: [`McapSink`], an MCAP file being written;
+//! - [`logger`]: [`McapLogger`], the logger thread draining the ring into a sink;
+//! - [`reader`]: reading logs back (info, tick rows, encoder angles for a replay);
+//! - [`replay`]: [`McapReplay`], `--device replay:FILE.mcap`.
+
+pub mod columns;
+pub mod encode;
+pub mod logger;
+pub mod reader;
+pub mod record;
+pub mod replay;
+pub mod schemas;
+pub mod writer;
+
+pub use logger::{McapLogger, McapReport};
+pub use record::{LoggedTick, WorldSample};
+pub use replay::McapReplay;
+pub use writer::{McapSetup, McapSink, McapStats};
+
+/// An MCAP metadata record (name and string map), re-exported from the `mcap` crate.
+pub use ::mcap::records::Metadata;
