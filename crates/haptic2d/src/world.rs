@@ -93,6 +93,8 @@ pub struct World {
     vel_before: Vec<(Vec2, f64)>,
     /// Force and torque the passivity guard integrates, per body (pre-integration velocity).
     guard_force: Vec<Wrench2>,
+    /// Point-motion bound of each body over this sample (m), for the swept test.
+    motion: Vec<f64>,
     /// Fraction of the sample each body keeps after the swept test (1 = all of it).
     put_back: Vec<f64>,
     /// Scratch of the swept test.
@@ -170,6 +172,7 @@ impl World {
             global_poses,
             vel_before: vec![(Vec2::ZERO, 0.0); n],
             guard_force: vec![Wrench2::default(); n],
+            motion: vec![0.0; n],
             put_back: vec![1.0; n],
             sweep: SweepScratch::with_capacity(max_vertices),
             swept_hits: 0,
@@ -409,11 +412,11 @@ impl World {
     fn sweep_fast_bodies(&mut self) {
         let dc = self.params.delta_c;
         let mut max_motion = 0.0f64;
-        for ((b, p), &r) in self.bodies.iter().zip(&self.prev).zip(&self.radius) {
-            if b.is_dynamic() {
-                let m = (b.pose.pos - p.pos).length() + (b.pose.angle - p.angle).abs() * r;
-                max_motion = max_motion.max(m);
-            }
+        for (i, b) in self.bodies.iter().enumerate() {
+            let p = self.prev[i];
+            let m = (b.pose.pos - p.pos).length() + (b.pose.angle - p.angle).abs() * self.radius[i];
+            self.motion[i] = if b.is_dynamic() { m } else { 0.0 };
+            max_motion = max_motion.max(self.motion[i]);
         }
         if 2.0 * max_motion <= allowed_depth(dc, self.thinnest, self.thinnest) {
             return;
@@ -431,6 +434,17 @@ impl World {
                 end: self.bodies[i].pose,
                 radius: self.radius[i],
             };
+            // Swept boxes apart: the start AABBs (this sample's colliders), each grown by its
+            // body's motion, do not overlap, so the pair cannot touch during the sample.
+            let (ba, bb) = (&self.colliders[ca].aabb, &self.colliders[cb].aabb);
+            let grow = self.motion[ia] + self.motion[ib];
+            if ba.min.x - bb.max.x > grow
+                || bb.min.x - ba.max.x > grow
+                || ba.min.y - bb.max.y > grow
+                || bb.min.y - ba.max.y > grow
+            {
+                continue;
+            }
             let allowed = allowed_depth(dc, self.thickness[ca], self.thickness[cb]);
             if let Some(l) = swept_put_back(&side(ca, ia), &side(cb, ib), allowed, &mut self.sweep)
             {

@@ -17,7 +17,8 @@
 //! Poses move linearly over the sample, `p(λ) = p_0 + λ·Δp`, `θ(λ) = θ_0 + λ·Δθ`, `λ ∈ [0, 1]`.
 //! A body point `c + R(θ)·r` then moves at most `M_i = |Δp_i| + |Δθ_i|·ρ_i` per sample (`ρ_i` the
 //! largest vertex radius about the centre of mass), so the distance of a pair shrinks at most at
-//! `M = M_a + M_b` per unit `λ`, and so does the pair's separating-axis depth `D(λ)` (the
+//! `M = M_a + M_b` per unit `λ` (the relative bound [`pair_motion`] is used: a common translation
+//! changes nothing), and so does the pair's separating-axis depth `D(λ)` (the
 //! penetration depth of two convex polygons: moving every point by at most `δ` changes it by at
 //! most `δ`). For a pair with `M > a` ([`allowed_depth`] `a`), `D` is sampled at `λ_j = j/n`,
 //! `n = ⌈2M/a⌉` (steps of at most `a/2` of motion, so no passage through a part thicker than
@@ -112,6 +113,17 @@ impl SweptShape<'_> {
     }
 }
 
+/// Bound on the motion of any point of `a` relative to `b` over the sample (m): the depth of a
+/// pair does not change under a common translation, so only the relative translation counts,
+/// `|Δp_a − Δp_b| + |Δθ_a|·ρ_a + |Δθ_b|·ρ_b` (two boxes falling side by side move 0 relative to
+/// each other and need no swept test).
+#[inline]
+pub fn pair_motion(a: &SweptShape, b: &SweptShape) -> f64 {
+    ((a.end.pos - a.start.pos) - (b.end.pos - b.start.pos)).length()
+        + (a.end.angle - a.start.angle).abs() * a.radius
+        + (b.end.angle - b.start.angle).abs() * b.radius
+}
+
 /// Scratch buffers of the swept test (world-frame vertices and normals), so it never allocates
 /// once they have grown to the largest polygon.
 #[derive(Clone, Debug, Default)]
@@ -175,7 +187,7 @@ pub fn swept_put_back(
     allowed: f64,
     scratch: &mut SweepScratch,
 ) -> Option<f64> {
-    let m = a.motion() + b.motion();
+    let m = pair_motion(a, b);
     if !(m > allowed && allowed > 0.0 && m.is_finite()) {
         // It cannot gain more than its motion.
         return None;
