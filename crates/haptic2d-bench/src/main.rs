@@ -1,10 +1,14 @@
-//! `haptic2d-bench`: haptic2d against rapier2d-f64 on the same scenes, in one process.
+//! `haptic2d-bench`: haptic2d against rapier2d-f64 and Box2D v3 (`boxdd`, 4 and 1 substeps) on the
+//! same scenes, in one process.
 //!
 //! ```text
-//! cargo run --release -p haptic2d-bench -- [--steps 2000] [--warmup 1000] [--scenes pile,sliding]
+//! cargo run --release -p haptic2d-bench -- [--quick] [--steps 2000] [--warmup 1000] [--scenes pile,sliding] [--pile 10,100]
+//! cargo run --release -p haptic2d-bench --features box2d-avx2 -- ...   # Box2D's AVX2 build
 //! ```
 //!
-//! Prints a table of median and p99 step times per engine and their ratio (haptic2d / rapier2d), and
+//! Prints a table of median and p99 step times per engine and their ratios (haptic2d / engine), the
+//! settle state of every engine after the run (largest speed, bodies above 1 cm/s, mean height,
+//! largest overlap), and
 //! writes `target/bench/compare.json` and `target/bench/compare.svg` (step time vs N for the pile).
 //!
 //! **Not apples to apples.** haptic2d is a haptic simulator: penalty (spring–damper) contacts per
@@ -14,14 +18,16 @@
 //! trajectories. What is identical is the scene: geometry, masses and inertias, initial state, constant
 //! loads (gravity as a body force, the 2 N push), time step (1 ms), number of steps, friction
 //! coefficient (μ_s) and restitution; rapier sleeping is disabled because haptic2d never sleeps. See
-//! `rapier_world.rs` for the details, and the sanity columns of the table (largest speed and mean
-//! height after the run) to check that both engines hold the same scene at rest.
+//! `rapier_world.rs` for the details, and the settle table (largest speed, moving bodies, mean height and
+//! overlap after the run) to check that the engines hold the same scene at rest. Box2D: `box2d_world.rs`.
 
 #![warn(missing_docs)]
 
+mod box2d_world;
 mod rapier_world;
 mod report;
 mod scenes;
+mod state;
 mod timing;
 
 use clap::Parser;
@@ -31,7 +37,7 @@ use std::path::PathBuf;
 #[derive(Parser, Debug)]
 #[command(
     name = "haptic2d-bench",
-    about = "haptic2d vs rapier2d-f64 step times on the same scenes"
+    about = "haptic2d vs rapier2d-f64 and Box2D v3 step times on the same scenes"
 )]
 struct Args {
     /// Timed steps per engine and scene (1 ms each).
@@ -43,12 +49,15 @@ struct Args {
     /// Steps per interleaved chunk (engines alternate every chunk).
     #[arg(long, default_value_t = 50)]
     chunk: usize,
-    /// Comma-separated scene filters (substrings of: pile, box-in-walls, sliding); all when absent.
+    /// Comma-separated scene filters (substrings of: pile, box-in-walls, sliding, pyramid); all when absent.
     #[arg(long, value_delimiter = ',')]
     scenes: Vec<String>,
     /// Comma-separated pile sizes N.
-    #[arg(long, value_delimiter = ',', default_values_t = [10usize, 100, 1000])]
+    #[arg(long, value_delimiter = ',', default_values_t = [10usize, 100, 1000, 5000])]
     pile: Vec<usize>,
+    /// Quick run: piles 10 and 100 only, 500 warm-up and 1000 timed steps (overrides those options).
+    #[arg(long)]
+    quick: bool,
     /// Output folder for compare.json and compare.svg (default: <workspace>/target/bench).
     #[arg(long)]
     out: Option<PathBuf>,
@@ -72,6 +81,20 @@ fn out_dir(args: &Args) -> PathBuf {
 }
 
 fn run(args: &Args) -> Result<(), String> {
+    let quick;
+    let args = if args.quick {
+        quick = Args {
+            steps: 1000,
+            warmup: 500,
+            pile: vec![10, 100],
+            scenes: args.scenes.clone(),
+            out: args.out.clone(),
+            ..*args
+        };
+        &quick
+    } else {
+        args
+    };
     if args.steps == 0 {
         return Err("--steps must be at least 1".into());
     }
@@ -81,12 +104,13 @@ fn run(args: &Args) -> Result<(), String> {
     let cases = scenes::cases(&args.pile, &args.scenes)?;
     if cases.is_empty() {
         return Err(format!(
-            "--scenes {:?} matches none of: pile, box-in-walls, sliding",
+            "--scenes {:?} matches none of: pile, box-in-walls, sliding, pyramid",
             args.scenes
         ));
     }
     let mut rows = Vec::new();
     for case in cases {
+        let label = format!("{} n={}", case.scene, case.n);
         let mut h = case.haptic.world;
         let mut r = rapier_world::twin(
             &h,
@@ -94,33 +118,75 @@ fn run(args: &Args) -> Result<(), String> {
             case.rapier_friction,
             case.rapier_restitution,
         )
-        .map_err(|e| format!("{} n={}: {e}", case.scene, case.n))?;
+        .map_err(|e| format!("{label}: {e}"))?;
+        let mut b4 = box2d_world::twin(
+            &h,
+            scenes::DT,
+            4,
+            case.rapier_friction,
+            case.rapier_restitution,
+        )
+        .map_err(|e| format!("{label}: {e}"))?;
+        let mut b1 = box2d_world::twin(
+            &h,
+            scenes::DT,
+            1,
+            case.rapier_friction,
+            case.rapier_restitution,
+        )
+        .map_err(|e| format!("{label}: {e}"))?;
         eprintln!(
-            "{} n={}: {} warm-up + {} timed steps per engine ...",
-            case.scene, case.n, args.warmup, args.steps
-        );
-        let (th, tr) = timing::interleaved(
+            "{label}: {} warm-up + {} timed steps per engine (4 engines, box2d build {}) ...",
             args.warmup,
             args.steps,
-            args.chunk,
-            || h.step(),
-            || r.step(),
+            box2d_world::BUILD
         );
-        let dyn_bodies = || h.bodies.iter().filter(|b| b.is_dynamic());
-        let n_dyn = dyn_bodies().count().max(1) as f64;
-        let haptic_state = (
-            dyn_bodies().map(|b| b.vel.length()).fold(0.0, f64::max),
-            dyn_bodies().map(|b| b.pose.pos.y).sum::<f64>() / n_dyn,
-        );
+        let samples = {
+            let (mut fh, mut fr, mut f4, mut f1) =
+                (|| h.step(), || r.step(), || b4.step(), || b1.step());
+            timing::interleaved(
+                args.warmup,
+                args.steps,
+                args.chunk,
+                &mut [&mut fh, &mut fr, &mut f4, &mut f1],
+            )
+        };
+        let haptic_poses: Vec<_> = h
+            .bodies
+            .iter()
+            .map(|b| (b.pose.pos, b.pose.angle, b.vel))
+            .collect();
+        let box2d = if box2d_world::BUILD == "avx2" {
+            "box2d_avx2"
+        } else {
+            "box2d"
+        };
+        let keys = [
+            "haptic2d".to_string(),
+            "rapier2d".to_string(),
+            box2d.to_string(),
+            format!("{box2d}_1sub"),
+        ];
+        let states = [
+            state::of(&h, &haptic_poses),
+            state::of(&h, &r.poses()),
+            state::of(&h, &b4.poses()),
+            state::of(&h, &b1.poses()),
+        ];
+        let engines = keys
+            .into_iter()
+            .zip(samples.iter().zip(states))
+            .map(|(key, (t, state))| report::EngineResult {
+                key,
+                median_us: t.median(),
+                p99_us: t.p99(),
+                state,
+            })
+            .collect();
         rows.push(report::Row {
             scene: case.scene.to_string(),
             n: case.n,
-            haptic_median_us: th.median(),
-            haptic_p99_us: th.p99(),
-            rapier_median_us: tr.median(),
-            rapier_p99_us: tr.p99(),
-            haptic_state,
-            rapier_state: (r.max_speed(), r.mean_height()),
+            engines,
         });
     }
     print!("{}", report::table(&rows));

@@ -25,6 +25,8 @@ use rapier2d_f64::prelude::{
 pub struct RapierTwin {
     /// The rapier state.
     pub world: PhysicsWorld,
+    /// Rapier body of every haptic2d body (same index).
+    handles: Vec<RigidBodyHandle>,
 }
 
 impl RapierTwin {
@@ -34,24 +36,15 @@ impl RapierTwin {
         self.world.step();
     }
 
-    /// Largest speed of any dynamic body (m/s), for the sanity line of the report.
-    pub fn max_speed(&self) -> f64 {
-        self.world
-            .bodies
+    /// (position m, angle rad, velocity m/s) of every body, in haptic2d body order.
+    pub fn poses(&self) -> Vec<(Vec2, f64, Vec2)> {
+        self.handles
             .iter()
-            .filter(|(_, b)| b.is_dynamic())
-            .map(|(_, b)| b.linvel().length())
-            .fold(0.0, f64::max)
-    }
-
-    /// Mean height of the dynamic bodies' centres (m).
-    pub fn mean_height(&self) -> f64 {
-        let (mut s, mut n) = (0.0, 0usize);
-        for (_, b) in self.world.bodies.iter().filter(|(_, b)| b.is_dynamic()) {
-            s += b.translation().y;
-            n += 1;
-        }
-        s / n.max(1) as f64
+            .map(|&h| {
+                let b = &self.world.bodies[h];
+                (b.translation(), b.rotation().angle(), b.linvel())
+            })
+            .collect()
     }
 }
 
@@ -116,5 +109,5 @@ pub fn twin(w: &World, dt: f64, mu: f64, e: f64) -> Result<RapierTwin, String> {
         rb.add_force(f, true);
         rb.add_torque(tau, true);
     }
-    Ok(RapierTwin { world })
+    Ok(RapierTwin { world, handles })
 }

@@ -4,66 +4,86 @@ use plotters::prelude::*;
 use std::fmt::Write as _;
 use std::path::Path;
 
-/// One line of the comparison.
+use crate::state::State;
+
+/// One engine's result on one case.
+pub struct EngineResult {
+    /// JSON key prefix and table label (`haptic2d`, `rapier2d`, `box2d`, `box2d_1sub`, `box2d_avx2`, ...).
+    pub key: String,
+    /// Median step time (µs).
+    pub median_us: f64,
+    /// 99th-percentile step time (µs).
+    pub p99_us: f64,
+    /// Settle state after the run.
+    pub state: State,
+}
+
+/// One line of the comparison: haptic2d first, then the other engines.
 pub struct Row {
     /// Scene label.
     pub scene: String,
     /// Number of dynamic bodies.
     pub n: usize,
-    /// haptic2d median step time (µs).
-    pub haptic_median_us: f64,
-    /// haptic2d 99th-percentile step time (µs).
-    pub haptic_p99_us: f64,
-    /// rapier2d median step time (µs).
-    pub rapier_median_us: f64,
-    /// rapier2d 99th-percentile step time (µs).
-    pub rapier_p99_us: f64,
-    /// Sanity check after the run, haptic2d: (largest body speed m/s, mean centre height m).
-    pub haptic_state: (f64, f64),
-    /// The same for rapier2d.
-    pub rapier_state: (f64, f64),
+    /// Results, haptic2d at index 0.
+    pub engines: Vec<EngineResult>,
 }
 
 impl Row {
-    /// haptic2d median / rapier2d median.
-    pub fn ratio(&self) -> f64 {
-        self.haptic_median_us / self.rapier_median_us
+    /// haptic2d median / engine `k`'s median.
+    pub fn ratio(&self, k: usize) -> f64 {
+        self.engines[0].median_us / self.engines[k].median_us
+    }
+    /// haptic2d p99 / engine `k`'s p99.
+    pub fn ratio_p99(&self, k: usize) -> f64 {
+        self.engines[0].p99_us / self.engines[k].p99_us
     }
 }
 
-/// The table printed to stdout.
+/// The tables printed to stdout: step times with ratios (haptic2d / engine, median and p99), then the
+/// settle state after the run.
 pub fn table(rows: &[Row]) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "{:<14} {:>5} | {:>12} {:>12} | {:>12} {:>12} | {:>6} | {:>21} | {:>21}",
-        "scene",
-        "n",
-        "haptic2d med",
-        "haptic2d p99",
-        "rapier2d med",
-        "rapier2d p99",
-        "ratio",
-        "haptic2d |v|max, ȳ",
-        "rapier2d |v|max, ȳ"
+        "{:<13} {:>5} | {:<15} {:>10} {:>10} | {:>7} {:>7}",
+        "scene", "n", "engine", "median µs", "p99 µs", "ratio", "p99 rat"
     );
-    let _ = writeln!(s, "{}", "-".repeat(140));
+    let _ = writeln!(s, "{}", "-".repeat(78));
     for r in rows {
-        let _ = writeln!(
-            s,
-            "{:<14} {:>5} | {:>9.2} µs {:>9.2} µs | {:>9.2} µs {:>9.2} µs | {:>6.3} | {:>8.4} m/s {:>6.3} m | {:>8.4} m/s {:>6.3} m",
-            r.scene,
-            r.n,
-            r.haptic_median_us,
-            r.haptic_p99_us,
-            r.rapier_median_us,
-            r.rapier_p99_us,
-            r.ratio(),
-            r.haptic_state.0,
-            r.haptic_state.1,
-            r.rapier_state.0,
-            r.rapier_state.1
-        );
+        for (k, e) in r.engines.iter().enumerate() {
+            let _ = writeln!(
+                s,
+                "{:<13} {:>5} | {:<15} {:>10.2} {:>10.2} | {:>7.3} {:>7.3}",
+                r.scene,
+                r.n,
+                e.key,
+                e.median_us,
+                e.p99_us,
+                r.ratio(k),
+                r.ratio_p99(k)
+            );
+        }
+    }
+    let _ = writeln!(
+        s,
+        "\n{:<13} {:>5} | {:<15} {:>10} {:>8} {:>8} {:>11}",
+        "scene", "n", "engine", "|v|max m/s", ">1cm/s", "ȳ m", "overlap mm"
+    );
+    let _ = writeln!(s, "{}", "-".repeat(80));
+    for r in rows {
+        for e in &r.engines {
+            let _ = writeln!(
+                s,
+                "{:<13} {:>5} | {:<15} {:>10.4} {:>8} {:>8.4} {:>11.3}",
+                r.scene,
+                r.n,
+                e.key,
+                e.state.max_speed,
+                e.state.moving,
+                e.state.mean_height,
+                e.state.max_overlap * 1e3
+            );
+        }
     }
     s
 }
@@ -76,22 +96,47 @@ fn num(x: f64) -> String {
     }
 }
 
-/// `compare.json`: a list of `{"scene","n","haptic2d_median_us","haptic2d_p99_us","rapier2d_median_us",
-/// "rapier2d_p99_us","ratio"}`.
+/// `compare.json`: a list of objects `{"scene", "n", "haptic2d_median_us", "haptic2d_p99_us",
+/// "rapier2d_median_us", "rapier2d_p99_us", "ratio", "box2d_median_us", "box2d_p99_us",
+/// "ratio_box2d", "ratio_p99_box2d", ...}`: for every engine `K` but haptic2d `K_median_us`,
+/// `K_p99_us`, `ratio_K` and `ratio_p99_K` (`ratio` alone is rapier2d's, as before), and for every
+/// engine the settle state `K_max_speed`, `K_moving`, `K_mean_height`, `K_max_overlap` (SI units).
 pub fn json(rows: &[Row]) -> String {
     let items: Vec<String> = rows
         .iter()
         .map(|r| {
-            format!(
-                "  {{\"scene\": \"{}\", \"n\": {}, \"haptic2d_median_us\": {}, \"haptic2d_p99_us\": {}, \"rapier2d_median_us\": {}, \"rapier2d_p99_us\": {}, \"ratio\": {}}}",
-                r.scene.replace('"', "'"),
-                r.n,
-                num(r.haptic_median_us),
-                num(r.haptic_p99_us),
-                num(r.rapier_median_us),
-                num(r.rapier_p99_us),
-                num(r.ratio())
-            )
+            let mut f = vec![
+                format!("\"scene\": \"{}\"", r.scene.replace('"', "'")),
+                format!("\"n\": {}", r.n),
+            ];
+            for (k, e) in r.engines.iter().enumerate() {
+                f.push(format!("\"{}_median_us\": {}", e.key, num(e.median_us)));
+                f.push(format!("\"{}_p99_us\": {}", e.key, num(e.p99_us)));
+                if k > 0 {
+                    if e.key == "rapier2d" {
+                        f.push(format!("\"ratio\": {}", num(r.ratio(k))));
+                    }
+                    f.push(format!("\"ratio_{}\": {}", e.key, num(r.ratio(k))));
+                    f.push(format!("\"ratio_p99_{}\": {}", e.key, num(r.ratio_p99(k))));
+                }
+                f.push(format!(
+                    "\"{}_max_speed\": {}",
+                    e.key,
+                    num(e.state.max_speed)
+                ));
+                f.push(format!("\"{}_moving\": {}", e.key, e.state.moving));
+                f.push(format!(
+                    "\"{}_mean_height\": {}",
+                    e.key,
+                    num(e.state.mean_height)
+                ));
+                f.push(format!(
+                    "\"{}_max_overlap\": {}",
+                    e.key,
+                    num(e.state.max_overlap)
+                ));
+            }
+            format!("  {{{}}}", f.join(", "))
         })
         .collect();
     format!("[\n{}\n]\n", items.join(",\n"))
@@ -109,14 +154,9 @@ pub fn svg(rows: &[Row], path: &Path) -> Result<(), String> {
     let err = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
     let n_lo = pile.iter().map(|r| r.n).min().unwrap_or(1) as f64;
     let n_hi = pile.iter().map(|r| r.n).max().unwrap_or(1) as f64;
-    let times = pile.iter().flat_map(|r| {
-        [
-            r.haptic_median_us,
-            r.haptic_p99_us,
-            r.rapier_median_us,
-            r.rapier_p99_us,
-        ]
-    });
+    let times = pile
+        .iter()
+        .flat_map(|r| r.engines.iter().flat_map(|e| [e.median_us, e.p99_us]));
     let t_lo = times.clone().fold(f64::INFINITY, f64::min).max(1e-3);
     let t_hi = times.fold(0.0, f64::max).max(t_lo * 10.0);
     let root = SVGBackend::new(path, (720, 480)).into_drawing_area();
@@ -140,24 +180,30 @@ pub fn svg(rows: &[Row], path: &Path) -> Result<(), String> {
         .y_desc("step time (µs)")
         .draw()
         .map_err(|e| err(&e))?;
-    type Series = (&'static str, RGBColor, fn(&Row) -> f64, u32);
-    let series: [Series; 4] = [
-        ("haptic2d median", BLUE, |r| r.haptic_median_us, 2),
-        ("haptic2d p99", BLUE, |r| r.haptic_p99_us, 1),
-        ("rapier2d median", RED, |r| r.rapier_median_us, 2),
-        ("rapier2d p99", RED, |r| r.rapier_p99_us, 1),
-    ];
-    for (label, color, get, width) in series {
-        let pts: Vec<(f64, f64)> = pile.iter().map(|r| (r.n as f64, get(r))).collect();
-        let style = color.stroke_width(width);
-        chart
-            .draw_series(LineSeries::new(pts.clone(), style))
-            .map_err(|e| err(&e))?
-            .label(label)
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
-        chart
-            .draw_series(pts.iter().map(|&p| Circle::new(p, 3, color.filled())))
-            .map_err(|e| err(&e))?;
+    const COLORS: [RGBColor; 5] = [BLUE, RED, GREEN, MAGENTA, CYAN];
+    let n_eng = pile[0].engines.len();
+    for k in 0..n_eng {
+        let color = COLORS[k % COLORS.len()];
+        let key = pile[0].engines[k].key.clone();
+        for (what, width) in [("median", 2u32), ("p99", 1)] {
+            let pts: Vec<(f64, f64)> = pile
+                .iter()
+                .filter(|r| r.engines.len() == n_eng)
+                .map(|r| {
+                    let e = &r.engines[k];
+                    (r.n as f64, if width == 2 { e.median_us } else { e.p99_us })
+                })
+                .collect();
+            let style = color.stroke_width(width);
+            chart
+                .draw_series(LineSeries::new(pts.clone(), style))
+                .map_err(|e| err(&e))?
+                .label(format!("{key} {what}"))
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+            chart
+                .draw_series(pts.iter().map(|&p| Circle::new(p, 3, color.filled())))
+                .map_err(|e| err(&e))?;
+        }
     }
     chart
         .configure_series_labels()

@@ -9,7 +9,7 @@ pub const DT: f64 = 0.001;
 
 /// One benchmark case: a haptic2d scene plus the few rapier2d settings that cannot be read off it.
 pub struct Case {
-    /// Scene label in the table and JSON (`pile`, `box-in-walls`, `sliding`).
+    /// Scene label in the table and JSON (`pile`, `box-in-walls`, `sliding`, `pyramid`).
     pub scene: &'static str,
     /// Number of dynamic bodies.
     pub n: usize,
@@ -72,6 +72,60 @@ per_mass = true
     s
 }
 
+/// The pyramid scene: `rows` rows of 0.05 m, 2 kg boxes (row `r` from the bottom holds `rows − r`
+/// boxes, 1 mm apart, each row resting on the one below: 210 boxes for 20 rows) on a floor, with the
+/// pile's contact laws; it starts at rest and should stay so.
+pub fn pyramid_toml(rows: usize) -> String {
+    let mut s = String::from(
+        r#"name = "pyramid"
+description = "a pyramid of boxes resting on the ground"
+
+[world]
+rate = 1000
+proximity_every = 10
+integration = "semi-implicit"
+
+[contact]
+impacts = true
+restitution = 0.2
+v_c = 0.05
+
+[normal]
+model = "paper"
+kc = 1.0e5
+bc = 40.0
+
+[friction]
+model = "reset-integrator"
+kr = 5.0e4
+mu_s = 0.5
+mu_k = 0.45
+beta = 20.0
+
+[[body]]
+name = "floor"
+kind = "fixed"
+pieces = [[[-1.0, -0.1], [3.0, -0.1], [3.0, 0.0], [-1.0, 0.0]]]
+
+[[load]]
+body = "*"
+force = [0.0, -9.81]
+per_mass = true
+"#,
+    );
+    let pitch = 0.051; // box width + 1 mm gap
+    for r in 0..rows {
+        for k in 0..rows - r {
+            let x = 0.5 * pitch * r as f64 + pitch * k as f64;
+            let y = 0.025 + 0.05 * r as f64;
+            s.push_str(&format!(
+                "\n[[body]]\nname = \"b{r}_{k}\"\nmass = 2.0\nbox = [0.05, 0.05]\nposition = [{x:.4}, {y:.4}]\n"
+            ));
+        }
+    }
+    s
+}
+
 fn scene(
     name: &str,
     result: Option<Result<Scene, haptic2d::scene::SceneErrors>>,
@@ -83,7 +137,8 @@ fn scene(
     }
 }
 
-/// All cases: `pile` for every `n` in `pile_sizes`, `box-in-walls`, `sliding` (10 boxes); those whose
+/// All cases: `pile` for every `n` in `pile_sizes`, `box-in-walls`, `sliding` (10 boxes), `pyramid`
+/// (20 rows, 210 boxes); those whose
 /// label contains none of `filter` (when non-empty) are left out.
 pub fn cases(pile_sizes: &[usize], filter: &[String]) -> Result<Vec<Case>, String> {
     let keep = |label: &str| filter.is_empty() || filter.iter().any(|f| label.contains(f.as_str()));
@@ -118,6 +173,19 @@ pub fn cases(pile_sizes: &[usize], filter: &[String]) -> Result<Vec<Case>, Strin
             haptic: scene(
                 "sliding",
                 Some(Scene::from_toml(&sliding_toml(n), "sliding", rate)),
+            )?,
+            rapier_friction: 0.5,
+            rapier_restitution: 0.2,
+        });
+    }
+    if keep("pyramid") {
+        let rows = 20;
+        out.push(Case {
+            scene: "pyramid",
+            n: rows * (rows + 1) / 2,
+            haptic: scene(
+                "pyramid",
+                Some(Scene::from_toml(&pyramid_toml(rows), "pyramid", rate)),
             )?,
             rapier_friction: 0.5,
             rapier_restitution: 0.2,

@@ -1,5 +1,5 @@
-//! Interleaved timing of the two engines in one process: both worlds advance in alternating chunks of
-//! steps (haptic2d first in even chunks, rapier2d first in odd ones), every step timed on its own, so
+//! Interleaved timing of the two engines in one process: all worlds advance in alternating chunks of
+//! steps (the first engine of a chunk rotates), every step timed on its own, so
 //! slow drifts of the machine (frequency, other processes) hit both engines alike.
 
 use std::time::Instant;
@@ -29,41 +29,37 @@ impl Samples {
 }
 
 /// Runs `warmup` untimed steps of each engine, then `steps` timed steps of each, interleaved in chunks
-/// of `chunk` steps. Returns `(haptic2d, rapier2d)` samples.
+/// of `chunk` steps; the engine that goes first rotates every chunk. Returns one sample set per
+/// engine, in the order given.
 pub fn interleaved(
     warmup: usize,
     steps: usize,
     chunk: usize,
-    mut a: impl FnMut(),
-    mut b: impl FnMut(),
-) -> (Samples, Samples) {
+    engines: &mut [&mut dyn FnMut()],
+) -> Vec<Samples> {
     for _ in 0..warmup {
-        a();
-        b();
+        for e in engines.iter_mut() {
+            e();
+        }
     }
     let chunk = chunk.max(1);
-    let mut ta = Vec::with_capacity(steps);
-    let mut tb = Vec::with_capacity(steps);
-    let run = |f: &mut dyn FnMut(), out: &mut Vec<f64>, n: usize| {
-        for _ in 0..n {
-            let t0 = Instant::now();
-            f();
-            out.push(t0.elapsed().as_secs_f64() * 1e6);
-        }
-    };
+    let m = engines.len();
+    let mut out: Vec<Vec<f64>> = (0..m).map(|_| Vec::with_capacity(steps)).collect();
     let mut done = 0;
     let mut k = 0;
     while done < steps {
         let n = chunk.min(steps - done);
-        if k % 2 == 0 {
-            run(&mut a, &mut ta, n);
-            run(&mut b, &mut tb, n);
-        } else {
-            run(&mut b, &mut tb, n);
-            run(&mut a, &mut ta, n);
+        for r in 0..m {
+            let e = (k + r) % m;
+            let f = &mut engines[e];
+            for _ in 0..n {
+                let t0 = Instant::now();
+                f();
+                out[e].push(t0.elapsed().as_secs_f64() * 1e6);
+            }
         }
         done += n;
         k += 1;
     }
-    (Samples(ta), Samples(tb))
+    out.into_iter().map(Samples).collect()
 }
