@@ -4,7 +4,8 @@
 //! Rendering of Planar Rigid-Body Motion using a Redundant Parallel Mechanism* (UBC).
 //!
 //! This core crate is pure computation: no threads, no I/O, `f64` throughout, deterministic. Section
-//! numbers (§) refer to the project's model specification, `spec/MODELS.md`.
+//! numbers (§) refer to the project's model documentation, `docs/MODELS.md`; `DESIGN §N` to
+//! `docs/ARCHITECTURE.md`.
 
 #![warn(missing_docs)]
 
