@@ -108,8 +108,12 @@ fn startup_torques_ramp_in_linearly_from_exactly_zero() {
 
 #[test]
 fn re_arming_and_resuming_re_align_and_ramp_again() {
+    // The spec gains: the f_cm ≈ 0 check below is on the position/velocity channels after
+    // re-alignment; the default's local force feedback (C6 = −1) adds the observer's hand-wrench
+    // estimate, which is not zero after a pause (the torques still start at exactly zero).
     let config = HapticConfig {
         keep_slave_loads: true,
+        controller: ControllerKind::FourChannel(FourChannelGains::spec()),
         ..HapticConfig::default()
     };
     let mut sys = system(&config, SafetyConfig::default());
@@ -153,7 +157,9 @@ fn master_mass_feedforward_acts_with_the_device_mass_matrix() {
     // recomputed from the record without the feed-forward (§11.1: K_m·(x_s − x_m) + B_m·(v_s − v_m)
     // − f_e); what is left is the feed-forward, which must be M̂_x·â_s with â_s the 30 Hz low-passed
     // backward difference of v_s. Off, nothing is left.
-    let gains = FourChannelGains::default();
+    // The §11.1 form f_cm = K_m·Δx + B_m·Δv − f_e (+ M̂_x·â_s) that `nominal` below writes out:
+    // the spec gains (C6 = 0, no damping injection), so the feed-forward is what is left over.
+    let gains = FourChannelGains::spec();
     let run = |ff: bool| {
         let config = HapticConfig {
             controller: ControllerKind::FourChannel(FourChannelGains {
