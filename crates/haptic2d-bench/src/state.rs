@@ -72,7 +72,7 @@ pub fn of(w: &World, poses: &[(Vec2, f64, Vec2)]) -> State {
         .collect();
     let speeds = dynamic.iter().map(|&i| poses[i].2.length());
     let max_speed = speeds.clone().fold(0.0, f64::max);
-    let moving = speeds.filter(|&v| !(v <= MOVING)).count();
+    let moving = speeds.filter(|&v| v.is_nan() || v > MOVING).count();
     let mean_height =
         dynamic.iter().map(|&i| poses[i].0.y).sum::<f64>() / dynamic.len().max(1) as f64;
     // Pairs by sweep along x over the pieces' bounds (fixed order, deterministic).

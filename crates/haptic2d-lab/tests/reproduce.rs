@@ -139,6 +139,7 @@ fn reproduce_all_writes_every_output_and_the_cases_pass() {
     assert_eq!(
         names(&m5, false, true),
         [
+            "coupling/pulse",
             "coupling/seh",
             "coupling/zoh",
             "four-channel-spec/hysteretic",

@@ -4,7 +4,7 @@
 
 use haptic2d::control::four_channel::FourChannelGains;
 use haptic2d::device::{DeviceParams, HandModel};
-use haptic2d::haptic::{ControllerKind, DeviceInTheLoop, HapticConfig, HapticSystem};
+use haptic2d::haptic::{ControllerKind, DeviceInTheLoop, HapticConfig, HapticSystem, SafetyConfig};
 use haptic2d::scene::{Scene, BUILTIN};
 use haptic2d::world::World;
 use haptic2d_lab::stability::eig::{eigenvalues, poly_roots, Complex};
@@ -150,7 +150,13 @@ fn linear_device() -> DeviceParams {
 /// quasi-static equilibrium (1 mm into the wall at 2 N), until `seconds` or until the deviation exceeds `limit` (still linear: the box keeps
 /// its contact).
 fn simulate_x(config: &HapticConfig, rate: f64, seconds: f64, limit: f64) -> Vec<f64> {
-    let sys = HapticSystem::new(box_on_wall(rate), config).unwrap();
+    // The start-up torque ramp is off: the linear model is of the loop at full gain, and the
+    // spec configuration's growth is fitted from 0.1 s, inside the default 0.5 s ramp.
+    let safety = SafetyConfig {
+        ramp_time: 0.0,
+        ..SafetyConfig::default()
+    };
+    let sys = HapticSystem::with_safety(box_on_wall(rate), config, safety).unwrap();
     let mut l = DeviceInTheLoop::new(sys, HandModel::Free, 10, false).unwrap();
     let n = (seconds * rate) as usize;
     let mut xs = Vec::with_capacity(n);
