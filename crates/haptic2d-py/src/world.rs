@@ -219,6 +219,8 @@ impl PyWorld {
             )));
         }
         let every = every as u64;
+        // As `haptic2d simulate`: the t = 0 state (contacts, stored energy) before the first row.
+        self.world.prime();
         let dt = self.world.params.dt;
         let ticks = (duration / dt).round() as u64;
         let rows = (ticks / every + 1) as usize;
