@@ -127,8 +127,23 @@ enum Command {
     },
 }
 
+/// A command that only prints (no sockets of its own) ends quietly of `SIGPIPE` when its reader closes
+/// the pipe (`haptic2d simulate … | head -1`), as `cat` does (status 141 in the shell), instead of
+/// panicking in `println!`. `run` and `emulate` keep Rust's default (`SIGPIPE` ignored): their sockets
+/// and serial ports must see `EPIPE` as an error they handle, not a signal that kills the loop.
+fn quiet_on_closed_pipe() {
+    #[cfg(unix)]
+    // SAFETY: called once at start-up, before any thread exists; SIG_DFL is a valid disposition.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    if !matches!(cli.command, Command::Run(_) | Command::Emulate(_)) {
+        quiet_on_closed_pipe();
+    }
     // Commands this module does not own report failures as plain strings: exit 1.
     let runtime = |r: Result<(), String>| r.map(|()| Status::Clean).map_err(Failure::error);
     let result = match cli.command {
