@@ -89,13 +89,26 @@ pub struct ReplayDevice {
     last_torques: [f64; 4],
 }
 
+/// Largest replay read (bytes): 1 GiB, about 10 million rows of a tick log (17 min at 10 kHz, 2.8 h at
+/// 1 kHz), held in memory as 32 bytes a row. Bounds a hostile or mistaken input (a pipe, `/dev/zero`,
+/// one endless line) before it exhausts memory.
+pub const MAX_REPLAY_BYTES: u64 = 1 << 30;
+
 impl ReplayDevice {
     /// Loads `path`, taking the four joint angles (radians) from the columns
     /// named `columns` (e.g. [`DEFAULT_REPLAY_COLUMNS`]); other columns are
     /// ignored. Errors name the file, the column or the row.
+    /// Files above [`MAX_REPLAY_BYTES`] are refused before anything is read.
     pub fn from_path(path: &Path, columns: [&str; 4], end: ReplayEnd) -> Result<Self, String> {
         let file = std::fs::File::open(path)
             .map_err(|e| format!("cannot open the replay file {}: {e}", path.display()))?;
+        let len = file.metadata().map(|m| m.len()).unwrap_or(0);
+        if len > MAX_REPLAY_BYTES {
+            return Err(format!(
+                "the replay file {} is {len} bytes, above the cap of {MAX_REPLAY_BYTES} bytes (1 GiB, about 10 million rows)\n    fix: cut the recording to the part to replay (e.g. `head -n 1000001 FILE > part.csv`)",
+                path.display()
+            ));
+        }
         Self::from_reader(file, &path.display().to_string(), columns, end)
     }
 
@@ -107,9 +120,21 @@ impl ReplayDevice {
         columns: [&str; 4],
         end: ReplayEnd,
     ) -> Result<Self, String> {
+        Self::from_reader_capped(reader, label, columns, end, MAX_REPLAY_BYTES)
+    }
+
+    /// [`from_reader`](Self::from_reader) with the byte cap as a parameter (tests use a small one).
+    fn from_reader_capped<R: std::io::Read>(
+        reader: R,
+        label: &str,
+        columns: [&str; 4],
+        end: ReplayEnd,
+        cap: u64,
+    ) -> Result<Self, String> {
+        // The byte cap also bounds a reader with no length (a pipe, /dev/zero) and one endless line.
         let mut rdr = csv::ReaderBuilder::new()
             .trim(csv::Trim::All)
-            .from_reader(reader);
+            .from_reader(std::io::Read::take(reader, cap + 1));
         let header = rdr
             .headers()
             .map_err(|e| format!("{label}: cannot read the CSV header: {e}"))?
@@ -124,10 +149,20 @@ impl ReplayDevice {
             })?;
         }
         let mut samples = Vec::new();
-        for (row, rec) in rdr.records().enumerate() {
-            // Row numbers as a person counts them in the file: header is line 1.
-            let line = row + 2;
-            let rec = rec.map_err(|e| format!("{label}: line {line}: {e}"))?;
+        let mut rec = csv::StringRecord::new();
+        // Row numbers as a person counts them in the file: header is line 1.
+        let mut line = 1usize;
+        loop {
+            line += 1;
+            let more = rdr.read_record(&mut rec);
+            if rdr.position().byte() > cap {
+                return Err(format!(
+                    "{label}: the replay is above the cap of {cap} bytes (about 10 million rows at 1 GiB)\n    fix: cut the recording to the part to replay"
+                ));
+            }
+            if !more.map_err(|e| format!("{label}: line {line}: {e}"))? {
+                break;
+            }
             let mut q = [0.0; 4];
             for k in 0..4 {
                 let field = rec.get(idx[k]).unwrap_or("");
@@ -210,5 +245,48 @@ impl DeviceIo for ReplayDevice {
 
     fn paced_by_ticks(&self) -> bool {
         true
+    }
+}
+
+#[cfg(test)]
+mod replay_cap_tests {
+    use super::*;
+
+    const COLS: [&str; 4] = DEFAULT_REPLAY_COLUMNS;
+
+    fn header() -> String {
+        format!("{}\n", COLS.join(","))
+    }
+
+    #[test]
+    fn replay_of_an_endless_line_stops_at_the_byte_cap() {
+        // A header, then one line that never ends (what `/dev/zero` or a stuck pipe looks like).
+        let head = header();
+        let r = std::io::Read::chain(head.as_bytes(), std::io::repeat(b'1'));
+        let e = ReplayDevice::from_reader_capped(r, "endless", COLS, ReplayEnd::Error, 4096)
+            .expect_err("an endless line is refused");
+        assert!(e.contains("above the cap of 4096 bytes"), "{e}");
+    }
+
+    #[test]
+    fn replay_of_too_many_rows_stops_at_the_byte_cap() {
+        let mut text = header();
+        while text.len() < 10_000 {
+            text.push_str("0,0,0,0\n");
+        }
+        let e =
+            ReplayDevice::from_reader_capped(text.as_bytes(), "long", COLS, ReplayEnd::Error, 4096)
+                .expect_err("a file above the cap is refused");
+        assert!(e.contains("above the cap"), "{e}");
+        // The same rows under the cap load.
+        let d = ReplayDevice::from_reader_capped(
+            text.as_bytes(),
+            "long",
+            COLS,
+            ReplayEnd::Error,
+            1 << 20,
+        )
+        .expect("under the cap");
+        assert_eq!(d.name(), "replay:long");
     }
 }
