@@ -277,6 +277,7 @@ fn released_handle_coupling_is_bounded_long() {
 
 /// A controller of the 1-DOF loop: the four-channel (any gains) or the virtual coupling.
 #[derive(Clone, Copy, Debug)]
+#[allow(clippy::large_enum_variant)]
 enum OneDofController {
     FourChannel(FourChannelGains),
     Coupling,
