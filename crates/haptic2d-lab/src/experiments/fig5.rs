@@ -58,6 +58,7 @@ use haptic2d::scene::{Scene, BUILTIN};
 use haptic2d::haptic::config::{ControllerKind, HapticConfig};
 use haptic2d::haptic::experiment::DeviceInTheLoop;
 use haptic2d::haptic::record::TickRecord;
+use haptic2d::haptic::safety::SafetyConfig;
 use haptic2d::haptic::system::HapticSystem;
 
 /// Settings of the Fig. 5–6 experiment.
@@ -91,6 +92,9 @@ pub struct Fig5Params {
     /// [REC] 1e-4 N·m·s/rad by default, i.e. m ≈ 0.014). Default `None` (the spec device);
     /// [`Fig5Params::calibrated_damping`] uses 2.
     pub colgate_margin: Option<f64>,
+    /// The haptic system's safety settings (start-up ramp, stall limit, torque trip margin).
+    /// Default: [`SafetyConfig::default`] (the torques ramp in over 0.5 s from the first tick).
+    pub safety: SafetyConfig,
 }
 
 impl Fig5Params {
@@ -199,6 +203,7 @@ impl Default for Fig5Params {
             guide_y_theta: true,
             pulse_device_mass: false,
             colgate_margin: None,
+            safety: SafetyConfig::default(),
         }
     }
 }
@@ -320,7 +325,7 @@ pub fn run_case(
     let world = Scene::from_toml(&walls_toml(normal, &extra)?, "fig5", Some(p.rate))
         .map_err(|e| e.to_string())?
         .world;
-    let system = HapticSystem::new(world, &haptic)?;
+    let system = HapticSystem::with_safety(world, &haptic, p.safety)?;
     let mut l = DeviceInTheLoop::new(system, HandModel::Free, 10, p.quantize)?;
     let start = l.plant.pose();
     let HandModel::SpringDamper {
