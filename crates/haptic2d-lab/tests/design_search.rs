@@ -13,10 +13,10 @@
 //! pulse and hysteretic walls; no Fig. 8–11 claim). The candidates that pass a Fig. 8–11 slip claim
 //! (`C6 = −0.5, D_m = 5`: classical and Salcudean–Vlaar; `C6 = −0.75, D_m ∈ {2, 5}`: Salcudean–Vlaar)
 //! keep part of the force reflection `C2 > 0` and are unstable released on the peg with the output
-//! delay (sampled growth +2.1 to +28 1/s on the peg's y axis): the slip needs the handle to be pushed back by the peg's
-//! contact force, which is the released-unstable path of §11.4. Fig. 5's "keeps bouncing" (SEH, ZOH)
-//! fails for every stable candidate: with `C2 ≤ 0.5` the handle does not stop with the box, and the
-//! box leaves the wall at most twice.
+//! delay (sampled growth +2.1 to +28 1/s on its x or y axis): the slip needs the handle to be pushed
+//! back by the peg's contact force, which is the released-unstable path of §11.4. Fig. 5's "keeps
+//! bouncing" (SEH, ZOH) fails for every candidate: with `C2 ≤ 0.5` the handle does not stop with the
+//! box, and the box leaves the wall at most twice.
 
 use haptic2d::control::four_channel::FourChannelGains;
 use haptic2d::haptic::config::{ControllerKind, HapticConfig};
