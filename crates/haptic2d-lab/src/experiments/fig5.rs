@@ -41,10 +41,11 @@
 //! (`C2 = 0`) the environment force no longer reaches the handle; the handle follows the box through
 //! the PD `(K_m, B_m)` and the slave's `(K_s, B_s)`, and at each impact the handle's momentum is
 //! dissipated in those dampers (the box stops, the handle does not). So the stable design is
-//! dissipative at the wall: the box bounces once (first ratio ≈ 0.37 with no injection), so the
-//! "keeps bouncing" claims of SEH and ZOH fail while the pulse and hysteretic walls pass. The
-//! bouncing claim needs the handle to stop with the box, i.e. force reflection `C2 = 1`, which is
-//! exactly the released-unstable path; no configuration found here has both.
+//! dissipative at the wall: the box bounces at most once (first ratio ≈ 0.37 with no injection, no
+//! separation at all with the default's `D_m = 2 N·s/m`), so the "keeps bouncing" claims of SEH and
+//! ZOH fail while the pulse and hysteretic walls pass. The bouncing claim needs the handle to stop
+//! with the box, i.e. force reflection `C2 = 1`, which is exactly the released-unstable path; no
+//! configuration found has both (`tests/design_search.rs`: 15 variants of `C6`, `C5`, `D_m`).
 
 use haptic2d::control::coupling::CouplingGains;
 use haptic2d::control::four_channel::FourChannelGains;
