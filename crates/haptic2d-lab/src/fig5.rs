@@ -290,10 +290,12 @@ fn report(m: &FigureMetrics, sweep: &str) -> String {
          walls because it moves those poles left (stable above b ≈ 2.65 N·s/m), a property of this \
          device model, not a measured one. The stable default (C6 = −1, C2 = 0) does not reflect the \
          wall force to the handle: at each impact the box stops but the handle does not, and its \
-         momentum is dissipated in the PD and slave dampers. The box bounces once and stays, so the \
-         pulse and hysteretic claims hold but SEH and ZOH cannot keep bouncing: their bouncing needs \
-         the handle to stop with the box, i.e. C2 = 1, which is the released-unstable path. No \
-         configuration found here has both.\n\n\
+         momentum is dissipated in the PD and slave dampers. The box stays at the wall from the first \
+         impact (0 separations), so the pulse and hysteretic claims hold but SEH and ZOH cannot keep \
+         bouncing: their bouncing needs the handle to stop with the box, i.e. C2 = 1, which is the \
+         released-unstable path. No configuration found has both: of 15 variants (C6 from −1 to \
+         −0.5, C5 = ±0.5, damping injection 0–10 N·s/m; `haptic2d-lab/tests/design_search.rs`), \
+         none that is stable released keeps bouncing.\n\n\
          ### Device-damping sweep (§11.1 table)\n\n\
          Every wall at damping margins `b_x/(K·T/2)` from 0.25 to 4 (`fig5/sweep.csv`; ✓/✗ = the \
          wall's claim, separations in 10 s and in the last 2 s):\n\n\

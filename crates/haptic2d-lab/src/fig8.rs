@@ -266,9 +266,12 @@ fn report(m: &FigureMetrics) -> String {
          models stick. But the push now reaches the peg through the hand-force estimate (C3 = 1) while \
          the handle follows through the PD, so every slip is braked by the handle's inertia and the \
          coupling's dampers: the advance per cycle stays below the 5 mm of F7-3, and the classical \
-         model's creep is slightly negative instead of drifting (F7-1). The virtual coupling \
-         (comparison) meets every claim: it sends no force channel to the device and drives the peg \
-         with the spring K_vc alone."
+         model's creep is slightly negative instead of drifting (F7-1). Of 15 variants (C6 from −1 \
+         to −0.5, C5 = ±0.5, damping injection 0–10 N·s/m; `haptic2d-lab/tests/design_search.rs`), \
+         none that is stable released with the real-device output delay passes a slip claim; those \
+         that pass one keep part of the force reflection (C2 > 0) and grow at +2 to +28 1/s \
+         released on the peg. The virtual coupling (comparison) meets every claim: it sends no \
+         force channel to the device and drives the peg with the spring K_vc alone."
     );
     s
 }

@@ -17,25 +17,41 @@ pub const MAX_MESSAGE_BYTES: usize = 4096;
 /// Largest accepted coordinate of a hand target (m or rad, absolute value).
 pub const MAX_TARGET_COORDINATE: f64 = 1000.0;
 
-/// The controllers the page can select.
+/// The controllers the page can select: the named configurations of `haptic2d run --controller`
+/// ([`haptic2d::haptic::ControllerKind::from_name`]), with the same names.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 pub enum ControllerKind {
-    /// The four-channel controller of §11.1 (the default of `haptic2d run`).
+    /// The four-channel controller of §11.1 with the released-stable default gains (local force
+    /// feedback `C6 = −1` and a small damping injection; the default of `haptic2d run`).
     #[serde(rename = "four-channel")]
     FourChannel,
+    /// The §11.1 table exactly: unstable with the hand released against a stiff contact (§11.4);
+    /// a comparison configuration.
+    #[serde(rename = "four-channel-spec")]
+    FourChannelSpec,
+    /// The §11.1 table with master damping injection alone (a comparison configuration).
+    #[serde(rename = "four-channel-damped")]
+    FourChannelDamped,
     /// The virtual-coupling (impedance) controller of §11.2.
     #[serde(rename = "coupling")]
     Coupling,
 }
 
 impl ControllerKind {
-    /// Every controller, in the order the page lists them.
-    pub const ALL: [ControllerKind; 2] = [ControllerKind::FourChannel, ControllerKind::Coupling];
+    /// Every controller, in the order the page lists them (the default first).
+    pub const ALL: [ControllerKind; 4] = [
+        ControllerKind::FourChannel,
+        ControllerKind::FourChannelSpec,
+        ControllerKind::FourChannelDamped,
+        ControllerKind::Coupling,
+    ];
 
     /// The name used on the command line and in messages.
     pub fn name(self) -> &'static str {
         match self {
             ControllerKind::FourChannel => "four-channel",
+            ControllerKind::FourChannelSpec => "four-channel-spec",
+            ControllerKind::FourChannelDamped => "four-channel-damped",
             ControllerKind::Coupling => "coupling",
         }
     }
@@ -45,7 +61,18 @@ impl ControllerKind {
         Self::ALL
             .into_iter()
             .find(|c| c.name() == name)
-            .ok_or_else(|| format!("unknown controller `{name}`; valid: four-channel, coupling"))
+            .ok_or_else(|| {
+                format!(
+                    "unknown controller `{name}`; valid: four-channel, four-channel-spec, \
+                     four-channel-damped, coupling"
+                )
+            })
+    }
+
+    /// The system's controller of this name, with its named gains (what the loop switches to).
+    pub fn system(self) -> haptic2d::haptic::ControllerKind {
+        // Every name of `ALL` is one of the system's (test `every_controller_exists_in_the_system`).
+        haptic2d::haptic::ControllerKind::from_name(self.name()).unwrap_or_default()
     }
 }
 
@@ -255,6 +282,10 @@ mod tests {
                 kind: ControllerKind::Coupling
             }
         );
+        for kind in ControllerKind::ALL {
+            let msg = format!(r#"{{"type":"set_controller","name":"{}"}}"#, kind.name());
+            assert_eq!(ok(&msg), Command::SetController { kind });
+        }
         assert_eq!(ok(r#"{"type":"pause"}"#), Command::Pause);
         assert_eq!(ok(r#"{"type":"resume"}"#), Command::Resume);
         assert_eq!(ok(r#"{"type":"reset"}"#), Command::Reset);
@@ -264,6 +295,26 @@ mod tests {
                 token: "abc".into()
             })
         );
+    }
+
+    /// The page offers exactly the controllers the loop can run: every name of
+    /// [`ControllerKind::ALL`] is a named configuration of the system (with the same name back),
+    /// and every name the system accepts (`haptic2d run --controller`) is on the page.
+    #[test]
+    fn every_controller_exists_in_the_system() {
+        use haptic2d::haptic::ControllerKind as System;
+        for kind in ControllerKind::ALL {
+            let sys = System::from_name(kind.name()).unwrap_or_else(|e| panic!("{e}"));
+            assert_eq!(sys.name(), kind.name());
+            assert_eq!(kind.system(), sys);
+        }
+        for name in System::NAMES.split(", ") {
+            assert!(
+                ControllerKind::from_name(name).is_ok(),
+                "the system's controller `{name}` is not on the page"
+            );
+        }
+        assert_eq!(ControllerKind::ALL[0].system(), System::default());
     }
 
     #[test]

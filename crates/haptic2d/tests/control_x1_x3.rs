@@ -76,9 +76,14 @@ enum HandForce {
     Observer,
 }
 
-fn run(mut ctrl: Controller, hand: HandForce) -> Trace {
-    let m_tot = M_DEV + M_HAND;
-    let b_tot = B_DEV + B_HAND;
+fn run(ctrl: Controller, hand: HandForce) -> Trace {
+    run_released_at(ctrl, hand, f64::INFINITY, DURATION)
+}
+
+/// [`run`] for `duration` (s), with the hand let go at `t_release` (s): from then on the plant is the device alone
+/// (0.3 kg, 0.5 N·s/m), nothing pushes it, and the hand-force signal is zero (`Applied`) or the
+/// observer's estimate of a zero interaction force (`Observer`).
+fn run_released_at(mut ctrl: Controller, hand: HandForce, t_release: f64, duration: f64) -> Trace {
     // Start 3 mm from the wall, at rest; the slave starts on the device.
     let (mut x_m, mut v_m) = (0.003, 0.0);
     let (mut x_s, mut v_s) = (0.003, 0.0);
@@ -86,7 +91,7 @@ fn run(mut ctrl: Controller, hand: HandForce) -> Trace {
     // 1-DOF momentum observer state.
     let (mut p0, mut integral, mut r) = (0.0, 0.0, 0.0);
     let (mut f_cm_prev, mut v_hat_prev) = (0.0, 0.0);
-    let n = (DURATION / T).round() as usize;
+    let n = (duration / T).round() as usize;
     let mut tr = Trace {
         x_m: Vec::with_capacity(n),
         x_s: Vec::with_capacity(n),
@@ -94,6 +99,12 @@ fn run(mut ctrl: Controller, hand: HandForce) -> Trace {
         f_e: Vec::with_capacity(n),
     };
     for k in 0..n {
+        let held = (k as f64) * T < t_release;
+        let (m_tot, b_tot, push) = if held {
+            (M_DEV + M_HAND, B_DEV + B_HAND, F_PUSH)
+        } else {
+            (M_DEV, B_DEV, 0.0)
+        };
         // 1. Sense the device; filtered velocity.
         let v_hat = filter.update(&[x_m, 0.0, 0.0])[0];
         // 2. Hand-force estimate: r_k = K_O·(p_k − p_0 − Σ T·(f_cm,j−1 − b·v̂_j−1 + r_j−1)).
@@ -117,7 +128,7 @@ fn run(mut ctrl: Controller, hand: HandForce) -> Trace {
             v_m: [v_hat, 0.0, 0.0],
             f_h: [
                 match hand {
-                    HandForce::Applied => F_PUSH,
+                    HandForce::Applied => push,
                     HandForce::Observer => r,
                 },
                 0.0,
@@ -137,7 +148,7 @@ fn run(mut ctrl: Controller, hand: HandForce) -> Trace {
         v_s += T * (f_cs[0] - f_e) / M_S;
         x_s += T * v_s;
         // Device + hand: continuous plant, f_cm held over the period.
-        (x_m, v_m) = zoh_step(x_m, v_m, F_PUSH + f_cm[0], m_tot, b_tot, T);
+        (x_m, v_m) = zoh_step(x_m, v_m, push + f_cm[0], m_tot, b_tot, T);
         f_cm_prev = f_cm[0];
         v_hat_prev = v_hat;
     }
@@ -333,4 +344,108 @@ fn x1_x3_default_configuration() {
     println!("X3 default four-channel: f_cm = {f_cm:.5} N, f_e = {f_e:.5} N");
     assert!(f_e < -1.9, "steady contact reached (f_e = {f_e})");
     assert!(rel < 0.01, "rel {rel}");
+}
+
+/// The default configuration with the gains of [`FourChannelGains::default`] and `K_m` (N/m) on x.
+fn default_four_channel(k_m: f64) -> Controller {
+    let gains = FourChannelGains {
+        k_m: [k_m, k_m, 1.0],
+        ..FourChannelGains::default()
+    };
+    Controller::FourChannel(FourChannel::new(gains, T).expect("valid gains"))
+}
+
+/// X2 (§11.3) for the default configuration at `K_m = 2000 N/m`, hand held (the spec's second X2
+/// case; the default `K_m` is checked in `x1_x3_default_configuration`).
+///
+/// Finding: the claim does not hold in its 4 s window. The loop is stable, but its contact mode is
+/// slow. With `C6 = −1` the environment force does not reach the master (`C2 = 0`); the linearised
+/// held loop (master + hand `m = 0.7 kg`, `b = 4.5 N·s/m`; slave `M_s = 0.5 kg` on `K_s + K_e`,
+/// damped by `B_s + B_e`) has the characteristic polynomial
+///
+/// ```text
+/// (m·s² + (b + B_m + D_m)·s + K_m)·(M_s·s² + (B_s + B_e)·s + K_s + K_e) − (B_m·s + K_m)·(B_s·s + K_s)
+/// ```
+///
+/// whose right-most roots are `−5.0 ± 17.8j` at `K_m = 500` but `−1.89 ± 33.5j` at `K_m = 2000`
+/// (`B_m = 5`, `D_m = 2`; damping ratio 0.056: `B_m` was sized for `K_m = 500`). From the ≈ 1 mm
+/// transient of the first contact, a decay of 1.9 1/s reaches 1e-5 m only after about 4 s, so the
+/// last-second window still holds 4e-5 m. (With `D_m = 10` the root is `−6.2 ± 33j`, with `B_m =
+/// 20` `−5.3 ± 34j`.) The test pins both: the measured decay rate matches the polynomial's
+/// (sampled at 500 Hz behind the velocity filter: within 20 %), and the X2 bound is missed, so a
+/// change of defaults that fixes it shows here.
+#[test]
+fn x2_default_configuration_raised_k_m() {
+    const PREDICTED_DECAY: f64 = 1.89; // 1/s, right-most root of the polynomial above
+    let tr = run_released_at(
+        default_four_channel(2000.0),
+        HandForce::Applied,
+        f64::INFINITY,
+        8.0,
+    );
+    let pp = window_pp(&tr.x_m, DURATION - 1.0);
+    let xm = tr.x_m[(DURATION / T) as usize - 1];
+    // Peak-to-peak over successive 1 s windows decays like exp(−σ·t).
+    let (a, b) = (window_pp(&tr.x_m, 3.0), window_pp(&tr.x_m, 7.0));
+    let sigma = (a / b).ln() / 4.0;
+    println!(
+        "X2 default four-channel, K_m = 2000: device {:.4} mm at 4 s, p-p over [3, 4) s = {pp:.3e} m, over [7, 8) s = {b:.3e} m, decay {sigma:.2} 1/s (polynomial {PREDICTED_DECAY})",
+        xm * 1e3
+    );
+    assert!(xm < -0.9e-3, "in steady contact (device at {xm:e} m)");
+    assert!(
+        (sigma - PREDICTED_DECAY).abs() <= 0.2 * PREDICTED_DECAY,
+        "decay {sigma} 1/s vs the polynomial's {PREDICTED_DECAY} 1/s"
+    );
+    assert!(
+        pp > 1e-5,
+        "documents the slow mode: p-p {pp:e} m; if this fails, X2 holds at K_m = 2000 (update the doc)"
+    );
+}
+
+/// Hand let go after 1.5 s of steady contact, then 4 s with no hand (spec §11.4: "X2 must also
+/// hold with no hand"); the window is the last 1 s.
+const RELEASE_AT: f64 = 1.5;
+
+/// Runs `ctrl` held for [`RELEASE_AT`], then released for [`DURATION`]; returns the trace and the
+/// device's peak-to-peak over the last 1 s.
+fn released_pp(ctrl: Controller, hand: HandForce) -> (Trace, f64) {
+    let tr = run_released_at(ctrl, hand, RELEASE_AT, RELEASE_AT + DURATION);
+    let pp = window_pp(&tr.x_m, RELEASE_AT + DURATION - 1.0);
+    (tr, pp)
+}
+
+/// X2 with no hand (§11.4) for the default configuration, at the default `K_m` and at 2000 N/m, with
+/// the applied-force signal (zero once released) and with the momentum observer's estimate: the
+/// device, let go in steady contact, is pushed out of the wall and comes to rest; its peak-to-peak
+/// over the last 1 s is < 1e-5 m and it stays out of the wall's far side.
+#[test]
+fn x2_default_configuration_released() {
+    for hand in [HandForce::Applied, HandForce::Observer] {
+        for k_m in [500.0, 2000.0] {
+            let (tr, pp) = released_pp(default_four_channel(k_m), hand);
+            let i_rel = (RELEASE_AT / T).round() as usize;
+            let xm = tr.x_m.last().copied().unwrap_or(0.0);
+            println!(
+                "X2 released, default four-channel, K_m = {k_m}, {hand:?}: device {:.4} mm at release, {:.4} mm at the end, p-p over the last 1 s = {pp:.3e} m",
+                tr.x_m[i_rel] * 1e3,
+                xm * 1e3
+            );
+            assert!(tr.x_m[i_rel] < -0.5e-3, "in contact when released");
+            assert!(tr.x_m.iter().all(|x| x.is_finite() && x.abs() < 0.05));
+            assert!(pp < 1e-5, "K_m = {k_m}, {hand:?}: p-p {pp:e} m");
+        }
+    }
+}
+
+/// The same released run with the §11.1 table (`four-channel-spec`): §11.4 predicts a growing
+/// contact oscillation for the released handle (the 1-DOF device here, 0.3 kg with 0.5 N·s/m, is
+/// below the `b ≈ 2.65 N·s/m` it would need); the test pins that the spec configuration does not
+/// meet X2 with no hand, so the default's pass above is not a property of the setup.
+#[test]
+fn x2_spec_configuration_released_is_not_stable() {
+    let (tr, pp) = released_pp(four_channel(500.0), HandForce::Applied);
+    let xm_max = tr.x_m.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+    println!("X2 released, four-channel-spec: p-p over the last 1 s = {pp:.3e} m, max |x_m| = {xm_max:.3e} m");
+    assert!(pp > 1e-5, "p-p {pp:e} m");
 }

@@ -41,10 +41,11 @@
 //! (`C2 = 0`) the environment force no longer reaches the handle; the handle follows the box through
 //! the PD `(K_m, B_m)` and the slave's `(K_s, B_s)`, and at each impact the handle's momentum is
 //! dissipated in those dampers (the box stops, the handle does not). So the stable design is
-//! dissipative at the wall: the box bounces once (first ratio ≈ 0.37 with no injection), so the
-//! "keeps bouncing" claims of SEH and ZOH fail while the pulse and hysteretic walls pass. The
-//! bouncing claim needs the handle to stop with the box, i.e. force reflection `C2 = 1`, which is
-//! exactly the released-unstable path; no configuration found here has both.
+//! dissipative at the wall: the box bounces at most once (first ratio ≈ 0.37 with no injection, no
+//! separation at all with the default's `D_m = 2 N·s/m`), so the "keeps bouncing" claims of SEH and
+//! ZOH fail while the pulse and hysteretic walls pass. The bouncing claim needs the handle to stop
+//! with the box, i.e. force reflection `C2 = 1`, which is exactly the released-unstable path; no
+//! configuration found has both (`tests/design_search.rs`: 15 variants of `C6`, `C5`, `D_m`).
 
 use haptic2d::control::coupling::CouplingGains;
 use haptic2d::control::four_channel::FourChannelGains;
@@ -58,6 +59,7 @@ use haptic2d::scene::{Scene, BUILTIN};
 use haptic2d::haptic::config::{ControllerKind, HapticConfig};
 use haptic2d::haptic::experiment::DeviceInTheLoop;
 use haptic2d::haptic::record::TickRecord;
+use haptic2d::haptic::safety::SafetyConfig;
 use haptic2d::haptic::system::HapticSystem;
 
 /// Settings of the Fig. 5–6 experiment.
@@ -91,6 +93,9 @@ pub struct Fig5Params {
     /// [REC] 1e-4 N·m·s/rad by default, i.e. m ≈ 0.014). Default `None` (the spec device);
     /// [`Fig5Params::calibrated_damping`] uses 2.
     pub colgate_margin: Option<f64>,
+    /// The haptic system's safety settings (start-up ramp, stall limit, torque trip margin).
+    /// Default: [`SafetyConfig::default`] (the torques ramp in over 0.5 s from the first tick).
+    pub safety: SafetyConfig,
 }
 
 impl Fig5Params {
@@ -199,6 +204,7 @@ impl Default for Fig5Params {
             guide_y_theta: true,
             pulse_device_mass: false,
             colgate_margin: None,
+            safety: SafetyConfig::default(),
         }
     }
 }
@@ -320,7 +326,7 @@ pub fn run_case(
     let world = Scene::from_toml(&walls_toml(normal, &extra)?, "fig5", Some(p.rate))
         .map_err(|e| e.to_string())?
         .world;
-    let system = HapticSystem::new(world, &haptic)?;
+    let system = HapticSystem::with_safety(world, &haptic, p.safety)?;
     let mut l = DeviceInTheLoop::new(system, HandModel::Free, 10, p.quantize)?;
     let start = l.plant.pose();
     let HandModel::SpringDamper {

@@ -20,9 +20,10 @@
 //! Usage: `haptic2d-view-demo [--bind ADDR:PORT] [--rate HZ] [--duration S] [--token TOKEN]`.
 //! Prints `display: http://…` on stdout once listening, and the loop's timing summary at exit.
 
-use haptic2d::control::coupling::{CouplingGains, VirtualCoupling};
-use haptic2d::control::four_channel::{FourChannel, FourChannelGains, TeleopSignals};
+use haptic2d::control::coupling::VirtualCoupling;
+use haptic2d::control::four_channel::{FourChannel, TeleopSignals};
 use haptic2d::device::{DeviceParams, TwinKinematics};
+use haptic2d::haptic::ControllerKind as SystemController;
 use haptic2d::laws::friction::FrictionModel;
 use haptic2d::laws::normal::NormalModel;
 use haptic2d::world::World;
@@ -102,19 +103,19 @@ enum Controller {
 
 impl Controller {
     fn new(kind: ControllerKind, dt: f64) -> Result<Self, String> {
-        Ok(match kind {
-            ControllerKind::Coupling => {
-                Controller::Coupling(VirtualCoupling::new(CouplingGains::default())?)
-            }
-            ControllerKind::FourChannel => {
-                Controller::FourChannel(FourChannel::new(FourChannelGains::default(), dt)?)
-            }
+        Ok(match kind.system() {
+            SystemController::Coupling(g) => Controller::Coupling(VirtualCoupling::new(g)?),
+            SystemController::FourChannel(g) => Controller::FourChannel(FourChannel::new(g, dt)?),
         })
     }
     fn kind(&self) -> ControllerKind {
         match self {
             Controller::Coupling(_) => ControllerKind::Coupling,
-            Controller::FourChannel(_) => ControllerKind::FourChannel,
+            Controller::FourChannel(c) => c
+                .gains
+                .name()
+                .and_then(|n| ControllerKind::from_name(n).ok())
+                .unwrap_or(ControllerKind::FourChannel),
         }
     }
     /// The slave drive `f_cs` (N, N, N·m).

@@ -87,11 +87,23 @@
 
   // ---------------------------------------------------------------- messages
   // `refused` maps a name to the reason it cannot be chosen (greyed out, the reason as tooltip).
+  // What the comparison controllers are (the names are those of `haptic2d run --controller`).
+  const NOTES = {
+    "four-channel": ["", "default: local force feedback C6 = -1 + damping injection, stable with the hand released"],
+    "four-channel-spec": ["(unstable released)", "the paper's §11.1 gains: unstable with the hand released against a stiff contact (comparison)"],
+    "four-channel-damped": ["(comparison)", "the §11.1 gains with 40 N·s/m of master damping injection (comparison)"],
+  };
+
   function fillSelect(sel, names, type, refused) {
     sel.innerHTML = "";
     for (const n of names) {
       const o = document.createElement("option");
       o.value = n; o.textContent = n;
+      const note = type === "set_controller" && NOTES[n];
+      if (note) {
+        if (note[0]) o.textContent = `${n} ${note[0]}`;
+        o.title = note[1];
+      }
       const why = refused && refused.get(n);
       if (why) {
         o.disabled = true;

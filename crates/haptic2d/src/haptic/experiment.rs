@@ -1,6 +1,11 @@
 //! [`DeviceInTheLoop`]: a [`HapticSystem`] closed around a simulated twin-pantograph plant and a
 //! simulated hand, stepped in simulated time (deterministic; no clock, no threads). Used by the
 //! device-in-the-loop experiments and tests.
+//!
+//! It stays in the core crate although the experiments live in `haptic2d-lab`: it is no experiment
+//! (no scenario, metric or report), only the loop closed around the core's own simulated plant, and
+//! the core's integration tests of the tick (`haptic_loop.rs`, `passivity_port.rs`,
+//! `workspace_bound.rs`) need it; the lab cannot be their dependency.
 
 use crate::device::linalg::V3;
 use crate::device::{DeviceFault, HandModel, SimDevice};

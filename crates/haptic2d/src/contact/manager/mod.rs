@@ -1,0 +1,223 @@
+//! The contact set: tracked VE pairs and contact records, their state machine (§8.2), god-objects
+//! (§8.3), simultaneous impacts (§7) and continuous-contact forces (§5.9, §1–§4).
+//!
+//! Entries are kept sorted by `(vertex collider, vertex, edge collider, edge)`; every loop runs in that
+//! order, so the result does not depend on anything but the inputs. After warm-up no step allocates:
+//! the buffers are swapped and reused.
+//!
+//! The step runs in stages, one file each, in the order of the spec (called in this order by
+//! [`ContactSet::step`]): [`sync`] (merge and measure), [`release`] (§8.2 rules 4–5), [`hand_over`]
+//! (the depth invariant), [`create`] (§8.2 rules 1–2, §8.3), [`impacts`] (§7), [`forces`] (§1–§4,
+//! §5.9); [`invariant`] holds the depth invariant's checks.
+
+mod create;
+mod forces;
+mod hand_over;
+mod impacts;
+mod invariant;
+mod release;
+mod sync;
+
+use crate::body::Body;
+use crate::collide::{Collider, VeCandidate, DEFAULT_DELTA_C, NEAR_PARALLEL_ANGLE};
+use crate::contact::impact::{ImpactRow, ImpactSolver};
+use crate::contact::law_pool::LawPool;
+use crate::contact::params::ContactParams;
+use crate::contact::record::{ContactEvent, LawState, VeContact};
+use crate::geom::{Pose, Rot, Vec2};
+use crate::laws::friction::FrictionModel;
+use crate::laws::normal::NormalModel;
+
+/// Per-body contact wrench of one sample: force (N) and torque about the COM (N·m).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Wrench2 {
+    /// Force (N).
+    pub force: Vec2,
+    /// Torque about the body's centre of mass (N·m).
+    pub torque: f64,
+}
+
+/// The past body poses the contact set needs for SEH history and god-object entry points.
+pub struct PastPoses<'a> {
+    /// Poses at `k − 1` (empty before the first step).
+    pub prev: &'a [Pose],
+    /// Poses at `k − 2` (empty before the second step).
+    pub prev2: &'a [Pose],
+}
+
+/// All tracked VE pairs and contact records of a world.
+#[derive(Clone, Debug)]
+pub struct ContactSet {
+    /// Thresholds and options.
+    pub params: ContactParams,
+    entries: Vec<VeContact>,
+    /// Law states of the records, addressed by [`VeContact::law`].
+    laws: LawPool,
+    merged: Vec<VeContact>,
+    pending: Vec<VeContact>,
+    events: Vec<ContactEvent>,
+    rows: Vec<ImpactRow>,
+    row_entry: Vec<usize>,
+    solver: ImpactSolver,
+    body_flag: Vec<bool>,
+    parent: Vec<u32>,
+    row_order: Vec<u32>,
+    row_island: Vec<u32>,
+    island_rows: Vec<ImpactRow>,
+    new_count: Vec<u32>,
+    nonfric: Vec<Vec2>,
+    /// Kinetic energy removed by the impacts of the last sample (J).
+    pub last_impact_loss: f64,
+    /// Energy stored in contact and friction springs after the last step (J).
+    stored: f64,
+    /// Number of contact records after the last step.
+    record_count: usize,
+    /// Number of impact sets solved so far.
+    pub impacts_solved: u64,
+    /// `cos(NEAR_PARALLEL_ANGLE)`: edges with `n·n < −cos_parallel` face each other.
+    cos_parallel: f64,
+    /// Contact distance tolerance `δ_c` (m): also the tolerance of the depth invariant.
+    delta_c: f64,
+}
+
+impl ContactSet {
+    /// An empty contact set.
+    pub fn new(params: ContactParams) -> Self {
+        Self {
+            params,
+            entries: Vec::with_capacity(64),
+            laws: LawPool::with_capacity(64),
+            merged: Vec::with_capacity(64),
+            pending: Vec::with_capacity(16),
+            events: Vec::with_capacity(64),
+            rows: Vec::with_capacity(16),
+            row_entry: Vec::with_capacity(16),
+            solver: ImpactSolver::new(),
+            body_flag: Vec::new(),
+            parent: Vec::new(),
+            row_order: Vec::with_capacity(16),
+            row_island: Vec::with_capacity(16),
+            island_rows: Vec::with_capacity(16),
+            new_count: Vec::new(),
+            nonfric: Vec::new(),
+            last_impact_loss: 0.0,
+            stored: 0.0,
+            record_count: 0,
+            impacts_solved: 0,
+            cos_parallel: NEAR_PARALLEL_ANGLE.cos(),
+            delta_c: DEFAULT_DELTA_C,
+        }
+    }
+
+    /// Sets the contact distance tolerance `δ_c` (m, the local stage's; default
+    /// [`DEFAULT_DELTA_C`]), which is also the tolerance of the depth invariant
+    /// ([`ContactSet::step`]). A non-finite or negative value is ignored.
+    pub fn set_delta_c(&mut self, delta_c: f64) {
+        if delta_c.is_finite() && delta_c >= 0.0 {
+            self.delta_c = delta_c;
+        }
+    }
+
+    /// Every tracked pair and contact record, sorted by key.
+    #[inline]
+    pub fn entries(&self) -> &[VeContact] {
+        &self.entries
+    }
+
+    /// The contact records (Colliding or Continuous), sorted by key.
+    pub fn records(&self) -> impl Iterator<Item = &VeContact> {
+        self.entries.iter().filter(|e| e.is_contact())
+    }
+
+    /// The law states of record `e` (an entry of [`entries`](Self::entries)); `None` for a pair that
+    /// is only tracked.
+    pub fn laws(&self, e: &VeContact) -> Option<&LawState> {
+        if e.is_contact() {
+            self.laws.get(e.law)
+        } else {
+            None
+        }
+    }
+
+    /// Number of contact records after the last step (counted in the force pass, so reading it
+    /// every tick costs nothing).
+    #[inline]
+    pub fn contact_count(&self) -> usize {
+        self.record_count
+    }
+
+    /// The state transitions of the last sample.
+    #[inline]
+    pub fn events(&self) -> &[ContactEvent] {
+        &self.events
+    }
+
+    /// Energy stored in all contact and friction springs after the last step (J).
+    pub fn stored_energy(&self) -> f64 {
+        self.stored
+    }
+
+    /// Steps 4–6 of §0.5 for one sample: merge the local stage's candidates into the tracked set and
+    /// measure every pair, run the state machine, resolve impacts (velocity jumps applied to `bodies`
+    /// now), then compute continuous-contact forces into `wrenches` (one per body, overwritten).
+    ///
+    /// **Depth invariant** (issue 10). A record `(V, e)` stores `½·K_c·d_e²`, a function of the
+    /// poses while its key is fixed, so the stored energy is continuous over its life; it can only
+    /// jump where a record is created or changes edge. There its depth must be the vertex's real
+    /// depth in the edge polygon B, up to the corner tolerance `δ_c`:
+    ///
+    /// ```text
+    /// d_e ≥ max_j d_j(V) − δ_c      (j over B's edge lines; −max_j d_j = depth of V inside B)
+    /// ```
+    ///
+    /// which also bounds `−d_e` by the pair's separating-axis depth `+ δ_c` (no vertex is deeper
+    /// in B than the pair's penetration depth). One exception, face on face: where `V` sits at a
+    /// corner of B on its side line (coincident corners of an aligned stack) and `e` *faces* an
+    /// edge of A at `V` (antiparallel within [`NEAR_PARALLEL_ANGLE`], the corner-on-corner rule),
+    /// the faces overlap by the pair's separating-axis depth while `V` is on B's boundary: the
+    /// record is then valid up to that depth, `−d_e ≤ depth_SAT + δ_c` (a landing 10-box stack
+    /// compresses its faces by 2.02 mm with `V` at `±1e-19 m` from the side line). A far edge
+    /// never faces A (its normal points away from A). Candidates satisfy it where they are made (the
+    /// local stage's nearest-line rule); `create` checks it for the edge it picks (the crossed-edge
+    /// rule may pick another one); `hand_over` moves a record whose vertex has come nearer to
+    /// another line of B by more than `δ_c` to that edge (or releases it if the vertex is outside
+    /// B): its stored energy then drops, never rises. Debug builds assert the invariant for every
+    /// record at the end of every sample.
+    #[allow(clippy::too_many_arguments)]
+    pub fn step(
+        &mut self,
+        tick: u64,
+        dt: f64,
+        candidates: &[VeCandidate],
+        colliders: &[Collider],
+        bodies: &mut [Body],
+        rots: &[Rot],
+        past: &PastPoses<'_>,
+        normal: &NormalModel,
+        friction: &FrictionModel,
+        wrenches: &mut [Wrench2],
+    ) {
+        self.events.clear();
+        self.last_impact_loss = 0.0;
+        self.resize_body_buffers(bodies.len());
+        self.sync(tick, candidates, colliders, bodies, rots, past);
+        self.release(tick);
+        self.hand_over(tick, colliders, bodies, past, normal, friction);
+        let any_colliding = self.create(tick, dt, colliders, bodies, past, normal, friction);
+        if any_colliding {
+            self.resolve_impacts(tick, bodies);
+        }
+        self.forces(dt, bodies, friction, wrenches);
+        #[cfg(debug_assertions)]
+        self.assert_depth_invariant(colliders);
+    }
+
+    fn resize_body_buffers(&mut self, n: usize) {
+        if self.body_flag.len() != n {
+            self.body_flag.resize(n, false);
+            self.parent.resize(n, 0);
+            self.new_count.resize(n, 0);
+            self.nonfric.resize(n, Vec2::ZERO);
+        }
+    }
+}

@@ -1,0 +1,38 @@
+//! Stage 2 of the contact step: §8.2 rule 4 (release of a record that left its edge) and rule 5
+//! (re-collision, optional).
+
+use super::ContactSet;
+use crate::contact::record::{ContactEvent, ContactState, EventKind, NO_LAW};
+
+impl ContactSet {
+    /// §8.2 rule 4 (release) and rule 5 (re-collision, optional).
+    pub(super) fn release(&mut self, tick: u64) {
+        let p = self.params;
+        for e in self.entries.iter_mut() {
+            if e.state != Some(ContactState::Continuous) {
+                continue;
+            }
+            if e.d[0] > p.delta_off || !e.in_range(p.eps_s) {
+                e.state = None;
+                self.laws.release(e.law);
+                e.law = NO_LAW;
+                e.f_n = 0.0;
+                e.f_t = 0.0;
+                self.events.push(ContactEvent {
+                    tick,
+                    key: e.key,
+                    kind: EventKind::Released,
+                });
+            } else if let Some(v_re) = p.v_re {
+                if p.impacts && e.c0 < -v_re {
+                    e.state = Some(ContactState::Colliding);
+                    self.events.push(ContactEvent {
+                        tick,
+                        key: e.key,
+                        kind: EventKind::Recollision,
+                    });
+                }
+            }
+        }
+    }
+}
