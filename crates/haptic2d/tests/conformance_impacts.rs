@@ -162,13 +162,18 @@ fn rod_corner_impact_matches_routh_through_the_world() {
     let (m, len, thick, e) = (1.0, 0.4, 0.01, 0.5);
     let inertia = m * (len * len + thick * thick) / 12.0;
     // (θ deg, μ, v_x, v_y, case)
-    let cases: [(f64, f64, f64, f64, &str); 4] = [
-        (45.0, 0.3, 2.0, -1.0, "sliding throughout"),
-        (30.0, 0.3, -1.5, -1.0, "sliding throughout"),
-        (45.0, 0.9, 0.0, -1.0, "sticking"),
-        (45.0, 0.2, 0.05, -1.0, "reversal"),
+    // (θ deg, μ, v_x, v_y, case); μ = None leaves impact_mu out: the default is the friction
+    // model's μ_k (0.5 here).
+    let cases: [(f64, Option<f64>, f64, f64, &str); 5] = [
+        (45.0, Some(0.3), 2.0, -1.0, "sliding throughout"),
+        (30.0, Some(0.3), -1.5, -1.0, "sliding throughout"),
+        (60.0, None, 1.0, -1.0, "sliding throughout, default μ = μ_k"),
+        (45.0, Some(0.9), 0.0, -1.0, "sticking"),
+        (45.0, Some(0.2), 0.05, -1.0, "reversal"),
     ];
-    for (theta, mu, vx, vy, case) in cases {
+    for (theta, mu_given, vx, vy, case) in cases {
+        let mu = mu_given.unwrap_or(0.5);
+        let mu_line = mu_given.map_or(String::new(), |m| format!("\nimpact_mu = {m}"));
         let th = theta.to_radians();
         // The lowest corner is the body-frame corner (−len/2, −thick/2) rotated by θ.
         let c = Vec2::new(-len / 2.0, -thick / 2.0);
@@ -178,7 +183,7 @@ fn rod_corner_impact_matches_routh_through_the_world() {
         );
         let y0 = -rc.y + 0.0015; // corner 1.5 mm above the floor
         let mut w = world(
-            &format!("restitution = {e}\nimpact_friction = \"coulomb\"\nimpact_mu = {mu}"),
+            &format!("restitution = {e}\nimpact_friction = \"coulomb\"{mu_line}"),
             CLASSICAL,
             &format!(
                 "[[body]]\nname = \"rod\"\nmass = {m}\ninertia = {inertia}\nbox = [{len}, {thick}]\n\

@@ -290,3 +290,44 @@ fn none_and_zero_mu_are_the_frictionless_solver() {
         "frictionless impact changed the tangential velocity"
     );
 }
+
+/// `[contact] impact_friction` and `impact_mu` are parsed like every other field: a bad value names
+/// the field and the fix, never panics; the defaults keep the frictionless impacts of §7.
+#[test]
+fn scene_impact_friction_fields_are_checked() {
+    use haptic2d::scene::Scene;
+    let base = "[[body]]\nname = \"wall\"\nkind = \"fixed\"\npolygon = [[-0.1, -0.2], [0.0, -0.2], [0.0, 0.2], [-0.1, 0.2]]\n";
+    let err = |contact: &str| {
+        let text = format!("[contact]\n{contact}\n{base}");
+        match Scene::from_toml(&text, "t.toml", None) {
+            Ok(_) => panic!("accepted {contact}"),
+            Err(e) => e,
+        }
+    };
+    let e = err("impact_friction = \"cone\"");
+    assert!(e.errors.iter().any(|x| x.field == "contact.impact_friction"
+        && x.message.contains("none, coulomb")
+        && x.fix.contains("coulomb")));
+    for bad in ["-0.1", "1e9", "nan"] {
+        let e = err(&format!("impact_friction = \"coulomb\"\nimpact_mu = {bad}"));
+        assert!(
+            e.errors
+                .iter()
+                .any(|x| x.field == "contact.impact_mu" && x.fix.contains("mu_k")),
+            "impact_mu = {bad}: {e}"
+        );
+    }
+    let ok = Scene::from_toml(
+        &format!("[contact]\nimpact_mu = 0.3\n{base}"),
+        "t.toml",
+        None,
+    )
+    .expect("valid");
+    assert!(ok.warnings.iter().any(|w| w.contains("impact_friction")));
+    let default = Scene::from_toml(base, "t.toml", None).expect("valid");
+    assert_eq!(
+        default.world.params.contact.impact_friction,
+        ImpactFriction::None
+    );
+    assert_eq!(default.world.params.contact.impact_mu, None);
+}
