@@ -76,6 +76,8 @@ impl MixedLcp {
     /// impulses for [`ImpactPhase::Restitution`] (ignored for compression). Returns the number of mode
     /// vectors tried when a solution within tolerance was found (read it with
     /// [`solution`](Self::solution)), `None` when none was (the caller then iterates).
+    // Contact `i` indexes its two rows, its mode and its prescribed impulse together.
+    #[allow(clippy::needless_range_loop)]
     pub fn solve(
         &mut self,
         a: &[f64],
