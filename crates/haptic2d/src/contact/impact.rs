@@ -173,7 +173,8 @@ impl ImpactSolver {
             eps_v: EPS_V,
             friction: ImpactFriction::None,
             mu: 0.0,
-            fric: FrictionalImpactSolver::with_capacity(rows),
+            // Grown on first use only: the frictionless default keeps §7's memory (impact_memory.rs).
+            fric: FrictionalImpactSolver::default(),
         };
         s.reserve(rows);
         s
@@ -199,6 +200,10 @@ impl ImpactSolver {
     pub fn set_friction(&mut self, friction: ImpactFriction, mu: f64) {
         self.friction = friction;
         self.mu = if mu.is_finite() && mu > 0.0 { mu } else { 0.0 };
+        if friction == ImpactFriction::Coulomb {
+            // The frictional buffers for a typical set, before the first impact needs them.
+            self.fric.reserve(8);
+        }
     }
 
     /// The frictional solver (its impulses of the last frictional solve, its fallback counters).
