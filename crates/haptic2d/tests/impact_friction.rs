@@ -20,6 +20,7 @@ fn random_frictional_impacts_never_gain_energy_and_stay_finite() {
     let mut solver = ImpactSolver::new();
     let mut rows = Vec::new();
     let (mut fallbacks_seen, mut multi) = (0u64, 0usize);
+    let (mut iterative, mut unconverged) = (0usize, 0usize);
     for case in 0..10_000 {
         let nb = rng.random_range(1..=3);
         let mut bodies = vec![Body::fixed("ground", Pose::IDENTITY)];
@@ -81,11 +82,16 @@ fn random_frictional_impacts_never_gain_energy_and_stay_finite() {
             fallbacks_seen += 1;
         }
         multi += (n > 1) as usize;
+        if n > 4 {
+            iterative += 1;
+            unconverged += (!out.compression.converged) as usize;
+        }
     }
     let (restitution_scaled, jump_scaled) = solver.frictional().fallbacks();
     eprintln!(
         "10^4 random sets: {multi} with several contacts; energy fallbacks {fallbacks_seen} \
-         (restitution scaled {restitution_scaled}, whole jump scaled {jump_scaled})"
+         (restitution scaled {restitution_scaled}, whole jump scaled {jump_scaled}); \
+         iterative (n > 4) {iterative}, of which at the sweep limit {unconverged}"
     );
     // The random set exercises the guarantee (Poisson with friction does create energy sometimes)
     // and the multi-contact solver.
