@@ -336,6 +336,7 @@ impl World {
             &mut self.contact_wrench,
         );
         self.ledger.impact_loss += self.contacts.last_impact_loss;
+        self.ledger.impact_energy_fallbacks = self.contacts.impact_energy_fallbacks();
         if let Some(g) = self.guard.as_mut() {
             // An impulse changes a body's energy without a held force: count that change as the body's
             // input, so the guard checks the integrator alone (impacts only lower the total, §7).

@@ -3,8 +3,11 @@
 //! The caller (the contact manager, §8.2) builds the impact set `𝒞`: every Colliding contact with
 //! restitution `e`, plus every Continuous contact touching a body of a colliding one with restitution 0.
 //! [`ImpactSolver::solve`] then runs §7.2 and applies the velocity jumps to the bodies. Friction is
-//! ignored during the impulse (§7, [REC]).
+//! ignored during the impulse (§7, [REC]) unless [`ImpactSolver::set_friction`] selects
+//! [`ImpactFriction::Coulomb`]: then every set goes to the frictional solver of issue 16
+//! ([`super::impact_friction`]).
 
+use super::impact_friction::{FrictionalImpactSolver, ImpactFriction, PhaseMethod};
 use super::lcp::{LcpReport, LcpSolver};
 use crate::body::Body;
 use crate::geom::{cross, Vec2};
@@ -42,7 +45,7 @@ pub struct ImpactRow {
 impl ImpactRow {
     /// The Jacobian row `G_i` as two blocks `(n, r_A × n)` for A and `(−n, −(r_B × n))` for B (§7.1).
     /// A fixed body's block is zero.
-    fn jacobian(&self, bodies: &[Body]) -> [f64; 6] {
+    pub(super) fn jacobian(&self, bodies: &[Body]) -> [f64; 6] {
         let mut j = [0.0; 6];
         if bodies[self.body_a].is_dynamic() {
             j[0] = self.n.x;
@@ -95,6 +98,9 @@ pub struct ImpactOutcome {
     pub correction: Option<LcpReport>,
     /// Smallest post-impact normal velocity `min_i b⁺_i` (m/s); `+∞` for an empty set.
     pub min_post_velocity: f64,
+    /// True if a frictional solve's energy check scaled an impulse (issue 16); always false without
+    /// friction.
+    pub energy_fallback: bool,
 }
 
 /// Solver for simultaneous frictionless impacts with Poisson restitution (§7.2).
@@ -128,6 +134,12 @@ pub struct ImpactSolver {
     step: Vec<f64>,
     /// Constraint-check tolerance `ε_v` (m/s).
     eps_v: f64,
+    /// Impact friction mode (issue 16; default none).
+    friction: ImpactFriction,
+    /// Impact friction coefficient `μ` (dimensionless).
+    mu: f64,
+    /// The frictional solver, used when `friction` is Coulomb and `μ > 0`.
+    fric: FrictionalImpactSolver,
 }
 
 impl Default for ImpactSolver {
@@ -159,6 +171,10 @@ impl ImpactSolver {
             impulse: Vec::new(),
             step: Vec::new(),
             eps_v: EPS_V,
+            friction: ImpactFriction::None,
+            mu: 0.0,
+            // Grown on first use only: the frictionless default keeps §7's memory (impact_memory.rs).
+            fric: FrictionalImpactSolver::default(),
         };
         s.reserve(rows);
         s
@@ -176,6 +192,30 @@ impl ImpactSolver {
         }
         self.eps_v = eps_v;
         Ok(())
+    }
+
+    /// Selects the impact friction mode and its coefficient `mu` (dimensionless; a non-finite or
+    /// negative value is treated as 0, i.e. frictionless). With [`ImpactFriction::None`] or `μ = 0`
+    /// the frictionless algorithm of §7.2 runs unchanged.
+    pub fn set_friction(&mut self, friction: ImpactFriction, mu: f64) {
+        self.friction = friction;
+        self.mu = if mu.is_finite() && mu > 0.0 { mu } else { 0.0 };
+        if friction == ImpactFriction::Coulomb {
+            // The frictional buffers for a typical set, before the first impact needs them.
+            self.fric.reserve(8);
+        }
+    }
+
+    /// The frictional solver (its impulses of the last frictional solve, its fallback counters).
+    pub fn frictional(&self) -> &FrictionalImpactSolver {
+        &self.fric
+    }
+
+    /// Number of impact sets whose energy check scaled an impulse so far (issue 16: restitution
+    /// scaled plus whole jump scaled); 0 without friction.
+    pub fn energy_fallbacks(&self) -> u64 {
+        let (r, j) = self.fric.fallbacks();
+        r + j
     }
 
     /// Largest impact set solvable without allocating.
@@ -277,6 +317,9 @@ impl ImpactSolver {
         let n = rows.len();
         self.reserve(n);
         self.n = n;
+        if self.friction == ImpactFriction::Coulomb && self.mu > 0.0 && n > 0 {
+            return self.solve_frictional(rows, bodies);
+        }
         if n > DENSE_MAX_ROWS {
             return self.solve_sparse(rows, bodies);
         }
@@ -404,6 +447,40 @@ impl ImpactSolver {
         self.outcome(bodies, ke_before, passes, compression, correction)
     }
 
+    /// Issue 16: the frictional solve; the per-row buffers report its normal impulses.
+    fn solve_frictional(&mut self, rows: &[ImpactRow], bodies: &mut [Body]) -> ImpactOutcome {
+        let n = rows.len();
+        let ke_before: f64 = bodies.iter().map(Body::kinetic_energy).sum();
+        for (i, row) in rows.iter().enumerate() {
+            self.jac[i] = row.jacobian(bodies);
+        }
+        self.normal_velocities(rows, bodies, Buf::Pre);
+        let out = self.fric.solve(rows, self.mu, self.eps_v, bodies);
+        self.normal_velocities(rows, bodies, Buf::Post);
+        self.b_mid[..n].copy_from_slice(&self.b_post[..n]);
+        self.lambda[..n].copy_from_slice(self.fric.compression_impulses());
+        self.impulse[..n].copy_from_slice(self.fric.normal_impulses());
+        for i in 0..n {
+            self.correction[i] = 0.0;
+        }
+        let method = match out.compression {
+            PhaseMethod::Enumeration | PhaseMethod::Routh => super::lcp::LcpMethod::Enumeration,
+            PhaseMethod::Pgs => super::lcp::LcpMethod::Pgs,
+            PhaseMethod::Empty => super::lcp::LcpMethod::Empty,
+        };
+        let mut o = self.outcome(
+            bodies,
+            ke_before,
+            out.correction_passes,
+            empty_report(n),
+            None,
+        );
+        o.compression.method = method;
+        o.compression.converged = out.converged;
+        o.energy_fallback = out.restitution_scale.is_some() || out.jump_scale.is_some();
+        o
+    }
+
     /// Projected Gauss–Seidel applied directly to the bodies' twists; accumulates the impulses in
     /// `lambda` (`Buf::Impulse`) or `step` (`Buf::Step`), which must start at zero. Stops when the
     /// largest increment of a sweep is below 1e-9 N·s, or after `PGS_MAX_SWEEPS` sweeps.
@@ -478,6 +555,7 @@ impl ImpactSolver {
                 .iter()
                 .copied()
                 .fold(f64::INFINITY, f64::min),
+            energy_fallback: false,
         }
     }
 

@@ -426,7 +426,7 @@ impl LcpSolver {
 
 /// Solves `m·x = rhs` in place (row-major `k × k`; the solution replaces `rhs`) by Gaussian
 /// elimination with partial pivoting. Returns false if a pivot has magnitude below [`PIVOT_MIN`].
-fn gauss_solve(m: &mut [f64], rhs: &mut [f64], k: usize) -> bool {
+pub(crate) fn gauss_solve(m: &mut [f64], rhs: &mut [f64], k: usize) -> bool {
     for col in 0..k {
         // Partial pivoting: largest |m[r][col]| for r ≥ col.
         let mut p = col;

@@ -2,6 +2,8 @@
 
 mod god_object;
 pub mod impact;
+pub mod impact_friction;
+pub mod impact_mlcp;
 mod law_pool;
 pub mod lcp;
 mod manager;
@@ -9,6 +11,7 @@ mod params;
 mod record;
 
 pub use god_object::entry_point;
+pub use impact_friction::{default_impact_mu, ImpactFriction};
 pub use manager::{ContactSet, PastPoses, Wrench2};
 pub use params::ContactParams;
 pub use record::{ContactEvent, ContactState, EventKind, LawState, VeContact, NO_LAW};

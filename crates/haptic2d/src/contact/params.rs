@@ -21,6 +21,10 @@ pub struct ContactParams {
     pub v_re: Option<f64>,
     /// Plastic-correction threshold `ε_v` (m/s) of the impact solver.
     pub eps_v: f64,
+    /// Friction during impacts (issue 16): none (default, §7) or Coulomb.
+    pub impact_friction: super::ImpactFriction,
+    /// Impact friction coefficient `μ` (dimensionless); `None` = the contact friction model's `μ_k`.
+    pub impact_mu: Option<f64>,
 }
 
 impl Default for ContactParams {
@@ -34,6 +38,8 @@ impl Default for ContactParams {
             restitution: 0.5,
             v_re: None,
             eps_v: 1e-6,
+            impact_friction: super::ImpactFriction::None,
+            impact_mu: None,
         }
     }
 }

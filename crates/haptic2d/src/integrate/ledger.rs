@@ -14,6 +14,9 @@ pub struct EnergyLedger {
     pub initial: f64,
     /// Kinetic energy removed by impacts so far (J, ≥ 0).
     pub impact_loss: f64,
+    /// Frictional impact sets (issue 16) whose energy check had to scale an impulse so that the
+    /// impact did not add kinetic energy (restitution scaled, or the whole jump); 0 without friction.
+    pub impact_energy_fallbacks: u64,
 }
 
 impl EnergyLedger {

@@ -246,6 +246,8 @@ pub(super) fn build(
     }
 
     // [contact]
+    /// Largest accepted impact friction coefficient (dimensionless): far above any material pair.
+    const MAX_IMPACT_MU: f64 = 100.0;
     let c = &file.contact;
     let mut cp = ContactParams::default();
     if let Some(x) = c.impacts {
@@ -290,6 +292,31 @@ pub(super) fn build(
             &mut errs,
         );
         cp.v_re = Some(v);
+    }
+    if let Some(name) = &c.impact_friction {
+        match crate::contact::ImpactFriction::from_name(name) {
+            Ok(f) => cp.impact_friction = f,
+            Err(e) => errs.push(SceneError::new(
+                "contact.impact_friction",
+                e,
+                "e.g. impact_friction = \"coulomb\" (or \"none\", the default)",
+            )),
+        }
+    }
+    if let Some(mu) = c.impact_mu {
+        if !(mu.is_finite() && (0.0..=MAX_IMPACT_MU).contains(&mu)) {
+            errs.push(SceneError::new(
+                "contact.impact_mu",
+                format!("must be a friction coefficient in [0, {MAX_IMPACT_MU}], got {mu}"),
+                "e.g. impact_mu = 0.3, or leave it out to use the friction model's mu_k",
+            ));
+        }
+        cp.impact_mu = Some(mu);
+        if cp.impact_friction == crate::contact::ImpactFriction::None {
+            warnings.push(
+                "contact.impact_mu is set but contact.impact_friction is \"none\": impacts stay frictionless (set impact_friction = \"coulomb\")".to_string(),
+            );
+        }
     }
     params.contact = cp;
 

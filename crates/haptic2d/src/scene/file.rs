@@ -75,6 +75,10 @@ pub struct ContactSection {
     pub eps_s: Option<f64>,
     /// Re-collision speed v_re (m/s); off when absent.
     pub recollision_speed: Option<f64>,
+    /// Friction during impacts: "none" (default, frictionless impulses) or "coulomb" (issue 16).
+    pub impact_friction: Option<String>,
+    /// Impact friction coefficient μ (dimensionless, ≥ 0); default the friction model's μ_k.
+    pub impact_mu: Option<f64>,
 }
 
 /// `[[body]]`.

@@ -152,6 +152,11 @@ impl ContactSet {
         &self.events
     }
 
+    /// Impact sets whose energy check scaled an impulse so far (issue 16; 0 without friction).
+    pub fn impact_energy_fallbacks(&self) -> u64 {
+        self.solver.energy_fallbacks()
+    }
+
     /// Energy stored in all contact and friction springs after the last step (J).
     pub fn stored_energy(&self) -> f64 {
         self.stored
@@ -205,6 +210,10 @@ impl ContactSet {
         self.hand_over(tick, colliders, bodies, past, normal, friction);
         let any_colliding = self.create(tick, dt, colliders, bodies, past, normal, friction);
         if any_colliding {
+            // Impact friction mode and coefficient (default μ = the friction model's μ_k; docs/MODELS.md §F).
+            let mu = (self.params.impact_mu)
+                .unwrap_or_else(|| crate::contact::default_impact_mu(friction));
+            self.solver.set_friction(self.params.impact_friction, mu);
             self.resolve_impacts(tick, bodies);
         }
         self.forces(dt, bodies, friction, wrenches);
