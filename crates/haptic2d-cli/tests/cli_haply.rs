@@ -3,8 +3,10 @@
 //!
 //! The device files used here are the shipped gen 3 file with a reply timeout of 100 periods: the
 //! tests run on machines shared with compilers, and what they check is the protocol and the exit
-//! paths, not the timing (the default 3 periods is exercised by the driver tests), and with the
-//! watchdog's missed-deadline check off (`max_missed_deadlines = 0`) for the same reason. The tests
+//! paths, not the timing (the default 3 periods is exercised by the driver tests), with the
+//! watchdog's missed-deadline check off (`max_missed_deadlines = 0`) and a stall limit of 1000
+//! periods for the same reason (an unprivileged loop on a loaded machine can sleep 10 ms past a
+//! deadline; the stall check itself is tested in `run_rig`'s unit tests on synthetic tick times). The tests
 //! take turns (one emulator at a time) to keep the load down.
 
 use std::io::{BufRead, BufReader};
@@ -33,7 +35,8 @@ fn device_file(dir: &Path, name: &str, edit: impl Fn(String) -> String) -> PathB
     let p = dir.join(name);
     let text = gen3_text()
         .replace("timeout_periods = 3 ", "timeout_periods = 100 ")
-        .replace("max_missed_deadlines = 10 ", "max_missed_deadlines = 0 ");
+        .replace("max_missed_deadlines = 10 ", "max_missed_deadlines = 0 ")
+        .replace("max_stall_periods = 5 ", "max_stall_periods = 1000 ");
     std::fs::write(&p, edit(text)).unwrap();
     p
 }
