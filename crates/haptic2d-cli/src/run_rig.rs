@@ -567,4 +567,147 @@ mod tests {
             1.0
         );
     }
+
+    /// A real 2-DOF device that answers at once, or after `wait` in the read of tick `slow_at`.
+    struct FakeBoard {
+        q: [f64; 2],
+        reads: u64,
+        slow_at: u64,
+        wait: std::time::Duration,
+        last: [f64; 4],
+    }
+
+    impl DeviceIo for FakeBoard {
+        fn read_encoders(&mut self) -> Result<[f64; 4], DeviceError> {
+            if self.reads == self.slow_at {
+                std::thread::sleep(self.wait);
+            }
+            self.reads += 1;
+            Ok([self.q[0], self.q[1], 0.0, 0.0])
+        }
+        fn write_torques(&mut self, tau: &[f64; 4]) -> Result<(), DeviceError> {
+            self.last = *tau;
+            Ok(())
+        }
+        fn zero_torques(&mut self) {
+            self.last = [0.0; 4];
+        }
+        fn name(&self) -> &str {
+            "fake-board"
+        }
+    }
+
+    /// A rig on a fake gen 3 2DIY held at its workspace centre; the read of tick `slow_at` waits
+    /// `wait`; the device's own timeout is `wait_periods`.
+    fn board_rig(slow_at: u64, wait: std::time::Duration, wait_periods: f64) -> Rig {
+        let scene = builtin("box-in-walls", Some(1000.0)).unwrap().unwrap();
+        let linkage = Pantograph2::new(0.038, 0.07, 0.09).unwrap();
+        let q = linkage.ik(haptic2d::geom::Vec2::new(0.019, 0.10)).unwrap();
+        let real = RealDevice {
+            name: "fake-board".into(),
+            model: DeviceModel::FiveBar {
+                linkage,
+                tau_max: 0.123,
+            },
+            summary: "a fake 2DIY".into(),
+            wait_periods,
+            max_missed_run: None,
+            max_stall_periods: 5.0,
+            open: Box::new(move |_| {
+                Ok(Box::new(FakeBoard {
+                    q,
+                    reads: 0,
+                    slow_at,
+                    wait,
+                    last: [0.0; 4],
+                }) as Box<dyn DeviceIo + Send>)
+            }),
+        };
+        Rig::with_real(
+            scene.world,
+            "box-in-walls",
+            HapticConfig::default(),
+            DeviceChoice::Haply("fake".into()),
+            real,
+        )
+        .unwrap()
+    }
+
+    /// One tick of the loop's order (read, system, watchdog) at `info`; the torques as guarded.
+    fn guarded_tick(
+        rig: &mut Rig,
+        dog: &mut Watchdog,
+        info: &TickInfo,
+    ) -> (TickOutput, [f64; 4], Result<(), haptic2d_rt::Fault>) {
+        let q = rig.read().unwrap();
+        let out = rig.tick_system(&q, info, false);
+        let mut tau = out.torques;
+        let g = dog.guard(&rig.safety_input(info, &out, false), &mut tau);
+        (out, tau, g)
+    }
+
+    /// Task L item 2: a stalled loop (the tick wakes 20 periods after the previous one, no wait
+    /// for the device) latches zero torques within that tick, and says why.
+    #[test]
+    fn a_stalled_loop_latches_zero_torques_within_the_tick_with_its_reason() {
+        let mut rig = board_rig(u64::MAX, std::time::Duration::ZERO, 3.0);
+        let cfg = rig.watchdog_config();
+        assert_eq!(cfg.max_stall_periods, Some(5.0));
+        let mut dog = Watchdog::new(cfg).unwrap();
+        for k in 0..10 {
+            let (out, _, g) = guarded_tick(&mut rig, &mut dog, &info(k));
+            assert!(g.is_ok() && !out.tripped, "tick {k}");
+        }
+        // The loop itself was away: the watchdog sees 20 periods on the loop's own account.
+        let (out, tau, g) = guarded_tick(&mut rig, &mut dog, &info(30));
+        let f = g.unwrap_err();
+        assert!(
+            matches!(f.kind, haptic2d_rt::FaultKind::Stall { .. }),
+            "{f}"
+        );
+        assert!(f.to_string().contains("stalled"), "{f}");
+        assert_eq!(tau, [0.0; 4]);
+        // And the system's own latch (limit 5 + 3 periods, wake to wake) agrees, with its reason.
+        assert!(out.tripped && out.torques == [0.0; 4]);
+        let trip = rig.system.safety_trip().unwrap();
+        assert!(
+            matches!(trip.reason, haptic2d::haptic::SafetyReason::Stall { .. }),
+            "{trip}"
+        );
+    }
+
+    /// Task L item 2: a device slow to answer (20 ms in one read, within its own timeout) is not a
+    /// stall of the loop: the wait is left to the driver's timeout (a lost device, exit 4).
+    #[test]
+    fn a_slow_device_within_its_timeout_is_not_a_loop_stall() {
+        let mut rig = board_rig(5, std::time::Duration::from_millis(20), 30.0);
+        let mut dog = Watchdog::new(rig.watchdog_config()).unwrap();
+        for k in 0..6 {
+            let (out, _, g) = guarded_tick(&mut rig, &mut dog, &info(k));
+            assert!(g.is_ok() && !out.tripped, "tick {k}");
+        }
+        // The tick after the slow read wakes 21 periods after the previous one.
+        let (out, _, g) = guarded_tick(&mut rig, &mut dog, &info(26));
+        assert!(g.is_ok(), "{g:?}");
+        assert!(!out.tripped, "{:?}", rig.system.safety_trip());
+        assert!(rig.elapsed_periods < 5.0, "{}", rig.elapsed_periods);
+    }
+
+    #[test]
+    fn a_real_2dof_rig_starts_at_zero_torque_and_has_no_twin_drawing() {
+        let mut rig = board_rig(u64::MAX, std::time::Duration::ZERO, 3.0);
+        let q = rig.read().unwrap();
+        let out = rig.tick_system(&q, &info(0), false);
+        assert_eq!(out.torques, [0.0; 4]);
+        assert!(rig.twin_params().is_none() && rig.system.twin_kinematics().is_none());
+        assert!(rig.target.is_none());
+        // A rebuild (the page's reset) keeps the device and starts a fresh 2-DOF system.
+        let world = builtin("box-in-walls", Some(1000.0))
+            .unwrap()
+            .unwrap()
+            .world;
+        rig.rebuild(world).unwrap();
+        assert!(matches!(rig.system, RigSystem::TwoDof(_)));
+        assert_eq!(rig.io.name(), "fake-board");
+    }
 }

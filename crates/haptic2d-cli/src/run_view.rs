@@ -307,7 +307,7 @@ mod tests {
             for _ in 0..n {
                 view.apply_commands(rig);
                 let q = rig.io.read_encoders().unwrap();
-                let out = rig.system.tick(&q);
+                let out = rig.system.tick(&q, None, false);
                 rig.io.write_torques(&out.torques).unwrap();
                 let info = TickInfo {
                     index: k,

@@ -45,12 +45,19 @@ fn planar2_torques_start_at_zero_and_ramp_in_over_the_shared_ramp_time() {
     let mut prev_ramp = 0.0;
     for n in 1..=150 {
         let ramp = sys.ramp();
-        assert!((ramp - (n as f64 / 100.0).min(1.0)).abs() < 1e-12, "tick {n}: {ramp}");
+        assert!(
+            (ramp - (n as f64 / 100.0).min(1.0)).abs() < 1e-12,
+            "tick {n}: {ramp}"
+        );
         assert!(ramp >= prev_ramp);
         prev_ramp = ramp;
         let out = sys.tick(&q_at(0.005));
         assert!(!out.tripped, "{:?}", sys.safety_trip());
-        assert!(peak(&out.torques) <= 0.123 + 1e-15, "clamped: {:?}", out.torques);
+        assert!(
+            peak(&out.torques) <= 0.123 + 1e-15,
+            "clamped: {:?}",
+            out.torques
+        );
     }
     assert_eq!(sys.ramp(), 1.0);
 }
