@@ -148,12 +148,16 @@ pub fn run(a: &RunArgs) -> Result<Status, Failure> {
         },
         None => device_arg::resolve(a.device_file.as_deref(), &scene, 1.0 / a.rate)?,
     };
-    let config = HapticConfig {
+    let mut config = HapticConfig {
         device: device_setting.params,
         controller: opts.controller,
         passivity: a.passivity.then(PlanarPassivity::default),
         ..HapticConfig::default()
     };
+    // The gains the device will run with (e.g. the Haply twin's θ gains matched to its crank).
+    if let Some(m) = real.as_ref().and_then(|r| r.match_controller.as_ref()) {
+        config.controller = m(config.controller);
+    }
     // A real device only starts with a configuration that is stable with the hand released (§11.4).
     if let (Some(r), false) = (&real, a.allow_unstable) {
         crate::cmd_stability::check_real_device(&r.model, &config, &scene.world)?;

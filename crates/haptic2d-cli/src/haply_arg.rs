@@ -98,6 +98,7 @@ pub fn real_device(port: &str, device_file: Option<&Path>) -> Result<RealDevice,
         file.source, file.torque_limit
     );
     let open_name = name.clone();
+    let matcher = file.clone();
     Ok(RealDevice {
         name,
         model,
@@ -105,6 +106,7 @@ pub fn real_device(port: &str, device_file: Option<&Path>) -> Result<RealDevice,
         wait_periods: file.timeout_periods,
         max_missed_run: file.max_missed_deadlines,
         max_stall_periods: file.max_stall_periods,
+        match_controller: Some(Box::new(move |k| matcher.controller_for(k))),
         // Open and hand-shake before the first deadline.
         open: Box::new(move |period| {
             let port = open_port(&path)?;

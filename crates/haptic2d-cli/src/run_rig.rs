@@ -17,6 +17,7 @@
 //!    - the device's own reply timeout (`wait_periods`, periods: a silent device is its driver's
 //!      [`DeviceError::Lost`](haptic2d_rt::DeviceError::Lost) → exit 4), the watchdog's
 //!      missed-deadline limit and the stall limit on the loop's own time;
+//!    - optionally a `match_controller` that adapts the gains to the device;
 //!    - an `open` closure that opens and hand-shakes the device at the control period and returns
 //!      it as a [`DeviceIo`]; a 2-joint driver implements
 //!      [`Device2Io`](haptic2d_rt::io::Device2Io) and is wrapped in
@@ -32,7 +33,7 @@ use haptic2d::device::linalg::{V3, V4};
 use haptic2d::device::pantograph2::Pantograph2;
 use haptic2d::device::DeviceParams;
 use haptic2d::haptic::planar2::{Planar2Config, Planar2System};
-use haptic2d::haptic::{HapticConfig, HapticSystem, SafetyConfig, TickOutput};
+use haptic2d::haptic::{ControllerKind, HapticConfig, HapticSystem, SafetyConfig, TickOutput};
 use haptic2d::world::World;
 use haptic2d_rt::clock::now_ns;
 use haptic2d_rt::io::DEFAULT_REPLAY_COLUMNS;
@@ -129,9 +130,15 @@ pub struct RealDevice {
     /// The loop's own delay between two ticks that trips the stall check (periods, ≥ 1; the shared
     /// safety layer's default is 5).
     pub max_stall_periods: f64,
+    /// Matches the controller to the device (e.g. the Haply twin's θ gains to its crank); `None`
+    /// keeps the controller as chosen.
+    pub match_controller: Option<MatchController>,
     /// Opens it.
     pub open: OpenDevice,
 }
+
+/// Adjusts a controller's gains to a device.
+pub type MatchController = Box<dyn Fn(ControllerKind) -> ControllerKind + Send>;
 
 impl std::fmt::Debug for RealDevice {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -248,6 +255,9 @@ impl Rig {
     ) -> Result<Self, RealOpenError> {
         if let DeviceModel::Twin(p) = &real.model {
             config.device = *p;
+        }
+        if let Some(m) = &real.match_controller {
+            config.controller = m(config.controller);
         }
         let limits = RealLimits {
             model: real.model,
@@ -613,6 +623,7 @@ mod tests {
             wait_periods,
             max_missed_run: None,
             max_stall_periods: 5.0,
+            match_controller: None,
             open: Box::new(move |_| {
                 Ok(Box::new(FakeBoard {
                     q,

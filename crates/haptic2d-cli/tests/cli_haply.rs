@@ -22,9 +22,9 @@ fn turn() -> std::sync::MutexGuard<'static, ()> {
     ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner())
 }
 
-fn gen3_text() -> String {
+fn shipped_text(file: &str) -> String {
     std::fs::read_to_string(format!(
-        "{}/../../devices/haply-2diy-gen3.toml",
+        "{}/../../devices/{file}",
         env!("CARGO_MANIFEST_DIR")
     ))
     .unwrap()
@@ -32,8 +32,13 @@ fn gen3_text() -> String {
 
 /// The gen 3 file with `edit` applied, written into `dir`.
 fn device_file(dir: &Path, name: &str, edit: impl Fn(String) -> String) -> PathBuf {
+    shipped_file(dir, "haply-2diy-gen3.toml", name, edit)
+}
+
+/// The shipped device file `file` with the test settings and `edit` applied, written into `dir`.
+fn shipped_file(dir: &Path, file: &str, name: &str, edit: impl Fn(String) -> String) -> PathBuf {
     let p = dir.join(name);
-    let text = gen3_text()
+    let text = shipped_text(file)
         .replace("timeout_periods = 3 ", "timeout_periods = 100 ")
         .replace("max_missed_deadlines = 10 ", "max_missed_deadlines = 0 ")
         .replace("max_stall_periods = 5 ", "max_stall_periods = 1000 ");
@@ -340,4 +345,46 @@ fn a_silent_emulated_device_exits_4_with_the_reason() {
         "{out}"
     );
     assert!(!out.contains("panicked"), "{out}");
+}
+
+/// Task L items 1 and 3: the twin pantograph of two 2DIY linkages (4 ports) through the one loop of
+/// `run`, against the emulated twin pushed by a constant hand: a clean run, all four motors driven,
+/// every torque within the limit.
+#[test]
+fn twin_runs_through_the_normal_loop_against_the_emulator() {
+    let _turn = turn();
+    let dir = tempfile::tempdir().unwrap();
+    let file = shipped_file(dir.path(), "haply-twin.toml", "twin.toml", |t| t);
+    let (emu, pty) = emulate(&[
+        "--device-file",
+        file.to_str().unwrap(),
+        "--hand",
+        "constant:0.3,0,0",
+    ]);
+    let log = dir.path().join("twin.csv");
+    let o = Command::new(BIN)
+        .args(["run", "--device", &format!("haply:{pty}"), "--device-file"])
+        .arg(&file)
+        .args(["--headless", "--duration", "1.5", "--no-rt", "--log"])
+        .arg(&log)
+        .output()
+        .unwrap();
+    stop(emu);
+    let out = text(&o);
+    assert!(o.status.success(), "{out}");
+    assert!(out.contains("twin pantograph"), "{out}");
+    let csv = std::fs::read_to_string(&log).unwrap();
+    let taus: Vec<Vec<f64>> = ["tau1", "tau2", "tau3", "tau4"]
+        .iter()
+        .map(|c| column(&csv, c))
+        .collect();
+    for (i, t) in taus.iter().enumerate() {
+        assert_eq!(t[0], 0.0, "tau{} of the first tick", i + 1);
+        let peak = t.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        assert!(
+            peak > 0.0 && peak <= 0.123 + 1e-9,
+            "tau{}: peak {peak}",
+            i + 1
+        );
+    }
 }

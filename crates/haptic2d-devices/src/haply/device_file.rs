@@ -29,6 +29,7 @@
 use haptic2d::device::pantograph2::Pantograph2;
 use haptic2d::device::DeviceParams;
 use haptic2d::geom::Vec2;
+use haptic2d::haptic::ControllerKind;
 use haptic2d::scene::{device_params_from_toml, SceneError, SceneErrors};
 use serde::Deserialize;
 
@@ -451,6 +452,45 @@ impl HaplyDeviceFile {
     /// Number of joints (2 or 4).
     pub fn joints(&self) -> usize {
         self.motors.len()
+    }
+
+    /// The controller `kind` matched to this device's θ axis. A 2DIY has none (unchanged). On the
+    /// twin, the master-side θ gains (coupling `k[2]`, `b[2]`; four-channel `k_m[2]`, `b_m[2]`,
+    /// `d_m[2]`) are capped at the translational ones times `r_c²`, i.e. at most the stiffness and
+    /// damping at the crank pin that x and y have at the handle (N/m, N·s/m):
+    ///
+    /// ```text
+    /// k_θ ≤ k_x·r_c²,   b_θ ≤ b_x·r_c²    (a θ error δθ moves the crank pin r_c·δθ; the torque
+    ///                                    k_θ·δθ is the crank-pin force k_θ/r_c² · (r_c·δθ) · r_c)
+    /// ```
+    ///
+    /// Why (issue 12, the twin's closed-loop test was 30 % off): the default θ gains (1 N·m/rad,
+    /// 0.01 N·m·s/rad) were chosen for the paper's device. Through the Haply twin's 2 cm crank they
+    /// are 2500 N/m at the crank pin, five times the 500 N/m at the handle; with the board's one
+    /// period of latency and a θ inertia of ~1e-5 kg·m², θ limit-cycles (rms 18 mrad), the four
+    /// motors sit at the 0.123 N·m clamp two ticks in three, and the direction-preserving
+    /// saturation scales the x force the hand feels down by a quarter. Capped (0.2 N·m/rad,
+    /// 0.002 N·m·s/rad) θ settles (rms 2 mrad), nothing saturates and the rendered force is
+    /// exactly the hand's 0.8 N.
+    pub fn controller_for(&self, kind: ControllerKind) -> ControllerKind {
+        let HaplyKind::Twin(p) = &self.kind else {
+            return kind;
+        };
+        let r2 = p.r_c * p.r_c;
+        let cap = |v: &mut [f64; 3]| v[2] = v[2].min(v[0].min(v[1]) * r2);
+        match kind {
+            ControllerKind::Coupling(mut g) => {
+                cap(&mut g.k);
+                cap(&mut g.b);
+                ControllerKind::Coupling(g)
+            }
+            ControllerKind::FourChannel(mut g) => {
+                cap(&mut g.k_m);
+                cap(&mut g.b_m);
+                cap(&mut g.d_m);
+                ControllerKind::FourChannel(g)
+            }
+        }
     }
 
     /// A start pose inside the workspace: the centre (m, board frame; θ = 0 for the twin).
