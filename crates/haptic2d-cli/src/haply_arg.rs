@@ -84,10 +84,13 @@ pub fn real_device(port: &str, device_file: Option<&Path>) -> Result<RealDevice,
     let path = port_of(&format!("haply:{port}"), &file)?;
     let name = format!("haply:{path}");
     let (model, kind) = match &file.kind {
-        HaplyKind::TwoDiy { linkage, .. } => (
+        HaplyKind::TwoDiy {
+            linkage, center, ..
+        } => (
             DeviceModel::FiveBar {
                 linkage: *linkage,
                 tau_max: file.torque_limit,
+                center: *center,
             },
             "2-DOF 2DIY",
         ),

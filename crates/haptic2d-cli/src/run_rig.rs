@@ -108,6 +108,8 @@ pub enum DeviceModel {
         linkage: Pantograph2,
         /// Motor torque limit (N·m).
         tau_max: f64,
+        /// Centre of the workspace (m, the linkage's frame): where the stability gate linearises.
+        center: [f64; 2],
     },
 }
 
@@ -302,7 +304,9 @@ impl Rig {
             DeviceModel::Twin(_) => {
                 RigSystem::Twin(HapticSystem::with_safety(world, config, safety)?)
             }
-            DeviceModel::FiveBar { linkage, tau_max } => {
+            DeviceModel::FiveBar {
+                linkage, tau_max, ..
+            } => {
                 if config.passivity.is_some() {
                     return Err("--passivity is not available on a 2-DOF device (its port has no hand-wrench observer); leave it out".into());
                 }
@@ -618,6 +622,7 @@ mod tests {
             model: DeviceModel::FiveBar {
                 linkage,
                 tau_max: 0.123,
+                center: [0.019, 0.10],
             },
             summary: "a fake 2DIY".into(),
             wait_periods,

@@ -388,3 +388,74 @@ fn twin_runs_through_the_normal_loop_against_the_emulator() {
         );
     }
 }
+
+/// Task L item 4: `haptic2d stability` on a 2DIY device file gives the x and y verdicts of the 2-DOF
+/// device (no θ axis): the default four-channel controller is stable, the paper's gains are not
+/// with the hand released.
+#[test]
+fn stability_of_the_2diy_is_per_axis_x_and_y() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = format!(
+        "{}/../../devices/haply-2diy-gen3.toml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let run = |controller: &str| {
+        let o = Command::new(BIN)
+            .args([
+                "stability",
+                "--device-file",
+                &file,
+                "--controller",
+                controller,
+                "--out",
+            ])
+            .arg(dir.path())
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", text(&o));
+        text(&o)
+    };
+    let out = run("four-channel");
+    assert!(
+        out.contains("2-DOF device") && out.contains("axis x") && out.contains("axis y"),
+        "{out}"
+    );
+    assert!(!out.contains("axis theta"), "{out}");
+    assert_eq!(out.matches("verdict: stable").count(), 2, "{out}");
+    let out = run("four-channel-spec");
+    assert_eq!(
+        out.matches("UNSTABLE with the hand released").count(),
+        2,
+        "{out}"
+    );
+}
+
+/// Task L item 4: `run` refuses to drive a real 2DIY with a configuration that is unstable with the
+/// hand released (exit 2, nothing opened), unless `--allow-unstable`.
+#[test]
+fn run_refuses_an_unstable_released_configuration_on_a_haply_board() {
+    let _turn = turn();
+    let dir = tempfile::tempdir().unwrap();
+    let file = device_file(dir.path(), "gen3.toml", |t| t);
+    let (emu, pty) = emulate(&["--device-file", file.to_str().unwrap()]);
+    let args = |extra: &[&str]| {
+        let mut c = Command::new(BIN);
+        c.args(["run", "--device", &format!("haply:{pty}"), "--device-file"])
+            .arg(&file)
+            .args(["--headless", "--duration", "0.5", "--no-rt"])
+            .args(["--controller", "four-channel-spec"])
+            .args(extra);
+        c.output().unwrap()
+    };
+    let o = args(&[]);
+    let out = text(&o);
+    assert_eq!(o.status.code(), Some(2), "{out}");
+    assert!(
+        out.contains("unstable on axis") && out.contains("--allow-unstable"),
+        "{out}"
+    );
+    let o = args(&["--allow-unstable"]);
+    stop(emu);
+    let out = text(&o);
+    assert!(out.contains("running box-in-walls"), "{out}");
+}
