@@ -187,6 +187,8 @@ pub struct Rig {
     pub target: Option<Arc<SharedTarget>>,
     /// A real device's model and limits; `None` for the simulation and a replay.
     real: Option<RealLimits>,
+    /// A real device's controller matching (applied to the page's controller switches too).
+    match_controller: Option<MatchController>,
     /// Measures the interval between ticks (wake to wake).
     interval: TickInterval,
     /// Time the last read waited for the device (ns; real devices only).
@@ -238,6 +240,7 @@ impl Rig {
             hand,
             target,
             real: None,
+            match_controller: None,
             interval: TickInterval::new(),
             read_wait_ns: 0,
             prev_read_wait_ns: 0,
@@ -280,6 +283,7 @@ impl Rig {
             hand: HandSpec::Follow,
             target: None,
             real: Some(limits),
+            match_controller: real.match_controller,
             interval: TickInterval::new(),
             read_wait_ns: 0,
             prev_read_wait_ns: 0,
@@ -487,6 +491,18 @@ impl Rig {
             (Some(t), Some(s)) => s.map().pose_to_world(&t.get()),
             _ => self.system.handle_world(),
         }
+    }
+
+    /// Switches the controller to `kind` (from the page), matched to a real device as at start;
+    /// on error nothing changes.
+    pub fn set_controller(&mut self, kind: ControllerKind) -> Result<(), String> {
+        let k = match &self.match_controller {
+            Some(m) => m(kind),
+            None => kind,
+        };
+        self.system.set_controller(k)?;
+        self.config.controller = k;
+        Ok(())
     }
 
     /// The twin pantograph's parameters when the display should draw the linkage (simulated device,

@@ -186,8 +186,7 @@ impl LiveView {
             }
             Command::SetController { kind } => {
                 let k = SystemController::from_name(kind.name())?;
-                rig.system.set_controller(k)?;
-                rig.config.controller = k;
+                rig.set_controller(k)?;
             }
             Command::Pause => self.paused = true,
             Command::Resume => self.paused = false,
