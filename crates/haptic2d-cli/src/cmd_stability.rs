@@ -5,8 +5,15 @@
 //! hand's impedance to `OUT/poles-<controller>.svg|png`.
 
 use crate::device_arg;
+use crate::run_rig::DeviceModel;
 use crate::scene_arg;
+use haptic2d::device::pantograph2::Pantograph2;
+use haptic2d::geom::Vec2;
 use haptic2d::haptic::{ControllerKind, HapticConfig};
+use haptic2d_devices::haply::{HaplyDeviceFile, HaplyKind, Plant2};
+use haptic2d_lab::stability::planar2::{
+    analyse_planar2, check_released_stability_planar2, FiveBarDynamics,
+};
 use haptic2d_lab::stability::{analyse_config, plot::write_pole_plot};
 use std::path::PathBuf;
 
@@ -19,7 +26,8 @@ pub struct StabilityArgs {
     /// Controller: four-channel (default), four-channel-spec, four-channel-damped or coupling.
     #[arg(long, default_value = "four-channel")]
     pub controller: String,
-    /// Device parameters (TOML; template devices/twin-pantograph.toml).
+    /// Device parameters (TOML; template devices/twin-pantograph.toml), or a Haply device file
+    /// (devices/haply-*.toml: a 2DIY gives the x and y axes of the 2-DOF device).
     #[arg(long, value_name = "FILE.toml")]
     pub device_file: Option<PathBuf>,
     /// Loop rate (Hz).
@@ -56,8 +64,35 @@ pub fn run(a: &StabilityArgs) -> Result<(), String> {
     }
     let controller =
         ControllerKind::from_name(&a.controller).map_err(|e| format!("--controller: {e}"))?;
+    // A Haply device file (a top-level `kind`): the 2DIY's x and y, or the twin with its θ gains
+    // matched to the crank.
+    let haply = match a.device_file.as_deref() {
+        Some(p) if is_haply_file(p) => Some(crate::haply_arg::load_file(Some(p))?),
+        _ => None,
+    };
+    if let Some(f) = &haply {
+        if let HaplyKind::TwoDiy {
+            linkage, center, ..
+        } = &f.kind
+        {
+            return run_planar2(a, f, &f.controller_for(controller), linkage, *center);
+        }
+    }
+    let controller = haply
+        .as_ref()
+        .map_or(controller, |f| f.controller_for(controller));
     let scene = scene_arg::load(&a.scene, Some(a.rate))?;
-    let device = device_arg::resolve(a.device_file.as_deref(), &scene, 1.0 / a.rate)?;
+    let device = match &haply {
+        Some(HaplyDeviceFile {
+            kind: HaplyKind::Twin(p),
+            source,
+            ..
+        }) => device_arg::DeviceSetting {
+            params: *p,
+            origin: source.clone(),
+        },
+        _ => device_arg::resolve(a.device_file.as_deref(), &scene, 1.0 / a.rate)?,
+    };
     let config = HapticConfig {
         device: device.params,
         controller,
@@ -83,4 +118,100 @@ pub fn run(a: &StabilityArgs) -> Result<(), String> {
         println!("wrote {}", f.display());
     }
     Ok(())
+}
+
+/// The gate `haptic2d run` applies before driving the real device of model `model`: the
+/// configuration `config` must be stable with the hand released on every axis of the device
+/// (x, y, θ for a twin pantograph; x and y for a 2-DOF device). The error names the axis and the fix
+/// (`--allow-unstable` overrides).
+pub fn check_real_device(
+    model: &DeviceModel,
+    config: &HapticConfig,
+    world: &haptic2d::world::World,
+) -> Result<(), String> {
+    match model {
+        DeviceModel::Twin(_) => haptic2d_lab::stability::check_released_stability(config, world),
+        DeviceModel::FiveBar {
+            linkage, center, ..
+        } => check_released_stability_planar2(
+            linkage,
+            &five_bar_dynamics(linkage, *center)?,
+            Vec2::new(center[0], center[1]),
+            &config.controller,
+            world,
+        ),
+    }
+}
+
+/// The lumped dynamics of a 2DIY five-bar: the numbers of the emulator's simulated linkage
+/// (`haptic2d_devices::haply::Plant2`; estimates, not measurements of a kit).
+fn five_bar_dynamics(linkage: &Pantograph2, center: [f64; 2]) -> Result<FiveBarDynamics, String> {
+    let p = Plant2::new(*linkage, Vec2::new(center[0], center[1]))?;
+    Ok(FiveBarDynamics {
+        i_j: p.i_j,
+        m_e: p.m_e,
+        b: p.b,
+    })
+}
+
+/// `haptic2d stability --device-file HAPLY.toml` for a 2DIY: the x and y axes.
+fn run_planar2(
+    a: &StabilityArgs,
+    file: &haptic2d_devices::haply::HaplyDeviceFile,
+    controller: &ControllerKind,
+    linkage: &Pantograph2,
+    center: [f64; 2],
+) -> Result<(), String> {
+    let scene = scene_arg::load(&a.scene, Some(a.rate))?;
+    let axes = analyse_planar2(
+        linkage,
+        &five_bar_dynamics(linkage, center)?,
+        Vec2::new(center[0], center[1]),
+        controller,
+        &scene.world,
+        a.rate,
+        a.delay,
+    )?;
+    println!(
+        "stability of scene {} with the 2-DOF device of {} (x and y of the grasp point; the rotation is left to the world), controller {} at {} Hz ({} extra output sample{}):",
+        scene.name,
+        file.source,
+        a.controller,
+        a.rate,
+        a.delay,
+        if a.delay == 1 { "" } else { "s" }
+    );
+    for r in &axes {
+        let m = &r.model;
+        println!(
+            "axis {}: device m {:.4} kg, b {:.4} N s/m; slave {:.4} kg; against the {} spring K_e {:.1} N/m, B_e {:.3} N s/m",
+            r.axis, m.m, m.b, m.m_s, r.contact, m.k_e, m.b_e
+        );
+        for (cond, p) in [("held", &r.held), ("released", &r.released)] {
+            println!("  {cond:<8} sampled growth {:+.2} 1/s", p.growth);
+        }
+        println!("  verdict: {}", r.verdict().label());
+    }
+    Ok(())
+}
+
+/// True when `path` is a Haply device file (a top-level `kind = …` line before any table), not a
+/// twin-pantograph parameter file; or the name of a built-in Haply file.
+fn is_haply_file(path: &std::path::Path) -> bool {
+    let builtin = crate::haply_arg::BUILTIN_FILES.iter().any(|(n, _)| {
+        path.to_str()
+            .is_some_and(|s| s == *n || s == format!("{n}.toml"))
+    });
+    let top_level_kind = |t: String| {
+        t.lines()
+            .map(str::trim)
+            .take_while(|l| !l.starts_with('['))
+            .any(|l| {
+                l.strip_prefix("kind")
+                    .is_some_and(|r| r.trim_start().starts_with('='))
+            })
+    };
+    builtin
+        || crate::scene_arg::read_bounded(path, haptic2d::scene::MAX_FILE_BYTES, "device file")
+            .is_ok_and(top_level_kind)
 }

@@ -67,13 +67,9 @@ fn two_diy_box_reaches_the_wall_and_handle_feels_its_stiffness() {
     assert!(report.replies >= 4000, "{report:?}");
 }
 
-/// Known failure, kept visible: over the emulator the twin settles with the coupling pushing
-/// 1.0–1.1 N against the 0.8 N hand (handle 2.6 mm in, 30 % over F/K_r) while drifting in y, whereas
-/// the same system against the in-process `SimDevice` settles at 2.00 mm. The emulator adds one period
-/// of latency (the reply samples the linkage when the write is serviced, as the board does); the
-/// twin's loop with that latency is not yet understood. Run with `--ignored`.
+/// The twin of two 2DIY linkages over the emulator. It was 30 % off (`#[ignore]`d) until the θ gains
+/// were matched to the Haply crank (`HaplyDeviceFile::controller_for`, which documents the cause).
 #[test]
-#[ignore = "twin over the emulator settles 30 % off F/K_r (see the doc comment)"]
 fn twin_box_reaches_the_wall_and_handle_feels_its_stiffness() {
     let file = device_file("haply-twin.toml");
     let start = file.workspace_center();

@@ -11,6 +11,7 @@
 //! torque_limit = 0.123          # N·m, ≤ the firmware's 0.123
 //! timeout_periods = 3           # a reply later than this many periods = device lost
 //! max_missed_deadlines = 10     # watchdog: consecutive missed deadlines (0 = off)
+//! max_stall_periods = 5         # the loop's own delay between two ticks that trips (periods)
 //! [linkage]                     # 2diy only (the twin's geometry is its [device] table)
 //! d = 0.038                     # m
 //! l1 = 0.07                     # m
@@ -28,6 +29,7 @@
 use haptic2d::device::pantograph2::Pantograph2;
 use haptic2d::device::DeviceParams;
 use haptic2d::geom::Vec2;
+use haptic2d::haptic::ControllerKind;
 use haptic2d::scene::{device_params_from_toml, SceneError, SceneErrors};
 use serde::Deserialize;
 
@@ -82,6 +84,10 @@ pub struct HaplyDeviceFile {
     /// The watchdog trips after this many consecutive missed deadlines; `None` (0 in the file)
     /// turns the check off. Default 10.
     pub max_missed_deadlines: Option<u32>,
+    /// The loop's own delay between two ticks (sleep overshoot and computation, not the wait for
+    /// the board, which `timeout_periods` bounds) that trips the stall check (periods, ≥ 1).
+    /// Default 5, the shared safety layer's.
+    pub max_stall_periods: f64,
     /// Motors in joint order.
     pub motors: Vec<MotorSpec>,
     /// 2DIY or twin.
@@ -118,6 +124,8 @@ struct RawBoard {
     timeout_periods: f64,
     #[serde(default = "ten")]
     max_missed_deadlines: i64,
+    #[serde(default = "five")]
+    max_stall_periods: f64,
 }
 
 #[derive(Deserialize)]
@@ -151,6 +159,9 @@ fn one() -> i64 {
 }
 fn three() -> f64 {
     3.0
+}
+fn five() -> f64 {
+    5.0
 }
 fn ten() -> i64 {
     10
@@ -250,6 +261,13 @@ impl HaplyDeviceFile {
                 "board.max_missed_deadlines",
                 format!("{} is not a count of periods", b.max_missed_deadlines),
                 "give a number of consecutive missed deadlines ≥ 1 (default 10), or 0 to turn the check off",
+            ));
+        }
+        if !(b.max_stall_periods.is_finite() && b.max_stall_periods >= 1.0) {
+            errs.push(SceneError::new(
+                "board.max_stall_periods",
+                format!("{} periods is not a stall limit", b.max_stall_periods),
+                "give a number of control periods ≥ 1 (default 5)",
             ));
         }
         let n_expected = match raw.kind.as_str() {
@@ -397,6 +415,7 @@ impl HaplyDeviceFile {
                 max_missed_deadlines: u32::try_from(b.max_missed_deadlines)
                     .ok()
                     .filter(|n| *n > 0),
+                max_stall_periods: b.max_stall_periods,
                 motors,
                 kind,
             }),
@@ -433,6 +452,45 @@ impl HaplyDeviceFile {
     /// Number of joints (2 or 4).
     pub fn joints(&self) -> usize {
         self.motors.len()
+    }
+
+    /// The controller `kind` matched to this device's θ axis. A 2DIY has none (unchanged). On the
+    /// twin, the master-side θ gains (coupling `k[2]`, `b[2]`; four-channel `k_m[2]`, `b_m[2]`,
+    /// `d_m[2]`) are capped at the translational ones times `r_c²`, i.e. at most the stiffness and
+    /// damping at the crank pin that x and y have at the handle (N/m, N·s/m):
+    ///
+    /// ```text
+    /// k_θ ≤ k_x·r_c²,   b_θ ≤ b_x·r_c²    (a θ error δθ moves the crank pin r_c·δθ; the torque
+    ///                                    k_θ·δθ is the crank-pin force k_θ/r_c² · (r_c·δθ) · r_c)
+    /// ```
+    ///
+    /// Why (issue 12, the twin's closed-loop test was 30 % off): the default θ gains (1 N·m/rad,
+    /// 0.01 N·m·s/rad) were chosen for the paper's device. Through the Haply twin's 2 cm crank they
+    /// are 2500 N/m at the crank pin, five times the 500 N/m at the handle; with the board's one
+    /// period of latency and a θ inertia of ~1e-5 kg·m², θ limit-cycles (rms 18 mrad), the four
+    /// motors sit at the 0.123 N·m clamp two ticks in three, and the direction-preserving
+    /// saturation scales the x force the hand feels down by a quarter. Capped (0.2 N·m/rad,
+    /// 0.002 N·m·s/rad) θ settles (rms 2 mrad), nothing saturates and the rendered force is
+    /// exactly the hand's 0.8 N.
+    pub fn controller_for(&self, kind: ControllerKind) -> ControllerKind {
+        let HaplyKind::Twin(p) = &self.kind else {
+            return kind;
+        };
+        let r2 = p.r_c * p.r_c;
+        let cap = |v: &mut [f64; 3]| v[2] = v[2].min(v[0].min(v[1]) * r2);
+        match kind {
+            ControllerKind::Coupling(mut g) => {
+                cap(&mut g.k);
+                cap(&mut g.b);
+                ControllerKind::Coupling(g)
+            }
+            ControllerKind::FourChannel(mut g) => {
+                cap(&mut g.k_m);
+                cap(&mut g.b_m);
+                cap(&mut g.d_m);
+                ControllerKind::FourChannel(g)
+            }
+        }
     }
 
     /// A start pose inside the workspace: the centre (m, board frame; θ = 0 for the twin).

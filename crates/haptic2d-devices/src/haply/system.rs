@@ -50,7 +50,7 @@ impl HaplySystem {
             HaplyKind::Twin(p) => {
                 let config = HapticConfig {
                     device: *p,
-                    controller,
+                    controller: file.controller_for(controller),
                     ..HapticConfig::default()
                 };
                 Ok(HaplySystem::Twin(HapticSystem::new(world, &config)?))

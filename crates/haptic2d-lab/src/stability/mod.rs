@@ -28,6 +28,7 @@ pub mod axis;
 pub mod dense;
 pub mod eig;
 pub mod loop_model;
+pub mod planar2;
 pub mod plot;
 pub mod report;
 
