@@ -235,8 +235,22 @@ fn log_info_prints_channels_counts_duration_and_the_timing_summary() {
 fn replay_of_an_mcap_recording_reproduces_its_device_motion() {
     let dir = tempfile::tempdir().unwrap();
     let (rec, rep) = (dir.path().join("rec.mcap"), dir.path().join("rep.mcap"));
-    run_logged(&rec, &["--duration", "0.5", "--hand", "sine:0.3,2"]);
-    let out = run_logged(&rep, &["--device", &format!("replay:{}", rec.display())]);
+    // At 500 Hz: the watchdog's stall limit (5 periods) is then 10 ms, which a loaded CI machine
+    // rarely reaches by scheduling alone (at 1 kHz a 6 ms stall tripped it and failed the run; the
+    // box-in-walls gains need T <= 2 ms).
+    run_logged(
+        &rec,
+        &["--rate", "500", "--duration", "0.5", "--hand", "sine:0.3,2"],
+    );
+    let out = run_logged(
+        &rep,
+        &[
+            "--rate",
+            "500",
+            "--device",
+            &format!("replay:{}", rec.display()),
+        ],
+    );
     assert!(out.contains("the replay ended"), "{out}");
     let (a, b) = (ticks_of(&rec), ticks_of(&rep));
     assert_eq!(a.len(), b.len(), "one replayed tick per recorded tick");
