@@ -45,4 +45,12 @@ impl DeviceIo for McapReplay {
     fn name(&self) -> &str {
         &self.name
     }
+
+    /// Like the CSV replay: one recorded row per read, whatever the wall clock says, so the loop
+    /// neither measures the interval nor trips on a stall. (Without this the MCAP replay was taken
+    /// for a real-time device: a scheduling stall of a loaded machine tripped the watchdog, and
+    /// the measured intervals changed the replayed device twist.)
+    fn paced_by_ticks(&self) -> bool {
+        self.inner.paced_by_ticks()
+    }
 }
