@@ -1,8 +1,9 @@
 //! `haptic2d log info FILE` and `haptic2d log convert IN OUT`: what a log holds, and tick logs
 //! between CSV and MCAP (format by extension). The conversion is lossless for the tick columns: a
 //! CSV tick log converted to MCAP and back is the same text; an MCAP log converted to CSV keeps
-//! every tick column it has (the loop columns too) but not the world channels (bodies, contacts,
-//! energy), which a CSV tick log has no columns for.
+//! every tick column it has (the loop columns too) in `OUT`, and writes each world channel the log
+//! has (bodies, contacts, energy) as its own CSV next to it: `OUT.bodies.csv`, `OUT.contacts.csv`,
+//! `OUT.energy.csv` (`OUT` without its `.csv`; layout in [`haptic2d_rt::mcap::world_csv`]).
 
 use crate::exit::{Failure, Status};
 use crate::run_log::is_mcap;
@@ -11,10 +12,11 @@ use haptic2d_rt::mcap::columns::{
 };
 use haptic2d_rt::mcap::reader::{read_file, read_info, read_ticks, LogInfo};
 use haptic2d_rt::mcap::schemas::TOPIC_TICK;
+use haptic2d_rt::mcap::world_csv::{read_world_tables, WorldTable};
 use haptic2d_rt::mcap::{McapSetup, McapSink};
 use std::collections::BTreeMap;
 use std::io::BufWriter;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// `haptic2d log` subcommands.
 #[derive(clap::Subcommand, Debug)]
@@ -213,8 +215,15 @@ fn convert(input: &Path, output: &Path) -> Result<Status, Failure> {
         (true, false) => {
             let bytes = read_file(input)?;
             let (rows, info) = read_ticks(&bytes, &inl)?;
+            let (tables, _) = read_world_tables(&bytes, &inl)?;
             if rows.is_empty() {
-                return Err(format!("{inl} has no {TOPIC_TICK} messages: nothing to convert to a CSV tick log").into());
+                if tables.iter().all(|t| t.messages == 0) {
+                    return Err(format!("{inl} has no {TOPIC_TICK}, bodies, contacts or energy messages: nothing to convert to CSV").into());
+                }
+                // A world recording (`simulate --out FILE.mcap`): the world channels only.
+                let written = write_world_tables(output, &tables)?;
+                println!("{inl} → {}: no {TOPIC_TICK} messages (a world recording), so no tick CSV", written.join(", "));
+                return Ok(Status::Clean);
             }
             let present: Vec<usize> = (0..TICK_TABLE_LEN).filter(|&k| rows[0][k].is_some()).collect();
             let mut w = csv::Writer::from_path(output)
@@ -242,13 +251,20 @@ fn convert(input: &Path, output: &Path) -> Result<Status, Failure> {
                 w.write_record(&fields).map_err(wr)?;
             }
             w.flush().map_err(|e| Failure::error(format!("cannot write {outl}: {e}")))?;
-            let skipped = info.messages - rows.len() as u64;
+            let written = write_world_tables(output, &tables)?;
+            let world: u64 = tables.iter().map(|t| t.messages).sum();
+            let skipped = info.messages - rows.len() as u64 - world;
             println!(
-                "{inl} → {outl}: {} ticks, {} columns{}",
+                "{inl} → {outl}: {} ticks, {} columns{}{}",
                 rows.len(),
                 order.len(),
+                if written.is_empty() {
+                    String::new()
+                } else {
+                    format!("; world channels → {}", written.join(", "))
+                },
                 if skipped > 0 {
-                    format!(" ({skipped} messages of other channels not converted: a CSV tick log has no columns for them)")
+                    format!(" ({skipped} messages of the scene and scene-update channels not converted)")
                 } else {
                     String::new()
                 }
@@ -262,4 +278,35 @@ fn convert(input: &Path, output: &Path) -> Result<Status, Failure> {
         }
     }
     Ok(Status::Clean)
+}
+
+/// The CSV of world channel `suffix` next to the tick CSV `output`: `OUT.csv` → `OUT.bodies.csv`
+/// (an output without `.csv` gets the suffix appended).
+pub fn world_csv_path(output: &Path, suffix: &str) -> PathBuf {
+    let name = output
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let stem = name.strip_suffix(".csv").unwrap_or(&name);
+    output.with_file_name(format!("{stem}{suffix}"))
+}
+
+/// Writes every world table with messages next to `output`; returns the paths written.
+fn write_world_tables(output: &Path, tables: &[WorldTable]) -> Result<Vec<String>, Failure> {
+    let mut written = Vec::new();
+    for t in tables.iter().filter(|t| t.messages > 0) {
+        let path = world_csv_path(output, t.channel.suffix);
+        let label = path.display().to_string();
+        let wr = |e: csv::Error| Failure::error(format!("cannot write {label}: {e}"));
+        let mut w = csv::Writer::from_path(&path)
+            .map_err(|e| Failure::error(format!("cannot create {label}: {e}")))?;
+        w.write_record(t.channel.header()).map_err(wr)?;
+        for r in &t.rows {
+            w.write_record(r).map_err(wr)?;
+        }
+        w.flush()
+            .map_err(|e| Failure::error(format!("cannot write {label}: {e}")))?;
+        written.push(label);
+    }
+    Ok(written)
 }

@@ -231,6 +231,19 @@ fn log_info_prints_channels_counts_duration_and_the_timing_summary() {
     assert!(text(&o).contains("is not an MCAP file"), "{}", text(&o));
 }
 
+/// Regression: the MCAP replay did not forward `paced_by_ticks` to the CSV replay it wraps, so the
+/// loop took it for a real-time device: a scheduling stall of a loaded machine tripped the
+/// watchdog mid-replay (the replay test failed that way) and measured intervals entered the twist.
+#[test]
+fn mcap_replay_is_paced_by_the_ticks_like_the_csv_replay() {
+    use haptic2d_rt::io::{DeviceIo, ReplayEnd};
+    let dir = tempfile::tempdir().unwrap();
+    let rec = dir.path().join("rec.mcap");
+    run_logged(&rec, &["--duration", "0.1"]);
+    let r = haptic2d_rt::mcap::McapReplay::from_path(&rec, ReplayEnd::Error).unwrap();
+    assert!(r.paced_by_ticks());
+}
+
 #[test]
 fn replay_of_an_mcap_recording_reproduces_its_device_motion() {
     let dir = tempfile::tempdir().unwrap();
@@ -238,6 +251,8 @@ fn replay_of_an_mcap_recording_reproduces_its_device_motion() {
     run_logged(&rec, &["--duration", "0.5", "--hand", "sine:0.3,2"]);
     let out = run_logged(&rep, &["--device", &format!("replay:{}", rec.display())]);
     assert!(out.contains("the replay ended"), "{out}");
+    // (The end of the replay itself latches the torques; a stall must not.)
+    assert!(!out.contains("stalled"), "{out}");
     let (a, b) = (ticks_of(&rec), ticks_of(&rep));
     assert_eq!(a.len(), b.len(), "one replayed tick per recorded tick");
     // Same encoder angles in → same device pose (forward kinematics) out, every tick.
@@ -362,4 +377,157 @@ fn foxglove_live_server_serves_a_loopback_client_and_survives_a_malformed_messag
         .status();
     let st = child.wait().unwrap();
     assert_eq!(st.code(), Some(130));
+}
+
+/// Every message of `topic` in the MCAP file `path`, decoded as JSON by serde (not by `log convert`).
+fn messages_of(path: &Path, topic: &str) -> Vec<serde_json::Value> {
+    let bytes = read_file(path).unwrap();
+    let mut out = Vec::new();
+    haptic2d_rt::mcap::reader::scan(&bytes, "test", |tp, _, data| {
+        if tp == topic {
+            out.push(serde_json::from_slice(data).unwrap());
+        }
+        Ok(())
+    })
+    .unwrap();
+    out
+}
+
+/// True if the CSV cell `cell` holds exactly the JSON value `v` (floats bit for bit; the
+/// non-finite floats are JSON strings `"NaN"`, `"inf"`, `"-inf"`).
+fn same_value(cell: &str, v: &serde_json::Value) -> bool {
+    match v {
+        serde_json::Value::String(s) => match (s.parse::<f64>(), cell.parse::<f64>()) {
+            (Ok(a), Ok(b)) if !a.is_finite() => {
+                a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan())
+            }
+            _ => cell == s,
+        },
+        serde_json::Value::Number(n) => match (n.as_f64(), cell.parse::<f64>()) {
+            (Some(a), Ok(b)) => a.to_bits() == b.to_bits(),
+            _ => false,
+        },
+        _ => false,
+    }
+}
+
+/// Checks that the world CSV `csv` of channel `topic` (an array `array` of entries, or a flat
+/// message) holds exactly the values of that channel's messages in `mcap`; returns its rows.
+fn check_world_csv(mcap: &Path, csv: &Path, topic: &str, array: Option<&str>) -> usize {
+    let msgs = messages_of(mcap, topic);
+    assert!(!msgs.is_empty(), "{topic} has messages");
+    let (header, rows) = csv_rows(csv);
+    let mut expected: Vec<Vec<(String, serde_json::Value)>> = Vec::new();
+    for m in &msgs {
+        let head = |k: &str| (k.to_string(), m[k].clone());
+        match array {
+            None => expected.push(header.iter().map(|k| head(k)).collect()),
+            Some(a) => {
+                let entries = m[a].as_array().unwrap();
+                assert_eq!(
+                    entries.len() as u64,
+                    m["count"].as_u64().unwrap().min(32),
+                    "{topic}: count"
+                );
+                for (i, e) in entries.iter().enumerate() {
+                    expected.push(
+                        header
+                            .iter()
+                            .map(|k| match k.as_str() {
+                                "t" | "count" => head(k),
+                                "i" => (k.clone(), serde_json::json!(i)),
+                                _ => (k.clone(), e[k.as_str()].clone()),
+                            })
+                            .collect(),
+                    );
+                }
+            }
+        }
+    }
+    assert_eq!(
+        rows.len(),
+        expected.len(),
+        "{}: one row per entry",
+        csv.display()
+    );
+    for (k, (row, exp)) in rows.iter().zip(&expected).enumerate() {
+        for (cell, (name, v)) in row.iter().zip(exp) {
+            assert!(
+                same_value(cell, v),
+                "{} row {k}, column {name}: CSV `{cell}`, MCAP {v}",
+                csv.display()
+            );
+        }
+    }
+    rows.len()
+}
+
+#[test]
+fn mcap_to_csv_writes_the_bodies_contacts_and_energy_channels_next_to_the_tick_csv() {
+    let dir = tempfile::tempdir().unwrap();
+    // A haptic run: the tick CSV and the three world CSVs, one energy row per tick.
+    let (m, c) = (dir.path().join("r.mcap"), dir.path().join("r.csv"));
+    run_logged(&m, &["--duration", "0.3", "--hand", "sine:0.3,2"]);
+    let r = haptic2d(&["log", "convert", m.to_str().unwrap(), c.to_str().unwrap()]);
+    let out = text(&r);
+    assert!(r.status.success(), "{out}");
+    assert!(
+        out.contains("r.bodies.csv") && out.contains("r.energy.csv"),
+        "{out}"
+    );
+    let ticks = ticks_of(&m).len();
+    let (_, tick_rows) = csv_rows(&c);
+    assert_eq!(tick_rows.len(), ticks);
+    let bodies = check_world_csv(
+        &m,
+        &dir.path().join("r.bodies.csv"),
+        TOPIC_BODIES,
+        Some("bodies"),
+    );
+    assert!(
+        bodies >= ticks,
+        "at least one body per tick: {bodies} rows, {ticks} ticks"
+    );
+    let energy = check_world_csv(&m, &dir.path().join("r.energy.csv"), TOPIC_ENERGY, None);
+    assert_eq!(energy, ticks, "one energy row per tick");
+    check_world_csv(
+        &m,
+        &dir.path().join("r.contacts.csv"),
+        TOPIC_CONTACTS,
+        Some("contacts"),
+    );
+    let (header, _) = csv_rows(&dir.path().join("r.bodies.csv"));
+    assert_eq!(
+        header,
+        ["t", "count", "i", "name", "x", "y", "theta", "vx", "vy", "omega"]
+    );
+
+    // A world recording of `simulate` (no tick channel) with resting contacts: the world CSVs only.
+    let (w, wc) = (dir.path().join("pile.mcap"), dir.path().join("pile.csv"));
+    let o = haptic2d(&[
+        "simulate",
+        "pile",
+        "--duration",
+        "0.3",
+        "--out",
+        w.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let r = haptic2d(&["log", "convert", w.to_str().unwrap(), wc.to_str().unwrap()]);
+    assert!(r.status.success(), "{}", text(&r));
+    assert!(!wc.exists(), "no tick CSV without tick messages");
+    let contacts = check_world_csv(
+        &w,
+        &dir.path().join("pile.contacts.csv"),
+        TOPIC_CONTACTS,
+        Some("contacts"),
+    );
+    assert!(contacts > 0, "the pile rests on contacts");
+    check_world_csv(
+        &w,
+        &dir.path().join("pile.bodies.csv"),
+        TOPIC_BODIES,
+        Some("bodies"),
+    );
+    check_world_csv(&w, &dir.path().join("pile.energy.csv"), TOPIC_ENERGY, None);
 }

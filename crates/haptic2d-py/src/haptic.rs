@@ -6,8 +6,10 @@ use crate::errors::{scene_error, value_error};
 use crate::world::PyWorld;
 use haptic2d::control::passivity::PlanarPassivity;
 use haptic2d::device::linalg::V3;
-use haptic2d::device::{DeviceFault, HandModel, SimDevice};
-use haptic2d::haptic::{ControllerKind, HapticConfig, HapticSystem, TickOutput, TICK_COLUMNS};
+use haptic2d::device::HandModel;
+use haptic2d::haptic::{
+    ControllerKind, DeviceInTheLoop, HapticConfig, HapticSystem, SafetyConfig, TICK_COLUMNS,
+};
 use haptic2d::scene::device_params_from_toml;
 use numpy::IntoPyArray;
 use pyo3::prelude::*;
@@ -109,37 +111,21 @@ fn hand_model(kind: &str, a: &[f64], start: V3) -> PyResult<HandModel> {
     })
 }
 
-/// A haptic system, the simulated twin-pantograph plant and the simulated hand acting on it.
-struct Loop {
-    system: HapticSystem,
-    plant: SimDevice,
-    hand: HandModel,
-}
-
-impl Loop {
-    /// One tick closed around the plant: read its encoders, run the haptic tick, then advance the
-    /// plant by `T` under the held torques and the hand. Errors if the plant leaves its reachable set.
-    fn step(&mut self) -> Result<TickOutput, DeviceFault> {
-        let q = self.plant.encoders()?;
-        let out = self.system.tick(&q);
-        self.plant
-            .step(&out.torques, &self.hand, self.system.dt())?;
-        Ok(out)
-    }
-}
-
 /// A haptic system closed around a simulated plant and hand.
 #[pyclass(module = "haptic2d._haptic2d", name = "HapticSystem")]
 pub struct PyHapticSystem {
-    dil: Loop,
+    /// The core's closed loop (the same one the lab's device-in-the-loop experiments step).
+    dil: DeviceInTheLoop,
     controller: &'static str,
 }
 
 #[pymethods]
 impl PyHapticSystem {
-    /// Builds the system around a copy of `world` (its period is the tick period).
+    /// Builds the system around a copy of `world` (its period is the tick period), with the
+    /// start-up torque ramp `ramp_time` (s; 0 = none) and the other safety settings at their
+    /// defaults.
     #[new]
-    #[pyo3(signature = (world, controller, device_toml, device_source, hand, hand_args, passivity, slave))]
+    #[pyo3(signature = (world, controller, device_toml, device_source, hand, hand_args, passivity, slave, ramp_time))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -151,6 +137,7 @@ impl PyHapticSystem {
         hand_args: Vec<f64>,
         passivity: bool,
         slave: Option<String>,
+        ramp_time: f64,
     ) -> PyResult<Self> {
         let dt = world.world.params.dt;
         let kind = ControllerKind::from_name(controller).map_err(value_error)?;
@@ -164,18 +151,16 @@ impl PyHapticSystem {
             config.device = device_params_from_toml(text, device_source, Some(dt))
                 .map_err(|e| scene_error(py, &e))?;
         }
-        let system = HapticSystem::new(world.world.clone(), &config).map_err(value_error)?;
+        let safety = SafetyConfig {
+            ramp_time,
+            ..SafetyConfig::default()
+        };
+        let system =
+            HapticSystem::with_safety(world.world.clone(), &config, safety).map_err(value_error)?;
         let model = hand_model(hand, &hand_args, system.device_start())?;
         // The plant starts at rest at the device origin, with encoder quantisation.
-        let mut plant =
-            SimDevice::new(&system.device().params, system.device_start()).map_err(value_error)?;
-        plant.substeps = plant_substeps(dt);
-        plant.quantize = true;
-        let dil = Loop {
-            system,
-            plant,
-            hand: model,
-        };
+        let dil =
+            DeviceInTheLoop::new(system, model, plant_substeps(dt), true).map_err(value_error)?;
         Ok(Self {
             dil,
             controller: kind.name(),
@@ -277,6 +262,13 @@ impl PyHapticSystem {
     #[getter]
     fn controller(&self) -> &'static str {
         self.controller
+    }
+
+    /// The start-up ramp factor the next tick applies (0 before the first reading and at it, 1 once
+    /// ramped in).
+    #[getter]
+    fn ramp(&self) -> f64 {
+        self.dil.system.ramp()
     }
 
     /// The handle pose the device starts at (m, m, rad, handle coordinates).

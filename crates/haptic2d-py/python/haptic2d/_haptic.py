@@ -8,7 +8,7 @@ from typing import Dict, List, Optional, Sequence, Tuple, Union
 import numpy as np
 
 from . import _haptic2d
-from ._checks import positive, real
+from ._checks import nonneg, positive, real
 from ._world import World
 
 HandSpec = Union[str, Tuple]
@@ -39,6 +39,14 @@ class HapticSystem:
     spring-damper grip at the start pose), ``"free"``, ``"constant:FX,FY,TAU"`` (N, N, N*m),
     ``"sine:FPK,FREQ[,DIRX,DIRY]"`` (N, Hz), ``"script:HOLD,FX,FY,TAU,PUSH[,RFX,RFY,RTAU]"`` (s, N,
     s), as ``haptic2d run --hand`` takes them, or the same as a tuple ``("sine", 2.1, 1.0)``.
+
+    ``ramp_time`` (s) is the safety layer's start-up ramp: the torques are scaled by
+    ``min(1, n*T/ramp_time)`` from the first device reading, so the first tick's torques are zero
+    (default 0.5 s, as ``haptic2d run``; 0 = no ramp). The ramp scales the workspace bound too: a
+    hand that pushes from the first tick (``"constant:..."``) drives the handle past the workspace
+    edge before the wall has its strength and trips the latch. Hold the handle through the ramp
+    (``"script:0.5,FX,FY,TAU,PUSH"``, as a user does) or study the loop at full gain with
+    ``ramp_time=0``.
     """
 
     def __init__(
@@ -49,6 +57,7 @@ class HapticSystem:
         hand: HandSpec = "hold",
         passivity: bool = False,
         slave: Optional[str] = None,
+        ramp_time: float = 0.5,
     ) -> None:
         if not isinstance(world, World):
             raise TypeError("world must be a haptic2d.World")
@@ -67,7 +76,15 @@ class HapticSystem:
             source = f"device file {path}"
         kind, args = _hand(hand)
         self._s = _haptic2d.HapticSystem(
-            world._w, controller, text, source, kind, args, bool(passivity), slave
+            world._w,
+            controller,
+            text,
+            source,
+            kind,
+            args,
+            bool(passivity),
+            slave,
+            nonneg("ramp_time", ramp_time),
         )
         #: The plant fault that ended the last :meth:`run_simulated` early, or ``None``.
         self.fault: Optional[str] = None
@@ -96,6 +113,12 @@ class HapticSystem:
     def safety_trip(self) -> Optional[str]:
         """Why the safety latch is set (torques held at zero), or ``None``."""
         return self._s.safety_trip
+
+    @property
+    def ramp(self) -> float:
+        """The start-up ramp factor the next tick applies (0 until the first reading and at it,
+        1 once ramped in)."""
+        return self._s.ramp
 
     def tick(self, encoders: Sequence[float]) -> np.ndarray:
         """One haptic tick: four encoder angles (rad) in, four motor torques (N*m) out."""

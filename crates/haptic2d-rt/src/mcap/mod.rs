@@ -7,7 +7,8 @@
 //! - [`writer`]: [`McapSink`], an MCAP file being written;
 //! - [`logger`]: [`McapLogger`], the logger thread draining the ring into a sink;
 //! - [`reader`]: reading logs back (info, tick rows, encoder angles for a replay);
-//! - [`replay`]: [`McapReplay`], `--device replay:FILE.mcap`.
+//! - [`replay`]: [`McapReplay`], `--device replay:FILE.mcap`;
+//! - [`world_csv`]: the world channels as CSV tables (`log convert FILE.mcap OUT.csv`).
 
 pub mod columns;
 pub mod encode;
@@ -16,6 +17,7 @@ pub mod reader;
 pub mod record;
 pub mod replay;
 pub mod schemas;
+pub mod world_csv;
 pub mod writer;
 
 pub use logger::{McapLogger, McapReport};
