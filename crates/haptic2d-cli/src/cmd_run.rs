@@ -185,6 +185,11 @@ pub fn run(a: &RunArgs) -> Result<Status, Failure> {
         )?,
     };
 
+    // The display's controller and scene switches pass the same gate as the start (§11.4).
+    if !a.allow_unstable {
+        rig.enforce_released_stability();
+    }
+
     // The display: bound before the loop starts, so that a taken port is an error now.
     let (server, view) = if a.headless {
         (None, None)

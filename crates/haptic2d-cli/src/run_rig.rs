@@ -189,6 +189,10 @@ pub struct Rig {
     real: Option<RealLimits>,
     /// A real device's controller matching (applied to the page's controller switches too).
     match_controller: Option<MatchController>,
+    /// A real device's stability gate (§11.4): every controller switch and scene switch from the
+    /// display must be stable with the hand released, like the configuration `run` started with.
+    /// Off for the simulation and a replay, and with `--allow-unstable`.
+    released_gate: bool,
     /// Measures the interval between ticks (wake to wake).
     interval: TickInterval,
     /// Time the last read waited for the device (ns; real devices only).
@@ -241,6 +245,7 @@ impl Rig {
             target,
             real: None,
             match_controller: None,
+            released_gate: false,
             interval: TickInterval::new(),
             read_wait_ns: 0,
             prev_read_wait_ns: 0,
@@ -284,6 +289,7 @@ impl Rig {
             target: None,
             real: Some(limits),
             match_controller: real.match_controller,
+            released_gate: false,
             interval: TickInterval::new(),
             read_wait_ns: 0,
             prev_read_wait_ns: 0,
@@ -443,6 +449,7 @@ impl Rig {
     /// stays open, and the new system aligns to the handle and ramps in from zero). On error nothing
     /// changes. Allocates: call it between ticks.
     pub fn rebuild(&mut self, world: World) -> Result<(), String> {
+        self.check_released(&self.config, &world)?;
         let system = match &self.real {
             Some(l) => Self::real_system(world, &self.config, l)?,
             None => {
@@ -500,9 +507,31 @@ impl Rig {
             Some(m) => m(kind),
             None => kind,
         };
+        let candidate = HapticConfig {
+            controller: k,
+            ..self.config.clone()
+        };
+        self.check_released(&candidate, self.system.world())?;
         self.system.set_controller(k)?;
         self.config.controller = k;
         Ok(())
+    }
+
+    /// Turns on the stability gate for a real device (`run` without `--allow-unstable`): from now on a
+    /// controller or scene switch that the analysis finds unstable with the hand released is refused
+    /// with the axis and the fix, and the loop keeps its current configuration. No effect on the
+    /// simulation or a replay.
+    pub fn enforce_released_stability(&mut self) {
+        self.released_gate = self.real.is_some();
+    }
+
+    /// The gate of [`Self::enforce_released_stability`] for `config` on `world`.
+    fn check_released(&self, config: &HapticConfig, world: &World) -> Result<(), String> {
+        match (&self.real, self.released_gate) {
+            (Some(l), true) => crate::cmd_stability::check_real_device(&l.model, config, world)
+                .map_err(|e| format!("{e}\n    (refused: the loop keeps its current configuration; restart with --allow-unstable to override)")),
+            _ => Ok(()),
+        }
     }
 
     /// The twin pantograph's parameters when the display should draw the linkage (simulated device,
@@ -741,5 +770,43 @@ mod tests {
         rig.rebuild(world).unwrap();
         assert!(matches!(rig.system, RigSystem::TwoDof(_)));
         assert_eq!(rig.io.name(), "fake-board");
+    }
+
+    /// Issue 11 (noticed in session 5): the display's controller switch skipped the released-handle
+    /// stability gate that `run` applies at start, so a page could switch a real device to the
+    /// spec's four-channel gains, unstable when the hand lets go. With the gate on, a switch the
+    /// analysis refuses leaves the controller as it was; a stable one goes through.
+    #[test]
+    fn display_controller_switch_on_a_real_device_passes_the_released_stability_gate() {
+        let mut rig = board_rig(u64::MAX, std::time::Duration::ZERO, 3.0);
+        rig.enforce_released_stability();
+        let before = rig.config.controller.name();
+        let spec = ControllerKind::from_name("four-channel-spec").unwrap();
+        let cfg = HapticConfig {
+            controller: spec,
+            ..rig.config.clone()
+        };
+        let verdict = match &rig.real {
+            Some(l) => crate::cmd_stability::check_real_device(&l.model, &cfg, rig.system.world()),
+            None => unreachable!("a board rig is real"),
+        };
+        assert!(
+            verdict.is_err(),
+            "premise: the spec gains are unstable released here"
+        );
+        let e = rig
+            .set_controller(spec)
+            .expect_err("the gate refuses the switch");
+        assert!(
+            e.contains("axis x") && e.contains("--allow-unstable"),
+            "{e}"
+        );
+        assert_eq!(rig.config.controller.name(), before, "refused: unchanged");
+        // The default (stable released, by the analysis) is accepted.
+        rig.set_controller(ControllerKind::default()).unwrap();
+        // Without the gate (the simulation, or --allow-unstable) the switch is not analysed.
+        let mut free = board_rig(u64::MAX, std::time::Duration::ZERO, 3.0);
+        free.set_controller(spec).unwrap();
+        assert_eq!(free.config.controller.name(), "four-channel-spec");
     }
 }
