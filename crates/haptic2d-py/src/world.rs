@@ -301,7 +301,8 @@ impl PyWorld {
         Ok(d)
     }
 
-    /// The energy ledger (J): kinetic, stored, applied_work, impact_loss, initial.
+    /// The energy ledger (J): kinetic, stored, applied_work, impact_loss, initial; and
+    /// impact_energy_fallbacks (count): frictional impacts whose energy check scaled an impulse.
     fn energy<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let e = self.world.ledger();
         let d = PyDict::new(py);
@@ -310,6 +311,7 @@ impl PyWorld {
         d.set_item("applied_work", e.applied_work)?;
         d.set_item("impact_loss", e.impact_loss)?;
         d.set_item("initial", e.initial)?;
+        d.set_item("impact_energy_fallbacks", e.impact_energy_fallbacks)?;
         Ok(d)
     }
 

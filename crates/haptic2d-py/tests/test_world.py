@@ -75,7 +75,15 @@ def test_energy_ledger_keys_and_work_of_the_push():
     w = World.load("box-in-walls")
     w.step(40)  # 0.08 s: the box reaches the wall (0.02 m at 4 m/s^2) only after 0.1 s
     e = w.energy()
-    assert set(e) == {"kinetic", "stored", "applied_work", "impact_loss", "initial"}
+    assert set(e) == {
+        "kinetic",
+        "stored",
+        "applied_work",
+        "impact_loss",
+        "initial",
+        "impact_energy_fallbacks",
+    }
+    assert e["impact_energy_fallbacks"] == 0
     assert e["applied_work"] > 0.0 and e["kinetic"] > 0.0
     # Before contact, semi-implicit Euler under a constant force F: v_k = k*a*T and the work is
     # sum F*T*v_k = m*a^2*T^2*n(n+1)/2, while KE = m*(n*a*T)^2/2, so W = KE*(n+1)/n.
@@ -129,3 +137,52 @@ def test_copy_is_independent():
     c = w.copy()
     w.step(10)
     assert c.tick == 0 and w.tick == 10
+
+
+def _landing(mode: str) -> World:
+    """A 1 kg box landing flat at 1 m/s down while sliding at 1 m/s (classical friction, mu = 0.5)."""
+    text = f"""
+name = "landing"
+[world]
+rate = 1000
+[contact]
+restitution = 0.0
+impact_friction = "{mode}"
+[friction]
+model = "classical"
+v_th = 0.001
+mu_s = 0.5
+mu_k = 0.5
+[[body]]
+name = "floor"
+kind = "fixed"
+polygon = [[-20.0, -0.1], [20.0, -0.1], [20.0, 0.0], [-20.0, 0.0]]
+[[body]]
+name = "box"
+mass = 1.0
+box = [0.1, 0.05]
+position = [0.0, 0.0255]
+velocity = [1.0, -1.0]
+"""
+    return World.from_toml(text)
+
+
+def test_impact_friction_coulomb_brakes_a_sliding_landing():
+    # A plastic frictional impact removes at most mu * |v_n| = 0.5 m/s of the sliding speed (Coulomb
+    # bound on the tangential impulse); the frictionless impact removes none of it.
+    runs = {}
+    for mode in ("none", "coulomb"):
+        w = _landing(mode)
+        w.step(3)  # the impact sample, before friction in contact has had time to act much
+        runs[mode] = (w.state()["vx"][1], w.energy())
+    vx_none, e_none = runs["none"]
+    vx_coul, e_coul = runs["coulomb"]
+    assert vx_none > 0.99
+    assert 0.45 <= vx_coul <= 0.6
+    # No energy created: the impact loss of the frictional impact is the larger.
+    assert e_coul["impact_loss"] > e_none["impact_loss"] > 0.0
+    with pytest.raises(ValueError, match="impact_friction"):
+        World.from_toml(
+            '[world]\nrate = 1000\n[contact]\nimpact_friction = "sticky"\n'
+            '[[body]]\nname = "b"\nbox = [0.1, 0.1]\nmass = 1.0\nposition = [0.0, 0.0]\n'
+        )
