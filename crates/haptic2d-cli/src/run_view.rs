@@ -15,6 +15,7 @@
 //! period is refused by the server with the reason (greyed out on the page), and again here.
 
 use crate::run_rig::Rig;
+use haptic2d::contact::ImpactFriction;
 use haptic2d::haptic::ControllerKind as SystemController;
 use haptic2d::laws::friction::FrictionModel;
 use haptic2d::laws::normal::NormalModel;
@@ -49,6 +50,8 @@ pub struct LiveView {
     /// `None` = the scene's own.
     wall_law: Option<NormalModel>,
     friction: Option<FrictionModel>,
+    /// The impact friction mode the page selected (kept likewise); `None` = the scene's own.
+    impact_friction: Option<ImpactFriction>,
     paused: bool,
     /// Built-in scenes the loop cannot run at its rate, with the reason (the server refuses them
     /// first; this is the loop's own check).
@@ -100,6 +103,7 @@ pub fn start(
         scene,
         wall_law: None,
         friction: None,
+        impact_friction: None,
         paused: false,
         too_heavy,
     };
@@ -184,6 +188,11 @@ impl LiveView {
                 rig.system.world_mut().friction = m;
                 self.friction = Some(m);
             }
+            Command::SetImpactFriction { name } => {
+                let m = ImpactFriction::from_name(name)?;
+                rig.system.world_mut().set_impact_friction(m);
+                self.impact_friction = Some(m);
+            }
             Command::SetController { kind } => {
                 let k = SystemController::from_name(kind.name())?;
                 rig.set_controller(k)?;
@@ -202,6 +211,9 @@ impl LiveView {
         }
         if let Some(m) = self.friction {
             world.friction = m;
+        }
+        if let Some(m) = self.impact_friction {
+            world.set_impact_friction(m);
         }
         rig.rebuild(world)
     }
@@ -406,6 +418,16 @@ mod tests {
         until("the command", || server.stats().commands_forwarded == 1);
         view.apply_commands(&mut rig);
         assert_eq!(rig.system.world().normal.name(), "zoh");
+        // The impact friction switch (issue 16) reaches the world and survives a reset.
+        page.send(tungstenite::Message::text(
+            r#"{"type":"set_impact_friction","name":"coulomb"}"#,
+        ))
+        .unwrap();
+        page.send(tungstenite::Message::text(r#"{"type":"reset"}"#))
+            .unwrap();
+        until("the commands", || server.stats().commands_forwarded == 3);
+        view.apply_commands(&mut rig);
+        assert_eq!(rig.system.world().impact_friction().name(), "coulomb");
         drop((evil, page));
         server.shutdown();
     }

@@ -6,6 +6,7 @@
 //! [`ViewHub::poll_command`](crate::ViewHub::poll_command). A [`Command`] is `Copy` and holds only
 //! `'static` names, so receiving and dropping one on the real-time thread never touches the heap.
 
+use haptic2d::contact::ImpactFriction;
 use haptic2d::laws::friction::FrictionModel;
 use haptic2d::laws::normal::NORMAL_MODEL_NAMES;
 use haptic2d::scene::BUILTIN;
@@ -96,6 +97,8 @@ impl ControllerKind {
 ///   every contact created from now on uses it (existing contacts keep their copy until released).
 /// - [`SetFriction`](Command::SetFriction): `world.friction = FrictionModel::from_name(name, true)`,
 ///   same rule as the wall law.
+/// - [`SetImpactFriction`](Command::SetImpactFriction): `world.set_impact_friction(mode)`
+///   (`"none"` or `"coulomb"`, [`ImpactFriction::NAMES`]): impacts from the next sample on.
 /// - [`SetController`](Command::SetController): switch the teleoperation controller, starting from a
 ///   reset state (no stored integrator or filter state carried over).
 /// - [`Pause`](Command::Pause): stop stepping the world and command zero device force; frames keep
@@ -130,6 +133,11 @@ pub enum Command {
         /// Model name.
         name: &'static str,
     },
+    /// Select the impact friction mode `name` (one of [`ImpactFriction::NAMES`]).
+    SetImpactFriction {
+        /// Mode name.
+        name: &'static str,
+    },
     /// Select the controller.
     SetController {
         /// Which one.
@@ -151,6 +159,7 @@ impl Command {
             Command::SwitchScene { .. } => "switch_scene",
             Command::SetWallLaw { .. } => "set_wall_law",
             Command::SetFriction { .. } => "set_friction",
+            Command::SetImpactFriction { .. } => "set_impact_friction",
             Command::SetController { .. } => "set_controller",
             Command::Pause => "pause",
             Command::Resume => "resume",
@@ -168,6 +177,7 @@ enum Incoming {
     SwitchScene { name: String },
     SetWallLaw { name: String },
     SetFriction { name: String },
+    SetImpactFriction { name: String },
     SetController { name: String },
     // Struct variants, so that `deny_unknown_fields` rejects extra fields.
     Pause {},
@@ -234,6 +244,9 @@ pub fn parse_client_message(text: &str) -> Result<ClientMessage, String> {
         Incoming::SetFriction { name } => Command::SetFriction {
             name: static_name("friction model", &name, FrictionModel::NAMES)?,
         },
+        Incoming::SetImpactFriction { name } => Command::SetImpactFriction {
+            name: static_name("impact friction mode", &name, ImpactFriction::NAMES)?,
+        },
         Incoming::SetController { name } => Command::SetController {
             kind: ControllerKind::from_name(&name)?,
         },
@@ -275,6 +288,10 @@ mod tests {
         assert_eq!(
             ok(r#"{"type":"set_friction","name":"dahl"}"#),
             Command::SetFriction { name: "dahl" }
+        );
+        assert_eq!(
+            ok(r#"{"type":"set_impact_friction","name":"coulomb"}"#),
+            Command::SetImpactFriction { name: "coulomb" }
         );
         assert_eq!(
             ok(r#"{"type":"set_controller","name":"coupling"}"#),

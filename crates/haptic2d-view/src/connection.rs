@@ -80,6 +80,7 @@ impl Viewer {
                 scene_costs: &self.state.scene_costs,
                 wall_laws: NORMAL_MODEL_NAMES.to_vec(),
                 friction_models: FrictionModel::NAMES.to_vec(),
+                impact_friction_modes: haptic2d::contact::ImpactFriction::NAMES.to_vec(),
                 controllers: ControllerKind::ALL.iter().map(|c| c.name()).collect(),
             },
         })

@@ -68,6 +68,8 @@ pub struct Energies {
     pub applied_work: f64,
     /// Kinetic energy removed by impacts so far (J).
     pub impact_loss: f64,
+    /// Frictional impact sets whose energy check scaled an impulse so far (count).
+    pub impact_energy_fallbacks: u64,
     /// `E_now − (E_0 + W_applied)` (J): positive means the simulation generated energy.
     pub excess: f64,
     /// Passivity-observer energy `E_obs` (J), when the loop runs one (§12).
@@ -160,6 +162,8 @@ pub struct Frame {
     pub wall_law: &'static str,
     /// Name of the friction model of the world.
     pub friction: &'static str,
+    /// Impact friction mode of the world (`"none"` or `"coulomb"`).
+    pub impact_friction: &'static str,
     /// Name of the controller.
     pub controller: &'static str,
     /// Pose `[x, y, θ]` of every body (m, m, rad), indexed like the scene's bodies.
@@ -213,6 +217,7 @@ impl Frame {
         Self {
             wall_law: "",
             friction: "",
+            impact_friction: "",
             controller: "",
             bodies: Vec::with_capacity(bodies),
             velocities: Vec::with_capacity(bodies),
@@ -234,6 +239,7 @@ impl Frame {
         self.tick = world.tick();
         self.paused = inputs.paused;
         self.wall_law = world.normal.name();
+        self.impact_friction = world.impact_friction().name();
         self.friction = world.friction.name();
         self.controller = inputs.controller;
 
@@ -297,6 +303,7 @@ impl Frame {
             stored: l.stored,
             applied_work: l.applied_work,
             impact_loss: l.impact_loss,
+            impact_energy_fallbacks: l.impact_energy_fallbacks,
             excess: l.excess(),
             passivity: inputs.passivity_energy,
         };

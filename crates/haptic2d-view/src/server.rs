@@ -143,6 +143,7 @@ pub(crate) struct Options<'a> {
     pub(crate) scene_costs: &'a [SceneCost],
     pub(crate) wall_laws: Vec<&'static str>,
     pub(crate) friction_models: Vec<&'static str>,
+    pub(crate) impact_friction_modes: Vec<&'static str>,
     pub(crate) controllers: Vec<&'static str>,
 }
 

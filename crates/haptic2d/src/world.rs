@@ -204,6 +204,16 @@ impl World {
     pub fn contacts(&self) -> &ContactSet {
         &self.contacts
     }
+    /// Whether impacts carry Coulomb friction (the scene's `contact.impact_friction`).
+    pub fn impact_friction(&self) -> crate::contact::ImpactFriction {
+        self.contacts.params.impact_friction
+    }
+    /// Sets the impact friction mode (the display's switch); impacts resolved from the next
+    /// sample on use it. The coefficient stays the scene's `impact_mu` (default: the friction
+    /// model's `μ_k`).
+    pub fn set_impact_friction(&mut self, mode: crate::contact::ImpactFriction) {
+        self.contacts.params.impact_friction = mode;
+    }
     /// Contact records of the last step.
     pub fn contact_records(&self) -> impl Iterator<Item = &VeContact> {
         self.contacts.records()

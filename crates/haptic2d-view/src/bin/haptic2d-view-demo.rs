@@ -227,6 +227,12 @@ impl Demo {
                 self.friction = m.name();
                 None
             }),
+            Command::SetImpactFriction { name } => {
+                haptic2d::contact::ImpactFriction::from_name(name).map(|m| {
+                    self.world.set_impact_friction(m);
+                    None
+                })
+            }
             Command::SetController { kind } => {
                 Controller::new(kind, self.world.params.dt).map(|c| {
                     self.controller = c;

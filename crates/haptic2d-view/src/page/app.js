@@ -2,7 +2,7 @@
 //
 // Protocol (JSON text over /ws): the server sends {type: "welcome" | "scene" | "frame" | "ack" |
 // "error"}; the page sends commands {type: "set_hand_target", x, y, theta} (world frame, m, rad),
-// {type: "switch_scene" | "set_wall_law" | "set_friction" | "set_controller", name},
+// {type: "switch_scene" | "set_wall_law" | "set_friction" | "set_impact_friction" | "set_controller", name},
 // {type: "pause" | "resume" | "reset"} and {type: "hello", token}.
 "use strict";
 
@@ -123,9 +123,10 @@
     fillSelect($("sel-scene"), o.scenes, "switch_scene", heavy);
     fillSelect($("sel-wall"), o.wall_laws, "set_wall_law");
     fillSelect($("sel-friction"), o.friction_models, "set_friction");
+    fillSelect($("sel-impact-friction"), o.impact_friction_modes || [], "set_impact_friction");
     fillSelect($("sel-controller"), o.controllers, "set_controller");
     const ctl = msg.control;
-    for (const id of ["sel-scene", "sel-wall", "sel-friction", "sel-controller", "btn-pause", "btn-reset"]) {
+    for (const id of ["sel-scene", "sel-wall", "sel-friction", "sel-impact-friction", "sel-controller", "btn-pause", "btn-reset"]) {
       $(id).disabled = !ctl;
     }
     $("control-hint").textContent = ctl ? "" :
@@ -170,7 +171,7 @@
     $("contact-count").textContent = f.contacts_total;
     $("paused-badge").style.display = f.paused ? "inline" : "none";
     $("btn-pause").textContent = f.paused ? "Resume" : "Pause";
-    for (const [id, v] of [["sel-wall", f.wall_law], ["sel-friction", f.friction], ["sel-controller", f.controller]]) {
+    for (const [id, v] of [["sel-wall", f.wall_law], ["sel-friction", f.friction], ["sel-impact-friction", f.impact_friction], ["sel-controller", f.controller]]) {
       const sel = $(id);
       if (document.activeElement !== sel && sel.value !== v) sel.value = v;
     }
