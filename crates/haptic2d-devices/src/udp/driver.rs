@@ -6,8 +6,8 @@
 //! pending, sends a poll — a command without [`FLAG_ENABLE`] — first);
 //! [`write_torques`](DeviceIo::write_torques) sends the command and returns. A missed answer is not
 //! yet a lost device: the read returns the newest state it has (a late answer counts), so a lost
-//! or reordered datagram costs one tick of stale angles. No state at all for `timeout_periods`
-//! periods, or a state with [`STATUS_FAULT`], means the device is lost.
+//! or reordered datagram costs one tick of stale angles. No state for `timeout_periods` periods
+//! after a command (measured from the host's send, so a stalled host does not blame the device), or a state with [`STATUS_FAULT`], means the device is lost.
 //!
 //! Safety in the driver itself: torques are zero until the first valid state; every torque is
 //! clamped to the device file's `torque_limit`; a non-finite torque sends a zero command and fails;
@@ -195,15 +195,12 @@ impl DeviceIo for UdpDevice {
         self.transport.wait_answer(deadline).map_err(|e| {
             DeviceError::Lost(format!("UDP device {}: receive failed: {e}", self.name))
         })?;
-        let silent_for = self
-            .transport
-            .latest_at()
-            .map_or(Duration::MAX, |t| t.elapsed());
+        let silent_for = self.transport.silent_for();
         if silent_for > self.timeout {
             self.lost = true;
             self.valid = false;
             return Err(DeviceError::Lost(format!(
-                "UDP device {}: no state for {:.1} ms (timeout {:.1} ms = protocol.timeout_periods); {}\n    check: that the device still runs and that the network between host and device is up",
+                "UDP device {}: no state for {:.1} ms after a command (timeout {:.1} ms = protocol.timeout_periods); {}\n    check: that the device still runs and that the network between host and device is up",
                 self.name,
                 silent_for.as_secs_f64() * 1e3,
                 self.timeout.as_secs_f64() * 1e3,

@@ -84,6 +84,8 @@ pub struct UdpTransport {
     highest: Option<u32>,
     latest: Option<State>,
     latest_at: Option<Instant>,
+    unanswered_since: Option<Instant>,
+    last_send_at: Instant,
     rtt_ns: Option<u64>,
     counters: UdpCounters,
     out: [u8; COMMAND_LEN],
@@ -109,6 +111,8 @@ impl UdpTransport {
             highest: None,
             latest: None,
             latest_at: None,
+            unanswered_since: None,
+            last_send_at: Instant::now(),
             rtt_ns: None,
             counters: UdpCounters::default(),
             out: [0; COMMAND_LEN],
@@ -137,7 +141,11 @@ impl UdpTransport {
         }
         .encode(&mut self.out);
         self.counters.sent += 1;
+        self.last_send_at = Instant::now();
         self.pending = Some(self.seq);
+        if self.unanswered_since.is_none() {
+            self.unanswered_since = Some(Instant::now());
+        }
         match self.socket.send(&self.out) {
             Ok(_) => Ok(self.seq),
             // A previous datagram's ICMP "port unreachable" surfaces on the next call.
@@ -233,10 +241,14 @@ impl UdpTransport {
         let now = Instant::now();
         if Some(s.echo_seq) == self.pending {
             self.pending = None;
+            self.unanswered_since = None;
             self.counters.fresh += 1;
             self.rtt_ns = Some(self.host_ns().saturating_sub(s.echo_host_ns));
         } else {
             self.counters.late += 1;
+            // Commands after the one answered are still open; the oldest of them is at most as
+            // old as the pending one (send times are not kept: this errs towards patience).
+            self.unanswered_since = self.pending.map(|_| self.last_send_at);
         }
         self.latest = Some(s);
         self.latest_at = Some(now);
@@ -245,6 +257,13 @@ impl UdpTransport {
     /// The newest state received (fresh or late).
     pub fn latest(&self) -> Option<&State> {
         self.latest.as_ref()
+    }
+
+    /// How long the device has been silent: since the oldest command sent after the newest state
+    /// received (zero when every command is answered). Measured from the host's sends, so a host
+    /// that stalled itself does not blame the device.
+    pub fn silent_for(&self) -> Duration {
+        self.unanswered_since.map_or(Duration::ZERO, |t| t.elapsed())
     }
 
     /// When the newest state arrived.
