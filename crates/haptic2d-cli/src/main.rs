@@ -22,6 +22,7 @@ mod run_log;
 mod run_rig;
 mod run_view;
 mod scene_arg;
+mod udp_arg;
 mod world_mcap;
 
 use clap::{Parser, Subcommand};
@@ -135,6 +136,7 @@ fn main() -> ExitCode {
         Command::Run(args) if args.device.starts_with("haply:") => {
             return cmd_run_haply::run(&args)
         }
+        Command::Run(args) if args.device.starts_with("udp:") => return udp_arg::run(&args),
         Command::Emulate(args) => return cmd_emulate::run(&args),
         Command::Devices => return cmd_devices::run(),
         Command::Device { command } => return cmd_device_check::run(&command),

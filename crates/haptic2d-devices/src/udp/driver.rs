@@ -137,6 +137,11 @@ impl UdpDevice {
         self.transport.counters()
     }
 
+    /// The round trip of the answer the last read received, if it was fresh (ns), once.
+    pub fn take_rtt(&mut self) -> Option<u64> {
+        self.transport.take_rtt()
+    }
+
     /// The transport (round trip, latest state).
     pub fn transport(&self) -> &UdpTransport {
         &self.transport

@@ -87,6 +87,7 @@ pub struct UdpTransport {
     unanswered_since: Option<Instant>,
     last_send_at: Instant,
     rtt_ns: Option<u64>,
+    rtt_new: bool,
     counters: UdpCounters,
     out: [u8; COMMAND_LEN],
     buf: [u8; 256],
@@ -114,6 +115,7 @@ impl UdpTransport {
             unanswered_since: None,
             last_send_at: Instant::now(),
             rtt_ns: None,
+            rtt_new: false,
             counters: UdpCounters::default(),
             out: [0; COMMAND_LEN],
             buf: [0; 256],
@@ -244,6 +246,7 @@ impl UdpTransport {
             self.unanswered_since = None;
             self.counters.fresh += 1;
             self.rtt_ns = Some(self.host_ns().saturating_sub(s.echo_host_ns));
+            self.rtt_new = true;
         } else {
             self.counters.late += 1;
             // Commands after the one answered are still open; the oldest of them is at most as
@@ -272,8 +275,15 @@ impl UdpTransport {
     }
 
     /// Round trip of the last fresh answer (ns): host send to host receive, from the echoed stamp.
+    /// A true round trip only when the host was already waiting when the answer arrived (as the
+    /// `udp_roundtrip` example does); an answer read from the queue a tick later shows its age.
     pub fn rtt_ns(&self) -> Option<u64> {
         self.rtt_ns
+    }
+
+    /// The round trip of a fresh answer received since the last call (ns), once.
+    pub fn take_rtt(&mut self) -> Option<u64> {
+        std::mem::take(&mut self.rtt_new).then_some(self.rtt_ns).flatten()
     }
 
     /// The counters.
