@@ -292,3 +292,72 @@ fn the_python_reference_device_answers_at_its_start_pose() {
     assert!(c.fresh >= 290, "{c}");
     assert_eq!(c.malformed, 0, "{c}");
 }
+
+#[test]
+fn the_python_reference_device_in_pose_mode_gives_the_same_angles() {
+    let Some((_py, addr)) = sim_device(&["--pose"]) else {
+        eprintln!("python3 not found: skipped");
+        return;
+    };
+    let mut file = UdpDeviceFile::reference();
+    file.timeout_periods = 50.0;
+    // A joints file against a pose device: refused, naming the field.
+    let e = UdpDevice::open(addr, &file, PERIOD, "udp:python").unwrap_err();
+    assert!(e.contains("protocol.input"), "{e}");
+    file.pose_input = true;
+    file.wrench_output = true;
+    let mut dev = UdpDevice::open(addr, &file, PERIOD, "udp:python").unwrap();
+    let q = dev.read_encoders().unwrap();
+    let expected = file.linkage.ik(haptic2d::geom::Vec2::new(0.019, 0.10)).unwrap();
+    assert!((q[0] - expected[0]).abs() < 1e-5 && (q[1] - expected[1]).abs() < 1e-5);
+    // A torque pair becomes the end-point force f = J⁻ᵀ·τ: check Jᵀ·f = τ.
+    run(&mut dev, 50, 0.01).unwrap();
+    let f = dev.last_sent();
+    let j = file.linkage.state([q[0], q[1]]).unwrap().j;
+    let jt_f = haptic2d::device::pantograph2::jt_mul(&j, [f[0] as f64, f[1] as f64]);
+    assert!((jt_f[0] - 0.01).abs() < 1e-3 && (jt_f[1] + 0.01).abs() < 1e-3, "{jt_f:?}");
+}
+
+/// devices/udp/sim_device.c, built with `cc` into the test's temp dir; `None` without `cc`.
+fn c_device() -> Option<(Python, SocketAddr)> {
+    let src = concat!(env!("CARGO_MANIFEST_DIR"), "/../../devices/udp/sim_device.c");
+    let exe = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("udp_sim_device");
+    let built = Process::new("cc")
+        .args(["-O2", "-Wall", "-Werror", "-o"])
+        .arg(&exe)
+        .arg(src)
+        .arg("-lm")
+        .status()
+        .ok()?;
+    assert!(built.success(), "sim_device.c does not build");
+    let mut child = Process::new(&exe)
+        .args(["--bind", "127.0.0.1:0"])
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut line = String::new();
+    use std::io::BufRead;
+    std::io::BufReader::new(child.stdout.take().unwrap())
+        .read_line(&mut line)
+        .unwrap();
+    let addr = line.trim().strip_prefix("listening on ").unwrap().parse().unwrap();
+    Some((Python(child), addr))
+}
+
+#[test]
+fn the_c_reference_device_builds_and_answers_like_the_python_one() {
+    let Some((_c, addr)) = c_device() else {
+        eprintln!("cc not found: skipped");
+        return;
+    };
+    let mut file = UdpDeviceFile::reference();
+    file.timeout_periods = 50.0;
+    let mut dev = UdpDevice::open(addr, &file, PERIOD, "udp:c").unwrap();
+    let q = dev.read_encoders().unwrap();
+    let e = file.linkage.fk([q[0], q[1]]).unwrap();
+    assert!((e.x - 0.019).abs() < 1e-5 && (e.y - 0.10).abs() < 1e-5, "{e:?}");
+    run(&mut dev, 300, 0.0).unwrap();
+    let c = *dev.counters();
+    assert!(c.fresh >= 290, "{c}");
+    assert_eq!(c.malformed, 0, "{c}");
+}
