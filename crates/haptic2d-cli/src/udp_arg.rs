@@ -33,7 +33,8 @@ enum End {
 /// The device address of `udp:ADDR:PORT` (a name is resolved once, here).
 pub fn address_of(device: &str) -> Result<SocketAddr, String> {
     let rest = device.strip_prefix("udp:").unwrap_or(device);
-    let hint = "expected udp:ADDR:PORT, e.g. udp:127.0.0.1:5005 (the address the device listens at)";
+    let hint =
+        "expected udp:ADDR:PORT, e.g. udp:127.0.0.1:5005 (the address the device listens at)";
     if rest.is_empty() {
         return Err(format!("--device `{device}`: {hint}"));
     }
@@ -94,13 +95,16 @@ fn run_inner(a: &RunArgs) -> Result<u8, (u8, String)> {
     let mut system = Planar2System::new(scene.world, config)
         .map_err(|e| bad(format!("scene {} with {}: {e}", scene.source, file.source)))?;
     if !a.headless {
-        eprintln!("note: the live display is not available with a UDP device yet; running headless");
+        eprintln!(
+            "note: the live display is not available with a UDP device yet; running headless"
+        );
     }
 
     // Open before the first deadline.
     let period = Duration::from_secs_f64(1.0 / a.rate);
     let name = format!("udp:{addr}");
-    let mut dev = UdpDevice::open(addr, &file, period, &name).map_err(|e| (exit::DEVICE_LOST, e))?;
+    let mut dev =
+        UdpDevice::open(addr, &file, period, &name).map_err(|e| (exit::DEVICE_LOST, e))?;
 
     let capacity = ((a.rate * 2.0) as usize).max(4096);
     let (mut tx, rx, _latest) =
@@ -194,7 +198,10 @@ fn run_inner(a: &RunArgs) -> Result<u8, (u8, String)> {
         if out.tripped {
             dev.zero_torques();
             ended = Some(End::Tripped(
-                system.safety_trip().map(|t| t.to_string()).unwrap_or_default(),
+                system
+                    .safety_trip()
+                    .map(|t| t.to_string())
+                    .unwrap_or_default(),
             ));
             return TickControl::Stop;
         }

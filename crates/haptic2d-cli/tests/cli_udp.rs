@@ -109,7 +109,7 @@ fn counter(out: &str, what: &str) -> u64 {
 /// What the proxy does to the device's answers.
 #[derive(Clone, Copy)]
 enum Mischief {
-    /// Drop answer n when n % drop == 0; hold answer n when n % swap == 0 and send it after the next.
+    /// Drop answer n when n.is_multiple_of(drop); hold answer n when n.is_multiple_of(swap) and send it after the next.
     LossAndReorder { drop: u64, swap: u64 },
     /// A garbage datagram to the host before every `every`-th answer.
     Garbage { every: u64 },
@@ -133,8 +133,11 @@ fn proxy(device: SocketAddr, mischief: Mischief) -> Proxy {
     let front = UdpSocket::bind("127.0.0.1:0").unwrap();
     let back = UdpSocket::bind("127.0.0.1:0").unwrap();
     back.connect(device).unwrap();
-    front.set_read_timeout(Some(Duration::from_millis(2))).unwrap();
-    back.set_read_timeout(Some(Duration::from_millis(2))).unwrap();
+    front
+        .set_read_timeout(Some(Duration::from_millis(2)))
+        .unwrap();
+    back.set_read_timeout(Some(Duration::from_millis(2)))
+        .unwrap();
     let addr = front.local_addr().unwrap();
     let stop = Arc::new(AtomicBool::new(false));
     let done = Arc::new(AtomicU64::new(0));
@@ -169,11 +172,11 @@ fn proxy(device: SocketAddr, mischief: Mischief) -> Proxy {
             n += 1;
             match mischief {
                 Mischief::LossAndReorder { drop, swap } => {
-                    if n > 5 && n % drop == 0 {
+                    if n > 5 && n.is_multiple_of(drop) {
                         d2.fetch_add(1, Ordering::Relaxed);
                         continue;
                     }
-                    if n > 5 && n % swap == 0 {
+                    if n > 5 && n.is_multiple_of(swap) {
                         held = Some(buf[..len].to_vec());
                         d2.fetch_add(1, Ordering::Relaxed);
                         continue;
@@ -184,7 +187,7 @@ fn proxy(device: SocketAddr, mischief: Mischief) -> Proxy {
                     }
                 }
                 Mischief::Garbage { every } => {
-                    if n % every == 0 {
+                    if n.is_multiple_of(every) {
                         // A state-sized datagram of the wrong version, then a short one.
                         let mut g = buf[..len].to_vec();
                         g[2] = 9;
@@ -258,10 +261,16 @@ fn malformed_datagrams_are_counted_and_ignored() {
     let malformed = counter(&out, "malformed");
     // Every garbled datagram the host read was counted; the last few may still be in flight.
     assert!(injected > 100, "{out}");
-    assert!(malformed <= injected && malformed + 3 >= injected, "{malformed} of {injected}\n{out}");
+    assert!(
+        malformed <= injected && malformed + 3 >= injected,
+        "{malformed} of {injected}\n{out}"
+    );
     // Ignored: no answer was lost to them, and the loop kept its ticks.
     assert_eq!(counter(&out, "lost"), 0, "{out}");
-    assert!(counter(&out, "fresh") * 10 >= counter(&out, "sent") * 9, "{out}");
+    assert!(
+        counter(&out, "fresh") * 10 >= counter(&out, "sent") * 9,
+        "{out}"
+    );
 }
 
 #[test]
@@ -283,21 +292,37 @@ fn device_killed_mid_run_exits_4_naming_the_device() {
     let out = text(&o);
     assert_eq!(o.status.code(), Some(4), "{out}");
     assert!(out.contains(&format!("udp:{}", dev.1)), "{out}");
-    assert!(out.contains("no state for") && out.contains("latched"), "{out}");
+    assert!(
+        out.contains("no state for") && out.contains("latched"),
+        "{out}"
+    );
     assert!(!out.contains("panicked"), "{out}");
 }
 
 #[test]
 fn no_device_and_bad_arguments_are_clear_errors() {
     let _t = turn();
-    let free = UdpSocket::bind("127.0.0.1:0").unwrap().local_addr().unwrap();
+    let free = UdpSocket::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap();
     let file = device_file("bad");
     let o = run(free, &file, "1").output().unwrap();
     let out = text(&o);
     assert_eq!(o.status.code(), Some(4), "{out}");
-    assert!(out.contains("no state from the device") && out.contains("sim_device.py"), "{out}");
+    assert!(
+        out.contains("no state from the device") && out.contains("sim_device.py"),
+        "{out}"
+    );
     let o = Command::new(BIN)
-        .args(["run", "--device", "udp:nowhere", "--headless", "--duration", "1"])
+        .args([
+            "run",
+            "--device",
+            "udp:nowhere",
+            "--headless",
+            "--duration",
+            "1",
+        ])
         .output()
         .unwrap();
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));

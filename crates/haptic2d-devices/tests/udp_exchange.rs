@@ -30,7 +30,7 @@ enum Fault {
     /// Stop answering after this many commands.
     SilentAfter(u64),
     /// Report a fault (status bit 5) from this many commands on.
-    FaultAfter(u64),
+    ReportsFaultAfter(u64),
 }
 
 struct FakeDevice {
@@ -71,7 +71,7 @@ impl FakeDevice {
                 } else {
                     0
                 };
-                if matches!(fault, Fault::FaultAfter(k) if n > k) {
+                if matches!(fault, Fault::ReportsFaultAfter(k) if n > k) {
                     status |= STATUS_FAULT;
                 }
                 let mut out = [0u8; STATE_LEN];
@@ -147,13 +147,24 @@ fn clean_exchange_answers_every_command_and_clamps_torques() {
     let fake = FakeDevice::start(Fault::None);
     let mut dev = open(fake.addr);
     let q = dev.read_encoders().unwrap();
-    assert_eq!([q[0], q[1]], [FakeDevice::Q[0] as f64, FakeDevice::Q[1] as f64]);
+    assert_eq!(
+        [q[0], q[1]],
+        [FakeDevice::Q[0] as f64, FakeDevice::Q[1] as f64]
+    );
     run(&mut dev, 300, 1.0).unwrap();
-    assert_eq!(dev.last_sent(), [0.123, -0.123, 0.0], "clamped to torque_limit");
+    assert_eq!(
+        dev.last_sent(),
+        [0.123, -0.123, 0.0],
+        "clamped to torque_limit"
+    );
     let c = *dev.counters();
     drop(dev);
     let got = fake.finish();
-    assert_eq!(c.malformed + c.reordered + c.duplicates + c.lost(), 0, "{c}");
+    assert_eq!(
+        c.malformed + c.reordered + c.duplicates + c.lost(),
+        0,
+        "{c}"
+    );
     assert!(c.fresh >= 300, "{c}");
     // The first command of the handshake is a poll: torques only once a state has arrived.
     assert_eq!(got[0].flags & FLAG_ENABLE, 0);
@@ -225,12 +236,15 @@ fn a_silent_device_is_lost_within_the_timeout() {
     drop(dev);
     let got = fake.finish();
     let last = got.iter().rev().find(|c| c.flags & FLAG_LATCHED != 0);
-    assert!(last.is_some_and(|c| c.command == [0.0; 3]), "a latched zero command was sent");
+    assert!(
+        last.is_some_and(|c| c.command == [0.0; 3]),
+        "a latched zero command was sent"
+    );
 }
 
 #[test]
 fn a_device_fault_is_a_lost_device() {
-    let fake = FakeDevice::start(Fault::FaultAfter(50));
+    let fake = FakeDevice::start(Fault::ReportsFaultAfter(50));
     let mut dev = open(fake.addr);
     let err = run(&mut dev, 200, 0.01).unwrap_err();
     fake.finish();
@@ -240,9 +254,15 @@ fn a_device_fault_is_a_lost_device() {
 #[test]
 fn no_device_at_the_address_is_a_clear_error() {
     // A port with nothing behind it: bind one, then free it.
-    let addr = UdpSocket::bind("127.0.0.1:0").unwrap().local_addr().unwrap();
+    let addr = UdpSocket::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap();
     let err = UdpDevice::open(addr, &UdpDeviceFile::reference(), PERIOD, "udp:nobody").unwrap_err();
-    assert!(err.contains("no state from the device") && err.contains("sim_device.py"), "{err}");
+    assert!(
+        err.contains("no state from the device") && err.contains("sim_device.py"),
+        "{err}"
+    );
 }
 
 struct Python(Child);
@@ -256,7 +276,10 @@ impl Drop for Python {
 
 /// Starts devices/udp/sim_device.py on an ephemeral loopback port; `None` without python3.
 fn sim_device(extra: &[&str]) -> Option<(Python, SocketAddr)> {
-    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/../../devices/udp/sim_device.py");
+    let script = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../devices/udp/sim_device.py"
+    );
     let mut child = Process::new("python3")
         .arg(script)
         .args(["--bind", "127.0.0.1:0"])
@@ -269,7 +292,12 @@ fn sim_device(extra: &[&str]) -> Option<(Python, SocketAddr)> {
     std::io::BufReader::new(child.stdout.take().unwrap())
         .read_line(&mut line)
         .unwrap();
-    let addr = line.trim().strip_prefix("listening on ").unwrap().parse().unwrap();
+    let addr = line
+        .trim()
+        .strip_prefix("listening on ")
+        .unwrap()
+        .parse()
+        .unwrap();
     Some((Python(child), addr))
 }
 
@@ -286,7 +314,10 @@ fn the_python_reference_device_answers_at_its_start_pose() {
     let mut dev = UdpDevice::open(addr, &file, PERIOD, "udp:python").unwrap();
     let q = dev.read_encoders().unwrap();
     let e = file.linkage.fk([q[0], q[1]]).unwrap();
-    assert!((e.x - 0.019).abs() < 1e-5 && (e.y - 0.10).abs() < 1e-5, "{e:?}");
+    assert!(
+        (e.x - 0.019).abs() < 1e-5 && (e.y - 0.10).abs() < 1e-5,
+        "{e:?}"
+    );
     run(&mut dev, 300, 0.0).unwrap();
     let c = *dev.counters();
     assert!(c.fresh >= 290, "{c}");
@@ -308,19 +339,28 @@ fn the_python_reference_device_in_pose_mode_gives_the_same_angles() {
     file.wrench_output = true;
     let mut dev = UdpDevice::open(addr, &file, PERIOD, "udp:python").unwrap();
     let q = dev.read_encoders().unwrap();
-    let expected = file.linkage.ik(haptic2d::geom::Vec2::new(0.019, 0.10)).unwrap();
+    let expected = file
+        .linkage
+        .ik(haptic2d::geom::Vec2::new(0.019, 0.10))
+        .unwrap();
     assert!((q[0] - expected[0]).abs() < 1e-5 && (q[1] - expected[1]).abs() < 1e-5);
     // A torque pair becomes the end-point force f = J⁻ᵀ·τ: check Jᵀ·f = τ.
     run(&mut dev, 50, 0.01).unwrap();
     let f = dev.last_sent();
     let j = file.linkage.state([q[0], q[1]]).unwrap().j;
     let jt_f = haptic2d::device::pantograph2::jt_mul(&j, [f[0] as f64, f[1] as f64]);
-    assert!((jt_f[0] - 0.01).abs() < 1e-3 && (jt_f[1] + 0.01).abs() < 1e-3, "{jt_f:?}");
+    assert!(
+        (jt_f[0] - 0.01).abs() < 1e-3 && (jt_f[1] + 0.01).abs() < 1e-3,
+        "{jt_f:?}"
+    );
 }
 
 /// devices/udp/sim_device.c, built with `cc` into the test's temp dir; `None` without `cc`.
 fn c_device() -> Option<(Python, SocketAddr)> {
-    let src = concat!(env!("CARGO_MANIFEST_DIR"), "/../../devices/udp/sim_device.c");
+    let src = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../devices/udp/sim_device.c"
+    );
     let exe = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("udp_sim_device");
     let built = Process::new("cc")
         .args(["-O2", "-Wall", "-Werror", "-o"])
@@ -340,7 +380,12 @@ fn c_device() -> Option<(Python, SocketAddr)> {
     std::io::BufReader::new(child.stdout.take().unwrap())
         .read_line(&mut line)
         .unwrap();
-    let addr = line.trim().strip_prefix("listening on ").unwrap().parse().unwrap();
+    let addr = line
+        .trim()
+        .strip_prefix("listening on ")
+        .unwrap()
+        .parse()
+        .unwrap();
     Some((Python(child), addr))
 }
 
@@ -355,7 +400,10 @@ fn the_c_reference_device_builds_and_answers_like_the_python_one() {
     let mut dev = UdpDevice::open(addr, &file, PERIOD, "udp:c").unwrap();
     let q = dev.read_encoders().unwrap();
     let e = file.linkage.fk([q[0], q[1]]).unwrap();
-    assert!((e.x - 0.019).abs() < 1e-5 && (e.y - 0.10).abs() < 1e-5, "{e:?}");
+    assert!(
+        (e.x - 0.019).abs() < 1e-5 && (e.y - 0.10).abs() < 1e-5,
+        "{e:?}"
+    );
     run(&mut dev, 300, 0.0).unwrap();
     let c = *dev.counters();
     assert!(c.fresh >= 290, "{c}");

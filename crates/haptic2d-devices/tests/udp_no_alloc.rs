@@ -76,5 +76,9 @@ fn the_exchange_allocates_nothing_once_open() {
     }
     MEASURING.with(|m| m.set(false));
     assert!(dev.counters().fresh > 400, "{}", dev.counters());
-    assert_eq!(ALLOCS.load(Ordering::Relaxed), 0, "allocations on the exchange");
+    assert_eq!(
+        ALLOCS.load(Ordering::Relaxed),
+        0,
+        "allocations on the exchange"
+    );
 }

@@ -266,11 +266,17 @@ mod tests {
         let e = UdpDeviceFile::from_toml(text, "device file x.toml")
             .unwrap_err()
             .to_string();
-        assert!(e.contains("protocol.input") && e.contains("\"pose\""), "{e}");
+        assert!(
+            e.contains("protocol.input") && e.contains("\"pose\""),
+            "{e}"
+        );
         assert!(e.contains("protocol.reply_wait_periods"), "{e}");
-        let e = UdpDeviceFile::from_toml("kind = \"udp\"\n[linkage]\nd = 0\nl1 = 0.07\nl2 = 0.09\nfoo = 1\n", "f")
-            .unwrap_err()
-            .to_string();
+        let e = UdpDeviceFile::from_toml(
+            "kind = \"udp\"\n[linkage]\nd = 0\nl1 = 0.07\nl2 = 0.09\nfoo = 1\n",
+            "f",
+        )
+        .unwrap_err()
+        .to_string();
         assert!(e.contains("foo"), "{e}");
     }
 }

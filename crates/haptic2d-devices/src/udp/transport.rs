@@ -130,9 +130,7 @@ impl UdpTransport {
     /// Sends the next command (`flags`, `command`); it becomes the pending one. Returns its `seq`.
     pub fn send(&mut self, flags: u16, command: [f32; 3]) -> std::io::Result<u32> {
         self.seq = self.seq.wrapping_add(1).max(1);
-        let (echo_seq, echo_device_ns) = self
-            .latest
-            .map_or((0, 0), |s| (s.seq, s.device_time_ns));
+        let (echo_seq, echo_device_ns) = self.latest.map_or((0, 0), |s| (s.seq, s.device_time_ns));
         Command {
             seq: self.seq,
             host_time_ns: self.host_ns(),
@@ -266,7 +264,8 @@ impl UdpTransport {
     /// received (zero when every command is answered). Measured from the host's sends, so a host
     /// that stalled itself does not blame the device.
     pub fn silent_for(&self) -> Duration {
-        self.unanswered_since.map_or(Duration::ZERO, |t| t.elapsed())
+        self.unanswered_since
+            .map_or(Duration::ZERO, |t| t.elapsed())
     }
 
     /// When the newest state arrived.
@@ -283,7 +282,9 @@ impl UdpTransport {
 
     /// The round trip of a fresh answer received since the last call (ns), once.
     pub fn take_rtt(&mut self) -> Option<u64> {
-        std::mem::take(&mut self.rtt_new).then_some(self.rtt_ns).flatten()
+        std::mem::take(&mut self.rtt_new)
+            .then_some(self.rtt_ns)
+            .flatten()
     }
 
     /// The counters.
