@@ -22,8 +22,14 @@ fn main() -> Result<(), String> {
         return Err("usage: udp_roundtrip ADDR:PORT [RATE_HZ] [SECONDS] [--rt]".into());
     }
     let addr = args[1].parse().map_err(|e| format!("{}: {e}", args[1]))?;
-    let rate: f64 = args.get(2).map_or(Ok(1000.0), |s| s.parse()).map_err(|e| format!("{e}"))?;
-    let secs: f64 = args.get(3).map_or(Ok(3.0), |s| s.parse()).map_err(|e| format!("{e}"))?;
+    let rate: f64 = args
+        .get(2)
+        .map_or(Ok(1000.0), |s| s.parse())
+        .map_err(|e| format!("{e}"))?;
+    let secs: f64 = args
+        .get(3)
+        .map_or(Ok(3.0), |s| s.parse())
+        .map_err(|e| format!("{e}"))?;
     let rt = args.iter().any(|a| a == "--rt");
     let mut t = UdpTransport::connect(addr).map_err(|e| e.to_string())?;
     // Warm up (and check that the device answers).
