@@ -409,3 +409,22 @@ fn the_c_reference_device_builds_and_answers_like_the_python_one() {
     assert!(c.fresh >= 290, "{c}");
     assert_eq!(c.malformed, 0, "{c}");
 }
+
+/// Regression: silence was measured from the newest state's arrival, so a host that stalled
+/// itself (descheduled for a few ms) and then missed one answer declared the device lost. It is
+/// measured from the host's send now: a host stall of 50 periods before each command, with every
+/// 5th answer dropped, is survived at a 20-period timeout (the old rule lost the device at the
+/// first drop; 20 periods leave room for a loaded machine's late wake-ups inside the wait).
+#[test]
+fn a_stalled_host_does_not_blame_the_device() {
+    let fake = FakeDevice::start(Fault::DropEvery(5));
+    let mut dev = open_patient(fake.addr);
+    for _ in 0..12 {
+        dev.read_encoders().unwrap();
+        thread::sleep(PERIOD * 50);
+        dev.write_torques(&[0.0; 4]).unwrap();
+    }
+    let c = *dev.counters();
+    fake.finish();
+    assert!(c.lost() >= 2, "{c}");
+}
