@@ -7,7 +7,7 @@ use crate::exit::{Failure, Status};
 use crate::foxglove_live::FoxgloveServer;
 use crate::hand_arg::HandSpec;
 use crate::run_log::{self, RunLogger};
-use crate::run_rig::{DeviceChoice, Rig};
+use crate::run_rig::{DeviceChoice, DeviceModel, RealOpenError, Rig};
 use crate::run_view::{self, LiveView, LoadedScene};
 use crate::scene_arg;
 use haptic2d::control::passivity::PlanarPassivity;
@@ -55,7 +55,7 @@ pub struct RunArgs {
     pub hand: Option<String>,
     /// Device: sim (simulated twin pantograph), replay:FILE.csv (recorded encoders q1..q4, rad),
     /// replay:FILE.mcap (the encoders of a `--log FILE.mcap` recording), haply:PATH or haply:auto
-    /// (a Haply board; --device-file a Haply device file, headless).
+    /// (a Haply board; --device-file a Haply device file, default haply-2diy-gen3).
     #[arg(long, default_value = "sim")]
     pub device: String,
     /// Device parameters (TOML: top-level fields or a [device] table; template:
@@ -135,7 +135,19 @@ pub fn run(a: &RunArgs) -> Result<Status, Failure> {
     for w in &scene.warnings {
         eprintln!("warning: {w}");
     }
-    let device_setting = device_arg::resolve(a.device_file.as_deref(), &scene, 1.0 / a.rate)?;
+    // A real device's --device-file is its own (e.g. a Haply file): read and checked now, opened
+    // after the stability gate.
+    let real = opts.device.load_real(a.device_file.as_deref())?;
+    let device_setting = match &real {
+        Some(r) => device_arg::DeviceSetting {
+            params: match &r.model {
+                DeviceModel::Twin(p) => *p,
+                DeviceModel::FiveBar { .. } => haptic2d::device::DeviceParams::default(),
+            },
+            origin: r.summary.clone(),
+        },
+        None => device_arg::resolve(a.device_file.as_deref(), &scene, 1.0 / a.rate)?,
+    };
     let config = HapticConfig {
         device: device_setting.params,
         controller: opts.controller,
@@ -143,9 +155,8 @@ pub fn run(a: &RunArgs) -> Result<Status, Failure> {
         ..HapticConfig::default()
     };
     // A real device only starts with a configuration that is stable with the hand released (§11.4).
-    let simulated = matches!(opts.device, DeviceChoice::Sim | DeviceChoice::Replay(_));
-    if !simulated && !a.allow_unstable {
-        haptic2d_lab::stability::check_released_stability(&config, &scene.world)?;
+    if let (Some(r), false) = (&real, a.allow_unstable) {
+        crate::cmd_stability::check_real_device(&r.model, &config, &scene.world)?;
     }
     let scene_name = scene.name.clone();
     let loaded = LoadedScene {
@@ -155,9 +166,20 @@ pub fn run(a: &RunArgs) -> Result<Status, Failure> {
     };
     let hand_name = match opts.device {
         DeviceChoice::Sim => a.hand.as_deref().unwrap_or("follow").to_string(),
-        DeviceChoice::Replay(_) => "-".to_string(),
+        _ => "-".to_string(),
     };
-    let mut rig = Rig::new(scene.world, &scene.source, config, opts.device, opts.hand)?;
+    let mut rig = match real {
+        None => Rig::new(scene.world, &scene.source, config, opts.device, opts.hand)?,
+        Some(r) => Rig::with_real(scene.world, &scene.source, config, opts.device, r).map_err(
+            |e| match e {
+                RealOpenError::Config(m) => Failure::from(m),
+                RealOpenError::Open(m) => Failure {
+                    status: Status::DeviceLost,
+                    message: m,
+                },
+            },
+        )?,
+    };
 
     // The display: bound before the loop starts, so that a taken port is an error now.
     let (server, view) = if a.headless {
@@ -219,7 +241,11 @@ pub fn run(a: &RunArgs) -> Result<Status, Failure> {
         tx,
         end: None,
     };
-    let summary = run_on_rt_thread(&loop_config, &stop, &mut state)?;
+    let summary = run_on_rt_thread(&loop_config, &stop, &mut state);
+    // Zero torques before anything else (Ctrl-C, the end of --duration, a failure alike); the port
+    // closes when the rig is dropped, after the report.
+    state.rig.io.zero_torques();
+    let summary = summary?;
     let end = state.end.take();
     drop(state);
     if let Some(s) = server {
@@ -256,6 +282,12 @@ fn validate_options(a: &RunArgs) -> Result<RunOptions, Failure> {
         (DeviceChoice::Replay(_), Some(_)) => {
             return Err(
                 "--hand applies to the simulated device only (a replay plays recorded motion)"
+                    .into(),
+            )
+        }
+        (d, Some(_)) if d.is_real() => {
+            return Err(
+                "--hand applies to the simulated device only: on a real device your hand is the hand (give --hand to `haptic2d emulate haply`)"
                     .into(),
             )
         }
@@ -371,7 +403,7 @@ impl LoopState<'_> {
             v.apply_commands(self.rig);
         }
         let paused = self.view.as_ref().is_some_and(|v| v.paused());
-        let (q, lost) = match self.rig.io.read_encoders() {
+        let (q, lost) = match self.rig.read() {
             Ok(q) => (q, None),
             Err(e) => ([f64::NAN; 4], Some(e)),
         };
@@ -446,7 +478,10 @@ fn run_on_rt_thread(
 fn end_status(end: Option<&LoopEnd>, interrupted: bool) -> (Status, Option<String>) {
     match end {
         Some(LoopEnd::ReplayEnded) => (Status::Clean, Some("the replay ended".into())),
-        Some(LoopEnd::DeviceLost(msg)) => (Status::DeviceLost, Some(msg.clone())),
+        Some(LoopEnd::DeviceLost(msg)) => (
+            Status::DeviceLost,
+            Some(format!("{msg}\n    torques were set to zero and latched")),
+        ),
         Some(LoopEnd::Watchdog(msg)) => (Status::SafetyStop, Some(msg.clone())),
         // The latch's own report (`system.safety_trip()`) is printed above.
         Some(LoopEnd::SafetyLatch) => (Status::SafetyStop, None),

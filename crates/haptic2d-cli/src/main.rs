@@ -7,7 +7,6 @@ mod cmd_emulate;
 mod cmd_log;
 mod cmd_reproduce;
 mod cmd_run;
-mod cmd_run_haply;
 mod cmd_scenes;
 mod cmd_simulate;
 mod cmd_stability;
@@ -18,6 +17,7 @@ mod exit;
 mod foxglove_live;
 mod hand_arg;
 mod haply_arg;
+mod rig_system;
 mod run_log;
 mod run_rig;
 mod run_view;
@@ -133,10 +133,6 @@ fn main() -> ExitCode {
     // Commands this module does not own report failures as plain strings: exit 1.
     let runtime = |r: Result<(), String>| r.map(|()| Status::Clean).map_err(Failure::error);
     let result = match cli.command {
-        Command::Run(args) if args.device.starts_with("haply:") => {
-            return cmd_run_haply::run(&args)
-        }
-        Command::Run(args) if args.device.starts_with("udp:") => return udp_arg::run(&args),
         Command::Emulate(args) => return cmd_emulate::run(&args),
         Command::Devices => return cmd_devices::run(),
         Command::Device { command } => return cmd_device_check::run(&command),

@@ -1,18 +1,48 @@
 //! The rig of `haptic2d run`: the haptic system (device estimator, controller, world) and the device
-//! it drives (simulated twin pantograph with a simulated hand, or a replay), built from a scene's
-//! world and rebuilt when the live display resets or switches the scene.
+//! it drives (simulated twin pantograph with a simulated hand, a replay, or a real device), built
+//! from a scene's world and rebuilt when the live display resets or switches the scene.
+//!
+//! # Adding a real device (the extension point)
+//!
+//! Every real device runs in this one loop (real-time thread, watchdog, safety latch, CSV/MCAP
+//! logs, signals and exit codes, the browser display). To add one, e.g. `--device udp:ADDR:PORT`:
+//!
+//! 1. a variant of [`DeviceChoice`] and its branch in [`DeviceChoice::parse`] (two lines);
+//! 2. its arm in [`DeviceChoice::load_real`], calling a glue function in its own file
+//!    (`haply_arg::real_device`, `udp_arg::real_device`, …) that reads and checks the device file
+//!    **without opening anything** and returns a [`RealDevice`]:
+//!    - its [`DeviceModel`]: [`DeviceModel::Twin`] (4 joints, MODELS §10, a [`DeviceParams`]) or
+//!      [`DeviceModel::FiveBar`] (2 joints: the linkage and the motor torque limit; the system is the
+//!      2-DOF [`Planar2System`](haptic2d::haptic::planar2::Planar2System));
+//!    - the device's own reply timeout (`wait_periods`, periods: a silent device is its driver's
+//!      [`DeviceError::Lost`](haptic2d_rt::DeviceError::Lost) → exit 4), the watchdog's
+//!      missed-deadline limit and the stall limit on the loop's own time;
+//!    - an `open` closure that opens and hand-shakes the device at the control period and returns
+//!      it as a [`DeviceIo`]; a 2-joint driver implements
+//!      [`Device2Io`](haptic2d_rt::io::Device2Io) and is wrapped in
+//!      [`Joints2`](haptic2d_rt::io::Joints2).
+//!
+//! The rig does the rest: the stability gate with the hand released (`--allow-unstable`), zero
+//! torques until the first valid reading and the start-up ramp of the shared safety layer, the
+//! stall check on the loop's own time (see [`Rig::tick_system`]), the final clamp.
 
 use crate::hand_arg::HandSpec;
+use crate::rig_system::RigSystem;
 use haptic2d::device::linalg::{V3, V4};
-use haptic2d::haptic::{HapticConfig, HapticSystem, TickOutput};
+use haptic2d::device::pantograph2::Pantograph2;
+use haptic2d::device::DeviceParams;
+use haptic2d::haptic::planar2::{Planar2Config, Planar2System};
+use haptic2d::haptic::{HapticConfig, HapticSystem, SafetyConfig, TickOutput};
 use haptic2d::world::World;
+use haptic2d_rt::clock::now_ns;
 use haptic2d_rt::io::DEFAULT_REPLAY_COLUMNS;
 use haptic2d_rt::{
-    DeviceIo, ReplayDevice, ReplayEnd, SafetyInput, SharedTarget, SimIo, TickInfo, TickInterval,
-    WatchdogConfig,
+    DeviceError, DeviceIo, ReplayDevice, ReplayEnd, SafetyInput, SharedTarget, SimIo, TickInfo,
+    TickInterval, WatchdogConfig,
 };
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
+use std::time::Duration;
 
 /// The device the loop drives.
 #[derive(Clone, Debug, PartialEq)]
@@ -22,10 +52,15 @@ pub enum DeviceChoice {
     /// Recorded encoder angles `q1..q4` (rad) played back from a CSV file, or the encoders of an
     /// MCAP tick log (`.mcap`).
     Replay(PathBuf),
+    /// A Haply board: the `PATH` of `haply:PATH`, or `auto` (device file: `--device-file`).
+    Haply(String),
+    /// A device on the open UDP protocol listening at the `ADDR:PORT` of `udp:ADDR:PORT`.
+    Udp(String),
 }
 
 impl DeviceChoice {
-    /// Parses `--device`: `sim` or `replay:FILE.csv`; the error says how to fix it.
+    /// Parses `--device`: `sim`, `replay:FILE.csv|FILE.mcap` or `haply:PATH|haply:auto`; the error
+    /// says how to fix it.
     pub fn parse(s: &str) -> Result<Self, String> {
         if s == "sim" {
             return Ok(DeviceChoice::Sim);
@@ -36,10 +71,94 @@ impl DeviceChoice {
             }
             return Ok(DeviceChoice::Replay(PathBuf::from(f)));
         }
+        if let Some(p) = s.strip_prefix("haply:") {
+            if p.is_empty() {
+                return Err("--device haply: needs a port: haply:PATH (e.g. haply:/dev/ttyACM0) or haply:auto".into());
+            }
+            return Ok(DeviceChoice::Haply(p.to_string()));
+        }
+        if let Some(a) = s.strip_prefix("udp:") {
+            return Ok(DeviceChoice::Udp(a.to_string()));
+        }
         Err(format!(
-            "--device `{s}` is not available\n    fix: use --device sim (the simulated twin pantograph) or --device replay:FILE.csv"
+            "--device `{s}` is not available\n    fix: use --device sim (the simulated twin pantograph), replay:FILE.csv, haply:PATH|haply:auto or udp:ADDR:PORT"
         ))
     }
+
+    /// True for a device that moves a person's hand (anything but the simulation and a replay).
+    pub fn is_real(&self) -> bool {
+        !matches!(self, DeviceChoice::Sim | DeviceChoice::Replay(_))
+    }
+
+    /// For a real device, reads and checks its device file `device_file` (nothing is opened yet);
+    /// `None` for the simulated device and a replay. Errors name the file, the field and the fix.
+    pub fn load_real(&self, device_file: Option<&Path>) -> Result<Option<RealDevice>, String> {
+        Ok(match self {
+            DeviceChoice::Sim | DeviceChoice::Replay(_) => None,
+            DeviceChoice::Haply(port) => Some(crate::haply_arg::real_device(port, device_file)?),
+            DeviceChoice::Udp(addr) => Some(crate::udp_arg::real_device(addr, device_file)?),
+        })
+    }
+}
+
+/// What the haptic system needs to know of a real device.
+#[derive(Clone, Debug, PartialEq)]
+pub enum DeviceModel {
+    /// A twin pantograph (4 joints `q11, q12, q21, q22`; MODELS §10) with these parameters.
+    Twin(DeviceParams),
+    /// A 2-DOF five-bar (joints `q1, q2` in `q[0..2]`) with this linkage (m) and motor torque limit
+    /// `tau_max` (N·m, both motors).
+    FiveBar {
+        /// The linkage (m).
+        linkage: Pantograph2,
+        /// Motor torque limit (N·m).
+        tau_max: f64,
+    },
+}
+
+/// Opens a real device at the control period: handshake done, ready for the first tick.
+pub type OpenDevice = Box<dyn FnOnce(Duration) -> Result<Box<dyn DeviceIo + Send>, String> + Send>;
+
+/// A real device whose device file has been read and checked, not yet opened.
+pub struct RealDevice {
+    /// Name in messages, e.g. `haply:/dev/ttyACM0`.
+    pub name: String,
+    /// Its model.
+    pub model: DeviceModel,
+    /// For the start line: where the parameters came from, the kind, the limits.
+    pub summary: String,
+    /// The longest the driver waits for the device in one read before it reports it lost
+    /// (periods). The stall check leaves this wait to the driver (see [`Rig::tick_system`]).
+    pub wait_periods: f64,
+    /// The watchdog's limit of consecutive missed deadlines (`None`: off).
+    pub max_missed_run: Option<u32>,
+    /// The loop's own delay between two ticks that trips the stall check (periods, ≥ 1; the shared
+    /// safety layer's default is 5).
+    pub max_stall_periods: f64,
+    /// Opens it.
+    pub open: OpenDevice,
+}
+
+impl std::fmt::Debug for RealDevice {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("RealDevice")
+            .field("name", &self.name)
+            .field("model", &self.model)
+            .field("summary", &self.summary)
+            .field("wait_periods", &self.wait_periods)
+            .field("max_missed_run", &self.max_missed_run)
+            .field("max_stall_periods", &self.max_stall_periods)
+            .finish_non_exhaustive()
+    }
+}
+
+/// The limits of a real device the rig keeps after opening it (to rebuild its system).
+#[derive(Clone, Debug, PartialEq)]
+struct RealLimits {
+    model: DeviceModel,
+    wait_periods: f64,
+    max_missed_run: Option<u32>,
+    max_stall_periods: f64,
 }
 
 /// RK4 sub-steps of the simulated plant per tick: one per 0.5 ms of period (at least one).
@@ -49,11 +168,12 @@ fn plant_substeps(dt: f64) -> u32 {
 
 /// The haptic system and its device, owned by the loop thread.
 pub struct Rig {
-    /// Device estimator, controller, passivity controller and world.
-    pub system: HapticSystem,
-    /// The device I/O.
+    /// Device estimator, controller, passivity controller and world (twin or 2-DOF).
+    pub system: RigSystem,
+    /// The device I/O (a 2-DOF device fills `q[0..2]`).
     pub io: Box<dyn DeviceIo + Send>,
-    /// The settings the system was built with; `controller` follows the page's selection.
+    /// The settings the system was built with; `controller` follows the page's selection. For a
+    /// real twin, `device` holds its parameters; for a 2-DOF device it is unused.
     pub config: HapticConfig,
     /// Which device.
     pub device: DeviceChoice,
@@ -62,16 +182,24 @@ pub struct Rig {
     /// The target a `follow` hand pulls the handle towards (m, m, rad, handle coordinates): set by
     /// the page's pointer. `None` for any other hand or device.
     pub target: Option<Arc<SharedTarget>>,
+    /// A real device's model and limits; `None` for the simulation and a replay.
+    real: Option<RealLimits>,
     /// Measures the interval between ticks (wake to wake).
     interval: TickInterval,
-    /// The last tick's interval, in periods (1 for a device paced by the ticks).
+    /// Time the last read waited for the device (ns; real devices only).
+    read_wait_ns: u64,
+    /// The same for the read of the previous tick (ns).
+    prev_read_wait_ns: u64,
+    /// The last tick's interval on the loop's own account, in periods (1 for a device paced by the
+    /// ticks): what the watchdog's stall check sees.
     elapsed_periods: f64,
 }
 
 impl Rig {
     /// Builds the system around `world` (of the scene loaded from `source`, named in errors) and
-    /// opens the device. The simulated device starts at rest at the system's start pose; a `follow`
-    /// hand holds it there until the target moves.
+    /// opens the simulated device or the replay. The simulated device starts at rest at the system's
+    /// start pose; a `follow` hand holds it there until the target moves. For a real device use
+    /// [`Self::with_real`].
     pub fn new(
         world: World,
         source: &str,
@@ -79,12 +207,16 @@ impl Rig {
         device: DeviceChoice,
         hand: HandSpec,
     ) -> Result<Self, String> {
+        if device.is_real() {
+            return Err(format!(
+                "{device:?}: a real device is opened with Rig::with_real"
+            ));
+        }
         let system =
             HapticSystem::new(world, &config).map_err(|e| format!("scene {source}: {e}"))?;
         let target = (device == DeviceChoice::Sim && hand == HandSpec::Follow)
             .then(|| Arc::new(SharedTarget::new(system.device_start())));
         let io: Box<dyn DeviceIo + Send> = match &device {
-            DeviceChoice::Sim => Box::new(Self::sim(&system, &config, &hand, target.as_ref())?),
             DeviceChoice::Replay(p) if crate::run_log::is_mcap(p) => Box::new(
                 haptic2d_rt::mcap::McapReplay::from_path(p, ReplayEnd::Error)?,
             ),
@@ -93,54 +225,168 @@ impl Rig {
                 DEFAULT_REPLAY_COLUMNS,
                 ReplayEnd::Error,
             )?),
+            _ => Box::new(Self::sim(&system, &config, &hand, target.as_ref())?),
         };
         Ok(Self {
-            system,
+            system: RigSystem::Twin(system),
             io,
             config,
             device,
             hand,
             target,
+            real: None,
             interval: TickInterval::new(),
+            read_wait_ns: 0,
+            prev_read_wait_ns: 0,
             elapsed_periods: 1.0,
         })
     }
 
+    /// Builds the system for the real device `real` around `world` (errors name the scene and the
+    /// setting; nothing is opened then), then opens the device at the world's period (its error:
+    /// the device and what to check). A twin's parameters replace `config.device`.
+    pub fn with_real(
+        world: World,
+        source: &str,
+        mut config: HapticConfig,
+        device: DeviceChoice,
+        real: RealDevice,
+    ) -> Result<Self, RealOpenError> {
+        if let DeviceModel::Twin(p) = &real.model {
+            config.device = *p;
+        }
+        let limits = RealLimits {
+            model: real.model,
+            wait_periods: real.wait_periods,
+            max_missed_run: real.max_missed_run,
+            max_stall_periods: real.max_stall_periods,
+        };
+        let period = Duration::from_secs_f64(world.params.dt);
+        let system = Self::real_system(world, &config, &limits).map_err(|e| {
+            RealOpenError::Config(format!("scene {source} with {}: {e}", real.summary))
+        })?;
+        let io = (real.open)(period).map_err(RealOpenError::Open)?;
+        Ok(Self {
+            system,
+            io,
+            config,
+            device,
+            hand: HandSpec::Follow,
+            target: None,
+            real: Some(limits),
+            interval: TickInterval::new(),
+            read_wait_ns: 0,
+            prev_read_wait_ns: 0,
+            elapsed_periods: 1.0,
+        })
+    }
+
+    /// The system of a real device. The tick's own stall limit is the loop's allowance plus the
+    /// device's own reply timeout: the interval it sees (wake to wake) includes the wait for the
+    /// device, which the driver bounds (lost device, exit 4); the watchdog checks the loop's own
+    /// share against the plain limit (see [`Self::tick_system`]).
+    fn real_system(
+        world: World,
+        config: &HapticConfig,
+        limits: &RealLimits,
+    ) -> Result<RigSystem, String> {
+        let safety = SafetyConfig {
+            max_stall_periods: limits.max_stall_periods + limits.wait_periods,
+            ..SafetyConfig::default()
+        };
+        Ok(match &limits.model {
+            DeviceModel::Twin(_) => {
+                RigSystem::Twin(HapticSystem::with_safety(world, config, safety)?)
+            }
+            DeviceModel::FiveBar { linkage, tau_max } => {
+                if config.passivity.is_some() {
+                    return Err("--passivity is not available on a 2-DOF device (its port has no hand-wrench observer); leave it out".into());
+                }
+                let mut c = Planar2Config::new(*linkage, *tau_max);
+                c.controller = config.controller;
+                c.slave = config.slave.clone();
+                c.safety = safety;
+                RigSystem::TwoDof(Planar2System::new(world, c)?)
+            }
+        })
+    }
+
     /// The watchdog's thresholds for this rig: the device file's singularity margin always; for a
-    /// real device also the stall limit of the tick's safety settings and 10 consecutive missed
-    /// deadlines. A device paced by the ticks (the simulated plant, a replay) does not move between
-    /// ticks, so a late tick cannot hurt anyone: stalls and misses are counted in the timing summary
-    /// but do not stop the run.
+    /// real device also the stall limit of the shared safety settings (on the loop's own time) and
+    /// the device's limit of consecutive missed deadlines. A device paced by the ticks (the
+    /// simulated plant, a replay) does not move between ticks, so a late tick cannot hurt anyone:
+    /// stalls and misses are counted in the timing summary but do not stop the run.
     pub fn watchdog_config(&self) -> WatchdogConfig {
         let real = !self.io.paced_by_ticks();
+        let missed = match &self.real {
+            Some(l) => l.max_missed_run,
+            None => Some(10),
+        };
         WatchdogConfig {
-            min_singularity_margin: self.config.device.min_singularity_margin,
-            max_missed_run: real.then_some(10),
-            max_stall_periods: real.then_some(self.system.safety_config().max_stall_periods),
+            min_singularity_margin: match &self.real {
+                // The 2-DOF system trips on its own margin (a five-bar's margin is another measure).
+                Some(RealLimits {
+                    model: DeviceModel::FiveBar { .. },
+                    ..
+                }) => 0.0,
+                _ => self.config.device.min_singularity_margin,
+            },
+            max_missed_run: if real { missed } else { None },
+            max_stall_periods: real.then_some(
+                self.real
+                    .as_ref()
+                    .map_or(SafetyConfig::default().max_stall_periods, |l| {
+                        l.max_stall_periods
+                    }),
+            ),
         }
     }
 
-    /// One tick of the system on encoder angles `q` (rad), `paused` or running. A real device gets
-    /// the measured interval since the previous tick (the system differentiates over it and trips
-    /// on a stall); a device paced by the ticks gets one period. Never allocates.
+    /// Reads the device, timing the read of a real device (the wait for the device is the driver's
+    /// business, bounded by its timeout, and is left out of the stall check). Never allocates.
+    #[inline]
+    pub fn read(&mut self) -> Result<V4, DeviceError> {
+        if self.io.paced_by_ticks() {
+            return self.io.read_encoders();
+        }
+        let t0 = now_ns();
+        let r = self.io.read_encoders();
+        self.read_wait_ns = now_ns().saturating_sub(t0);
+        r
+    }
+
+    /// One tick of the system on encoder angles `q` (rad), `paused` or running. Never allocates.
+    ///
+    /// A device paced by the ticks gets one period. A real device gets the measured wake-to-wake
+    /// interval `Δ_k` (its signals are differentiated over it; the system's own stall limit allows
+    /// for the device's reply timeout), and the watchdog sees the loop's own share of it,
+    ///
+    /// ```text
+    /// Δ_loop,k = Δ_k − w_{k−1},   w_{k−1} = time the previous tick's read waited for the device,
+    /// ```
+    ///
+    /// i.e. sleep overshoot and computation: a loop that stalls (an overloaded machine, a blocked
+    /// thread) trips the stall check within the tick, with its reason; a device that is slow or
+    /// silent is the driver's read timeout (lost device, exit 4), never a stall.
     pub fn tick_system(&mut self, q: &V4, info: &TickInfo, paused: bool) -> TickOutput {
         let elapsed_ns = self.interval.update(info);
+        let wait_ns = std::mem::replace(&mut self.prev_read_wait_ns, self.read_wait_ns);
         if paused {
             self.elapsed_periods = 1.0;
-            self.system.tick_paused(q)
+            self.system.tick(q, None, true)
         } else if self.io.paced_by_ticks() {
             self.elapsed_periods = 1.0;
-            self.system.tick(q)
+            self.system.tick(q, None, false)
         } else {
-            self.elapsed_periods = elapsed_ns as f64 / info.period_ns as f64;
-            let elapsed_s = elapsed_ns as f64 * 1e-9;
-            self.system.tick_elapsed(q, elapsed_s)
+            let own_ns = elapsed_ns.saturating_sub(wait_ns);
+            self.elapsed_periods = own_ns as f64 / info.period_ns as f64;
+            self.system.tick(q, Some(elapsed_ns as f64 * 1e-9), false)
         }
     }
 
     /// The watchdog's input for the tick `info` whose output is `out`: the real singularity margin
-    /// and closure status of the tick, the interval in periods, the deadline flag and whether the
-    /// device was lost (`lost`; the pose is then unknown and reported as zeros).
+    /// and closure status of the tick, the loop's own interval in periods, the deadline flag and
+    /// whether the device was lost (`lost`; the pose is then unknown and reported as zeros).
     pub fn safety_input(
         &self,
         info: &TickInfo,
@@ -181,18 +427,25 @@ impl Rig {
 
     /// Rebuilds the system around `world` with the current settings (controller, passivity
     /// controller and estimator start from their reset states), and puts a simulated device back at
-    /// rest at the start pose with the hand target there (a replay keeps playing). On error nothing
+    /// rest at the start pose with the hand target there (a replay keeps playing; a real device
+    /// stays open, and the new system aligns to the handle and ramps in from zero). On error nothing
     /// changes. Allocates: call it between ticks.
     pub fn rebuild(&mut self, world: World) -> Result<(), String> {
-        let system = HapticSystem::new(world, &self.config)?;
-        if self.device == DeviceChoice::Sim {
-            self.io = Box::new(Self::sim(
-                &system,
-                &self.config,
-                &self.hand,
-                self.target.as_ref(),
-            )?);
-        }
+        let system = match &self.real {
+            Some(l) => Self::real_system(world, &self.config, l)?,
+            None => {
+                let system = HapticSystem::new(world, &self.config)?;
+                if self.device == DeviceChoice::Sim {
+                    self.io = Box::new(Self::sim(
+                        &system,
+                        &self.config,
+                        &self.hand,
+                        self.target.as_ref(),
+                    )?);
+                }
+                RigSystem::Twin(system)
+            }
+        };
         self.system = system;
         self.interval.reset();
         Ok(())
@@ -201,11 +454,7 @@ impl Rig {
     /// Translation from handle coordinates to world coordinates (m): world = device + offset (the
     /// mapping has scale 1 in `haptic2d run`).
     pub fn device_to_world(&self) -> [f64; 2] {
-        let m = self.system.map();
-        [
-            m.world_origin[0] - m.device_origin[0],
-            m.world_origin[1] - m.device_origin[1],
-        ]
+        self.system.device_to_world()
     }
 
     /// Moves the hand target to the world pose `world` (m, m, rad), clamped to the device workspace
@@ -213,7 +462,7 @@ impl Rig {
     /// no hand follows a target.
     pub fn set_hand_target(&self, world: V3) -> Option<V3> {
         let t = self.target.as_ref()?;
-        let map = self.system.map();
+        let map = self.system.twin()?.map();
         let p = &self.config.device;
         let mut d = map.pose_to_device(&world);
         let hw = p.workspace_half_width;
@@ -226,12 +475,26 @@ impl Rig {
     /// The hand target in world coordinates (m, m, rad), or, when no hand follows a target, where
     /// the handle is.
     pub fn hand_target_world(&self) -> V3 {
-        let map = self.system.map();
-        match &self.target {
-            Some(t) => map.pose_to_world(&t.get()),
-            None => map.pose_to_world(&self.system.last_record().x_m),
+        match (&self.target, self.system.twin()) {
+            (Some(t), Some(s)) => s.map().pose_to_world(&t.get()),
+            _ => self.system.handle_world(),
         }
     }
+
+    /// The twin pantograph's parameters when the display should draw the linkage (simulated device,
+    /// replay, real twin); `None` for a 2-DOF device.
+    pub fn twin_params(&self) -> Option<&DeviceParams> {
+        self.system.twin().map(|_| &self.config.device)
+    }
+}
+
+/// Why a real device's rig could not be built.
+#[derive(Debug)]
+pub enum RealOpenError {
+    /// The configuration was rejected (bad input, exit 2).
+    Config(String),
+    /// The device could not be opened or did not answer (exit 4).
+    Open(String),
 }
 
 #[cfg(test)]
@@ -275,7 +538,10 @@ mod tests {
         let out = rig.tick_system(&q, &info(0), false);
         let input = rig.safety_input(&info(0), &out, false);
         assert!(input.singularity_margin < 1.0 && input.singularity_margin > 0.1);
-        assert_eq!(input.singularity_margin, rig.system.device().margin());
+        assert_eq!(
+            input.singularity_margin,
+            rig.system.twin().unwrap().device().margin()
+        );
         assert!(!input.closure_fault);
         let mut tau = out.torques;
         assert!(dog.guard(&input, &mut tau).is_ok());
@@ -306,5 +572,148 @@ mod tests {
             rig.safety_input(&info(50), &out, false).elapsed_periods,
             1.0
         );
+    }
+
+    /// A real 2-DOF device that answers at once, or after `wait` in the read of tick `slow_at`.
+    struct FakeBoard {
+        q: [f64; 2],
+        reads: u64,
+        slow_at: u64,
+        wait: std::time::Duration,
+        last: [f64; 4],
+    }
+
+    impl DeviceIo for FakeBoard {
+        fn read_encoders(&mut self) -> Result<[f64; 4], DeviceError> {
+            if self.reads == self.slow_at {
+                std::thread::sleep(self.wait);
+            }
+            self.reads += 1;
+            Ok([self.q[0], self.q[1], 0.0, 0.0])
+        }
+        fn write_torques(&mut self, tau: &[f64; 4]) -> Result<(), DeviceError> {
+            self.last = *tau;
+            Ok(())
+        }
+        fn zero_torques(&mut self) {
+            self.last = [0.0; 4];
+        }
+        fn name(&self) -> &str {
+            "fake-board"
+        }
+    }
+
+    /// A rig on a fake gen 3 2DIY held at its workspace centre; the read of tick `slow_at` waits
+    /// `wait`; the device's own timeout is `wait_periods`.
+    fn board_rig(slow_at: u64, wait: std::time::Duration, wait_periods: f64) -> Rig {
+        let scene = builtin("box-in-walls", Some(1000.0)).unwrap().unwrap();
+        let linkage = Pantograph2::new(0.038, 0.07, 0.09).unwrap();
+        let q = linkage.ik(haptic2d::geom::Vec2::new(0.019, 0.10)).unwrap();
+        let real = RealDevice {
+            name: "fake-board".into(),
+            model: DeviceModel::FiveBar {
+                linkage,
+                tau_max: 0.123,
+            },
+            summary: "a fake 2DIY".into(),
+            wait_periods,
+            max_missed_run: None,
+            max_stall_periods: 5.0,
+            open: Box::new(move |_| {
+                Ok(Box::new(FakeBoard {
+                    q,
+                    reads: 0,
+                    slow_at,
+                    wait,
+                    last: [0.0; 4],
+                }) as Box<dyn DeviceIo + Send>)
+            }),
+        };
+        Rig::with_real(
+            scene.world,
+            "box-in-walls",
+            HapticConfig::default(),
+            DeviceChoice::Haply("fake".into()),
+            real,
+        )
+        .unwrap()
+    }
+
+    /// One tick of the loop's order (read, system, watchdog) at `info`; the torques as guarded.
+    fn guarded_tick(
+        rig: &mut Rig,
+        dog: &mut Watchdog,
+        info: &TickInfo,
+    ) -> (TickOutput, [f64; 4], Result<(), haptic2d_rt::Fault>) {
+        let q = rig.read().unwrap();
+        let out = rig.tick_system(&q, info, false);
+        let mut tau = out.torques;
+        let g = dog.guard(&rig.safety_input(info, &out, false), &mut tau);
+        (out, tau, g)
+    }
+
+    /// Task L item 2: a stalled loop (the tick wakes 20 periods after the previous one, no wait
+    /// for the device) latches zero torques within that tick, and says why.
+    #[test]
+    fn a_stalled_loop_latches_zero_torques_within_the_tick_with_its_reason() {
+        let mut rig = board_rig(u64::MAX, std::time::Duration::ZERO, 3.0);
+        let cfg = rig.watchdog_config();
+        assert_eq!(cfg.max_stall_periods, Some(5.0));
+        let mut dog = Watchdog::new(cfg).unwrap();
+        for k in 0..10 {
+            let (out, _, g) = guarded_tick(&mut rig, &mut dog, &info(k));
+            assert!(g.is_ok() && !out.tripped, "tick {k}");
+        }
+        // The loop itself was away: the watchdog sees 20 periods on the loop's own account.
+        let (out, tau, g) = guarded_tick(&mut rig, &mut dog, &info(30));
+        let f = g.unwrap_err();
+        assert!(
+            matches!(f.kind, haptic2d_rt::FaultKind::Stall { .. }),
+            "{f}"
+        );
+        assert!(f.to_string().contains("stalled"), "{f}");
+        assert_eq!(tau, [0.0; 4]);
+        // And the system's own latch (limit 5 + 3 periods, wake to wake) agrees, with its reason.
+        assert!(out.tripped && out.torques == [0.0; 4]);
+        let trip = rig.system.safety_trip().unwrap();
+        assert!(
+            matches!(trip.reason, haptic2d::haptic::SafetyReason::Stall { .. }),
+            "{trip}"
+        );
+    }
+
+    /// Task L item 2: a device slow to answer (20 ms in one read, within its own timeout) is not a
+    /// stall of the loop: the wait is left to the driver's timeout (a lost device, exit 4).
+    #[test]
+    fn a_slow_device_within_its_timeout_is_not_a_loop_stall() {
+        let mut rig = board_rig(5, std::time::Duration::from_millis(20), 30.0);
+        let mut dog = Watchdog::new(rig.watchdog_config()).unwrap();
+        for k in 0..6 {
+            let (out, _, g) = guarded_tick(&mut rig, &mut dog, &info(k));
+            assert!(g.is_ok() && !out.tripped, "tick {k}");
+        }
+        // The tick after the slow read wakes 21 periods after the previous one.
+        let (out, _, g) = guarded_tick(&mut rig, &mut dog, &info(26));
+        assert!(g.is_ok(), "{g:?}");
+        assert!(!out.tripped, "{:?}", rig.system.safety_trip());
+        assert!(rig.elapsed_periods < 5.0, "{}", rig.elapsed_periods);
+    }
+
+    #[test]
+    fn a_real_2dof_rig_starts_at_zero_torque_and_has_no_twin_drawing() {
+        let mut rig = board_rig(u64::MAX, std::time::Duration::ZERO, 3.0);
+        let q = rig.read().unwrap();
+        let out = rig.tick_system(&q, &info(0), false);
+        assert_eq!(out.torques, [0.0; 4]);
+        assert!(rig.twin_params().is_none() && rig.system.twin_kinematics().is_none());
+        assert!(rig.target.is_none());
+        // A rebuild (the page's reset) keeps the device and starts a fresh 2-DOF system.
+        let world = builtin("box-in-walls", Some(1000.0))
+            .unwrap()
+            .unwrap()
+            .world;
+        rig.rebuild(world).unwrap();
+        assert!(matches!(rig.system, RigSystem::TwoDof(_)));
+        assert_eq!(rig.io.name(), "fake-board");
     }
 }

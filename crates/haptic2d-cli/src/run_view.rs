@@ -137,7 +137,7 @@ impl LiveView {
                 slave: Some(sys.slave()),
                 hand_target: rig.hand_target_world(),
                 drive: rec.f_cs,
-                device: Some((&sys.device().kin, rec.x_m)),
+                device: sys.twin_kinematics().map(|k| (k, rec.x_m)),
                 device_to_world: rig.device_to_world(),
                 passivity_energy: sys.passivity().map(|p| p.e_obs()),
                 timing: self.timing.snapshot(),
@@ -214,7 +214,7 @@ impl LiveView {
             &self.scene.name,
             &self.scene.description,
             Some(sys.slave()),
-            Some((&rig.config.device, rig.device_to_world())),
+            rig.twin_params().map(|p| (p, rig.device_to_world())),
         );
         if let Err(e) = self.hub.publish_scene(info) {
             eprintln!("display: {e}");
@@ -307,7 +307,7 @@ mod tests {
             for _ in 0..n {
                 view.apply_commands(rig);
                 let q = rig.io.read_encoders().unwrap();
-                let out = rig.system.tick(&q);
+                let out = rig.system.tick(&q, None, false);
                 rig.io.write_torques(&out.torques).unwrap();
                 let info = TickInfo {
                     index: k,

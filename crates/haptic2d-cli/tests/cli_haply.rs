@@ -3,8 +3,10 @@
 //!
 //! The device files used here are the shipped gen 3 file with a reply timeout of 100 periods: the
 //! tests run on machines shared with compilers, and what they check is the protocol and the exit
-//! paths, not the timing (the default 3 periods is exercised by the driver tests), and with the
-//! watchdog's missed-deadline check off (`max_missed_deadlines = 0`) for the same reason. The tests
+//! paths, not the timing (the default 3 periods is exercised by the driver tests), with the
+//! watchdog's missed-deadline check off (`max_missed_deadlines = 0`) and a stall limit of 1000
+//! periods for the same reason (an unprivileged loop on a loaded machine can sleep 10 ms past a
+//! deadline; the stall check itself is tested in `run_rig`'s unit tests on synthetic tick times). The tests
 //! take turns (one emulator at a time) to keep the load down.
 
 use std::io::{BufRead, BufReader};
@@ -33,7 +35,8 @@ fn device_file(dir: &Path, name: &str, edit: impl Fn(String) -> String) -> PathB
     let p = dir.join(name);
     let text = gen3_text()
         .replace("timeout_periods = 3 ", "timeout_periods = 100 ")
-        .replace("max_missed_deadlines = 10 ", "max_missed_deadlines = 0 ");
+        .replace("max_missed_deadlines = 10 ", "max_missed_deadlines = 0 ")
+        .replace("max_stall_periods = 5 ", "max_stall_periods = 1000 ");
     std::fs::write(&p, edit(text)).unwrap();
     p
 }
@@ -237,4 +240,104 @@ fn missing_port_and_bad_device_file_are_clear_errors() {
 fn devices_lists_ports_without_failing() {
     let o = Command::new(BIN).arg("devices").output().unwrap();
     assert!(o.status.success(), "{}", text(&o));
+}
+
+/// Column `name` of a CSV log, as numbers.
+fn column(csv: &str, name: &str) -> Vec<f64> {
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let i = header.iter().position(|h| *h == name).unwrap();
+    lines
+        .map(|l| l.split(',').nth(i).unwrap().parse().unwrap())
+        .collect()
+}
+
+/// Task L item 1: the Haply board runs in the one loop of `run` — its CSV log has the same columns
+/// as the simulated device's, the torques start at exactly zero and ramp in (a constant hand push
+/// on the emulated handle makes them grow), and every torque stays within the device file's limit.
+#[test]
+fn haply_run_is_the_normal_loop_torques_start_at_zero_ramp_in_and_stay_clamped() {
+    let _turn = turn();
+    let dir = tempfile::tempdir().unwrap();
+    let file = device_file(dir.path(), "gen3.toml", |t| t);
+    let (emu, pty) = emulate(&[
+        "--device-file",
+        file.to_str().unwrap(),
+        "--hand",
+        "constant:0.5,0,0",
+    ]);
+    let log = dir.path().join("ramp.csv");
+    let o = Command::new(BIN)
+        .args(["run", "--device", &format!("haply:{pty}"), "--device-file"])
+        .arg(&file)
+        .args(["--headless", "--duration", "1.5", "--no-rt", "--log"])
+        .arg(&log)
+        .output()
+        .unwrap();
+    stop(emu);
+    let out = text(&o);
+    assert!(o.status.success(), "{out}");
+    let csv = std::fs::read_to_string(&log).unwrap();
+    let header = csv.lines().next().unwrap();
+    assert!(
+        header.starts_with("t,") && header.contains("tau1"),
+        "{header}"
+    );
+    let (t1, t2) = (column(&csv, "tau1"), column(&csv, "tau2"));
+    assert_eq!((t1[0], t2[0]), (0.0, 0.0), "first tick's torques");
+    let peak = |a: &[f64], b: &[f64]| a.iter().chain(b).fold(0.0f64, |m, v| m.max(v.abs()));
+    // Every torque within the limit; the 2DIY's τ3, τ4 are zero.
+    assert!(peak(&t1, &t2) <= 0.123 + 1e-9, "{}", peak(&t1, &t2));
+    assert_eq!(peak(&column(&csv, "tau3"), &column(&csv, "tau4")), 0.0);
+    // The ramp: the first 50 ms carry far less torque than the time after the 0.5 s ramp.
+    let n = t1.len();
+    assert!(n > 600, "only {n} rows:\n{out}");
+    let early = peak(&t1[..50], &t2[..50]);
+    let late = peak(&t1[600..], &t2[600..]);
+    assert!(
+        late > 0.0 && early < 0.25 * late,
+        "early {early}, late {late}"
+    );
+}
+
+/// Task L item 2: a silent device (the emulator stopped with SIGSTOP: the port stays open, nothing
+/// answers) is the driver's read timeout → zero torques, exit 4, a message naming the device and
+/// what to check — not a stall.
+#[test]
+fn a_silent_emulated_device_exits_4_with_the_reason() {
+    let _turn = turn();
+    let dir = tempfile::tempdir().unwrap();
+    let file = device_file(dir.path(), "gen3.toml", |t| t);
+    let (mut emu, pty) = emulate(&["--device-file", file.to_str().unwrap()]);
+    let run = Command::new(BIN)
+        .args(["run", "--device", &format!("haply:{pty}"), "--device-file"])
+        .arg(&file)
+        .args(["--headless", "--duration", "20", "--no-rt"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(1500));
+    let pid = emu.id().to_string();
+    let _ = Command::new("kill").args(["-STOP", &pid]).status();
+    let t0 = Instant::now();
+    let o = run.wait_with_output().unwrap();
+    let _ = Command::new("kill").args(["-CONT", &pid]).status();
+    let _ = emu.kill();
+    let _ = emu.wait();
+    let out = text(&o);
+    assert_eq!(o.status.code(), Some(4), "{out}");
+    assert!(
+        t0.elapsed() < Duration::from_secs(5),
+        "took {:?}",
+        t0.elapsed()
+    );
+    assert!(
+        out.contains(&format!("haply:{pty}"))
+            && out.contains("check the USB cable")
+            && out.contains("torques were set to zero")
+            && !out.contains("stalled"),
+        "{out}"
+    );
+    assert!(!out.contains("panicked"), "{out}");
 }

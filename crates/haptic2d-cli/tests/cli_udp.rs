@@ -2,8 +2,8 @@
 //! another process, on loopback (issue 15), directly or through a proxy in the test that drops,
 //! reorders or garbles datagrams. Skipped (with a note) where `python3` is missing.
 //!
-//! The device file is the shipped reference file with a timeout of 50 periods and the
-//! missed-deadline check off: the tests run on machines shared with compilers and check the
+//! The device file is the shipped reference file with a timeout of 50 periods, the
+//! missed-deadline check off and the stall limit at 1000 periods: the tests run on machines shared with compilers and check the
 //! protocol and the exit paths, not the timing (the 3-period timeout is exercised by the driver
 //! tests in haptic2d-devices). The tests take turns to keep the load down.
 
@@ -33,8 +33,10 @@ fn device_file(tag: &str) -> PathBuf {
     let text = std::fs::read_to_string(root().join("devices/udp-pantograph.toml"))
         .unwrap()
         .replace("timeout_periods = 3 ", "timeout_periods = 50")
-        .replace("max_missed_deadlines = 10 ", "max_missed_deadlines = 0  ");
+        .replace("max_missed_deadlines = 10 ", "max_missed_deadlines = 0  ")
+        .replace("max_stall_periods = 5 ", "max_stall_periods = 1000");
     assert!(text.contains("timeout_periods = 50") && text.contains("max_missed_deadlines = 0 "));
+    assert!(text.contains("max_stall_periods = 1000"));
     let dir = std::env::temp_dir().join(format!("haptic2d-cli-udp-{}-{tag}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let p = dir.join("udp.toml");

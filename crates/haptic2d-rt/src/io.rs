@@ -4,6 +4,10 @@
 //! after the reduction: joint angles `q11, q12, q21, q22` of MODELS §10.3) and
 //! takes four joint torques (N·m). Real drivers, the simulated device and the
 //! [`ReplayDevice`] all implement [`DeviceIo`].
+//!
+//! A 2-joint device (a 2-DOF five-bar such as a Haply 2DIY) implements [`Device2Io`] (two motor
+//! angles in, two motor torques out) and enters the loop through [`Joints2`], which is a
+//! [`DeviceIo`] that fills `q[0..2]`, leaves `q[2..4]` zero and drops `τ[2..4]`.
 
 use std::fmt;
 use std::path::Path;
@@ -57,6 +61,50 @@ pub trait DeviceIo {
     /// applied unsupervised.
     fn paced_by_ticks(&self) -> bool {
         false
+    }
+}
+
+/// The device interface of a 2-joint device (a 2-DOF five-bar: motor 1, motor 2), with the same
+/// contract as [`DeviceIo`]: called from the real-time thread, once per tick at most, never blocking
+/// past one transfer (a device silent for its timeout returns [`DeviceError::Lost`]).
+pub trait Device2Io {
+    /// Reads the two motor angles `[q1, q2]` (rad, the linkage's own convention).
+    fn read_joints(&mut self) -> Result<[f64; 2], DeviceError>;
+
+    /// Commands the two motor torques `[τ1, τ2]` (N·m; the caller has saturated them; a driver
+    /// clamps once more to its own limit).
+    fn write_joint_torques(&mut self, tau: &[f64; 2]) -> Result<(), DeviceError>;
+
+    /// Commands zero torque on both motors. Must not fail (best effort on a lost device).
+    fn zero_torques(&mut self);
+
+    /// A short human-readable name, e.g. "udp:127.0.0.1:9000".
+    fn name(&self) -> &str;
+}
+
+/// A [`Device2Io`] seen as a [`DeviceIo`]: `q = [q1, q2, 0, 0]`, `τ[2..4]` dropped. This is how a
+/// 2-DOF device enters the loop of `haptic2d run`.
+#[derive(Debug)]
+pub struct Joints2<D>(pub D);
+
+impl<D: Device2Io> DeviceIo for Joints2<D> {
+    #[inline]
+    fn read_encoders(&mut self) -> Result<[f64; 4], DeviceError> {
+        let q = self.0.read_joints()?;
+        Ok([q[0], q[1], 0.0, 0.0])
+    }
+
+    #[inline]
+    fn write_torques(&mut self, tau: &[f64; 4]) -> Result<(), DeviceError> {
+        self.0.write_joint_torques(&[tau[0], tau[1]])
+    }
+
+    fn zero_torques(&mut self) {
+        self.0.zero_torques();
+    }
+
+    fn name(&self) -> &str {
+        self.0.name()
     }
 }
 

@@ -11,6 +11,7 @@
 //! torque_limit = 0.123          # N·m, ≤ the firmware's 0.123
 //! timeout_periods = 3           # a reply later than this many periods = device lost
 //! max_missed_deadlines = 10     # watchdog: consecutive missed deadlines (0 = off)
+//! max_stall_periods = 5         # the loop's own delay between two ticks that trips (periods)
 //! [linkage]                     # 2diy only (the twin's geometry is its [device] table)
 //! d = 0.038                     # m
 //! l1 = 0.07                     # m
@@ -82,6 +83,10 @@ pub struct HaplyDeviceFile {
     /// The watchdog trips after this many consecutive missed deadlines; `None` (0 in the file)
     /// turns the check off. Default 10.
     pub max_missed_deadlines: Option<u32>,
+    /// The loop's own delay between two ticks (sleep overshoot and computation, not the wait for
+    /// the board, which `timeout_periods` bounds) that trips the stall check (periods, ≥ 1).
+    /// Default 5, the shared safety layer's.
+    pub max_stall_periods: f64,
     /// Motors in joint order.
     pub motors: Vec<MotorSpec>,
     /// 2DIY or twin.
@@ -118,6 +123,8 @@ struct RawBoard {
     timeout_periods: f64,
     #[serde(default = "ten")]
     max_missed_deadlines: i64,
+    #[serde(default = "five")]
+    max_stall_periods: f64,
 }
 
 #[derive(Deserialize)]
@@ -151,6 +158,9 @@ fn one() -> i64 {
 }
 fn three() -> f64 {
     3.0
+}
+fn five() -> f64 {
+    5.0
 }
 fn ten() -> i64 {
     10
@@ -250,6 +260,13 @@ impl HaplyDeviceFile {
                 "board.max_missed_deadlines",
                 format!("{} is not a count of periods", b.max_missed_deadlines),
                 "give a number of consecutive missed deadlines ≥ 1 (default 10), or 0 to turn the check off",
+            ));
+        }
+        if !(b.max_stall_periods.is_finite() && b.max_stall_periods >= 1.0) {
+            errs.push(SceneError::new(
+                "board.max_stall_periods",
+                format!("{} periods is not a stall limit", b.max_stall_periods),
+                "give a number of control periods ≥ 1 (default 5)",
             ));
         }
         let n_expected = match raw.kind.as_str() {
@@ -397,6 +414,7 @@ impl HaplyDeviceFile {
                 max_missed_deadlines: u32::try_from(b.max_missed_deadlines)
                     .ok()
                     .filter(|n| *n > 0),
+                max_stall_periods: b.max_stall_periods,
                 motors,
                 kind,
             }),

@@ -12,6 +12,7 @@
 //! reply_wait_periods = 0.3      # how long a read waits for the answer (periods)
 //! torque_limit = 0.123          # N·m on each joint, enforced by the host
 //! max_missed_deadlines = 10     # watchdog: consecutive missed deadlines (0 = off)
+//! max_stall_periods = 5         # the loop's own delay between two ticks that trips (periods)
 //! [linkage]                     # the 2-DOF pantograph (DEVICES §2), device frame
 //! d = 0.038                     # m
 //! l1 = 0.07                     # m
@@ -52,6 +53,8 @@ pub struct UdpDeviceFile {
     pub torque_limit: f64,
     /// Consecutive missed deadlines that trip the watchdog; `None` (0) = off. Default 10.
     pub max_missed_deadlines: Option<u32>,
+    /// The loop's own delay between two ticks that trips the stall check (periods, ≥ 1). Default 5.
+    pub max_stall_periods: f64,
     /// The linkage (m).
     pub linkage: Pantograph2,
 }
@@ -82,6 +85,8 @@ struct RawProtocol {
     torque_limit: f64,
     #[serde(default = "ten")]
     max_missed_deadlines: i64,
+    #[serde(default = "five")]
+    max_stall_periods: f64,
 }
 
 impl Default for RawProtocol {
@@ -93,6 +98,7 @@ impl Default for RawProtocol {
             reply_wait_periods: wait(),
             torque_limit: limit(),
             max_missed_deadlines: ten(),
+            max_stall_periods: five(),
         }
     }
 }
@@ -122,6 +128,9 @@ fn limit() -> f64 {
 }
 fn ten() -> i64 {
     10
+}
+fn five() -> f64 {
+    5.0
 }
 
 impl UdpDeviceFile {
@@ -217,6 +226,13 @@ impl UdpDeviceFile {
                 "give a number of consecutive deadlines ≥ 0 (0 turns the check off)",
             ));
         }
+        if !(p.max_stall_periods.is_finite() && p.max_stall_periods >= 1.0) {
+            errs.push(SceneError::new(
+                "protocol.max_stall_periods",
+                format!("{} periods is not a stall limit", p.max_stall_periods),
+                "give the loop's longest delay between two ticks in periods, ≥ 1 (default 5)",
+            ));
+        }
         let l = &raw.linkage;
         let linkage = match Pantograph2::new(l.d, l.l1, l.l2) {
             Ok(k) => Some(k),
@@ -241,6 +257,7 @@ impl UdpDeviceFile {
                 max_missed_deadlines: u32::try_from(p.max_missed_deadlines)
                     .ok()
                     .filter(|n| *n > 0),
+                max_stall_periods: p.max_stall_periods,
                 linkage,
             }),
             _ => Err(fail(errs)),

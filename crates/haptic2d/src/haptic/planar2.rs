@@ -49,9 +49,11 @@ pub struct Planar2Config {
     pub grasp: [f64; 2],
     /// Velocity low-pass cut-off (Hz), §10.7. Default 50.
     pub velocity_cutoff_hz: f64,
-    /// Start-up ramp (s): device torques scale linearly from 0 to 1 over this time after the first
-    /// tick. Default 0.5 s; 0 disables it.
-    pub ramp_s: f64,
+    /// The shared safety settings (§ DESIGN 7, [`SafetyConfig`]): the start-up ramp (torques scale
+    /// by `min(1, n·T / ramp_time)` at the `n`-th tick after the first valid reading, so the first
+    /// tick's torques are exactly zero), the stall limit and the torque trip margin — the same
+    /// layer and the same defaults as the twin pantograph's [`HapticSystem`](super::HapticSystem).
+    pub safety: SafetyConfig,
     /// Trip below this singularity margin (dimensionless `|sin|` of the distal links). Default 0.1.
     pub min_singularity_margin: f64,
     /// Keep the scene's loads on the slave body. Default false (the hand drives it).
@@ -69,7 +71,7 @@ impl Planar2Config {
             slave: None,
             grasp: [0.0; 2],
             velocity_cutoff_hz: 50.0,
-            ramp_s: 0.5,
+            safety: SafetyConfig::default(),
             min_singularity_margin: 0.1,
             keep_slave_loads: false,
         }
@@ -106,7 +108,12 @@ pub struct Planar2System {
     /// World point of the grasp at start (m): the first handle position maps here.
     world_origin: Vec2,
     device_origin: Option<Vec2>,
-    ticks: u64,
+    /// Ticks since the alignment at the first valid reading (the ramp's clock).
+    ramp_ticks: u64,
+    /// Ticks of the ramp, `round(ramp_time / T)` (0 = no ramp).
+    ramp_len: u64,
+    /// True once a tick has read the device (the stall check needs a previous tick).
+    started: bool,
     dt: f64,
     record: TickRecord,
 }
@@ -128,9 +135,7 @@ impl Planar2System {
         if !(config.velocity_cutoff_hz.is_finite() && config.velocity_cutoff_hz > 0.0) {
             return Err("velocity_cutoff_hz must be > 0 Hz (default 50)".into());
         }
-        if !(config.ramp_s.is_finite() && config.ramp_s >= 0.0) {
-            return Err("ramp_s must be ≥ 0 s (default 0.5)".into());
-        }
+        config.safety.validate()?;
         let slave = match &config.slave {
             Some(name) => world
                 .body_index(name)
@@ -168,24 +173,49 @@ impl Planar2System {
             safety: Safety::new(
                 config.min_singularity_margin,
                 config.tau_max[0].min(config.tau_max[1]),
-                SafetyConfig::default().torque_trip_margin,
+                config.safety.torque_trip_margin,
             ),
+            ramp_len: (config.safety.ramp_time / dt).round() as u64,
+            ramp_ticks: 0,
+            started: false,
             config,
             controller,
             world,
             slave,
             world_origin,
             device_origin: None,
-            ticks: 0,
             dt,
             record: TickRecord::default(),
         })
     }
 
-    /// One sample from the motor angles `q` (rad) to the motor torques (N·m).
+    /// One sample taken on time (one period after the previous one): see [`Self::tick_elapsed`].
     pub fn tick(&mut self, q: &[f64; 2]) -> Planar2Output {
+        self.tick_elapsed(q, self.dt)
+    }
+
+    /// One sample from the motor angles `q` (rad) to the motor torques (N·m), `elapsed` seconds
+    /// after the previous tick (the loop's own interval, measured by the caller). A tick more than
+    /// `safety.max_stall_periods` periods late trips the latch with [`SafetyReason::Stall`] in this
+    /// same tick (the device held its last torques unsupervised for that long); a NaN interval
+    /// counts as a stall. The filter and the world use the fixed period `T`.
+    pub fn tick_elapsed(&mut self, q: &[f64; 2], elapsed: f64) -> Planar2Output {
         let (k, t, dt) = (self.world.tick(), self.world.time(), self.dt);
         let mut flags = 0u32;
+
+        // 0. Stall, as in HapticSystem::tick_elapsed (the shared safety layer's limit).
+        let stall_limit = self.config.safety.max_stall_periods * dt;
+        if self.started && (elapsed.is_nan() || elapsed > stall_limit) {
+            self.safety.trip(
+                k,
+                t,
+                SafetyReason::Stall {
+                    elapsed,
+                    limit: stall_limit,
+                },
+            );
+        }
+        self.started = true;
 
         // 1–2. Handle point, Jacobian, margin; filtered velocity; device → world translation.
         let st = match self.config.linkage.state(*q) {
@@ -260,11 +290,7 @@ impl Planar2System {
             if scale < 1.0 {
                 flags |= FLAG_SATURATED;
             }
-            let ramp = if self.config.ramp_s > 0.0 {
-                (self.ticks as f64 * dt / self.config.ramp_s).min(1.0)
-            } else {
-                1.0
-            };
+            let ramp = self.ramp();
             tau4[0] = tau[0] * scale * ramp;
             tau4[1] = tau[1] * scale * ramp;
         }
@@ -272,13 +298,14 @@ impl Planar2System {
             flags |= FLAG_SAFETY;
             f_cs = [0.0; 3];
             f_cm = [0.0; 3];
+        } else if st.is_some() {
+            self.ramp_ticks = self.ramp_ticks.saturating_add(1);
         }
 
         // 10. Slave drive at the grasp point, integration.
         let f = Vec2::new(f_cs[0], f_cs[1]);
         self.world.set_drive(self.slave, f, cross(r, f));
         self.world.finish_step();
-        self.ticks += 1;
 
         // 11. Record.
         let body = &self.world.bodies[self.slave];
@@ -309,6 +336,112 @@ impl Planar2System {
             tripped: self.safety.is_latched(),
             record: self.record,
         }
+    }
+
+    /// The start-up ramp factor of the next tick, `min(1, n / N)` with `n` the ticks since the first
+    /// valid reading (exactly 0 before and at it), `N = round(ramp_time / T)`; 1 without a ramp.
+    #[inline]
+    pub fn ramp(&self) -> f64 {
+        if self.ramp_len == 0 {
+            1.0
+        } else {
+            (self.ramp_ticks as f64 / self.ramp_len as f64).min(1.0)
+        }
+    }
+
+    /// A paused sample: the handle is still read (its filter keeps tracking), no controller runs,
+    /// the world stands still and the torques are zero; the next running tick re-anchors the
+    /// device↔world translation at the handle and ramps the torques in again from zero. Never
+    /// allocates.
+    pub fn tick_paused(&mut self, q: &[f64; 2]) -> Planar2Output {
+        let (k, t) = (self.world.tick(), self.world.time());
+        let mut x_m = [f64::NAN; 3];
+        let mut margin = f64::NAN;
+        match self.config.linkage.state(*q) {
+            Ok(s) => {
+                let origin = self.device_origin.unwrap_or(s.e);
+                let p = s.e - origin + self.world_origin;
+                self.filter.update(&[p.x, p.y, 0.0]);
+                x_m = [p.x, p.y, 0.0];
+                margin = s.margin;
+            }
+            Err(f) => self.safety.trip(k, t, SafetyReason::Device(f)),
+        }
+        let mut tau4 = [0.0; 4];
+        let mut flags = 0u32;
+        if self.safety.gate(k, t, &mut tau4) {
+            flags |= FLAG_SAFETY;
+        }
+        self.realign();
+        let body = &self.world.bodies[self.slave];
+        x_m[2] = body.pose.angle;
+        let cw = self.world.contact_wrench(self.slave);
+        let ledger = self.world.ledger();
+        self.record = TickRecord {
+            t,
+            x_m,
+            x_s: [body.pose.pos.x, body.pose.pos.y, body.pose.angle],
+            v_s: [body.vel.x, body.vel.y, body.omega],
+            f_e: [-cw.force.x, -cw.force.y, -cw.torque],
+            contacts: self.world.contacts().contact_count() as u32,
+            kinetic: ledger.kinetic,
+            stored: ledger.stored,
+            applied_work: ledger.applied_work,
+            margin,
+            flags,
+            ..TickRecord::default()
+        };
+        Planar2Output {
+            torques: [0.0; 2],
+            tripped: self.safety.is_latched(),
+            record: self.record,
+        }
+    }
+
+    /// Forgets the alignment: the next running tick maps the measured handle point onto the slave's
+    /// current grasp point and restarts the ramp and the stall clock.
+    fn realign(&mut self) {
+        self.device_origin = None;
+        self.world_origin = grasp_world(&self.world, self.slave, self.config.grasp);
+        self.ramp_ticks = 0;
+        self.started = false;
+    }
+
+    /// Re-arms the safety latch (an explicit user action): the next tick re-aligns and ramps in from
+    /// zero, as at start-up.
+    pub fn reset_safety(&mut self) {
+        self.safety.reset();
+        self.realign();
+    }
+
+    /// Switches the teleoperation controller to `kind` from its reset state; the gains are checked
+    /// against the slave's mass as in [`Self::new`], and on error the running controller is kept.
+    pub fn set_controller(&mut self, kind: ControllerKind) -> Result<(), String> {
+        let body = &self.world.bodies[self.slave];
+        let mass = [body.mass, body.mass, body.inertia];
+        self.controller = match kind {
+            ControllerKind::FourChannel(g) => {
+                g.check_slave_mass(&mass, self.dt)?;
+                Controller2::FourChannel(FourChannel::new(g, self.dt)?)
+            }
+            ControllerKind::Coupling(g) => {
+                let c = VirtualCoupling::new(g)?;
+                c.check_slave_mass(&mass, self.dt)?;
+                Controller2::Coupling(c)
+            }
+        };
+        self.config.controller = kind;
+        Ok(())
+    }
+
+    /// Mutable access to the world (e.g. to switch its laws between ticks).
+    pub fn world_mut(&mut self) -> &mut World {
+        &mut self.world
+    }
+
+    /// The sample period `T` (s).
+    pub fn dt(&self) -> f64 {
+        self.dt
     }
 
     /// Latches the safety stop from outside (e.g. the device was lost): zero torques from now on.
