@@ -100,12 +100,14 @@ def serve(args):
     command, wrench = (0.0, 0.0), False  # held until the next command
     seq, last_cmd, t_last = 0, None, time.monotonic()
     t0, limited = t_last, False
+    t_first = None  # the first command: --push-after counts from here
     deadline = t0 + args.duration if args.duration else None
 
     def step(now):
         """Advance the plant from t_last to now (semi-implicit Euler, 0.25 ms sub-steps)."""
         nonlocal x, y, vx, vy, t_last
         total = min(now - t_last, 0.1)
+        pushing = t_first is not None and now - t_first >= args.push_after
         n = max(1, math.ceil(total / 0.00025))
         h = total / n
         for _ in range(n):
@@ -115,7 +117,7 @@ def serve(args):
             else:
                 j = link.jacobian(x, y, q)
                 fx, fy = solve2(((j[0][0], j[1][0]), (j[0][1], j[1][1])), command)  # J^T f = tau
-            px, py = args.push if now - t0 >= args.push_after else (0.0, 0.0)
+            px, py = args.push if pushing else (0.0, 0.0)
             fx += args.k_hand * (x0 - x) - args.b_hand * vx + px
             fy += args.k_hand * (y0 - y) - args.b_hand * vy + py
             vx += h * fx / args.mass
@@ -138,6 +140,8 @@ def serve(args):
         cmd = unpack_command(data)
         if cmd is None:
             continue  # malformed: ignore, never answer
+        if t_first is None:
+            t_first = t_last = now  # the plant starts at rest with the first command
         step(now)
         last_cmd = now
         flags = cmd["flags"]
@@ -180,7 +184,8 @@ def main():
     p.add_argument("--k-hand", type=float, default=200.0, help="hand stiffness (N/m)")
     p.add_argument("--b-hand", type=float, default=3.0, help="hand damping (N s/m)")
     p.add_argument("--push", type=pair, default=(0.0, 0.0), help="FX,FY constant hand push (N)")
-    p.add_argument("--push-after", type=float, default=0.5, help="push starts after (s)")
+    p.add_argument("--push-after", type=float, default=0.5,
+                   help="push starts this long after the first command (s)")
     p.add_argument("--torque-limit", type=float, default=0.123, help="motor limit (N m)")
     p.add_argument("--force-limit", type=float, default=5.0, help="wrench limit (N)")
     p.add_argument("--watchdog-ms", type=float, default=100.0, help="motors off after (ms)")

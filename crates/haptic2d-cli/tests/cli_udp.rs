@@ -225,6 +225,74 @@ fn run_against_the_python_reference_device_for_3_s_exits_clean() {
     assert!(!out.contains("panicked"), "{out}");
 }
 
+/// Closed loop over UDP: the reference device's hand (no spring, a constant 0.8 N push towards
+/// −x after 0.3 s) drives the box of box-in-walls through the virtual coupling into the left wall,
+/// and the handle settles where the rendered stiffness says: with the coupling (K_c = 500 N/m) in
+/// series with the wall (k_c = 1000 N/m per corner, two corners: K_w = 2000 N/m),
+/// `K_r = 1/(1/K_c + 1/K_w) = 400 N/m`; the box face touches the wall (x = 0) with its centre at
+/// its half-length 0.02 m, so the handle, mapped to the world, sits at `0.02 − F/K_r` and the
+/// device pushes back on the hand with F.
+#[test]
+fn a_pushed_handle_drives_the_box_into_the_wall_and_feels_it() {
+    let _t = turn();
+    let Some(dev) = sim_device(&["--push=-0.8,0", "--push-after", "0.3", "--k-hand", "0"]) else {
+        eprintln!("python3 not found: skipped");
+        return;
+    };
+    let file = device_file("wall");
+    let log = file.with_file_name("wall.csv");
+    let o = run(dev.1, &file, "4")
+        .args(["--controller", "coupling", "--log"])
+        .arg(&log)
+        .output()
+        .unwrap();
+    let out = text(&o);
+    assert_eq!(o.status.code(), Some(0), "{out}");
+    let csv = std::fs::read_to_string(&log).unwrap();
+    let mut lines = csv.lines();
+    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |n: &str| head.iter().position(|h| *h == n).unwrap();
+    let (dx, sx, fx, c) = (
+        col("device.x"),
+        col("slave.x"),
+        col("f_cm.x"),
+        col("contacts"),
+    );
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| {
+            l.split(',')
+                .map(|v| v.parse().unwrap_or(f64::NAN))
+                .collect()
+        })
+        .collect();
+    assert!(
+        rows.len() > 1000,
+        "{} rows
+{out}",
+        rows.len()
+    );
+    let tail = &rows[rows.len() - 200..];
+    let mean = |i: usize| tail.iter().map(|r| r[i]).sum::<f64>() / tail.len() as f64;
+    assert!(
+        tail.iter().all(|r| r[c] > 0.0),
+        "the box is not at the wall
+{out}"
+    );
+    let (handle, slave, f) = (mean(dx), mean(sx), mean(fx));
+    eprintln!("handle {handle:.5} m, slave {slave:.5} m, f_cm.x {f:.3} N");
+    assert!((slave - 0.02).abs() < 1e-3, "box centre at {slave} m");
+    let expected = 0.8 / 400.0;
+    let displacement = 0.02 - handle;
+    assert!(
+        (displacement - expected).abs() < 0.2 * expected,
+        "handle displacement {displacement} m, expected {expected} m"
+    );
+    assert!(
+        (f - 0.8).abs() < 0.16,
+        "the device pushes back with {f} N, expected 0.8 N"
+    );
+}
+
 #[test]
 fn loss_and_reordering_through_a_proxy_are_counted_and_survived() {
     let _t = turn();
