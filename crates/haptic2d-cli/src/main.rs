@@ -22,6 +22,7 @@ mod run_log;
 mod run_rig;
 mod run_view;
 mod scene_arg;
+mod udp_arg;
 mod world_mcap;
 
 use clap::{Parser, Subcommand};

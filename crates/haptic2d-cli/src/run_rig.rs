@@ -55,6 +55,8 @@ pub enum DeviceChoice {
     Replay(PathBuf),
     /// A Haply board: the `PATH` of `haply:PATH`, or `auto` (device file: `--device-file`).
     Haply(String),
+    /// A device on the open UDP protocol listening at the `ADDR:PORT` of `udp:ADDR:PORT`.
+    Udp(String),
 }
 
 impl DeviceChoice {
@@ -76,8 +78,11 @@ impl DeviceChoice {
             }
             return Ok(DeviceChoice::Haply(p.to_string()));
         }
+        if let Some(a) = s.strip_prefix("udp:") {
+            return Ok(DeviceChoice::Udp(a.to_string()));
+        }
         Err(format!(
-            "--device `{s}` is not available\n    fix: use --device sim (the simulated twin pantograph), replay:FILE.csv or haply:PATH|haply:auto"
+            "--device `{s}` is not available\n    fix: use --device sim (the simulated twin pantograph), replay:FILE.csv, haply:PATH|haply:auto or udp:ADDR:PORT"
         ))
     }
 
@@ -92,6 +97,7 @@ impl DeviceChoice {
         Ok(match self {
             DeviceChoice::Sim | DeviceChoice::Replay(_) => None,
             DeviceChoice::Haply(port) => Some(crate::haply_arg::real_device(port, device_file)?),
+            DeviceChoice::Udp(addr) => Some(crate::udp_arg::real_device(addr, device_file)?),
         })
     }
 }

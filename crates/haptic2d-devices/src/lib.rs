@@ -3,6 +3,9 @@
 //!
 //! - [`haply`]: Haply boards (the 2DIY pantograph, and the twin pantograph built from two 2DIY
 //!   linkages on one board's 4 ports), DEVICES §1–§3.
+//! - [`udp`]: the open UDP device protocol for custom hardware and other programs
+//!   (docs/DEVICE-PROTOCOL.md).
 #![warn(missing_docs)]
 
 pub mod haply;
+pub mod udp;

@@ -1,0 +1,124 @@
+//! `haptic2d run --device udp:ADDR:PORT [--device-file FILE]`: a device on the open UDP protocol
+//! (docs/DEVICE-PROTOCOL.md) as a real device of the one run loop (the extension point in
+//! `run_rig.rs`). The device listens at ADDR:PORT; the device file (default: the reference
+//! pantograph, devices/udp-pantograph.toml) says whether joints or a pose come in, what goes out
+//! and which linkage applies; the system is the 2-DOF pantograph system. When the device closes
+//! (end of the run, a lost device, Ctrl-C) the network counters are printed on stdout:
+//! `udp: N sent, N received: … fresh, … late, … lost, … reordered, … duplicate, … malformed; …`.
+
+use crate::run_rig::{DeviceModel, RealDevice};
+use haptic2d_devices::udp::{UdpDevice, UdpDeviceFile};
+use haptic2d_rt::{DeviceError, DeviceIo};
+use std::net::{SocketAddr, ToSocketAddrs};
+use std::path::Path;
+
+/// The device address of `ADDR:PORT` (the part after `udp:`; a name is resolved once, here).
+pub fn address_of(addr: &str) -> Result<SocketAddr, String> {
+    let hint =
+        "expected udp:ADDR:PORT, e.g. udp:127.0.0.1:5005 (the address the device listens at)";
+    if addr.is_empty() {
+        return Err(format!("--device udp:{addr}: {hint}"));
+    }
+    if let Ok(a) = addr.parse::<SocketAddr>() {
+        return Ok(a);
+    }
+    addr.to_socket_addrs()
+        .map_err(|e| format!("--device udp:{addr}: {e}; {hint}"))?
+        .next()
+        .ok_or_else(|| format!("--device udp:{addr}: no address; {hint}"))
+}
+
+/// The UDP device of `--device udp:ADDR:PORT` for the rig of `haptic2d run`: the address resolved,
+/// the device file read and checked, nothing opened yet.
+pub fn real_device(addr: &str, device_file: Option<&Path>) -> Result<RealDevice, String> {
+    let addr = address_of(addr)?;
+    let file = match device_file {
+        Some(p) => UdpDeviceFile::from_path(p)?,
+        None => UdpDeviceFile::reference(),
+    };
+    let name = format!("udp:{addr}");
+    let summary = format!(
+        "{}, 2-DOF pantograph, {} in, {} out, torque limit {} N·m",
+        file.source,
+        if file.pose_input { "pose" } else { "joints" },
+        if file.wrench_output {
+            "wrench"
+        } else {
+            "torques"
+        },
+        file.torque_limit
+    );
+    let open_name = name.clone();
+    Ok(RealDevice {
+        name,
+        model: DeviceModel::FiveBar {
+            linkage: file.linkage,
+            tau_max: file.torque_limit,
+        },
+        summary,
+        wait_periods: file.timeout_periods,
+        max_missed_run: file.max_missed_deadlines,
+        max_stall_periods: file.max_stall_periods,
+        // Open (the first state received) before the first deadline.
+        open: Box::new(move |period| {
+            let dev = UdpDevice::open(addr, &file, period, &open_name)?;
+            Ok(Box::new(Counted(dev)) as Box<dyn DeviceIo + Send>)
+        }),
+    })
+}
+
+/// A [`UdpDevice`] that prints its network counters when it closes (after the loop).
+struct Counted(UdpDevice);
+
+impl DeviceIo for Counted {
+    #[inline]
+    fn read_encoders(&mut self) -> Result<[f64; 4], DeviceError> {
+        self.0.read_encoders()
+    }
+
+    #[inline]
+    fn write_torques(&mut self, tau: &[f64; 4]) -> Result<(), DeviceError> {
+        self.0.write_torques(tau)
+    }
+
+    fn zero_torques(&mut self) {
+        self.0.zero_torques()
+    }
+
+    fn name(&self) -> &str {
+        self.0.name()
+    }
+}
+
+impl Drop for Counted {
+    fn drop(&mut self) {
+        println!("udp: {}", self.0.counters());
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn udp_addresses_parse_and_bad_ones_say_the_form() {
+        assert_eq!(
+            address_of("127.0.0.1:5005").unwrap(),
+            "127.0.0.1:5005".parse::<SocketAddr>().unwrap()
+        );
+        assert!(address_of("[::1]:5005").unwrap().is_ipv6());
+        let e = address_of("").unwrap_err();
+        assert!(e.contains("udp:ADDR:PORT"), "{e}");
+        let e = address_of("127.0.0.1").unwrap_err();
+        assert!(e.contains("udp:ADDR:PORT"), "{e}");
+    }
+
+    #[test]
+    fn the_reference_device_is_a_five_bar_with_its_limits() {
+        let r = real_device("127.0.0.1:5005", None).unwrap();
+        assert_eq!(r.name, "udp:127.0.0.1:5005");
+        assert!(matches!(r.model, DeviceModel::FiveBar { tau_max, .. } if tau_max == 0.123));
+        assert_eq!(r.wait_periods, 3.0);
+        assert_eq!(r.max_missed_run, Some(10));
+    }
+}

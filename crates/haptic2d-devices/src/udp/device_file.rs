@@ -1,0 +1,299 @@
+//! UDP device files (`devices/udp-*.toml`): what the device sends (joint angles or a pose), what it
+//! takes (joint torques or a wrench), the kinematics that relate them to the 2-DOF system, the
+//! limits and the timing. Problems are reported with the field, the unit and the fix.
+//!
+//! ```toml
+//! kind = "udp"
+//! name = "UDP reference pantograph"
+//! [protocol]
+//! input = "joints"              # joints | pose: what the device's states carry
+//! output = "torques"            # torques | wrench: what the host's commands carry
+//! timeout_periods = 3           # no state for this many periods = device lost
+//! reply_wait_periods = 0.3      # how long a read waits for the answer (periods)
+//! torque_limit = 0.123          # N·m on each joint, enforced by the host
+//! max_missed_deadlines = 10     # watchdog: consecutive missed deadlines (0 = off)
+//! max_stall_periods = 5         # the loop's own delay between two ticks that trips (periods)
+//! [linkage]                     # the 2-DOF pantograph (DEVICES §2), device frame
+//! d = 0.038                     # m
+//! l1 = 0.07                     # m
+//! l2 = 0.09                     # m
+//! ```
+//!
+//! With `input = "pose"` the host turns the pose into joint angles by the linkage's inverse
+//! kinematics (elbows out); with `output = "wrench"` it turns the joint torques into the end-point
+//! force `f = J⁻ᵀ·τ` at the current angles. The system behind the device is always the 2-DOF
+//! pantograph system, so both ends of a pose/wrench device meet in joint space.
+
+use haptic2d::device::pantograph2::Pantograph2;
+use haptic2d::scene::{SceneError, SceneErrors};
+use serde::Deserialize;
+
+/// The template named in error messages.
+pub const UDP_TEMPLATE: &str = "devices/udp-pantograph.toml";
+
+/// The reference device's file, embedded (the default of `--device udp:ADDR:PORT`).
+pub const REFERENCE_FILE: &str = include_str!("../../../../devices/udp-pantograph.toml");
+
+/// A parsed, validated UDP device file.
+#[derive(Clone, Debug, PartialEq)]
+pub struct UdpDeviceFile {
+    /// Human-readable name.
+    pub name: String,
+    /// Where it was read from (for messages).
+    pub source: String,
+    /// The device sends a pose `(x, y, θ)` (true) or joint angles.
+    pub pose_input: bool,
+    /// The host sends a wrench (true) or joint torques.
+    pub wrench_output: bool,
+    /// No state for this many periods = device lost. Default 3.
+    pub timeout_periods: f64,
+    /// A read waits this many periods for the answer to the previous command. Default 0.3.
+    pub reply_wait_periods: f64,
+    /// Torque limit on each joint (N·m), enforced by the host. Default 0.123.
+    pub torque_limit: f64,
+    /// Consecutive missed deadlines that trip the watchdog; `None` (0) = off. Default 10.
+    pub max_missed_deadlines: Option<u32>,
+    /// The loop's own delay between two ticks that trips the stall check (periods, ≥ 1). Default 5.
+    pub max_stall_periods: f64,
+    /// The linkage (m).
+    pub linkage: Pantograph2,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawFile {
+    kind: String,
+    #[serde(default)]
+    name: Option<String>,
+    #[serde(default)]
+    protocol: Option<RawProtocol>,
+    linkage: RawLinkage,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawProtocol {
+    #[serde(default = "joints")]
+    input: String,
+    #[serde(default = "torques")]
+    output: String,
+    #[serde(default = "three")]
+    timeout_periods: f64,
+    #[serde(default = "wait")]
+    reply_wait_periods: f64,
+    #[serde(default = "limit")]
+    torque_limit: f64,
+    #[serde(default = "ten")]
+    max_missed_deadlines: i64,
+    #[serde(default = "five")]
+    max_stall_periods: f64,
+}
+
+impl Default for RawProtocol {
+    fn default() -> Self {
+        Self {
+            input: joints(),
+            output: torques(),
+            timeout_periods: three(),
+            reply_wait_periods: wait(),
+            torque_limit: limit(),
+            max_missed_deadlines: ten(),
+            max_stall_periods: five(),
+        }
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawLinkage {
+    d: f64,
+    l1: f64,
+    l2: f64,
+}
+
+fn joints() -> String {
+    "joints".into()
+}
+fn torques() -> String {
+    "torques".into()
+}
+fn three() -> f64 {
+    3.0
+}
+fn wait() -> f64 {
+    0.3
+}
+fn limit() -> f64 {
+    0.123
+}
+fn ten() -> i64 {
+    10
+}
+fn five() -> f64 {
+    5.0
+}
+
+impl UdpDeviceFile {
+    /// The reference device's file (devices/udp-pantograph.toml, embedded).
+    pub fn reference() -> Self {
+        Self::from_toml(REFERENCE_FILE, "built-in device file udp-pantograph")
+            .expect("the shipped reference file is valid (tested)")
+    }
+
+    /// Reads and parses the file at `path`.
+    pub fn from_path(path: &std::path::Path) -> Result<Self, String> {
+        let name = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|e| {
+            format!("cannot read device file {name}: {e}\n    fix: give the path of a UDP device file, e.g. {UDP_TEMPLATE}")
+        })?;
+        Self::from_toml(&text, &format!("device file {name}")).map_err(|e| e.to_string())
+    }
+
+    /// Parses a device file's text; `source` names it in messages.
+    pub fn from_toml(text: &str, source: &str) -> Result<Self, SceneErrors> {
+        let fail = |errors| SceneErrors {
+            source: source.to_string(),
+            errors,
+        };
+        let raw: RawFile = toml::from_str(text).map_err(|e| {
+            fail(vec![SceneError::from_toml(
+                text,
+                &e,
+                format!("check the field names and TOML syntax against {UDP_TEMPLATE}"),
+            )])
+        })?;
+        let mut errs = Vec::new();
+        if raw.kind != "udp" {
+            errs.push(SceneError::new(
+                "kind",
+                format!("`{}` is not a UDP device file", raw.kind),
+                "write kind = \"udp\" (Haply boards use --device haply:PATH with a Haply device file)",
+            ));
+        }
+        let p = raw.protocol.unwrap_or_default();
+        let pose_input = match p.input.as_str() {
+            "joints" => false,
+            "pose" => true,
+            o => {
+                errs.push(SceneError::new(
+                    "protocol.input",
+                    format!("`{o}` is not a kind of state"),
+                    "write input = \"joints\" (joint angles) or \"pose\" (x, y, θ)",
+                ));
+                false
+            }
+        };
+        let wrench_output = match p.output.as_str() {
+            "torques" => false,
+            "wrench" => true,
+            o => {
+                errs.push(SceneError::new(
+                    "protocol.output",
+                    format!("`{o}` is not a kind of command"),
+                    "write output = \"torques\" (joint torques) or \"wrench\" (fx, fy, τ)",
+                ));
+                false
+            }
+        };
+        if !(p.timeout_periods.is_finite() && p.timeout_periods >= 1.0) {
+            errs.push(SceneError::new(
+                "protocol.timeout_periods",
+                format!("{} periods is not a timeout", p.timeout_periods),
+                "give a number of control periods ≥ 1 (default 3)",
+            ));
+        }
+        if !(p.reply_wait_periods.is_finite()
+            && p.reply_wait_periods > 0.0
+            && p.reply_wait_periods < 1.0)
+        {
+            errs.push(SceneError::new(
+                "protocol.reply_wait_periods",
+                format!("{} periods is outside (0, 1)", p.reply_wait_periods),
+                "give a fraction of the control period, e.g. 0.3 (a read must leave time for the tick)",
+            ));
+        }
+        if !(p.torque_limit.is_finite() && p.torque_limit > 0.0) {
+            errs.push(SceneError::new(
+                "protocol.torque_limit",
+                format!("{} N·m is not a torque limit", p.torque_limit),
+                "give the device's joint torque limit in N·m, > 0",
+            ));
+        }
+        if p.max_missed_deadlines < 0 || p.max_missed_deadlines > u32::MAX as i64 {
+            errs.push(SceneError::new(
+                "protocol.max_missed_deadlines",
+                format!("{} is not a count", p.max_missed_deadlines),
+                "give a number of consecutive deadlines ≥ 0 (0 turns the check off)",
+            ));
+        }
+        if !(p.max_stall_periods.is_finite() && p.max_stall_periods >= 1.0) {
+            errs.push(SceneError::new(
+                "protocol.max_stall_periods",
+                format!("{} periods is not a stall limit", p.max_stall_periods),
+                "give the loop's longest delay between two ticks in periods, ≥ 1 (default 5)",
+            ));
+        }
+        let l = &raw.linkage;
+        let linkage = match Pantograph2::new(l.d, l.l1, l.l2) {
+            Ok(k) => Some(k),
+            Err(e) => {
+                errs.push(SceneError::new(
+                    "linkage",
+                    e,
+                    "give the pantograph's d, l1, l2 in metres (DEVICES §2)",
+                ));
+                None
+            }
+        };
+        match linkage {
+            Some(linkage) if errs.is_empty() => Ok(Self {
+                name: raw.name.unwrap_or_else(|| "UDP device".into()),
+                source: source.to_string(),
+                pose_input,
+                wrench_output,
+                timeout_periods: p.timeout_periods,
+                reply_wait_periods: p.reply_wait_periods,
+                torque_limit: p.torque_limit,
+                max_missed_deadlines: u32::try_from(p.max_missed_deadlines)
+                    .ok()
+                    .filter(|n| *n > 0),
+                max_stall_periods: p.max_stall_periods,
+                linkage,
+            }),
+            _ => Err(fail(errs)),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_reference_file_parses() {
+        let f = UdpDeviceFile::reference();
+        assert!(!f.pose_input && !f.wrench_output);
+        assert_eq!(f.linkage.d, 0.038);
+        assert_eq!(f.timeout_periods, 3.0);
+    }
+
+    #[test]
+    fn bad_fields_are_named_with_their_fix() {
+        let text = "kind = \"udp\"\n[protocol]\ninput = \"angles\"\nreply_wait_periods = 2\n[linkage]\nd = 0.0\nl1 = 0.07\nl2 = 0.09\n";
+        let e = UdpDeviceFile::from_toml(text, "device file x.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("protocol.input") && e.contains("\"pose\""),
+            "{e}"
+        );
+        assert!(e.contains("protocol.reply_wait_periods"), "{e}");
+        let e = UdpDeviceFile::from_toml(
+            "kind = \"udp\"\n[linkage]\nd = 0\nl1 = 0.07\nl2 = 0.09\nfoo = 1\n",
+            "f",
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("foo"), "{e}");
+    }
+}

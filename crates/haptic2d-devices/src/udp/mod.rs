@@ -1,0 +1,12 @@
+//! The open UDP device protocol (docs/DEVICE-PROTOCOL.md): the codec, the host transport over
+//! `std::net::UdpSocket`, device files and the driver behind `DeviceIo`.
+
+pub mod codec;
+pub mod device_file;
+pub mod driver;
+pub mod transport;
+
+pub use codec::{CodecError, Command, State};
+pub use device_file::UdpDeviceFile;
+pub use driver::UdpDevice;
+pub use transport::{UdpCounters, UdpTransport};
