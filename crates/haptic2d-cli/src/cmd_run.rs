@@ -55,7 +55,9 @@ pub struct RunArgs {
     pub hand: Option<String>,
     /// Device: sim (simulated twin pantograph), replay:FILE.csv (recorded encoders q1..q4, rad),
     /// replay:FILE.mcap (the encoders of a `--log FILE.mcap` recording), haply:PATH or haply:auto
-    /// (a Haply board; --device-file a Haply device file, default haply-2diy-gen3).
+    /// (a Haply board; --device-file a Haply device file, default haply-2diy-gen3), udp:ADDR:PORT (a
+    /// device on the open UDP protocol, docs/DEVICE-PROTOCOL.md; --device-file a UDP device file,
+    /// default devices/udp-pantograph.toml).
     #[arg(long, default_value = "sim")]
     pub device: String,
     /// Device parameters (TOML: top-level fields or a [device] table; template:

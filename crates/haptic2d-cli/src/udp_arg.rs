@@ -54,17 +54,29 @@ pub fn real_device(addr: &str, device_file: Option<&Path>) -> Result<RealDevice,
         model: DeviceModel::FiveBar {
             linkage: file.linkage,
             tau_max: file.torque_limit,
+            center: reach_center(&file.linkage),
         },
         summary,
         wait_periods: file.timeout_periods,
         max_missed_run: file.max_missed_deadlines,
         max_stall_periods: file.max_stall_periods,
+        match_controller: None,
         // Open (the first state received) before the first deadline.
         open: Box::new(move |period| {
             let dev = UdpDevice::open(addr, &file, period, &open_name)?;
             Ok(Box::new(Counted(dev)) as Box<dyn DeviceIo + Send>)
         }),
     })
+}
+
+/// Where the stability gate linearises a UDP pantograph (m, device frame): on the symmetry axis
+/// `x = d/2`, at the middle of the reach of each motor's two links, `r = (l1 + l2 + |l1 − l2|)/2`
+/// from the motor, so `y = √(r² − (d/2)²)`. For the reference (Haply 2DIY gen 3) geometry this is
+/// (0.019, 0.088) m, beside the Haply device file's workspace centre (0.019, 0.10) m.
+fn reach_center(l: &haptic2d::device::pantograph2::Pantograph2) -> [f64; 2] {
+    let r = 0.5 * (l.l1 + l.l2 + (l.l1 - l.l2).abs());
+    let x = 0.5 * l.d;
+    [x, (r * r - x * x).max(0.0).sqrt()]
 }
 
 /// A [`UdpDevice`] that prints its network counters when it closes (after the loop).
