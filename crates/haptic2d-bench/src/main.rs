@@ -27,6 +27,7 @@ mod box2d_world;
 mod rapier_world;
 mod report;
 mod scenes;
+mod settle;
 mod state;
 mod timing;
 
@@ -58,6 +59,21 @@ struct Args {
     /// Quick run: piles 10 and 100 only, 500 warm-up and 1000 timed steps (overrides those options).
     #[arg(long)]
     quick: bool,
+    /// Run haptic2d's global proximity stage whole every N_g-th sample (the old schedule, with its
+    /// deadline spike) instead of spread over the samples (the default, `WorldParams::proximity_spread`).
+    #[arg(long)]
+    no_spread: bool,
+    /// Instead of timing: run haptic2d alone on the selected cases for this many simulated seconds
+    /// and print the settle state every `--every` seconds (no files written).
+    #[arg(long)]
+    settle: Option<f64>,
+    /// Print interval of `--settle` (simulated s).
+    #[arg(long, default_value_t = 0.5)]
+    every: f64,
+    /// Law parameter overrides for haptic2d, comma-separated `normal.KEY=V` / `friction.KEY=V`
+    /// (e.g. `--set normal.bc=200`); reported in the output.
+    #[arg(long, value_delimiter = ',')]
+    set: Vec<String>,
     /// Output folder for compare.json and compare.svg (default: <workspace>/target/bench).
     #[arg(long)]
     out: Option<PathBuf>,
@@ -89,6 +105,7 @@ fn run(args: &Args) -> Result<(), String> {
             pile: vec![10, 100],
             scenes: args.scenes.clone(),
             out: args.out.clone(),
+            set: args.set.clone(),
             ..*args
         };
         &quick
@@ -108,10 +125,28 @@ fn run(args: &Args) -> Result<(), String> {
             args.scenes
         ));
     }
+    if let Some(secs) = args.settle {
+        if !(secs.is_finite() && secs > 0.0 && args.every.is_finite() && args.every > 0.0) {
+            return Err("--settle and --every must be positive durations in s".into());
+        }
+        for case in cases {
+            let label = format!("{} n={}", case.scene, case.n);
+            let mut h = case.haptic.world;
+            h.params.proximity_spread = !args.no_spread;
+            settle::apply(&mut h, &args.set).map_err(|e| format!("{label}: {e}"))?;
+            settle::run(&label, &mut h, scenes::DT, secs, args.every);
+        }
+        return Ok(());
+    }
     let mut rows = Vec::new();
     for case in cases {
         let label = format!("{} n={}", case.scene, case.n);
         let mut h = case.haptic.world;
+        h.params.proximity_spread = !args.no_spread;
+        settle::apply(&mut h, &args.set).map_err(|e| format!("{label}: {e}"))?;
+        if !args.set.is_empty() {
+            eprintln!("{label}: haptic2d with {}", args.set.join(", "));
+        }
         let mut r = rapier_world::twin(
             &h,
             scenes::DT,

@@ -1,0 +1,56 @@
+//! `--settle SECONDS`: how a haptic2d scene comes to rest. Runs the selected cases for haptic2d only
+//! (optionally with law parameters overridden, `--set normal.bc=200`) and prints the settle state
+//! every `--every` seconds of simulated time: largest speed, bodies above 1 cm/s, mean height,
+//! largest overlap. Used to find why the pile keeps moving (docs/PERFORMANCE.md, issue 17).
+
+use haptic2d::world::World;
+
+use crate::state;
+
+/// Applies `law.key=value` overrides (`normal.bc=200`, `friction.beta=40`) to the prototypes of the
+/// world's laws (every contact created afterwards gets them), and `world.proximity_spread=0/1`.
+pub fn apply(w: &mut World, sets: &[String]) -> Result<(), String> {
+    for s in sets {
+        let (k, v) = s
+            .split_once('=')
+            .ok_or_else(|| format!("--set {s}: expected law.key=value, e.g. normal.bc=200"))?;
+        let v: f64 = v
+            .trim()
+            .parse()
+            .map_err(|e| format!("--set {s}: value: {e}"))?;
+        let r = match k.trim().split_once('.') {
+            Some(("normal", key)) => w.normal.set_param(key, v),
+            Some(("friction", key)) => w.friction.set_param(key, v),
+            _ => Err("expected normal.KEY or friction.KEY".into()),
+        };
+        r.map_err(|e| format!("--set {s}: {e}"))?;
+    }
+    Ok(())
+}
+
+/// Runs `w` for `seconds` of simulated time at `dt` (s), printing the state every `every` seconds.
+pub fn run(label: &str, w: &mut World, dt: f64, seconds: f64, every: f64) {
+    let steps = (seconds / dt).round() as usize;
+    let every = ((every / dt).round() as usize).max(1);
+    println!("{label}: t s | |v|max m/s | >1cm/s | mean y m | overlap mm | contacts",);
+    for k in 1..=steps {
+        w.step();
+        if k % every == 0 || k == steps {
+            let poses: Vec<_> = w
+                .bodies
+                .iter()
+                .map(|b| (b.pose.pos, b.pose.angle, b.vel))
+                .collect();
+            let s = state::of(w, &poses);
+            println!(
+                "{label}: {:6.2} | {:10.4} | {:6} | {:8.4} | {:10.3} | {}",
+                k as f64 * dt,
+                s.max_speed,
+                s.moving,
+                s.mean_height,
+                s.max_overlap * 1e3,
+                w.contacts().contact_count()
+            );
+        }
+    }
+}
