@@ -63,6 +63,9 @@ struct Args {
     /// deadline spike) instead of spread over the samples (the default, `WorldParams::proximity_spread`).
     #[arg(long)]
     no_spread: bool,
+    /// Clock that times each step: wall (default) or this thread's CPU time (fairer under load).
+    #[arg(long, value_enum, default_value_t = timing::Clock::Wall)]
+    clock: timing::Clock,
     /// Instead of timing: run haptic2d alone on the selected cases for this many simulated seconds
     /// and print the settle state every `--every` seconds (no files written).
     #[arg(long)]
@@ -171,15 +174,17 @@ fn run(args: &Args) -> Result<(), String> {
         )
         .map_err(|e| format!("{label}: {e}"))?;
         eprintln!(
-            "{label}: {} warm-up + {} timed steps per engine (4 engines, box2d build {}) ...",
+            "{label}: {} warm-up + {} timed steps per engine (4 engines, box2d build {}, {:?} clock) ...",
             args.warmup,
             args.steps,
-            box2d_world::BUILD
+            box2d_world::BUILD,
+            args.clock
         );
         let samples = {
             let (mut fh, mut fr, mut f4, mut f1) =
                 (|| h.step(), || r.step(), || b4.step(), || b1.step());
             timing::interleaved(
+                args.clock,
                 args.warmup,
                 args.steps,
                 args.chunk,

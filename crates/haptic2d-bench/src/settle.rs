@@ -6,6 +6,7 @@
 use haptic2d::world::World;
 
 use crate::state;
+use crate::timing::{now, Clock};
 
 /// Applies `law.key=value` overrides (`normal.bc=200`, `friction.beta=40`) to the prototypes of the
 /// world's laws (every contact created afterwards gets them), and `world.proximity_spread=0/1`.
@@ -32,9 +33,16 @@ pub fn apply(w: &mut World, sets: &[String]) -> Result<(), String> {
 pub fn run(label: &str, w: &mut World, dt: f64, seconds: f64, every: f64) {
     let steps = (seconds / dt).round() as usize;
     let every = ((every / dt).round() as usize).max(1);
-    println!("{label}: t s | |v|max m/s | >1cm/s | mean y m | overlap mm | contacts",);
+    println!(
+        "{label}: t s | |v|max m/s | >1cm/s | mean y m | overlap mm | contacts | early | cpu µs/step"
+    );
+    let origin = std::time::Instant::now();
+    let (mut cpu, mut since) = (0.0, 0usize);
     for k in 1..=steps {
+        let t0 = now(Clock::Cpu, origin);
         w.step();
+        cpu += now(Clock::Cpu, origin) - t0;
+        since += 1;
         if k % every == 0 || k == steps {
             let poses: Vec<_> = w
                 .bodies
@@ -43,14 +51,17 @@ pub fn run(label: &str, w: &mut World, dt: f64, seconds: f64, every: f64) {
                 .collect();
             let s = state::of(w, &poses);
             println!(
-                "{label}: {:6.2} | {:10.4} | {:6} | {:8.4} | {:10.3} | {}",
+                "{label}: {:6.2} | {:10.4} | {:6} | {:8.4} | {:10.3} | {:8} | {:5} | {:8.1}",
                 k as f64 * dt,
                 s.max_speed,
                 s.moving,
                 s.mean_height,
                 s.max_overlap * 1e3,
-                w.contacts().contact_count()
+                w.contacts().contact_count(),
+                w.continuous_stats().1,
+                cpu * 1e6 / since as f64
             );
+            (cpu, since) = (0.0, 0);
         }
     }
 }
