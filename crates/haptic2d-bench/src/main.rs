@@ -73,6 +73,10 @@ struct Args {
     /// Print interval of `--settle` (simulated s).
     #[arg(long, default_value_t = 0.5)]
     every: f64,
+    /// With `--settle`: steps after this simulated time (s) run through `settle::profiled_step`,
+    /// for `valgrind --tool=callgrind --toggle-collect='*profiled_step*'`.
+    #[arg(long, default_value_t = f64::INFINITY)]
+    profile_after: f64,
     /// Law parameter overrides for haptic2d, comma-separated `normal.KEY=V` / `friction.KEY=V`
     /// (e.g. `--set normal.bc=200`); reported in the output.
     #[arg(long, value_delimiter = ',')]
@@ -137,7 +141,14 @@ fn run(args: &Args) -> Result<(), String> {
             let mut h = case.haptic.world;
             h.params.proximity_spread = !args.no_spread;
             settle::apply(&mut h, &args.set).map_err(|e| format!("{label}: {e}"))?;
-            settle::run(&label, &mut h, scenes::DT, secs, args.every);
+            settle::run(
+                &label,
+                &mut h,
+                scenes::DT,
+                secs,
+                args.every,
+                args.profile_after,
+            );
         }
         return Ok(());
     }

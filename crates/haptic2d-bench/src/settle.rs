@@ -29,8 +29,17 @@ pub fn apply(w: &mut World, sets: &[String]) -> Result<(), String> {
     Ok(())
 }
 
-/// Runs `w` for `seconds` of simulated time at `dt` (s), printing the state every `every` seconds.
-pub fn run(label: &str, w: &mut World, dt: f64, seconds: f64, every: f64) {
+/// One step through a function of its own, so a profiler can be limited to the steps after
+/// `--profile-after` (`valgrind --tool=callgrind --toggle-collect='*profiled_step*'`).
+#[inline(never)]
+pub fn profiled_step(w: &mut World) {
+    w.step();
+}
+
+/// Runs `w` for `seconds` of simulated time at `dt` (s), printing the state every `every` seconds;
+/// steps after `profile_after` (s) go through [`profiled_step`].
+pub fn run(label: &str, w: &mut World, dt: f64, seconds: f64, every: f64, profile_after: f64) {
+    let first_profiled = (profile_after / dt).round() as usize;
     let steps = (seconds / dt).round() as usize;
     let every = ((every / dt).round() as usize).max(1);
     println!(
@@ -40,7 +49,11 @@ pub fn run(label: &str, w: &mut World, dt: f64, seconds: f64, every: f64) {
     let (mut cpu, mut since) = (0.0, 0usize);
     for k in 1..=steps {
         let t0 = now(Clock::Cpu, origin);
-        w.step();
+        if k > first_profiled {
+            profiled_step(w);
+        } else {
+            w.step();
+        }
         cpu += now(Clock::Cpu, origin) - t0;
         since += 1;
         if k % every == 0 || k == steps {
