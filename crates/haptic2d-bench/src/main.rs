@@ -202,6 +202,30 @@ fn run(args: &Args) -> Result<(), String> {
                 &mut [&mut fh, &mut fr, &mut f4, &mut f1],
             )
         };
+        // Step `i` of the timed run is haptic2d's sample `warmup + i`: its median per phase of
+        // the global stage's period shows a deadline spike (or its absence) directly.
+        let n_g = h.params.proximity_every.max(1) as usize;
+        let phase_medians: Vec<String> = (0..n_g)
+            .map(|ph| {
+                let v: Vec<f64> = samples[0]
+                    .0
+                    .iter()
+                    .enumerate()
+                    .filter(|(i, _)| (args.warmup + i) % n_g == ph)
+                    .map(|(_, &t)| t)
+                    .collect();
+                format!("{:.1}", timing::Samples(v).median())
+            })
+            .collect();
+        eprintln!(
+            "{label}: haptic2d median µs by sample mod {n_g} (global stage {}): {}",
+            if h.params.proximity_spread {
+                "spread"
+            } else {
+                "whole at 0"
+            },
+            phase_medians.join(" ")
+        );
         let haptic_poses: Vec<_> = h
             .bodies
             .iter()
