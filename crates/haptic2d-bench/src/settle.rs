@@ -46,6 +46,9 @@ pub fn run(label: &str, w: &mut World, dt: f64, seconds: f64, every: f64, profil
         "{label}: t s | |v|max m/s | >1cm/s | mean y m | overlap mm | contacts | early | cpu µs/step"
     );
     let origin = std::time::Instant::now();
+    // CPU time of every step after `profile_after`, by sample phase of the global period.
+    let n_g = w.params.proximity_every.max(1) as usize;
+    let mut by_phase: Vec<Vec<f64>> = vec![Vec::new(); n_g];
     let (mut cpu, mut since) = (0.0, 0usize);
     for k in 1..=steps {
         let t0 = now(Clock::Cpu, origin);
@@ -54,7 +57,11 @@ pub fn run(label: &str, w: &mut World, dt: f64, seconds: f64, every: f64, profil
         } else {
             w.step();
         }
-        cpu += now(Clock::Cpu, origin) - t0;
+        let dt_cpu = now(Clock::Cpu, origin) - t0;
+        cpu += dt_cpu;
+        if k > first_profiled {
+            by_phase[(k - 1) % n_g].push(dt_cpu * 1e6);
+        }
         since += 1;
         if k % every == 0 || k == steps {
             let poses: Vec<_> = w
@@ -77,4 +84,18 @@ pub fn run(label: &str, w: &mut World, dt: f64, seconds: f64, every: f64, profil
             (cpu, since) = (0.0, 0);
         }
     }
+    if by_phase[0].is_empty() {
+        return;
+    }
+    let med: Vec<f64> = by_phase
+        .into_iter()
+        .map(|v| crate::timing::Samples(v).median())
+        .collect();
+    let all = med.iter().sum::<f64>() / med.len() as f64;
+    println!(
+        "{label}: CPU µs per step by sample mod {n_g} after {profile_after} s (global stage {}): {} (worst / mean of phases {:.2})",
+        if w.params.proximity_spread { "spread" } else { "whole at 0" },
+        med.iter().map(|m| format!("{m:.1}")).collect::<Vec<_>>().join(" "),
+        med.iter().fold(0.0f64, |a, &b| a.max(b)) / all
+    );
 }
