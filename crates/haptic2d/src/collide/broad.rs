@@ -32,8 +32,9 @@
 //! so the work can instead be spread over the `N_g` samples of a period (the world's default):
 //!
 //! ```text
-//! sample k·N_g      publish(set of (k−1)·N_g)   begin(poses of k·N_g)   advance(⌈n/N_g⌉ boxes)
-//! sample k·N_g + j  advance(⌈remaining/(N_g − j)⌉ boxes)                          j = 1 … N_g−1
+//! sample k·N_g      publish(set of (k−1)·N_g)   begin(poses of k·N_g)   advance: ⌈n/(N_g−1)⌉ boxes
+//! sample k·N_g + j  advance: ⌈remaining/(N_g−1−j)⌉ boxes                      j = 1 … N_g−2
+//! sample k·N_g + N_g−1   advance: sort the pairs (publish only copies them out)
 //! ```
 //!
 //! `begin` copies the world vertices (the snapshot), so the set published at `(k+1)·N_g` is
@@ -122,6 +123,8 @@ pub struct BroadPhase {
     tested: Vec<Tested>,
     /// `(pair key, index into tested)`, sorted at publish.
     order: Vec<(u64, u32)>,
+    /// `order` is complete for the update in progress.
+    sorted: bool,
     gjk_iterations: u64,
     cache_pairs: Vec<(u32, u32)>,
     caches: Vec<GjkCache>,
@@ -146,6 +149,7 @@ impl BroadPhase {
             next: None,
             tested: Vec::new(),
             order: Vec::new(),
+            sorted: false,
             gjk_iterations: 0,
             cache_pairs: Vec::new(),
             caches: Vec::new(),
@@ -214,18 +218,22 @@ impl BroadPhase {
         self.sweep
             .sort_unstable_by(|p, q| p.min_x.total_cmp(&q.min_x).then(p.index.cmp(&q.index)));
         self.tested.clear();
+        self.sorted = false;
         self.gjk_iterations = 0;
         self.next = Some(0);
     }
 
-    /// Sweeps the next boxes of the update in progress, so that what is left is split evenly over
-    /// `samples_left` calls (this one included; at least 1): about `⌈remaining / samples_left⌉`
-    /// boxes, each tested against the boxes that start before it ends in x, GJK on every pair
-    /// that overlaps. Does nothing when no update is in progress.
+    /// Advances the update in progress by one sample's share, `samples_left` being the number of
+    /// calls left before [`publish`](Self::publish) (this one included; at least 1): while
+    /// `samples_left ≥ 2` the remaining boxes are split evenly over `samples_left − 1` calls
+    /// (`⌈remaining / (samples_left − 1)⌉` boxes, each tested against the boxes that start before it
+    /// ends in x, GJK on every pair that overlaps); the last call (`samples_left = 1`) sweeps
+    /// whatever is left and sorts the pairs, so the publishing sample only copies them out. Does
+    /// nothing when no update is in progress.
     pub fn advance(&mut self, samples_left: usize) {
         let Some(start) = self.next else { return };
         let n = self.sweep.len();
-        let share = (n - start).div_ceil(samples_left.max(1));
+        let share = (n - start).div_ceil(samples_left.saturating_sub(1).max(1));
         let stop = (start + share).min(n);
         // 2. Sweep on x, test y, filter same-body and fixed–fixed pairs; 3. warm-started GJK per
         //    pair (each pair's result depends on its own cache only, so the order of this loop
@@ -263,6 +271,19 @@ impl BroadPhase {
             }
         }
         self.next = Some(stop);
+        if samples_left <= 1 && !self.sorted {
+            // Sorted by pair through a list of (key, index): sorting the 16-byte keys instead of
+            // the ~90-byte records keeps this sample close to the others in cost.
+            self.order.clear();
+            self.order.extend(
+                self.tested
+                    .iter()
+                    .enumerate()
+                    .map(|(k, t)| (((t.pair.0 as u64) << 32) | t.pair.1 as u64, k as u32)),
+            );
+            self.order.sort_unstable();
+            self.sorted = true;
+        }
     }
 
     /// Finishes the update in progress (sweeps what is left) and writes its proximity set into
@@ -274,16 +295,6 @@ impl BroadPhase {
         }
         self.advance(1);
         self.next = None;
-        // Sorted by pair through a list of (key, index): sorting the 16-byte keys instead of the
-        // ~90-byte records keeps the publishing sample close to the others in cost.
-        self.order.clear();
-        self.order.extend(
-            self.tested
-                .iter()
-                .enumerate()
-                .map(|(k, t)| (((t.pair.0 as u64) << 32) | t.pair.1 as u64, k as u32)),
-        );
-        self.order.sort_unstable();
         out.clear();
         self.cache_pairs.clear();
         self.caches.clear();
@@ -404,16 +415,26 @@ mod tests {
         }
     }
 
-    /// `advance(k)` splits the remaining boxes evenly: an update advanced once per sample over
-    /// `N_g` samples has swept every box by its last sample (publish has nothing left to do).
+    /// `advance(k)` splits the remaining boxes evenly over the first `N_g − 1` samples of the period
+    /// and sorts at the last one, so publish has nothing left to do but copy.
     #[test]
     fn advance_shares_cover_the_sweep() {
         let cols = grid(0.0, 0.05);
         let mut bp = BroadPhase::new(DEFAULT_DELTA_PROX).unwrap();
         bp.begin(&cols);
-        for j in 0..10 {
+        let mut swept = Vec::new();
+        for j in 0..9 {
             bp.advance(10 - j);
+            swept.push(bp.next.unwrap());
         }
+        // Nine even shares of the boxes, then the last sample sorts only.
+        let share = cols.len().div_ceil(9);
+        assert_eq!(swept[0], share);
         assert_eq!(bp.next, Some(cols.len()));
+        assert!(!bp.sorted);
+        let pairs = bp.tested.len();
+        bp.advance(1);
+        assert!(bp.sorted && bp.order.len() == pairs && pairs > 0);
+        assert!(bp.order.windows(2).all(|w| w[0] < w[1]));
     }
 }
