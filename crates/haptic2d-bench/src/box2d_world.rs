@@ -2,7 +2,7 @@
 //! body, piece, pose, velocity, mass, inertia and load is copied from the haptic2d [`World`].
 //!
 //! What is identical: geometry (each convex piece becomes one Box2D polygon, radius 0), mass and
-//! centroidal inertia (set explicitly with `set_mass_data`, shapes have zero density), initial poses
+//! centroidal inertia (set explicitly with `set_mass_data` after the shapes, which have zero density), initial poses
 //! and velocities, the time step (1 ms), friction and restitution, sleeping off (world and bodies).
 //! Loads: a per-mass load shared by every dynamic body (gravity) becomes Box2D's world gravity
 //! (`m·g`, the same body force); any other constant load is re-applied before every step, because
@@ -156,7 +156,10 @@ pub fn twin(w: &World, dt: f64, substeps: i32, mu: f64, e: f64) -> Result<Box2dT
     let shape_def = ShapeDef::builder()
         .material(material)
         .density(0.0)
-        .update_body_mass(false)
+        // `false` would leave the body's mass flagged dirty (Box2D asserts on it in the first step:
+        // `b2Body_SetMassData` does not clear the flag); with density 0 the shapes add nothing, and
+        // `set_mass_data` below sets the mass and inertia after the last shape.
+        .update_body_mass(true)
         .build()
         .map_err(|x| err("shape definition", x))?;
     for c in &w.colliders {

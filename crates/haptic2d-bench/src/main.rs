@@ -27,6 +27,7 @@ mod box2d_world;
 mod rapier_world;
 mod report;
 mod scenes;
+mod settle;
 mod state;
 mod timing;
 
@@ -58,6 +59,28 @@ struct Args {
     /// Quick run: piles 10 and 100 only, 500 warm-up and 1000 timed steps (overrides those options).
     #[arg(long)]
     quick: bool,
+    /// Run haptic2d's global proximity stage whole every N_g-th sample (the old schedule, with its
+    /// deadline spike) instead of spread over the samples (the default, `WorldParams::proximity_spread`).
+    #[arg(long)]
+    no_spread: bool,
+    /// Clock that times each step: wall (default) or this thread's CPU time (fairer under load).
+    #[arg(long, value_enum, default_value_t = timing::Clock::Wall)]
+    clock: timing::Clock,
+    /// Instead of timing: run haptic2d alone on the selected cases for this many simulated seconds
+    /// and print the settle state every `--every` seconds (no files written).
+    #[arg(long)]
+    settle: Option<f64>,
+    /// Print interval of `--settle` (simulated s).
+    #[arg(long, default_value_t = 0.5)]
+    every: f64,
+    /// With `--settle`: steps after this simulated time (s) run through `settle::profiled_step`,
+    /// for `valgrind --tool=callgrind --toggle-collect='*profiled_step*'`.
+    #[arg(long, default_value_t = f64::INFINITY)]
+    profile_after: f64,
+    /// Law parameter overrides for haptic2d, comma-separated `normal.KEY=V` / `friction.KEY=V`
+    /// (e.g. `--set normal.bc=200`); reported in the output.
+    #[arg(long, value_delimiter = ',')]
+    set: Vec<String>,
     /// Output folder for compare.json and compare.svg (default: <workspace>/target/bench).
     #[arg(long)]
     out: Option<PathBuf>,
@@ -89,6 +112,7 @@ fn run(args: &Args) -> Result<(), String> {
             pile: vec![10, 100],
             scenes: args.scenes.clone(),
             out: args.out.clone(),
+            set: args.set.clone(),
             ..*args
         };
         &quick
@@ -108,10 +132,35 @@ fn run(args: &Args) -> Result<(), String> {
             args.scenes
         ));
     }
+    if let Some(secs) = args.settle {
+        if !(secs.is_finite() && secs > 0.0 && args.every.is_finite() && args.every > 0.0) {
+            return Err("--settle and --every must be positive durations in s".into());
+        }
+        for case in cases {
+            let label = format!("{} n={}", case.scene, case.n);
+            let mut h = case.haptic.world;
+            h.params.proximity_spread = !args.no_spread;
+            settle::apply(&mut h, &args.set).map_err(|e| format!("{label}: {e}"))?;
+            settle::run(
+                &label,
+                &mut h,
+                scenes::DT,
+                secs,
+                args.every,
+                args.profile_after,
+            );
+        }
+        return Ok(());
+    }
     let mut rows = Vec::new();
     for case in cases {
         let label = format!("{} n={}", case.scene, case.n);
         let mut h = case.haptic.world;
+        h.params.proximity_spread = !args.no_spread;
+        settle::apply(&mut h, &args.set).map_err(|e| format!("{label}: {e}"))?;
+        if !args.set.is_empty() {
+            eprintln!("{label}: haptic2d with {}", args.set.join(", "));
+        }
         let mut r = rapier_world::twin(
             &h,
             scenes::DT,
@@ -136,21 +185,47 @@ fn run(args: &Args) -> Result<(), String> {
         )
         .map_err(|e| format!("{label}: {e}"))?;
         eprintln!(
-            "{label}: {} warm-up + {} timed steps per engine (4 engines, box2d build {}) ...",
+            "{label}: {} warm-up + {} timed steps per engine (4 engines, box2d build {}, {:?} clock) ...",
             args.warmup,
             args.steps,
-            box2d_world::BUILD
+            box2d_world::BUILD,
+            args.clock
         );
         let samples = {
             let (mut fh, mut fr, mut f4, mut f1) =
                 (|| h.step(), || r.step(), || b4.step(), || b1.step());
             timing::interleaved(
+                args.clock,
                 args.warmup,
                 args.steps,
                 args.chunk,
                 &mut [&mut fh, &mut fr, &mut f4, &mut f1],
             )
         };
+        // Step `i` of the timed run is haptic2d's sample `warmup + i`: its median per phase of
+        // the global stage's period shows a deadline spike (or its absence) directly.
+        let n_g = h.params.proximity_every.max(1) as usize;
+        let phase_medians: Vec<String> = (0..n_g)
+            .map(|ph| {
+                let v: Vec<f64> = samples[0]
+                    .0
+                    .iter()
+                    .enumerate()
+                    .filter(|(i, _)| (args.warmup + i) % n_g == ph)
+                    .map(|(_, &t)| t)
+                    .collect();
+                format!("{:.1}", timing::Samples(v).median())
+            })
+            .collect();
+        eprintln!(
+            "{label}: haptic2d median µs by sample mod {n_g} (global stage {}): {}",
+            if h.params.proximity_spread {
+                "spread"
+            } else {
+                "whole at 0"
+            },
+            phase_medians.join(" ")
+        );
         let haptic_poses: Vec<_> = h
             .bodies
             .iter()

@@ -45,20 +45,21 @@ pub fn table(rows: &[Row]) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "{:<13} {:>5} | {:<15} {:>10} {:>10} | {:>7} {:>7}",
-        "scene", "n", "engine", "median µs", "p99 µs", "ratio", "p99 rat"
+        "{:<13} {:>5} | {:<15} {:>10} {:>10} {:>7} | {:>7} {:>7}",
+        "scene", "n", "engine", "median µs", "p99 µs", "p99/med", "ratio", "p99 rat"
     );
-    let _ = writeln!(s, "{}", "-".repeat(78));
+    let _ = writeln!(s, "{}", "-".repeat(86));
     for r in rows {
         for (k, e) in r.engines.iter().enumerate() {
             let _ = writeln!(
                 s,
-                "{:<13} {:>5} | {:<15} {:>10.2} {:>10.2} | {:>7.3} {:>7.3}",
+                "{:<13} {:>5} | {:<15} {:>10.2} {:>10.2} {:>7.2} | {:>7.3} {:>7.3}",
                 r.scene,
                 r.n,
                 e.key,
                 e.median_us,
                 e.p99_us,
+                e.p99_us / e.median_us,
                 r.ratio(k),
                 r.ratio_p99(k)
             );

@@ -24,6 +24,11 @@ pub struct WorldParams {
     pub dt: f64,
     /// Run the global proximity stage every `N_g` samples.
     pub proximity_every: u32,
+    /// Spread the global proximity stage over the `N_g` samples of its period (default) instead
+    /// of running it whole every `N_g`-th sample: every sample then costs about the same (no
+    /// deadline spike), and the set in use describes the poses one period earlier, which the
+    /// §9.1 margin allows (`collide/broad.rs`). Early updates for fast bodies still run whole.
+    pub proximity_spread: bool,
     /// Proximity margin `δ_prox` (m), §9.1.
     pub delta_prox: f64,
     /// Contact distance tolerance `δ_c` (m), §9.5.
@@ -41,6 +46,7 @@ impl Default for WorldParams {
         Self {
             dt: 0.002,
             proximity_every: 10,
+            proximity_spread: true,
             delta_prox: 0.042,
             delta_c: 0.002,
             mode: IntegrationMode::SemiImplicit,
@@ -87,8 +93,10 @@ pub struct World {
     thickness: Vec<f64>,
     /// The smallest of `thickness` (m).
     thinnest: f64,
-    /// Body poses at the last global update.
+    /// Body poses the proximity set in use was computed for.
     global_poses: Vec<Pose>,
+    /// Body poses of the spread global update in progress (its snapshot).
+    job_poses: Vec<Pose>,
     /// Velocities `(v, ω)` before this sample's integration, per body.
     vel_before: Vec<(Vec2, f64)>,
     /// Force and torque the passivity guard integrates, per body (pre-integration velocity).
@@ -135,7 +143,7 @@ impl World {
         let thickness: Vec<f64> = colliders.iter().map(|c| body_thickness(&c.local)).collect();
         let thinnest = thickness.iter().fold(f64::INFINITY, |a, &t| a.min(t));
         let max_vertices = colliders.iter().map(|c| c.len()).max().unwrap_or(4);
-        let global_poses = bodies.iter().map(|b| b.pose).collect();
+        let global_poses: Vec<Pose> = bodies.iter().map(|b| b.pose).collect();
         let mut w = Self {
             guard: params.guard.map(|eps| PassivityGuard::new(eps, &bodies)),
             bodies,
@@ -169,6 +177,7 @@ impl World {
             radius,
             thickness,
             thinnest,
+            job_poses: global_poses.clone(),
             global_poses,
             vel_before: vec![(Vec2::ZERO, 0.0); n],
             guard_force: vec![Wrench2::default(); n],
@@ -287,17 +296,7 @@ impl World {
         }
         // 3. Global proximity stage: AABB sort-and-sweep + GJK, every N_g samples, and early when
         //    a body may have outrun the margin (`moved_past_margin`).
-        let periodic = self
-            .tick
-            .is_multiple_of(self.params.proximity_every.max(1) as u64);
-        let early = !periodic && self.moved_past_margin();
-        if periodic || early {
-            self.broad.update(&self.colliders, &mut self.pairs);
-            for (g, b) in self.global_poses.iter_mut().zip(&self.bodies) {
-                *g = b.pose;
-            }
-            self.early_global_updates += early as u64;
-        }
+        self.global_stage();
         // 4. Local stage: closest-feature tracking and VE candidates for proximate pairs.
         self.local.update(
             &self.colliders,
@@ -356,6 +355,46 @@ impl World {
         }
         if self.tick == 0 {
             self.ledger.initial = self.ledger.kinetic + self.contacts.stored_energy();
+        }
+    }
+
+    /// §0.5 step 3, the global proximity stage (`collide/broad.rs`), scheduled by sample:
+    ///
+    /// - early (a body may have outrun the margin since the poses of the set in use): the whole
+    ///   stage now, for the current poses; with spreading on, a new spread update starts too;
+    /// - every `N_g`-th sample without spreading: the whole stage now;
+    /// - every `N_g`-th sample with spreading: publish the update begun `N_g` samples ago (the
+    ///   whole stage now if none is in progress: the first sample, or after an early update was
+    ///   abandoned) and begin the next one for the current poses;
+    /// - with spreading, every sample: advance the update in progress by its share, so that it
+    ///   ends by the next `N_g`-th sample.
+    ///
+    /// The poses of the set in use (`global_poses`) are those of the update that produced it, so
+    /// `moved_past_margin` measures the motion since then whatever the delay.
+    fn global_stage(&mut self) {
+        let n_g = self.params.proximity_every.max(1) as u64;
+        let phase = self.tick % n_g;
+        let periodic = phase == 0;
+        let early = !periodic && self.moved_past_margin();
+        let spread = self.params.proximity_spread && n_g > 1;
+        if early || (periodic && !(spread && self.broad.in_progress())) {
+            self.broad.update(&self.colliders, &mut self.pairs);
+            for (g, b) in self.global_poses.iter_mut().zip(&self.bodies) {
+                *g = b.pose;
+            }
+            self.early_global_updates += early as u64;
+        } else if periodic {
+            self.broad.publish(&mut self.pairs);
+            std::mem::swap(&mut self.global_poses, &mut self.job_poses);
+        }
+        if spread && (periodic || early) {
+            self.broad.begin(&self.colliders);
+            for (g, b) in self.job_poses.iter_mut().zip(&self.bodies) {
+                *g = b.pose;
+            }
+        }
+        if spread {
+            self.broad.advance((n_g - phase) as usize);
         }
     }
 

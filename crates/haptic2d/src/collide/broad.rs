@@ -24,10 +24,30 @@
 //! ```text
 //! δ_prox ≥ 2·v_rel,max·T_g + δ_c      (1 m/s, 0.02 s, 0.002 m → 0.042 m)
 //! ```
+//!
+//! # Spreading the stage over the samples
+//!
+//! Run at once, the stage makes every `N_g`-th sample the slowest (≈ 2.7× the others at 1000
+//! bodies): a deadline spike. The margin above already allows one period for the update itself,
+//! so the work can instead be spread over the `N_g` samples of a period (the world's default):
+//!
+//! ```text
+//! sample k·N_g      publish(set of (k−1)·N_g)   begin(poses of k·N_g)   advance: ⌈n/(N_g−1)⌉ boxes
+//! sample k·N_g + j  advance: ⌈remaining/(N_g−1−j)⌉ boxes                      j = 1 … N_g−2
+//! sample k·N_g + N_g−1   advance: sort the pairs (publish only copies them out)
+//! ```
+//!
+//! `begin` copies the world vertices (the snapshot), so the set published at `(k+1)·N_g` is
+//! exactly the set [`BroadPhase::update`] would have computed at `k·N_g` (same pairs, distances
+//! and caches: each pair's GJK depends only on its vertices and its own cache, not on the order
+//! of the pairs). It is used until `(k+2)·N_g`: a pair it leaves out was `≥ δ_prox` apart at
+//! `k·N_g` and, at `v_rel,max`, is still `> δ_c` apart `2·T_g` later, which is the margin rule.
+//! The world's early update (a body that moved more than `(δ_prox − δ_c)/2` since the poses of
+//! the set in use) still runs the whole stage at once, so fast bodies keep their guarantee.
 
 use super::gjk::{gjk_distance, GjkCache};
 use super::Collider;
-use crate::geom::Aabb;
+use crate::geom::{Aabb, Vec2};
 
 /// Default proximity distance `δ_prox` (m), §9.1: `2·(1 m/s)·(0.02 s) + 0.002 m`.
 pub const DEFAULT_DELTA_PROX: f64 = 0.042;
@@ -39,7 +59,7 @@ pub fn required_delta_prox(v_rel_max: f64, t_g: f64, delta_c: f64) -> f64 {
     2.0 * v_rel_max * t_g + delta_c
 }
 
-/// Work counters of the last [`BroadPhase::update`].
+/// Work counters of the last [`BroadPhase::update`] (or published spread update).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct BroadStats {
     /// Pairs whose inflated AABBs overlap (after the same-body / fixed–fixed filters).
@@ -58,17 +78,56 @@ struct SweepEntry {
     index: u32,
 }
 
+/// One AABB-overlapping pair of an update in progress: its warm-start cache and GJK distance (m).
+#[derive(Clone, Copy, Debug)]
+struct Tested {
+    pair: (u32, u32),
+    cache: GjkCache,
+    distance: f64,
+}
+
+/// The colliders as they were when an update began: world vertices (flat), and per collider its
+/// vertex range, body and whether it is dynamic. An update spread over several samples works on
+/// this copy, so its result is the proximity set of that one instant.
+#[derive(Clone, Debug, Default)]
+struct Snapshot {
+    vertices: Vec<Vec2>,
+    /// `(first vertex, vertex count, body, dynamic)` per collider.
+    colliders: Vec<(u32, u32, usize, bool)>,
+}
+
+impl Snapshot {
+    fn vertices(&self, c: u32) -> &[Vec2] {
+        let (s, n, _, _) = self.colliders[c as usize];
+        &self.vertices[s as usize..(s + n) as usize]
+    }
+}
+
 /// The global proximity stage with its reusable buffers and per-pair GJK caches.
+///
+/// Two ways to run it, with the same result for the same collider poses:
+///
+/// - [`update`](Self::update): the whole stage at once;
+/// - spread over samples: [`begin`](Self::begin) copies the colliders' world features and sorts the
+///   boxes, [`advance`](Self::advance) sweeps a share of the boxes and runs GJK on their pairs (call
+///   it once per sample), [`publish`](Self::publish) finishes what is left and writes the set. The
+///   set then describes the poses at `begin`; the §9.1 margin covers that delay (module docs).
 #[derive(Clone, Debug)]
 pub struct BroadPhase {
     delta_prox: f64,
     boxes: Vec<Aabb>,
     sweep: Vec<SweepEntry>,
-    tested: Vec<(u32, u32)>,
+    snapshot: Snapshot,
+    /// Sweep position of the update in progress (`None` = no update in progress).
+    next: Option<usize>,
+    tested: Vec<Tested>,
+    /// `(pair key, index into tested)`, sorted at publish.
+    order: Vec<(u64, u32)>,
+    /// `order` is complete for the update in progress.
+    sorted: bool,
+    gjk_iterations: u64,
     cache_pairs: Vec<(u32, u32)>,
     caches: Vec<GjkCache>,
-    new_cache_pairs: Vec<(u32, u32)>,
-    new_caches: Vec<GjkCache>,
     distances: Vec<f64>,
     stats: BroadStats,
 }
@@ -86,11 +145,14 @@ impl BroadPhase {
             delta_prox,
             boxes: Vec::new(),
             sweep: Vec::new(),
+            snapshot: Snapshot::default(),
+            next: None,
             tested: Vec::new(),
+            order: Vec::new(),
+            sorted: false,
+            gjk_iterations: 0,
             cache_pairs: Vec::new(),
             caches: Vec::new(),
-            new_cache_pairs: Vec::new(),
-            new_caches: Vec::new(),
             distances: Vec::new(),
             stats: BroadStats::default(),
         })
@@ -111,13 +173,36 @@ impl BroadPhase {
         (&self.cache_pairs, &self.distances)
     }
 
+    /// Whether a spread update is in progress (between [`begin`](Self::begin) and
+    /// [`publish`](Self::publish)).
+    pub fn in_progress(&self) -> bool {
+        self.next.is_some()
+    }
+
     /// Computes the proximity set of `colliders` (world features must be current) into `out`
     /// (cleared first): sorted `(a, b)` collider indices, `a < b`, with GJK distance `< δ_prox`.
-    /// No allocation once the buffers have grown to the scene's size.
+    /// Abandons a spread update in progress. No allocation once the buffers have grown to the
+    /// scene's size.
     pub fn update(&mut self, colliders: &[Collider], out: &mut Vec<(u32, u32)>) {
-        out.clear();
-        let half = 0.5 * self.delta_prox;
+        self.begin(colliders);
+        self.publish(out);
+    }
 
+    /// Starts an update for the current poses of `colliders`: copies their world vertices, builds
+    /// the inflated boxes and sorts them (abandons an update in progress). Nothing is published
+    /// until [`publish`](Self::publish).
+    pub fn begin(&mut self, colliders: &[Collider]) {
+        let half = 0.5 * self.delta_prox;
+        // 0. The snapshot: the rest of the update reads only this copy.
+        self.snapshot.vertices.clear();
+        self.snapshot.colliders.clear();
+        for c in colliders {
+            let s = self.snapshot.vertices.len() as u32;
+            self.snapshot.vertices.extend_from_slice(&c.world_vertices);
+            self.snapshot
+                .colliders
+                .push((s, c.world_vertices.len() as u32, c.body, c.dynamic));
+        }
         // 1. Inflated boxes, sorted by (min.x, index).
         self.boxes.clear();
         self.sweep.clear();
@@ -132,56 +217,101 @@ impl BroadPhase {
         }
         self.sweep
             .sort_unstable_by(|p, q| p.min_x.total_cmp(&q.min_x).then(p.index.cmp(&q.index)));
-
-        // 2. Sweep on x, test y, filter same-body and fixed–fixed pairs.
         self.tested.clear();
-        for i in 0..self.sweep.len() {
+        self.sorted = false;
+        self.gjk_iterations = 0;
+        self.next = Some(0);
+    }
+
+    /// Advances the update in progress by one sample's share, `samples_left` being the number of
+    /// calls left before [`publish`](Self::publish) (this one included; at least 1): while
+    /// `samples_left ≥ 2` the remaining boxes are split evenly over `samples_left − 1` calls
+    /// (`⌈remaining / (samples_left − 1)⌉` boxes, each tested against the boxes that start before it
+    /// ends in x, GJK on every pair that overlaps); the last call (`samples_left = 1`) sweeps
+    /// whatever is left and sorts the pairs, so the publishing sample only copies them out. Does
+    /// nothing when no update is in progress.
+    pub fn advance(&mut self, samples_left: usize) {
+        let Some(start) = self.next else { return };
+        let n = self.sweep.len();
+        let share = (n - start).div_ceil(samples_left.saturating_sub(1).max(1));
+        let stop = (start + share).min(n);
+        // 2. Sweep on x, test y, filter same-body and fixed–fixed pairs; 3. warm-started GJK per
+        //    pair (each pair's result depends on its own cache only, so the order of this loop
+        //    does not change any result).
+        for i in start..stop {
             let ei = self.sweep[i];
             for ej in &self.sweep[i + 1..] {
                 if ej.min_x > ei.max_x {
                     break;
                 }
                 let (a, b) = (ei.index.min(ej.index), ei.index.max(ej.index));
-                let (ca, cb) = (&colliders[a as usize], &colliders[b as usize]);
-                if ca.body == cb.body || !(ca.dynamic || cb.dynamic) {
+                let (_, _, body_a, dyn_a) = self.snapshot.colliders[a as usize];
+                let (_, _, body_b, dyn_b) = self.snapshot.colliders[b as usize];
+                if body_a == body_b || !(dyn_a || dyn_b) {
                     continue;
                 }
-                if self.boxes[a as usize].overlaps(&self.boxes[b as usize]) {
-                    self.tested.push((a, b));
+                if !self.boxes[a as usize].overlaps(&self.boxes[b as usize]) {
+                    continue;
                 }
+                let mut cache = match self.cache_pairs.binary_search(&(a, b)) {
+                    Ok(k) => self.caches[k],
+                    Err(_) => GjkCache::new(),
+                };
+                let g = gjk_distance(
+                    self.snapshot.vertices(a),
+                    self.snapshot.vertices(b),
+                    &mut cache,
+                );
+                self.gjk_iterations += g.iterations as u64;
+                self.tested.push(Tested {
+                    pair: (a, b),
+                    cache,
+                    distance: g.distance,
+                });
             }
         }
-        self.tested.sort_unstable();
-
-        // 3. Warm-started GJK per pair; the caches follow the (sorted) pair list.
-        self.new_cache_pairs.clear();
-        self.new_caches.clear();
-        self.distances.clear();
-        let mut gjk_iterations = 0;
-        for &(a, b) in &self.tested {
-            let mut cache = match self.cache_pairs.binary_search(&(a, b)) {
-                Ok(k) => self.caches[k],
-                Err(_) => GjkCache::new(),
-            };
-            let g = gjk_distance(
-                &colliders[a as usize].world_vertices,
-                &colliders[b as usize].world_vertices,
-                &mut cache,
+        self.next = Some(stop);
+        if samples_left <= 1 && !self.sorted {
+            // Sorted by pair through a list of (key, index): sorting the 16-byte keys instead of
+            // the ~90-byte records keeps this sample close to the others in cost.
+            self.order.clear();
+            self.order.extend(
+                self.tested
+                    .iter()
+                    .enumerate()
+                    .map(|(k, t)| (((t.pair.0 as u64) << 32) | t.pair.1 as u64, k as u32)),
             );
-            gjk_iterations += g.iterations as u64;
-            if g.distance < self.delta_prox {
-                out.push((a, b));
-            }
-            self.new_cache_pairs.push((a, b));
-            self.new_caches.push(cache);
-            self.distances.push(g.distance);
+            self.order.sort_unstable();
+            self.sorted = true;
         }
-        std::mem::swap(&mut self.cache_pairs, &mut self.new_cache_pairs);
-        std::mem::swap(&mut self.caches, &mut self.new_caches);
+    }
+
+    /// Finishes the update in progress (sweeps what is left) and writes its proximity set into
+    /// `out` (cleared first; sorted, `a < b`, GJK distance `< δ_prox`); the pairs' caches become
+    /// the warm starts of the next update. Leaves `out` untouched when no update is in progress.
+    pub fn publish(&mut self, out: &mut Vec<(u32, u32)>) {
+        if self.next.is_none() {
+            return;
+        }
+        self.advance(1);
+        self.next = None;
+        out.clear();
+        self.cache_pairs.clear();
+        self.caches.clear();
+        self.distances.clear();
+        for &(_, k) in &self.order {
+            let t = &self.tested[k as usize];
+            if t.distance < self.delta_prox {
+                out.push(t.pair);
+            }
+            self.cache_pairs.push(t.pair);
+            self.caches.push(t.cache);
+            self.distances.push(t.distance);
+        }
         self.stats = BroadStats {
             aabb_pairs: self.tested.len(),
             proximate_pairs: out.len(),
-            gjk_iterations,
+            gjk_iterations: self.gjk_iterations,
         };
     }
 }
@@ -221,5 +351,90 @@ mod tests {
         let mut out = Vec::new();
         bp.update(&cols, &mut out);
         assert_eq!(out, vec![(0, 2), (0, 3)]);
+    }
+
+    /// A jittered grid of squares, some rotated, with a fixed floor: many AABB pairs, some proximate.
+    fn grid(shift: f64, pitch: f64) -> Vec<Collider> {
+        let mut cols = vec![Collider::new(
+            0,
+            false,
+            ConvexPolygon::rectangle(2.0, 0.1).unwrap(),
+            &Pose::new(0.0, -0.05, 0.0),
+        )];
+        for k in 0..120usize {
+            let (i, j) = ((k % 12) as f64, (k / 12) as f64);
+            let jitter = ((k * 7919) % 13) as f64 * 1e-3;
+            cols.push(Collider::new(
+                k + 1,
+                true,
+                ConvexPolygon::rectangle(0.04, 0.04).unwrap(),
+                &Pose::new(
+                    -0.3 + i * pitch + jitter + shift,
+                    0.021 + j * 0.0455,
+                    0.1 * jitter * k as f64,
+                ),
+            ));
+        }
+        cols
+    }
+
+    /// The spread update publishes exactly the set, distances, caches and counters of the whole
+    /// update at the poses of `begin`, whatever the poses of the colliders in between, and
+    /// whatever number of samples it is spread over.
+    #[test]
+    fn spread_update_equals_whole_update_at_begin() {
+        let (a, b) = (grid(0.0, 0.05), grid(0.013, 0.09));
+        for samples in [1usize, 2, 3, 10, 500] {
+            let mut whole = BroadPhase::new(DEFAULT_DELTA_PROX).unwrap();
+            let mut spread = whole.clone();
+            let (mut out_w, mut out_s) = (Vec::new(), vec![(7, 7)]);
+            // Warm both caches on `b` first, so the warm starts are exercised.
+            whole.update(&b, &mut out_w);
+            spread.update(&b, &mut out_s);
+            whole.update(&a, &mut out_w);
+            spread.begin(&a);
+            for j in 0..samples {
+                assert!(spread.in_progress());
+                spread.advance(samples - j);
+            }
+            let before = out_s.clone();
+            spread.publish(&mut out_s);
+            assert_ne!(out_s, before, "the set of `a` differs from the set of `b`");
+            assert!(!spread.in_progress());
+            assert!(whole.stats().aabb_pairs > 200, "{:?}", whole.stats());
+            assert_eq!(out_s, out_w, "{samples} samples");
+            assert_eq!(spread.stats(), whole.stats(), "{samples} samples");
+            let (pw, dw) = whole.tested_pairs();
+            let (ps, ds) = spread.tested_pairs();
+            assert_eq!(pw, ps);
+            let bits = |d: &[f64]| d.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(dw), bits(ds));
+            // Publishing with no update in progress leaves the set alone.
+            spread.publish(&mut out_s);
+            assert_eq!(out_s, out_w);
+        }
+    }
+
+    /// `advance(k)` splits the remaining boxes evenly over the first `N_g − 1` samples of the period
+    /// and sorts at the last one, so publish has nothing left to do but copy.
+    #[test]
+    fn advance_shares_cover_the_sweep() {
+        let cols = grid(0.0, 0.05);
+        let mut bp = BroadPhase::new(DEFAULT_DELTA_PROX).unwrap();
+        bp.begin(&cols);
+        let mut swept = Vec::new();
+        for j in 0..9 {
+            bp.advance(10 - j);
+            swept.push(bp.next.unwrap());
+        }
+        // Nine even shares of the boxes, then the last sample sorts only.
+        let share = cols.len().div_ceil(9);
+        assert_eq!(swept[0], share);
+        assert_eq!(bp.next, Some(cols.len()));
+        assert!(!bp.sorted);
+        let pairs = bp.tested.len();
+        bp.advance(1);
+        assert!(bp.sorted && bp.order.len() == pairs && pairs > 0);
+        assert!(bp.order.windows(2).all(|w| w[0] < w[1]));
     }
 }

@@ -1,0 +1,101 @@
+//! `--settle SECONDS`: how a haptic2d scene comes to rest. Runs the selected cases for haptic2d only
+//! (optionally with law parameters overridden, `--set normal.bc=200`) and prints the settle state
+//! every `--every` seconds of simulated time: largest speed, bodies above 1 cm/s, mean height,
+//! largest overlap. Used to find why the pile keeps moving (docs/PERFORMANCE.md, issue 17).
+
+use haptic2d::world::World;
+
+use crate::state;
+use crate::timing::{now, Clock};
+
+/// Applies `law.key=value` overrides (`normal.bc=200`, `friction.beta=40`) to the prototypes of the
+/// world's laws (every contact created afterwards gets them), and `world.proximity_spread=0/1`.
+pub fn apply(w: &mut World, sets: &[String]) -> Result<(), String> {
+    for s in sets {
+        let (k, v) = s
+            .split_once('=')
+            .ok_or_else(|| format!("--set {s}: expected law.key=value, e.g. normal.bc=200"))?;
+        let v: f64 = v
+            .trim()
+            .parse()
+            .map_err(|e| format!("--set {s}: value: {e}"))?;
+        let r = match k.trim().split_once('.') {
+            Some(("normal", key)) => w.normal.set_param(key, v),
+            Some(("friction", key)) => w.friction.set_param(key, v),
+            _ => Err("expected normal.KEY or friction.KEY".into()),
+        };
+        r.map_err(|e| format!("--set {s}: {e}"))?;
+    }
+    Ok(())
+}
+
+/// One step through a function of its own, so a profiler can be limited to the steps after
+/// `--profile-after` (`valgrind --tool=callgrind --toggle-collect='*profiled_step*'`).
+#[inline(never)]
+pub fn profiled_step(w: &mut World) {
+    w.step();
+}
+
+/// Runs `w` for `seconds` of simulated time at `dt` (s), printing the state every `every` seconds;
+/// steps after `profile_after` (s) go through [`profiled_step`].
+pub fn run(label: &str, w: &mut World, dt: f64, seconds: f64, every: f64, profile_after: f64) {
+    let first_profiled = (profile_after / dt).round() as usize;
+    let steps = (seconds / dt).round() as usize;
+    let every = ((every / dt).round() as usize).max(1);
+    println!(
+        "{label}: t s | |v|max m/s | >1cm/s | mean y m | overlap mm | contacts | early | cpu µs/step"
+    );
+    let origin = std::time::Instant::now();
+    // CPU time of every step after `profile_after`, by sample phase of the global period.
+    let n_g = w.params.proximity_every.max(1) as usize;
+    let mut by_phase: Vec<Vec<f64>> = vec![Vec::new(); n_g];
+    let (mut cpu, mut since) = (0.0, 0usize);
+    for k in 1..=steps {
+        let t0 = now(Clock::Cpu, origin);
+        if k > first_profiled {
+            profiled_step(w);
+        } else {
+            w.step();
+        }
+        let dt_cpu = now(Clock::Cpu, origin) - t0;
+        cpu += dt_cpu;
+        if k > first_profiled {
+            by_phase[(k - 1) % n_g].push(dt_cpu * 1e6);
+        }
+        since += 1;
+        if k % every == 0 || k == steps {
+            let poses: Vec<_> = w
+                .bodies
+                .iter()
+                .map(|b| (b.pose.pos, b.pose.angle, b.vel))
+                .collect();
+            let s = state::of(w, &poses);
+            println!(
+                "{label}: {:6.2} | {:10.4} | {:6} | {:8.4} | {:10.3} | {:8} | {:5} | {:8.1}",
+                k as f64 * dt,
+                s.max_speed,
+                s.moving,
+                s.mean_height,
+                s.max_overlap * 1e3,
+                w.contacts().contact_count(),
+                w.continuous_stats().1,
+                cpu * 1e6 / since as f64
+            );
+            (cpu, since) = (0.0, 0);
+        }
+    }
+    if by_phase[0].is_empty() {
+        return;
+    }
+    let med: Vec<f64> = by_phase
+        .into_iter()
+        .map(|v| crate::timing::Samples(v).median())
+        .collect();
+    let all = med.iter().sum::<f64>() / med.len() as f64;
+    println!(
+        "{label}: CPU µs per step by sample mod {n_g} after {profile_after} s (global stage {}): {} (worst / mean of phases {:.2})",
+        if w.params.proximity_spread { "spread" } else { "whole at 0" },
+        med.iter().map(|m| format!("{m:.1}")).collect::<Vec<_>>().join(" "),
+        med.iter().fold(0.0f64, |a, &b| a.max(b)) / all
+    );
+}

@@ -1,0 +1,68 @@
+//! The global proximity stage spread over the samples of its period (`WorldParams::proximity_spread`,
+//! `collide/broad.rs`): the set in use from sample `(k+1)·N_g` is the set of the poses at `k·N_g`,
+//! and a world with the spread keeps the same contacts as one without it when nothing moves fast.
+
+use haptic2d::collide::{BroadPhase, DEFAULT_DELTA_PROX};
+use haptic2d::scene::builtin;
+
+/// The set published at sample 2·N_g is the whole stage's set for the poses at sample N_g.
+#[test]
+fn spread_set_is_the_whole_stage_set_one_period_earlier() {
+    let mut w = builtin("pile:100", Some(1000.0)).unwrap().unwrap().world;
+    assert!(w.params.proximity_spread, "spreading is the default");
+    let n_g = w.params.proximity_every as usize;
+    // While the pile falls (from 0.15 s: the set changes from period to period, without early updates).
+    const START: usize = 150;
+    for _ in 0..START {
+        w.step();
+    }
+    let early = w.continuous_stats().1;
+    let mut changes = 0;
+    for period in 0..8 {
+        assert_eq!(w.tick() as usize, START + period * n_g);
+        // The whole stage for the poses at this sample.
+        let mut whole = w.clone();
+        whole.params.proximity_spread = false;
+        whole.begin_step(); // world features at these poses, and the whole stage
+        let mut expected = Vec::new();
+        BroadPhase::new(DEFAULT_DELTA_PROX)
+            .unwrap()
+            .update(&whole.colliders, &mut expected);
+        assert_eq!(whole.proximate_pairs(), &expected[..]);
+        assert!(expected.len() > 100, "{} pairs", expected.len());
+        // One period later the spread world publishes exactly that set.
+        for _ in 0..n_g {
+            w.step();
+        }
+        let mut next = w.clone();
+        next.begin_step();
+        assert_eq!(next.continuous_stats().1, early, "no early update");
+        assert_eq!(next.proximate_pairs(), &expected[..], "period {period}");
+        let mut now = Vec::new();
+        BroadPhase::new(DEFAULT_DELTA_PROX)
+            .unwrap()
+            .update(&next.colliders, &mut now);
+        changes += (now != expected) as usize;
+    }
+    assert!(
+        changes > 0,
+        "the set never changed: the test would not see a wrong delay"
+    );
+}
+
+/// With spreading on and off, pile:100 falls and comes to the same state (the pairs a spread update
+/// adds a period later are never in contact yet, so the contacts and forces are the same).
+#[test]
+fn spread_and_whole_stage_give_the_same_pile() {
+    let mut a = builtin("pile:100", Some(1000.0)).unwrap().unwrap().world;
+    let mut b = a.clone();
+    b.params.proximity_spread = false;
+    for _ in 0..1500 {
+        a.step();
+        b.step();
+    }
+    for (x, y) in a.bodies.iter().zip(&b.bodies) {
+        assert_eq!(x.pose.pos, y.pose.pos, "{}", x.name);
+        assert_eq!(x.vel, y.vel, "{}", x.name);
+    }
+}
