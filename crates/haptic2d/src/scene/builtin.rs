@@ -43,11 +43,29 @@ pub fn builtin(name: &str, rate: Option<f64>) -> Option<Result<Scene, SceneError
     Some(Scene::from_toml(text, &format!("built-in:{name}"), rate))
 }
 
-/// The pile scene's TOML with `n` boxes (at most 25 per row).
+/// The pile scene's TOML with `n` boxes (at most 25 per row). The container's walls (3 m in
+/// `scenes/pile.toml`, above the 40 rows of 1000 boxes) are raised to 0.2 m above the top row when
+/// the rows reach higher (0.03 m + 0.056 m a row): pile:5000's 200 rows start up to 11.2 m high,
+/// and with 3 m walls the upper rows fell out of the container.
 pub fn pile_toml(n: usize) -> String {
     let text = BUILTIN[3].2;
     let columns = n.clamp(1, 25);
-    text.replace("count = 1000", &format!("count = {n}"))
+    let rows = n.div_ceil(columns);
+    let top = 0.03 + rows as f64 * 0.056 + 0.2;
+    let mut t = text
+        .replace("count = 1000", &format!("count = {n}"))
         .replace("columns = 25", &format!("columns = {columns}"))
-        .replace("name = \"pile\"", &format!("name = \"pile:{n}\""))
+        .replace("name = \"pile\"", &format!("name = \"pile:{n}\""));
+    if top > 3.0 {
+        t = t
+            .replace(
+                "[0.0, 3.0], [-0.1, 3.0]",
+                &format!("[0.0, {top}], [-0.1, {top}]"),
+            )
+            .replace(
+                "[1.5, 3.0], [1.4, 3.0]",
+                &format!("[1.5, {top}], [1.4, {top}]"),
+            );
+    }
+    t
 }
