@@ -484,8 +484,13 @@ impl Rig {
 
     /// Moves the hand target to the world pose `world` (m, m, rad), clamped to the device workspace
     /// square. Returns the target actually set, in world coordinates, or `None` (nothing done) when
-    /// no hand follows a target.
-    pub fn set_hand_target(&self, world: V3) -> Option<V3> {
+    /// no hand follows a target. On a 2-DOF device (the real hand moves x and y) only the angle is
+    /// used: it becomes the twist target of the slave's virtual torsion spring (the wheel / Q–E).
+    pub fn set_hand_target(&mut self, world: V3) -> Option<V3> {
+        if let RigSystem::TwoDof(s) = &mut self.system {
+            s.set_twist_target(Some(world[2]));
+            return Some(self.hand_target_world());
+        }
         let t = self.target.as_ref()?;
         let map = self.system.twin()?.map();
         let p = &self.config.device;
@@ -500,8 +505,13 @@ impl Rig {
     /// The hand target in world coordinates (m, m, rad), or, when no hand follows a target, where
     /// the handle is.
     pub fn hand_target_world(&self) -> V3 {
-        match (&self.target, self.system.twin()) {
-            (Some(t), Some(s)) => s.map().pose_to_world(&t.get()),
+        match (&self.target, &self.system) {
+            (Some(t), RigSystem::Twin(s)) => s.map().pose_to_world(&t.get()),
+            // 2-DOF: the handle's x and y, and the twist target (else the slave's angle).
+            (_, RigSystem::TwoDof(s)) => {
+                let h = self.system.handle_world();
+                [h[0], h[1], s.twist_target().unwrap_or(h[2])]
+            }
             _ => self.system.handle_world(),
         }
     }
@@ -768,6 +778,17 @@ mod tests {
         assert_eq!(out.torques, [0.0; 4]);
         assert!(rig.twin_params().is_none() && rig.system.twin_kinematics().is_none());
         assert!(rig.target.is_none());
+        // The page's wheel / Q–E: only the angle is used, as the slave's twist target.
+        let set = rig
+            .set_hand_target([9.0, 9.0, 0.3])
+            .expect("a 2-DOF rig takes the angle");
+        assert_eq!(set[2], 0.3);
+        assert_ne!(set[0], 9.0, "x and y stay the handle's");
+        match &rig.system {
+            RigSystem::TwoDof(s) => assert_eq!(s.twist_target(), Some(0.3)),
+            _ => unreachable!(),
+        }
+        assert_eq!(rig.hand_target_world()[2], 0.3);
         // A rebuild (the page's reset) keeps the device and starts a fresh 2-DOF system.
         let world = builtin("box-in-walls", Some(1000.0))
             .unwrap()

@@ -17,6 +17,16 @@
 //! 11.  record
 //! ```
 //!
+//! **Twist target** (the display's wheel / Q–E): a 2-DOF device cannot turn the body, so the page
+//! may set a target angle `θ_t` for a virtual torsion spring-damper on the slave,
+//! `τ_t = K_t·(θ_t − θ) − B_t·ω`, world side only (no motor torque). It is sized from the slave's
+//! inertia `I` as a critically damped 5 Hz mode, `K_t = I·ω_n²`, `B_t = 2·I·ω_n` (`ω_n = 2π·5`
+//! rad/s): its explicit damping number `B_t·T/I = 2·ω_n·T` is 0.063 at 1 kHz, far below the
+//! semi-implicit limit of 2. With a fixed target it is a passive spring-damper (its stored energy
+//! `½·K_t·(θ_t − θ)²` plus the body's kinetic energy never rises); moving the target is work done by
+//! the page, which the ledger books as applied work like any drive. Off (`None`) until the page sets
+//! a target; dropped while the safety latch holds.
+//!
 //! There is no hand-wrench observer on a 2DIY (no model of its dynamics): `f_h = 0` is given to the
 //! controller, so the four-channel controller runs without its C2 channel. The device↔world mapping is
 //! a translation set at the **first measured handle position** (the slave starts aligned with the
@@ -33,6 +43,9 @@ use crate::world::World;
 use super::config::ControllerKind;
 use super::record::{TickRecord, FLAG_NEAR_SINGULAR, FLAG_SAFETY, FLAG_SATURATED};
 use super::safety::{Safety, SafetyConfig, SafetyReason, SafetyTrip};
+
+/// Natural frequency of the twist target's torsion spring on the slave (Hz), critically damped.
+pub const TWIST_TARGET_HZ: f64 = 5.0;
 
 /// Settings of a [`Planar2System`].
 #[derive(Clone, Debug, PartialEq)]
@@ -114,6 +127,10 @@ pub struct Planar2System {
     ramp_len: u64,
     /// True once a tick has read the device (the stall check needs a previous tick).
     started: bool,
+    /// The page's twist target `θ_t` (rad), `None` = off (see the module doc).
+    twist_target: Option<f64>,
+    /// Torsion stiffness `K_t` (N·m/rad) and damping `B_t` (N·m·s/rad) of the twist target.
+    twist_gains: (f64, f64),
     dt: f64,
     record: TickRecord,
 }
@@ -163,6 +180,8 @@ impl Planar2System {
             }
         };
         let world_origin = grasp_world(&world, slave, config.grasp);
+        let wn = 2.0 * std::f64::consts::PI * TWIST_TARGET_HZ;
+        let twist_gains = (body.inertia * wn * wn, 2.0 * body.inertia * wn);
         if !config.keep_slave_loads {
             world.loads.retain(|l| l.body != slave);
         }
@@ -178,6 +197,8 @@ impl Planar2System {
             ramp_len: (config.safety.ramp_time / dt).round() as u64,
             ramp_ticks: 0,
             started: false,
+            twist_target: None,
+            twist_gains,
             config,
             controller,
             world,
@@ -187,6 +208,22 @@ impl Planar2System {
             dt,
             record: TickRecord::default(),
         })
+    }
+
+    /// Sets the twist target `θ_t` (rad, unwrapped like the body's angle), or turns it off (`None`);
+    /// a non-finite angle turns it off.
+    pub fn set_twist_target(&mut self, theta: Option<f64>) {
+        self.twist_target = theta.filter(|t| t.is_finite());
+    }
+
+    /// The twist target (rad), `None` when off.
+    pub fn twist_target(&self) -> Option<f64> {
+        self.twist_target
+    }
+
+    /// Torsion stiffness `K_t` (N·m/rad) and damping `B_t` (N·m·s/rad) of the twist target.
+    pub fn twist_gains(&self) -> (f64, f64) {
+        self.twist_gains
     }
 
     /// One sample taken on time (one period after the previous one): see [`Self::tick_elapsed`].
@@ -302,9 +339,17 @@ impl Planar2System {
             self.ramp_ticks = self.ramp_ticks.saturating_add(1);
         }
 
-        // 10. Slave drive at the grasp point, integration.
+        // 10. Slave drive at the grasp point (plus the twist target's torsion spring-damper, world
+        // side only), integration.
         let f = Vec2::new(f_cs[0], f_cs[1]);
-        self.world.set_drive(self.slave, f, cross(r, f));
+        let twist = match self.twist_target {
+            Some(th) if !self.safety.is_latched() => {
+                let (k, b) = self.twist_gains;
+                k * (th - theta) - b * omega
+            }
+            _ => 0.0,
+        };
+        self.world.set_drive(self.slave, f, cross(r, f) + twist);
         self.world.finish_step();
 
         // 11. Record.
