@@ -26,7 +26,9 @@ pub enum RunLogger {
 pub fn scene_text(arg: &str) -> String {
     let p = Path::new(arg);
     if p.exists() {
-        if let Ok(t) = std::fs::read_to_string(p) {
+        if let Ok(t) =
+            crate::scene_arg::read_bounded(p, haptic2d::scene::MAX_FILE_BYTES, "scene file")
+        {
             return t;
         }
     }
@@ -57,7 +59,8 @@ pub fn scene_strings(
         m.insert("device_file".into(), d.display().to_string());
         m.insert(
             "device_toml".into(),
-            std::fs::read_to_string(d).unwrap_or_default(),
+            crate::scene_arg::read_bounded(d, haptic2d::scene::MAX_FILE_BYTES, "device file")
+                .unwrap_or_default(),
         );
     }
     for (k, v) in settings {

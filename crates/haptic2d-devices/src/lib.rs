@@ -7,5 +7,6 @@
 //!   (docs/DEVICE-PROTOCOL.md).
 #![warn(missing_docs)]
 
+pub mod file_read;
 pub mod haply;
 pub mod udp;

@@ -106,3 +106,17 @@ fn wrong_motor_count_is_refused() {
     let e = err(&GOOD[..two]);
     assert!(e.contains("exactly 2"), "{e}");
 }
+
+/// Device files were read with no size cap (scene files have 16 MiB since issue 10):
+/// `--device-file /dev/zero` would read until memory ran out. Both kinds now stop at the cap.
+#[test]
+fn device_files_are_read_with_the_scene_file_cap() {
+    let zero = std::path::Path::new("/dev/zero");
+    if !zero.exists() {
+        return;
+    }
+    let e = haptic2d_devices::haply::HaplyDeviceFile::from_path(zero).unwrap_err();
+    assert!(e.contains("larger than the cap"), "{e}");
+    let e = haptic2d_devices::udp::UdpDeviceFile::from_path(zero).unwrap_err();
+    assert!(e.contains("larger than the cap"), "{e}");
+}

@@ -138,8 +138,7 @@ impl PyWorld {
         check_rate(rate)?;
         let path = Path::new(name_or_path);
         if path.exists() {
-            let text = std::fs::read_to_string(path)
-                .map_err(|e| value_error(format!("cannot read scene file {name_or_path}: {e}")))?;
+            let text = read_scene_file(path).map_err(value_error)?;
             return Scene::from_toml(&text, name_or_path, rate)
                 .map(Self::from_scene)
                 .map_err(|e| scene_error(py, &e));
@@ -422,4 +421,25 @@ impl PyWorld {
             self.world.params.dt
         )
     }
+}
+
+/// The scene file at `path`, at most `MAX_FILE_BYTES` (16 MiB, the CLI's cap), so
+/// `World.load("/dev/zero")` is a clear `ValueError`, not a hang.
+fn read_scene_file(path: &Path) -> Result<String, String> {
+    use std::io::Read;
+    let max = haptic2d::scene::MAX_FILE_BYTES;
+    let shown = path.display();
+    let file =
+        std::fs::File::open(path).map_err(|e| format!("cannot read scene file {shown}: {e}"))?;
+    let mut bytes = Vec::new();
+    file.take(max + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| format!("cannot read scene file {shown}: {e}"))?;
+    if bytes.len() as u64 > max {
+        return Err(format!(
+            "scene file {shown} is larger than the cap of {max} bytes ({} MiB)",
+            max >> 20
+        ));
+    }
+    String::from_utf8(bytes).map_err(|e| format!("scene file {shown} is not UTF-8 text ({e})"))
 }

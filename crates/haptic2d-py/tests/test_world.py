@@ -186,3 +186,9 @@ def test_impact_friction_coulomb_brakes_a_sliding_landing():
             '[world]\nrate = 1000\n[contact]\nimpact_friction = "sticky"\n'
             '[[body]]\nname = "b"\nbox = [0.1, 0.1]\nmass = 1.0\nposition = [0.0, 0.0]\n'
         )
+
+
+def test_load_refuses_a_scene_file_above_the_cap():
+    # Scene files are read with the CLI's 16 MiB cap: /dev/zero used to be read until memory ran out.
+    with pytest.raises(ValueError, match="larger than the cap"):
+        World.load("/dev/zero")

@@ -200,9 +200,10 @@ impl HaplyDeviceFile {
     /// Reads and parses the file at `path`.
     pub fn from_path(path: &std::path::Path) -> Result<Self, String> {
         let name = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| {
-            format!("cannot read device file {name}: {e}\n    fix: give the path of a Haply device file, e.g. {HAPLY_TEMPLATE}")
-        })?;
+        let text = crate::file_read::read_device_file(
+            path,
+            &format!("give the path of a Haply device file, e.g. {HAPLY_TEMPLATE}"),
+        )?;
         Self::from_toml(&text, &format!("device file {name}")).map_err(|e| e.to_string())
     }
 
