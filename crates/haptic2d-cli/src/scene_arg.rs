@@ -1,7 +1,6 @@
 //! Resolves a SCENE argument: a file path, or a built-in scene name.
 
 use haptic2d::scene::{builtin, builtin_names, Scene, MAX_FILE_BYTES, MAX_RATE_HZ};
-use std::io::Read;
 use std::path::Path;
 
 /// Loads the scene named by `arg` (path or built-in), with an optional rate override (Hz). Bodies
@@ -67,22 +66,5 @@ fn load_unchecked(arg: &str, rate: Option<f64>) -> Result<Scene, String> {
     ))
 }
 
-/// Reads the UTF-8 text file at `path` (`what` names it in messages, e.g. "scene file"), refusing
-/// more than `max` bytes: a device such as /dev/zero or a huge file is an error, not an unbounded
-/// read; at most `max + 1` bytes are ever read.
-pub fn read_bounded(path: &Path, max: u64, what: &str) -> Result<String, String> {
-    let shown = path.display();
-    let file = std::fs::File::open(path).map_err(|e| format!("cannot read {what} {shown}: {e}"))?;
-    let mut bytes = Vec::new();
-    file.take(max + 1)
-        .read_to_end(&mut bytes)
-        .map_err(|e| format!("cannot read {what} {shown}: {e}"))?;
-    if bytes.len() as u64 > max {
-        return Err(format!(
-            "{what} {shown} is larger than the documented cap of {max} bytes ({} MiB)\n    fix: give a TOML {what} (scene piles are built with [[grid]] tables)",
-            max >> 20
-        ));
-    }
-    String::from_utf8(bytes)
-        .map_err(|e| format!("{what} {shown} is not UTF-8 text ({e})\n    fix: give a TOML {what}"))
-}
+/// The capped text-file read of every input file (shared with the device drivers' files).
+pub use haptic2d_devices::file_read::read_bounded;

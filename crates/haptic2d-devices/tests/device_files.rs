@@ -116,7 +116,7 @@ fn device_files_are_read_with_the_scene_file_cap() {
         return;
     }
     let e = haptic2d_devices::haply::HaplyDeviceFile::from_path(zero).unwrap_err();
-    assert!(e.contains("larger than the cap"), "{e}");
+    assert!(e.contains("larger than the documented cap"), "{e}");
     let e = haptic2d_devices::udp::UdpDeviceFile::from_path(zero).unwrap_err();
-    assert!(e.contains("larger than the cap"), "{e}");
+    assert!(e.contains("larger than the documented cap"), "{e}");
 }

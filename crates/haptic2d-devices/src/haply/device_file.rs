@@ -30,6 +30,7 @@ use haptic2d::device::pantograph2::Pantograph2;
 use haptic2d::device::DeviceParams;
 use haptic2d::geom::Vec2;
 use haptic2d::haptic::ControllerKind;
+use haptic2d::scene::MAX_FILE_BYTES;
 use haptic2d::scene::{device_params_from_toml, SceneError, SceneErrors};
 use serde::Deserialize;
 
@@ -200,10 +201,10 @@ impl HaplyDeviceFile {
     /// Reads and parses the file at `path`.
     pub fn from_path(path: &std::path::Path) -> Result<Self, String> {
         let name = path.display().to_string();
-        let text = crate::file_read::read_device_file(
-            path,
-            &format!("give the path of a Haply device file, e.g. {HAPLY_TEMPLATE}"),
-        )?;
+        let text =
+            crate::file_read::read_bounded(path, MAX_FILE_BYTES, "device file").map_err(|e| {
+                format!("{e}\n    fix: give the path of a Haply device file, e.g. {HAPLY_TEMPLATE}")
+            })?;
         Self::from_toml(&text, &format!("device file {name}")).map_err(|e| e.to_string())
     }
 

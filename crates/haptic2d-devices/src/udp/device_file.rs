@@ -25,6 +25,7 @@
 //! pantograph system, so both ends of a pose/wrench device meet in joint space.
 
 use haptic2d::device::pantograph2::Pantograph2;
+use haptic2d::scene::MAX_FILE_BYTES;
 use haptic2d::scene::{SceneError, SceneErrors};
 use serde::Deserialize;
 
@@ -143,10 +144,10 @@ impl UdpDeviceFile {
     /// Reads and parses the file at `path`.
     pub fn from_path(path: &std::path::Path) -> Result<Self, String> {
         let name = path.display().to_string();
-        let text = crate::file_read::read_device_file(
-            path,
-            &format!("give the path of a UDP device file, e.g. {UDP_TEMPLATE}"),
-        )?;
+        let text =
+            crate::file_read::read_bounded(path, MAX_FILE_BYTES, "device file").map_err(|e| {
+                format!("{e}\n    fix: give the path of a UDP device file, e.g. {UDP_TEMPLATE}")
+            })?;
         Self::from_toml(&text, &format!("device file {name}")).map_err(|e| e.to_string())
     }
 
