@@ -279,10 +279,20 @@ impl Server {
                 }
                 Ok(Message::Close(_)) => break false,
                 Ok(_) => {}
-                Err(tungstenite::Error::Io(e)) if e.kind() == ErrorKind::WouldBlock => {
+                // Interrupted (a signal, or SIGSTOP/SIGCONT): nothing lost, try again next round.
+                Err(tungstenite::Error::Io(e))
+                    if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::Interrupted) =>
+                {
                     break match c.ws.flush() {
                         Ok(()) => true,
-                        Err(tungstenite::Error::Io(e)) if e.kind() == ErrorKind::WouldBlock => true,
+                        Err(tungstenite::Error::Io(e))
+                            if matches!(
+                                e.kind(),
+                                ErrorKind::WouldBlock | ErrorKind::Interrupted
+                            ) =>
+                        {
+                            true
+                        }
                         Err(_) => false,
                     };
                 }
@@ -332,7 +342,11 @@ impl Server {
                     buf[1..5].copy_from_slice(&sub.to_le_bytes());
                     match c.ws.send(Message::binary(buf.clone())) {
                         Ok(()) => {}
-                        Err(tungstenite::Error::Io(e)) if e.kind() == ErrorKind::WouldBlock => {}
+                        Err(tungstenite::Error::Io(e))
+                            if matches!(
+                                e.kind(),
+                                ErrorKind::WouldBlock | ErrorKind::Interrupted
+                            ) => {}
                         Err(_) => return false, // closed, or its buffer is full: too slow
                     }
                 }

@@ -199,7 +199,14 @@ fn wait_for(
     let end = std::time::Instant::now() + std::time::Duration::from_secs_f64(secs);
     let mut last = serde_json::Value::Null;
     while std::time::Instant::now() < end {
-        let msg = ws.read().expect("a message");
+        let msg = match ws.read() {
+            Ok(m) => m,
+            // SIGSTOP/SIGCONT (CI suspends its machines) interrupts a read with a timeout.
+            Err(tungstenite::Error::Io(e)) if e.kind() == std::io::ErrorKind::Interrupted => {
+                continue
+            }
+            Err(e) => panic!("a message: {e:?}"),
+        };
         let tungstenite::Message::Text(t) = msg else {
             continue;
         };

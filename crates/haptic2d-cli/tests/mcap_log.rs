@@ -336,7 +336,7 @@ fn foxglove_live_server_serves_a_loopback_client_and_survives_a_malformed_messag
         "foxglove.websocket.v1"
     );
     let text_msg = |ws: &mut tungstenite::WebSocket<std::net::TcpStream>| loop {
-        if let Message::Text(t) = ws.read().unwrap() {
+        if let Message::Text(t) = read_retrying(ws) {
             break serde_json::from_str::<serde_json::Value>(t.as_str()).unwrap();
         }
     };
@@ -361,7 +361,7 @@ fn foxglove_live_server_serves_a_loopback_client_and_survives_a_malformed_messag
     .unwrap();
     let mut indices = Vec::new();
     while indices.len() < 10 {
-        if let Message::Binary(b) = ws.read().unwrap() {
+        if let Message::Binary(b) = read_retrying(&mut ws) {
             assert_eq!(b[0], 1, "message data opcode");
             assert_eq!(u32::from_le_bytes(b[1..5].try_into().unwrap()), 7);
             let v: serde_json::Value = serde_json::from_slice(&b[13..]).unwrap();
@@ -530,4 +530,16 @@ fn mcap_to_csv_writes_the_bodies_contacts_and_energy_channels_next_to_the_tick_c
         Some("bodies"),
     );
     check_world_csv(&w, &dir.path().join("pile.energy.csv"), TOPIC_ENERGY, None);
+}
+
+/// The next WebSocket message; a read interrupted by SIGSTOP/SIGCONT (CI suspends its machines,
+/// and a socket with a read timeout then fails with EINTR) is retried.
+fn read_retrying(ws: &mut tungstenite::WebSocket<std::net::TcpStream>) -> tungstenite::Message {
+    loop {
+        match ws.read() {
+            Ok(m) => return m,
+            Err(tungstenite::Error::Io(e)) if e.kind() == std::io::ErrorKind::Interrupted => {}
+            Err(e) => panic!("a WebSocket message: {e:?}"),
+        }
+    }
 }

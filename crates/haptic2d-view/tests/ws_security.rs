@@ -231,9 +231,11 @@ fn time_to_close(s: &mut std::net::TcpStream, limit: Duration) -> Option<Duratio
         match s.read(&mut buf) {
             Ok(0) => return Some(t0.elapsed()),
             Ok(_) => {}
+            // Interrupted: SIGSTOP/SIGCONT on a socket with a read timeout (CI suspends machines).
             Err(e)
                 if e.kind() == std::io::ErrorKind::WouldBlock
-                    || e.kind() == std::io::ErrorKind::TimedOut => {}
+                    || e.kind() == std::io::ErrorKind::TimedOut
+                    || e.kind() == std::io::ErrorKind::Interrupted => {}
             Err(_) => return Some(t0.elapsed()),
         }
     }

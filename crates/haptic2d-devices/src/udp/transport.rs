@@ -185,7 +185,13 @@ impl UdpTransport {
             self.socket.set_nonblocking(false)?;
             match self.socket.recv(&mut self.buf) {
                 Ok(n) => self.classify(n),
-                Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {}
+                // Interrupted: a signal, or SIGSTOP/SIGCONT (job control, a suspended VM) on a
+                // socket with a read timeout; the loop re-checks the deadline.
+                Err(e)
+                    if matches!(
+                        e.kind(),
+                        ErrorKind::WouldBlock | ErrorKind::TimedOut | ErrorKind::Interrupted
+                    ) => {}
                 Err(e) if e.kind() == ErrorKind::ConnectionRefused => {
                     self.counters.refused += 1;
                     // Nothing listens: do not spin on the error, wait out the deadline quietly.
@@ -199,7 +205,12 @@ impl UdpTransport {
     /// Receives one datagram if one is queued (non-blocking). Returns whether one was read.
     fn drain_one(&mut self) -> std::io::Result<bool> {
         self.socket.set_nonblocking(true)?;
-        let r = self.socket.recv(&mut self.buf);
+        let r = loop {
+            match self.socket.recv(&mut self.buf) {
+                Err(e) if e.kind() == ErrorKind::Interrupted => continue,
+                r => break r,
+            }
+        };
         self.socket.set_nonblocking(false)?;
         match r {
             Ok(n) => {
