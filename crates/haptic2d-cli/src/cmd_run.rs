@@ -11,7 +11,8 @@ use crate::run_rig::{DeviceChoice, DeviceModel, RealOpenError, Rig};
 use crate::run_view::{self, LiveView, LoadedScene};
 use crate::scene_arg;
 use haptic2d::control::passivity::PlanarPassivity;
-use haptic2d::haptic::{ControllerKind, HapticConfig};
+use haptic2d::device::DeviceFault;
+use haptic2d::haptic::{ControllerKind, HapticConfig, SafetyReason};
 use haptic2d::scene::MAX_RATE_HZ;
 use haptic2d_rt::mcap::{LoggedTick, McapSetup};
 use haptic2d_rt::signal::install_stop_signals;
@@ -528,7 +529,13 @@ fn report(
     );
     let system = &rig.system;
     if let Some(trip) = system.safety_trip() {
-        println!("{trip}");
+        // A lost device's last tick runs the system on NaN joints, so the latch trips too; its
+        // "non-finite device input" is the lost reading, not a second fault: not printed.
+        let lost_reading = matches!(end, Some(LoopEnd::DeviceLost(_)))
+            && matches!(trip.reason, SafetyReason::Device(DeviceFault::NonFinite));
+        if !lost_reading {
+            println!("{trip}");
+        }
     }
     let (status, why) = end_status(end.as_ref(), interrupted);
     if let Some(why) = why {
