@@ -52,6 +52,9 @@ pub struct RunArgs {
     pub passivity: bool,
     /// Simulated hand (simulated device only): follow | free | constant:FX,FY,TAU |
     /// sine:FPK,FREQ[,DIRX,DIRY] | script:HOLD,FX,FY,TAU,PUSH[,RFX,RFY,RTAU]. Default: follow.
+    /// constant and sine push from t = 0, while the torques still ramp in (0.5 s): on box-in-walls a
+    /// push of 2 N runs the handle past the workspace edge, a safety stop (exit 3); script waits
+    /// HOLD seconds first (e.g. script:0.6,-2,0,0,1).
     #[arg(long, allow_hyphen_values = true)]
     pub hand: Option<String>,
     /// Device: sim (simulated twin pantograph), replay:FILE.csv (recorded encoders q1..q4, rad),
