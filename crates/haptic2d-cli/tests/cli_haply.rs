@@ -79,6 +79,16 @@ fn unsafe_sigint(pid: u32) {
         .status();
 }
 
+/// `haptic2d run` on the emulated board at `pty` with device file `file`, headless, normal
+/// scheduling, for `duration` seconds; callers add their own options.
+fn haply_run(pty: &str, file: &Path, duration: &str) -> Command {
+    let mut c = Command::new(BIN);
+    c.args(["run", "--device", &format!("haply:{pty}"), "--device-file"])
+        .arg(file)
+        .args(["--headless", "--duration", duration, "--no-rt"]);
+    c
+}
+
 fn text(o: &Output) -> String {
     format!(
         "{}\n{}",
@@ -94,10 +104,8 @@ fn run_against_the_emulator_for_3_s_logs_and_exits_clean() {
     let file = device_file(dir.path(), "gen3.toml", |t| t);
     let (emu, pty) = emulate(&["--device-file", file.to_str().unwrap()]);
     let log = dir.path().join("x.csv");
-    let o = Command::new(BIN)
-        .args(["run", "--device", &format!("haply:{pty}"), "--device-file"])
-        .arg(&file)
-        .args(["--headless", "--duration", "3", "--no-rt", "--log"])
+    let o = haply_run(&pty, &file, "3")
+        .arg("--log")
         .arg(&log)
         .output()
         .unwrap();
@@ -118,10 +126,7 @@ fn emulator_killed_mid_run_exits_4_naming_the_device() {
     let dir = tempfile::tempdir().unwrap();
     let file = device_file(dir.path(), "gen3.toml", |t| t);
     let (mut emu, pty) = emulate(&["--device-file", file.to_str().unwrap()]);
-    let run = Command::new(BIN)
-        .args(["run", "--device", &format!("haply:{pty}"), "--device-file"])
-        .arg(&file)
-        .args(["--headless", "--duration", "20", "--no-rt"])
+    let run = haply_run(&pty, &file, "20")
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
@@ -274,10 +279,8 @@ fn haply_run_is_the_normal_loop_torques_start_at_zero_ramp_in_and_stay_clamped()
         "constant:0.5,0,0",
     ]);
     let log = dir.path().join("ramp.csv");
-    let o = Command::new(BIN)
-        .args(["run", "--device", &format!("haply:{pty}"), "--device-file"])
-        .arg(&file)
-        .args(["--headless", "--duration", "1.5", "--no-rt", "--log"])
+    let o = haply_run(&pty, &file, "1.5")
+        .arg("--log")
         .arg(&log)
         .output()
         .unwrap();
@@ -316,10 +319,7 @@ fn a_silent_emulated_device_exits_4_with_the_reason() {
     let dir = tempfile::tempdir().unwrap();
     let file = device_file(dir.path(), "gen3.toml", |t| t);
     let (mut emu, pty) = emulate(&["--device-file", file.to_str().unwrap()]);
-    let run = Command::new(BIN)
-        .args(["run", "--device", &format!("haply:{pty}"), "--device-file"])
-        .arg(&file)
-        .args(["--headless", "--duration", "20", "--no-rt"])
+    let run = haply_run(&pty, &file, "20")
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
@@ -364,10 +364,8 @@ fn twin_runs_through_the_normal_loop_against_the_emulator() {
         "constant:0.3,0,0",
     ]);
     let log = dir.path().join("twin.csv");
-    let o = Command::new(BIN)
-        .args(["run", "--device", &format!("haply:{pty}"), "--device-file"])
-        .arg(&file)
-        .args(["--headless", "--duration", "1.5", "--no-rt", "--log"])
+    let o = haply_run(&pty, &file, "1.5")
+        .arg("--log")
         .arg(&log)
         .output()
         .unwrap();
@@ -441,13 +439,11 @@ fn run_refuses_an_unstable_released_configuration_on_a_haply_board() {
     let file = device_file(dir.path(), "gen3.toml", |t| t);
     let (emu, pty) = emulate(&["--device-file", file.to_str().unwrap()]);
     let args = |extra: &[&str]| {
-        let mut c = Command::new(BIN);
-        c.args(["run", "--device", &format!("haply:{pty}"), "--device-file"])
-            .arg(&file)
-            .args(["--headless", "--duration", "0.5", "--no-rt"])
+        haply_run(&pty, &file, "0.5")
             .args(["--controller", "four-channel-spec"])
-            .args(extra);
-        c.output().unwrap()
+            .args(extra)
+            .output()
+            .unwrap()
     };
     let o = args(&[]);
     let out = text(&o);

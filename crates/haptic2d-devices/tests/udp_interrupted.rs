@@ -5,13 +5,15 @@
 //! The test provokes the same EINTR deterministically: a SIGUSR1 handler installed without
 //! `SA_RESTART`, sent to the thread that waits for the device's answer.
 
-use std::net::UdpSocket;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::thread;
 use std::time::{Duration, Instant};
 
-use haptic2d_devices::udp::codec::{Command, State, STATE_LEN};
 use haptic2d_devices::udp::UdpTransport;
+
+#[path = "support/udp_echo.rs"]
+mod udp_echo;
+use udp_echo::{spawn_echo_device, ECHO_POSITION};
 
 static SIGNALS: AtomicUsize = AtomicUsize::new(0);
 
@@ -34,32 +36,7 @@ fn install_interrupting_handler() {
 fn a_receive_interrupted_by_a_signal_is_retried_until_the_answer() {
     install_interrupting_handler();
     // The device answers each command 60 ms late.
-    let sock = UdpSocket::bind("127.0.0.1:0").unwrap();
-    let addr = sock.local_addr().unwrap();
-    thread::spawn(move || {
-        let mut buf = [0u8; 256];
-        let mut seq = 0;
-        while let Ok((n, peer)) = sock.recv_from(&mut buf) {
-            let Ok(c) = Command::decode(&buf[..n]) else {
-                continue;
-            };
-            thread::sleep(Duration::from_millis(60));
-            seq += 1;
-            let mut out = [0u8; STATE_LEN];
-            State {
-                seq,
-                echo_seq: c.seq,
-                status: 0,
-                device_time_ns: 0,
-                echo_host_ns: c.host_time_ns,
-                position: [1.9, 1.2, 0.0],
-                velocity: [0.0; 3],
-                force: [0.0; 3],
-            }
-            .encode(&mut out);
-            let _ = sock.send_to(&out, peer);
-        }
-    });
+    let addr = spawn_echo_device(Duration::from_millis(60));
 
     let mut t = UdpTransport::connect(addr).unwrap();
     // Signal this thread three times while it waits (10, 20, 30 ms into the wait).
@@ -87,6 +64,6 @@ fn a_receive_interrupted_by_a_signal_is_retried_until_the_answer() {
         3,
         "signals delivered"
     );
-    assert_eq!(t.latest().expect("a state").position, [1.9, 1.2, 0.0]);
+    assert_eq!(t.latest().expect("a state").position, ECHO_POSITION);
     assert_eq!(t.counters().timeouts, 0);
 }

@@ -3,14 +3,16 @@
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
-use std::net::UdpSocket;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::thread;
 use std::time::Duration;
 
-use haptic2d_devices::udp::codec::{Command, State, STATE_LEN};
 use haptic2d_devices::udp::{UdpDevice, UdpDeviceFile};
 use haptic2d_rt::DeviceIo;
+
+#[path = "support/udp_echo.rs"]
+mod udp_echo;
+use udp_echo::spawn_echo_device;
 
 struct Counting;
 
@@ -36,31 +38,7 @@ static A: Counting = Counting;
 
 #[test]
 fn the_exchange_allocates_nothing_once_open() {
-    let sock = UdpSocket::bind("127.0.0.1:0").unwrap();
-    let addr = sock.local_addr().unwrap();
-    thread::spawn(move || {
-        let mut buf = [0u8; 256];
-        let mut seq = 0;
-        while let Ok((n, peer)) = sock.recv_from(&mut buf) {
-            let Ok(c) = Command::decode(&buf[..n]) else {
-                continue;
-            };
-            seq += 1;
-            let mut out = [0u8; STATE_LEN];
-            State {
-                seq,
-                echo_seq: c.seq,
-                status: 0,
-                device_time_ns: 0,
-                echo_host_ns: c.host_time_ns,
-                position: [1.9, 1.2, 0.0],
-                velocity: [0.0; 3],
-                force: [0.0; 3],
-            }
-            .encode(&mut out);
-            let _ = sock.send_to(&out, peer);
-        }
-    });
+    let addr = spawn_echo_device(Duration::ZERO);
     let mut file = UdpDeviceFile::reference();
     file.timeout_periods = 100.0;
     let mut dev = UdpDevice::open(addr, &file, Duration::from_millis(1), "udp:alloc").unwrap();

@@ -1,0 +1,45 @@
+//! A minimal device on the UDP protocol for the driver's tests: answers every command with a fixed
+//! joint state that echoes the command's sequence number and host time.
+
+use std::net::{SocketAddr, UdpSocket};
+use std::thread;
+use std::time::Duration;
+
+use haptic2d_devices::udp::codec::{Command, State, STATE_LEN};
+
+/// The joint angles every answer carries (rad).
+pub const ECHO_POSITION: [f32; 3] = [1.9, 1.2, 0.0];
+
+/// Starts the device on a free loopback port, answering each command `delay` after it arrives, on
+/// its own thread (it ends with the test process). Returns its address.
+pub fn spawn_echo_device(delay: Duration) -> SocketAddr {
+    let sock = UdpSocket::bind("127.0.0.1:0").unwrap();
+    let addr = sock.local_addr().unwrap();
+    thread::spawn(move || {
+        let mut buf = [0u8; 256];
+        let mut seq = 0;
+        while let Ok((n, peer)) = sock.recv_from(&mut buf) {
+            let Ok(c) = Command::decode(&buf[..n]) else {
+                continue;
+            };
+            if !delay.is_zero() {
+                thread::sleep(delay);
+            }
+            seq += 1;
+            let mut out = [0u8; STATE_LEN];
+            State {
+                seq,
+                echo_seq: c.seq,
+                status: 0,
+                device_time_ns: 0,
+                echo_host_ns: c.host_time_ns,
+                position: ECHO_POSITION,
+                velocity: [0.0; 3],
+                force: [0.0; 3],
+            }
+            .encode(&mut out);
+            let _ = sock.send_to(&out, peer);
+        }
+    });
+    addr
+}
