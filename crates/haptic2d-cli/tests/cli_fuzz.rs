@@ -3,9 +3,10 @@
 //! timeout: no panic, no abort (death by a signal), no hang, and an exit status from the documented
 //! table. The arguments come from a fixed-seed generator, so every run spawns the same processes.
 
-use std::io::Read;
+mod common;
+
 use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 const NUMBERS: &[&str] = &[
     "nan",
@@ -51,36 +52,15 @@ impl Rng {
 
 /// Runs `args` with a 60 s deadline; returns the exit code, panicking on a signal, a panic or a hang.
 fn run(args: &[String]) -> i32 {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_haptic2d"))
+    let child = Command::new(env!("CARGO_BIN_EXE_haptic2d"))
         .args(args)
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    let t0 = Instant::now();
-    let status = loop {
-        if let Some(s) = child.try_wait().unwrap() {
-            break s;
-        }
-        if t0.elapsed() > Duration::from_secs(60) {
-            let _ = child.kill();
-            panic!("{args:?} hung (no exit within 60 s)");
-        }
-        std::thread::sleep(Duration::from_millis(10));
+    let Some((status, out)) = common::wait_with_limit(child, Duration::from_secs(60)) else {
+        panic!("{args:?} hung (no exit within 60 s)");
     };
-    let mut out = String::new();
-    child
-        .stdout
-        .take()
-        .unwrap()
-        .read_to_string(&mut out)
-        .unwrap();
-    child
-        .stderr
-        .take()
-        .unwrap()
-        .read_to_string(&mut out)
-        .unwrap();
     assert!(!out.contains("panicked"), "{args:?} panicked:\n{out}");
     let code = status
         .code()

@@ -2,7 +2,8 @@
 //! every log ending on a whole row, exit status 130 (interrupted). Signals are sent with
 //! `libc::kill` to the spawned binary.
 
-use std::io::Read;
+mod common;
+
 use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
@@ -32,34 +33,13 @@ fn wait_for_file(path: &Path, bytes: u64, child: &mut Child) {
 }
 
 /// Sends `sig`, waits (at most 30 s: no hang) and returns (exit code, stdout + stderr).
-fn signal_and_wait(mut child: Child, sig: libc::c_int) -> (Option<i32>, String) {
+fn signal_and_wait(child: Child, sig: libc::c_int) -> (Option<i32>, String) {
     let pid = child.id() as libc::pid_t;
     // SAFETY: kill(2) on the pid of a child we spawned and have not reaped.
     assert_eq!(unsafe { libc::kill(pid, sig) }, 0);
-    let t0 = Instant::now();
-    let status = loop {
-        if let Some(s) = child.try_wait().unwrap() {
-            break s;
-        }
-        if t0.elapsed() > Duration::from_secs(30) {
-            let _ = child.kill();
-            panic!("did not exit within 30 s of the signal");
-        }
-        std::thread::sleep(Duration::from_millis(10));
+    let Some((status, out)) = common::wait_with_limit(child, Duration::from_secs(30)) else {
+        panic!("did not exit within 30 s of the signal");
     };
-    let mut out = String::new();
-    child
-        .stdout
-        .take()
-        .unwrap()
-        .read_to_string(&mut out)
-        .unwrap();
-    child
-        .stderr
-        .take()
-        .unwrap()
-        .read_to_string(&mut out)
-        .unwrap();
     (status.code(), out)
 }
 
