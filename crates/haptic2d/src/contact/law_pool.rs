@@ -3,7 +3,7 @@
 
 use super::record::{LawState, NO_LAW};
 use crate::laws::friction::FrictionModel;
-use crate::laws::normal::NormalModel;
+use crate::laws::normal::{ContactNormal, NormalModel};
 
 /// Slots of law states, addressed by [`VeContact::law`](super::VeContact::law).
 #[derive(Clone, Debug, Default)]
@@ -26,7 +26,7 @@ impl LawPool {
     /// A slot holding copies of the prototypes `normal` and `friction`.
     pub(crate) fn acquire(&mut self, normal: &NormalModel, friction: &FrictionModel) -> u32 {
         let fresh = LawState {
-            normal: *normal,
+            normal: ContactNormal::new(*normal),
             friction: *friction,
         };
         match self.free.pop() {

@@ -25,6 +25,12 @@ pub struct ContactParams {
     pub impact_friction: super::ImpactFriction,
     /// Impact friction coefficient `μ` (dimensionless); `None` = the contact friction model's `μ_k`.
     pub impact_mu: Option<f64>,
+    /// Whether a resolved impact's record starts its normal law at the depth found at detection
+    /// (issue 16, docs/MODELS.md §F.7): `false` (default) is §7.2 step 4, the §5.9 law acts on the
+    /// whole remaining penetration from the impact sample on; `true` moves the law's surface in to
+    /// the depth gained in the detection sample and restarts its SEH history, so the rebound is the
+    /// restitution law's alone ([`ContactNormal`](crate::laws::normal::ContactNormal)).
+    pub impact_surface_offset: bool,
 }
 
 impl Default for ContactParams {
@@ -40,6 +46,7 @@ impl Default for ContactParams {
             eps_v: 1e-6,
             impact_friction: super::ImpactFriction::None,
             impact_mu: None,
+            impact_surface_offset: false,
         }
     }
 }

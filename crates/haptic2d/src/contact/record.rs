@@ -1,14 +1,14 @@
 //! The per-VE-pair record (§8.1): distance history, edge coordinate, god-object, and the slot of
 //! its law states.
 //!
-//! The law states ([`LawState`]: a [`NormalModel`] and a [`FrictionModel`], about 270 bytes) live out
+//! The law states ([`LawState`]: a [`NormalModel`](crate::laws::normal::NormalModel) and a [`FrictionModel`], about 270 bytes) live out
 //! of line in the contact set's pool, so the record that every per-sample pass walks stays small
 //! (the tracked pairs that are not contacts, the majority on a pile, need no law state at all).
 
 use crate::collide::VeCandidate;
 use crate::geom::Vec2;
 use crate::laws::friction::{FrictionLaw, FrictionModel};
-use crate::laws::normal::{NormalLaw, NormalModel};
+use crate::laws::normal::{ContactNormal, NormalLaw};
 
 /// Sentinel of [`VeContact::law`] for an entry without law states (only tracked).
 pub const NO_LAW: u32 = u32::MAX;
@@ -16,8 +16,9 @@ pub const NO_LAW: u32 = u32::MAX;
 /// The per-contact states of the normal law and the friction model of one contact record.
 #[derive(Clone, Copy, Debug)]
 pub struct LawState {
-    /// Normal-law state (a copy of the world's prototype, taken when the record was created).
-    pub normal: NormalModel,
+    /// Normal-law state (a copy of the world's prototype, taken when the record was created) with
+    /// the surface offset of a resolved impact ([`ContactNormal`], docs/MODELS.md §F.7).
+    pub normal: ContactNormal,
     /// Friction-model state (a copy of the world's prototype, taken when the record was created).
     pub friction: FrictionModel,
 }

@@ -318,6 +318,9 @@ pub(super) fn build(
             );
         }
     }
+    if let Some(on) = c.impact_surface_offset {
+        cp.impact_surface_offset = on;
+    }
     params.contact = cp;
 
     // [device]

@@ -79,6 +79,9 @@ pub struct ContactSection {
     pub impact_friction: Option<String>,
     /// Impact friction coefficient μ (dimensionless, ≥ 0); default the friction model's μ_k.
     pub impact_mu: Option<f64>,
+    /// Impact records start their normal law at the detection depth (default false, §7.2 step 4;
+    /// docs/MODELS.md §F.7).
+    pub impact_surface_offset: Option<bool>,
 }
 
 /// `[[body]]`.

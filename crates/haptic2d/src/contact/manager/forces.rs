@@ -67,21 +67,29 @@ impl ContactSet {
         self.record_count = records;
     }
 
-    /// `F_ext,t,i = (t·F_A^nonfric)/n_t` for the classical model (§4.1): the non-friction force on A
-    /// along this contact's tangent, shared by A's contacts with parallel tangents.
+    /// `F_ext,t,i` for the classical model (§4.1): the non-friction force on A along this
+    /// contact's tangent, shared by A's contacts with parallel tangents in proportion to their
+    /// normal forces, `(t·F_A^nonfric)·F_n,i/Σ F_n,j` (equally, `/n_t`, if none pushes). Each
+    /// contact then sticks iff `|t·F_A^nonfric| ≤ μ_s·Σ F_n,j`, rigid Coulomb's condition for the
+    /// body; the equal share let the unloaded corner of a tall block slip below it (issue 16,
+    /// docs/MODELS.md §4.1).
     fn external_share(&self, idx: usize) -> f64 {
         let e = &self.entries[idx];
-        let n_t = self
-            .entries
-            .iter()
-            .filter(|o| {
-                o.state == Some(ContactState::Continuous)
-                    && o.body_a == e.body_a
-                    && o.t.dot(e.t).abs() > 0.99
-            })
-            .count()
-            .max(1);
-        e.t.dot(self.nonfric[e.body_a]) / n_t as f64
+        let (mut n_t, mut fn_sum) = (0usize, 0.0);
+        for o in self.entries.iter().filter(|o| {
+            o.state == Some(ContactState::Continuous)
+                && o.body_a == e.body_a
+                && o.t.dot(e.t).abs() > 0.99
+        }) {
+            n_t += 1;
+            fn_sum += o.f_n;
+        }
+        let demand = e.t.dot(self.nonfric[e.body_a]);
+        if fn_sum > 0.0 {
+            demand * (e.f_n / fn_sum)
+        } else {
+            demand / n_t.max(1) as f64
+        }
     }
 }
 

@@ -15,6 +15,7 @@
 
 mod colgate;
 mod hysteretic;
+mod impact_offset;
 mod massie;
 mod minsky;
 mod paper;
@@ -24,6 +25,7 @@ mod zoh;
 
 pub use colgate::{colgate_margin, ColgateLaw};
 pub use hysteretic::{HystereticLaw, SlideElement, BLOCK_STICK_SPEED, MAX_ELEMENTS};
+pub use impact_offset::ContactNormal;
 pub use massie::MassiePiLaw;
 pub use minsky::MinskyLaw;
 pub use paper::PaperLaw;
