@@ -196,3 +196,23 @@ fn no_service_is_a_clear_error_at_open() {
     assert!(e.contains("haptic2d emulate inverse3"), "{e}");
     assert!(e.contains(&format!("ws://127.0.0.1:{port}/")), "{e}");
 }
+
+#[test]
+fn the_versegrip_orientation_reaches_the_driver_as_the_handle_angle() {
+    let a: f64 = 0.3;
+    let emu = emulator(Emulator3Config {
+        hand: Some(Hand3::hold([0.0; 3], 300.0, 5.0)),
+        grip: Some([(a / 2.0).cos(), 0.0, 0.0, (a / 2.0).sin()]),
+        ..Emulator3Config::default()
+    });
+    let mut dev = open(&file_for(&emu, 50.0));
+    drive(&mut dev, &emu, [0.0; 2], 20);
+    let th = dev.handle_angle().expect("a VerseGrip is reported");
+    // The quaternion crosses the wire as f32.
+    assert!((th - a).abs() < 1e-6, "{th}");
+    // Without a grip: none.
+    let emu2 = emulator(Emulator3Config::default());
+    let mut dev2 = open(&file_for(&emu2, 50.0));
+    drive(&mut dev2, &emu2, [0.0; 2], 20);
+    assert_eq!(dev2.handle_angle(), None);
+}

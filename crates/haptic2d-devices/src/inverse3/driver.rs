@@ -302,3 +302,27 @@ impl Drop for Inverse3Device {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_handle_angle_is_the_grip_yaw_about_the_held_axis() {
+        let map = PlaneMap::new(&Inverse3DeviceFile::shipped()); // world x, y = device x, y
+        let a: f64 = 0.5; // rad about +z: q = (cos a/2, 0, 0, sin a/2)
+        let q = [(a / 2.0).cos(), 0.0, 0.0, (a / 2.0).sin()];
+        assert!((handle_angle(&map, q).unwrap() - a).abs() < 1e-12);
+        assert!(handle_angle(&map, [1.0, 0.0, 0.0, 0.0]).unwrap().abs() < 1e-12);
+        // A plane on device x and −z: a turn about +y takes x towards −z, i.e. +θ in the plane.
+        let text = super::super::device_file::DEFAULT_FILE
+            .replace("axes = [\"x\", \"y\"]", "axes = [\"x\", \"-z\"]");
+        let map = PlaneMap::new(&Inverse3DeviceFile::from_toml(&text, "f").unwrap());
+        let q = [(a / 2.0).cos(), 0.0, (a / 2.0).sin(), 0.0];
+        assert!((handle_angle(&map, q).unwrap() - a).abs() < 1e-12);
+        // A grip turned so that the plane's x axis points along the held axis: no angle.
+        let h = std::f64::consts::FRAC_PI_4;
+        let map = PlaneMap::new(&Inverse3DeviceFile::shipped());
+        assert_eq!(handle_angle(&map, [h.cos(), 0.0, -h.sin(), 0.0]), None);
+    }
+}

@@ -574,3 +574,43 @@ pub fn state_payload(cfg: &Emulator3Config, plant: &Plant3) -> ServiceState {
         ..Default::default()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hands_parse_and_bad_ones_say_the_form() {
+        let s = [0.01, 0.0, 0.0];
+        let h = Hand3::parse("follow", s, 2.0).unwrap().unwrap();
+        assert_eq!(h.force(0.0, &[0.0; 3], &[0.0; 3]), [3.0, 0.0, 0.0]);
+        assert_eq!(Hand3::parse("free", s, 0.0).unwrap(), None);
+        let h = Hand3::parse("push:-0.8,0,0.4,0.5", s, 0.0)
+            .unwrap()
+            .unwrap();
+        assert_eq!(h.force(0.4, &s, &[0.0; 3]), [0.0; 3]);
+        assert_eq!(h.force(0.6, &s, &[0.0; 3]), [-0.8, 0.0, 0.4]);
+        for bad in ["push:1,2", "push:a,b,c", "shove", "push:1,2,3,-1"] {
+            let e = Hand3::parse(bad, s, 0.0).unwrap_err();
+            assert!(e.contains("--hand"), "{bad}: {e}");
+        }
+    }
+
+    #[test]
+    fn the_plant_moves_under_force_and_clamps_at_its_limit() {
+        let cfg = Emulator3Config::default(); // 0.2 kg, 1 N·s/m, 10 N
+        let mut p = Plant3 {
+            p: [0.0; 3],
+            v: [0.0; 3],
+            f_cmd: [1.0, 0.0, 0.0],
+            t: 0.0,
+        };
+        p.step(&cfg, 2.0);
+        // Terminal velocity F/b = 1 m/s after 10 time constants (m/b = 0.2 s).
+        assert!((p.v[0] - 1.0).abs() < 1e-3, "{:?}", p.v);
+        assert_eq!(
+            super::super::planar::clamp_norm([30.0, 40.0, 0.0], cfg.force_limit),
+            [6.0, 8.0, 0.0]
+        );
+    }
+}
