@@ -2,6 +2,12 @@
 //! output is `pty: PATH`; a host (`haptic2d run --device haply:PATH`) opens PATH like the board's
 //! serial port. The emulated board moves a simulated linkage under the motor torques and a simulated
 //! hand until Ctrl-C (or `--duration`).
+//!
+//! `haptic2d emulate inverse3 [--bind 127.0.0.1:PORT]`: a stand-in for Haply's Inverse Service on
+//! loopback (default `127.0.0.1:10001`, the service's own port; port 0 picks a free one). The first
+//! line of standard output is `listening: http://ADDR:PORT`; a host runs
+//! `haptic2d run --device inverse3:http://ADDR:PORT`. It moves a simulated 3-DOF device (mass and
+//! damping per axis) under the commanded force and a simulated hand.
 
 use crate::hand_arg::HandSpec;
 use crate::haply_arg::{exit, fail, load_file};
@@ -17,17 +23,22 @@ use std::time::Duration;
 /// Options of `haptic2d emulate`.
 #[derive(clap::Args, Debug)]
 pub struct EmulateArgs {
-    /// What to emulate: haply.
+    /// What to emulate: haply | inverse3.
     pub target: String,
+    /// inverse3: the address to listen at (loopback by default; port 0 = any free port).
+    #[arg(long, default_value = "127.0.0.1:10001")]
+    pub bind: String,
     /// The board's wiring and linkage (a Haply device file, or haply-2diy-gen3 | haply-2diy-gen2 |
     /// haply-twin). Default haply-2diy-gen3.
     #[arg(long, value_name = "FILE.toml")]
     pub device_file: Option<PathBuf>,
     /// Simulated hand: follow (hold the start point) | free | constant:FX,FY,TAU |
     /// sine:FPK,FREQ[,DIRX,DIRY] | script:HOLD,FX,FY,TAU,PUSH[,RFX,RFY,RTAU]. Default follow.
+    /// inverse3: follow | free | push:FX,FY,FZ[,HOLD].
     #[arg(long, allow_hyphen_values = true)]
     pub hand: Option<String>,
     /// Start point of the handle X,Y (m, the device file's frame). Default the workspace centre.
+    /// inverse3: X,Y,Z of the cursor (m, device frame), default 0,0,0.
     #[arg(long, allow_hyphen_values = true)]
     pub start: Option<String>,
     /// Service time of the board (µs), at least 50.
@@ -51,9 +62,12 @@ pub fn run(a: &EmulateArgs) -> ExitCode {
 
 fn run_inner(a: &EmulateArgs) -> Result<u8, (u8, String)> {
     let bad = |m: String| (exit::BAD_INPUT, m);
+    if a.target == "inverse3" {
+        return run_inverse3(a);
+    }
     if a.target != "haply" {
         return Err(bad(format!(
-            "emulate `{}`: no such emulator\n    fix: haptic2d emulate haply",
+            "emulate `{}`: no such emulator\n    fix: haptic2d emulate haply | haptic2d emulate inverse3",
             a.target
         )));
     }
@@ -119,6 +133,76 @@ fn run_inner(a: &EmulateArgs) -> Result<u8, (u8, String)> {
     eprintln!(
         "emulator stopped ({}): {} frames, {} replies, {} bytes discarded",
         report.reason, report.frames, report.replies, report.discarded
+    );
+    Ok(exit::CLEAN)
+}
+
+/// `haptic2d emulate inverse3`.
+fn run_inverse3(a: &EmulateArgs) -> Result<u8, (u8, String)> {
+    use haptic2d_devices::inverse3::{Emulator3Config, Hand3, Inverse3Emulator};
+    let bad = |m: String| (exit::BAD_INPUT, m);
+    let bind: std::net::SocketAddr = a.bind.parse().map_err(|_| {
+        bad(format!(
+            "--bind `{}`: expected ADDR:PORT, e.g. 127.0.0.1:10001 (port 0 = any free port)",
+            a.bind
+        ))
+    })?;
+    if !(a.hand_damping.is_finite() && a.hand_damping >= 0.0) {
+        return Err(bad("--hand-damping must be ≥ 0 N·s/m".into()));
+    }
+    let mut start = [0.0; 3];
+    if let Some(s) = &a.start {
+        let v: Vec<f64> = s
+            .split(',')
+            .map(|p| p.trim().parse::<f64>())
+            .collect::<Result<_, _>>()
+            .map_err(|_| bad(format!("--start `{s}`: expected X,Y,Z in metres")))?;
+        if !(v.len() == 2 || v.len() == 3) || !v.iter().all(|x| x.is_finite()) {
+            return Err(bad(format!("--start `{s}`: expected X,Y,Z in metres")));
+        }
+        start[..v.len()].copy_from_slice(&v);
+    }
+    let spec = a.hand.as_deref().unwrap_or("follow");
+    let hand = Hand3::parse(spec, start, a.hand_damping).map_err(bad)?;
+    let cfg = Emulator3Config {
+        start,
+        hand,
+        ..Emulator3Config::default()
+    };
+    let stop = install_ctrlc_stop().map_err(|e| (exit::ERROR, e))?;
+    let mut emu = Inverse3Emulator::start(bind, cfg.clone()).map_err(|e| {
+        (
+            exit::ERROR,
+            format!("cannot listen at {bind}: {e}\n    fix: pick a free port with --bind 127.0.0.1:PORT (0 = any)"),
+        )
+    })?;
+    println!("listening: http://{}", emu.addr());
+    let _ = std::io::stdout().flush();
+    if !bind.ip().is_loopback() {
+        eprintln!("warning: listening beyond loopback at {bind}: anyone on that network can drive the emulated device");
+    }
+    eprintln!(
+        "emulating Haply's Inverse Service at ws://{}/ (device `{}`: mass {:?} kg, damping {:?} N·s/m, force limit {} N); hand {spec}; Ctrl-C stops",
+        emu.addr(),
+        haptic2d_devices::inverse3::emulator::EMULATED_ID,
+        cfg.mass,
+        cfg.damping,
+        cfg.force_limit
+    );
+    let end = match a.duration {
+        Some(d) if d.is_finite() && d > 0.0 => {
+            Some(std::time::Instant::now() + Duration::from_secs_f64(d))
+        }
+        Some(_) => return Err(bad("--duration must be > 0 s".into())),
+        None => None,
+    };
+    while !stop.load(Ordering::Relaxed) && end.is_none_or(|e| std::time::Instant::now() < e) {
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let r = emu.stop();
+    eprintln!(
+        "emulator stopped: {} connections, {} messages ({} malformed), {} states, {} force commands",
+        r.connections, r.messages, r.malformed, r.states, r.forces
     );
     Ok(exit::CLEAN)
 }

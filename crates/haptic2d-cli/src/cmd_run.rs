@@ -61,7 +61,8 @@ pub struct RunArgs {
     /// replay:FILE.mcap (the encoders of a `--log FILE.mcap` recording), haply:PATH or haply:auto
     /// (a Haply board; --device-file a Haply device file, default haply-2diy-gen3), udp:ADDR:PORT (a
     /// device on the open UDP protocol, docs/DEVICE-PROTOCOL.md; --device-file a UDP device file,
-    /// default devices/udp-pantograph.toml).
+    /// default devices/udp-pantograph.toml), inverse3[:URL] (a Haply Inverse3 through its Inverse
+    /// Service, default http://localhost:10001; --device-file default devices/inverse3.toml).
     #[arg(long, default_value = "sim")]
     pub device: String,
     /// Device parameters (TOML: top-level fields or a [device] table; template:

@@ -17,6 +17,7 @@ mod exit;
 mod foxglove_live;
 mod hand_arg;
 mod haply_arg;
+mod inverse3_arg;
 mod rig_system;
 mod run_log;
 mod run_rig;

@@ -57,6 +57,9 @@ pub enum DeviceChoice {
     Haply(String),
     /// A device on the open UDP protocol listening at the `ADDR:PORT` of `udp:ADDR:PORT`.
     Udp(String),
+    /// A Haply Inverse3 through the Inverse Service at the `URL` of `inverse3:URL` (`None`: the
+    /// device file's, default `http://localhost:10001`).
+    Inverse3(Option<String>),
 }
 
 impl DeviceChoice {
@@ -81,8 +84,14 @@ impl DeviceChoice {
         if let Some(a) = s.strip_prefix("udp:") {
             return Ok(DeviceChoice::Udp(a.to_string()));
         }
+        if s == "inverse3" {
+            return Ok(DeviceChoice::Inverse3(None));
+        }
+        if let Some(u) = s.strip_prefix("inverse3:") {
+            return Ok(DeviceChoice::Inverse3(Some(u.to_string())));
+        }
         Err(format!(
-            "--device `{s}` is not available\n    fix: use --device sim (the simulated twin pantograph), replay:FILE.csv, haply:PATH|haply:auto or udp:ADDR:PORT"
+            "--device `{s}` is not available\n    fix: use --device sim (the simulated twin pantograph), replay:FILE.csv, haply:PATH|haply:auto, udp:ADDR:PORT or inverse3[:URL]"
         ))
     }
 
@@ -98,6 +107,10 @@ impl DeviceChoice {
             DeviceChoice::Sim | DeviceChoice::Replay(_) => None,
             DeviceChoice::Haply(port) => Some(crate::haply_arg::real_device(port, device_file)?),
             DeviceChoice::Udp(addr) => Some(crate::udp_arg::real_device(addr, device_file)?),
+            DeviceChoice::Inverse3(url) => Some(crate::inverse3_arg::real_device(
+                url.as_deref(),
+                device_file,
+            )?),
         })
     }
 }

@@ -1,0 +1,132 @@
+//! `haptic2d run --device inverse3[:URL] [--device-file FILE]`: a Haply Inverse3 through its Inverse
+//! Service (the `haply` client crate) as a real device of the one run loop (the extension point in
+//! `run_rig.rs`), in planar mode. `URL` is the service's address, `http://HOST:PORT` (the WebSocket
+//! is `ws://HOST:PORT/`); without it the device file's `[service]` (default
+//! `http://localhost:10001`, `ws://localhost:10001/`). The device file (default the shipped
+//! devices/inverse3.toml) maps two device axes to the world plane and holds the third; the system is
+//! the 2-DOF system on the driver's virtual five-bar (see `haptic2d_devices::inverse3::planar`).
+
+use crate::run_rig::{DeviceModel, RealDevice};
+use haptic2d_devices::inverse3::planar::{virtual_center, virtual_linkage, virtual_torque_limit};
+use haptic2d_devices::inverse3::{Inverse3Device, Inverse3DeviceFile};
+use haptic2d_rt::io::Joints2;
+use haptic2d_rt::DeviceIo;
+use std::path::Path;
+
+/// The service addresses `(http, ws)` of the `URL` of `inverse3:URL`: `http://HOST:PORT[/]`,
+/// `ws://HOST:PORT[/]` or a bare `HOST:PORT`.
+pub fn service_urls(url: &str) -> Result<(String, String), String> {
+    let hint = "expected inverse3:http://HOST:PORT (e.g. inverse3:http://localhost:10001, the Inverse Service's address) or plain inverse3";
+    let rest = url
+        .strip_prefix("http://")
+        .or_else(|| url.strip_prefix("ws://"))
+        .unwrap_or(url);
+    let host = rest.trim_end_matches('/');
+    let ok = !host.is_empty()
+        && !host.contains('/')
+        && !host.contains("://")
+        && host
+            .rsplit_once(':')
+            .is_some_and(|(h, p)| !h.is_empty() && p.parse::<u16>().is_ok());
+    if !ok {
+        return Err(format!("--device inverse3:{url}: {hint}"));
+    }
+    Ok((format!("http://{host}"), format!("ws://{host}/")))
+}
+
+/// The Inverse3 of `--device inverse3[:URL]` for the rig of `haptic2d run`: the device file read and
+/// checked, the service address resolved, nothing opened yet.
+pub fn real_device(url: Option<&str>, device_file: Option<&Path>) -> Result<RealDevice, String> {
+    let mut file = match device_file {
+        Some(p) => Inverse3DeviceFile::from_path(p)?,
+        None => Inverse3DeviceFile::shipped(),
+    };
+    if let Some(u) = url {
+        let (http, ws) = service_urls(u)?;
+        file = file.with_service(http, ws);
+    }
+    let name = format!("inverse3:{}", file.http_url);
+    let axis = |a: haptic2d_devices::inverse3::device_file::SignedAxis| {
+        format!(
+            "{}{}",
+            if a.sign < 0.0 { "-" } else { "" },
+            ["x", "y", "z"][a.index]
+        )
+    };
+    let summary = format!(
+        "{}, planar: world x = device {}, y = device {}, {} held at {} m (K {} N/m, B {} N·s/m), force limit {} N",
+        file.source,
+        axis(file.axes[0]),
+        axis(file.axes[1]),
+        ["x", "y", "z"][file.held_axis],
+        file.plane_position,
+        file.plane_stiffness,
+        file.plane_damping,
+        file.force_limit
+    );
+    let open_name = name.clone();
+    Ok(RealDevice {
+        name,
+        model: DeviceModel::FiveBar {
+            linkage: virtual_linkage(),
+            tau_max: virtual_torque_limit(file.force_limit),
+            center: virtual_center(),
+        },
+        summary,
+        wait_periods: file.timeout_periods,
+        max_missed_run: file.max_missed_deadlines,
+        max_stall_periods: file.max_stall_periods,
+        match_controller: None,
+        // Connect and wait for the first state before the first deadline.
+        open: Box::new(move |period| {
+            let dev = Inverse3Device::open(&file, period, &open_name)?;
+            Ok(Box::new(Joints2(dev)) as Box<dyn DeviceIo + Send>)
+        }),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn service_urls_parse_and_bad_ones_say_the_form() {
+        let w = |a: &str, b: &str| (a.to_string(), b.to_string());
+        assert_eq!(
+            service_urls("http://127.0.0.1:10001").unwrap(),
+            w("http://127.0.0.1:10001", "ws://127.0.0.1:10001/")
+        );
+        assert_eq!(
+            service_urls("ws://localhost:9000/").unwrap(),
+            w("http://localhost:9000", "ws://localhost:9000/")
+        );
+        assert_eq!(
+            service_urls("localhost:9000").unwrap(),
+            w("http://localhost:9000", "ws://localhost:9000/")
+        );
+        for bad in [
+            "",
+            "http://",
+            "localhost",
+            "http://h:port",
+            "https://h:1",
+            "h:1/x",
+        ] {
+            let e = service_urls(bad).unwrap_err();
+            assert!(e.contains("inverse3:http://HOST:PORT"), "{bad}: {e}");
+        }
+    }
+
+    #[test]
+    fn the_shipped_file_is_a_virtual_five_bar_with_the_file_limits() {
+        let r = real_device(Some("http://127.0.0.1:1234"), None).unwrap();
+        assert_eq!(r.name, "inverse3:http://127.0.0.1:1234");
+        assert!(
+            matches!(r.model, DeviceModel::FiveBar { tau_max, .. } if tau_max == virtual_torque_limit(5.0))
+        );
+        assert_eq!(r.wait_periods, 20.0);
+        assert_eq!(r.max_missed_run, Some(10));
+        let r = real_device(None, None).unwrap();
+        assert_eq!(r.name, "inverse3:http://localhost:10001");
+    }
+}

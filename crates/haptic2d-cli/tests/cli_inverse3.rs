@@ -1,0 +1,208 @@
+//! `haptic2d run --device inverse3:URL` against `haptic2d emulate inverse3` in another process, on
+//! loopback (issue 15): a clean 3 s run with the box pushed into the wall, the emulator killed
+//! mid-run (exit 4, a message naming the device and what to check, no panic), and clear errors for
+//! a bad URL and no service.
+//!
+//! The device file is the shipped one with the missed-deadline check off and the stall limit at
+//! 1000 periods: the tests run on machines shared with compilers and check the protocol and the
+//! exit paths, not the timing (the timeout is exercised by the driver tests in haptic2d-devices).
+
+use std::io::{BufRead, BufReader};
+use std::path::PathBuf;
+use std::process::{Child, Command, Output, Stdio};
+use std::thread;
+use std::time::Duration;
+
+const BIN: &str = env!("CARGO_BIN_EXE_haptic2d");
+
+static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+fn turn() -> std::sync::MutexGuard<'static, ()> {
+    ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+/// The shipped file, patient about the machine's timing, in a temp dir.
+fn device_file(tag: &str) -> PathBuf {
+    let text = std::fs::read_to_string(root().join("devices/inverse3.toml"))
+        .unwrap()
+        .replace("timeout_periods = 20 ", "timeout_periods = 100")
+        .replace("max_missed_deadlines = 10 ", "max_missed_deadlines = 0  ")
+        .replace("max_stall_periods = 5 ", "max_stall_periods = 1000");
+    assert!(text.contains("timeout_periods = 100") && text.contains("max_missed_deadlines = 0 "));
+    assert!(text.contains("max_stall_periods = 1000"));
+    let dir = std::env::temp_dir().join(format!(
+        "haptic2d-cli-inverse3-{}-{tag}",
+        std::process::id()
+    ));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join("inverse3.toml");
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+struct Emulator(Child, String);
+
+impl Drop for Emulator {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+/// `haptic2d emulate inverse3` on an ephemeral loopback port; its service URL.
+fn emulator(extra: &[&str]) -> Emulator {
+    let mut child = Command::new(BIN)
+        .args(["emulate", "inverse3", "--bind", "127.0.0.1:0"])
+        .args(extra)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let mut line = String::new();
+    BufReader::new(child.stdout.take().unwrap())
+        .read_line(&mut line)
+        .unwrap();
+    let url = line
+        .trim()
+        .strip_prefix("listening: ")
+        .unwrap_or_else(|| panic!("first line `{line}`"))
+        .to_string();
+    assert!(url.starts_with("http://127.0.0.1:"), "{url}");
+    Emulator(child, url)
+}
+
+fn run(url: &str, file: &PathBuf, duration: &str) -> Command {
+    let mut c = Command::new(BIN);
+    c.args([
+        "run",
+        "--device",
+        &format!("inverse3:{url}"),
+        "--device-file",
+    ])
+    .arg(file)
+    .args(["--headless", "--no-rt", "--duration", duration]);
+    c
+}
+
+fn text(o: &Output) -> String {
+    format!(
+        "{}\n{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    )
+}
+
+#[test]
+fn run_against_the_emulated_service_for_3_s_drives_the_box_into_the_wall() {
+    let _t = turn();
+    // The hand holds for 0.5 s, then pushes 0.8 N towards the left wall (the box starts 0.02 m
+    // from it, grasped at its centre: the cursor must travel 0.02 m to the contact).
+    let emu = emulator(&["--hand", "push:-0.8,0,0,0.5"]);
+    let file = device_file("clean");
+    let dir = file.parent().unwrap().to_path_buf();
+    let log = dir.join("run.csv");
+    let o = run(&emu.1, &file, "3")
+        .args(["--controller", "coupling", "--log"])
+        .arg(&log)
+        .output()
+        .unwrap();
+    let out = text(&o);
+    assert_eq!(o.status.code(), Some(0), "{out}");
+    assert!(out.contains("planar: world x = device x"), "{out}");
+    assert!(!out.contains("panicked"), "{out}");
+    let csv = std::fs::read_to_string(&log).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |n: &str| {
+        header
+            .iter()
+            .position(|h| *h == n)
+            .unwrap_or_else(|| panic!("no column {n} in {header:?}"))
+    };
+    let (xs, contacts) = (col("slave.x"), col("contacts"));
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| {
+            l.split(',')
+                .map(|v| v.parse().unwrap_or(f64::NAN))
+                .collect()
+        })
+        .collect();
+    assert!(rows.len() > 1500, "{} rows", rows.len());
+    let last = &rows[rows.len() - 300..];
+    assert!(
+        last.iter().all(|r| r[contacts] > 0.0),
+        "the box is not at the wall at the end"
+    );
+    let slave = last.iter().map(|r| r[xs]).sum::<f64>() / last.len() as f64;
+    assert!((slave - 0.02).abs() < 2e-3, "box centre at {slave} m");
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+#[test]
+fn service_killed_mid_run_exits_4_naming_the_device() {
+    let _t = turn();
+    let mut emu = emulator(&[]);
+    let file = device_file("kill");
+    let child = run(&emu.1, &file, "10")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    thread::sleep(Duration::from_millis(1500));
+    emu.0.kill().unwrap();
+    let o = child.wait_with_output().unwrap();
+    let out = text(&o);
+    assert_eq!(o.status.code(), Some(4), "{out}");
+    assert!(out.contains(&format!("inverse3:{}", emu.1)), "{out}");
+    assert!(
+        out.contains("check:") && out.contains("Inverse Service"),
+        "{out}"
+    );
+    assert!(!out.contains("panicked"), "{out}");
+}
+
+#[test]
+fn no_service_and_bad_urls_are_clear_errors() {
+    let _t = turn();
+    let port = std::net::TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port();
+    let file = device_file("none");
+    let o = run(&format!("http://127.0.0.1:{port}"), &file, "1")
+        .output()
+        .unwrap();
+    let out = text(&o);
+    // A device that cannot be opened is the device-lost exit code, as for every driver.
+    assert_eq!(o.status.code(), Some(4), "{out}");
+    assert!(out.contains("haptic2d emulate inverse3"), "{out}");
+    assert!(!out.contains("panicked"), "{out}");
+    let o = Command::new(BIN)
+        .args([
+            "run",
+            "--device",
+            "inverse3:nonsense",
+            "--headless",
+            "--duration",
+            "1",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(
+        text(&o).contains("inverse3:http://HOST:PORT"),
+        "{}",
+        text(&o)
+    );
+    let o = Command::new(BIN)
+        .args(["emulate", "inverse3", "--bind", "nowhere"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(text(&o).contains("--bind"), "{}", text(&o));
+}
