@@ -50,6 +50,10 @@ pub struct EmulateArgs {
     /// Hand damping (N·s/m) added to the hand model.
     #[arg(long, default_value_t = 2.0)]
     pub hand_damping: f64,
+    /// inverse3: report a VerseGrip turning about the device's z axis at this rate (rad/s, from
+    /// angle 0 at the start); the loop turns the slave with it. Default: no VerseGrip.
+    #[arg(long, allow_hyphen_values = true)]
+    pub grip_rate: Option<f64>,
 }
 
 /// Runs the emulator.
@@ -164,9 +168,18 @@ fn run_inverse3(a: &EmulateArgs) -> Result<u8, (u8, String)> {
     }
     let spec = a.hand.as_deref().unwrap_or("follow");
     let hand = Hand3::parse(spec, start, a.hand_damping).map_err(bad)?;
+    if let Some(r) = a.grip_rate {
+        if !(r.is_finite() && r.abs() <= 100.0) {
+            return Err(bad(format!(
+                "--grip-rate {r}: expected a finite rate within ±100 rad/s"
+            )));
+        }
+    }
     let cfg = Emulator3Config {
         start,
         hand,
+        grip: a.grip_rate.map(|_| [1.0, 0.0, 0.0, 0.0]),
+        grip_rate: a.grip_rate.unwrap_or(0.0),
         ..Emulator3Config::default()
     };
     let stop = install_ctrlc_stop().map_err(|e| (exit::ERROR, e))?;

@@ -15,6 +15,7 @@ mod csv_out;
 mod device_arg;
 mod exit;
 mod foxglove_live;
+mod grip_twist;
 mod hand_arg;
 mod haply_arg;
 mod inverse3_arg;

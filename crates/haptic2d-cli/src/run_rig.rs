@@ -27,6 +27,7 @@
 //! torques until the first valid reading and the start-up ramp of the shared safety layer, the
 //! stall check on the loop's own time (see [`Rig::tick_system`]), the final clamp.
 
+use crate::grip_twist::GripTwist;
 use crate::hand_arg::HandSpec;
 use crate::rig_system::RigSystem;
 use haptic2d::device::linalg::{V3, V4};
@@ -221,6 +222,8 @@ pub struct Rig {
     /// The last tick's interval on the loop's own account, in periods (1 for a device paced by the
     /// ticks): what the watchdog's stall check sees.
     elapsed_periods: f64,
+    /// The twist target from a device that senses its handle's orientation (2-DOF devices).
+    grip: GripTwist,
 }
 
 impl Rig {
@@ -269,6 +272,7 @@ impl Rig {
             read_wait_ns: 0,
             prev_read_wait_ns: 0,
             elapsed_periods: 1.0,
+            grip: GripTwist::default(),
         })
     }
 
@@ -313,6 +317,7 @@ impl Rig {
             read_wait_ns: 0,
             prev_read_wait_ns: 0,
             elapsed_periods: 1.0,
+            grip: GripTwist::default(),
         })
     }
 
@@ -408,6 +413,11 @@ impl Rig {
     pub fn tick_system(&mut self, q: &V4, info: &TickInfo, paused: bool) -> TickOutput {
         let elapsed_ns = self.interval.update(info);
         let wait_ns = std::mem::replace(&mut self.prev_read_wait_ns, self.read_wait_ns);
+        // A sensed handle orientation turns the slave's twist target (2-DOF devices).
+        if let (Some(a), RigSystem::TwoDof(s)) = (self.io.handle_angle(), &mut self.system) {
+            let slave_angle = s.world().bodies[s.slave()].pose.angle;
+            s.set_twist_target(self.grip.target(a, slave_angle));
+        }
         if paused {
             self.elapsed_periods = 1.0;
             self.system.tick(q, None, true)
@@ -486,6 +496,7 @@ impl Rig {
         };
         self.system = system;
         self.interval.reset();
+        self.grip.reset();
         Ok(())
     }
 

@@ -207,12 +207,12 @@ fn the_versegrip_orientation_reaches_the_driver_as_the_handle_angle() {
     });
     let mut dev = open(&file_for(&emu, 50.0));
     drive(&mut dev, &emu, [0.0; 2], 20);
-    let th = dev.handle_angle().expect("a VerseGrip is reported");
+    let th = dev.grip_angle().expect("a VerseGrip is reported");
     // The quaternion crosses the wire as f32.
     assert!((th - a).abs() < 1e-6, "{th}");
     // Without a grip: none.
     let emu2 = emulator(Emulator3Config::default());
     let mut dev2 = open(&file_for(&emu2, 50.0));
     drive(&mut dev2, &emu2, [0.0; 2], 20);
-    assert_eq!(dev2.handle_angle(), None);
+    assert_eq!(dev2.grip_angle(), None);
 }

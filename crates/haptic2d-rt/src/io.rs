@@ -54,6 +54,13 @@ pub trait DeviceIo {
     /// A short human-readable name, e.g. "sim", "replay:run.csv".
     fn name(&self) -> &str;
 
+    /// The handle's sensed orientation about the world plane's normal (rad), for a device whose
+    /// joints do not carry it (an Inverse3's VerseGrip); `None` (the default) when there is none.
+    /// The loop turns its changes into the slave's twist target. Read after `read_encoders`.
+    fn handle_angle(&self) -> Option<f64> {
+        None
+    }
+
     /// True for a device whose motion advances one period per tick whatever the wall clock says (a
     /// simulated plant stepped in `write_torques`, a replay that plays one row per read): a late tick
     /// cannot hurt anyone there, so the loop neither measures the interval for it nor trips on
@@ -80,6 +87,11 @@ pub trait Device2Io {
 
     /// A short human-readable name, e.g. "udp:127.0.0.1:9000".
     fn name(&self) -> &str;
+
+    /// The handle's sensed orientation (rad), as [`DeviceIo::handle_angle`]; `None` by default.
+    fn handle_angle(&self) -> Option<f64> {
+        None
+    }
 }
 
 /// A [`Device2Io`] seen as a [`DeviceIo`]: `q = [q1, q2, 0, 0]`, `τ[2..4]` dropped. This is how a
@@ -105,6 +117,10 @@ impl<D: Device2Io> DeviceIo for Joints2<D> {
 
     fn name(&self) -> &str {
         self.0.name()
+    }
+
+    fn handle_angle(&self) -> Option<f64> {
+        self.0.handle_angle()
     }
 }
 

@@ -193,12 +193,12 @@ impl Inverse3Device {
     /// service reports one: the device's unit vector along the plane's x axis, rotated by the
     /// quaternion `(w, x, y, z)` and seen in the plane, `atan2(u_y, u_x)` (for the plane x = device
     /// x, y = device y, the yaw `atan2(2(wz + xy), 1 − 2(y² + z²))`). `None` without a VerseGrip.
-    pub fn handle_angle(&self) -> Option<f64> {
+    pub fn grip_angle(&self) -> Option<f64> {
         handle_angle(&self.map, self.sample.orientation?)
     }
 }
 
-/// [`Inverse3Device::handle_angle`] for the mapping `map` and the quaternion `q = (w, x, y, z)`.
+/// [`Inverse3Device::grip_angle`] for the mapping `map` and the quaternion `q = (w, x, y, z)`.
 pub fn handle_angle(map: &PlaneMap, q: [f64; 4]) -> Option<f64> {
     let [w, x, y, z] = q;
     let (i, s) = map.axis(0);
@@ -275,6 +275,11 @@ impl Device2Io for Inverse3Device {
 
     fn name(&self) -> &str {
         &self.name
+    }
+
+    /// The VerseGrip's angle ([`Inverse3Device::grip_angle`]): the loop's twist target.
+    fn handle_angle(&self) -> Option<f64> {
+        self.grip_angle()
     }
 }
 

@@ -130,6 +130,9 @@ pub struct Emulator3Config {
     pub hand: Option<Hand3>,
     /// Report a VerseGrip with this orientation quaternion `(w, x, y, z)`; `None` = no VerseGrip.
     pub grip: Option<[f64; 4]>,
+    /// The VerseGrip turns about the device's z axis at this rate (rad/s of simulated time), from
+    /// `grip` at t = 0. Default 0.
+    pub grip_rate: f64,
 }
 
 impl Default for Emulator3Config {
@@ -141,6 +144,7 @@ impl Default for Emulator3Config {
             start: [0.0; 3],
             hand: None,
             grip: None,
+            grip_rate: 0.0,
         }
     }
 }
@@ -497,6 +501,19 @@ fn inverse3_state(plant: &Plant3) -> (Inverse3State, Inverse3Status) {
     )
 }
 
+/// The VerseGrip's orientation at simulated time `t` (s): `grip` turned by `grip_rate·t` about the
+/// device's z axis (the quaternion product `r ⊗ q`, `r = (cos(b/2), 0, 0, sin(b/2))`).
+fn grip_now(cfg: &Emulator3Config, t: f64) -> Option<[f64; 4]> {
+    let q = cfg.grip?;
+    let (s, c) = (0.5 * cfg.grip_rate * t).sin_cos();
+    Some([
+        c * q[0] - s * q[3],
+        c * q[1] - s * q[2],
+        c * q[2] + s * q[1],
+        c * q[3] + s * q[0],
+    ])
+}
+
 fn grip_state(q: [f64; 4]) -> (VerseGripState, VerseGripStatus) {
     (
         VerseGripState {
@@ -529,8 +546,7 @@ pub fn full_payload(cfg: &Emulator3Config, plant: &Plant3) -> ServiceData {
             state,
             status,
         }],
-        verse_grip: cfg
-            .grip
+        verse_grip: grip_now(cfg, plant.t)
             .map(|q| {
                 let (state, status) = grip_state(q);
                 vec![VerseGripDevice {
@@ -559,8 +575,7 @@ pub fn state_payload(cfg: &Emulator3Config, plant: &Plant3) -> ServiceState {
             state,
             status,
         }],
-        verse_grip: cfg
-            .grip
+        verse_grip: grip_now(cfg, plant.t)
             .map(|q| {
                 let (state, status) = grip_state(q);
                 vec![VerseGripMessage {
