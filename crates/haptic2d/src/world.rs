@@ -44,9 +44,9 @@ pub struct WorldParams {
     pub contact: ContactParams,
     /// Damping time `τ` (s) of the implicit chain damper (`integrate/chain_damping.rs`): contacts
     /// of bodies that touch two or more others get an extra normal damper `m_c/τ` on the
-    /// end-of-sample velocity, so stacks come to rest. `None` = off. Default 1 ms.
+    /// end-of-sample velocity, so stacks come to rest. `None` = off. Default 0.2 ms.
     pub chain_tau: Option<f64>,
-    /// Gauss–Seidel sweeps of the chain damper per sample; default 8.
+    /// Gauss–Seidel sweeps of the chain damper per sample; default 16.
     pub chain_sweeps: u32,
 }
 

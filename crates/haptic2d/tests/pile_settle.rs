@@ -175,3 +175,33 @@ fn pile_1000_comes_to_rest_within_5_s() {
         max_speed(&w)
     );
 }
+
+/// `[world] chain_tau` / `chain_sweeps`: bad values are errors naming the field and the fix; 0
+/// turns the damper off; the default is on.
+#[test]
+fn chain_damper_scene_fields_are_checked() {
+    let wall = "[[body]]\nname = \"wall\"\nkind = \"fixed\"\npolygon = [[-0.1, -0.2], [0.0, -0.2], [0.0, 0.2], [-0.1, 0.2]]\n";
+    for (world, field) in [
+        ("chain_tau = -0.001", "world.chain_tau"),
+        ("chain_tau = nan", "world.chain_tau"),
+        ("chain_sweeps = 100000", "world.chain_sweeps"),
+    ] {
+        let text = format!("[world]\n{world}\n{wall}");
+        let e = match Scene::from_toml(&text, "t.toml", None) {
+            Ok(_) => panic!("expected an error for {world}"),
+            Err(e) => e,
+        };
+        assert!(
+            e.errors
+                .iter()
+                .any(|x| x.field == field && !x.fix.is_empty()),
+            "{world}: {e}"
+        );
+    }
+    let off = Scene::from_toml(&format!("[world]\nchain_tau = 0\n{wall}"), "t.toml", None)
+        .expect("chain_tau = 0 is valid");
+    assert_eq!(off.world.params.chain_tau, None);
+    let on = Scene::from_toml(wall, "t.toml", None).expect("valid");
+    assert_eq!(on.world.params.chain_tau, Some(0.0002));
+    assert_eq!(on.world.params.chain_sweeps, 16);
+}

@@ -26,6 +26,17 @@
 //! energy (returned by [`ChainDamping::apply`]). Positions then advance with the damped velocity
 //! (semi-implicit Euler), as they do with any other held force.
 //!
+//! **Choice of τ and sweeps** (pile:1000 at 1 kHz, `haptic2d-bench --settle 6 --every 0.25 (or
+//! 0.05) --set world.chain_tau=τ,world.chain_sweeps=S`; "at rest from" = the first check after
+//! which no body moved ≥ 1 cm/s): off, 1000 bodies moving at 6 s; τ = 1 ms / 8 sweeps, 4.5 s
+//! (0.0098 m/s at 5 s: no margin); 0.5 ms / 8, 3.75 s; 0.5 ms / 12 and / 16, blips of 1–2 cm/s
+//! up to 3.2–5 s; 0.2 ms / 8, 2.25 s; 0.1 ms / 4, *never* (500 bodies at 0.1 m/s at 5 s);
+//! **0.2 ms / 16, 2.15 s** (0.05 s checks; largest speed after 2.5 s 6.8 mm/s; the default).
+//! The sweeps matter beyond the pile: with 8 sweeps at τ = 0.2 ms the 25 aligned 10-box stacks
+//! of `tests/stack_corners.rs` kept rocking (2 cm/s, contacts churning after 2 s); with 16 they
+//! pass (2e-3 m/s). A sweep that has not converged leaves `F ≠ −B_c·v⁺` (still passive, but the
+//! impulses then shuffle energy between the stack's modes instead of removing it).
+//!
 //! **Scope.** Bodies that touch only one other body (a box on the floor, a probe against a wall:
 //! the paper's one- and two-contact scenes) are not chains: their contacts keep the explicit law
 //! alone, bit for bit. The pass runs in [`IntegrationMode::SemiImplicit`](super::IntegrationMode)
@@ -76,9 +87,9 @@ pub struct ChainDamping {
 }
 
 /// Default damping time `τ` (s) of [`ChainDamping`].
-pub const DEFAULT_CHAIN_TAU: f64 = 1.0e-3;
+pub const DEFAULT_CHAIN_TAU: f64 = 2.0e-4;
 /// Default number of Gauss–Seidel sweeps of [`ChainDamping`].
-pub const DEFAULT_CHAIN_SWEEPS: u32 = 8;
+pub const DEFAULT_CHAIN_SWEEPS: u32 = 16;
 
 impl Default for ChainDamping {
     fn default() -> Self {
@@ -187,8 +198,10 @@ impl ChainDamping {
         }
         let ke_star = self.kinetic(bodies);
         // 4. Projected Gauss–Seidel on F = −B_c·v⁺_n, F ≥ −f_n.
+        let nrows = self.rows.len();
         for _ in 0..self.sweeps {
-            for row in self.rows.iter_mut() {
+            for j in 0..nrows {
+                let row = &mut self.rows[j];
                 let (a, b) = (row.a, row.b);
                 let v_rel = (self.vel[a] - self.vel[b]).dot(row.n) + self.omega[a] * row.rna
                     - self.omega[b] * row.rnb;

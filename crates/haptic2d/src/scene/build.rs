@@ -242,7 +242,7 @@ pub(super) fn build(
             errs.push(SceneError::new(
                 "world.chain_tau",
                 format!("must be a damping time in [0, {MAX_CHAIN_TAU_S}] s, got {t}"),
-                "e.g. chain_tau = 0.001, or chain_tau = 0 to turn the chain damper off",
+                "e.g. chain_tau = 0.0002, or chain_tau = 0 to turn the chain damper off",
             ));
         }
         params.chain_tau = (t > 0.0 && t.is_finite()).then_some(t);
@@ -252,7 +252,7 @@ pub(super) fn build(
             errs.push(SceneError::new(
                 "world.chain_sweeps",
                 format!("must be in [0, {MAX_CHAIN_SWEEPS}], got {n}"),
-                "e.g. chain_sweeps = 8",
+                "e.g. chain_sweeps = 16",
             ));
         }
         params.chain_sweeps = n.min(MAX_CHAIN_SWEEPS);

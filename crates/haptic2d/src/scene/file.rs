@@ -55,9 +55,9 @@ pub struct WorldSection {
     /// Passivity guard tolerance ε_E (J); off when absent.
     pub guard: Option<f64>,
     /// Damping time τ (s) of the implicit chain damper (stacks come to rest); 0 = off;
-    /// default 0.001 (`WorldParams::chain_tau`).
+    /// default 0.0002 (`WorldParams::chain_tau`).
     pub chain_tau: Option<f64>,
-    /// Gauss–Seidel sweeps of the chain damper per sample; default 8.
+    /// Gauss–Seidel sweeps of the chain damper per sample; default 16.
     pub chain_sweeps: Option<u32>,
     /// Accept bodies lighter than 1.5 × min_mass with a warning instead of an error.
     pub allow_light_bodies: Option<bool>,
