@@ -50,7 +50,8 @@ use crate::geom::{cross, Vec2};
 /// No partner yet (per-body scratch).
 const NONE: u32 = u32::MAX;
 
-/// One chain contact in the solve.
+/// One chain contact in the solve, with everything its update needs (no body lookups in the
+/// sweeps).
 #[derive(Clone, Copy, Debug)]
 struct Row {
     a: usize,
@@ -59,6 +60,11 @@ struct Row {
     /// `r_A × n`, `r_B × n` (m).
     rna: f64,
     rnb: f64,
+    /// Velocity change of A / B per unit impulse: `n/m`, and `(r × n)/I` (1/kg, 1/(kg·m)).
+    ja: Vec2,
+    ka: f64,
+    jb: Vec2,
+    kb: f64,
     /// Inverse effective normal mass `w` (1/kg).
     w: f64,
     /// `c = r/((1 + r)·w)` with `r = T/τ` (kg).
@@ -175,6 +181,10 @@ impl ChainDamping {
                 n: e.n,
                 rna,
                 rnb,
+                ja: e.n * ba.inv_mass,
+                ka: rna * ba.inv_inertia,
+                jb: e.n * bb.inv_mass,
+                kb: rnb * bb.inv_inertia,
                 w,
                 c: r / ((1.0 + r) * w),
                 lo: -dt * e.f_n,
@@ -198,21 +208,18 @@ impl ChainDamping {
         }
         let ke_star = self.kinetic(bodies);
         // 4. Projected Gauss–Seidel on F = −B_c·v⁺_n, F ≥ −f_n.
-        let nrows = self.rows.len();
+        let (vel, omega) = (&mut self.vel, &mut self.omega);
         for _ in 0..self.sweeps {
-            for j in 0..nrows {
-                let row = &mut self.rows[j];
+            for row in self.rows.iter_mut() {
                 let (a, b) = (row.a, row.b);
-                let v_rel = (self.vel[a] - self.vel[b]).dot(row.n) + self.omega[a] * row.rna
-                    - self.omega[b] * row.rnb;
+                let v_rel = (vel[a] - vel[b]).dot(row.n) + omega[a] * row.rna - omega[b] * row.rnb;
                 let new = (-row.c * (v_rel - row.w * row.lambda)).max(row.lo);
                 let d = new - row.lambda;
                 row.lambda = new;
-                let (ba, bb) = (&bodies[a], &bodies[b]);
-                self.vel[a] += row.n * (d * ba.inv_mass);
-                self.omega[a] += row.rna * d * ba.inv_inertia;
-                self.vel[b] -= row.n * (d * bb.inv_mass);
-                self.omega[b] -= row.rnb * d * bb.inv_inertia;
+                vel[a] += row.ja * d;
+                omega[a] += row.ka * d;
+                vel[b] -= row.jb * d;
+                omega[b] -= row.kb * d;
             }
         }
         let removed = ke_star - self.kinetic(bodies);
