@@ -26,6 +26,7 @@
 mod box2d_world;
 mod rapier_world;
 mod report;
+mod rest_time;
 mod scenes;
 mod settle;
 mod state;
@@ -70,6 +71,11 @@ struct Args {
     /// and print the settle state every `--every` seconds (no files written).
     #[arg(long)]
     settle: Option<f64>,
+    /// Instead of timing: run every engine (untimed) on the selected cases for this many
+    /// simulated seconds and print when each came to rest (every body below 1 cm/s from then on,
+    /// checked every 10 ms; no files written).
+    #[arg(long)]
+    rest_time: Option<f64>,
     /// Print interval of `--settle` (simulated s).
     #[arg(long, default_value_t = 0.5)]
     every: f64,
@@ -149,6 +155,64 @@ fn run(args: &Args) -> Result<(), String> {
                 args.every,
                 args.profile_after,
             );
+        }
+        return Ok(());
+    }
+    if let Some(secs) = args.rest_time {
+        if !(secs.is_finite() && secs > 0.0) {
+            return Err("--rest-time must be a positive duration in s".into());
+        }
+        for case in cases {
+            let label = format!("{} n={}", case.scene, case.n);
+            let mut h = case.haptic.world;
+            h.params.proximity_spread = !args.no_spread;
+            settle::apply(&mut h, &args.set).map_err(|e| format!("{label}: {e}"))?;
+            let (mu, e) = (case.rapier_friction, case.rapier_restitution);
+            let mut r =
+                rapier_world::twin(&h, scenes::DT, mu, e).map_err(|x| format!("{label}: {x}"))?;
+            let mut b4 =
+                box2d_world::twin(&h, scenes::DT, 4, mu, e).map_err(|x| format!("{label}: {x}"))?;
+            let mut b1 =
+                box2d_world::twin(&h, scenes::DT, 1, mu, e).map_err(|x| format!("{label}: {x}"))?;
+            let dynamic: Vec<bool> = h.bodies.iter().map(|b| b.is_dynamic()).collect();
+            let dt = scenes::DT;
+            let res = {
+                let hc = std::cell::RefCell::new(&mut h);
+                rest_time::run(
+                    &dynamic,
+                    dt,
+                    secs,
+                    &mut || hc.borrow_mut().step(),
+                    &mut || {
+                        hc.borrow()
+                            .bodies
+                            .iter()
+                            .map(|b| (b.pose.pos, b.pose.angle, b.vel))
+                            .collect()
+                    },
+                )
+            };
+            println!("{}", rest_time::line(&label, "haptic2d", secs, &res));
+            let rc = std::cell::RefCell::new(&mut r);
+            let res = rest_time::run(
+                &dynamic,
+                dt,
+                secs,
+                &mut || rc.borrow_mut().step(),
+                &mut || rc.borrow().poses(),
+            );
+            println!("{}", rest_time::line(&label, "rapier2d", secs, &res));
+            for (name, b) in [("box2d 4 sub", &mut b4), ("box2d 1 sub", &mut b1)] {
+                let bc = std::cell::RefCell::new(b);
+                let res = rest_time::run(
+                    &dynamic,
+                    dt,
+                    secs,
+                    &mut || bc.borrow_mut().step(),
+                    &mut || bc.borrow_mut().poses(),
+                );
+                println!("{}", rest_time::line(&label, name, secs, &res));
+            }
         }
         return Ok(());
     }

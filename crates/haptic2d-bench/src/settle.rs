@@ -9,7 +9,9 @@ use crate::state;
 use crate::timing::{now, Clock};
 
 /// Applies `law.key=value` overrides (`normal.bc=200`, `friction.beta=40`) to the prototypes of the
-/// world's laws (every contact created afterwards gets them), and `world.proximity_spread=0/1`.
+/// world's laws (every contact created afterwards gets them), and the world options
+/// `world.proximity_spread=0/1`, `world.chain_tau=SECONDS` (0 = chain damper off) and
+/// `world.chain_sweeps=N`.
 pub fn apply(w: &mut World, sets: &[String]) -> Result<(), String> {
     for s in sets {
         let (k, v) = s
@@ -22,7 +24,19 @@ pub fn apply(w: &mut World, sets: &[String]) -> Result<(), String> {
         let r = match k.trim().split_once('.') {
             Some(("normal", key)) => w.normal.set_param(key, v),
             Some(("friction", key)) => w.friction.set_param(key, v),
-            _ => Err("expected normal.KEY or friction.KEY".into()),
+            Some(("world", "proximity_spread")) => {
+                w.params.proximity_spread = v != 0.0;
+                Ok(())
+            }
+            Some(("world", "chain_tau")) => {
+                w.params.chain_tau = (v > 0.0).then_some(v);
+                Ok(())
+            }
+            Some(("world", "chain_sweeps")) if v >= 0.0 && v.fract() == 0.0 => {
+                w.params.chain_sweeps = v as u32;
+                Ok(())
+            }
+            _ => Err("expected normal.KEY, friction.KEY or world.{proximity_spread, chain_tau, chain_sweeps} (chain_sweeps a whole number)".into()),
         };
         r.map_err(|e| format!("--set {s}: {e}"))?;
     }

@@ -12,7 +12,10 @@ use crate::collide::{
 };
 use crate::contact::{ContactParams, ContactSet, PastPoses, VeContact, Wrench2};
 use crate::geom::{Pose, Rot, Vec2};
-use crate::integrate::{integrate_body, EnergyLedger, IntegrationMode, PassivityGuard};
+use crate::integrate::{
+    integrate_body, ChainDamping, EnergyLedger, IntegrationMode, PassivityGuard,
+    DEFAULT_CHAIN_SWEEPS, DEFAULT_CHAIN_TAU,
+};
 use crate::laws::friction::FrictionModel;
 use crate::laws::normal::NormalModel;
 use crate::load::Load;
@@ -39,6 +42,12 @@ pub struct WorldParams {
     pub guard: Option<f64>,
     /// Contact state machine and impact options.
     pub contact: ContactParams,
+    /// Damping time `τ` (s) of the implicit chain damper (`integrate/chain_damping.rs`): contacts
+    /// of bodies that touch two or more others get an extra normal damper `m_c/τ` on the
+    /// end-of-sample velocity, so stacks come to rest. `None` = off. Default 0.2 ms.
+    pub chain_tau: Option<f64>,
+    /// Gauss–Seidel sweeps of the chain damper per sample; default 16.
+    pub chain_sweeps: u32,
 }
 
 impl Default for WorldParams {
@@ -52,6 +61,8 @@ impl Default for WorldParams {
             mode: IntegrationMode::SemiImplicit,
             guard: None,
             contact: ContactParams::default(),
+            chain_tau: Some(DEFAULT_CHAIN_TAU),
+            chain_sweeps: DEFAULT_CHAIN_SWEEPS,
         }
     }
 }
@@ -83,6 +94,7 @@ pub struct World {
     prev: Vec<Pose>,
     prev2: Vec<Pose>,
     ledger: EnergyLedger,
+    chain: ChainDamping,
     guard: Option<PassivityGuard>,
     ke_before: Vec<f64>,
     rots: Vec<Rot>,
@@ -171,6 +183,7 @@ impl World {
             prev: Vec::with_capacity(n),
             prev2: Vec::with_capacity(n),
             ledger: EnergyLedger::default(),
+            chain: ChainDamping::default(),
             ke_before: vec![0.0; n],
             rots: vec![Rot::IDENTITY; n],
             tick: 0,
@@ -538,6 +551,20 @@ impl World {
             let cw = self.contact_wrench[i];
             b.force = self.held[i].force + self.drive[i].force + cw.force;
             b.torque = self.held[i].torque + self.drive[i].torque + cw.torque;
+        }
+        // Implicit chain damper on the end-of-sample velocities (adds to forces and contact wrench).
+        if self.params.mode == IntegrationMode::SemiImplicit {
+            self.chain.tau = self.params.chain_tau;
+            self.chain.sweeps = self.params.chain_sweeps;
+            self.ledger.chain_damping_loss += self.chain.apply(
+                dt,
+                self.contacts.entries(),
+                &mut self.bodies,
+                &mut self.contact_wrench,
+            );
+        }
+        for i in 0..self.bodies.len() {
+            let b = &mut self.bodies[i];
             if !b.is_dynamic() {
                 continue;
             }

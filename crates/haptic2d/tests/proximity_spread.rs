@@ -10,6 +10,10 @@ use haptic2d::scene::builtin;
 fn spread_set_is_the_whole_stage_set_one_period_earlier() {
     let mut w = builtin("pile:100", Some(1000.0)).unwrap().unwrap().world;
     assert!(w.params.proximity_spread, "spreading is the default");
+    // The check needs a set that still changes from 0.15 s on; the chain damper (issue 17) damps
+    // the landing pile:100 so fast that its set stops changing there: off in this test of the
+    // global stage alone.
+    w.params.chain_tau = None;
     let n_g = w.params.proximity_every as usize;
     // While the pile falls (from 0.15 s: the set changes from period to period, without early updates).
     const START: usize = 150;

@@ -17,6 +17,9 @@ pub struct EnergyLedger {
     /// Frictional impact sets (issue 16) whose energy check had to scale an impulse so that the
     /// impact did not add kinetic energy (restitution scaled, or the whole jump); 0 without friction.
     pub impact_energy_fallbacks: u64,
+    /// Kinetic energy removed by the implicit chain damper so far (J, ≥ 0 up to rounding;
+    /// `integrate/chain_damping.rs`).
+    pub chain_damping_loss: f64,
 }
 
 impl EnergyLedger {

@@ -41,6 +41,10 @@ pub const MAX_FREQUENCY_HZ: f64 = 1e4;
 pub const MAX_CONTACT_SPEED_M_S: f64 = 1e3;
 /// Largest passivity-guard tolerance (J).
 pub const MAX_GUARD_J: f64 = 1e6;
+/// Largest chain-damper damping time `world.chain_tau` (s).
+pub const MAX_CHAIN_TAU_S: f64 = 1e3;
+/// Largest number of chain-damper sweeps `world.chain_sweeps` per sample.
+pub const MAX_CHAIN_SWEEPS: u32 = 1000;
 /// Largest `proximity_every` (samples).
 pub const MAX_PROXIMITY_EVERY: u32 = 1_000_000;
 /// Largest |parameter| of a normal law or friction model (stiffness N/m, damping N·s/m, …).

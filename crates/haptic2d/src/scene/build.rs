@@ -1,11 +1,11 @@
 //! Validation and construction: a parsed [`SceneFile`] → a [`World`], collecting every problem.
 
 use super::bounds::{
-    check_abs, check_count, check_pos, damping_ok, MAX_ANGLE_RAD, MAX_BODIES,
-    MAX_CONTACT_SPEED_M_S, MAX_DAMPING_N_S_M, MAX_DENSITY_KG_M2, MAX_FORCE_N, MAX_FREQUENCY_HZ,
-    MAX_GUARD_J, MAX_INERTIA_KG_M2, MAX_LENGTH_M, MAX_LOADS, MAX_MASS_KG, MAX_OMEGA_RAD_S,
-    MAX_PIECES_PER_BODY, MAX_PROXIMITY_EVERY, MAX_RATE_HZ, MAX_SPEED_M_S, MAX_TORQUE_N_M,
-    MAX_VERTICES, MIN_RATE_HZ,
+    check_abs, check_count, check_pos, damping_ok, MAX_ANGLE_RAD, MAX_BODIES, MAX_CHAIN_SWEEPS,
+    MAX_CHAIN_TAU_S, MAX_CONTACT_SPEED_M_S, MAX_DAMPING_N_S_M, MAX_DENSITY_KG_M2, MAX_FORCE_N,
+    MAX_FREQUENCY_HZ, MAX_GUARD_J, MAX_INERTIA_KG_M2, MAX_LENGTH_M, MAX_LOADS, MAX_MASS_KG,
+    MAX_OMEGA_RAD_S, MAX_PIECES_PER_BODY, MAX_PROXIMITY_EVERY, MAX_RATE_HZ, MAX_SPEED_M_S,
+    MAX_TORQUE_N_M, MAX_VERTICES, MIN_RATE_HZ,
 };
 use super::device::device_from_table;
 use super::file::{BodySection, SceneFile};
@@ -236,6 +236,26 @@ pub(super) fn build(
             ));
         }
         params.guard = Some(g);
+    }
+    if let Some(t) = w.chain_tau {
+        if !(t.is_finite() && (0.0..=MAX_CHAIN_TAU_S).contains(&t)) {
+            errs.push(SceneError::new(
+                "world.chain_tau",
+                format!("must be a damping time in [0, {MAX_CHAIN_TAU_S}] s, got {t}"),
+                "e.g. chain_tau = 0.0002, or chain_tau = 0 to turn the chain damper off",
+            ));
+        }
+        params.chain_tau = (t > 0.0 && t.is_finite()).then_some(t);
+    }
+    if let Some(n) = w.chain_sweeps {
+        if n > MAX_CHAIN_SWEEPS {
+            errs.push(SceneError::new(
+                "world.chain_sweeps",
+                format!("must be in [0, {MAX_CHAIN_SWEEPS}], got {n}"),
+                "e.g. chain_sweeps = 16",
+            ));
+        }
+        params.chain_sweeps = n.min(MAX_CHAIN_SWEEPS);
     }
     let margin_needed = 2.0 * 1.0 * dt * params.proximity_every as f64 + params.delta_c;
     if params.delta_prox < margin_needed {

@@ -54,6 +54,11 @@ pub struct WorldSection {
     pub integration: Option<String>,
     /// Passivity guard tolerance ε_E (J); off when absent.
     pub guard: Option<f64>,
+    /// Damping time τ (s) of the implicit chain damper (stacks come to rest); 0 = off;
+    /// default 0.0002 (`WorldParams::chain_tau`).
+    pub chain_tau: Option<f64>,
+    /// Gauss–Seidel sweeps of the chain damper per sample; default 16.
+    pub chain_sweeps: Option<u32>,
     /// Accept bodies lighter than 1.5 × min_mass with a warning instead of an error.
     pub allow_light_bodies: Option<bool>,
     /// Accept bodies that start overlapping by more than `delta_c` (reported as warnings instead
