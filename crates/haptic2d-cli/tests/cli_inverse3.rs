@@ -128,7 +128,10 @@ fn a_turning_versegrip_turns_the_slave() {
         .collect();
     let end = *theta.last().unwrap();
     assert!(theta[0].abs() < 1e-6, "starts at {}", theta[0]);
-    assert!((0.45..0.95).contains(&end), "slave angle {end} rad after 3 s");
+    assert!(
+        (0.45..0.95).contains(&end),
+        "slave angle {end} rad after 3 s"
+    );
     // It turned steadily one way: never back by more than 0.05 rad.
     let mut top = f64::MIN;
     for &t in &theta {
