@@ -9,6 +9,7 @@
 //!   client crate, in planar mode, and an emulator of the service (DEVICES §4).
 #![warn(missing_docs)]
 
+pub mod device_toml;
 pub mod file_read;
 pub mod haply;
 #[cfg(feature = "inverse3")]

@@ -30,7 +30,6 @@ use haptic2d::device::pantograph2::Pantograph2;
 use haptic2d::device::DeviceParams;
 use haptic2d::geom::Vec2;
 use haptic2d::haptic::ControllerKind;
-use haptic2d::scene::MAX_FILE_BYTES;
 use haptic2d::scene::{device_params_from_toml, SceneError, SceneErrors};
 use serde::Deserialize;
 
@@ -200,12 +199,8 @@ fn usb_id(s: &str) -> Option<(u16, u16)> {
 impl HaplyDeviceFile {
     /// Reads and parses the file at `path`.
     pub fn from_path(path: &std::path::Path) -> Result<Self, String> {
-        let name = path.display().to_string();
-        let text =
-            crate::file_read::read_bounded(path, MAX_FILE_BYTES, "device file").map_err(|e| {
-                format!("{e}\n    fix: give the path of a Haply device file, e.g. {HAPLY_TEMPLATE}")
-            })?;
-        Self::from_toml(&text, &format!("device file {name}")).map_err(|e| e.to_string())
+        let (text, source) = crate::device_toml::read(path, "a Haply device file", HAPLY_TEMPLATE)?;
+        Self::from_toml(&text, &source).map_err(|e| e.to_string())
     }
 
     /// Parses a device file's text; `source` names it in messages.
@@ -214,13 +209,7 @@ impl HaplyDeviceFile {
             source: source.to_string(),
             errors,
         };
-        let raw: RawFile = toml::from_str(text).map_err(|e| {
-            fail(vec![SceneError::from_toml(
-                text,
-                &e,
-                format!("check the field names and TOML syntax against {HAPLY_TEMPLATE}"),
-            )])
-        })?;
+        let raw: RawFile = crate::device_toml::parse(text, source, HAPLY_TEMPLATE)?;
         let mut errs = Vec::new();
         let b = &raw.board;
         if !(0..=255).contains(&b.id) {

@@ -22,7 +22,6 @@
 //! half_width = 0.15             # m
 //! ```
 
-use haptic2d::scene::MAX_FILE_BYTES;
 use haptic2d::scene::{SceneError, SceneErrors};
 use serde::Deserialize;
 
@@ -170,14 +169,9 @@ impl Inverse3DeviceFile {
 
     /// Reads and parses the file at `path`.
     pub fn from_path(path: &std::path::Path) -> Result<Self, String> {
-        let name = path.display().to_string();
-        let text =
-            crate::file_read::read_bounded(path, MAX_FILE_BYTES, "device file").map_err(|e| {
-                format!(
-                    "{e}\n    fix: give the path of an Inverse3 device file, e.g. {INVERSE3_TEMPLATE}"
-                )
-            })?;
-        Self::from_toml(&text, &format!("device file {name}")).map_err(|e| e.to_string())
+        let (text, source) =
+            crate::device_toml::read(path, "an Inverse3 device file", INVERSE3_TEMPLATE)?;
+        Self::from_toml(&text, &source).map_err(|e| e.to_string())
     }
 
     /// Parses a device file's text; `source` names it in messages.
@@ -186,13 +180,7 @@ impl Inverse3DeviceFile {
             source: source.to_string(),
             errors,
         };
-        let raw: RawFile = toml::from_str(text).map_err(|e| {
-            fail(vec![SceneError::from_toml(
-                text,
-                &e,
-                format!("check the field names and TOML syntax against {INVERSE3_TEMPLATE}"),
-            )])
-        })?;
+        let raw: RawFile = crate::device_toml::parse(text, source, INVERSE3_TEMPLATE)?;
         let mut errs = Vec::new();
         let mut bad = |field: &str, msg: String, fix: &str| {
             errs.push(SceneError::new(field, msg, fix));

@@ -25,7 +25,6 @@
 //! pantograph system, so both ends of a pose/wrench device meet in joint space.
 
 use haptic2d::device::pantograph2::Pantograph2;
-use haptic2d::scene::MAX_FILE_BYTES;
 use haptic2d::scene::{SceneError, SceneErrors};
 use serde::Deserialize;
 
@@ -143,12 +142,8 @@ impl UdpDeviceFile {
 
     /// Reads and parses the file at `path`.
     pub fn from_path(path: &std::path::Path) -> Result<Self, String> {
-        let name = path.display().to_string();
-        let text =
-            crate::file_read::read_bounded(path, MAX_FILE_BYTES, "device file").map_err(|e| {
-                format!("{e}\n    fix: give the path of a UDP device file, e.g. {UDP_TEMPLATE}")
-            })?;
-        Self::from_toml(&text, &format!("device file {name}")).map_err(|e| e.to_string())
+        let (text, source) = crate::device_toml::read(path, "a UDP device file", UDP_TEMPLATE)?;
+        Self::from_toml(&text, &source).map_err(|e| e.to_string())
     }
 
     /// Parses a device file's text; `source` names it in messages.
@@ -157,13 +152,7 @@ impl UdpDeviceFile {
             source: source.to_string(),
             errors,
         };
-        let raw: RawFile = toml::from_str(text).map_err(|e| {
-            fail(vec![SceneError::from_toml(
-                text,
-                &e,
-                format!("check the field names and TOML syntax against {UDP_TEMPLATE}"),
-            )])
-        })?;
+        let raw: RawFile = crate::device_toml::parse(text, source, UDP_TEMPLATE)?;
         let mut errs = Vec::new();
         if raw.kind != "udp" {
             errs.push(SceneError::new(
