@@ -11,16 +11,13 @@
 
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Output, Stdio};
+use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
+mod common;
+use common::{column, text, turn};
+
 const BIN: &str = env!("CARGO_BIN_EXE_haptic2d");
-
-static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
-
-fn turn() -> std::sync::MutexGuard<'static, ()> {
-    ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner())
-}
 
 fn shipped_text(file: &str) -> String {
     std::fs::read_to_string(format!(
@@ -87,14 +84,6 @@ fn haply_run(pty: &str, file: &Path, duration: &str) -> Command {
         .arg(file)
         .args(["--headless", "--duration", duration, "--no-rt"]);
     c
-}
-
-fn text(o: &Output) -> String {
-    format!(
-        "{}\n{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
 }
 
 #[test]
@@ -255,15 +244,6 @@ fn devices_lists_ports_without_failing() {
 }
 
 /// Column `name` of a CSV log, as numbers.
-fn column(csv: &str, name: &str) -> Vec<f64> {
-    let mut lines = csv.lines();
-    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let i = header.iter().position(|h| *h == name).unwrap();
-    lines
-        .map(|l| l.split(',').nth(i).unwrap().parse().unwrap())
-        .collect()
-}
-
 /// Task L item 1: the Haply board runs in the one loop of `run` — its CSV log has the same columns
 /// as the simulated device's, the torques start at exactly zero and ramp in (a constant hand push
 /// on the emulated handle makes them grow), and every torque stays within the device file's limit.

@@ -9,39 +9,18 @@
 
 use std::io::{BufRead, BufReader};
 use std::path::PathBuf;
-use std::process::{Child, Command, Output, Stdio};
+use std::process::{Child, Command, Stdio};
 use std::thread;
 use std::time::Duration;
 
+mod common;
+use common::{column, patient_device_file, text, turn};
+
 const BIN: &str = env!("CARGO_BIN_EXE_haptic2d");
-
-static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
-
-fn turn() -> std::sync::MutexGuard<'static, ()> {
-    ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner())
-}
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
 
 /// The shipped file, patient about the machine's timing, in a temp dir.
 fn device_file(tag: &str) -> PathBuf {
-    let text = std::fs::read_to_string(root().join("devices/inverse3.toml"))
-        .unwrap()
-        .replace("timeout_periods = 20 ", "timeout_periods = 100")
-        .replace("max_missed_deadlines = 10 ", "max_missed_deadlines = 0  ")
-        .replace("max_stall_periods = 5 ", "max_stall_periods = 1000");
-    assert!(text.contains("timeout_periods = 100") && text.contains("max_missed_deadlines = 0 "));
-    assert!(text.contains("max_stall_periods = 1000"));
-    let dir = std::env::temp_dir().join(format!(
-        "haptic2d-cli-inverse3-{}-{tag}",
-        std::process::id()
-    ));
-    std::fs::create_dir_all(&dir).unwrap();
-    let p = dir.join("inverse3.toml");
-    std::fs::write(&p, text).unwrap();
-    p
+    patient_device_file("inverse3.toml", ("20", "100"), tag, "inverse3.toml")
 }
 
 struct Emulator(Child, String);
@@ -88,14 +67,6 @@ fn run(url: &str, file: &PathBuf, duration: &str) -> Command {
     c
 }
 
-fn text(o: &Output) -> String {
-    format!(
-        "{}\n{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
-}
-
 /// The VerseGrip's orientation turns the slave (issue 15: "θ comes from the handle's orientation
 /// where the service reports one"): the emulated grip turns at 0.3 rad/s while the hand holds the
 /// cursor still, the loop makes the grip's turn since the first reading the slave's twist target, and
@@ -116,16 +87,7 @@ fn a_turning_versegrip_turns_the_slave() {
         .unwrap();
     let out = text(&o);
     assert_eq!(o.status.code(), Some(0), "{out}");
-    let csv = std::fs::read_to_string(&log).unwrap();
-    let mut lines = csv.lines();
-    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let th = header
-        .iter()
-        .position(|h| *h == "slave.theta")
-        .unwrap_or_else(|| panic!("no slave.theta in {header:?}"));
-    let theta: Vec<f64> = lines
-        .map(|l| l.split(',').nth(th).unwrap().parse().unwrap())
-        .collect();
+    let theta = column(&std::fs::read_to_string(&log).unwrap(), "slave.theta");
     let end = *theta.last().unwrap();
     assert!(theta[0].abs() < 1e-6, "starts at {}", theta[0]);
     assert!(

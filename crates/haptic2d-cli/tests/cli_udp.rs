@@ -10,38 +10,20 @@
 use std::io::{BufRead, BufReader};
 use std::net::{SocketAddr, UdpSocket};
 use std::path::PathBuf;
-use std::process::{Child, Command, Output, Stdio};
+use std::process::{Child, Command, Stdio};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::Arc;
 use std::thread;
 use std::time::Duration;
 
+mod common;
+use common::{patient_device_file, root, text, turn};
+
 const BIN: &str = env!("CARGO_BIN_EXE_haptic2d");
-
-static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
-
-fn turn() -> std::sync::MutexGuard<'static, ()> {
-    ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner())
-}
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
 
 /// The reference file with a patient timeout and no missed-deadline limit, in a temp dir.
 fn device_file(tag: &str) -> PathBuf {
-    let text = std::fs::read_to_string(root().join("devices/udp-pantograph.toml"))
-        .unwrap()
-        .replace("timeout_periods = 3 ", "timeout_periods = 50")
-        .replace("max_missed_deadlines = 10 ", "max_missed_deadlines = 0  ")
-        .replace("max_stall_periods = 5 ", "max_stall_periods = 1000");
-    assert!(text.contains("timeout_periods = 50") && text.contains("max_missed_deadlines = 0 "));
-    assert!(text.contains("max_stall_periods = 1000"));
-    let dir = std::env::temp_dir().join(format!("haptic2d-cli-udp-{}-{tag}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let p = dir.join("udp.toml");
-    std::fs::write(&p, text).unwrap();
-    p
+    patient_device_file("udp-pantograph.toml", ("3", "50"), tag, "udp.toml")
 }
 
 struct Device(Child, SocketAddr);
@@ -81,14 +63,6 @@ fn run(addr: SocketAddr, file: &PathBuf, duration: &str) -> Command {
         .arg(file)
         .args(["--headless", "--no-rt", "--duration", duration]);
     c
-}
-
-fn text(o: &Output) -> String {
-    format!(
-        "{}\n{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
 }
 
 /// The number before `what` in the `udp:` counters line.

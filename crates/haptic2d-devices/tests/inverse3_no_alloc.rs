@@ -1,40 +1,19 @@
-//! The Inverse3 driver's exchange on the tick allocates nothing once open (issue 15): a counting
-//! allocator that counts only on the thread being measured (the client thread and the emulator
-//! allocate freely, off the tick).
+//! The Inverse3 driver's exchange on the tick allocates nothing once open (issue 15): the shared
+//! counting allocator counts per thread, so the client thread and the emulator allocate freely, off
+//! the tick.
 #![cfg(feature = "inverse3")]
 
 mod inverse3_support;
 use inverse3_support::*;
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
-use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
 use haptic2d_devices::inverse3::{Emulator3Config, Hand3};
 use haptic2d_rt::io::Device2Io;
 
-struct Counting;
-
-static ALLOCS: AtomicUsize = AtomicUsize::new(0);
-thread_local! {
-    static MEASURING: Cell<bool> = const { Cell::new(false) };
-}
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
-        if MEASURING.try_with(|m| m.get()).unwrap_or(false) {
-            ALLOCS.fetch_add(1, Ordering::Relaxed);
-        }
-        unsafe { System.alloc(l) }
-    }
-    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
-        unsafe { System.dealloc(p, l) }
-    }
-}
-
-#[global_allocator]
-static A: Counting = Counting;
+#[path = "../../haptic2d/tests/support/counting_alloc.rs"]
+mod counting_alloc;
+use counting_alloc::allocations;
 
 #[test]
 fn the_exchange_allocates_nothing_once_open() {
@@ -51,22 +30,19 @@ fn the_exchange_allocates_nothing_once_open() {
         wait_tick(t0, k + 1);
     }
     let mut reads = 0;
+    let mut allocs = 0;
     for k in 50..550 {
-        MEASURING.with(|m| m.set(true));
+        let before = allocations();
         let q = dev.read_joints();
         let w = dev.write_joint_torques(&[0.01, -0.01]);
-        MEASURING.with(|m| m.set(false));
+        allocs += allocations() - before;
         q.unwrap();
         w.unwrap();
         reads += 1;
         wait_tick(t0, k + 1);
     }
     assert_eq!(reads, 500);
-    assert_eq!(
-        ALLOCS.load(Ordering::Relaxed),
-        0,
-        "allocations on the tick's exchange"
-    );
+    assert_eq!(allocs, 0, "allocations on the tick's exchange");
     assert!(
         dev.sample().seq > 100,
         "states kept arriving: {}",

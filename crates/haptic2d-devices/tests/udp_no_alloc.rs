@@ -1,9 +1,6 @@
-//! The UDP exchange allocates nothing once open (issue 15): a counting allocator that counts only
-//! on the thread being measured (the in-test device thread allocates freely).
+//! The UDP exchange allocates nothing once open (issue 15): the shared counting allocator counts per
+//! thread, so the in-test device thread allocates freely.
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
-use std::sync::atomic::{AtomicUsize, Ordering};
 use std::thread;
 use std::time::Duration;
 
@@ -14,27 +11,9 @@ use haptic2d_rt::DeviceIo;
 mod udp_echo;
 use udp_echo::spawn_echo_device;
 
-struct Counting;
-
-static ALLOCS: AtomicUsize = AtomicUsize::new(0);
-thread_local! {
-    static MEASURING: Cell<bool> = const { Cell::new(false) };
-}
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
-        if MEASURING.try_with(|m| m.get()).unwrap_or(false) {
-            ALLOCS.fetch_add(1, Ordering::Relaxed);
-        }
-        unsafe { System.alloc(l) }
-    }
-    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
-        unsafe { System.dealloc(p, l) }
-    }
-}
-
-#[global_allocator]
-static A: Counting = Counting;
+#[path = "../../haptic2d/tests/support/counting_alloc.rs"]
+mod counting_alloc;
+use counting_alloc::allocations;
 
 #[test]
 fn the_exchange_allocates_nothing_once_open() {
@@ -46,17 +25,13 @@ fn the_exchange_allocates_nothing_once_open() {
         dev.read_encoders().unwrap();
         dev.write_torques(&[0.01, -0.01, 0.0, 0.0]).unwrap();
     }
-    MEASURING.with(|m| m.set(true));
+    let before = allocations();
     for _ in 0..500 {
         dev.read_encoders().unwrap();
         dev.write_torques(&[0.01, -0.01, 0.0, 0.0]).unwrap();
         thread::sleep(Duration::from_micros(200));
     }
-    MEASURING.with(|m| m.set(false));
+    let allocs = allocations() - before;
     assert!(dev.counters().fresh > 400, "{}", dev.counters());
-    assert_eq!(
-        ALLOCS.load(Ordering::Relaxed),
-        0,
-        "allocations on the exchange"
-    );
+    assert_eq!(allocs, 0, "allocations on the exchange");
 }

@@ -554,9 +554,9 @@ impl World {
         }
         // Implicit chain damper on the end-of-sample velocities (adds to forces and contact wrench).
         if self.params.mode == IntegrationMode::SemiImplicit {
-            self.chain.tau = self.params.chain_tau;
-            self.chain.sweeps = self.params.chain_sweeps;
             self.ledger.chain_damping_loss += self.chain.apply(
+                self.params.chain_tau,
+                self.params.chain_sweeps,
                 dt,
                 self.contacts.entries(),
                 &mut self.bodies,

@@ -11,10 +11,10 @@ pub fn haptic2d(args: &[&str]) -> Output {
         .expect("the binary runs")
 }
 
-/// Standard output and standard error of a finished run, concatenated.
+/// Standard output and standard error of a finished run, one after the other.
 pub fn text(o: &Output) -> String {
     format!(
-        "{}{}",
+        "{}\n{}",
         String::from_utf8_lossy(&o.stdout),
         String::from_utf8_lossy(&o.stderr)
     )
@@ -55,4 +55,58 @@ pub fn wait_with_limit(
     };
     let text = out.join().unwrap() + &err.join().unwrap();
     status.map(|s| (s, text))
+}
+
+/// Serialises the tests of one binary that start emulators or devices (keeps the load down).
+pub fn turn() -> std::sync::MutexGuard<'static, ()> {
+    static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// The repository's root.
+pub fn root() -> std::path::PathBuf {
+    std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+/// The shipped device file `devices/SHIPPED`, patient about a loaded machine's timing (its
+/// `timeout_periods = FROM` line set to `TO`, the missed-deadline check off, the stall limit at 1000
+/// periods: the CLI tests check protocols and exit paths, not timing), written as `NAME` into a
+/// temp dir of its own (`TAG` tells the tests of one binary apart).
+pub fn patient_device_file(
+    shipped: &str,
+    timeout: (&str, &str),
+    tag: &str,
+    name: &str,
+) -> std::path::PathBuf {
+    let from = format!("timeout_periods = {} ", timeout.0);
+    let to = format!("timeout_periods = {}", timeout.1);
+    let text = std::fs::read_to_string(root().join("devices").join(shipped))
+        .unwrap()
+        .replace(&from, &to)
+        .replace("max_missed_deadlines = 10 ", "max_missed_deadlines = 0  ")
+        .replace("max_stall_periods = 5 ", "max_stall_periods = 1000");
+    assert!(text.contains(&to) && text.contains("max_missed_deadlines = 0 "));
+    assert!(text.contains("max_stall_periods = 1000"));
+    let dir = std::env::temp_dir().join(format!(
+        "haptic2d-cli-{}-{}-{tag}",
+        name.trim_end_matches(".toml"),
+        std::process::id()
+    ));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+/// The column `name` of a CSV text with a header line, as numbers.
+pub fn column(csv: &str, name: &str) -> Vec<f64> {
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let i = header
+        .iter()
+        .position(|h| *h == name)
+        .unwrap_or_else(|| panic!("no column {name} in {header:?}"));
+    lines
+        .map(|l| l.split(',').nth(i).unwrap().parse().unwrap())
+        .collect()
 }

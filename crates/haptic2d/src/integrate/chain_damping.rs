@@ -11,7 +11,7 @@
 //! **What.** For every contact of a *chain* — a Continuous, loaded (`f_n > 0`) record of which a
 //! dynamic body touches at least two other bodies — an extra normal damper
 //! `B_c = m_c/τ` (`m_c = 1/w` the contact's effective normal mass,
-//! `w = 1/m_A + 1/m_B + (r_A×n)²/I_A + (r_B×n)²/I_B`, `τ` = [`ChainDamping::tau`]) acts on the
+//! `w = 1/m_A + 1/m_B + (r_A×n)²/I_A + (r_B×n)²/I_B`, `τ` = `WorldParams::chain_tau`) acts on the
 //! *end-of-sample* relative normal velocity (backward Euler): `F = −B_c·v⁺_n`, solved for all
 //! chain contacts together by projected Gauss–Seidel (fixed number of sweeps, in the contact
 //! set's key order, from zero impulses) with the bound `F ≥ −f_n` (the damper may cancel the
@@ -78,11 +78,6 @@ struct Row {
 /// The implicit chain damper of a world (its parameters and reused buffers).
 #[derive(Clone, Debug)]
 pub struct ChainDamping {
-    /// Damping time `τ` (s): a chain contact's damper is `B_c = m_c/τ` (N·s/m). `None` = off.
-    pub tau: Option<f64>,
-    /// Gauss–Seidel sweeps per sample (every sweep is passive; more sweeps damp the collective
-    /// modes of tall stacks faster).
-    pub sweeps: u32,
     partner: Vec<u32>,
     multi: Vec<bool>,
     vel: Vec<Vec2>,
@@ -92,23 +87,14 @@ pub struct ChainDamping {
     pub last_rows: usize,
 }
 
-/// Default damping time `τ` (s) of [`ChainDamping`].
+/// Default damping time `τ` (s) of the chain damper (`WorldParams::chain_tau`).
 pub const DEFAULT_CHAIN_TAU: f64 = 2.0e-4;
-/// Default number of Gauss–Seidel sweeps of [`ChainDamping`].
+/// Default number of the chain damper's Gauss–Seidel sweeps (`WorldParams::chain_sweeps`).
 pub const DEFAULT_CHAIN_SWEEPS: u32 = 16;
 
 impl Default for ChainDamping {
     fn default() -> Self {
-        Self::new(Some(DEFAULT_CHAIN_TAU), DEFAULT_CHAIN_SWEEPS)
-    }
-}
-
-impl ChainDamping {
-    /// A damper with damping time `tau` (s; `None` = off) and `sweeps` Gauss–Seidel sweeps.
-    pub fn new(tau: Option<f64>, sweeps: u32) -> Self {
         Self {
-            tau,
-            sweeps,
             partner: Vec::new(),
             multi: Vec::new(),
             vel: Vec::new(),
@@ -117,20 +103,27 @@ impl ChainDamping {
             last_rows: 0,
         }
     }
+}
 
+impl ChainDamping {
     /// Adds the chain dampers' forces of this sample to `wrenches` and to the bodies' held
     /// `force`/`torque` (which must hold every other force of the sample), given the contact
-    /// records `entries` of this sample and the sample period `dt` (s). Returns the kinetic energy
-    /// the dampers remove over the sample (J, ≥ 0 up to rounding).
+    /// records `entries` of this sample and the sample period `dt` (s), with damping time `tau`
+    /// (s: a chain contact's damper is `B_c = m_c/τ`, N·s/m; `None` = off) and `sweeps`
+    /// Gauss–Seidel sweeps (each one passive; more damp the collective modes of tall stacks
+    /// faster). Returns the kinetic energy the dampers remove over the sample (J, ≥ 0 up to
+    /// rounding).
     pub fn apply(
         &mut self,
+        tau: Option<f64>,
+        sweeps: u32,
         dt: f64,
         entries: &[VeContact],
         bodies: &mut [Body],
         wrenches: &mut [Wrench2],
     ) -> f64 {
         self.last_rows = 0;
-        let tau = match self.tau {
+        let tau = match tau {
             Some(t) if t > 0.0 && t.is_finite() && dt > 0.0 => t,
             _ => return 0.0,
         };
@@ -209,7 +202,7 @@ impl ChainDamping {
         let ke_star = self.kinetic(bodies);
         // 4. Projected Gauss–Seidel on F = −B_c·v⁺_n, F ≥ −f_n.
         let (vel, omega) = (&mut self.vel, &mut self.omega);
-        for _ in 0..self.sweeps {
+        for _ in 0..sweeps {
             for row in self.rows.iter_mut() {
                 let (a, b) = (row.a, row.b);
                 let v_rel = (vel[a] - vel[b]).dot(row.n) + omega[a] * row.rna - omega[b] * row.rnb;
