@@ -57,7 +57,7 @@ pub fn run(label: &str, w: &mut World, dt: f64, seconds: f64, every: f64, profil
     let steps = (seconds / dt).round() as usize;
     let every = ((every / dt).round() as usize).max(1);
     println!(
-        "{label}: t s | |v|max m/s | >1cm/s | mean y m | overlap mm | contacts | early | cpu µs/step"
+        "{label}: t s | |v|max m/s | >1cm/s | mean y m | overlap mm | contacts | early | chain sweeps | cpu µs/step"
     );
     let origin = std::time::Instant::now();
     // CPU time of every step after `profile_after`, by sample phase of the global period.
@@ -85,7 +85,7 @@ pub fn run(label: &str, w: &mut World, dt: f64, seconds: f64, every: f64, profil
                 .collect();
             let s = state::of(w, &poses);
             println!(
-                "{label}: {:6.2} | {:10.4} | {:6} | {:8.4} | {:10.3} | {:8} | {:5} | {:8.1}",
+                "{label}: {:6.2} | {:10.4} | {:6} | {:8.4} | {:10.3} | {:8} | {:5} | {:12} | {:8.1}",
                 k as f64 * dt,
                 s.max_speed,
                 s.moving,
@@ -93,6 +93,7 @@ pub fn run(label: &str, w: &mut World, dt: f64, seconds: f64, every: f64, profil
                 s.max_overlap * 1e3,
                 w.contacts().contact_count(),
                 w.continuous_stats().1,
+                w.chain_damper().last_sweeps,
                 cpu * 1e6 / since as f64
             );
             (cpu, since) = (0.0, 0);

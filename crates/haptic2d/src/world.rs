@@ -251,6 +251,12 @@ impl World {
     pub fn contact_wrench(&self, i: usize) -> Wrench2 {
         self.contact_wrench[i]
     }
+    /// The implicit chain damper: rows damped, sweeps run and warm-start scale of the last
+    /// sample (`integrate/chain_damping.rs`).
+    #[inline]
+    pub fn chain_damper(&self) -> &ChainDamping {
+        &self.chain
+    }
     /// Number of passivity-guard triggers so far (0 if the guard is off).
     pub fn guard_triggers(&self) -> u64 {
         self.guard.as_ref().map_or(0, |g| g.triggers)
@@ -558,7 +564,7 @@ impl World {
                 self.params.chain_tau,
                 self.params.chain_sweeps,
                 dt,
-                self.contacts.entries(),
+                self.contacts.loaded(),
                 &mut self.bodies,
                 &mut self.contact_wrench,
             );

@@ -14,4 +14,6 @@ pub use god_object::entry_point;
 pub use impact_friction::{default_impact_mu, ImpactFriction};
 pub use manager::{ContactSet, PastPoses, Wrench2};
 pub use params::ContactParams;
-pub use record::{ContactEvent, ContactState, EventKind, LawState, VeContact, NO_LAW};
+pub use record::{
+    ContactEvent, ContactState, EventKind, LawState, LoadedContact, VeContact, NO_LAW,
+};

@@ -127,6 +127,24 @@ impl VeContact {
     }
 }
 
+/// A Continuous record whose normal law pushed in the last sample (`f_n > 0`), as the force pass
+/// lists them for later passes (the chain damper): 64 bytes instead of the whole record.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LoadedContact {
+    /// The record's key (its place in key order).
+    pub key: VeCandidate,
+    /// Body owning the vertex ("A").
+    pub body_a: u32,
+    /// Body owning the edge ("B").
+    pub body_b: u32,
+    /// World position of the vertex (m).
+    pub point: Vec2,
+    /// Outward edge normal (world).
+    pub n: Vec2,
+    /// Normal force of the sample (N, > 0).
+    pub f_n: f64,
+}
+
 /// One transition of the contact state machine, for the trace that tests assert on (§8.2).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ContactEvent {

@@ -44,27 +44,27 @@
 //! body includes it after `finish_step` (before, in `begin_step`, only the explicit laws).
 
 use crate::body::Body;
-use crate::contact::{ContactState, VeContact, Wrench2};
+use crate::collide::VeCandidate;
+use crate::contact::{LoadedContact, Wrench2};
 use crate::geom::{cross, Vec2};
 
 /// No partner yet (per-body scratch).
 const NONE: u32 = u32::MAX;
 
-/// One chain contact in the solve, with everything its update needs (no body lookups in the
-/// sweeps).
+/// Colours of the row graph; rows that find none of them free go to one last, overflow colour.
+const COLOURS: u32 = 64;
+
+/// One chain contact in the solve: the normal, lever arms, masses and impulse its update needs
+/// (72 bytes, so the sweeps stream through a few hundred kB at most for a 1000-body pile).
 #[derive(Clone, Copy, Debug)]
 struct Row {
-    a: usize,
-    b: usize,
+    /// Solver-body indices of A and B.
+    a: u32,
+    b: u32,
     n: Vec2,
     /// `r_A × n`, `r_B × n` (m).
     rna: f64,
     rnb: f64,
-    /// Velocity change of A / B per unit impulse: `n/m`, and `(r × n)/I` (1/kg, 1/(kg·m)).
-    ja: Vec2,
-    ka: f64,
-    jb: Vec2,
-    kb: f64,
     /// Inverse effective normal mass `w` (1/kg).
     w: f64,
     /// `c = r/((1 + r)·w)` with `r = T/τ` (kg).
@@ -75,17 +75,72 @@ struct Row {
     lambda: f64,
 }
 
+/// A body's velocity and inverse mass, as the sweeps read and write them.
+#[derive(Clone, Copy, Debug, Default)]
+struct SolverBody {
+    v: Vec2,
+    omega: f64,
+    inv_mass: f64,
+    inv_inertia: f64,
+}
+
+impl Row {
+    /// Relative normal velocity of the row's points (m/s; positive separating).
+    #[inline(always)]
+    fn v_rel(&self, s: &[SolverBody]) -> f64 {
+        let (a, b) = (&s[self.a as usize], &s[self.b as usize]);
+        (a.v - b.v).dot(self.n) + a.omega * self.rna - b.omega * self.rnb
+    }
+
+    /// Applies the impulse `d` (N·s along `+n` on A, `−n` on B) to the working velocities.
+    #[inline(always)]
+    fn apply(&self, d: f64, s: &mut [SolverBody]) {
+        let a = &mut s[self.a as usize];
+        a.v += self.n * (a.inv_mass * d);
+        a.omega += a.inv_inertia * self.rna * d;
+        let b = &mut s[self.b as usize];
+        b.v -= self.n * (b.inv_mass * d);
+        b.omega -= b.inv_inertia * self.rnb * d;
+    }
+}
+
 /// The implicit chain damper of a world (its parameters and reused buffers).
 #[derive(Clone, Debug)]
 pub struct ChainDamping {
     partner: Vec<u32>,
     multi: Vec<bool>,
-    vel: Vec<Vec2>,
-    omega: Vec<f64>,
+    solver: Vec<SolverBody>,
+    /// The velocities without the dampers, `v*` (semi-implicit Euler).
+    star: Vec<SolverBody>,
+    /// Body positions (m).
+    pos: Vec<Vec2>,
+    /// Rows in contact-key order, then (after colouring) `sorted` in colour order.
     rows: Vec<Row>,
+    sorted: Vec<Row>,
+    /// Key-order index of each row of `sorted`.
+    slot: Vec<u32>,
+    /// Colour of each row (key order), rows per colour, and colours used per body.
+    colour: Vec<u32>,
+    per_colour: Vec<u32>,
+    used: Vec<u64>,
+    /// Keys of this sample's rows (key order) and the last sample's keys and impulses, for the
+    /// warm start.
+    keys: Vec<VeCandidate>,
+    prev_keys: Vec<VeCandidate>,
+    prev_lambda: Vec<f64>,
     /// Chain contacts damped in the last sample.
     pub last_rows: usize,
+    /// Sweeps run in the last sample (at most the `sweeps` asked for; fewer once converged).
+    pub last_sweeps: u32,
+    /// Scale `s ∈ [0, 1]` of the warm start in the last sample (1 = the last sample's impulses
+    /// kept whole; see [`ChainDamping::apply`]).
+    pub last_warm_scale: f64,
 }
+
+/// A sweep that changes no row's relative velocity by more than this (m/s) ends the solve:
+/// the impulses have converged (to far below the 1 cm/s rest criterion), and further sweeps
+/// would not change the sample. Any number of sweeps is passive, so stopping early is too.
+const CONVERGED: f64 = 1e-5;
 
 /// Default damping time `τ` (s) of the chain damper (`WorldParams::chain_tau`).
 pub const DEFAULT_CHAIN_TAU: f64 = 2.0e-4;
@@ -97,10 +152,21 @@ impl Default for ChainDamping {
         Self {
             partner: Vec::new(),
             multi: Vec::new(),
-            vel: Vec::new(),
-            omega: Vec::new(),
+            solver: Vec::new(),
+            star: Vec::new(),
+            pos: Vec::new(),
             rows: Vec::with_capacity(64),
+            sorted: Vec::with_capacity(64),
+            slot: Vec::with_capacity(64),
+            colour: Vec::with_capacity(64),
+            per_colour: vec![0; COLOURS as usize + 1],
+            used: Vec::new(),
+            keys: Vec::with_capacity(64),
+            prev_keys: Vec::with_capacity(64),
+            prev_lambda: Vec::with_capacity(64),
             last_rows: 0,
+            last_sweeps: 0,
+            last_warm_scale: 0.0,
         }
     }
 }
@@ -113,142 +179,267 @@ impl ChainDamping {
     /// Gauss–Seidel sweeps (each one passive; more damp the collective modes of tall stacks
     /// faster). Returns the kinetic energy the dampers remove over the sample (J, ≥ 0 up to
     /// rounding).
+    ///
+    /// **Warm start.** The sweeps start from the last sample's impulses of the same contacts
+    /// (by key), clamped to this sample's bounds and scaled by the `s ∈ [0, 1]` that minimises
+    /// `Φ(s·λ₀) = s·g + ½s²·h` (`g = λ₀ᵀv*`, `h = λ₀ᵀ(W + K⁻¹)λ₀`, both exact from two passes
+    /// over the rows), so `Φ(s·λ₀) ≤ Φ(0) = 0`: the passivity argument of the module docs holds
+    /// from there, and the sweeps only lower `Φ` further. A pile at rest changes its impulses
+    /// little from sample to sample, so a few sweeps reach what many cold ones did.
+    ///
+    /// **Order.** Rows are coloured greedily in key order (no two rows of a colour share a
+    /// dynamic body) and swept colour by colour: the updates of a colour are independent, so the
+    /// processor overlaps them instead of waiting on the body a row just wrote. Deterministic.
     pub fn apply(
         &mut self,
         tau: Option<f64>,
         sweeps: u32,
         dt: f64,
-        entries: &[VeContact],
+        loaded: &[LoadedContact],
         bodies: &mut [Body],
         wrenches: &mut [Wrench2],
     ) -> f64 {
         self.last_rows = 0;
+        self.last_sweeps = 0;
+        self.last_warm_scale = 0.0;
         let tau = match tau {
             Some(t) if t > 0.0 && t.is_finite() && dt > 0.0 => t,
-            _ => return 0.0,
+            _ => {
+                self.prev_keys.clear();
+                self.prev_lambda.clear();
+                return 0.0;
+            }
         };
+        if loaded.is_empty() {
+            self.prev_keys.clear();
+            self.prev_lambda.clear();
+            return 0.0;
+        }
         let n = bodies.len();
         if self.partner.len() != n {
             self.partner.resize(n, NONE);
             self.multi.resize(n, false);
-            self.vel.resize(n, Vec2::ZERO);
-            self.omega.resize(n, 0.0);
+            self.solver.resize(n, SolverBody::default());
+            self.star.resize(n, SolverBody::default());
+            self.pos.resize(n, Vec2::ZERO);
+            self.used.resize(n, 0);
         }
+        // 1. The velocities the integrator would reach without the dampers (semi-implicit
+        //    Euler), with the inverse masses the impulses act through (none for fixed bodies).
+        for (i, b) in bodies.iter().enumerate() {
+            self.pos[i] = b.pose.pos;
+            self.star[i] = if b.is_dynamic() {
+                let f = b.force - b.vel * b.damping;
+                SolverBody {
+                    v: b.vel + f * (dt * b.inv_mass),
+                    omega: b.omega + b.torque * dt * b.inv_inertia,
+                    inv_mass: b.inv_mass,
+                    inv_inertia: b.inv_inertia,
+                }
+            } else {
+                SolverBody {
+                    v: b.vel,
+                    omega: b.omega,
+                    inv_mass: 0.0,
+                    inv_inertia: 0.0,
+                }
+            };
+        }
+        let star = &self.star;
+        let dynamic = |i: usize| star[i].inv_mass > 0.0 || star[i].inv_inertia > 0.0;
+        // 2. Which dynamic bodies touch two or more other bodies.
         self.partner.fill(NONE);
         self.multi.fill(false);
-        // 1. Which dynamic bodies touch two or more other bodies.
-        for e in entries.iter().filter(|e| is_loaded(e)) {
+        for e in loaded {
             for (x, y) in [(e.body_a, e.body_b), (e.body_b, e.body_a)] {
-                if !bodies[x].is_dynamic() {
+                if !dynamic(x as usize) {
                     continue;
                 }
-                let p = &mut self.partner[x];
+                let p = &mut self.partner[x as usize];
                 if *p == NONE {
-                    *p = y as u32;
-                } else if *p != y as u32 {
-                    self.multi[x] = true;
+                    *p = y;
+                } else if *p != y {
+                    self.multi[x as usize] = true;
                 }
             }
         }
-        // 2. The chain contacts.
+        // 3. The chain contacts in key order, each with its colour (greedy: the lowest colour
+        //    neither body has yet; fixed bodies take any number) and its warm-start impulse:
+        //    the last sample's impulse of the same key (a merge of two key-sorted lists), within
+        //    this sample's bound.
         let r = dt / tau;
         self.rows.clear();
-        for e in entries.iter().filter(|e| is_loaded(e)) {
-            let (a, b) = (e.body_a, e.body_b);
-            let chain = (bodies[a].is_dynamic() && self.multi[a])
-                || (bodies[b].is_dynamic() && self.multi[b]);
-            if !chain {
+        self.keys.clear();
+        self.colour.clear();
+        self.per_colour.fill(0);
+        self.used.fill(0);
+        let mut g = 0.0;
+        let mut j = 0;
+        for e in loaded {
+            let (a, b) = (e.body_a as usize, e.body_b as usize);
+            let (dyn_a, dyn_b) = (dynamic(a), dynamic(b));
+            if !((dyn_a && self.multi[a]) || (dyn_b && self.multi[b])) {
                 continue;
             }
-            let (ba, bb) = (&bodies[a], &bodies[b]);
-            let rna = cross(e.point - ba.pose.pos, e.n);
-            let rnb = cross(e.point - bb.pose.pos, e.n);
+            let (sa, sb) = (&star[a], &star[b]);
+            let rna = cross(e.point - self.pos[a], e.n);
+            let rnb = cross(e.point - self.pos[b], e.n);
             let w =
-                ba.inv_mass + bb.inv_mass + ba.inv_inertia * rna * rna + bb.inv_inertia * rnb * rnb;
+                sa.inv_mass + sb.inv_mass + sa.inv_inertia * rna * rna + sb.inv_inertia * rnb * rnb;
             if !(w > 0.0 && w.is_finite()) {
                 continue;
             }
-            self.rows.push(Row {
-                a,
-                b,
+            while j < self.prev_keys.len() && self.prev_keys[j] < e.key {
+                j += 1;
+            }
+            let lo = -dt * e.f_n;
+            let warm = if j < self.prev_keys.len() && self.prev_keys[j] == e.key {
+                self.prev_lambda[j].max(lo)
+            } else {
+                0.0
+            };
+            let row = Row {
+                a: a as u32,
+                b: b as u32,
                 n: e.n,
                 rna,
                 rnb,
-                ja: e.n * ba.inv_mass,
-                ka: rna * ba.inv_inertia,
-                jb: e.n * bb.inv_mass,
-                kb: rnb * bb.inv_inertia,
                 w,
                 c: r / ((1.0 + r) * w),
-                lo: -dt * e.f_n,
-                lambda: 0.0,
-            });
+                lo,
+                lambda: if warm.is_finite() { warm } else { 0.0 },
+            };
+            // g = λ₀ᵀ·J·v* (see `warm_start`).
+            g += row.lambda * row.v_rel(star);
+            let taken = if dyn_a { self.used[a] } else { 0 } | if dyn_b { self.used[b] } else { 0 };
+            let c = (!taken).trailing_zeros().min(COLOURS);
+            if c < COLOURS {
+                self.used[a] |= (dyn_a as u64) << c;
+                self.used[b] |= (dyn_b as u64) << c;
+            }
+            self.colour.push(c);
+            self.per_colour[c as usize] += 1;
+            self.rows.push(row);
+            self.keys.push(e.key);
         }
         self.last_rows = self.rows.len();
         if self.rows.is_empty() {
+            self.prev_keys.clear();
+            self.prev_lambda.clear();
             return 0.0;
         }
-        // 3. The velocities the integrator would reach without the dampers (semi-implicit Euler).
-        for (i, b) in bodies.iter().enumerate() {
-            if b.is_dynamic() {
-                let f = b.force - b.vel * b.damping;
-                self.vel[i] = b.vel + f * (dt * b.inv_mass);
-                self.omega[i] = b.omega + b.torque * dt * b.inv_inertia;
-            } else {
-                self.vel[i] = b.vel;
-                self.omega[i] = b.omega;
-            }
-        }
-        let ke_star = self.kinetic(bodies);
-        // 4. Projected Gauss–Seidel on F = −B_c·v⁺_n, F ≥ −f_n.
-        let (vel, omega) = (&mut self.vel, &mut self.omega);
+        self.solver.copy_from_slice(&self.star);
+        let ke_star = kinetic(&self.star, bodies);
+        // 4. Warm start, scaled so that Φ(s·λ₀) ≤ 0 (see above).
+        self.last_warm_scale = self.warm_start(g, r);
+        // 5. Rows sorted by colour (stable: key order within a colour).
+        self.sort_by_colour();
+        // 6. Projected Gauss–Seidel on F = −B_c·v⁺_n, F ≥ −f_n, until converged.
+        let solver = &mut self.solver;
         for _ in 0..sweeps {
-            for row in self.rows.iter_mut() {
-                let (a, b) = (row.a, row.b);
-                let v_rel = (vel[a] - vel[b]).dot(row.n) + omega[a] * row.rna - omega[b] * row.rnb;
+            // Largest change of a row's relative velocity in this sweep (m/s).
+            let mut largest = 0.0f64;
+            for row in self.sorted.iter_mut() {
+                let v_rel = row.v_rel(solver);
                 let new = (-row.c * (v_rel - row.w * row.lambda)).max(row.lo);
                 let d = new - row.lambda;
                 row.lambda = new;
-                vel[a] += row.ja * d;
-                omega[a] += row.ka * d;
-                vel[b] -= row.jb * d;
-                omega[b] -= row.kb * d;
+                row.apply(d, solver);
+                largest = largest.max((d * row.w).abs());
+            }
+            self.last_sweeps += 1;
+            if largest <= CONVERGED {
+                break;
             }
         }
-        let removed = ke_star - self.kinetic(bodies);
-        // 5. The impulses as forces held over the sample.
+        let removed = ke_star - kinetic(&self.solver, bodies);
+        // 7. The impulses as forces held over the sample; remembered by key for the next warm start.
+        self.prev_lambda.clear();
+        self.prev_lambda.resize(self.rows.len(), 0.0);
         let inv_dt = 1.0 / dt;
-        for row in &self.rows {
+        for (row, &k) in self.sorted.iter().zip(&self.slot) {
+            self.prev_lambda[k as usize] = row.lambda;
+            let (a, b) = (row.a as usize, row.b as usize);
             let f = row.n * (row.lambda * inv_dt);
             let (ta, tb) = (row.rna * row.lambda * inv_dt, row.rnb * row.lambda * inv_dt);
-            wrenches[row.a].force += f;
-            wrenches[row.a].torque += ta;
-            wrenches[row.b].force -= f;
-            wrenches[row.b].torque -= tb;
-            bodies[row.a].force += f;
-            bodies[row.a].torque += ta;
-            bodies[row.b].force -= f;
-            bodies[row.b].torque -= tb;
+            wrenches[a].force += f;
+            wrenches[a].torque += ta;
+            wrenches[b].force -= f;
+            wrenches[b].torque -= tb;
+            bodies[a].force += f;
+            bodies[a].torque += ta;
+            bodies[b].force -= f;
+            bodies[b].torque -= tb;
         }
+        std::mem::swap(&mut self.prev_keys, &mut self.keys);
         removed
     }
 
-    /// Kinetic energy of the working velocities (J).
-    fn kinetic(&self, bodies: &[Body]) -> f64 {
-        let mut ke = 0.0;
-        for (i, b) in bodies.iter().enumerate() {
-            if b.is_dynamic() {
-                ke += 0.5
-                    * (b.mass * self.vel[i].dot(self.vel[i])
-                        + b.inertia * self.omega[i] * self.omega[i]);
+    /// Applies the warm-start impulses `λ₀` (in `rows`, with `g = λ₀ᵀ·J·v*`) scaled by the
+    /// `s ∈ [0, 1]` minimising `Φ(s·λ₀)`, starting from the velocities `v*` in `solver`;
+    /// returns `s`.
+    fn warm_start(&mut self, g: f64, r: f64) -> f64 {
+        for row in &self.rows {
+            if row.lambda != 0.0 {
+                row.apply(row.lambda, &mut self.solver);
             }
         }
-        ke
+        // h = λ₀ᵀ·W·λ₀ + λ₀ᵀ·K⁻¹·λ₀ = λ₀ᵀ·J·(v₀ − v*) + Σ λ₀ᵢ²·wᵢ/r.
+        let mut h = 0.0;
+        for row in &self.rows {
+            if row.lambda != 0.0 {
+                h += row.lambda * row.v_rel(&self.solver) + row.lambda * row.lambda * row.w / r;
+            }
+        }
+        h -= g;
+        let s = if h > 0.0 && g.is_finite() && h.is_finite() {
+            (-g / h).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        if s < 1.0 {
+            // v = v* + s·(v₀ − v*): from v* again, with the scaled impulses.
+            self.solver.copy_from_slice(&self.star);
+            for row in self.rows.iter_mut() {
+                row.lambda *= s;
+                if row.lambda != 0.0 {
+                    row.apply(row.lambda, &mut self.solver);
+                }
+            }
+        }
+        s
+    }
+
+    /// A stable counting sort of the rows by colour into `sorted`, with `slot` the key-order
+    /// index of each.
+    fn sort_by_colour(&mut self) {
+        // Exclusive prefix sums: the first position of each colour.
+        let mut at = 0u32;
+        for k in self.per_colour.iter_mut() {
+            let count = *k;
+            *k = at;
+            at += count;
+        }
+        self.sorted.clear();
+        self.sorted.resize(self.rows.len(), self.rows[0]);
+        self.slot.clear();
+        self.slot.resize(self.rows.len(), 0);
+        for (i, (row, &c)) in self.rows.iter().zip(&self.colour).enumerate() {
+            let p = &mut self.per_colour[c as usize];
+            self.sorted[*p as usize] = *row;
+            self.slot[*p as usize] = i as u32;
+            *p += 1;
+        }
     }
 }
 
-/// A Continuous record whose law pushes this sample.
-#[inline]
-fn is_loaded(e: &VeContact) -> bool {
-    e.state == Some(ContactState::Continuous) && e.f_n > 0.0
+/// Kinetic energy of the working velocities `s` of `bodies` (J; fixed bodies count none).
+fn kinetic(s: &[SolverBody], bodies: &[Body]) -> f64 {
+    let mut ke = 0.0;
+    for (sb, b) in s.iter().zip(bodies) {
+        if b.is_dynamic() {
+            ke += 0.5 * (b.mass * sb.v.dot(sb.v) + b.inertia * sb.omega * sb.omega);
+        }
+    }
+    ke
 }

@@ -4,7 +4,7 @@
 use super::ContactSet;
 use super::Wrench2;
 use crate::body::Body;
-use crate::contact::record::{ContactState, LawState, VeContact};
+use crate::contact::record::{ContactState, LawState, LoadedContact, VeContact};
 use crate::geom::{cross, Vec2};
 use crate::laws::friction::{FrictionInput, FrictionLaw, FrictionModel};
 use crate::laws::normal::{NormalInput, NormalLaw};
@@ -27,6 +27,7 @@ impl ContactSet {
         let mut stored = 0.0;
         // Every record is Continuous here (Colliding ones were resolved by the impacts of step 5).
         let mut records = 0;
+        self.loaded.clear();
         for idx in 0..self.entries.len() {
             if self.entries[idx].state != Some(ContactState::Continuous) {
                 continue;
@@ -42,6 +43,16 @@ impl ContactSet {
                 m_eff: e.m_eff,
             };
             e.f_n = law.normal.force(&input);
+            if e.f_n > 0.0 {
+                self.loaded.push(LoadedContact {
+                    key: e.key,
+                    body_a: e.body_a as u32,
+                    body_b: e.body_b as u32,
+                    point: e.point,
+                    n: e.n,
+                    f_n: e.f_n,
+                });
+            }
             add_force(wrenches, bodies, e.body_a, e.body_b, e.n * e.f_n, e.point);
             if !needs_ext {
                 friction_step(e, law, dt, 0.0, wrenches, bodies);

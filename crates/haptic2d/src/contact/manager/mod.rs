@@ -23,7 +23,7 @@ use crate::collide::{Collider, VeCandidate, DEFAULT_DELTA_C, NEAR_PARALLEL_ANGLE
 use crate::contact::impact::{ImpactRow, ImpactSolver};
 use crate::contact::law_pool::LawPool;
 use crate::contact::params::ContactParams;
-use crate::contact::record::{ContactEvent, LawState, VeContact};
+use crate::contact::record::{ContactEvent, LawState, LoadedContact, VeContact};
 use crate::geom::{Pose, Rot, Vec2};
 use crate::laws::friction::FrictionModel;
 use crate::laws::normal::NormalModel;
@@ -51,6 +51,8 @@ pub struct ContactSet {
     /// Thresholds and options.
     pub params: ContactParams,
     entries: Vec<VeContact>,
+    /// The Continuous records that pushed in the last force pass, in key order.
+    loaded: Vec<LoadedContact>,
     /// Law states of the records, addressed by [`VeContact::law`].
     laws: LawPool,
     merged: Vec<VeContact>,
@@ -86,6 +88,7 @@ impl ContactSet {
         Self {
             params,
             entries: Vec::with_capacity(64),
+            loaded: Vec::with_capacity(64),
             laws: LawPool::with_capacity(64),
             merged: Vec::with_capacity(64),
             pending: Vec::with_capacity(16),
@@ -122,6 +125,13 @@ impl ContactSet {
     #[inline]
     pub fn entries(&self) -> &[VeContact] {
         &self.entries
+    }
+
+    /// The Continuous records whose normal law pushed in the last sample (`f_n > 0`), in key
+    /// order, with what later passes need of them (the chain damper).
+    #[inline]
+    pub fn loaded(&self) -> &[LoadedContact] {
+        &self.loaded
     }
 
     /// The contact records (Colliding or Continuous), sorted by key.
