@@ -105,6 +105,12 @@ pub struct World {
     thickness: Vec<f64>,
     /// The smallest of `thickness` (m).
     thinnest: f64,
+    /// Running bound on how far any point of each body has moved (m): `|Δp| + |Δθ|·ρ` between
+    /// the poses of consecutive samples, however they changed (integration or a pose set from
+    /// outside). The local stage skips separated pairs whose gap this cannot have closed.
+    odometer: Vec<f64>,
+    /// Poses at the last odometer reading.
+    odometer_poses: Vec<Pose>,
     /// Body poses the proximity set in use was computed for.
     global_poses: Vec<Pose>,
     /// Body poses of the spread global update in progress (its snapshot).
@@ -190,6 +196,8 @@ impl World {
             radius,
             thickness,
             thinnest,
+            odometer: vec![0.0; n],
+            odometer_poses: global_poses.clone(),
             job_poses: global_poses.clone(),
             global_poses,
             vel_before: vec![(Vec2::ZERO, 0.0); n],
@@ -316,11 +324,22 @@ impl World {
         // 3. Global proximity stage: AABB sort-and-sweep + GJK, every N_g samples, and early when
         //    a body may have outrun the margin (`moved_past_margin`).
         self.global_stage();
-        // 4. Local stage: closest-feature tracking and VE candidates for proximate pairs.
-        self.local.update(
+        // 4. Local stage: closest-feature tracking and VE candidates for proximate pairs
+        //    (separated pairs whose gap the bodies' motion cannot have closed are skipped).
+        for ((odo, last), (b, &r)) in self
+            .odometer
+            .iter_mut()
+            .zip(self.odometer_poses.iter_mut())
+            .zip(self.bodies.iter().zip(&self.radius))
+        {
+            *odo += (b.pose.pos - last.pos).length() + (b.pose.angle - last.angle).abs() * r;
+            *last = b.pose;
+        }
+        self.local.update_with_motion(
             &self.colliders,
             &self.pairs,
             self.params.delta_c,
+            &self.odometer,
             &mut self.candidates,
         );
         // Loads are evaluated once per sample (held over it). Loads and drives enter the bodies'

@@ -66,6 +66,26 @@ pub struct PairState {
     pub features: ClosestFeatures,
 }
 
+impl PairState {
+    /// The state of a pair not tracked yet: separated at infinite distance.
+    fn untracked(pair: (u32, u32)) -> Self {
+        Self {
+            pair,
+            features: ClosestFeatures {
+                status: TrackStatus::Separated,
+                feature_a: Feature::Vertex(0),
+                feature_b: Feature::Vertex(0),
+                point_a: Vec2::ZERO,
+                point_b: Vec2::ZERO,
+                distance: f64::INFINITY,
+                parallel: false,
+                iterations: 0,
+                used_gjk: false,
+            },
+        }
+    }
+}
+
 /// Local stage: one closest-feature tracker per proximate pair, and VE candidate generation.
 #[derive(Clone, Debug)]
 pub struct LocalStage {
@@ -73,10 +93,44 @@ pub struct LocalStage {
     cos_parallel: f64,
     pairs: Vec<(u32, u32)>,
     trackers: Vec<FeatureTracker>,
+    /// The certified gap of each pair at its last tracked sample (see [`Gap`]).
+    gaps: Vec<Gap>,
     states: Vec<PairState>,
     old_pairs: Vec<(u32, u32)>,
     old_trackers: Vec<FeatureTracker>,
+    old_gaps: Vec<Gap>,
+    old_states: Vec<PairState>,
+    /// Pairs whose tracking the last update skipped (their gap still held).
+    skipped: usize,
+    /// Scratch of the candidate sort.
+    sort_buf: Vec<VeCandidate>,
+    bucket: Vec<u32>,
 }
+
+/// The slack of a separated pair beyond the contact tolerance when it was last tracked, and the
+/// two bodies' odometers then: while the bodies have moved less than the slack since (the
+/// odometers are bounds on the motion of every point of a body, m), the pair is still farther
+/// apart than `δ_c` and has no candidate, so its tracking can wait.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Gap {
+    /// `distance − δ_c − GAP_GUARD` at the last tracked sample (m); ≤ 0 = track every sample.
+    slack: f64,
+    /// Odometers of the two bodies then (m).
+    odo_a: f64,
+    odo_b: f64,
+}
+
+impl Gap {
+    const NONE: Gap = Gap {
+        slack: 0.0,
+        odo_a: 0.0,
+        odo_b: 0.0,
+    };
+}
+
+/// Kept off every certified gap (m): the tracker's distance is exact up to round-off, this
+/// absorbs that and the odometers' own rounding.
+const GAP_GUARD: f64 = 1e-6;
 
 impl Default for LocalStage {
     fn default() -> Self {
@@ -92,9 +146,15 @@ impl LocalStage {
             cos_parallel: NEAR_PARALLEL_ANGLE.cos(),
             pairs: Vec::new(),
             trackers: Vec::new(),
+            gaps: Vec::new(),
             states: Vec::new(),
             old_pairs: Vec::new(),
             old_trackers: Vec::new(),
+            old_gaps: Vec::new(),
+            old_states: Vec::new(),
+            skipped: 0,
+            sort_buf: Vec::new(),
+            bucket: Vec::new(),
         }
     }
 
@@ -104,9 +164,13 @@ impl LocalStage {
         let mut s = Self::new();
         s.pairs.reserve(pairs);
         s.trackers.reserve(pairs);
+        s.gaps.reserve(pairs);
         s.states.reserve(pairs);
         s.old_pairs.reserve(pairs);
         s.old_trackers.reserve(pairs);
+        s.old_gaps.reserve(pairs);
+        s.old_states.reserve(pairs);
+        s.sort_buf.reserve(2 * pairs);
         s
     }
 
@@ -131,9 +195,17 @@ impl LocalStage {
         &self.pairs
     }
 
-    /// Tracker results of the last update, one per pair, in pair order.
+    /// Tracker results, one per pair, in pair order: of the last update that tracked the pair
+    /// (a pair skipped by [`update_with_motion`](Self::update_with_motion) keeps its last
+    /// features; a pair never tracked, e.g. one naming a collider that does not exist, reads
+    /// separated at infinite distance).
     pub fn pair_states(&self) -> &[PairState] {
         &self.states
+    }
+
+    /// Pairs whose tracking the last update skipped because their certified gap still held.
+    pub fn skipped(&self) -> usize {
+        self.skipped
     }
 
     /// The trackers (with their work counters), in pair order.
@@ -145,15 +217,27 @@ impl LocalStage {
     fn rebuild(&mut self, pairs: &[(u32, u32)]) {
         std::mem::swap(&mut self.pairs, &mut self.old_pairs);
         std::mem::swap(&mut self.trackers, &mut self.old_trackers);
+        std::mem::swap(&mut self.gaps, &mut self.old_gaps);
+        std::mem::swap(&mut self.states, &mut self.old_states);
         self.pairs.clear();
         self.trackers.clear();
+        self.gaps.clear();
+        self.states.clear();
+        // Both lists are sorted: one merge keeps the trackers (and gaps) of pairs that persist.
+        let mut k = 0;
         for &p in pairs {
-            let t = match self.old_pairs.binary_search(&p) {
-                Ok(k) => self.old_trackers[k],
-                Err(_) => FeatureTracker::new(),
+            while k < self.old_pairs.len() && self.old_pairs[k] < p {
+                k += 1;
+            }
+            let (t, g, st) = if k < self.old_pairs.len() && self.old_pairs[k] == p {
+                (self.old_trackers[k], self.old_gaps[k], self.old_states[k])
+            } else {
+                (FeatureTracker::new(), Gap::NONE, PairState::untracked(p))
             };
             self.pairs.push(p);
             self.trackers.push(t);
+            self.gaps.push(g);
+            self.states.push(st);
         }
     }
 
@@ -168,16 +252,47 @@ impl LocalStage {
         delta_c: f64,
         out: &mut Vec<VeCandidate>,
     ) {
+        self.update_with_motion(colliders, pairs, delta_c, &[], out);
+    }
+
+    /// [`update`](Self::update), skipping the tracking of separated pairs that cannot have come
+    /// within `delta_c` since they were last tracked: `odometer[i]` (m) is a running bound on
+    /// the distance any point of body `i` has moved (non-decreasing; the world adds
+    /// `|Δp| + |Δθ|·ρ` every sample). A pair last tracked at distance `D` is skipped while its
+    /// bodies' odometers have grown by less than `D − δ_c` (less a guard) in all: its distance
+    /// is then still above `δ_c`, where it has no candidate, so the candidates are those of
+    /// tracking every pair. Its tracker and [`PairState`] keep their last features. An empty
+    /// `odometer` (or one shorter than the bodies) tracks every pair.
+    pub fn update_with_motion(
+        &mut self,
+        colliders: &[Collider],
+        pairs: &[(u32, u32)],
+        delta_c: f64,
+        odometer: &[f64],
+        out: &mut Vec<VeCandidate>,
+    ) {
         if self.pairs.as_slice() != pairs {
             self.rebuild(pairs);
         }
         out.clear();
-        self.states.clear();
+        self.skipped = 0;
+        // The candidate sort's buckets are sized now, before any contact needs them.
+        self.bucket.resize(colliders.len() + 1, 0);
         for (k, &(ia, ib)) in pairs.iter().enumerate() {
             let (Some(a), Some(b)) = (colliders.get(ia as usize), colliders.get(ib as usize))
             else {
                 continue;
             };
+            // The gap certified at the last tracked sample still holds: nothing to do.
+            let (odo_a, odo_b) = match (odometer.get(a.body), odometer.get(b.body)) {
+                (Some(&x), Some(&y)) => (x, y),
+                _ => (f64::NAN, f64::NAN),
+            };
+            let g = self.gaps[k];
+            if (odo_a - g.odo_a) + (odo_b - g.odo_b) < g.slack {
+                self.skipped += 1;
+                continue;
+            }
             let ctx = Ctx {
                 delta_c,
                 eps_s: self.eps_s,
@@ -193,20 +308,30 @@ impl LocalStage {
                 let inside_b = ctx.vertices_against(sb, sa, out);
                 if let Some(at) = inside_a.or(inside_b) {
                     let f = self.trackers[k].confirm_penetration(at);
-                    self.states.push(PairState {
+                    self.states[k] = PairState {
                         pair: (ia, ib),
                         features: f,
-                    });
+                    };
+                    self.gaps[k] = Gap::NONE;
                     continue;
                 }
                 out.truncate(mark);
             }
             // Closest features (§9.3).
             let f = self.trackers[k].update(a, b);
-            self.states.push(PairState {
+            self.states[k] = PairState {
                 pair: (ia, ib),
                 features: f,
-            });
+            };
+            // A separated pair farther than δ_c may wait until its bodies have moved its slack.
+            self.gaps[k] = match f.status {
+                TrackStatus::Separated if f.distance > delta_c + GAP_GUARD => Gap {
+                    slack: f.distance - delta_c - GAP_GUARD,
+                    odo_a,
+                    odo_b,
+                },
+                _ => Gap::NONE,
+            };
             // VE candidates (§9.4–9.5).
             let (a, b) = (sa, sb);
             match f.status {
@@ -231,8 +356,65 @@ impl LocalStage {
                 TrackStatus::Separated => {}
             }
         }
+        sort_dedup(out, &mut self.sort_buf, &mut self.bucket, colliders.len());
+    }
+}
+
+/// Sorts and deduplicates `out` (the candidates of one update): a counting sort by vertex
+/// collider into `buf` (each collider's candidates are a handful), then an insertion sort of
+/// each bucket. The same order as `sort_unstable` + `dedup` (keys are plain integers), in
+/// `O(n + colliders)`. `bucket` is scratch of `colliders + 1` starts.
+fn sort_dedup(
+    out: &mut Vec<VeCandidate>,
+    buf: &mut Vec<VeCandidate>,
+    bucket: &mut Vec<u32>,
+    colliders: usize,
+) {
+    if out.len() < 2 {
+        return;
+    }
+    if out.iter().any(|c| c.vertex_collider as usize >= colliders) {
+        // Not from these colliders (cannot happen from `update`): the general sort.
         out.sort_unstable();
         out.dedup();
+        return;
+    }
+    bucket.clear();
+    bucket.resize(colliders + 1, 0); // no allocation: sized by the caller
+    for c in out.iter() {
+        bucket[c.vertex_collider as usize + 1] += 1;
+    }
+    for i in 1..bucket.len() {
+        bucket[i] += bucket[i - 1];
+    }
+    buf.clear();
+    buf.resize(out.len(), out[0]);
+    for c in out.iter() {
+        let at = &mut bucket[c.vertex_collider as usize];
+        buf[*at as usize] = *c;
+        *at += 1;
+    }
+    // `bucket[i]` is now the end of collider i's run (and the start of i + 1's).
+    out.clear();
+    let mut start = 0usize;
+    for &end in bucket.iter().take(colliders) {
+        let run = &mut buf[start..end as usize];
+        if run.len() > 32 {
+            run.sort_unstable();
+        }
+        for i in 1..run.len() {
+            let mut j = i;
+            while j > 0 && run[j - 1] > run[j] {
+                run.swap(j - 1, j);
+                j -= 1;
+            }
+        }
+        for &c in run.iter() {
+            if out.last() != Some(&c) {
+                out.push(c);
+            }
+        }
+        start = end as usize;
     }
 }
 
@@ -413,8 +595,16 @@ impl Ctx {
     /// [`nearest_line`]).
     fn vertices_against(&self, a: Side, b: Side, out: &mut Vec<VeCandidate>) -> Option<Vec2> {
         let mut inside = None;
+        // A vertex farther than `δ_c + ε_s` outside B's box is farther than that from B: no
+        // candidate (one needs an edge whose range holds it within `ε_s` and whose line is
+        // within `δ_c`, which puts it within `δ_c + ε_s` of that edge) and not inside.
+        let reach = Vec2::new(self.delta_c + self.eps_s, self.delta_c + self.eps_s);
+        let (lo, hi) = (b.c.aabb.min - reach, b.c.aabb.max + reach);
         'vertex: for v in 0..a.c.len() {
             let p = a.c.world_vertices[v];
+            if p.x < lo.x || p.x > hi.x || p.y < lo.y || p.y > hi.y {
+                continue;
+            }
             let mut nearest = 0usize;
             let mut max_d = f64::NEG_INFINITY;
             // Edge lines within reach of the vertex (−δ_c ≤ d ≤ δ_c): two or more only within

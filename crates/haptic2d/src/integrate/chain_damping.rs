@@ -210,11 +210,8 @@ impl ChainDamping {
                 return 0.0;
             }
         };
-        if loaded.is_empty() {
-            self.prev_keys.clear();
-            self.prev_lambda.clear();
-            return 0.0;
-        }
+        // Per-body buffers are sized at the first call, before any contact, so that the first
+        // contacts do not allocate on the hot path.
         let n = bodies.len();
         if self.partner.len() != n {
             self.partner.resize(n, NONE);
@@ -223,6 +220,11 @@ impl ChainDamping {
             self.star.resize(n, SolverBody::default());
             self.pos.resize(n, Vec2::ZERO);
             self.used.resize(n, 0);
+        }
+        if loaded.is_empty() {
+            self.prev_keys.clear();
+            self.prev_lambda.clear();
+            return 0.0;
         }
         // 1. The velocities the integrator would reach without the dampers (semi-implicit
         //    Euler), with the inverse masses the impulses act through (none for fixed bodies).
