@@ -118,14 +118,26 @@ struct Gap {
     /// Odometers of the two bodies then (m).
     odo_a: f64,
     odo_b: f64,
+    /// The pair's bodies (`u32::MAX` for a collider that does not exist), kept here so that a
+    /// skipped pair reads nothing but this record.
+    body_a: u32,
+    body_b: u32,
+    /// The tracker's penetration flag after its last update (a copy, read every sample).
+    penetrating: bool,
 }
 
 impl Gap {
-    const NONE: Gap = Gap {
-        slack: 0.0,
-        odo_a: 0.0,
-        odo_b: 0.0,
-    };
+    /// A pair of bodies `body_a`, `body_b` to track at the next sample.
+    fn track(body_a: u32, body_b: u32) -> Gap {
+        Gap {
+            slack: 0.0,
+            odo_a: 0.0,
+            odo_b: 0.0,
+            body_a,
+            body_b,
+            penetrating: false,
+        }
+    }
 }
 
 /// Kept off every certified gap (m): the tracker's distance is exact up to round-off, this
@@ -214,7 +226,7 @@ impl LocalStage {
     }
 
     /// Replaces the pair list, keeping the trackers of pairs that persist (capacity is reused).
-    fn rebuild(&mut self, pairs: &[(u32, u32)]) {
+    fn rebuild(&mut self, pairs: &[(u32, u32)], colliders: &[Collider]) {
         std::mem::swap(&mut self.pairs, &mut self.old_pairs);
         std::mem::swap(&mut self.trackers, &mut self.old_trackers);
         std::mem::swap(&mut self.gaps, &mut self.old_gaps);
@@ -232,7 +244,10 @@ impl LocalStage {
             let (t, g, st) = if k < self.old_pairs.len() && self.old_pairs[k] == p {
                 (self.old_trackers[k], self.old_gaps[k], self.old_states[k])
             } else {
-                (FeatureTracker::new(), Gap::NONE, PairState::untracked(p))
+                let body = |c: u32| colliders.get(c as usize).map_or(u32::MAX, |c| c.body as u32);
+                let t = FeatureTracker::new();
+                let g = Gap::track(body(p.0), body(p.1));
+                (t, g, PairState::untracked(p))
             };
             self.pairs.push(p);
             self.trackers.push(t);
@@ -272,27 +287,30 @@ impl LocalStage {
         out: &mut Vec<VeCandidate>,
     ) {
         if self.pairs.as_slice() != pairs {
-            self.rebuild(pairs);
+            self.rebuild(pairs, colliders);
         }
         out.clear();
         self.skipped = 0;
         // The candidate sort's buckets are sized now, before any contact needs them.
         self.bucket.resize(colliders.len() + 1, 0);
         for (k, &(ia, ib)) in pairs.iter().enumerate() {
-            let (Some(a), Some(b)) = (colliders.get(ia as usize), colliders.get(ib as usize))
-            else {
-                continue;
-            };
             // The gap certified at the last tracked sample still holds: nothing to do.
-            let (odo_a, odo_b) = match (odometer.get(a.body), odometer.get(b.body)) {
+            let g = self.gaps[k];
+            let (odo_a, odo_b) = match (
+                odometer.get(g.body_a as usize),
+                odometer.get(g.body_b as usize),
+            ) {
                 (Some(&x), Some(&y)) => (x, y),
                 _ => (f64::NAN, f64::NAN),
             };
-            let g = self.gaps[k];
             if (odo_a - g.odo_a) + (odo_b - g.odo_b) < g.slack {
                 self.skipped += 1;
                 continue;
             }
+            let (Some(a), Some(b)) = (colliders.get(ia as usize), colliders.get(ib as usize))
+            else {
+                continue;
+            };
             let ctx = Ctx {
                 delta_c,
                 eps_s: self.eps_s,
@@ -302,7 +320,7 @@ impl LocalStage {
             // A pair that was penetrating and still has a vertex strictly inside the other polygon is
             // still penetrating: its candidates are exactly the vertex scan (§9.4), and the closest-
             // feature walk/GJK is skipped (resting contacts, e.g. a pile, stay on this path).
-            if self.trackers[k].is_penetrating() {
+            if g.penetrating {
                 let mark = out.len();
                 let inside_a = ctx.vertices_against(sa, sb, out);
                 let inside_b = ctx.vertices_against(sb, sa, out);
@@ -312,7 +330,10 @@ impl LocalStage {
                         pair: (ia, ib),
                         features: f,
                     };
-                    self.gaps[k] = Gap::NONE;
+                    self.gaps[k] = Gap {
+                        penetrating: self.trackers[k].is_penetrating(),
+                        ..Gap::track(g.body_a, g.body_b)
+                    };
                     continue;
                 }
                 out.truncate(mark);
@@ -329,9 +350,11 @@ impl LocalStage {
                     slack: f.distance - delta_c - GAP_GUARD,
                     odo_a,
                     odo_b,
+                    ..Gap::track(g.body_a, g.body_b)
                 },
-                _ => Gap::NONE,
+                _ => Gap::track(g.body_a, g.body_b),
             };
+            self.gaps[k].penetrating = self.trackers[k].is_penetrating();
             // VE candidates (§9.4–9.5).
             let (a, b) = (sa, sb);
             match f.status {

@@ -27,6 +27,8 @@ impl ContactSet {
         let mut stored = 0.0;
         // Every record is Continuous here (Colliding ones were resolved by the impacts of step 5).
         let mut records = 0;
+        // Records whose law slot does not follow the previous record's (see `LawPool::repack`).
+        let (mut last_slot, mut breaks) = (u32::MAX, 0usize);
         self.loaded.clear();
         for idx in 0..self.entries.len() {
             if self.entries[idx].state != Some(ContactState::Continuous) {
@@ -34,6 +36,8 @@ impl ContactSet {
             }
             records += 1;
             let e = &mut self.entries[idx];
+            breaks += (e.law != last_slot.wrapping_add(1)) as usize;
+            last_slot = e.law;
             let law = self.laws.get_mut(e.law);
             let input = NormalInput {
                 d: e.d,
@@ -76,6 +80,12 @@ impl ContactSet {
         }
         self.stored = stored;
         self.record_count = records;
+        // Scattered law slots cost a cache miss per record every sample: put them back in
+        // record order once an eighth of the records are out of sequence (new records take
+        // free or new slots).
+        if breaks > 1 && breaks * 8 > records {
+            self.laws.repack(&mut self.entries);
+        }
     }
 
     /// `F_ext,t,i` for the classical model (§4.1): the non-friction force on A along this
