@@ -68,3 +68,26 @@ fn every_pile_starts_inside_its_container() {
         }
     }
 }
+
+/// pile:5000 as 200 rows of 25 dropped its top rows from 11.2 m, and two boxes ended up inside
+/// each other on landing (issue 17): a pile of more than 1000 boxes keeps 40 rows and widens its
+/// container instead, so no box starts higher than pile:1000's.
+#[test]
+fn large_piles_keep_forty_rows_and_widen_the_container() {
+    let highest = |n: usize| {
+        let w = builtin(&format!("pile:{n}"), None).unwrap().unwrap().world;
+        w.bodies
+            .iter()
+            .filter(|b| b.is_dynamic())
+            .map(|b| b.pose.pos.y)
+            .fold(f64::NEG_INFINITY, f64::max)
+    };
+    let reference = highest(1000);
+    for n in [1001, 5000, 19_999] {
+        let h = highest(n);
+        assert!(
+            h <= reference + 1e-12,
+            "pile:{n} starts up to {h} m, pile:1000 {reference} m"
+        );
+    }
+}

@@ -244,7 +244,11 @@ impl LocalStage {
             let (t, g, st) = if k < self.old_pairs.len() && self.old_pairs[k] == p {
                 (self.old_trackers[k], self.old_gaps[k], self.old_states[k])
             } else {
-                let body = |c: u32| colliders.get(c as usize).map_or(u32::MAX, |c| c.body as u32);
+                let body = |c: u32| {
+                    colliders
+                        .get(c as usize)
+                        .map_or(u32::MAX, |c| c.body as u32)
+                };
                 let t = FeatureTracker::new();
                 let g = Gap::track(body(p.0), body(p.1));
                 (t, g, PairState::untracked(p))

@@ -79,3 +79,93 @@ impl LawPool {
         &mut self.states[slot as usize]
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::contact::VeContact;
+    use crate::laws::normal::PaperLaw;
+
+    fn record() -> VeContact {
+        use crate::collide::VeCandidate;
+        use crate::contact::record::LocalGeom;
+        use crate::geom::Vec2;
+        VeContact {
+            key: VeCandidate {
+                vertex_collider: 0,
+                vertex: 0,
+                edge_collider: 1,
+                edge: 0,
+            },
+            body_a: 0,
+            body_b: 1,
+            state: None,
+            d: [0.0; 3],
+            hist: 1,
+            s: 0.0,
+            s_prev: 0.0,
+            len: 1.0,
+            point: Vec2::ZERO,
+            n: Vec2::new(0.0, 1.0),
+            t: Vec2::new(1.0, 0.0),
+            c0: 0.0,
+            s0: 0.0,
+            s_g: 0.0,
+            s_entry: 0.0,
+            m_eff: 0.0,
+            law: NO_LAW,
+            f_n: 0.0,
+            f_t: 0.0,
+            since: 0,
+            local: LocalGeom {
+                v: Vec2::ZERO,
+                e0: Vec2::ZERO,
+                n: Vec2::new(0.0, 1.0),
+                t: Vec2::new(1.0, 0.0),
+            },
+        }
+    }
+
+    /// Repacking puts the records' slots in their order and keeps every record's state.
+    #[test]
+    fn repack_orders_slots_and_keeps_states() {
+        let mut pool = LawPool::with_capacity(8);
+        let normal = |kc: f64| NormalModel::Paper(PaperLaw::new(kc, 1.0));
+        // Slots handed out, some released and reused, so the records' slots are scattered.
+        let mut slots: Vec<u32> = (0..6)
+            .map(|i| pool.acquire(&normal(100.0 + i as f64), &FrictionModel::None))
+            .collect();
+        pool.release(slots[1]);
+        pool.release(slots[4]);
+        slots[1] = pool.acquire(&normal(201.0), &FrictionModel::None);
+        slots.swap(0, 5);
+        let kc_of = |pool: &LawPool, slot: u32| match pool.get(slot).unwrap().normal.model {
+            NormalModel::Paper(l) => l.kc,
+            _ => unreachable!(),
+        };
+        let mut records: Vec<VeContact> = Vec::new();
+        let template = record();
+        for &s in &slots {
+            records.push(VeContact { law: s, ..template });
+        }
+        records.insert(
+            2,
+            VeContact {
+                law: NO_LAW,
+                ..template
+            },
+        );
+        let before: Vec<f64> = slots.iter().map(|&s| kc_of(&pool, s)).collect();
+        pool.repack(&mut records);
+        let after: Vec<u32> = records.iter().map(|e| e.law).collect();
+        assert_eq!(after, vec![0, 1, NO_LAW, 2, 3, 4, 5]);
+        let kcs: Vec<f64> = records
+            .iter()
+            .filter(|e| e.law != NO_LAW)
+            .map(|e| kc_of(&pool, e.law))
+            .collect();
+        assert_eq!(kcs, before);
+        // The pool hands out new slots after the packed ones.
+        assert_eq!(pool.acquire(&normal(1.0), &FrictionModel::None), 6);
+    }
+}

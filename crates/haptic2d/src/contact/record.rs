@@ -14,13 +14,19 @@ use crate::laws::normal::{ContactNormal, NormalLaw};
 pub const NO_LAW: u32 = u32::MAX;
 
 /// The per-contact states of the normal law and the friction model of one contact record.
+///
+/// Laid out friction first, then the normal law's offset and model (`repr(C)` here and in
+/// [`ContactNormal`]): the common laws' fields (the reset integrator, 64 bytes; the paper law,
+/// 24) then sit in the first two cache lines of the 272-byte slot, which the force pass streams
+/// through every sample; the largest variant (the hysteretic wall's elements) fills the rest.
 #[derive(Clone, Copy, Debug)]
+#[repr(C)]
 pub struct LawState {
+    /// Friction-model state (a copy of the world's prototype, taken when the record was created).
+    pub friction: FrictionModel,
     /// Normal-law state (a copy of the world's prototype, taken when the record was created) with
     /// the surface offset of a resolved impact ([`ContactNormal`], docs/MODELS.md §F.7).
     pub normal: ContactNormal,
-    /// Friction-model state (a copy of the world's prototype, taken when the record was created).
-    pub friction: FrictionModel,
 }
 
 /// The state of a VE pair that is in contact (§8.2). A pair that is only tracked has no state.

@@ -445,3 +445,115 @@ fn kinetic(s: &[SolverBody], bodies: &[Body]) -> f64 {
     }
     ke
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::Pose;
+
+    /// A column of three 1 kg boxes (0.1 m) on a fixed floor: contacts floor–1, 1–2, 2–3 at the
+    /// boxes' bottom faces, each pushing with 10 N.
+    fn column() -> (Vec<Body>, Vec<LoadedContact>) {
+        let mut bodies = vec![Body::fixed("floor", Pose::new(0.0, -0.05, 0.0))];
+        for i in 0..3 {
+            let y = 0.05 + 0.1 * i as f64;
+            bodies.push(Body::dynamic(
+                "box",
+                1.0,
+                1.0 / 600.0,
+                Pose::new(0.0, y, 0.0),
+            ));
+        }
+        let loaded = (0..3u32)
+            .map(|i| LoadedContact {
+                key: VeCandidate {
+                    vertex_collider: i + 1,
+                    vertex: 0,
+                    edge_collider: i,
+                    edge: 2,
+                },
+                body_a: i + 1,
+                body_b: i,
+                point: Vec2::new(0.0, 0.1 * i as f64),
+                n: Vec2::new(0.0, 1.0),
+                f_n: 10.0,
+            })
+            .collect();
+        (bodies, loaded)
+    }
+
+    fn kinetic_of(bodies: &[Body]) -> f64 {
+        bodies.iter().map(|b| b.kinetic_energy()).sum()
+    }
+
+    /// A warm start from impulses that would now add energy (the column compressing, then
+    /// springing apart) is scaled down, and the damper still only removes energy.
+    #[test]
+    fn warm_start_that_would_add_energy_is_scaled_down() {
+        let (mut bodies, loaded) = column();
+        let mut wrenches = vec![Wrench2::default(); bodies.len()];
+        let mut chain = ChainDamping::default();
+        let dt = 1e-3;
+        // Sample 1: every box falls faster than the one below: the dampers push the boxes apart
+        // (λ > 0 on every row).
+        for (i, b) in bodies.iter_mut().enumerate().skip(1) {
+            b.vel = Vec2::new(0.0, -0.1 * i as f64);
+        }
+        let before = kinetic_of(&bodies);
+        let removed = chain.apply(Some(2e-4), 16, dt, &loaded, &mut bodies, &mut wrenches);
+        assert!(
+            removed > 0.0 && removed <= before,
+            "removed {removed} of {before} J"
+        );
+        assert!(
+            chain.prev_lambda.iter().all(|&l| l > 0.0),
+            "{:?}",
+            chain.prev_lambda
+        );
+        // Sample 2: the column springs apart instead; the last impulses (pushing apart) would add
+        // energy, so the warm start is scaled down, and the pass still removes energy.
+        for (i, b) in bodies.iter_mut().enumerate().skip(1) {
+            b.vel = Vec2::new(0.0, 0.1 * i as f64);
+            b.force = Vec2::ZERO;
+            b.torque = 0.0;
+        }
+        let removed = chain.apply(Some(2e-4), 0, dt, &loaded, &mut bodies, &mut wrenches);
+        assert!(
+            chain.last_warm_scale < 1.0,
+            "scale {}",
+            chain.last_warm_scale
+        );
+        assert!(removed >= 0.0, "removed {removed} J");
+        // And with sweeps the dampers pull nothing (F ≥ −f_n) and still only remove energy.
+        let removed = chain.apply(Some(2e-4), 16, dt, &loaded, &mut bodies, &mut wrenches);
+        assert!(removed >= 0.0, "removed {removed} J");
+    }
+
+    /// A warm start that still fits (the same compression again) is kept whole, and fewer sweeps
+    /// are needed than from zero.
+    #[test]
+    fn warm_start_that_fits_is_kept_and_saves_sweeps() {
+        let (mut bodies, loaded) = column();
+        let mut wrenches = vec![Wrench2::default(); bodies.len()];
+        let mut chain = ChainDamping::default();
+        let set = |bodies: &mut Vec<Body>| {
+            for (i, b) in bodies.iter_mut().enumerate().skip(1) {
+                b.vel = Vec2::new(0.0, -0.1 * i as f64);
+                b.force = Vec2::ZERO;
+                b.torque = 0.0;
+            }
+        };
+        set(&mut bodies);
+        chain.apply(Some(2e-4), 64, 1e-3, &loaded, &mut bodies, &mut wrenches);
+        let cold = chain.last_sweeps;
+        set(&mut bodies);
+        let removed = chain.apply(Some(2e-4), 64, 1e-3, &loaded, &mut bodies, &mut wrenches);
+        assert_eq!(chain.last_warm_scale, 1.0);
+        assert!(
+            chain.last_sweeps < cold,
+            "{} sweeps warm, {cold} cold",
+            chain.last_sweeps
+        );
+        assert!(removed > 0.0);
+    }
+}

@@ -28,11 +28,12 @@ use super::{NormalInput, NormalLaw, NormalModel};
 /// A contact record's normal law ([`NormalModel`], the copy of the scene's prototype) and its
 /// impact surface offset `σ` (m, ≥ 0; 0 outside an impact's aftermath).
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
 pub struct ContactNormal {
+    /// Surface offset `σ` (m): the law acts on the depth beyond it (first: read every sample).
+    offset: f64,
     /// The law and its per-contact state.
     pub model: NormalModel,
-    /// Surface offset `σ` (m): the law acts on the depth beyond it.
-    offset: f64,
 }
 
 impl ContactNormal {
