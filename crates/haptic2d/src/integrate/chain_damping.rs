@@ -13,17 +13,19 @@
 //! `B_c = m_c/τ` (`m_c = 1/w` the contact's effective normal mass,
 //! `w = 1/m_A + 1/m_B + (r_A×n)²/I_A + (r_B×n)²/I_B`, `τ` = `WorldParams::chain_tau`) acts on the
 //! *end-of-sample* relative normal velocity (backward Euler): `F = −B_c·v⁺_n`, solved for all
-//! chain contacts together by projected Gauss–Seidel (fixed number of sweeps, in the contact
-//! set's key order, from zero impulses) with the bound `F ≥ −f_n` (the damper may cancel the
+//! chain contacts together by projected Gauss–Seidel (warm-started from the last sample's
+//! impulses, rows in a greedy graph colouring, at most `chain_sweeps` sweeps, stopping once
+//! converged; see [`ChainDamping::apply`]) with the bound `F ≥ −f_n` (the damper may cancel the
 //! law's push but never pulls). Implicit, it is stable for any `τ > 0` and any number of contacts
 //! per body, so a contact can be damped near or above critical and the collective modes decay.
 //!
 //! **Passive.** With `v*` the velocities the integrator would reach without this damper, impulses
 //! `λ` change the kinetic energy by `λᵀv* + ½λᵀWλ = Φ(λ) − ½λᵀK⁻¹λ`, where
 //! `Φ(λ) = ½λᵀ(W + K⁻¹)λ + λᵀv*` (`K = diag(T·B_c)`) is the convex function that projected
-//! Gauss–Seidel decreases monotonically from `Φ(0) = 0` inside a box that contains 0. So
-//! `ΔKE ≤ −½λᵀK⁻¹λ ≤ 0` after every sweep, whatever the number of sweeps: the pass only removes
-//! energy (returned by [`ChainDamping::apply`]). Positions then advance with the damped velocity
+//! Gauss–Seidel decreases monotonically inside a box that contains 0, from any start with
+//! `Φ ≤ Φ(0) = 0` (zero impulses, or the warm start scaled to the exact minimiser of `Φ` along
+//! it). So `ΔKE ≤ −½λᵀK⁻¹λ ≤ 0` after every sweep, whatever the number of sweeps: the pass only
+//! removes energy (returned by [`ChainDamping::apply`]). Positions then advance with the damped velocity
 //! (semi-implicit Euler), as they do with any other held force.
 //!
 //! **Choice of τ and sweeps** (pile:1000 at 1 kHz, `haptic2d-bench --settle 6 --every 0.25 (or
@@ -32,6 +34,11 @@
 //! (0.0098 m/s at 5 s: no margin); 0.5 ms / 8, 3.75 s; 0.5 ms / 12 and / 16, blips of 1–2 cm/s
 //! up to 3.2–5 s; 0.2 ms / 8, 2.25 s; 0.1 ms / 4, *never* (500 bodies at 0.1 m/s at 5 s);
 //! **0.2 ms / 16, 2.15 s** (0.05 s checks; largest speed after 2.5 s 6.8 mm/s; the default).
+//! Those are cold sweeps (from zero). Warm-started (session 7): at most 4 / 6 / 8 / 16 sweeps
+//! gave rest from 2.35 / 2.05 / 2.65 / 2.15 s, and with the convergence stop (1e-5 m/s) at most
+//! 16 gives 2.15 s while a settled pile runs 1–4 sweeps; 4 or 6 fixed sweeps left the 10-box
+//! stacks of `tests/stack_corners.rs` with contacts churning after 2 s (4: 3.9 cm/s, 6:
+//! 7.7 mm/s), 8 passed (4.3 mm/s), 16 with the stop 0.64 mm/s.
 //! The sweeps matter beyond the pile: with 8 sweeps at τ = 0.2 ms the 25 aligned 10-box stacks
 //! of `tests/stack_corners.rs` kept rocking (2 cm/s, contacts churning after 2 s); with 16 they
 //! pass (2e-3 m/s). A sweep that has not converged leaves `F ≠ −B_c·v⁺` (still passive, but the
@@ -173,11 +180,12 @@ impl Default for ChainDamping {
 
 impl ChainDamping {
     /// Adds the chain dampers' forces of this sample to `wrenches` and to the bodies' held
-    /// `force`/`torque` (which must hold every other force of the sample), given the contact
-    /// records `entries` of this sample and the sample period `dt` (s), with damping time `tau`
-    /// (s: a chain contact's damper is `B_c = m_c/τ`, N·s/m; `None` = off) and `sweeps`
-    /// Gauss–Seidel sweeps (each one passive; more damp the collective modes of tall stacks
-    /// faster). Returns the kinetic energy the dampers remove over the sample (J, ≥ 0 up to
+    /// `force`/`torque` (which must hold every other force of the sample), given the loaded
+    /// contacts of this sample (`loaded`, from
+    /// [`ContactSet::loaded`](crate::contact::ContactSet::loaded)) and the sample period `dt`
+    /// (s), with damping time `tau` (s: a chain contact's damper is `B_c = m_c/τ`, N·s/m; `None`
+    /// = off) and at most `sweeps` Gauss–Seidel sweeps (each one passive; they stop once a sweep
+    /// changes no row's relative velocity by more than 1e-5 m/s). Returns the kinetic energy the dampers remove over the sample (J, ≥ 0 up to
     /// rounding).
     ///
     /// **Warm start.** The sweeps start from the last sample's impulses of the same contacts

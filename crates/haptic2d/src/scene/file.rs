@@ -57,7 +57,8 @@ pub struct WorldSection {
     /// Damping time τ (s) of the implicit chain damper (stacks come to rest); 0 = off;
     /// default 0.0002 (`WorldParams::chain_tau`).
     pub chain_tau: Option<f64>,
-    /// Gauss–Seidel sweeps of the chain damper per sample; default 16.
+    /// Gauss–Seidel sweeps of the chain damper per sample, at most (fewer once converged);
+    /// default 16.
     pub chain_sweeps: Option<u32>,
     /// Accept bodies lighter than 1.5 × min_mass with a warning instead of an error.
     pub allow_light_bodies: Option<bool>,
