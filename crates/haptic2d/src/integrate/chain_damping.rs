@@ -236,13 +236,19 @@ impl ChainDamping {
         }
         // 1. The velocities the integrator would reach without the dampers (semi-implicit
         //    Euler), with the inverse masses the impulses act through (none for fixed bodies).
+        let mut ke_star = 0.0;
         for (i, b) in bodies.iter().enumerate() {
             self.pos[i] = b.pose.pos;
             self.star[i] = if b.is_dynamic() {
                 let f = b.force - b.vel * b.damping;
+                let (v, omega) = (
+                    b.vel + f * (dt * b.inv_mass),
+                    b.omega + b.torque * dt * b.inv_inertia,
+                );
+                ke_star += 0.5 * (b.mass * v.dot(v) + b.inertia * omega * omega);
                 SolverBody {
-                    v: b.vel + f * (dt * b.inv_mass),
-                    omega: b.omega + b.torque * dt * b.inv_inertia,
+                    v,
+                    omega,
                     inv_mass: b.inv_mass,
                     inv_inertia: b.inv_inertia,
                 }
@@ -278,6 +284,7 @@ impl ChainDamping {
         //    the last sample's impulse of the same key (a merge of two key-sorted lists), within
         //    this sample's bound.
         let r = dt / tau;
+        self.solver.copy_from_slice(&self.star);
         self.rows.clear();
         self.keys.clear();
         self.colour.clear();
@@ -319,8 +326,11 @@ impl ChainDamping {
                 lo,
                 lambda: if warm.is_finite() { warm } else { 0.0 },
             };
-            // g = λ₀ᵀ·J·v* (see `warm_start`).
-            g += row.lambda * row.v_rel(star);
+            // g = λ₀ᵀ·J·v* (see `warm_start`), and the warm impulse applied.
+            if row.lambda != 0.0 {
+                g += row.lambda * row.v_rel(star);
+                row.apply(row.lambda, &mut self.solver);
+            }
             let taken = if dyn_a { self.used[a] } else { 0 } | if dyn_b { self.used[b] } else { 0 };
             let c = (!taken).trailing_zeros().min(COLOURS);
             if c < COLOURS {
@@ -338,12 +348,10 @@ impl ChainDamping {
             self.prev_lambda.clear();
             return 0.0;
         }
-        self.solver.copy_from_slice(&self.star);
-        let ke_star = kinetic(&self.star, bodies);
-        // 4. Warm start, scaled so that Φ(s·λ₀) ≤ 0 (see above).
-        self.last_warm_scale = self.warm_start(g, r);
-        // 5. Rows sorted by colour (stable: key order within a colour).
-        self.sort_by_colour();
+        // 4. Rows sorted by colour (stable: key order within a colour), and the warm start
+        //    scaled so that Φ(s·λ₀) ≤ 0 (see above).
+        let h = self.sort_by_colour(r);
+        self.last_warm_scale = self.scale_warm_start(g, h);
         // 6. Projected Gauss–Seidel on F = −B_c·v⁺_n, F ≥ −f_n, until converged.
         let solver = &mut self.solver;
         for _ in 0..sweeps {
@@ -385,32 +393,21 @@ impl ChainDamping {
         removed
     }
 
-    /// Applies the warm-start impulses `λ₀` (in `rows`, with `g = λ₀ᵀ·J·v*`) scaled by the
-    /// `s ∈ [0, 1]` minimising `Φ(s·λ₀)`, starting from the velocities `v*` in `solver`;
-    /// returns `s`.
-    fn warm_start(&mut self, g: f64, r: f64) -> f64 {
-        for row in &self.rows {
-            if row.lambda != 0.0 {
-                row.apply(row.lambda, &mut self.solver);
-            }
-        }
-        // h = λ₀ᵀ·W·λ₀ + λ₀ᵀ·K⁻¹·λ₀ = λ₀ᵀ·J·(v₀ − v*) + Σ λ₀ᵢ²·wᵢ/r.
-        let mut h = 0.0;
-        for row in &self.rows {
-            if row.lambda != 0.0 {
-                h += row.lambda * row.v_rel(&self.solver) + row.lambda * row.lambda * row.w / r;
-            }
-        }
-        h -= g;
+    /// Scales the warm start `λ₀` (applied whole to `solver` as the rows were built; `g =
+    /// λ₀ᵀ·J·v*`, `h = λ₀ᵀ·(W + K⁻¹)·λ₀`) by the `s ∈ [0, 1]` minimising `Φ(s·λ₀) = s·g +
+    /// ½s²·h`; returns `s`.
+    fn scale_warm_start(&mut self, g: f64, h: f64) -> f64 {
         let s = if h > 0.0 && g.is_finite() && h.is_finite() {
             (-g / h).clamp(0.0, 1.0)
+        } else if h == 0.0 && g == 0.0 {
+            1.0 // no warm impulse at all: nothing to scale
         } else {
             0.0
         };
         if s < 1.0 {
             // v = v* + s·(v₀ − v*): from v* again, with the scaled impulses.
             self.solver.copy_from_slice(&self.star);
-            for row in self.rows.iter_mut() {
+            for row in self.sorted.iter_mut() {
                 row.lambda *= s;
                 if row.lambda != 0.0 {
                     row.apply(row.lambda, &mut self.solver);
@@ -421,8 +418,9 @@ impl ChainDamping {
     }
 
     /// A stable counting sort of the rows by colour into `sorted`, with `slot` the key-order
-    /// index of each.
-    fn sort_by_colour(&mut self) {
+    /// index of each; returns `h = λ₀ᵀ·(W + K⁻¹)·λ₀ = λ₀ᵀ·J·(v₀ − v*) + Σ λ₀ᵢ²·wᵢ/r` of the warm
+    /// impulses `λ₀` (already applied to `solver`, so `J·v₀` is read there; `r = T/τ`).
+    fn sort_by_colour(&mut self, r: f64) -> f64 {
         // Exclusive prefix sums: the first position of each colour.
         let mut at = 0u32;
         for k in self.per_colour.iter_mut() {
@@ -434,12 +432,18 @@ impl ChainDamping {
         self.sorted.resize(self.rows.len(), self.rows[0]);
         self.slot.clear();
         self.slot.resize(self.rows.len(), 0);
+        let mut h = 0.0;
         for (i, (row, &c)) in self.rows.iter().zip(&self.colour).enumerate() {
+            if row.lambda != 0.0 {
+                h += row.lambda * (row.v_rel(&self.solver) - row.v_rel(&self.star))
+                    + row.lambda * row.lambda * row.w / r;
+            }
             let p = &mut self.per_colour[c as usize];
             self.sorted[*p as usize] = *row;
             self.slot[*p as usize] = i as u32;
             *p += 1;
         }
+        h
     }
 }
 
