@@ -102,6 +102,13 @@ pub fn run(label: &str, w: &mut World, dt: f64, seconds: f64, every: f64, profil
     if by_phase[0].is_empty() {
         return;
     }
+    let all_steps = crate::timing::Samples(by_phase.iter().flatten().copied().collect());
+    let (median, p99) = (all_steps.median(), all_steps.p99());
+    println!(
+        "{label}: CPU µs per step after {profile_after} s: median {median:.1}, p99 {p99:.1} (p99/median {:.2}), largest {:.1}",
+        p99 / median,
+        all_steps.quantile(1.0)
+    );
     let med: Vec<f64> = by_phase
         .into_iter()
         .map(|v| crate::timing::Samples(v).median())
