@@ -131,3 +131,34 @@ fn skipping_in_a_landing_pile_gives_the_same_candidates() {
         "{tracked} tracked, {skipped} skipped"
     );
 }
+
+/// A skipped pair is checked against the contact tolerance of the sample that checks it: a box
+/// 5 mm above a floor, tracked with `δ_c` = 2 mm (no candidate, then skipped while nothing moves),
+/// gets its candidates at once when `δ_c` is raised to 10 mm (the parameters are re-read every
+/// sample), as a stage that tracks every pair does.
+#[test]
+fn a_raised_contact_tolerance_reaches_skipped_pairs_at_once() {
+    let text = "name = \"gap\"\n[[body]]\nname = \"floor\"\nkind = \"fixed\"\n\
+                pieces = [[[-0.5, -0.1], [0.5, -0.1], [0.5, 0.0], [-0.5, 0.0]]]\n\
+                [[body]]\nname = \"box\"\nmass = 1.0\nbox = [0.1, 0.1]\nposition = [0.0, 0.055]\n";
+    let w = Scene::from_toml(text, "gap", None).expect("scene").world;
+    let colliders = w.colliders.clone();
+    let mut pairs = Vec::new();
+    haptic2d::collide::BroadPhase::new(haptic2d::collide::DEFAULT_DELTA_PROX)
+        .unwrap()
+        .update(&colliders, &mut pairs);
+    assert_eq!(pairs.len(), 1, "{pairs:?}");
+    let odometer = vec![0.0; w.bodies.len()];
+    let mut skipping = LocalStage::new();
+    let mut out = Vec::new();
+    for _ in 0..3 {
+        skipping.update_with_motion(&colliders, &pairs, 0.002, &odometer, &mut out);
+        assert!(out.is_empty(), "5 mm apart, δ_c = 2 mm: {out:?}");
+    }
+    assert_eq!(skipping.skipped(), 1, "the pair waits while nothing moves");
+    skipping.update_with_motion(&colliders, &pairs, 0.010, &odometer, &mut out);
+    let mut expected = Vec::new();
+    LocalStage::new().update(&colliders, &pairs, 0.010, &mut expected);
+    assert_eq!(expected.len(), 2, "the face's two corners: {expected:?}");
+    assert_eq!(out, expected);
+}

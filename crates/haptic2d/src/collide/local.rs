@@ -107,14 +107,15 @@ pub struct LocalStage {
     bucket: Vec<u32>,
 }
 
-/// The slack of a separated pair beyond the contact tolerance when it was last tracked, and the
-/// two bodies' odometers then: while the bodies have moved less than the slack since (the
+/// The certified distance of a separated pair when it was last tracked, and the two bodies'
+/// odometers then: while the bodies have moved less than that distance less `δ_c` since (the
 /// odometers are bounds on the motion of every point of a body, m), the pair is still farther
-/// apart than `δ_c` and has no candidate, so its tracking can wait.
+/// apart than `δ_c` and has no candidate, so its tracking can wait. `δ_c` is the one of the
+/// sample that checks, so a tolerance changed at run time counts at once.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Gap {
-    /// `distance − δ_c − GAP_GUARD` at the last tracked sample (m); ≤ 0 = track every sample.
-    slack: f64,
+    /// `distance − GAP_GUARD` at the last tracked sample (m); 0 = track every sample.
+    clear: f64,
     /// Odometers of the two bodies then (m).
     odo_a: f64,
     odo_b: f64,
@@ -130,7 +131,7 @@ impl Gap {
     /// A pair of bodies `body_a`, `body_b` to track at the next sample.
     fn track(body_a: u32, body_b: u32) -> Gap {
         Gap {
-            slack: 0.0,
+            clear: 0.0,
             odo_a: 0.0,
             odo_b: 0.0,
             body_a,
@@ -307,7 +308,7 @@ impl LocalStage {
                 (Some(&x), Some(&y)) => (x, y),
                 _ => (f64::NAN, f64::NAN),
             };
-            if (odo_a - g.odo_a) + (odo_b - g.odo_b) < g.slack {
+            if (odo_a - g.odo_a) + (odo_b - g.odo_b) < g.clear - delta_c {
                 self.skipped += 1;
                 continue;
             }
@@ -348,10 +349,10 @@ impl LocalStage {
                 pair: (ia, ib),
                 features: f,
             };
-            // A separated pair farther than δ_c may wait until its bodies have moved its slack.
+            // A separated pair farther than δ_c may wait until its bodies have moved its gap.
             self.gaps[k] = match f.status {
                 TrackStatus::Separated if f.distance > delta_c + GAP_GUARD => Gap {
-                    slack: f.distance - delta_c - GAP_GUARD,
+                    clear: f.distance - GAP_GUARD,
                     odo_a,
                     odo_b,
                     ..Gap::track(g.body_a, g.body_b)
