@@ -9,7 +9,7 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use haptic2d::device::{HandModel, SimDevice};
-use haptic2d::haptic::{HapticConfig, HapticSystem};
+use haptic2d::haptic::{HapticConfig, HapticSystem, SafetyConfig};
 use haptic2d::scene::builtin;
 use std::hint::black_box;
 use std::time::{Duration, Instant};
@@ -20,7 +20,14 @@ fn setup(scene: &str, hand: HandModel) -> (HapticSystem, SimDevice, HandModel) {
         .expect("valid")
         .world;
     let config = HapticConfig::default();
-    let sys = HapticSystem::new(world, &config).expect("system");
+    // The steady-state tick, without the start-up ramp: a hand that pushes from the first tick
+    // would carry the handle past the workspace while the torques ramp in (a safety stop, by
+    // design; the ramp's own path is tested in `tests/startup_ramp.rs`).
+    let safety = SafetyConfig {
+        ramp_time: 0.0,
+        ..SafetyConfig::default()
+    };
+    let sys = HapticSystem::with_safety(world, &config, safety).expect("system");
     let mut plant = SimDevice::new(&config.device, sys.device_start()).expect("plant");
     plant.substeps = 2;
     (sys, plant, hand)
