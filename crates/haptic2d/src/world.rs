@@ -333,7 +333,7 @@ impl World {
             .zip(self.odometer_poses.iter_mut())
             .zip(self.bodies.iter().zip(&self.radius))
         {
-            *odo += (b.pose.pos - last.pos).length() + (b.pose.angle - last.angle).abs() * r;
+            *odo += point_motion(last, &b.pose, r);
             *last = b.pose;
         }
         self.local.update_with_motion(
@@ -457,7 +457,7 @@ impl World {
             .zip(&self.radius)
             .any(|((b, g), &r)| {
                 b.is_dynamic() && {
-                    let d = (b.pose.pos - g.pos).length() + (b.pose.angle - g.angle).abs() * r;
+                    let d = point_motion(g, &b.pose, r);
                     let m = (b.vel.length() + b.omega.abs() * r) * dt;
                     d + m > limit
                 }
@@ -503,7 +503,7 @@ impl World {
         let mut max_motion = 0.0f64;
         for (i, b) in self.bodies.iter().enumerate() {
             let p = self.prev[i];
-            let m = (b.pose.pos - p.pos).length() + (b.pose.angle - p.angle).abs() * self.radius[i];
+            let m = point_motion(&p, &b.pose, self.radius[i]);
             self.motion[i] = if b.is_dynamic() { m } else { 0.0 };
             max_motion = max_motion.max(self.motion[i]);
         }
@@ -629,4 +629,12 @@ impl World {
         self.ledger.stored = self.contacts.stored_energy();
         self.tick += 1;
     }
+}
+
+/// A bound on how far any point of a body of vertex radius `radius` (m) moves between the poses
+/// `from` and `to`: `|Δp| + |Δθ|·ρ` (m), since a rotation by `Δθ` moves a point at distance `ρ`
+/// from the centre by `2ρ·|sin(Δθ/2)| ≤ |Δθ|·ρ`.
+#[inline]
+fn point_motion(from: &Pose, to: &Pose, radius: f64) -> f64 {
+    (to.pos - from.pos).length() + (to.angle - from.angle).abs() * radius
 }

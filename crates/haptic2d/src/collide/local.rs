@@ -401,12 +401,8 @@ fn sort_dedup(
     if out.len() < 2 {
         return;
     }
-    if out.iter().any(|c| c.vertex_collider as usize >= colliders) {
-        // Not from these colliders (cannot happen from `update`): the general sort.
-        out.sort_unstable();
-        out.dedup();
-        return;
-    }
+    // Candidates come only from pairs whose colliders exist (`update_with_motion` skips others).
+    debug_assert!(out.iter().all(|c| (c.vertex_collider as usize) < colliders));
     bucket.clear();
     bucket.resize(colliders + 1, 0); // no allocation: sized by the caller
     for c in out.iter() {
@@ -429,12 +425,13 @@ fn sort_dedup(
         let run = &mut buf[start..end as usize];
         if run.len() > 32 {
             run.sort_unstable();
-        }
-        for i in 1..run.len() {
-            let mut j = i;
-            while j > 0 && run[j - 1] > run[j] {
-                run.swap(j - 1, j);
-                j -= 1;
+        } else {
+            for i in 1..run.len() {
+                let mut j = i;
+                while j > 0 && run[j - 1] > run[j] {
+                    run.swap(j - 1, j);
+                    j -= 1;
+                }
             }
         }
         for &c in run.iter() {

@@ -25,8 +25,8 @@
 //! Gauss–Seidel decreases monotonically inside a box that contains 0, from any start with
 //! `Φ ≤ Φ(0) = 0` (zero impulses, or the warm start scaled to the exact minimiser of `Φ` along
 //! it). So `ΔKE ≤ −½λᵀK⁻¹λ ≤ 0` after every sweep, whatever the number of sweeps: the pass only
-//! removes energy (returned by [`ChainDamping::apply`]). Positions then advance with the damped velocity
-//! (semi-implicit Euler), as they do with any other held force.
+//! removes energy (returned by [`ChainDamping::apply`]). Positions then advance with the damped
+//! velocity (semi-implicit Euler), as they do with any other held force.
 //!
 //! **Choice of τ and sweeps** (pile:1000 at 1 kHz, `haptic2d-bench --settle 6 --every 0.25 (or
 //! 0.05) --set world.chain_tau=τ,world.chain_sweeps=S`; "at rest from" = the first check after
@@ -185,13 +185,13 @@ impl ChainDamping {
     /// [`ContactSet::loaded`](crate::contact::ContactSet::loaded)) and the sample period `dt`
     /// (s), with damping time `tau` (s: a chain contact's damper is `B_c = m_c/τ`, N·s/m; `None`
     /// = off) and at most `sweeps` Gauss–Seidel sweeps (each one passive; they stop once a sweep
-    /// changes no row's relative velocity by more than 1e-5 m/s). Returns the kinetic energy the dampers remove over the sample (J, ≥ 0 up to
-    /// rounding).
+    /// changes no row's relative velocity by more than 1e-5 m/s). Returns the kinetic energy the
+    /// dampers remove over the sample (J, ≥ 0 up to rounding).
     ///
     /// **Warm start.** The sweeps start from the last sample's impulses of the same contacts
     /// (by key), clamped to this sample's bounds and scaled by the `s ∈ [0, 1]` that minimises
-    /// `Φ(s·λ₀) = s·g + ½s²·h` (`g = λ₀ᵀv*`, `h = λ₀ᵀ(W + K⁻¹)λ₀`, both exact from two passes
-    /// over the rows), so `Φ(s·λ₀) ≤ Φ(0) = 0`: the passivity argument of the module docs holds
+    /// `Φ(s·λ₀) = s·g + ½s²·h` (`g = λ₀ᵀv*`, `h = λ₀ᵀ(W + K⁻¹)λ₀`, both exact, summed as the
+    /// rows are built and sorted), so `Φ(s·λ₀) ≤ Φ(0) = 0`: the passivity argument of the module docs holds
     /// from there, and the sweeps only lower `Φ` further. A pile at rest changes its impulses
     /// little from sample to sample, so a few sweeps reach what many cold ones did.
     ///
@@ -245,7 +245,7 @@ impl ChainDamping {
                     b.vel + f * (dt * b.inv_mass),
                     b.omega + b.torque * dt * b.inv_inertia,
                 );
-                ke_star += 0.5 * (b.mass * v.dot(v) + b.inertia * omega * omega);
+                ke_star += kinetic_of(b, v, omega);
                 SolverBody {
                     v,
                     omega,
@@ -326,7 +326,7 @@ impl ChainDamping {
                 lo,
                 lambda: if warm.is_finite() { warm } else { 0.0 },
             };
-            // g = λ₀ᵀ·J·v* (see `warm_start`), and the warm impulse applied.
+            // g = λ₀ᵀ·J·v* (see `scale_warm_start`), and the warm impulse applied.
             if row.lambda != 0.0 {
                 g += row.lambda * row.v_rel(star);
                 row.apply(row.lambda, &mut self.solver);
@@ -352,7 +352,7 @@ impl ChainDamping {
         //    scaled so that Φ(s·λ₀) ≤ 0 (see above).
         let h = self.sort_by_colour(r);
         self.last_warm_scale = self.scale_warm_start(g, h);
-        // 6. Projected Gauss–Seidel on F = −B_c·v⁺_n, F ≥ −f_n, until converged.
+        // 5. Projected Gauss–Seidel on F = −B_c·v⁺_n, F ≥ −f_n, until converged.
         let solver = &mut self.solver;
         for _ in 0..sweeps {
             // Largest change of a row's relative velocity in this sweep (m/s).
@@ -371,7 +371,7 @@ impl ChainDamping {
             }
         }
         let removed = ke_star - kinetic(&self.solver, bodies);
-        // 7. The impulses as forces held over the sample; remembered by key for the next warm start.
+        // 6. The impulses as forces held over the sample; remembered by key for the next warm start.
         self.prev_lambda.clear();
         self.prev_lambda.resize(self.rows.len(), 0.0);
         let inv_dt = 1.0 / dt;
@@ -452,10 +452,16 @@ fn kinetic(s: &[SolverBody], bodies: &[Body]) -> f64 {
     let mut ke = 0.0;
     for (sb, b) in s.iter().zip(bodies) {
         if b.is_dynamic() {
-            ke += 0.5 * (b.mass * sb.v.dot(sb.v) + b.inertia * sb.omega * sb.omega);
+            ke += kinetic_of(b, sb.v, sb.omega);
         }
     }
     ke
+}
+
+/// Kinetic energy of body `b` at velocity `v` (m/s) and spin `omega` (rad/s) (J).
+#[inline]
+fn kinetic_of(b: &Body, v: Vec2, omega: f64) -> f64 {
+    0.5 * (b.mass * v.dot(v) + b.inertia * omega * omega)
 }
 
 #[cfg(test)]
