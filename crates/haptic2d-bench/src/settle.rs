@@ -63,6 +63,8 @@ pub fn run(label: &str, w: &mut World, dt: f64, seconds: f64, every: f64, profil
     // CPU time of every step after `profile_after`, by sample phase of the global period.
     let n_g = w.params.proximity_every.max(1) as usize;
     let mut by_phase: Vec<Vec<f64>> = vec![Vec::new(); n_g];
+    // Every profiled step: (CPU µs, step, sweeps, damped rows, contact events).
+    let mut each: Vec<(f64, usize, u32, usize, usize)> = Vec::new();
     let (mut cpu, mut since) = (0.0, 0usize);
     for k in 1..=steps {
         let t0 = now(Clock::Cpu, origin);
@@ -75,6 +77,14 @@ pub fn run(label: &str, w: &mut World, dt: f64, seconds: f64, every: f64, profil
         cpu += dt_cpu;
         if k > first_profiled {
             by_phase[(k - 1) % n_g].push(dt_cpu * 1e6);
+            let d = w.chain_damper();
+            each.push((
+                dt_cpu * 1e6,
+                k,
+                d.last_sweeps,
+                d.last_rows,
+                w.contacts().events().len(),
+            ));
         }
         since += 1;
         if k % every == 0 || k == steps {
@@ -108,6 +118,15 @@ pub fn run(label: &str, w: &mut World, dt: f64, seconds: f64, every: f64, profil
         "{label}: CPU µs per step after {profile_after} s: median {median:.1}, p99 {p99:.1} (p99/median {:.2}), largest {:.1}",
         p99 / median,
         all_steps.quantile(1.0)
+    );
+    each.sort_by(|a, b| b.0.total_cmp(&a.0));
+    println!(
+        "{label}: slowest steps (µs @ step: phase mod {n_g}, chain sweeps, damped rows, contact events): {}",
+        each.iter()
+            .take(8)
+            .map(|(t, k, s, r, e)| format!("{t:.0} @ {k}: {}, {s}, {r}, {e}", (k - 1) % n_g))
+            .collect::<Vec<_>>()
+            .join("; ")
     );
     let med: Vec<f64> = by_phase
         .into_iter()

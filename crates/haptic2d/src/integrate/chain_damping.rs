@@ -92,6 +92,44 @@ struct SolverBody {
 }
 
 impl Row {
+    /// The row of chain contact `e` between solver bodies `a` and `b` (body positions `pos`,
+    /// velocities and inverse masses `star`; `r = T/τ`, `dt = T` in s), warm-started from the
+    /// impulse `prev` (N·s) within this sample's bound; `None` if the effective mass is not
+    /// finite and positive.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn new(
+        e: &LoadedContact,
+        a: u32,
+        b: u32,
+        pos: &[Vec2],
+        star: &[SolverBody],
+        r: f64,
+        dt: f64,
+        prev: f64,
+    ) -> Option<Row> {
+        let (sa, sb) = (&star[a as usize], &star[b as usize]);
+        let rna = cross(e.point - pos[a as usize], e.n);
+        let rnb = cross(e.point - pos[b as usize], e.n);
+        let w = sa.inv_mass + sb.inv_mass + sa.inv_inertia * rna * rna + sb.inv_inertia * rnb * rnb;
+        if !(w > 0.0 && w.is_finite()) {
+            return None;
+        }
+        let lo = -dt * e.f_n;
+        let warm = prev.max(lo);
+        Some(Row {
+            a,
+            b,
+            n: e.n,
+            rna,
+            rnb,
+            w,
+            c: r / ((1.0 + r) * w),
+            lo,
+            lambda: if warm.is_finite() { warm } else { 0.0 },
+        })
+    }
+
     /// Relative normal velocity of the row's points (m/s; positive separating).
     #[inline(always)]
     fn v_rel(&self, s: &[SolverBody]) -> f64 {
@@ -124,8 +162,15 @@ pub struct ChainDamping {
     /// Rows in contact-key order, then (after colouring) `sorted` in colour order.
     rows: Vec<Row>,
     sorted: Vec<Row>,
-    /// Key-order index of each row of `sorted`.
+    /// Key-order index of each row of `sorted`, and its index in the sample's loaded list.
     slot: Vec<u32>,
+    src: Vec<u32>,
+    /// Loaded-list index of each row of `rows` (key order).
+    row_src: Vec<u32>,
+    /// Keys of the last sample's loaded list (all of it, chain or not), and which bodies were
+    /// dynamic: when both are unchanged, the rows are refreshed in place.
+    loaded_keys: Vec<VeCandidate>,
+    was_dynamic: Vec<bool>,
     /// Colour of each row (key order), rows per colour, and colours used per body.
     colour: Vec<u32>,
     per_colour: Vec<u32>,
@@ -137,6 +182,9 @@ pub struct ChainDamping {
     prev_lambda: Vec<f64>,
     /// Chain contacts damped in the last sample.
     pub last_rows: usize,
+    /// Whether the last sample refreshed the rows of the sample before in place (its loaded
+    /// contacts were the same) instead of building them.
+    pub last_refreshed: bool,
     /// Sweeps run in the last sample (at most the `sweeps` asked for; fewer once converged).
     pub last_sweeps: u32,
     /// Scale `s ∈ [0, 1]` of the warm start in the last sample (1 = the last sample's impulses
@@ -165,6 +213,10 @@ impl Default for ChainDamping {
             rows: Vec::with_capacity(64),
             sorted: Vec::with_capacity(64),
             slot: Vec::with_capacity(64),
+            src: Vec::with_capacity(64),
+            row_src: Vec::with_capacity(64),
+            loaded_keys: Vec::with_capacity(64),
+            was_dynamic: Vec::new(),
             colour: Vec::with_capacity(64),
             per_colour: vec![0; COLOURS as usize + 1],
             used: Vec::new(),
@@ -172,6 +224,7 @@ impl Default for ChainDamping {
             prev_keys: Vec::with_capacity(64),
             prev_lambda: Vec::with_capacity(64),
             last_rows: 0,
+            last_refreshed: false,
             last_sweeps: 0,
             last_warm_scale: 0.0,
         }
@@ -198,6 +251,11 @@ impl ChainDamping {
     /// **Order.** Rows are coloured greedily in key order (no two rows of a colour share a
     /// dynamic body) and swept colour by colour: the updates of a colour are independent, so the
     /// processor overlaps them instead of waiting on the body a row just wrote. Deterministic.
+    ///
+    /// **Refresh.** When the loaded contacts are those of the last sample (same keys in the same
+    /// order, same dynamic bodies: most samples of a pile at rest), so are the chain contacts,
+    /// their colours and their order; the rows are then refreshed in place from the new geometry
+    /// instead of being matched by key, coloured and sorted again (`last_refreshed`).
     pub fn apply(
         &mut self,
         tau: Option<f64>,
@@ -208,13 +266,13 @@ impl ChainDamping {
         wrenches: &mut [Wrench2],
     ) -> f64 {
         self.last_rows = 0;
+        self.last_refreshed = false;
         self.last_sweeps = 0;
         self.last_warm_scale = 0.0;
         let tau = match tau {
             Some(t) if t > 0.0 && t.is_finite() && dt > 0.0 => t,
             _ => {
-                self.prev_keys.clear();
-                self.prev_lambda.clear();
+                self.forget();
                 return 0.0;
             }
         };
@@ -228,15 +286,17 @@ impl ChainDamping {
             self.star.resize(n, SolverBody::default());
             self.pos.resize(n, Vec2::ZERO);
             self.used.resize(n, 0);
+            self.was_dynamic.resize(n, false);
+            self.forget();
         }
         if loaded.is_empty() {
-            self.prev_keys.clear();
-            self.prev_lambda.clear();
+            self.forget();
             return 0.0;
         }
         // 1. The velocities the integrator would reach without the dampers (semi-implicit
         //    Euler), with the inverse masses the impulses act through (none for fixed bodies).
         let mut ke_star = 0.0;
+        let mut same_bodies = true;
         for (i, b) in bodies.iter().enumerate() {
             self.pos[i] = b.pose.pos;
             self.star[i] = if b.is_dynamic() {
@@ -260,6 +320,93 @@ impl ChainDamping {
                     inv_inertia: 0.0,
                 }
             };
+            let d = self.star[i].inv_mass > 0.0 || self.star[i].inv_inertia > 0.0;
+            same_bodies &= self.was_dynamic[i] == d;
+            self.was_dynamic[i] = d;
+        }
+        // 2–4. The rows: refreshed in place when the loaded contacts are those of the last
+        //      sample (a pile at rest, most samples), built from scratch otherwise.
+        let r = dt / tau;
+        let same = same_bodies
+            && !self.sorted.is_empty()
+            && loaded.len() == self.loaded_keys.len()
+            && loaded
+                .iter()
+                .zip(&self.loaded_keys)
+                .all(|(e, k)| e.key == *k);
+        let (g, h) = match same.then(|| self.refresh_rows(r, dt, loaded)).flatten() {
+            Some(gh) => {
+                self.last_refreshed = true;
+                gh
+            }
+            None => {
+                let g = self.build_rows(r, dt, loaded);
+                if self.rows.is_empty() {
+                    self.forget();
+                    return 0.0;
+                }
+                (g, self.sort_by_colour(r))
+            }
+        };
+        self.last_rows = self.sorted.len();
+        self.last_warm_scale = self.scale_warm_start(g, h);
+        // 5. Projected Gauss–Seidel on F = −B_c·v⁺_n, F ≥ −f_n, until converged.
+        let solver = &mut self.solver;
+        for _ in 0..sweeps {
+            // Largest change of a row's relative velocity in this sweep (m/s).
+            let mut largest = 0.0f64;
+            for row in self.sorted.iter_mut() {
+                let v_rel = row.v_rel(solver);
+                let new = (-row.c * (v_rel - row.w * row.lambda)).max(row.lo);
+                let d = new - row.lambda;
+                row.lambda = new;
+                row.apply(d, solver);
+                largest = largest.max((d * row.w).abs());
+            }
+            self.last_sweeps += 1;
+            if largest <= CONVERGED {
+                break;
+            }
+        }
+        let removed = ke_star - kinetic(&self.solver, bodies);
+        // 6. The impulses as forces held over the sample (the rows keep them for the next warm
+        //    start).
+        let inv_dt = 1.0 / dt;
+        for row in &self.sorted {
+            let (a, b) = (row.a as usize, row.b as usize);
+            let f = row.n * (row.lambda * inv_dt);
+            let (ta, tb) = (row.rna * row.lambda * inv_dt, row.rnb * row.lambda * inv_dt);
+            wrenches[a].force += f;
+            wrenches[a].torque += ta;
+            wrenches[b].force -= f;
+            wrenches[b].torque -= tb;
+            bodies[a].force += f;
+            bodies[a].torque += ta;
+            bodies[b].force -= f;
+            bodies[b].torque -= tb;
+        }
+        removed
+    }
+
+    /// Drops the rows of the last sample: the next sample starts cold.
+    fn forget(&mut self) {
+        self.sorted.clear();
+        self.slot.clear();
+        self.src.clear();
+        self.keys.clear();
+        self.loaded_keys.clear();
+    }
+
+    /// Steps 2–3 from scratch: the chain contacts of `loaded` in key order (`rows`, `keys`), each
+    /// with its colour and its warm-start impulse, the last sample's impulse of the same key
+    /// within this sample's bound, applied to `solver`. Returns `g = λ₀ᵀ·J·v*`.
+    fn build_rows(&mut self, r: f64, dt: f64, loaded: &[LoadedContact]) -> f64 {
+        // The last sample's impulses by key (its rows keep them in colour order).
+        std::mem::swap(&mut self.prev_keys, &mut self.keys);
+        self.prev_lambda.clear();
+        self.prev_lambda.resize(self.prev_keys.len(), 0.0);
+        for (row, &k) in self.sorted.iter().zip(&self.slot) {
+            self.prev_lambda[k as usize] = row.lambda;
         }
         let star = &self.star;
         let dynamic = |i: usize| star[i].inv_mass > 0.0 || star[i].inv_inertia > 0.0;
@@ -283,48 +430,33 @@ impl ChainDamping {
         //    neither body has yet; fixed bodies take any number) and its warm-start impulse:
         //    the last sample's impulse of the same key (a merge of two key-sorted lists), within
         //    this sample's bound.
-        let r = dt / tau;
         self.solver.copy_from_slice(&self.star);
         self.rows.clear();
         self.keys.clear();
+        self.row_src.clear();
         self.colour.clear();
         self.per_colour.fill(0);
         self.used.fill(0);
+        self.loaded_keys.clear();
         let mut g = 0.0;
         let mut j = 0;
-        for e in loaded {
+        for (i, e) in loaded.iter().enumerate() {
+            self.loaded_keys.push(e.key);
             let (a, b) = (e.body_a as usize, e.body_b as usize);
             let (dyn_a, dyn_b) = (dynamic(a), dynamic(b));
             if !((dyn_a && self.multi[a]) || (dyn_b && self.multi[b])) {
                 continue;
             }
-            let (sa, sb) = (&star[a], &star[b]);
-            let rna = cross(e.point - self.pos[a], e.n);
-            let rnb = cross(e.point - self.pos[b], e.n);
-            let w =
-                sa.inv_mass + sb.inv_mass + sa.inv_inertia * rna * rna + sb.inv_inertia * rnb * rnb;
-            if !(w > 0.0 && w.is_finite()) {
-                continue;
-            }
             while j < self.prev_keys.len() && self.prev_keys[j] < e.key {
                 j += 1;
             }
-            let lo = -dt * e.f_n;
-            let warm = if j < self.prev_keys.len() && self.prev_keys[j] == e.key {
-                self.prev_lambda[j].max(lo)
+            let prev = if j < self.prev_keys.len() && self.prev_keys[j] == e.key {
+                self.prev_lambda[j]
             } else {
                 0.0
             };
-            let row = Row {
-                a: a as u32,
-                b: b as u32,
-                n: e.n,
-                rna,
-                rnb,
-                w,
-                c: r / ((1.0 + r) * w),
-                lo,
-                lambda: if warm.is_finite() { warm } else { 0.0 },
+            let Some(row) = Row::new(e, a as u32, b as u32, &self.pos, star, r, dt, prev) else {
+                continue;
             };
             // g = λ₀ᵀ·J·v* (see `scale_warm_start`), and the warm impulse applied.
             if row.lambda != 0.0 {
@@ -341,56 +473,60 @@ impl ChainDamping {
             self.per_colour[c as usize] += 1;
             self.rows.push(row);
             self.keys.push(e.key);
+            self.row_src.push(i as u32);
         }
-        self.last_rows = self.rows.len();
-        if self.rows.is_empty() {
-            self.prev_keys.clear();
-            self.prev_lambda.clear();
-            return 0.0;
-        }
-        // 4. Rows sorted by colour (stable: key order within a colour), and the warm start
-        //    scaled so that Φ(s·λ₀) ≤ 0 (see above).
-        let h = self.sort_by_colour(r);
-        self.last_warm_scale = self.scale_warm_start(g, h);
-        // 5. Projected Gauss–Seidel on F = −B_c·v⁺_n, F ≥ −f_n, until converged.
-        let solver = &mut self.solver;
-        for _ in 0..sweeps {
-            // Largest change of a row's relative velocity in this sweep (m/s).
-            let mut largest = 0.0f64;
-            for row in self.sorted.iter_mut() {
-                let v_rel = row.v_rel(solver);
-                let new = (-row.c * (v_rel - row.w * row.lambda)).max(row.lo);
-                let d = new - row.lambda;
-                row.lambda = new;
-                row.apply(d, solver);
-                largest = largest.max((d * row.w).abs());
+        g
+    }
+
+    /// Steps 2–4 when `loaded` holds the same contacts as the last sample (same keys in the same
+    /// order, same dynamic bodies): the chain contacts, their colours and order are then those of
+    /// the last sample, so its rows (colour order) are refreshed in place from the new
+    /// geometry, each warm-started from its own last impulse within this sample's bound — what
+    /// [`build_rows`](Self::build_rows) and [`sort_by_colour`](Self::sort_by_colour) would build,
+    /// without the key merge, the colouring and the sort. Returns `(g, h)` of
+    /// [`scale_warm_start`](Self::scale_warm_start), or `None` (the caller builds from scratch)
+    /// if a row's effective mass is no longer finite.
+    fn refresh_rows(&mut self, r: f64, dt: f64, loaded: &[LoadedContact]) -> Option<(f64, f64)> {
+        self.solver.copy_from_slice(&self.star);
+        let star = &self.star;
+        let (mut g, mut k) = (0.0, 0.0);
+        for (row, &i) in self.sorted.iter_mut().zip(&self.src) {
+            // A row that fails here keeps `max(λ, lo)` or 0, which `build_rows` maps the same way.
+            *row = Row::new(
+                &loaded[i as usize],
+                row.a,
+                row.b,
+                &self.pos,
+                star,
+                r,
+                dt,
+                row.lambda,
+            )?;
+            if row.lambda != 0.0 {
+                g += row.lambda * row.v_rel(star);
+                k += row.lambda * row.lambda * row.w;
+                row.apply(row.lambda, &mut self.solver);
             }
-            self.last_sweeps += 1;
-            if largest <= CONVERGED {
-                break;
+        }
+        Some((g, self.curvature(k / r)))
+    }
+
+    /// `h = λ₀ᵀ·(W + K⁻¹)·λ₀` of the warm impulses `λ₀` (already applied to `solver`), given
+    /// `λ₀ᵀK⁻¹λ₀ = Σ λ₀ᵢ²·wᵢ/r` (`k_part`): `λ₀ᵀJWJᵀλ₀ = Σ_bodies Δpᵀ·M⁻¹·Δp` with `Δp = JᵀΛ₀` the
+    /// momentum the warm impulses gave each body, i.e. `m·|Δv|² + I·Δω²` summed over the bodies
+    /// (`Δv = v₀ − v*`) — one pass over the bodies instead of two velocity reads per row.
+    fn curvature(&self, k_part: f64) -> f64 {
+        let mut h = k_part;
+        for (s, v) in self.solver.iter().zip(&self.star) {
+            if v.inv_mass > 0.0 {
+                h += (s.v - v.v).length_squared() / v.inv_mass;
+            }
+            if v.inv_inertia > 0.0 {
+                let dw = s.omega - v.omega;
+                h += dw * dw / v.inv_inertia;
             }
         }
-        let removed = ke_star - kinetic(&self.solver, bodies);
-        // 6. The impulses as forces held over the sample; remembered by key for the next warm start.
-        self.prev_lambda.clear();
-        self.prev_lambda.resize(self.rows.len(), 0.0);
-        let inv_dt = 1.0 / dt;
-        for (row, &k) in self.sorted.iter().zip(&self.slot) {
-            self.prev_lambda[k as usize] = row.lambda;
-            let (a, b) = (row.a as usize, row.b as usize);
-            let f = row.n * (row.lambda * inv_dt);
-            let (ta, tb) = (row.rna * row.lambda * inv_dt, row.rnb * row.lambda * inv_dt);
-            wrenches[a].force += f;
-            wrenches[a].torque += ta;
-            wrenches[b].force -= f;
-            wrenches[b].torque -= tb;
-            bodies[a].force += f;
-            bodies[a].torque += ta;
-            bodies[b].force -= f;
-            bodies[b].torque -= tb;
-        }
-        std::mem::swap(&mut self.prev_keys, &mut self.keys);
-        removed
+        h
     }
 
     /// Scales the warm start `λ₀` (applied whole to `solver` as the rows were built; `g =
@@ -418,8 +554,8 @@ impl ChainDamping {
     }
 
     /// A stable counting sort of the rows by colour into `sorted`, with `slot` the key-order
-    /// index of each; returns `h = λ₀ᵀ·(W + K⁻¹)·λ₀ = λ₀ᵀ·J·(v₀ − v*) + Σ λ₀ᵢ²·wᵢ/r` of the warm
-    /// impulses `λ₀` (already applied to `solver`, so `J·v₀` is read there; `r = T/τ`).
+    /// index of each and `src` its loaded-list index; returns `h = λ₀ᵀ·(W + K⁻¹)·λ₀` of the warm
+    /// impulses `λ₀` (already applied to `solver`; see [`curvature`](Self::curvature); `r = T/τ`).
     fn sort_by_colour(&mut self, r: f64) -> f64 {
         // Exclusive prefix sums: the first position of each colour.
         let mut at = 0u32;
@@ -432,18 +568,18 @@ impl ChainDamping {
         self.sorted.resize(self.rows.len(), self.rows[0]);
         self.slot.clear();
         self.slot.resize(self.rows.len(), 0);
-        let mut h = 0.0;
+        self.src.clear();
+        self.src.resize(self.rows.len(), 0);
+        let mut k = 0.0;
         for (i, (row, &c)) in self.rows.iter().zip(&self.colour).enumerate() {
-            if row.lambda != 0.0 {
-                h += row.lambda * (row.v_rel(&self.solver) - row.v_rel(&self.star))
-                    + row.lambda * row.lambda * row.w / r;
-            }
+            k += row.lambda * row.lambda * row.w;
             let p = &mut self.per_colour[c as usize];
             self.sorted[*p as usize] = *row;
             self.slot[*p as usize] = i as u32;
+            self.src[*p as usize] = self.row_src[i];
             *p += 1;
         }
-        h
+        self.curvature(k / r)
     }
 }
 
@@ -523,10 +659,10 @@ mod tests {
             removed > 0.0 && removed <= before,
             "removed {removed} of {before} J"
         );
+        let impulses: Vec<f64> = chain.sorted.iter().map(|r| r.lambda).collect();
         assert!(
-            chain.prev_lambda.iter().all(|&l| l > 0.0),
-            "{:?}",
-            chain.prev_lambda
+            impulses.len() == 3 && impulses.iter().all(|&l| l > 0.0),
+            "{impulses:?}"
         );
         // Sample 2: the column springs apart instead; the last impulses (pushing apart) would add
         // energy, so the warm start is scaled down, and the pass still removes energy.
@@ -573,5 +709,66 @@ mod tests {
             chain.last_sweeps
         );
         assert!(removed > 0.0);
+    }
+
+    /// A sample whose loaded contacts are those of the last one refreshes the rows in place; it
+    /// gives what building them from scratch gives (up to the order of the sums' rounding), and a
+    /// changed list of contacts or of dynamic bodies rebuilds them.
+    #[test]
+    fn rows_refreshed_in_place_match_rows_rebuilt() {
+        let (bodies0, loaded) = column();
+        let dt = 1e-3;
+        let (mut fast, mut full) = (ChainDamping::default(), ChainDamping::default());
+        let (mut b_fast, mut b_full) = (bodies0.clone(), bodies0.clone());
+        let mut wrenches = vec![Wrench2::default(); bodies0.len()];
+        for k in 0..6 {
+            for bodies in [&mut b_fast, &mut b_full] {
+                for (i, b) in bodies.iter_mut().enumerate().skip(1) {
+                    b.vel = Vec2::new(0.01 * k as f64, -0.1 * i as f64 + 0.03 * k as f64);
+                    b.omega = 0.2 * (k as f64 - i as f64);
+                    b.force = Vec2::new(0.0, -9.81);
+                    b.torque = 0.0;
+                }
+            }
+            // Forgetting the loaded keys (but not the impulses) forces a rebuild every sample.
+            full.loaded_keys.clear();
+            let r_fast = fast.apply(Some(2e-4), 3, dt, &loaded, &mut b_fast, &mut wrenches);
+            let r_full = full.apply(Some(2e-4), 3, dt, &loaded, &mut b_full, &mut wrenches);
+            assert!(
+                (r_fast - r_full).abs() <= 1e-12 * r_full.abs().max(1e-9),
+                "{k}: {r_fast} {r_full}"
+            );
+            for (a, b) in b_fast.iter().zip(&b_full) {
+                assert!(
+                    (a.force - b.force).length() <= 1e-9,
+                    "{k}: {:?} {:?}",
+                    a.force,
+                    b.force
+                );
+                assert!((a.torque - b.torque).abs() <= 1e-9);
+            }
+            assert_eq!(fast.last_rows, 3);
+            assert_eq!((fast.last_refreshed, full.last_refreshed), (k > 0, false));
+            assert!((fast.last_warm_scale - full.last_warm_scale).abs() <= 1e-12);
+        }
+        // One fewer contact: rebuilt (the top box is no longer a chain's end, two rows remain).
+        let mut b = b_fast.clone();
+        fast.apply(Some(2e-4), 3, dt, &loaded[..2], &mut b, &mut wrenches);
+        assert_eq!((fast.last_rows, fast.last_refreshed), (2, false));
+        // A body that became fixed: rebuilt too (box 1 fixed: the floor–box 1 contact joins two
+        // fixed bodies and is no row; box 2 still touches boxes 1 and 3).
+        fast.apply(
+            Some(2e-4),
+            3,
+            dt,
+            &loaded,
+            &mut b_fast.clone(),
+            &mut wrenches,
+        );
+        assert_eq!((fast.last_rows, fast.last_refreshed), (3, false));
+        let mut b = b_fast.clone();
+        b[1] = Body::fixed("now fixed", b[1].pose);
+        fast.apply(Some(2e-4), 3, dt, &loaded, &mut b, &mut wrenches);
+        assert_eq!((fast.last_rows, fast.last_refreshed), (2, false));
     }
 }
