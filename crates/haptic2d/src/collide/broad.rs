@@ -121,14 +121,32 @@ pub struct BroadPhase {
     /// Sweep position of the update in progress (`None` = no update in progress).
     next: Option<usize>,
     tested: Vec<Tested>,
-    /// `(pair key, index into tested)`, sorted at publish.
-    order: Vec<(u64, u32)>,
-    /// `order` is complete for the update in progress.
+    /// Indices into `tested` in pair order, made by the last `advance` of an update.
+    order: Vec<u32>,
+    /// Pairs per first collider (counting sort of `order`).
+    bucket: Vec<u32>,
+    /// The result of the update in progress is complete in `ready` (published by a swap).
     sorted: bool,
     gjk_iterations: u64,
+    /// The published update: its pairs (sorted), caches and distances, and where each first
+    /// collider's pairs start (`cache_pairs[cache_start[a]..cache_start[a + 1]]`).
     cache_pairs: Vec<(u32, u32)>,
     caches: Vec<GjkCache>,
     distances: Vec<f64>,
+    cache_start: Vec<u32>,
+    /// The same for the update in progress, once sorted, with its proximity set.
+    ready: Published,
+    stats: BroadStats,
+}
+
+/// The result of an update, as [`BroadPhase::publish`] hands it over.
+#[derive(Clone, Debug, Default)]
+struct Published {
+    set: Vec<(u32, u32)>,
+    pairs: Vec<(u32, u32)>,
+    caches: Vec<GjkCache>,
+    distances: Vec<f64>,
+    start: Vec<u32>,
     stats: BroadStats,
 }
 
@@ -149,11 +167,14 @@ impl BroadPhase {
             next: None,
             tested: Vec::new(),
             order: Vec::new(),
+            bucket: Vec::new(),
             sorted: false,
             gjk_iterations: 0,
             cache_pairs: Vec::new(),
             caches: Vec::new(),
             distances: Vec::new(),
+            cache_start: Vec::new(),
+            ready: Published::default(),
             stats: BroadStats::default(),
         })
     }
@@ -253,10 +274,7 @@ impl BroadPhase {
                 if !self.boxes[a as usize].overlaps(&self.boxes[b as usize]) {
                     continue;
                 }
-                let mut cache = match self.cache_pairs.binary_search(&(a, b)) {
-                    Ok(k) => self.caches[k],
-                    Err(_) => GjkCache::new(),
-                };
+                let mut cache = self.cached(a, b).unwrap_or_else(GjkCache::new);
                 let g = gjk_distance(
                     self.snapshot.vertices(a),
                     self.snapshot.vertices(b),
@@ -272,18 +290,90 @@ impl BroadPhase {
         }
         self.next = Some(stop);
         if samples_left <= 1 && !self.sorted {
-            // Sorted by pair through a list of (key, index): sorting the 16-byte keys instead of
-            // the ~90-byte records keeps this sample close to the others in cost.
-            self.order.clear();
-            self.order.extend(
-                self.tested
-                    .iter()
-                    .enumerate()
-                    .map(|(k, t)| (((t.pair.0 as u64) << 32) | t.pair.1 as u64, k as u32)),
-            );
-            self.order.sort_unstable();
+            self.sort_tested();
+            self.fill_ready();
             self.sorted = true;
         }
+    }
+
+    /// The warm-start cache of pair `(a, b)` from the published update, if it tested the pair.
+    #[inline]
+    fn cached(&self, a: u32, b: u32) -> Option<GjkCache> {
+        let from = *self.cache_start.get(a as usize)? as usize;
+        let to = *self.cache_start.get(a as usize + 1)? as usize;
+        let k = from + self.cache_pairs[from..to].iter().position(|p| p.1 == b)?;
+        Some(self.caches[k])
+    }
+
+    /// `order` = the indices of `tested` sorted by pair: a counting sort on the first collider,
+    /// then an insertion sort of each collider's few pairs on the second (pairs are unique, so
+    /// the order is the one any sort gives).
+    fn sort_tested(&mut self) {
+        let n = self.snapshot.colliders.len();
+        self.bucket.clear();
+        self.bucket.resize(n + 1, 0);
+        for t in &self.tested {
+            self.bucket[t.pair.0 as usize + 1] += 1;
+        }
+        for i in 0..n {
+            self.bucket[i + 1] += self.bucket[i];
+        }
+        self.order.clear();
+        self.order.resize(self.tested.len(), 0);
+        for (k, t) in self.tested.iter().enumerate() {
+            let at = &mut self.bucket[t.pair.0 as usize];
+            self.order[*at as usize] = k as u32;
+            *at += 1;
+        }
+        // `bucket[a]` is now the end of collider a's pairs; sort each run on the second collider.
+        let mut from = 0;
+        for a in 0..n {
+            let to = self.bucket[a] as usize;
+            for i in from + 1..to {
+                let k = self.order[i];
+                let key = self.tested[k as usize].pair.1;
+                let mut j = i;
+                while j > from && self.tested[self.order[j - 1] as usize].pair.1 > key {
+                    self.order[j] = self.order[j - 1];
+                    j -= 1;
+                }
+                self.order[j] = k;
+            }
+            from = to;
+        }
+    }
+
+    /// Writes the sorted result of the update in progress into `ready` (the set, the pairs'
+    /// caches and distances, where each first collider's pairs start, the counters), so that
+    /// publishing is a swap.
+    fn fill_ready(&mut self) {
+        let r = &mut self.ready;
+        r.set.clear();
+        r.pairs.clear();
+        r.caches.clear();
+        r.distances.clear();
+        r.start.clear();
+        let n = self.snapshot.colliders.len();
+        for &k in &self.order {
+            let t = &self.tested[k as usize];
+            if t.distance < self.delta_prox {
+                r.set.push(t.pair);
+            }
+            while r.start.len() <= t.pair.0 as usize {
+                r.start.push(r.pairs.len() as u32);
+            }
+            r.pairs.push(t.pair);
+            r.caches.push(t.cache);
+            r.distances.push(t.distance);
+        }
+        while r.start.len() <= n {
+            r.start.push(r.pairs.len() as u32);
+        }
+        r.stats = BroadStats {
+            aabb_pairs: self.tested.len(),
+            proximate_pairs: r.set.len(),
+            gjk_iterations: self.gjk_iterations,
+        };
     }
 
     /// Finishes the update in progress (sweeps what is left) and writes its proximity set into
@@ -295,24 +385,14 @@ impl BroadPhase {
         }
         self.advance(1);
         self.next = None;
-        out.clear();
-        self.cache_pairs.clear();
-        self.caches.clear();
-        self.distances.clear();
-        for &(_, k) in &self.order {
-            let t = &self.tested[k as usize];
-            if t.distance < self.delta_prox {
-                out.push(t.pair);
-            }
-            self.cache_pairs.push(t.pair);
-            self.caches.push(t.cache);
-            self.distances.push(t.distance);
-        }
-        self.stats = BroadStats {
-            aabb_pairs: self.tested.len(),
-            proximate_pairs: out.len(),
-            gjk_iterations: self.gjk_iterations,
-        };
+        // Everything was written by the last `advance`: publishing swaps the buffers.
+        let r = &mut self.ready;
+        std::mem::swap(out, &mut r.set);
+        std::mem::swap(&mut self.cache_pairs, &mut r.pairs);
+        std::mem::swap(&mut self.caches, &mut r.caches);
+        std::mem::swap(&mut self.distances, &mut r.distances);
+        std::mem::swap(&mut self.cache_start, &mut r.start);
+        self.stats = r.stats;
     }
 }
 
@@ -435,6 +515,32 @@ mod tests {
         let pairs = bp.tested.len();
         bp.advance(1);
         assert!(bp.sorted && bp.order.len() == pairs && pairs > 0);
-        assert!(bp.order.windows(2).all(|w| w[0] < w[1]));
+        assert!(bp.ready.pairs.windows(2).all(|w| w[0] < w[1]));
+        assert_eq!(bp.ready.pairs.len(), pairs);
+    }
+
+    /// The warm-start lookup by first collider finds exactly the published pairs' caches.
+    #[test]
+    fn cache_lookup_finds_the_published_pairs() {
+        let cols = grid(0.0, 0.05);
+        let mut bp = BroadPhase::new(DEFAULT_DELTA_PROX).unwrap();
+        let mut out = Vec::new();
+        bp.update(&cols, &mut out);
+        assert!(bp.cache_pairs.len() > 200);
+        for (k, &(a, b)) in bp.cache_pairs.iter().enumerate() {
+            let c = bp.cached(a, b).expect("a published pair has its cache");
+            assert_eq!(format!("{c:?}"), format!("{:?}", bp.caches[k]));
+        }
+        let n = cols.len() as u32;
+        let tested: std::collections::BTreeSet<_> = bp.cache_pairs.iter().copied().collect();
+        for a in 0..n + 2 {
+            for b in a + 1..n + 2 {
+                assert_eq!(
+                    bp.cached(a, b).is_some(),
+                    tested.contains(&(a, b)),
+                    "{a} {b}"
+                );
+            }
+        }
     }
 }
