@@ -274,7 +274,7 @@ impl BroadPhase {
                 if !self.boxes[a as usize].overlaps(&self.boxes[b as usize]) {
                     continue;
                 }
-                let mut cache = self.cached(a, b).unwrap_or_else(GjkCache::new);
+                let mut cache = self.cached(a, b).unwrap_or_default();
                 let g = gjk_distance(
                     self.snapshot.vertices(a),
                     self.snapshot.vertices(b),
