@@ -125,6 +125,10 @@ struct Gap {
     body_b: u32,
     /// The tracker's penetration flag after its last update (a copy, read every sample).
     penetrating: bool,
+    /// The pair's state is the tracker's confirmed penetration (see
+    /// [`FeatureTracker::confirm_penetration`]): confirming it again only moves the reported
+    /// point, so the tracker is not touched.
+    confirmed: bool,
 }
 
 impl Gap {
@@ -137,6 +141,7 @@ impl Gap {
             body_a,
             body_b,
             penetrating: false,
+            confirmed: false,
         }
     }
 }
@@ -221,7 +226,9 @@ impl LocalStage {
         self.skipped
     }
 
-    /// The trackers (with their work counters), in pair order.
+    /// The trackers (with their work counters), in pair order. A pair that stays penetrating is
+    /// confirmed once (counted in its tracker's `updates`); the samples after that only move the
+    /// reported point and are not counted.
     pub fn trackers(&self) -> &[FeatureTracker] {
         &self.trackers
     }
@@ -330,6 +337,12 @@ impl LocalStage {
                 let inside_a = ctx.vertices_against(sa, sb, out);
                 let inside_b = ctx.vertices_against(sb, sa, out);
                 if let Some(at) = inside_a.or(inside_b) {
+                    if g.confirmed {
+                        // What `confirm_penetration` would return again, but for the point.
+                        let f = &mut self.states[k].features;
+                        (f.point_a, f.point_b) = (at, at);
+                        continue;
+                    }
                     let f = self.trackers[k].confirm_penetration(at);
                     self.states[k] = PairState {
                         pair: (ia, ib),
@@ -337,6 +350,7 @@ impl LocalStage {
                     };
                     self.gaps[k] = Gap {
                         penetrating: self.trackers[k].is_penetrating(),
+                        confirmed: true,
                         ..Gap::track(g.body_a, g.body_b)
                     };
                     continue;
@@ -783,5 +797,52 @@ pub fn sat_depth(a: &Collider, b: &Collider) -> f64 {
         depth
     } else {
         0.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::{ConvexPolygon, Pose};
+
+    /// A pair that stays penetrating is confirmed by its tracker once; the samples after that
+    /// report the same states (the point moving) and candidates as confirming every sample.
+    #[test]
+    fn confirmed_penetration_reports_what_confirming_again_would() {
+        let square = |body, dynamic, pose: &Pose| {
+            Collider::new(
+                body,
+                dynamic,
+                ConvexPolygon::rectangle(0.05, 0.05).unwrap(),
+                pose,
+            )
+        };
+        let mut cols = vec![
+            square(0, false, &Pose::new(0.0, 0.0, 0.0)),
+            square(1, true, &Pose::new(0.01, 0.049, 0.02)),
+        ];
+        let pairs = [(0u32, 1u32)];
+        let (mut fast, mut every) = (LocalStage::new(), LocalStage::new());
+        let (mut out_fast, mut out_every) = (Vec::new(), Vec::new());
+        for k in 0..20 {
+            let pose = Pose::new(0.01 + 1e-4 * k as f64, 0.049 - 2e-5 * k as f64, 0.02);
+            cols[1].update(&pose);
+            for g in every.gaps.iter_mut() {
+                g.confirmed = false;
+            }
+            fast.update(&cols, &pairs, DEFAULT_DELTA_C, &mut out_fast);
+            every.update(&cols, &pairs, DEFAULT_DELTA_C, &mut out_every);
+            assert_eq!(fast.pair_states(), every.pair_states(), "sample {k}");
+            assert_eq!(out_fast, out_every, "sample {k}");
+            assert!(!out_fast.is_empty());
+            assert_eq!(
+                fast.pair_states()[0].features.status,
+                TrackStatus::Penetrating
+            );
+        }
+        assert!(fast.gaps[0].confirmed);
+        // The first sample walks, the second confirms; the rest do not touch the tracker.
+        assert_eq!(fast.trackers()[0].stats.updates, 2);
+        assert_eq!(every.trackers()[0].stats.updates, 20);
     }
 }
