@@ -269,7 +269,7 @@ impl Frame {
                     },
                     point: [c.point.x, c.point.y],
                     normal: [c.n.x, c.n.y],
-                    tangent: [c.t.x, c.t.y],
+                    tangent: [c.t().x, c.t().y],
                     depth: c.d[0],
                     god_object: [g.x, g.y],
                     f_n: c.f_n,

@@ -107,7 +107,6 @@ mod tests {
             len: 1.0,
             point: Vec2::ZERO,
             n: Vec2::new(0.0, 1.0),
-            t: Vec2::new(1.0, 0.0),
             c0: 0.0,
             s0: 0.0,
             s_g: 0.0,
@@ -121,7 +120,6 @@ mod tests {
                 v: Vec2::ZERO,
                 e0: Vec2::ZERO,
                 n: Vec2::new(0.0, 1.0),
-                t: Vec2::new(1.0, 0.0),
             },
         }
     }

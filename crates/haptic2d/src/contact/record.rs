@@ -73,10 +73,8 @@ pub struct VeContact {
     pub len: f64,
     /// World position of the vertex `V` (m).
     pub point: Vec2,
-    /// Outward edge normal (world).
+    /// Outward edge normal (world); the tangent is [`VeContact::t`].
     pub n: Vec2,
-    /// Edge tangent (world).
-    pub t: Vec2,
     /// Normal relative velocity `C0` (m/s), positive when separating.
     pub c0: f64,
     /// Tangential slip velocity `S0` (m/s).
@@ -108,13 +106,19 @@ pub struct LocalGeom {
     pub v: Vec2,
     /// Edge start `E0` in B's centre-of-mass frame (m).
     pub e0: Vec2,
-    /// Outward edge normal in B's frame.
+    /// Outward edge normal in B's frame (the tangent is `(−n_y, n_x)`, see [`VeContact::t`]).
     pub n: Vec2,
-    /// Edge tangent in B's frame.
-    pub t: Vec2,
 }
 
 impl VeContact {
+    /// Edge tangent (world): `t = (−n_y, n_x)`, exactly the rotated polygon tangent, since a
+    /// polygon's normals are `n = (t_y, −t_x)` (`geom/polygon.rs`) and rotating both by the same
+    /// `(cos, sin)` keeps that relation exactly (each component is the same two products added in
+    /// the other order, or negated; only the sign of an exact zero can differ).
+    #[inline]
+    pub fn t(&self) -> Vec2 {
+        Vec2::new(-self.n.y, self.n.x)
+    }
     /// True for a contact record (Colliding or Continuous).
     #[inline]
     pub fn is_contact(&self) -> bool {
@@ -129,7 +133,7 @@ impl VeContact {
     #[inline]
     pub fn god_object(&self) -> Vec2 {
         // point = E0 + s·t + d·n, so E0 = point − s·t − d·n.
-        self.point - self.t * self.s - self.n * self.d[0] + self.t * self.s_g
+        self.point - self.t() * self.s - self.n * self.d[0] + self.t() * self.s_g
     }
 }
 
@@ -175,4 +179,50 @@ pub enum EventKind {
     Released,
     /// A Continuous record was promoted back to Colliding (§8.2 rule 5, option).
     Recollision,
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::geom::{ConvexPolygon, Rot, Vec2};
+    use rand::{Rng, SeedableRng};
+
+    /// `VeContact::t` derives the world tangent from the world normal: for random convex
+    /// polygons and angles (and the axis-aligned box at 0 rad), the rotated tangent is exactly
+    /// `(−n_y, n_x)` of the rotated normal.
+    #[test]
+    fn world_tangent_is_the_rotated_normal_turned_exactly() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(17);
+        for _ in 0..500 {
+            let n = rng.random_range(3..9);
+            let r = rng.random_range(1e-3..2.0);
+            let phase = rng.random_range(0.0..6.3);
+            let vertices = (0..n)
+                .map(|i| {
+                    let a = phase
+                        + std::f64::consts::TAU * (i as f64 + rng.random_range(-0.3..0.3))
+                            / n as f64;
+                    Vec2::new(r * a.cos() + 0.3, r * a.sin() - 0.7)
+                })
+                .collect();
+            let Ok(p) = ConvexPolygon::new(vertices) else {
+                continue;
+            };
+            let p = if n == 4 {
+                ConvexPolygon::rectangle(r, 0.5 * r).unwrap()
+            } else {
+                p
+            };
+            for k in 0..20 {
+                let rot = Rot::new(if k == 0 {
+                    0.0
+                } else {
+                    rng.random_range(-50.0..50.0)
+                });
+                for (t, nl) in p.tangents().iter().zip(p.normals()) {
+                    let (tw, nw) = (rot.apply(*t), rot.apply(*nl));
+                    assert_eq!((tw.x, tw.y), (-nw.y, nw.x));
+                }
+            }
+        }
+    }
 }

@@ -100,12 +100,12 @@ impl ContactSet {
         for o in self.entries.iter().filter(|o| {
             o.state == Some(ContactState::Continuous)
                 && o.body_a == e.body_a
-                && o.t.dot(e.t).abs() > 0.99
+                && o.t().dot(e.t()).abs() > 0.99
         }) {
             n_t += 1;
             fn_sum += o.f_n;
         }
-        let demand = e.t.dot(self.nonfric[e.body_a]);
+        let demand = e.t().dot(self.nonfric[e.body_a]);
         if fn_sum > 0.0 {
             demand * (e.f_n / fn_sum)
         } else {
@@ -136,7 +136,7 @@ fn friction_step(
     e.f_t = law.friction.update(&input);
     e.s_g = law.friction.anchor(e.s).unwrap_or(e.s.clamp(0.0, e.len));
     if e.f_t != 0.0 {
-        add_force(wrenches, bodies, e.body_a, e.body_b, e.t * e.f_t, e.point);
+        add_force(wrenches, bodies, e.body_a, e.body_b, e.t() * e.f_t, e.point);
     }
 }
 

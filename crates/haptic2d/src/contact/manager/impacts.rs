@@ -68,7 +68,7 @@ impl ContactSet {
             let v_rel =
                 bodies[e.body_a].point_velocity(e.point) - bodies[e.body_b].point_velocity(e.point);
             e.c0 = e.n.dot(v_rel);
-            e.s0 = e.t.dot(v_rel);
+            e.s0 = e.t().dot(v_rel);
         }
     }
 

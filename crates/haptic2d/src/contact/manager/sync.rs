@@ -76,7 +76,8 @@ pub(super) fn measure(e: &mut VeContact, bodies: &[Body], rots: &[Rot]) {
     let v = ba.pose.pos + ra.apply(e.local.v);
     let e0 = bb.pose.pos + rb.apply(e.local.e0);
     let n = rb.apply(e.local.n);
-    let t = rb.apply(e.local.t);
+    // = rb.apply(local tangent), bit for bit (see `VeContact::t`).
+    let t = Vec2::new(-n.y, n.x);
     let rel = v - e0;
     e.d = [n.dot(rel), e.d[0], e.d[1]];
     e.hist = (e.hist + 1).min(3);
@@ -84,7 +85,6 @@ pub(super) fn measure(e: &mut VeContact, bodies: &[Body], rots: &[Rot]) {
     e.s = t.dot(rel);
     e.point = v;
     e.n = n;
-    e.t = t;
     let v_rel = ba.point_velocity(v) - bb.point_velocity(v);
     e.c0 = n.dot(v_rel);
     e.s0 = t.dot(v_rel);
@@ -110,7 +110,6 @@ pub(super) fn new_entry(
         v: ca.vertices()[key.vertex as usize],
         e0: cb.vertices()[key.edge as usize],
         n: cb.normals()[key.edge as usize],
-        t: cb.tangents()[key.edge as usize],
     };
     let rel = v - e0;
     let (d0, s0) = (n.dot(rel), t.dot(rel));
@@ -140,7 +139,6 @@ pub(super) fn new_entry(
         len,
         point: v,
         n,
-        t,
         c0: n.dot(v_rel),
         s0: t.dot(v_rel),
         s_g: s0.clamp(0.0, len),
