@@ -112,6 +112,16 @@ pub fn run(label: &str, w: &mut World, dt: f64, seconds: f64, every: f64, profil
     if by_phase[0].is_empty() {
         return;
     }
+    let b = w.broad_stats();
+    println!(
+        "{label}: work at the end: {} AABB pairs and {} proximate pairs in the global stage, {} of them skipped by the local stage, {} tracked VE pairs, {} contacts, {} chain rows",
+        b.aabb_pairs,
+        b.proximate_pairs,
+        w.local_stage().skipped(),
+        w.contacts().entries().len(),
+        w.contacts().contact_count(),
+        w.chain_damper().last_rows
+    );
     let all_steps = crate::timing::Samples(by_phase.iter().flatten().copied().collect());
     let (median, p99) = (all_steps.median(), all_steps.p99());
     println!(

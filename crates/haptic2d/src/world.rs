@@ -254,6 +254,15 @@ impl World {
     pub fn proximate_pairs(&self) -> &[(u32, u32)] {
         &self.pairs
     }
+    /// Work counters of the last published global update (AABB pairs, proximate pairs, GJK
+    /// iterations).
+    pub fn broad_stats(&self) -> crate::collide::BroadStats {
+        self.broad.stats()
+    }
+    /// The local stage (its pair states, trackers and the pairs it skipped in the last sample).
+    pub fn local_stage(&self) -> &LocalStage {
+        &self.local
+    }
     /// The contact wrench on body `i` at the last step (N, N·m): the sum of normal and friction forces.
     /// The wrench the body applies to the environment, `f_e` of §11, is its negative.
     #[inline]

@@ -70,11 +70,15 @@ pub struct BroadStats {
     pub gjk_iterations: u64,
 }
 
-/// One box in the sweep: inflated `min.x`, `max.x` and the collider index.
+/// One box in the sweep: the inflated box's x and y ranges and the collider index (the y range
+/// here too, so that the sweep rejects boxes apart in y without reading anything else: in a
+/// pile, every box of a column overlaps in x).
 #[derive(Clone, Copy, Debug)]
 struct SweepEntry {
     min_x: f64,
     max_x: f64,
+    min_y: f64,
+    max_y: f64,
     index: u32,
 }
 
@@ -233,6 +237,8 @@ impl BroadPhase {
             self.sweep.push(SweepEntry {
                 min_x: bx.min.x,
                 max_x: bx.max.x,
+                min_y: bx.min.y,
+                max_y: bx.max.y,
                 index: i as u32,
             });
         }
@@ -264,6 +270,11 @@ impl BroadPhase {
             for ej in &self.sweep[i + 1..] {
                 if ej.min_x > ei.max_x {
                     break;
+                }
+                // The boxes overlap in x (sorted, and `ej` starts before `ei` ends); in y too?
+                // (the same closed-interval test as `Aabb::overlaps`)
+                if ej.min_y > ei.max_y || ei.min_y > ej.max_y {
+                    continue;
                 }
                 let (a, b) = (ei.index.min(ej.index), ei.index.max(ej.index));
                 let (_, _, body_a, dyn_a) = self.snapshot.colliders[a as usize];
