@@ -639,8 +639,10 @@ impl Ctx {
         // within `δ_c`, which puts it within `δ_c + ε_s` of that edge) and not inside.
         let reach = Vec2::new(self.delta_c + self.eps_s, self.delta_c + self.eps_s);
         let (lo, hi) = (b.c.aabb.min - reach, b.c.aabb.max + reach);
-        'vertex: for v in 0..a.c.len() {
-            let p = a.c.world_vertices[v];
+        // B's edges as (start, normal) pairs, read without bounds checks in the loop below.
+        let (b_starts, b_normals) = (&b.c.world_vertices[..], &b.c.world_normals[..]);
+        let b_normals = &b_normals[..b_starts.len()];
+        'vertex: for (v, &p) in a.c.world_vertices.iter().enumerate() {
             if p.x < lo.x || p.x > hi.x || p.y < lo.y || p.y > hi.y {
                 continue;
             }
@@ -651,8 +653,9 @@ impl Ctx {
             // can be decided by round-off. Counting costs one compare per edge; the corner rule
             // itself runs only then.
             let mut near_lines = 0u32;
-            for e in 0..b.c.len() {
-                let d = b.c.edge_distance(e, p);
+            for (e, (&e0, &n)) in b_starts.iter().zip(b_normals).enumerate() {
+                // = `b.c.edge_distance(e, p)`
+                let d = n.dot(p - e0);
                 if d > self.delta_c {
                     // Farther than δ_c from B's half-plane, so from B.
                     continue 'vertex;
