@@ -40,7 +40,11 @@ impl ContactSet {
             while h < self.entries.len() && same_group(&self.entries[g].key, &self.entries[h].key) {
                 h += 1;
             }
-            let group_has_record = self.entries[g..h].iter().any(|e| e.is_contact());
+            // A group with a record creates nothing (rule 1: one record per vertex).
+            if self.entries[g..h].iter().any(|e| e.is_contact()) {
+                g = h;
+                continue;
+            }
             let touching = self.entries[g..h]
                 .iter()
                 .enumerate()
@@ -51,16 +55,15 @@ impl ContactSet {
             // One VE pair per coincident corner (see `twin_has_record`): checked on the proposed
             // edge first, so a suppressed twin costs no crossed-edge search.
             let touching = touching.filter(|&t| {
-                !group_has_record
-                    && !twin_has_record(
-                        &self.entries,
-                        &self.pending,
-                        self.entries[t].key,
-                        colliders,
-                        cos,
-                    )
+                !twin_has_record(
+                    &self.entries,
+                    &self.pending,
+                    self.entries[t].key,
+                    colliders,
+                    cos,
+                )
             });
-            if let (false, Some(fallback)) = (group_has_record, touching) {
+            if let Some(fallback) = touching {
                 let key = self.entries[fallback].key;
                 let edge = creation_edge(key, colliders, past, p.eps_s, cos);
                 // The depth invariant (see `step`): the crossed edge of a fast vertex may be one
