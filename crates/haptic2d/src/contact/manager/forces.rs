@@ -116,7 +116,7 @@ impl ContactSet {
 
 /// Friction force of one Continuous record for this sample (after its normal force), and its
 /// god-object (§8.3).
-#[inline]
+#[inline(always)]
 fn friction_step(
     e: &mut VeContact,
     law: &mut LawState,
@@ -140,6 +140,7 @@ fn friction_step(
     }
 }
 
+#[inline(always)]
 fn add_force(w: &mut [Wrench2], bodies: &[Body], a: usize, b: usize, f: Vec2, p: Vec2) {
     w[a].force += f;
     w[a].torque += cross(p - bodies[a].pose.pos, f);
