@@ -47,12 +47,21 @@ impl Collider {
     /// [`Collider::update`] with the pose's rotation already computed (one `sin_cos` per body).
     pub fn update_with(&mut self, pose: &Pose, rot: Rot) {
         let mut aabb = Aabb::EMPTY;
-        for i in 0..self.local.len() {
-            let v = pose.pos + rot.apply(self.local.vertices()[i]);
-            self.world_vertices[i] = v;
-            self.world_normals[i] = rot.apply(self.local.normals()[i]);
-            self.world_tangents[i] = rot.apply(self.local.tangents()[i]);
-            aabb.grow(v);
+        let local = (
+            self.local.vertices(),
+            self.local.normals(),
+            self.local.tangents(),
+        );
+        let world = self
+            .world_vertices
+            .iter_mut()
+            .zip(self.world_normals.iter_mut())
+            .zip(self.world_tangents.iter_mut());
+        for (((v, n), t), ((wv, wn), wt)) in local.0.iter().zip(local.1).zip(local.2).zip(world) {
+            *wv = pose.pos + rot.apply(*v);
+            *wn = rot.apply(*n);
+            *wt = rot.apply(*t);
+            aabb.grow(*wv);
         }
         self.aabb = aabb;
     }
