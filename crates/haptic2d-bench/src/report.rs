@@ -14,6 +14,9 @@ pub struct EngineResult {
     pub median_us: f64,
     /// 99th-percentile step time (µs).
     pub p99_us: f64,
+    /// 99th-percentile step time (µs) without the first step of each interleaved chunk (the
+    /// step that runs right after the other engines, with its data evicted from the caches).
+    pub p99_warm_us: f64,
     /// Settle state after the run.
     pub state: State,
 }
@@ -45,21 +48,22 @@ pub fn table(rows: &[Row]) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "{:<13} {:>5} | {:<15} {:>10} {:>10} {:>7} | {:>7} {:>7}",
-        "scene", "n", "engine", "median µs", "p99 µs", "p99/med", "ratio", "p99 rat"
+        "{:<13} {:>5} | {:<15} {:>10} {:>10} {:>7} {:>8} | {:>7} {:>7}",
+        "scene", "n", "engine", "median µs", "p99 µs", "p99/med", "warm/med", "ratio", "p99 rat"
     );
-    let _ = writeln!(s, "{}", "-".repeat(86));
+    let _ = writeln!(s, "{}", "-".repeat(95));
     for r in rows {
         for (k, e) in r.engines.iter().enumerate() {
             let _ = writeln!(
                 s,
-                "{:<13} {:>5} | {:<15} {:>10.2} {:>10.2} {:>7.2} | {:>7.3} {:>7.3}",
+                "{:<13} {:>5} | {:<15} {:>10.2} {:>10.2} {:>7.2} {:>8.2} | {:>7.3} {:>7.3}",
                 r.scene,
                 r.n,
                 e.key,
                 e.median_us,
                 e.p99_us,
                 e.p99_us / e.median_us,
+                e.p99_warm_us / e.median_us,
                 r.ratio(k),
                 r.ratio_p99(k)
             );
@@ -100,8 +104,9 @@ fn num(x: f64) -> String {
 /// `compare.json`: a list of objects `{"scene", "n", "haptic2d_median_us", "haptic2d_p99_us",
 /// "rapier2d_median_us", "rapier2d_p99_us", "ratio", "box2d_median_us", "box2d_p99_us",
 /// "ratio_box2d", "ratio_p99_box2d", ...}`: for every engine `K` but haptic2d `K_median_us`,
-/// `K_p99_us`, `ratio_K` and `ratio_p99_K` (`ratio` alone is rapier2d's, as before), and for every
-/// engine the settle state `K_max_speed`, `K_moving`, `K_mean_height`, `K_max_overlap` (SI units).
+/// `K_p99_us`, `ratio_K` and `ratio_p99_K` (`ratio` alone is rapier2d's, as before), for every
+/// engine `K_p99_warm_us` (the p99 without the first step of each interleaved chunk) and the settle
+/// state `K_max_speed`, `K_moving`, `K_mean_height`, `K_max_overlap` (SI units).
 pub fn json(rows: &[Row]) -> String {
     let items: Vec<String> = rows
         .iter()
@@ -113,6 +118,7 @@ pub fn json(rows: &[Row]) -> String {
             for (k, e) in r.engines.iter().enumerate() {
                 f.push(format!("\"{}_median_us\": {}", e.key, num(e.median_us)));
                 f.push(format!("\"{}_p99_us\": {}", e.key, num(e.p99_us)));
+                f.push(format!("\"{}_p99_warm_us\": {}", e.key, num(e.p99_warm_us)));
                 if k > 0 {
                     if e.key == "rapier2d" {
                         f.push(format!("\"ratio\": {}", num(r.ratio(k))));
