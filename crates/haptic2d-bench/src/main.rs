@@ -319,14 +319,7 @@ fn run(args: &Args) -> Result<(), String> {
                 key,
                 median_us: t.median(),
                 p99_us: t.p99(),
-                p99_warm_us: timing::Samples(
-                    t.0.iter()
-                        .enumerate()
-                        .filter(|(i, _)| i % args.chunk.max(1) != 0)
-                        .map(|(_, &x)| x)
-                        .collect(),
-                )
-                .p99(),
+                p99_warm_us: t.without_chunk_starts(args.chunk).p99(),
                 state,
             })
             .collect();

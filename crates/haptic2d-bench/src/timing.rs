@@ -56,6 +56,21 @@ impl Samples {
     pub fn p99(&self) -> f64 {
         self.quantile(0.99)
     }
+    /// These samples of one engine from [`interleaved`] with `chunk`, without the first step of
+    /// each chunk: the step that runs right after the other engines, with its data evicted from
+    /// the caches (every engine's samples are its chunks back to back, each `chunk` steps long
+    /// but the last).
+    pub fn without_chunk_starts(&self, chunk: usize) -> Samples {
+        let chunk = chunk.max(1);
+        Samples(
+            self.0
+                .iter()
+                .enumerate()
+                .filter(|(i, _)| i % chunk != 0)
+                .map(|(_, &x)| x)
+                .collect(),
+        )
+    }
 }
 
 /// Runs `warmup` untimed steps of each engine, then `steps` timed steps of each, interleaved in chunks

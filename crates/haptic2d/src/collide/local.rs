@@ -640,8 +640,7 @@ impl Ctx {
         let reach = Vec2::new(self.delta_c + self.eps_s, self.delta_c + self.eps_s);
         let (lo, hi) = (b.c.aabb.min - reach, b.c.aabb.max + reach);
         // B's edges as (start, normal) pairs, read without bounds checks in the loop below.
-        let (b_starts, b_normals) = (&b.c.world_vertices[..], &b.c.world_normals[..]);
-        let b_normals = &b_normals[..b_starts.len()];
+        let (b_starts, b_normals) = (&b.c.world_vertices, &b.c.world_normals);
         'vertex: for (v, &p) in a.c.world_vertices.iter().enumerate() {
             if p.x < lo.x || p.x > hi.x || p.y < lo.y || p.y > hi.y {
                 continue;

@@ -167,10 +167,13 @@ pub struct ChainDamping {
     src: Vec<u32>,
     /// Loaded-list index of each row of `rows` (key order).
     row_src: Vec<u32>,
-    /// Keys of the last sample's loaded list (all of it, chain or not), and which bodies were
-    /// dynamic: when both are unchanged, the rows are refreshed in place.
+    /// Keys of the last sample's loaded list (all of it, chain or not), and which bodies are
+    /// dynamic (this sample's, once step 1 has run; the last sample's before): when both are
+    /// unchanged and the last build dropped no chain contact, the rows are refreshed in place.
     loaded_keys: Vec<VeCandidate>,
-    was_dynamic: Vec<bool>,
+    dynamic: Vec<bool>,
+    /// The last build dropped a chain contact whose effective mass was not finite and positive.
+    dropped: bool,
     /// Colour of each row (key order), rows per colour, and colours used per body.
     colour: Vec<u32>,
     per_colour: Vec<u32>,
@@ -216,7 +219,8 @@ impl Default for ChainDamping {
             src: Vec::with_capacity(64),
             row_src: Vec::with_capacity(64),
             loaded_keys: Vec::with_capacity(64),
-            was_dynamic: Vec::new(),
+            dynamic: Vec::new(),
+            dropped: false,
             colour: Vec::with_capacity(64),
             per_colour: vec![0; COLOURS as usize + 1],
             used: Vec::new(),
@@ -286,7 +290,7 @@ impl ChainDamping {
             self.star.resize(n, SolverBody::default());
             self.pos.resize(n, Vec2::ZERO);
             self.used.resize(n, 0);
-            self.was_dynamic.resize(n, false);
+            self.dynamic.resize(n, false);
             self.forget();
         }
         if loaded.is_empty() {
@@ -321,13 +325,14 @@ impl ChainDamping {
                 }
             };
             let d = self.star[i].inv_mass > 0.0 || self.star[i].inv_inertia > 0.0;
-            same_bodies &= self.was_dynamic[i] == d;
-            self.was_dynamic[i] = d;
+            same_bodies &= self.dynamic[i] == d;
+            self.dynamic[i] = d;
         }
         // 2–4. The rows: refreshed in place when the loaded contacts are those of the last
         //      sample (a pile at rest, most samples), built from scratch otherwise.
         let r = dt / tau;
         let same = same_bodies
+            && !self.dropped
             && !self.sorted.is_empty()
             && loaded.len() == self.loaded_keys.len()
             && loaded
@@ -408,14 +413,13 @@ impl ChainDamping {
         for (row, &k) in self.sorted.iter().zip(&self.slot) {
             self.prev_lambda[k as usize] = row.lambda;
         }
-        let star = &self.star;
-        let dynamic = |i: usize| star[i].inv_mass > 0.0 || star[i].inv_inertia > 0.0;
+        let (star, dynamic) = (&self.star, &self.dynamic);
         // 2. Which dynamic bodies touch two or more other bodies.
         self.partner.fill(NONE);
         self.multi.fill(false);
         for e in loaded {
             for (x, y) in [(e.body_a, e.body_b), (e.body_b, e.body_a)] {
-                if !dynamic(x as usize) {
+                if !dynamic[x as usize] {
                     continue;
                 }
                 let p = &mut self.partner[x as usize];
@@ -438,12 +442,13 @@ impl ChainDamping {
         self.per_colour.fill(0);
         self.used.fill(0);
         self.loaded_keys.clear();
+        self.dropped = false;
         let mut g = 0.0;
         let mut j = 0;
         for (i, e) in loaded.iter().enumerate() {
             self.loaded_keys.push(e.key);
             let (a, b) = (e.body_a as usize, e.body_b as usize);
-            let (dyn_a, dyn_b) = (dynamic(a), dynamic(b));
+            let (dyn_a, dyn_b) = (dynamic[a], dynamic[b]);
             if !((dyn_a && self.multi[a]) || (dyn_b && self.multi[b])) {
                 continue;
             }
@@ -456,6 +461,7 @@ impl ChainDamping {
                 0.0
             };
             let Some(row) = Row::new(e, a as u32, b as u32, &self.pos, star, r, dt, prev) else {
+                self.dropped = true;
                 continue;
             };
             // g = λ₀ᵀ·J·v* (see `scale_warm_start`), and the warm impulse applied.

@@ -76,15 +76,14 @@ pub(super) fn measure(e: &mut VeContact, bodies: &[Body], rots: &[Rot]) {
     let v = ba.pose.pos + ra.apply(e.local.v);
     let e0 = bb.pose.pos + rb.apply(e.local.e0);
     let n = rb.apply(e.local.n);
-    // = rb.apply(local tangent), bit for bit (see `VeContact::t`).
-    let t = Vec2::new(-n.y, n.x);
+    e.n = n;
+    let t = e.t();
     let rel = v - e0;
     e.d = [n.dot(rel), e.d[0], e.d[1]];
     e.hist = (e.hist + 1).min(3);
     e.s_prev = e.s;
     e.s = t.dot(rel);
     e.point = v;
-    e.n = n;
     let v_rel = ba.point_velocity(v) - bb.point_velocity(v);
     e.c0 = n.dot(v_rel);
     e.s0 = t.dot(v_rel);
