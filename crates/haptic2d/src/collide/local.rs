@@ -45,6 +45,7 @@
 
 use super::gjk::GJK_EPS_ABS;
 use super::tracker::{ClosestFeatures, Feature, FeatureTracker, TrackStatus};
+use super::reuse::{Reused, Slack};
 use super::{Collider, VeCandidate};
 use crate::geom::Vec2;
 
@@ -100,8 +101,15 @@ pub struct LocalStage {
     old_trackers: Vec<FeatureTracker>,
     old_gaps: Vec<Gap>,
     old_states: Vec<PairState>,
+    /// The candidates of each pair's reused vertex scan (see [`Gap::reused`]).
+    reused_scans: Vec<Reused>,
+    old_reused_scans: Vec<Reused>,
+    /// `δ_c` of the reused scans (a change drops them).
+    reused_delta_c: f64,
     /// Pairs whose tracking the last update skipped (their gap still held).
     skipped: usize,
+    /// Penetrating pairs whose vertex scan the last update reused (`reuse.rs`).
+    reused: usize,
     /// Scratch of the candidate sort.
     sort_buf: Vec<VeCandidate>,
     bucket: Vec<u32>,
@@ -112,6 +120,9 @@ pub struct LocalStage {
 /// odometers are bounds on the motion of every point of a body, m), the pair is still farther
 /// apart than `δ_c` and has no candidate, so its tracking can wait. `δ_c` is the one of the
 /// sample that checks, so a tolerance changed at run time counts at once.
+///
+/// A penetrating pair's vertex scan is reused the same way (`reused`, see `reuse.rs`): while
+/// `k_a·ΔD_A + k_b·ΔD_B < clear − δ_c`, with `clear = σ + δ_c` of the scan.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Gap {
     /// `distance − GAP_GUARD` at the last tracked sample (m); 0 = track every sample.
@@ -119,6 +130,10 @@ struct Gap {
     /// Odometers of the two bodies then (m).
     odo_a: f64,
     odo_b: f64,
+    /// How much a unit of each body's motion moves the pair's compared quantities (1 for a
+    /// separated pair's distance).
+    k_a: f64,
+    k_b: f64,
     /// The pair's bodies (`u32::MAX` for a collider that does not exist), kept here so that a
     /// skipped pair reads nothing but this record.
     body_a: u32,
@@ -129,6 +144,8 @@ struct Gap {
     /// [`FeatureTracker::confirm_penetration`]): confirming it again only moves the reported
     /// point, so the tracker is not touched.
     confirmed: bool,
+    /// The pair's last vertex scan is reused while the gap holds (its candidates are kept).
+    reused: bool,
 }
 
 impl Gap {
@@ -138,10 +155,13 @@ impl Gap {
             clear: 0.0,
             odo_a: 0.0,
             odo_b: 0.0,
+            k_a: 1.0,
+            k_b: 1.0,
             body_a,
             body_b,
             penetrating: false,
             confirmed: false,
+            reused: false,
         }
     }
 }
@@ -170,7 +190,11 @@ impl LocalStage {
             old_trackers: Vec::new(),
             old_gaps: Vec::new(),
             old_states: Vec::new(),
+            reused_scans: Vec::new(),
+            old_reused_scans: Vec::new(),
+            reused_delta_c: DEFAULT_DELTA_C,
             skipped: 0,
+            reused: 0,
             sort_buf: Vec::new(),
             bucket: Vec::new(),
         }
@@ -188,6 +212,8 @@ impl LocalStage {
         s.old_trackers.reserve(pairs);
         s.old_gaps.reserve(pairs);
         s.old_states.reserve(pairs);
+        s.reused_scans.reserve(pairs);
+        s.old_reused_scans.reserve(pairs);
         s.sort_buf.reserve(2 * pairs);
         s
     }
@@ -198,6 +224,9 @@ impl LocalStage {
             return Err(format!(
                 "eps_s (edge-range tolerance) must be a finite distance ≥ 0 m, got {eps_s}"
             ));
+        }
+        if eps_s != self.eps_s {
+            self.drop_reused_scans();
         }
         self.eps_s = eps_s;
         Ok(())
@@ -226,6 +255,24 @@ impl LocalStage {
         self.skipped
     }
 
+    /// Penetrating pairs whose vertex scan the last update reused because their bodies had not
+    /// moved enough to change any of its comparisons (the candidates are those a scan would give;
+    /// the pair's reported point is the scan's).
+    pub fn reused(&self) -> usize {
+        self.reused
+    }
+
+    /// Drops every reused vertex scan: the next update scans those pairs again.
+    fn drop_reused_scans(&mut self) {
+        for g in self.gaps.iter_mut().filter(|g| g.reused) {
+            *g = Gap {
+                penetrating: g.penetrating,
+                confirmed: g.confirmed,
+                ..Gap::track(g.body_a, g.body_b)
+            };
+        }
+    }
+
     /// The trackers (with their work counters), in pair order. A pair that stays penetrating is
     /// confirmed once (counted in its tracker's `updates`); the samples after that only move the
     /// reported point and are not counted.
@@ -239,18 +286,25 @@ impl LocalStage {
         std::mem::swap(&mut self.trackers, &mut self.old_trackers);
         std::mem::swap(&mut self.gaps, &mut self.old_gaps);
         std::mem::swap(&mut self.states, &mut self.old_states);
+        std::mem::swap(&mut self.reused_scans, &mut self.old_reused_scans);
         self.pairs.clear();
         self.trackers.clear();
         self.gaps.clear();
         self.states.clear();
+        self.reused_scans.clear();
         // Both lists are sorted: one merge keeps the trackers (and gaps) of pairs that persist.
         let mut k = 0;
         for &p in pairs {
             while k < self.old_pairs.len() && self.old_pairs[k] < p {
                 k += 1;
             }
-            let (t, g, st) = if k < self.old_pairs.len() && self.old_pairs[k] == p {
-                (self.old_trackers[k], self.old_gaps[k], self.old_states[k])
+            let (t, g, st, r) = if k < self.old_pairs.len() && self.old_pairs[k] == p {
+                (
+                    self.old_trackers[k],
+                    self.old_gaps[k],
+                    self.old_states[k],
+                    self.old_reused_scans[k],
+                )
             } else {
                 let body = |c: u32| {
                     colliders
@@ -259,12 +313,13 @@ impl LocalStage {
                 };
                 let t = FeatureTracker::new();
                 let g = Gap::track(body(p.0), body(p.1));
-                (t, g, PairState::untracked(p))
+                (t, g, PairState::untracked(p), Reused::EMPTY)
             };
             self.pairs.push(p);
             self.trackers.push(t);
             self.gaps.push(g);
             self.states.push(st);
+            self.reused_scans.push(r);
         }
     }
 
@@ -303,6 +358,11 @@ impl LocalStage {
         }
         out.clear();
         self.skipped = 0;
+        self.reused = 0;
+        if delta_c != self.reused_delta_c {
+            self.drop_reused_scans();
+            self.reused_delta_c = delta_c;
+        }
         // The candidate sort's buckets are sized now, before any contact needs them.
         self.bucket.resize(colliders.len() + 1, 0);
         for (k, &(ia, ib)) in pairs.iter().enumerate() {
@@ -315,8 +375,13 @@ impl LocalStage {
                 (Some(&x), Some(&y)) => (x, y),
                 _ => (f64::NAN, f64::NAN),
             };
-            if (odo_a - g.odo_a) + (odo_b - g.odo_b) < g.clear - delta_c {
-                self.skipped += 1;
+            if (odo_a - g.odo_a) * g.k_a + (odo_b - g.odo_b) * g.k_b < g.clear - delta_c {
+                if g.reused {
+                    out.extend_from_slice(self.reused_scans[k].get());
+                    self.reused += 1;
+                } else {
+                    self.skipped += 1;
+                }
                 continue;
             }
             let (Some(a), Some(b)) = (colliders.get(ia as usize), colliders.get(ib as usize))
@@ -334,13 +399,36 @@ impl LocalStage {
             // feature walk/GJK is skipped (resting contacts, e.g. a pile, stay on this path).
             if g.penetrating {
                 let mark = out.len();
-                let inside_a = ctx.vertices_against(sa, sb, out);
-                let inside_b = ctx.vertices_against(sb, sa, out);
+                let mut slack = Slack::new();
+                let inside_a = ctx.vertices_against(sa, sb, out, &mut slack);
+                let inside_b = ctx.vertices_against(sb, sa, out, &mut slack);
                 if let Some(at) = inside_a.or(inside_b) {
                     if g.confirmed {
                         // What `confirm_penetration` would return again, but for the point.
                         let f = &mut self.states[k].features;
                         (f.point_a, f.point_b) = (at, at);
+                        // The scan is reused while the bodies cannot have changed it.
+                        let cert = slack.certificate(a, b, delta_c, self.eps_s, GAP_GUARD);
+                        let found = Reused::of(&out[mark..]);
+                        self.gaps[k] = match (cert, found) {
+                            (Some((sigma, k_a, k_b)), Some(found)) => {
+                                self.reused_scans[k] = found;
+                                Gap {
+                                    clear: sigma + delta_c,
+                                    odo_a,
+                                    odo_b,
+                                    k_a,
+                                    k_b,
+                                    reused: true,
+                                    ..g
+                                }
+                            }
+                            _ => Gap {
+                                clear: 0.0,
+                                reused: false,
+                                ..g
+                            },
+                        };
                         continue;
                     }
                     let f = self.trackers[k].confirm_penetration(at);
@@ -378,8 +466,8 @@ impl LocalStage {
             let (a, b) = (sa, sb);
             match f.status {
                 TrackStatus::Penetrating => {
-                    ctx.vertices_against(a, b, out);
-                    ctx.vertices_against(b, a, out);
+                    ctx.vertices_against(a, b, out, &mut Slack::new());
+                    ctx.vertices_against(b, a, out, &mut Slack::new());
                 }
                 // Closer than GJK's ε_abs, "apart" is not a certificate: two equal boxes stacked
                 // corner on corner overlap with every vertex of each exactly on a side line of the
@@ -389,8 +477,8 @@ impl LocalStage {
                 // The vertex scan (§9.4) proposes every touching vertex instead (at distance 0 it
                 // is exact for touching pairs as well).
                 TrackStatus::Separated if f.distance <= GJK_EPS_ABS => {
-                    ctx.vertices_against(a, b, out);
-                    ctx.vertices_against(b, a, out);
+                    ctx.vertices_against(a, b, out, &mut Slack::new());
+                    ctx.vertices_against(b, a, out, &mut Slack::new());
                 }
                 TrackStatus::Separated if f.distance <= delta_c => {
                     ctx.closest_feature_candidates(a, b, &f, out);
@@ -632,7 +720,15 @@ impl Ctx {
     /// limited to a neighbour whose line is within `δ_c` of the nearest one, so every candidate
     /// satisfies `d_e ≥ max_j d_j − δ_c` (the invariant the contact manager checks,
     /// [`nearest_line`]).
-    fn vertices_against(&self, a: Side, b: Side, out: &mut Vec<VeCandidate>) -> Option<Vec2> {
+    ///
+    /// Every comparison's distance from its threshold is recorded in `slack` (`reuse.rs`).
+    fn vertices_against(
+        &self,
+        a: Side,
+        b: Side,
+        out: &mut Vec<VeCandidate>,
+        slack: &mut Slack,
+    ) -> Option<Vec2> {
         let mut inside = None;
         // A vertex farther than `δ_c + ε_s` outside B's box is farther than that from B: no
         // candidate (one needs an edge whose range holds it within `ε_s` and whose line is
@@ -643,10 +739,13 @@ impl Ctx {
         let (b_starts, b_normals) = (&b.c.world_vertices, &b.c.world_normals);
         'vertex: for (v, &p) in a.c.world_vertices.iter().enumerate() {
             if p.x < lo.x || p.x > hi.x || p.y < lo.y || p.y > hi.y {
+                slack.decided((lo - p).max(p - hi).max_element());
                 continue;
             }
             let mut nearest = 0usize;
             let mut max_d = f64::NEG_INFINITY;
+            // The second largest line distance: the nearest line is decided by their gap.
+            let mut second = f64::NEG_INFINITY;
             // Edge lines within reach of the vertex (−δ_c ≤ d ≤ δ_c): two or more only within
             // ~δ_c of a corner of B (or across a part of B thinner than 2·δ_c), where least depth
             // can be decided by round-off. Counting costs one compare per edge; the corner rule
@@ -657,25 +756,38 @@ impl Ctx {
                 let d = n.dot(p - e0);
                 if d > self.delta_c {
                     // Farther than δ_c from B's half-plane, so from B.
+                    slack.decided(d - self.delta_c);
                     continue 'vertex;
                 }
                 if d > max_d {
+                    second = max_d;
                     max_d = d;
                     nearest = e;
+                } else {
+                    second = second.max(d);
                 }
                 near_lines += (d >= -self.delta_c) as u32;
+                slack.decided((self.delta_c - d).min((d + self.delta_c).abs()));
             }
-            if max_d < 0.0 && inside.is_none() {
-                inside = Some(p);
+            slack.decided(0.5 * (max_d - second));
+            if max_d < 0.0 {
+                slack.inside = slack.inside.max(-max_d);
+                if inside.is_none() {
+                    inside = Some(p);
+                }
             }
             // Nearest line first: its edge must hold the vertex (always so inside B, see above);
             // otherwise the vertex is in a corner region outside B and gets no candidate.
             let s = b.c.edge_coordinate(nearest, p);
-            if s < -self.eps_s || s > b.c.local.lengths()[nearest] + self.eps_s {
+            let l = b.c.local.lengths()[nearest];
+            slack.decided((s + self.eps_s).abs().min((l + self.eps_s - s).abs()));
+            if s < -self.eps_s || s > l + self.eps_s {
                 continue;
             }
             let mut e = nearest;
             if near_lines >= 2 {
+                // Decided by orientation (the corner-on-corner rule): not reused.
+                slack.decided(0.0);
                 e = self.corner_edge(a.c, v, b.c, e, max_d);
             }
             out.push(VeCandidate {

@@ -20,6 +20,7 @@ mod broad;
 mod collider;
 mod gjk;
 mod local;
+mod reuse;
 mod toi;
 mod tracker;
 
