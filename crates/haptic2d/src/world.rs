@@ -384,6 +384,7 @@ impl World {
             self.tick,
             dt,
             &self.candidates,
+            self.local.from_vertex_scan(),
             &self.colliders,
             &mut self.bodies,
             &self.rots,

@@ -2,7 +2,7 @@
 //! bodies have not moved enough to change any comparison of its scan keeps its candidates
 //! without scanning. Checked against a local stage that tracks and scans every pair every sample.
 
-use haptic2d::collide::{Collider, LocalStage, DEFAULT_DELTA_C};
+use haptic2d::collide::{nearest_line, Collider, LocalStage, DEFAULT_DELTA_C};
 use haptic2d::geom::{ConvexPolygon, Pose, Vec2};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -36,6 +36,7 @@ fn small(rng: &mut ChaCha8Rng, top: f64) -> f64 {
 fn reused_vertex_scans_give_the_candidates_of_scanning_every_sample() {
     let mut reused_total = 0usize;
     let mut scanned_total = 0usize;
+    let mut flagged_total = 0usize;
     for seed in 0..12u64 {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         // A row of overlapping polygons (each overlaps its neighbours by up to a few mm), one of
@@ -90,13 +91,36 @@ fn reused_vertex_scans_give_the_candidates_of_scanning_every_sample() {
                 );
                 p.pos = home[i].pos + (p.pos - home[i].pos).clamp_length_max(0.003);
                 p.angle = home[i].angle + (p.angle - home[i].angle).clamp(-0.05, 0.05);
-                odometer[i] += (p.pos - last.pos).length() + (p.angle - last.angle).abs() * radius[i];
+                odometer[i] +=
+                    (p.pos - last.pos).length() + (p.angle - last.angle).abs() * radius[i];
                 poses[i] = p;
                 colliders[i].update(&p);
             }
-            fast.update_with_motion(&colliders, &pairs, DEFAULT_DELTA_C, &odometer, &mut out_fast);
+            fast.update_with_motion(
+                &colliders,
+                &pairs,
+                DEFAULT_DELTA_C,
+                &odometer,
+                &mut out_fast,
+            );
             every.update(&colliders, &pairs, DEFAULT_DELTA_C, &mut out_every);
             assert_eq!(out_fast, out_every, "seed {seed}, sample {k}");
+            // A vertex-scan candidate's edge passes the contact manager's hand-over check
+            // exactly (`d_e ≥ max_j d_j − δ_c` from the same world features), which is why its
+            // record skips that check.
+            let flags = fast.from_vertex_scan();
+            assert_eq!(flags.len(), out_fast.len());
+            assert_eq!(flags, every.from_vertex_scan(), "seed {seed}, sample {k}");
+            for (c, _) in out_fast.iter().zip(flags).filter(|(_, &f)| f) {
+                let v = colliders[c.vertex_collider as usize].world_vertices[c.vertex as usize];
+                let b = &colliders[c.edge_collider as usize];
+                let d_e = b.edge_distance(c.edge as usize, v);
+                assert!(
+                    d_e >= nearest_line(b, v).1 - DEFAULT_DELTA_C,
+                    "seed {seed}, sample {k}"
+                );
+                flagged_total += 1;
+            }
             reused_total += fast.reused();
             scanned_total += pairs.len() - fast.reused() - fast.skipped();
         }
@@ -104,6 +128,7 @@ fn reused_vertex_scans_give_the_candidates_of_scanning_every_sample() {
     // The suite exercises both paths: scans reused, and scans redone once the motion used up the
     // slack (or on the samples a pair was not reusable).
     assert!(reused_total > 20_000, "reused {reused_total}");
+    assert!(flagged_total > 20_000, "flagged {flagged_total}");
     assert!(scanned_total > 20_000, "scanned {scanned_total}");
 }
 
@@ -121,7 +146,10 @@ fn a_changed_contact_tolerance_drops_the_reused_scans() {
     let odometer = [0.0, 0.0];
     let (mut fast, mut every) = (LocalStage::new(), LocalStage::new());
     let (mut out_fast, mut out_every) = (Vec::new(), Vec::new());
-    for (k, delta_c) in [2e-3, 2e-3, 2e-3, 2e-3, 0.04, 0.04, 2e-3].into_iter().enumerate() {
+    for (k, delta_c) in [2e-3, 2e-3, 2e-3, 2e-3, 0.04, 0.04, 2e-3]
+        .into_iter()
+        .enumerate()
+    {
         fast.update_with_motion(&colliders, &pairs, delta_c, &odometer, &mut out_fast);
         every.update(&colliders, &pairs, delta_c, &mut out_every);
         assert_eq!(out_fast, out_every, "sample {k}");

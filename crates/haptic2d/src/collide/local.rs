@@ -44,8 +44,8 @@
 //! Candidates are sorted and deduplicated so that everything downstream is deterministic.
 
 use super::gjk::GJK_EPS_ABS;
+use super::reuse::{PairCandidates, Slack, SLOT};
 use super::tracker::{ClosestFeatures, Feature, FeatureTracker, TrackStatus};
-use super::reuse::{Reused, Slack};
 use super::{Collider, VeCandidate};
 use crate::geom::Vec2;
 
@@ -101,18 +101,30 @@ pub struct LocalStage {
     old_trackers: Vec<FeatureTracker>,
     old_gaps: Vec<Gap>,
     old_states: Vec<PairState>,
-    /// The candidates of each pair's reused vertex scan (see [`Gap::reused`]).
-    reused_scans: Vec<Reused>,
-    old_reused_scans: Vec<Reused>,
+    /// Each pair's candidates at its last tracked sample (a reused scan's while it is reused,
+    /// see [`Gap::reused`]).
+    candidates: Vec<PairCandidates>,
+    old_candidates: Vec<PairCandidates>,
     /// `δ_c` of the reused scans (a change drops them).
     reused_delta_c: f64,
     /// Pairs whose tracking the last update skipped (their gap still held).
     skipped: usize,
     /// Penetrating pairs whose vertex scan the last update reused (`reuse.rs`).
     reused: usize,
-    /// Scratch of the candidate sort.
-    sort_buf: Vec<VeCandidate>,
+    /// The output of the last update, sorted and deduplicated, and whether it is assembled from
+    /// the current pairs' candidates (false after the pair list changed).
+    sorted: Vec<VeCandidate>,
+    assembled: bool,
+    /// This update's tracked pairs' candidates, and the ranges of the pairs with more than a
+    /// slot holds (with their `from_scan` flag).
+    fresh: Vec<VeCandidate>,
+    overflow: Vec<(u32, u32, bool)>,
+    /// Scratch of the candidate sort (each candidate with its `from_scan` flag).
+    sort_buf: Vec<(VeCandidate, bool)>,
     bucket: Vec<u32>,
+    /// For each candidate of the last update (in output order), whether the vertex scan proposed
+    /// it (see [`LocalStage::from_vertex_scan`]).
+    from_scan: Vec<bool>,
 }
 
 /// The certified distance of a separated pair when it was last tracked, and the two bodies'
@@ -190,13 +202,18 @@ impl LocalStage {
             old_trackers: Vec::new(),
             old_gaps: Vec::new(),
             old_states: Vec::new(),
-            reused_scans: Vec::new(),
-            old_reused_scans: Vec::new(),
+            candidates: Vec::new(),
+            old_candidates: Vec::new(),
             reused_delta_c: DEFAULT_DELTA_C,
             skipped: 0,
             reused: 0,
+            sorted: Vec::new(),
+            assembled: false,
+            fresh: Vec::new(),
+            overflow: Vec::new(),
             sort_buf: Vec::new(),
             bucket: Vec::new(),
+            from_scan: Vec::new(),
         }
     }
 
@@ -212,9 +229,12 @@ impl LocalStage {
         s.old_trackers.reserve(pairs);
         s.old_gaps.reserve(pairs);
         s.old_states.reserve(pairs);
-        s.reused_scans.reserve(pairs);
-        s.old_reused_scans.reserve(pairs);
+        s.candidates.reserve(pairs);
+        s.old_candidates.reserve(pairs);
+        s.sorted.reserve(2 * pairs);
+        s.fresh.reserve(2 * pairs);
         s.sort_buf.reserve(2 * pairs);
+        s.from_scan.reserve(2 * pairs);
         s
     }
 
@@ -262,6 +282,16 @@ impl LocalStage {
         self.reused
     }
 
+    /// For each candidate of the last update (parallel to its output), whether it came from the
+    /// vertex scan (§9.4, fresh or reused): its edge is then its vertex's nearest edge line, or
+    /// the corner-on-corner rule's edge within `δ_c` of it, computed from the colliders' world
+    /// features of this sample. A contact record with that key satisfies the depth invariant
+    /// (`d_e ≥ max_j d_j − δ_c`, see [`ContactSet::step`](crate::contact::ContactSet::step))
+    /// exactly as the contact manager would compute it, so its hand-over check can be skipped.
+    pub fn from_vertex_scan(&self) -> &[bool] {
+        &self.from_scan
+    }
+
     /// Drops every reused vertex scan: the next update scans those pairs again.
     fn drop_reused_scans(&mut self) {
         for g in self.gaps.iter_mut().filter(|g| g.reused) {
@@ -286,12 +316,13 @@ impl LocalStage {
         std::mem::swap(&mut self.trackers, &mut self.old_trackers);
         std::mem::swap(&mut self.gaps, &mut self.old_gaps);
         std::mem::swap(&mut self.states, &mut self.old_states);
-        std::mem::swap(&mut self.reused_scans, &mut self.old_reused_scans);
+        std::mem::swap(&mut self.candidates, &mut self.old_candidates);
+        self.assembled = false;
         self.pairs.clear();
         self.trackers.clear();
         self.gaps.clear();
         self.states.clear();
-        self.reused_scans.clear();
+        self.candidates.clear();
         // Both lists are sorted: one merge keeps the trackers (and gaps) of pairs that persist.
         let mut k = 0;
         for &p in pairs {
@@ -303,7 +334,7 @@ impl LocalStage {
                     self.old_trackers[k],
                     self.old_gaps[k],
                     self.old_states[k],
-                    self.old_reused_scans[k],
+                    self.old_candidates[k],
                 )
             } else {
                 let body = |c: u32| {
@@ -313,13 +344,13 @@ impl LocalStage {
                 };
                 let t = FeatureTracker::new();
                 let g = Gap::track(body(p.0), body(p.1));
-                (t, g, PairState::untracked(p), Reused::EMPTY)
+                (t, g, PairState::untracked(p), PairCandidates::EMPTY)
             };
             self.pairs.push(p);
             self.trackers.push(t);
             self.gaps.push(g);
             self.states.push(st);
-            self.reused_scans.push(r);
+            self.candidates.push(r);
         }
     }
 
@@ -356,7 +387,6 @@ impl LocalStage {
         if self.pairs.as_slice() != pairs {
             self.rebuild(pairs, colliders);
         }
-        out.clear();
         self.skipped = 0;
         self.reused = 0;
         if delta_c != self.reused_delta_c {
@@ -365,8 +395,15 @@ impl LocalStage {
         }
         // The candidate sort's buckets are sized now, before any contact needs them.
         self.bucket.resize(colliders.len() + 1, 0);
+        // Each tracked pair's candidates go to `fresh` and are compared with its last ones: the
+        // sorted output is assembled again only if some pair's changed.
+        let mut changed = !self.assembled;
+        let mut fresh = std::mem::take(&mut self.fresh);
+        fresh.clear();
+        self.overflow.clear();
         for (k, &(ia, ib)) in pairs.iter().enumerate() {
-            // The gap certified at the last tracked sample still holds: nothing to do.
+            // The gap certified at the last tracked sample still holds: nothing to do (a reused
+            // scan's candidates are its last ones).
             let g = self.gaps[k];
             let (odo_a, odo_b) = match (
                 odometer.get(g.body_a as usize),
@@ -377,7 +414,6 @@ impl LocalStage {
             };
             if (odo_a - g.odo_a) * g.k_a + (odo_b - g.odo_b) * g.k_b < g.clear - delta_c {
                 if g.reused {
-                    out.extend_from_slice(self.reused_scans[k].get());
                     self.reused += 1;
                 } else {
                     self.skipped += 1;
@@ -388,118 +424,179 @@ impl LocalStage {
             else {
                 continue;
             };
-            let ctx = Ctx {
-                delta_c,
-                eps_s: self.eps_s,
-                cos_parallel: self.cos_parallel,
-            };
-            let (sa, sb) = (Side { id: ia, c: a }, Side { id: ib, c: b });
-            // A pair that was penetrating and still has a vertex strictly inside the other polygon is
-            // still penetrating: its candidates are exactly the vertex scan (§9.4), and the closest-
-            // feature walk/GJK is skipped (resting contacts, e.g. a pile, stay on this path).
-            if g.penetrating {
-                let mark = out.len();
-                let mut slack = Slack::new();
-                let inside_a = ctx.vertices_against(sa, sb, out, &mut slack);
-                let inside_b = ctx.vertices_against(sb, sa, out, &mut slack);
-                if let Some(at) = inside_a.or(inside_b) {
-                    if g.confirmed {
-                        // What `confirm_penetration` would return again, but for the point.
-                        let f = &mut self.states[k].features;
-                        (f.point_a, f.point_b) = (at, at);
-                        // The scan is reused while the bodies cannot have changed it.
-                        let cert = slack.certificate(a, b, delta_c, self.eps_s, GAP_GUARD);
-                        let found = Reused::of(&out[mark..]);
-                        self.gaps[k] = match (cert, found) {
-                            (Some((sigma, k_a, k_b)), Some(found)) => {
-                                self.reused_scans[k] = found;
-                                Gap {
-                                    clear: sigma + delta_c,
-                                    odo_a,
-                                    odo_b,
-                                    k_a,
-                                    k_b,
-                                    reused: true,
-                                    ..g
-                                }
-                            }
-                            _ => Gap {
-                                clear: 0.0,
-                                reused: false,
-                                ..g
-                            },
-                        };
-                        continue;
+            let mark = fresh.len();
+            let scan = self.track(k, (ia, a), (ib, b), (odo_a, odo_b), delta_c, &mut fresh);
+            let found = &fresh[mark..];
+            match PairCandidates::of(found, scan) {
+                Some(c) => {
+                    if self.candidates[k] != c {
+                        self.candidates[k] = c;
+                        changed = true;
                     }
-                    let f = self.trackers[k].confirm_penetration(at);
-                    self.states[k] = PairState {
-                        pair: (ia, ib),
-                        features: f,
-                    };
-                    self.gaps[k] = Gap {
-                        penetrating: self.trackers[k].is_penetrating(),
-                        confirmed: true,
-                        ..Gap::track(g.body_a, g.body_b)
-                    };
-                    continue;
                 }
-                out.truncate(mark);
-            }
-            // Closest features (§9.3).
-            let f = self.trackers[k].update(a, b);
-            self.states[k] = PairState {
-                pair: (ia, ib),
-                features: f,
-            };
-            // A separated pair farther than δ_c may wait until its bodies have moved its gap.
-            self.gaps[k] = match f.status {
-                TrackStatus::Separated if f.distance > delta_c + GAP_GUARD => Gap {
-                    clear: f.distance - GAP_GUARD,
-                    odo_a,
-                    odo_b,
-                    ..Gap::track(g.body_a, g.body_b)
-                },
-                _ => Gap::track(g.body_a, g.body_b),
-            };
-            self.gaps[k].penetrating = self.trackers[k].is_penetrating();
-            // VE candidates (§9.4–9.5).
-            let (a, b) = (sa, sb);
-            match f.status {
-                TrackStatus::Penetrating => {
-                    ctx.vertices_against(a, b, out, &mut Slack::new());
-                    ctx.vertices_against(b, a, out, &mut Slack::new());
+                None => {
+                    self.candidates[k] = PairCandidates::OVERFLOW;
+                    self.overflow.push((mark as u32, fresh.len() as u32, scan));
+                    changed = true;
                 }
-                // Closer than GJK's ε_abs, "apart" is not a certificate: two equal boxes stacked
-                // corner on corner overlap with every vertex of each exactly on a side line of the
-                // other (signed distance 0 or ±1e-19 m), so no vertex is strictly inside, GJK stops
-                // at |v| ≤ ε_abs and the walk certifies a vertex–side-edge pair at ~1e-20 m, which
-                // would propose one side-edge candidate and let the boxes sink through each other.
-                // The vertex scan (§9.4) proposes every touching vertex instead (at distance 0 it
-                // is exact for touching pairs as well).
-                TrackStatus::Separated if f.distance <= GJK_EPS_ABS => {
-                    ctx.vertices_against(a, b, out, &mut Slack::new());
-                    ctx.vertices_against(b, a, out, &mut Slack::new());
-                }
-                TrackStatus::Separated if f.distance <= delta_c => {
-                    ctx.closest_feature_candidates(a, b, &f, out);
-                }
-                TrackStatus::Separated => {}
             }
         }
-        sort_dedup(out, &mut self.sort_buf, &mut self.bucket, colliders.len());
+        if changed {
+            self.assemble(&fresh, colliders.len());
+        }
+        self.fresh = fresh;
+        out.clone_from(&self.sorted);
+    }
+
+    /// The sorted, deduplicated candidates of every pair (`sorted`, with `from_scan`), from the
+    /// pairs' last candidates and this update's overflowing ones (ranges of `fresh`).
+    fn assemble(&mut self, fresh: &[VeCandidate], colliders: usize) {
+        self.sorted.clear();
+        self.from_scan.clear();
+        for c in self.candidates.iter().filter(|c| !c.overflows()) {
+            self.sorted.extend_from_slice(c.get());
+            self.from_scan.resize(self.sorted.len(), c.scan);
+        }
+        for &(start, end, scan) in &self.overflow {
+            self.sorted
+                .extend_from_slice(&fresh[start as usize..end as usize]);
+            self.from_scan.resize(self.sorted.len(), scan);
+        }
+        sort_dedup(
+            &mut self.sorted,
+            &mut self.from_scan,
+            &mut self.sort_buf,
+            &mut self.bucket,
+            colliders,
+        );
+        self.assembled = true;
+    }
+
+    /// Tracks pair `k` (colliders `a`, `b` with their indices; the bodies' odometers `odo`) and
+    /// pushes its VE candidates to `out`. Returns whether they are the vertex scan's (§9.4).
+    fn track(
+        &mut self,
+        k: usize,
+        (ia, a): (u32, &Collider),
+        (ib, b): (u32, &Collider),
+        (odo_a, odo_b): (f64, f64),
+        delta_c: f64,
+        out: &mut Vec<VeCandidate>,
+    ) -> bool {
+        let g = self.gaps[k];
+        let ctx = Ctx {
+            delta_c,
+            eps_s: self.eps_s,
+            cos_parallel: self.cos_parallel,
+        };
+        let (sa, sb) = (Side { id: ia, c: a }, Side { id: ib, c: b });
+        // A pair that was penetrating and still has a vertex strictly inside the other polygon is
+        // still penetrating: its candidates are exactly the vertex scan (§9.4), and the closest-
+        // feature walk/GJK is skipped (resting contacts, e.g. a pile, stay on this path).
+        if g.penetrating {
+            let mark = out.len();
+            let mut slack = Slack::new();
+            let inside_a = ctx.vertices_against(sa, sb, out, &mut slack);
+            let inside_b = ctx.vertices_against(sb, sa, out, &mut slack);
+            if let Some(at) = inside_a.or(inside_b) {
+                if g.confirmed {
+                    // What `confirm_penetration` would return again, but for the point.
+                    let f = &mut self.states[k].features;
+                    (f.point_a, f.point_b) = (at, at);
+                    // The scan is reused while the bodies cannot have changed it.
+                    let cert = slack.certificate(a, b, delta_c, self.eps_s, GAP_GUARD);
+                    let fits = out.len() - mark <= SLOT;
+                    self.gaps[k] = match cert {
+                        Some((sigma, k_a, k_b)) if fits => Gap {
+                            clear: sigma + delta_c,
+                            odo_a,
+                            odo_b,
+                            k_a,
+                            k_b,
+                            reused: true,
+                            ..g
+                        },
+                        _ => Gap {
+                            clear: 0.0,
+                            reused: false,
+                            ..g
+                        },
+                    };
+                    return true;
+                }
+                let f = self.trackers[k].confirm_penetration(at);
+                self.states[k] = PairState {
+                    pair: (ia, ib),
+                    features: f,
+                };
+                self.gaps[k] = Gap {
+                    penetrating: self.trackers[k].is_penetrating(),
+                    confirmed: true,
+                    ..Gap::track(g.body_a, g.body_b)
+                };
+                return true;
+            }
+            out.truncate(mark);
+        }
+        // Closest features (§9.3).
+        let f = self.trackers[k].update(a, b);
+        self.states[k] = PairState {
+            pair: (ia, ib),
+            features: f,
+        };
+        // A separated pair farther than δ_c may wait until its bodies have moved its gap.
+        self.gaps[k] = match f.status {
+            TrackStatus::Separated if f.distance > delta_c + GAP_GUARD => Gap {
+                clear: f.distance - GAP_GUARD,
+                odo_a,
+                odo_b,
+                ..Gap::track(g.body_a, g.body_b)
+            },
+            _ => Gap::track(g.body_a, g.body_b),
+        };
+        self.gaps[k].penetrating = self.trackers[k].is_penetrating();
+        // VE candidates (§9.4–9.5).
+        let (a, b) = (sa, sb);
+        match f.status {
+            TrackStatus::Penetrating => {
+                ctx.vertices_against(a, b, out, &mut Slack::new());
+                ctx.vertices_against(b, a, out, &mut Slack::new());
+                true
+            }
+            // Closer than GJK's ε_abs, "apart" is not a certificate: two equal boxes stacked
+            // corner on corner overlap with every vertex of each exactly on a side line of the
+            // other (signed distance 0 or ±1e-19 m), so no vertex is strictly inside, GJK stops
+            // at |v| ≤ ε_abs and the walk certifies a vertex–side-edge pair at ~1e-20 m, which
+            // would propose one side-edge candidate and let the boxes sink through each other.
+            // The vertex scan (§9.4) proposes every touching vertex instead (at distance 0 it
+            // is exact for touching pairs as well).
+            TrackStatus::Separated if f.distance <= GJK_EPS_ABS => {
+                ctx.vertices_against(a, b, out, &mut Slack::new());
+                ctx.vertices_against(b, a, out, &mut Slack::new());
+                true
+            }
+            TrackStatus::Separated if f.distance <= delta_c => {
+                ctx.closest_feature_candidates(a, b, &f, out);
+                false
+            }
+            TrackStatus::Separated => false,
+        }
     }
 }
 
-/// Sorts and deduplicates `out` (the candidates of one update): a counting sort by vertex
+/// Sorts and deduplicates `out` (the candidates of one update) with their flags `flag`
+/// (parallel; a key proposed twice keeps the flag only if both had it): a counting sort by vertex
 /// collider into `buf` (each collider's candidates are a handful), then an insertion sort of
 /// each bucket. The same order as `sort_unstable` + `dedup` (keys are plain integers), in
 /// `O(n + colliders)`. `bucket` is scratch of `colliders + 1` starts.
 fn sort_dedup(
     out: &mut Vec<VeCandidate>,
-    buf: &mut Vec<VeCandidate>,
+    flag: &mut Vec<bool>,
+    buf: &mut Vec<(VeCandidate, bool)>,
     bucket: &mut Vec<u32>,
     colliders: usize,
 ) {
+    debug_assert_eq!(out.len(), flag.len());
     if out.len() < 2 {
         return;
     }
@@ -514,14 +611,15 @@ fn sort_dedup(
         bucket[i] += bucket[i - 1];
     }
     buf.clear();
-    buf.resize(out.len(), out[0]);
-    for c in out.iter() {
+    buf.resize(out.len(), (out[0], false));
+    for (&c, &f) in out.iter().zip(flag.iter()) {
         let at = &mut bucket[c.vertex_collider as usize];
-        buf[*at as usize] = *c;
+        buf[*at as usize] = (c, f);
         *at += 1;
     }
     // `bucket[i]` is now the end of collider i's run (and the start of i + 1's).
     out.clear();
+    flag.clear();
     let mut start = 0usize;
     for &end in bucket.iter().take(colliders) {
         let run = &mut buf[start..end as usize];
@@ -536,9 +634,14 @@ fn sort_dedup(
                 }
             }
         }
-        for &c in run.iter() {
-            if out.last() != Some(&c) {
+        for &(c, f) in run.iter() {
+            if out.last() == Some(&c) {
+                // Equal keys sort `false` first: the `&&` keeps a flag only if both had it.
+                let last = flag.last_mut().expect("parallel to out");
+                *last = *last && f;
+            } else {
                 out.push(c);
+                flag.push(f);
             }
         }
         start = end as usize;

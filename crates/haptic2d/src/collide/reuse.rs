@@ -104,17 +104,20 @@ fn motion_factor(c: &Collider, delta_c: f64, eps_s: f64) -> f64 {
     }
 }
 
-/// The candidates of a reused scan (`len ≤ SLOT`).
+/// One pair's candidates at its last tracked sample (`len ≤ SLOT`, or [`OVERFLOW`](Self::OVERFLOW)
+/// for more), and whether they are the vertex scan's (`LocalStage::from_vertex_scan`).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(super) struct Reused {
-    pub len: u8,
-    pub candidates: [VeCandidate; SLOT],
+pub(super) struct PairCandidates {
+    len: u8,
+    pub scan: bool,
+    candidates: [VeCandidate; SLOT],
 }
 
-impl Reused {
+impl PairCandidates {
     /// No candidates.
-    pub const EMPTY: Reused = Reused {
+    pub const EMPTY: PairCandidates = PairCandidates {
         len: 0,
+        scan: false,
         candidates: [VeCandidate {
             vertex_collider: 0,
             vertex: 0,
@@ -123,17 +126,31 @@ impl Reused {
         }; SLOT],
     };
 
-    /// The candidates `found`, or `None` if there are more than a slot holds.
-    pub fn of(found: &[VeCandidate]) -> Option<Reused> {
-        let mut r = Reused::EMPTY;
+    /// More candidates than a slot holds (kept elsewhere, for one update).
+    pub const OVERFLOW: PairCandidates = PairCandidates {
+        len: u8::MAX,
+        ..Self::EMPTY
+    };
+
+    /// The candidates `found` (with the flag `scan`), or `None` if there are more than a slot
+    /// holds. Unused places are zero, so equal candidates compare equal.
+    pub fn of(found: &[VeCandidate], scan: bool) -> Option<PairCandidates> {
+        let mut r = PairCandidates::EMPTY;
         r.candidates.get_mut(..found.len())?.copy_from_slice(found);
         r.len = found.len() as u8;
+        r.scan = scan;
         Some(r)
     }
 
-    /// The candidates.
+    /// Whether the candidates did not fit.
+    #[inline]
+    pub fn overflows(&self) -> bool {
+        self.len == u8::MAX
+    }
+
+    /// The candidates (none if they overflowed).
     #[inline]
     pub fn get(&self) -> &[VeCandidate] {
-        &self.candidates[..self.len as usize]
+        self.candidates.get(..self.len as usize).unwrap_or(&[])
     }
 }

@@ -98,6 +98,7 @@ mod tests {
                 edge: 0,
             },
             body_a: 0,
+            nearest_edge: false,
             body_b: 1,
             state: None,
             d: [0.0; 3],

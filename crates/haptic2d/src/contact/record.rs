@@ -65,6 +65,11 @@ pub struct VeContact {
     pub d: [f64; 3],
     /// Number of valid entries in `d` (1..=3).
     pub hist: u8,
+    /// This sample's local stage proposed the key from its vertex scan
+    /// ([`LocalStage::from_vertex_scan`](crate::collide::LocalStage::from_vertex_scan)): the edge
+    /// is its vertex's nearest edge line (or the corner rule's, within `δ_c`), so the record
+    /// satisfies the depth invariant and the hand-over has nothing to check. Set by the merge.
+    pub nearest_edge: bool,
     /// Edge coordinate `s^B_k` (m).
     pub s: f64,
     /// Previous edge coordinate `s^B_{k−1}` (m).

@@ -35,7 +35,8 @@ impl ContactSet {
         self.pending.clear();
         for idx in 0..self.entries.len() {
             let e = &self.entries[idx];
-            if e.state != Some(ContactState::Continuous) {
+            // A key from this sample's vertex scan holds the invariant (`nearest_edge`).
+            if e.state != Some(ContactState::Continuous) || e.nearest_edge {
                 continue;
             }
             let cb = &colliders[e.key.edge_collider as usize];

@@ -175,6 +175,10 @@ impl ContactSet {
     /// Steps 4–6 of §0.5 for one sample: merge the local stage's candidates into the tracked set and
     /// measure every pair, run the state machine, resolve impacts (velocity jumps applied to `bodies`
     /// now), then compute continuous-contact forces into `wrenches` (one per body, overwritten).
+    /// `from_scan` (parallel to `candidates`, as
+    /// [`LocalStage::from_vertex_scan`](crate::collide::LocalStage::from_vertex_scan) gives it;
+    /// empty = none) marks the candidates of the local stage's vertex scan, whose records need no
+    /// hand-over check.
     ///
     /// **Depth invariant** (issue 10). A record `(V, e)` stores `½·K_c·d_e²`, a function of the
     /// poses while its key is fixed, so the stored energy is continuous over its life; it can only
@@ -204,6 +208,7 @@ impl ContactSet {
         tick: u64,
         dt: f64,
         candidates: &[VeCandidate],
+        from_scan: &[bool],
         colliders: &[Collider],
         bodies: &mut [Body],
         rots: &[Rot],
@@ -215,7 +220,7 @@ impl ContactSet {
         self.events.clear();
         self.last_impact_loss = 0.0;
         self.resize_body_buffers(bodies.len());
-        self.sync(tick, candidates, colliders, bodies, rots, past);
+        self.sync(tick, candidates, from_scan, colliders, bodies, rots, past);
         self.release(tick);
         self.hand_over(tick, colliders, bodies, past, normal, friction);
         let any_colliding = self.create(tick, dt, colliders, bodies, past, normal, friction);

@@ -12,11 +12,15 @@ use crate::geom::{Pose, Rot, Vec2};
 impl ContactSet {
     /// Merges the sorted candidates with the tracked set: existing entries are re-measured (history
     /// shifted), new candidates get a fresh entry whose history is rebuilt from the past poses, tracked
-    /// pairs that are neither candidates nor records are dropped.
+    /// pairs that are neither candidates nor records are dropped. Every entry's `nearest_edge` is
+    /// its candidate's `from_scan` flag (parallel to `candidates`; false for a record that is not a
+    /// candidate, or if `from_scan` is not parallel).
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn sync(
         &mut self,
         tick: u64,
         candidates: &[VeCandidate],
+        from_scan: &[bool],
         colliders: &[Collider],
         bodies: &[Body],
         rots: &[Rot],
@@ -26,14 +30,18 @@ impl ContactSet {
         // whether merging would keep exactly the current entries: every candidate is tracked already,
         // and every tracked pair is a candidate or a record. That is the steady-contact case, and then
         // nothing is copied. (An entry that the merge drops is measured for nothing; that is harmless.)
+        let flags = (from_scan.len() == candidates.len()).then_some(from_scan);
+        let flag = |j: usize| flags.is_some_and(|f| f[j]);
         let mut same = true;
         let mut j = 0;
         for e in self.entries.iter_mut() {
             measure(e, bodies, rots);
+            e.nearest_edge = false;
             if !same {
                 continue;
             }
             if j < candidates.len() && e.key == candidates[j] {
+                e.nearest_edge = flag(j);
                 j += 1;
             } else if !e.is_contact() || (j < candidates.len() && candidates[j] < e.key) {
                 same = false;
@@ -50,7 +58,10 @@ impl ContactSet {
             if take_old {
                 let same = j < candidates.len() && old[i].key == candidates[j];
                 if same || old[i].is_contact() {
-                    self.merged.push(old[i]);
+                    self.merged.push(VeContact {
+                        nearest_edge: same && flag(j),
+                        ..old[i]
+                    });
                 }
                 if same {
                     j += 1;
@@ -58,7 +69,10 @@ impl ContactSet {
                 i += 1;
             } else {
                 let e = new_entry(tick, candidates[j], colliders, bodies, past);
-                self.merged.push(e);
+                self.merged.push(VeContact {
+                    nearest_edge: flag(j),
+                    ..e
+                });
                 j += 1;
             }
         }
@@ -133,6 +147,7 @@ pub(super) fn new_entry(
         state: None,
         d,
         hist,
+        nearest_edge: false,
         s: s0,
         s_prev,
         len,
