@@ -114,8 +114,9 @@ pub fn run(label: &str, w: &mut World, dt: f64, seconds: f64, every: f64, profil
     }
     let b = w.broad_stats();
     println!(
-        "{label}: work at the end: {} AABB pairs and {} proximate pairs in the global stage, {} of them skipped by the local stage and {} penetrating ones whose vertex scan it reused, {} tracked VE pairs, {} contacts, {} chain rows",
+        "{label}: work at the end: {} AABB pairs ({} of them with their last GJK distance reused) and {} proximate pairs in the global stage, {} of them skipped by the local stage and {} penetrating ones whose vertex scan it reused, {} tracked VE pairs, {} contacts, {} chain rows",
         b.aabb_pairs,
+        b.reused_distances,
         b.proximate_pairs,
         w.local_stage().skipped(),
         w.local_stage().reused(),

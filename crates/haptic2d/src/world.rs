@@ -331,11 +331,8 @@ impl World {
         for c in self.colliders.iter_mut() {
             c.update_with(&self.bodies[c.body].pose, self.rots[c.body]);
         }
-        // 3. Global proximity stage: AABB sort-and-sweep + GJK, every N_g samples, and early when
-        //    a body may have outrun the margin (`moved_past_margin`).
-        self.global_stage();
-        // 4. Local stage: closest-feature tracking and VE candidates for proximate pairs
-        //    (separated pairs whose gap the bodies' motion cannot have closed are skipped).
+        // The odometers: a running bound on how far any point of each body has moved (m), read
+        // by the global and local stages to skip work the motion cannot have changed.
         for ((odo, last), (b, &r)) in self
             .odometer
             .iter_mut()
@@ -345,6 +342,11 @@ impl World {
             *odo += point_motion(last, &b.pose, r);
             *last = b.pose;
         }
+        // 3. Global proximity stage: AABB sort-and-sweep + GJK, every N_g samples, and early when
+        //    a body may have outrun the margin (`moved_past_margin`).
+        self.global_stage();
+        // 4. Local stage: closest-feature tracking and VE candidates for proximate pairs
+        //    (separated pairs whose gap the bodies' motion cannot have closed are skipped).
         self.local.update_with_motion(
             &self.colliders,
             &self.pairs,
@@ -427,7 +429,8 @@ impl World {
         let early = !periodic && self.moved_past_margin();
         let spread = self.params.proximity_spread && n_g > 1;
         if early || (periodic && !(spread && self.broad.in_progress())) {
-            self.broad.update(&self.colliders, &mut self.pairs);
+            self.broad
+                .update_with_motion(&self.colliders, &self.odometer, &mut self.pairs);
             for (g, b) in self.global_poses.iter_mut().zip(&self.bodies) {
                 *g = b.pose;
             }
@@ -437,7 +440,8 @@ impl World {
             std::mem::swap(&mut self.global_poses, &mut self.job_poses);
         }
         if spread && (periodic || early) {
-            self.broad.begin(&self.colliders);
+            self.broad
+                .begin_with_motion(&self.colliders, &self.odometer);
             for (g, b) in self.job_poses.iter_mut().zip(&self.bodies) {
                 *g = b.pose;
             }

@@ -44,6 +44,15 @@
 //! `k·N_g` and, at `v_rel,max`, is still `> δ_c` apart `2·T_g` later, which is the margin rule.
 //! The world's early update (a body that moved more than `(δ_prox − δ_c)/2` since the poses of
 //! the set in use) still runs the whole stage at once, so fast bodies keep their guarantee.
+//!
+//! # Distances that need no GJK (issue 17)
+//!
+//! Given the bodies' odometers (bounds on how far any point of a body has moved, m), a pair
+//! tested by the last update at distance `D` whose bodies have moved `m` in all since that
+//! distance was computed is now between `D − m` and `D + m` apart. When that interval is on one
+//! side of `δ_prox` (by a 1 µm guard), the pair's side of the test is known: GJK is skipped and
+//! the pair keeps its distance, cache and odometer reference (`BroadStats::reused_distances`).
+//! A pile at rest moves micrometres per period, so its pairs are re-tested only in the sweep.
 
 use super::gjk::{gjk_distance, GjkCache};
 use super::Collider;
@@ -68,6 +77,9 @@ pub struct BroadStats {
     pub proximate_pairs: usize,
     /// GJK iterations spent on all pairs.
     pub gjk_iterations: u64,
+    /// Pairs whose side of `δ_prox` the bodies' motion could not have changed: GJK skipped, the
+    /// last distance kept (module docs).
+    pub reused_distances: usize,
 }
 
 /// One box in the sweep: the inflated box's x and y ranges and the collider index (the y range
@@ -82,13 +94,19 @@ struct SweepEntry {
     index: u32,
 }
 
-/// One AABB-overlapping pair of an update in progress: its warm-start cache and GJK distance (m).
+/// One AABB-overlapping pair of an update in progress: its warm-start cache and GJK distance (m),
+/// and the sum of its bodies' odometers when that distance was computed (m; NaN = unknown).
 #[derive(Clone, Copy, Debug)]
 struct Tested {
     pair: (u32, u32),
     cache: GjkCache,
     distance: f64,
+    odo_ref: f64,
 }
+
+/// Kept between a reused distance's interval and `δ_prox` (m): GJK's tolerance and the
+/// odometers' rounding are far below it.
+const REUSE_GUARD: f64 = 1e-6;
 
 /// The colliders as they were when an update began: world vertices (flat), and per collider its
 /// vertex range, body and whether it is dynamic. An update spread over several samples works on
@@ -98,6 +116,8 @@ struct Snapshot {
     vertices: Vec<Vec2>,
     /// `(first vertex, vertex count, body, dynamic)` per collider.
     colliders: Vec<(u32, u32, usize, bool)>,
+    /// The odometer of each collider's body (m; NaN if not given).
+    odo: Vec<f64>,
 }
 
 impl Snapshot {
@@ -131,11 +151,13 @@ pub struct BroadPhase {
     /// The result of the update in progress is complete in `ready` (published by a swap).
     sorted: bool,
     gjk_iterations: u64,
-    /// The published update: its pairs (sorted), caches and distances, and where each first
-    /// collider's pairs start (`cache_pairs[cache_start[a]..cache_start[a + 1]]`).
+    reused_distances: usize,
+    /// The published update: its pairs (sorted), caches, distances and odometer references, and
+    /// where each first collider's pairs start (`cache_pairs[cache_start[a]..cache_start[a + 1]]`).
     cache_pairs: Vec<(u32, u32)>,
     caches: Vec<GjkCache>,
     distances: Vec<f64>,
+    odo_refs: Vec<f64>,
     cache_start: Vec<u32>,
     /// The same for the update in progress, once sorted, with its proximity set.
     ready: Published,
@@ -149,6 +171,7 @@ struct Published {
     pairs: Vec<(u32, u32)>,
     caches: Vec<GjkCache>,
     distances: Vec<f64>,
+    odo_refs: Vec<f64>,
     start: Vec<u32>,
     stats: BroadStats,
 }
@@ -172,9 +195,11 @@ impl BroadPhase {
             bucket: Vec::new(),
             sorted: false,
             gjk_iterations: 0,
+            reused_distances: 0,
             cache_pairs: Vec::new(),
             caches: Vec::new(),
             distances: Vec::new(),
+            odo_refs: Vec::new(),
             cache_start: Vec::new(),
             ready: Published::default(),
             stats: BroadStats::default(),
@@ -207,7 +232,20 @@ impl BroadPhase {
     /// Abandons a spread update in progress. No allocation once the buffers have grown to the
     /// scene's size.
     pub fn update(&mut self, colliders: &[Collider], out: &mut Vec<(u32, u32)>) {
-        self.begin(colliders);
+        self.update_with_motion(colliders, &[], out);
+    }
+
+    /// [`update`](Self::update), skipping GJK for the pairs whose side of `δ_prox` the bodies'
+    /// motion since their last distance cannot have changed (module docs): `odometer[i]` (m) is
+    /// a running bound on the distance any point of body `i` has moved (non-decreasing). An empty
+    /// `odometer` (or one shorter than the bodies) runs GJK on every pair.
+    pub fn update_with_motion(
+        &mut self,
+        colliders: &[Collider],
+        odometer: &[f64],
+        out: &mut Vec<(u32, u32)>,
+    ) {
+        self.begin_with_motion(colliders, odometer);
         self.publish(out);
     }
 
@@ -215,16 +253,26 @@ impl BroadPhase {
     /// the inflated boxes and sorts them (abandons an update in progress). Nothing is published
     /// until [`publish`](Self::publish).
     pub fn begin(&mut self, colliders: &[Collider]) {
+        self.begin_with_motion(colliders, &[]);
+    }
+
+    /// [`begin`](Self::begin) with the bodies' odometers now (see
+    /// [`update_with_motion`](Self::update_with_motion)).
+    pub fn begin_with_motion(&mut self, colliders: &[Collider], odometer: &[f64]) {
         let half = 0.5 * self.delta_prox;
         // 0. The snapshot: the rest of the update reads only this copy.
         self.snapshot.vertices.clear();
         self.snapshot.colliders.clear();
+        self.snapshot.odo.clear();
         for c in colliders {
             let s = self.snapshot.vertices.len() as u32;
             self.snapshot.vertices.extend_from_slice(&c.world_vertices);
             self.snapshot
                 .colliders
                 .push((s, c.world_vertices.len() as u32, c.body, c.dynamic));
+            self.snapshot
+                .odo
+                .push(odometer.get(c.body).copied().unwrap_or(f64::NAN));
         }
         // 1. Inflated boxes, sorted by (min.x, index).
         self.sweep.clear();
@@ -243,6 +291,7 @@ impl BroadPhase {
         self.tested.clear();
         self.sorted = false;
         self.gjk_iterations = 0;
+        self.reused_distances = 0;
         self.next = Some(0);
     }
 
@@ -278,7 +327,25 @@ impl BroadPhase {
                 if body_a == body_b || !(dyn_a || dyn_b) {
                     continue;
                 }
-                let mut cache = self.cached(a, b).unwrap_or_default();
+                let odo = self.snapshot.odo[a as usize] + self.snapshot.odo[b as usize];
+                let last = self.cached(a, b);
+                if let Some(k) = last {
+                    // The pair's side of δ_prox is known from its last distance and the motion.
+                    let (d, moved) = (self.distances[k], odo - self.odo_refs[k]);
+                    if d + moved < self.delta_prox - REUSE_GUARD
+                        || d - moved > self.delta_prox + REUSE_GUARD
+                    {
+                        self.reused_distances += 1;
+                        self.tested.push(Tested {
+                            pair: (a, b),
+                            cache: self.caches[k],
+                            distance: d,
+                            odo_ref: self.odo_refs[k],
+                        });
+                        continue;
+                    }
+                }
+                let mut cache = last.map(|k| self.caches[k]).unwrap_or_default();
                 let g = gjk_distance(
                     self.snapshot.vertices(a),
                     self.snapshot.vertices(b),
@@ -289,6 +356,7 @@ impl BroadPhase {
                     pair: (a, b),
                     cache,
                     distance: g.distance,
+                    odo_ref: odo,
                 });
             }
         }
@@ -300,13 +368,13 @@ impl BroadPhase {
         }
     }
 
-    /// The warm-start cache of pair `(a, b)` from the published update, if it tested the pair.
+    /// Where pair `(a, b)` is in the published update (its cache, distance and odometer
+    /// reference), if it tested the pair.
     #[inline]
-    fn cached(&self, a: u32, b: u32) -> Option<GjkCache> {
+    fn cached(&self, a: u32, b: u32) -> Option<usize> {
         let from = *self.cache_start.get(a as usize)? as usize;
         let to = *self.cache_start.get(a as usize + 1)? as usize;
-        let k = from + self.cache_pairs[from..to].iter().position(|p| p.1 == b)?;
-        Some(self.caches[k])
+        Some(from + self.cache_pairs[from..to].iter().position(|p| p.1 == b)?)
     }
 
     /// `order` = the indices of `tested` sorted by pair: a counting sort on the first collider,
@@ -356,6 +424,7 @@ impl BroadPhase {
         r.pairs.clear();
         r.caches.clear();
         r.distances.clear();
+        r.odo_refs.clear();
         r.start.clear();
         let n = self.snapshot.colliders.len();
         for &k in &self.order {
@@ -369,6 +438,7 @@ impl BroadPhase {
             r.pairs.push(t.pair);
             r.caches.push(t.cache);
             r.distances.push(t.distance);
+            r.odo_refs.push(t.odo_ref);
         }
         while r.start.len() <= n {
             r.start.push(r.pairs.len() as u32);
@@ -377,6 +447,7 @@ impl BroadPhase {
             aabb_pairs: self.tested.len(),
             proximate_pairs: r.set.len(),
             gjk_iterations: self.gjk_iterations,
+            reused_distances: self.reused_distances,
         };
     }
 
@@ -395,6 +466,7 @@ impl BroadPhase {
         std::mem::swap(&mut self.cache_pairs, &mut r.pairs);
         std::mem::swap(&mut self.caches, &mut r.caches);
         std::mem::swap(&mut self.distances, &mut r.distances);
+        std::mem::swap(&mut self.odo_refs, &mut r.odo_refs);
         std::mem::swap(&mut self.cache_start, &mut r.start);
         self.stats = r.stats;
     }
@@ -533,7 +605,7 @@ mod tests {
         assert!(bp.cache_pairs.len() > 200);
         for (k, &(a, b)) in bp.cache_pairs.iter().enumerate() {
             let c = bp.cached(a, b).expect("a published pair has its cache");
-            assert_eq!(format!("{c:?}"), format!("{:?}", bp.caches[k]));
+            assert_eq!(c, k);
         }
         let n = cols.len() as u32;
         let tested: std::collections::BTreeSet<_> = bp.cache_pairs.iter().copied().collect();
@@ -546,5 +618,48 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// GJK skipped on the pairs whose side of `δ_prox` the motion cannot have changed gives the
+    /// proximity set of running GJK on every pair, update after update, with bodies creeping
+    /// (reused) and jumping (re-tested) by turns.
+    #[test]
+    fn reused_distances_give_the_set_of_testing_every_pair() {
+        let home = grid(0.0, 0.05);
+        let mut cols = home.clone();
+        let radius = 0.02 * 2f64.sqrt();
+        let mut odometer = vec![0.0; cols.len()];
+        let mut poses: Vec<Pose> = (0..cols.len()).map(|_| Pose::new(0.0, 0.0, 0.0)).collect();
+        let (mut fast, mut every) = (
+            BroadPhase::new(DEFAULT_DELTA_PROX).unwrap(),
+            BroadPhase::new(DEFAULT_DELTA_PROX).unwrap(),
+        );
+        let (mut out_fast, mut out_every) = (Vec::new(), Vec::new());
+        let mut reused = 0;
+        for k in 0..60u64 {
+            // Every third update some bodies jump by up to 3 cm; otherwise all creep by 1 µm.
+            for i in 1..cols.len() {
+                let h = (i as u64 * 2654435761 + k * 40503) % 1000;
+                let step = if k % 3 == 2 && h < 300 { 0.03 } else { 1e-6 };
+                let u = h as f64 / 1000.0 - 0.5;
+                let last = poses[i];
+                let p = Pose::new(
+                    last.pos.x + step * u,
+                    last.pos.y - step * u.abs(),
+                    last.angle + step * u,
+                );
+                odometer[i] += (p.pos - last.pos).length() + (p.angle - last.angle).abs() * radius;
+                poses[i] = p;
+                let h0 = home[i].world_vertices[0] - home[i].local.vertices()[0];
+                cols[i].update(&Pose::new(h0.x + p.pos.x, h0.y + p.pos.y, p.angle));
+            }
+            fast.update_with_motion(&cols, &odometer, &mut out_fast);
+            every.update(&cols, &mut out_every);
+            assert_eq!(out_fast, out_every, "update {k}");
+            assert_eq!(fast.stats().aabb_pairs, every.stats().aabb_pairs);
+            assert_eq!(every.stats().reused_distances, 0);
+            reused += fast.stats().reused_distances;
+        }
+        assert!(reused > 1000, "reused {reused}");
     }
 }
