@@ -131,6 +131,22 @@ pub fn run(label: &str, w: &mut World, dt: f64, seconds: f64, every: f64, profil
         p99 / median,
         all_steps.quantile(1.0)
     );
+    // How many chain-damper sweeps the profiled steps ran (the sweeps stop once converged).
+    let mut sweeps = [0usize; 5];
+    for &(_, _, n, _, _) in &each {
+        sweeps[match n {
+            0..=1 => 0,
+            2..=3 => 1,
+            4..=7 => 2,
+            8..=15 => 3,
+            _ => 4,
+        }] += 1;
+    }
+    let mean = each.iter().map(|e| e.2 as f64).sum::<f64>() / each.len().max(1) as f64;
+    println!(
+        "{label}: chain damper sweeps per step after {profile_after} s: mean {mean:.1}; steps with 0–1 / 2–3 / 4–7 / 8–15 / 16+: {} / {} / {} / {} / {}",
+        sweeps[0], sweeps[1], sweeps[2], sweeps[3], sweeps[4]
+    );
     each.sort_by(|a, b| b.0.total_cmp(&a.0));
     println!(
         "{label}: slowest steps (µs @ step: phase mod {n_g}, chain sweeps, damped rows, contact events): {}",
