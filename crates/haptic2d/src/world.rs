@@ -346,12 +346,14 @@ impl World {
         //    a body may have outrun the margin (`moved_past_margin`).
         self.global_stage();
         // 4. Local stage: closest-feature tracking and VE candidates for proximate pairs
-        //    (separated pairs whose gap the bodies' motion cannot have closed are skipped).
+        //    (separated pairs whose gap the bodies' relative motion cannot have closed are
+        //    skipped, and penetrating pairs' vertex scans it cannot have changed are reused)
+        //    (`odometer_poses` are the bodies' poses now: the odometers were just read).
         self.local.update_with_motion(
             &self.colliders,
             &self.pairs,
             self.params.delta_c,
-            &self.odometer,
+            &self.odometer_poses,
             &mut self.candidates,
         );
         // Loads are evaluated once per sample (held over it). Loads and drives enter the bodies'

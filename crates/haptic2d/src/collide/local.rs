@@ -44,10 +44,10 @@
 //! Candidates are sorted and deduplicated so that everything downstream is deterministic.
 
 use super::gjk::GJK_EPS_ABS;
-use super::reuse::{PairCandidates, Slack, SLOT};
+use super::reuse::{vertex_radius, PairCandidates, Slack, SLOT};
 use super::tracker::{ClosestFeatures, Feature, FeatureTracker, TrackStatus};
 use super::{Collider, VeCandidate};
-use crate::geom::Vec2;
+use crate::geom::{Pose, Vec2};
 
 /// Default contact distance tolerance `δ_c` (m), §9.5.
 pub const DEFAULT_DELTA_C: f64 = 0.002;
@@ -128,24 +128,26 @@ pub struct LocalStage {
 }
 
 /// The certified distance of a separated pair when it was last tracked, and the two bodies'
-/// odometers then: while the bodies have moved less than that distance less `δ_c` since (the
-/// odometers are bounds on the motion of every point of a body, m), the pair is still farther
-/// apart than `δ_c` and has no candidate, so its tracking can wait. `δ_c` is the one of the
-/// sample that checks, so a tolerance changed at run time counts at once.
+/// relative pose then: the distance between a point of A and a point of B changes by at most
+/// the relative motion `m = |ΔP_A − ΔP_B|₁ + |Δθ_A|·l_a + |Δθ_B|·l_b` (body origins `P`, net
+/// rotations `Δθ`, each polygon's vertex radius `l` about its body's origin; a common translation
+/// of both bodies changes nothing). While `m` is less than that distance less `δ_c`, the pair is
+/// still farther apart than `δ_c` and has no candidate, so its tracking can wait. `δ_c` is the
+/// one of the sample that checks, so a tolerance changed at run time counts at once.
 ///
 /// A penetrating pair's vertex scan is reused the same way (`reused`, see `reuse.rs`): while
-/// `k_a·ΔD_A + k_b·ΔD_B < clear − δ_c`, with `clear = σ + δ_c` of the scan.
+/// `m < clear − δ_c`, with `clear = σ + δ_c` of the scan and the levers `l` of its lines.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Gap {
     /// `distance − GAP_GUARD` at the last tracked sample (m); 0 = track every sample.
     clear: f64,
-    /// Odometers of the two bodies then (m).
-    odo_a: f64,
-    odo_b: f64,
-    /// How much a unit of each body's motion moves the pair's compared quantities (1 for a
-    /// separated pair's distance).
-    k_a: f64,
-    k_b: f64,
+    /// `P_A − P_B` (m) and the bodies' angles (rad) then.
+    rel: Vec2,
+    angle_a: f64,
+    angle_b: f64,
+    /// How far a unit rotation of each body moves the pair's compared quantities (m/rad).
+    l_a: f64,
+    l_b: f64,
     /// The pair's bodies (`u32::MAX` for a collider that does not exist), kept here so that a
     /// skipped pair reads nothing but this record.
     body_a: u32,
@@ -165,10 +167,11 @@ impl Gap {
     fn track(body_a: u32, body_b: u32) -> Gap {
         Gap {
             clear: 0.0,
-            odo_a: 0.0,
-            odo_b: 0.0,
-            k_a: 1.0,
-            k_b: 1.0,
+            rel: Vec2::ZERO,
+            angle_a: 0.0,
+            angle_b: 0.0,
+            l_a: 0.0,
+            l_b: 0.0,
             body_a,
             body_b,
             penetrating: false,
@@ -179,8 +182,44 @@ impl Gap {
 }
 
 /// Kept off every certified gap (m): the tracker's distance is exact up to round-off, this
-/// absorbs that and the odometers' own rounding.
+/// absorbs that and the rounding of the poses and slacks.
 const GAP_GUARD: f64 = 1e-6;
+
+/// The pose of the two bodies of a pair when it is tracked: `P_A − P_B` and the angles (NaN when
+/// a body has no pose, so that nothing is skipped).
+#[derive(Clone, Copy, Debug)]
+struct RelPose {
+    rel: Vec2,
+    angle_a: f64,
+    angle_b: f64,
+}
+
+impl RelPose {
+    fn of(poses: &[Pose], body_a: u32, body_b: u32) -> RelPose {
+        match (poses.get(body_a as usize), poses.get(body_b as usize)) {
+            (Some(a), Some(b)) => RelPose {
+                rel: a.pos - b.pos,
+                angle_a: a.angle,
+                angle_b: b.angle,
+            },
+            _ => RelPose {
+                rel: Vec2::splat(f64::NAN),
+                angle_a: f64::NAN,
+                angle_b: f64::NAN,
+            },
+        }
+    }
+
+    /// The relative motion bound `m` of [`Gap`] since `g` was certified (m; NaN if unknown).
+    #[inline]
+    fn moved_since(&self, g: &Gap) -> f64 {
+        let d = self.rel - g.rel;
+        d.x.abs()
+            + d.y.abs()
+            + (self.angle_a - g.angle_a).abs() * g.l_a
+            + (self.angle_b - g.angle_b).abs() * g.l_b
+    }
+}
 
 impl Default for LocalStage {
     fn default() -> Self {
@@ -369,19 +408,21 @@ impl LocalStage {
     }
 
     /// [`update`](Self::update), skipping the tracking of separated pairs that cannot have come
-    /// within `delta_c` since they were last tracked: `odometer[i]` (m) is a running bound on
-    /// the distance any point of body `i` has moved (non-decreasing; the world adds
-    /// `|Δp| + |Δθ|·ρ` every sample). A pair last tracked at distance `D` is skipped while its
-    /// bodies' odometers have grown by less than `D − δ_c` (less a guard) in all: its distance
-    /// is then still above `δ_c`, where it has no candidate, so the candidates are those of
-    /// tracking every pair. Its tracker and [`PairState`] keep their last features. An empty
-    /// `odometer` (or one shorter than the bodies) tracks every pair.
+    /// within `delta_c` since they were last tracked, given the bodies' poses `poses` (indexed
+    /// by body; the colliders' world features must be those of these poses). A pair last
+    /// tracked at distance `D` is skipped while its bodies' relative motion since (`m` of the
+    /// private `Gap`: relative translation plus each body's rotation times its polygon's
+    /// radius) is less than `D − δ_c` (less a guard): its distance is then still above `δ_c`,
+    /// where it has no candidate, so the candidates are those of tracking every pair. Its
+    /// tracker and [`PairState`] keep their last features. A penetrating pair's vertex scan is
+    /// reused the same way ([`reused`](Self::reused), `reuse.rs`). An empty `poses` (or one
+    /// shorter than the bodies) tracks every pair.
     pub fn update_with_motion(
         &mut self,
         colliders: &[Collider],
         pairs: &[(u32, u32)],
         delta_c: f64,
-        odometer: &[f64],
+        poses: &[Pose],
         out: &mut Vec<VeCandidate>,
     ) {
         if self.pairs.as_slice() != pairs {
@@ -405,14 +446,8 @@ impl LocalStage {
             // The gap certified at the last tracked sample still holds: nothing to do (a reused
             // scan's candidates are its last ones).
             let g = self.gaps[k];
-            let (odo_a, odo_b) = match (
-                odometer.get(g.body_a as usize),
-                odometer.get(g.body_b as usize),
-            ) {
-                (Some(&x), Some(&y)) => (x, y),
-                _ => (f64::NAN, f64::NAN),
-            };
-            if (odo_a - g.odo_a) * g.k_a + (odo_b - g.odo_b) * g.k_b < g.clear - delta_c {
+            let now = RelPose::of(poses, g.body_a, g.body_b);
+            if now.moved_since(&g) < g.clear - delta_c {
                 if g.reused {
                     self.reused += 1;
                 } else {
@@ -425,7 +460,7 @@ impl LocalStage {
                 continue;
             };
             let mark = fresh.len();
-            let scan = self.track(k, (ia, a), (ib, b), (odo_a, odo_b), delta_c, &mut fresh);
+            let scan = self.track(k, (ia, a), (ib, b), now, delta_c, &mut fresh);
             let found = &fresh[mark..];
             match PairCandidates::of(found, scan) {
                 Some(c) => {
@@ -472,14 +507,14 @@ impl LocalStage {
         self.assembled = true;
     }
 
-    /// Tracks pair `k` (colliders `a`, `b` with their indices; the bodies' odometers `odo`) and
-    /// pushes its VE candidates to `out`. Returns whether they are the vertex scan's (§9.4).
+    /// Tracks pair `k` (colliders `a`, `b` with their indices; the bodies' relative pose `now`)
+    /// and pushes its VE candidates to `out`. Returns whether they are the vertex scan's (§9.4).
     fn track(
         &mut self,
         k: usize,
         (ia, a): (u32, &Collider),
         (ib, b): (u32, &Collider),
-        (odo_a, odo_b): (f64, f64),
+        now: RelPose,
         delta_c: f64,
         out: &mut Vec<VeCandidate>,
     ) -> bool {
@@ -507,12 +542,13 @@ impl LocalStage {
                     let cert = slack.certificate(a, b, delta_c, self.eps_s, GAP_GUARD);
                     let fits = out.len() - mark <= SLOT;
                     self.gaps[k] = match cert {
-                        Some((sigma, k_a, k_b)) if fits => Gap {
+                        Some((sigma, l_a, l_b)) if fits => Gap {
                             clear: sigma + delta_c,
-                            odo_a,
-                            odo_b,
-                            k_a,
-                            k_b,
+                            rel: now.rel,
+                            angle_a: now.angle_a,
+                            angle_b: now.angle_b,
+                            l_a,
+                            l_b,
                             reused: true,
                             ..g
                         },
@@ -548,8 +584,11 @@ impl LocalStage {
         self.gaps[k] = match f.status {
             TrackStatus::Separated if f.distance > delta_c + GAP_GUARD => Gap {
                 clear: f.distance - GAP_GUARD,
-                odo_a,
-                odo_b,
+                rel: now.rel,
+                angle_a: now.angle_a,
+                angle_b: now.angle_b,
+                l_a: vertex_radius(a),
+                l_b: vertex_radius(b),
                 ..Gap::track(g.body_a, g.body_b)
             },
             _ => Gap::track(g.body_a, g.body_b),

@@ -10,26 +10,29 @@
 //! While every `q` has moved by less than its distance from its threshold (its *slack*), every
 //! outcome and so every candidate is the same: the scan can be skipped and its candidates reused.
 //!
-//! **How far a `q` can move.** Let `D_A`, `D_B` (m) bound the motion of every point of bodies A
-//! and B since the scan (the world's odometers, `|Δp| + |Δθ|·ρ` summed over samples, `ρ` the
-//! body's vertex radius). A box bound moves by at most the motion of its polygon's vertices,
-//! `D_B`, and the vertex by `D_A`. A line quantity `q = n·(V − E0)` (or with `t`) changes by
+//! **How far a `q` can move.** Every `q` is a function of vectors `p − e` between a point `p` of
+//! A and a point `e` of B (vertex minus edge start, vertex minus another polygon's box corner)
+//! and, for a line quantity `n·(p − e)` or `t·(p − e)`, of B's (or A's) edge direction. With body
+//! origins `P`, net rotations `Δθ` since the scan and `r` each polygon's vertex radius about its
+//! body's origin, `|Δ(p − e)| ≤ |ΔP_A − ΔP_B| + |Δθ_A|·r_A + |Δθ_B|·r_B` (a translation of
+//! both bodies together changes nothing), and a line quantity of B's line changes by
 //!
 //! ```text
-//! |Δq| ≤ |ΔV| + |ΔE0| + |Δn|·|V' − E0'| ≤ D_A + D_B + (D_B/r_B)·(diag_B + δ_c)
+//! |Δq| ≤ |Δ(p − e)| + |Δn|·|p' − e'| ≤ |ΔP_A − ΔP_B| + |Δθ_A|·r_A + |Δθ_B|·(r_B + diag_B + δ_c)
 //! ```
 //!
-//! because `|Δn| ≤ |Δθ_B| ≤ D_B/ρ_B ≤ D_B/r_B` (`r_B` the vertex radius of B's polygon, at most
-//! its body's) and both `V` and `E0` lie in B's grown box (`diag_B` its diagonal) at the scan,
-//! each moving less than `δ_c` since (below). The scan of B's vertices against A is the same with
-//! the roles swapped, so every `q` of the pair moves by less than
+//! because `|Δn| ≤ |Δθ_B|` and both `p` and `e` lie in B's box grown by `δ_c + ε_s` (`diag_B`
+//! its diagonal) at the scan, and have moved apart by less than `δ_c` since (below). The scan of
+//! B's vertices against A is the same with the roles swapped, so every `q` of the pair moves by
+//! less than
 //!
 //! ```text
-//! Δ = k_A·D_A + k_B·D_B,   k_X = 1 + (diag_X + δ_c)/r_X.
+//! m = |ΔP_A − ΔP_B|₁ + |Δθ_A|·l_A + |Δθ_B|·l_B,   l_X = r_X + diag_X + δ_c.
 //! ```
 //!
-//! The scan is reused while `Δ < σ = min(slacks, δ_c) − guard` (so `D_A + D_B < δ_c` as used
-//! above); the guard (1 µm) covers round-off in the slacks and odometers.
+//! The scan is reused while `m < σ = min(slacks, δ_c) − guard` (so `|Δ(p − e)| < δ_c` as used
+//! above); the guard (1 µm) covers round-off in the slacks and poses. A pile settling as a whole
+//! sinks and creeps together: its relative motions are a small part of its absolute ones.
 //!
 //! **What is not reused.** A vertex within `δ_c` of two lines (the corner-on-corner rule decides by
 //! orientation there), equal line distances (no slack), more candidates than a slot holds, or a
@@ -67,8 +70,8 @@ impl Slack {
         self.decided = self.decided.min(slack);
     }
 
-    /// The scan's certificate: `σ` (m) and `k_A`, `k_B` of the module docs, or `None` if the scan
-    /// must run every sample.
+    /// The scan's certificate: `σ` (m) and the levers `l_A`, `l_B` (m/rad) of the module docs, or
+    /// `None` if the scan must run every sample.
     pub fn certificate(
         &self,
         a: &Collider,
@@ -78,30 +81,26 @@ impl Slack {
         guard: f64,
     ) -> Option<(f64, f64, f64)> {
         let sigma = self.decided.min(self.inside).min(delta_c) - guard;
-        let (k_a, k_b) = (
-            motion_factor(a, delta_c, eps_s),
-            motion_factor(b, delta_c, eps_s),
-        );
-        (sigma > 0.0 && k_a.is_finite() && k_b.is_finite()).then_some((sigma, k_a, k_b))
+        let (l_a, l_b) = (lever(a, delta_c, eps_s), lever(b, delta_c, eps_s));
+        (sigma > 0.0 && l_a.is_finite() && l_b.is_finite()).then_some((sigma, l_a, l_b))
     }
 }
 
-/// `k = 1 + (diag + δ_c)/r` of collider `c` (module docs): `diag` the diagonal of its box grown by
-/// `δ_c + ε_s`, `r` its vertex radius (m, about its body's origin). Infinite without a radius.
-fn motion_factor(c: &Collider, delta_c: f64, eps_s: f64) -> f64 {
+/// `l = r + diag + δ_c` of collider `c` (m, module docs): `r` its vertex radius about its body's
+/// origin, `diag` the diagonal of its box grown by `δ_c + ε_s`.
+fn lever(c: &Collider, delta_c: f64, eps_s: f64) -> f64 {
     let grown = 2.0 * (delta_c + eps_s);
     let diag = (c.aabb.max - c.aabb.min + Vec2::splat(grown)).length();
-    let r = c
-        .local
+    vertex_radius(c) + diag + delta_c
+}
+
+/// The largest distance of a vertex of `c` from its body's origin (m).
+pub(super) fn vertex_radius(c: &Collider) -> f64 {
+    c.local
         .vertices()
         .iter()
         .map(|v| v.length())
-        .fold(0.0, f64::max);
-    if r > 0.0 {
-        1.0 + (diag + delta_c) / r
-    } else {
-        f64::INFINITY
-    }
+        .fold(0.0, f64::max)
 }
 
 /// One pair's candidates at its last tracked sample (`len ≤ SLOT`, or [`OVERFLOW`](Self::OVERFLOW)
