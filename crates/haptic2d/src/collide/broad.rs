@@ -104,6 +104,31 @@ struct Tested {
     odo_ref: f64,
 }
 
+/// The sweep's total order: by `min.x`, then by collider index.
+fn sweep_order(p: &SweepEntry, q: &SweepEntry) -> std::cmp::Ordering {
+    p.min_x.total_cmp(&q.min_x).then(p.index.cmp(&q.index))
+}
+
+/// Sorts `sweep` by [`sweep_order`]: an insertion sort, linear on the nearly sorted order of the
+/// last update; past `8·n` moves it finishes with a full sort instead (the order is total, so
+/// either gives the same result).
+fn sort_sweep(sweep: &mut [SweepEntry]) {
+    let budget = 8 * sweep.len();
+    let mut moves = 0;
+    for i in 1..sweep.len() {
+        let mut j = i;
+        while j > 0 && sweep_order(&sweep[j - 1], &sweep[j]).is_gt() {
+            sweep.swap(j - 1, j);
+            j -= 1;
+            moves += 1;
+        }
+        if moves > budget {
+            sweep.sort_unstable_by(sweep_order);
+            return;
+        }
+    }
+}
+
 /// Kept between a reused distance's interval and `δ_prox` (m): GJK's tolerance and the
 /// odometers' rounding are far below it.
 const REUSE_GUARD: f64 = 1e-6;
@@ -274,20 +299,31 @@ impl BroadPhase {
                 .odo
                 .push(odometer.get(c.body).copied().unwrap_or(f64::NAN));
         }
-        // 1. Inflated boxes, sorted by (min.x, index).
-        self.sweep.clear();
-        for (i, c) in colliders.iter().enumerate() {
+        // 1. Inflated boxes, sorted by (min.x, index): in the last update's order, which is
+        //    nearly sorted when the bodies move little between updates (insertion sort), or by
+        //    index (a full sort) when the colliders changed.
+        let entry = |i: usize, c: &Collider| {
             let bx = c.aabb.inflated(half);
-            self.sweep.push(SweepEntry {
+            SweepEntry {
                 min_x: bx.min.x,
                 max_x: bx.max.x,
                 min_y: bx.min.y,
                 max_y: bx.max.y,
                 index: i as u32,
-            });
+            }
+        };
+        if self.sweep.len() == colliders.len() {
+            for e in self.sweep.iter_mut() {
+                *e = entry(e.index as usize, &colliders[e.index as usize]);
+            }
+            sort_sweep(&mut self.sweep);
+        } else {
+            self.sweep.clear();
+            for (i, c) in colliders.iter().enumerate() {
+                self.sweep.push(entry(i, c));
+            }
+            self.sweep.sort_unstable_by(sweep_order);
         }
-        self.sweep
-            .sort_unstable_by(|p, q| p.min_x.total_cmp(&q.min_x).then(p.index.cmp(&q.index)));
         self.tested.clear();
         self.sorted = false;
         self.gjk_iterations = 0;
@@ -661,5 +697,37 @@ mod tests {
             reused += fast.stats().reused_distances;
         }
         assert!(reused > 1000, "reused {reused}");
+    }
+
+    /// The sweep's insertion sort gives the order of a full sort, on nearly sorted input (the
+    /// last update's order) and on shuffled input (past its move budget), ties on `min.x` too.
+    #[test]
+    fn sweep_sort_matches_a_full_sort() {
+        let mut seed = 12345u64;
+        let mut next = move || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for (n, jitter) in [(0, 0.0), (1, 0.0), (50, 0.01), (1000, 0.002), (1000, 10.0)] {
+            let mut sweep: Vec<SweepEntry> = (0..n)
+                .map(|i| {
+                    let x = (i / 2) as f64 * 0.05 + jitter * next();
+                    SweepEntry {
+                        min_x: if i % 7 == 0 { 0.5 } else { x },
+                        max_x: x + 0.1,
+                        min_y: 0.0,
+                        max_y: 0.1,
+                        index: i as u32,
+                    }
+                })
+                .collect();
+            let mut full = sweep.clone();
+            full.sort_unstable_by(sweep_order);
+            sort_sweep(&mut sweep);
+            let order = |v: &[SweepEntry]| v.iter().map(|e| e.index).collect::<Vec<_>>();
+            assert_eq!(order(&sweep), order(&full), "n {n}, jitter {jitter}");
+        }
     }
 }

@@ -111,16 +111,31 @@ impl Row {
         dt: f64,
         prev: f64,
     ) -> Option<Row> {
+        let row = Row::build(e, a, b, pos, star, r, dt, prev);
+        row.valid().then_some(row)
+    }
+
+    /// [`Row::new`] without the check: the row may have an effective mass that is not finite
+    /// and positive ([`valid`](Self::valid) says).
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn build(
+        e: &LoadedContact,
+        a: u32,
+        b: u32,
+        pos: &[Vec2],
+        star: &[SolverBody],
+        r: f64,
+        dt: f64,
+        prev: f64,
+    ) -> Row {
         let (sa, sb) = (&star[a as usize], &star[b as usize]);
         let rna = cross(e.point - pos[a as usize], e.n);
         let rnb = cross(e.point - pos[b as usize], e.n);
         let w = sa.inv_mass + sb.inv_mass + sa.inv_inertia * rna * rna + sb.inv_inertia * rnb * rnb;
-        if !(w > 0.0 && w.is_finite()) {
-            return None;
-        }
         let lo = -dt * e.f_n;
         let warm = prev.max(lo);
-        Some(Row {
+        Row {
             a,
             b,
             n: e.n,
@@ -130,7 +145,13 @@ impl Row {
             c: r / ((1.0 + r) * w),
             lo,
             lambda: if warm.is_finite() { warm } else { 0.0 },
-        })
+        }
+    }
+
+    /// Whether the effective mass is finite and positive.
+    #[inline(always)]
+    fn valid(&self) -> bool {
+        self.w > 0.0 && self.w.is_finite()
     }
 
     /// Relative normal velocity of the row's points (m/s; positive separating).
@@ -500,9 +521,12 @@ impl ChainDamping {
         self.solver.copy_from_slice(&self.star);
         let star = &self.star;
         let (mut g, mut k) = (0.0, 0.0);
+        // Checked once at the end (no branch per row): if a row failed, the caller rebuilds from
+        // scratch, from `star` and the rows' impulses; every row keeps `max(λ, lo)` or 0 here,
+        // which `build_rows` maps the same way.
+        let mut valid = true;
         for (row, &i) in self.sorted.iter_mut().zip(&self.src) {
-            // A row that fails here keeps `max(λ, lo)` or 0, which `build_rows` maps the same way.
-            *row = Row::new(
+            *row = Row::build(
                 &loaded[i as usize],
                 row.a,
                 row.b,
@@ -511,14 +535,15 @@ impl ChainDamping {
                 r,
                 dt,
                 row.lambda,
-            )?;
+            );
+            valid &= row.valid();
             if row.lambda != 0.0 {
                 g += row.lambda * row.v_rel(star);
                 k += row.lambda * row.lambda * row.w;
                 row.apply(row.lambda, &mut self.solver);
             }
         }
-        Some((g, self.curvature(k / r)))
+        valid.then(|| (g, self.curvature(k / r)))
     }
 
     /// `h = λ₀ᵀ·(W + K⁻¹)·λ₀` of the warm impulses `λ₀` (already applied to `solver`), given
