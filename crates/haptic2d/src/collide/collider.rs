@@ -16,8 +16,6 @@ pub struct Collider {
     pub world_vertices: Vec<Vec2>,
     /// Outward unit edge normals in world coordinates.
     pub world_normals: Vec<Vec2>,
-    /// Unit edge tangents in world coordinates.
-    pub world_tangents: Vec<Vec2>,
     /// World bounding box (m), not inflated.
     pub aabb: Aabb,
 }
@@ -32,7 +30,6 @@ impl Collider {
             local,
             world_vertices: vec![Vec2::ZERO; n],
             world_normals: vec![Vec2::ZERO; n],
-            world_tangents: vec![Vec2::ZERO; n],
             aabb: Aabb::EMPTY,
         };
         c.update(pose);
@@ -47,23 +44,26 @@ impl Collider {
     /// [`Collider::update`] with the pose's rotation already computed (one `sin_cos` per body).
     pub fn update_with(&mut self, pose: &Pose, rot: Rot) {
         let mut aabb = Aabb::EMPTY;
-        let local = (
-            self.local.vertices(),
-            self.local.normals(),
-            self.local.tangents(),
-        );
+        let local = (self.local.vertices(), self.local.normals());
         let world = self
             .world_vertices
             .iter_mut()
-            .zip(self.world_normals.iter_mut())
-            .zip(self.world_tangents.iter_mut());
-        for (((v, n), t), ((wv, wn), wt)) in local.0.iter().zip(local.1).zip(local.2).zip(world) {
+            .zip(self.world_normals.iter_mut());
+        for ((v, n), (wv, wn)) in local.0.iter().zip(local.1).zip(world) {
             *wv = pose.pos + rot.apply(*v);
             *wn = rot.apply(*n);
-            *wt = rot.apply(*t);
             aabb.grow(*wv);
         }
         self.aabb = aabb;
+    }
+
+    /// The unit tangent of edge `e` in world coordinates, `(−n_y, n_x)` of its outward normal:
+    /// exactly the rotated polygon tangent (normals are `(t_y, −t_x)`, and a rotation keeps that
+    /// relation bit for bit; only the sign of an exact zero can differ).
+    #[inline]
+    pub fn world_tangent(&self, e: usize) -> Vec2 {
+        let n = self.world_normals[e];
+        Vec2::new(-n.y, n.x)
     }
 
     /// Number of vertices (= edges).
@@ -87,6 +87,6 @@ impl Collider {
     /// Edge coordinate `s = t_e·(p − E0_e)` of world point `p` along edge `e` (m).
     #[inline]
     pub fn edge_coordinate(&self, e: usize, p: Vec2) -> f64 {
-        self.world_tangents[e].dot(p - self.world_vertices[e])
+        self.world_tangent(e).dot(p - self.world_vertices[e])
     }
 }

@@ -789,7 +789,7 @@ impl Ctx {
         strict: bool,
         out: &mut Vec<VeCandidate>,
     ) -> bool {
-        if strict && a.c.world_tangents[ea].dot(b.c.world_tangents[eb]) > -self.cos_parallel {
+        if strict && a.c.world_tangent(ea).dot(b.c.world_tangent(eb)) > -self.cos_parallel {
             return false;
         }
         let ea1 = a.c.local.next(ea);

@@ -159,7 +159,7 @@ fn edge_len(c: &Collider, e: usize) -> f64 {
 #[inline]
 fn project_on_edge(c: &Collider, e: usize, p: Vec2) -> Vec2 {
     let s = c.edge_coordinate(e, p).clamp(0.0, edge_len(c, e));
-    c.world_vertices[e] + c.world_tangents[e] * s
+    c.world_vertices[e] + c.world_tangent(e) * s
 }
 
 fn feature_valid(c: &Collider, f: Feature) -> bool {
@@ -190,14 +190,14 @@ fn closest_points(a: &Collider, fa: Feature, b: &Collider, fb: Feature) -> Step 
             let a1 = a.world_vertices[next(a, ea)];
             let b0 = b.world_vertices[eb];
             let b1 = b.world_vertices[next(b, eb)];
-            if a.world_tangents[ea].dot(b.world_tangents[eb]).abs() > 1.0 - PARALLEL_TOL {
+            if a.world_tangent(ea).dot(b.world_tangent(eb)).abs() > 1.0 - PARALLEL_TOL {
                 // Parallel: overlap of A's edge with B's edge in B's edge coordinate.
                 let s0 = b.edge_coordinate(eb, a0);
                 let s1 = b.edge_coordinate(eb, a1);
                 let lo = s0.min(s1).max(0.0);
                 let hi = s0.max(s1).min(edge_len(b, eb));
                 if lo <= hi {
-                    let pb = b0 + b.world_tangents[eb] * (0.5 * (lo + hi));
+                    let pb = b0 + b.world_tangent(eb) * (0.5 * (lo + hi));
                     return Step::Points(project_on_edge(a, ea, pb), pb, true);
                 }
             }
@@ -234,14 +234,14 @@ fn most_violated(c: &Collider, f: Feature, p: Vec2) -> Option<Across> {
             let i = i as usize;
             let r = p - c.world_vertices[i];
             // (p − V_i)·u_i ≤ 0, else → E_i.
-            let out_next = r.dot(c.world_tangents[i]);
+            let out_next = r.dot(c.world_tangent(i));
             if out_next > worst {
                 worst = out_next;
                 across = Some(Across::Feature(Feature::Edge(i as u32)));
             }
             // (p − V_i)·u_{i−1} ≥ 0, else → E_{i−1}.
             let ip = prev(c, i);
-            let out_prev = -r.dot(c.world_tangents[ip]);
+            let out_prev = -r.dot(c.world_tangent(ip));
             if out_prev > worst {
                 across = Some(Across::Feature(Feature::Edge(ip as u32)));
             }
@@ -249,7 +249,7 @@ fn most_violated(c: &Collider, f: Feature, p: Vec2) -> Option<Across> {
         Feature::Edge(i) => {
             let i = i as usize;
             let r = p - c.world_vertices[i];
-            let s = r.dot(c.world_tangents[i]);
+            let s = r.dot(c.world_tangent(i));
             // (p − V_i)·u_i ≥ 0, else → V_i.
             if -s > worst {
                 worst = -s;

@@ -176,7 +176,7 @@ pub(super) fn geometry(key: VeCandidate, colliders: &[Collider]) -> (Vec2, Vec2,
         ca.world_vertices[key.vertex as usize],
         cb.world_vertices[e],
         cb.world_normals[e],
-        cb.world_tangents[e],
+        cb.world_tangent(e),
         cb.local.lengths()[e],
     )
 }
