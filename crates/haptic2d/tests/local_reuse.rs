@@ -8,20 +8,9 @@ use haptic2d::geom::{ConvexPolygon, Pose, Vec2};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::f64::consts::TAU;
-
-/// A random strictly convex polygon of `n ∈ [3, 8]` points on an ellipse of size `r` (m).
-fn random_polygon(rng: &mut ChaCha8Rng, r: f64) -> ConvexPolygon {
-    let n = rng.random_range(3..=8usize);
-    let (sx, sy) = (rng.random_range(0.6..1.4), rng.random_range(0.6..1.4));
-    let phase = rng.random_range(0.0..TAU);
-    let pts = (0..n)
-        .map(|k| {
-            let a = phase + TAU * (k as f64 + 0.3 + 0.4 * rng.random::<f64>()) / n as f64;
-            Vec2::new(r * sx * a.cos(), r * sy * a.sin())
-        })
-        .collect();
-    ConvexPolygon::new(pts).expect("points on an ellipse, one per sector, are strictly convex")
-}
+#[path = "support/polygon.rs"]
+mod polygon_support;
+use polygon_support::random_polygon;
 
 /// A motion of size drawn log-uniformly in `[1e-9, 10^top]` (m or rad).
 fn small(rng: &mut ChaCha8Rng, top: f64) -> f64 {
@@ -44,10 +33,7 @@ fn reused_vertex_scans_give_the_candidates_of_scanning_every_sample() {
         // them fixed, plus every pair as proximate.
         let n = 6;
         let shapes: Vec<ConvexPolygon> = (0..n)
-            .map(|_| {
-                let r = rng.random_range(0.02..0.05);
-                random_polygon(&mut rng, r)
-            })
+            .map(|_| random_polygon(&mut rng, 0.02, 0.05))
             .collect();
         let radius: Vec<f64> = shapes
             .iter()

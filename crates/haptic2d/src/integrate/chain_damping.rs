@@ -97,26 +97,8 @@ struct SolverBody {
 impl Row {
     /// The row of chain contact `e` between solver bodies `a` and `b` (body positions `pos`,
     /// velocities and inverse masses `star`; `r = T/τ`, `dt = T` in s), warm-started from the
-    /// impulse `prev` (N·s) within this sample's bound; `None` if the effective mass is not
-    /// finite and positive.
-    #[allow(clippy::too_many_arguments)]
-    #[inline(always)]
-    fn new(
-        e: &LoadedContact,
-        a: u32,
-        b: u32,
-        pos: &[Vec2],
-        star: &[SolverBody],
-        r: f64,
-        dt: f64,
-        prev: f64,
-    ) -> Option<Row> {
-        let row = Row::build(e, a, b, pos, star, r, dt, prev);
-        row.valid().then_some(row)
-    }
-
-    /// [`Row::new`] without the check: the row may have an effective mass that is not finite
-    /// and positive ([`valid`](Self::valid) says).
+    /// impulse `prev` (N·s) within this sample's bound. Its effective mass may be not finite
+    /// and positive: [`valid`](Self::valid) says.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     fn build(
@@ -485,10 +467,11 @@ impl ChainDamping {
             } else {
                 0.0
             };
-            let Some(row) = Row::new(e, a as u32, b as u32, &self.pos, star, r, dt, prev) else {
+            let row = Row::build(e, a as u32, b as u32, &self.pos, star, r, dt, prev);
+            if !row.valid() {
                 self.dropped = true;
                 continue;
-            };
+            }
             // g = λ₀ᵀ·J·v* (see `scale_warm_start`), and the warm impulse applied.
             if row.lambda != 0.0 {
                 g += row.lambda * row.v_rel(star);
