@@ -332,7 +332,7 @@ impl World {
             c.update_with(&self.bodies[c.body].pose, self.rots[c.body]);
         }
         // The odometers: a running bound on how far any point of each body has moved (m), read
-        // by the global and local stages to skip work the motion cannot have changed.
+        // by the global stage to skip GJK where the motion cannot have changed its result.
         for ((odo, last), (b, &r)) in self
             .odometer
             .iter_mut()
@@ -347,8 +347,8 @@ impl World {
         self.global_stage();
         // 4. Local stage: closest-feature tracking and VE candidates for proximate pairs
         //    (separated pairs whose gap the bodies' relative motion cannot have closed are
-        //    skipped, and penetrating pairs' vertex scans it cannot have changed are reused)
-        //    (`odometer_poses` are the bodies' poses now: the odometers were just read).
+        //    skipped, and penetrating pairs' vertex scans it cannot have changed are reused;
+        //    `odometer_poses` are the bodies' poses now, the odometers having just been read).
         self.local.update_with_motion(
             &self.colliders,
             &self.pairs,

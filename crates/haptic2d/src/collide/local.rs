@@ -44,7 +44,7 @@
 //! Candidates are sorted and deduplicated so that everything downstream is deterministic.
 
 use super::gjk::GJK_EPS_ABS;
-use super::reuse::{vertex_radius, PairCandidates, Slack, SLOT};
+use super::reuse::{PairCandidates, Slack, SLOT};
 use super::tracker::{ClosestFeatures, Feature, FeatureTracker, TrackStatus};
 use super::{Collider, VeCandidate};
 use crate::geom::{Pose, Vec2};
@@ -587,8 +587,8 @@ impl LocalStage {
                 rel: now.rel,
                 angle_a: now.angle_a,
                 angle_b: now.angle_b,
-                l_a: vertex_radius(a),
-                l_b: vertex_radius(b),
+                l_a: a.local.radius(),
+                l_b: b.local.radius(),
                 ..Gap::track(g.body_a, g.body_b)
             },
             _ => Gap::track(g.body_a, g.body_b),
@@ -675,7 +675,7 @@ fn sort_dedup(
         }
         for &(c, f) in run.iter() {
             if out.last() == Some(&c) {
-                // Equal keys sort `false` first: the `&&` keeps a flag only if both had it.
+                // A key proposed twice keeps the flag only if both proposals had it.
                 let last = flag.last_mut().expect("parallel to out");
                 *last = *last && f;
             } else {

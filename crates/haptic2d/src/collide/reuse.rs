@@ -91,16 +91,7 @@ impl Slack {
 fn lever(c: &Collider, delta_c: f64, eps_s: f64) -> f64 {
     let grown = 2.0 * (delta_c + eps_s);
     let diag = (c.aabb.max - c.aabb.min + Vec2::splat(grown)).length();
-    vertex_radius(c) + diag + delta_c
-}
-
-/// The largest distance of a vertex of `c` from its body's origin (m).
-pub(super) fn vertex_radius(c: &Collider) -> f64 {
-    c.local
-        .vertices()
-        .iter()
-        .map(|v| v.length())
-        .fold(0.0, f64::max)
+    c.local.radius() + diag + delta_c
 }
 
 /// One pair's candidates at its last tracked sample (`len ≤ SLOT`, or [`OVERFLOW`](Self::OVERFLOW)

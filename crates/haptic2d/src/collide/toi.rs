@@ -79,9 +79,10 @@ pub fn thickness(p: &ConvexPolygon) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
-/// Largest distance of a vertex from the body-frame origin (the centre of mass) (m).
+/// Largest distance of a vertex from the body-frame origin (the centre of mass) (m): the
+/// polygon's [`ConvexPolygon::radius`].
 pub fn radius(p: &ConvexPolygon) -> f64 {
-    p.vertices().iter().map(|v| v.length()).fold(0.0, f64::max)
+    p.radius()
 }
 
 /// One body's side of a swept pair: its shape (body frame), its poses at the start and end of the

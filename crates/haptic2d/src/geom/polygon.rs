@@ -51,6 +51,13 @@ pub struct ConvexPolygon {
     tangents: Vec<Vec2>,
     normals: Vec<Vec2>,
     lengths: Vec<f64>,
+    /// Largest distance of a vertex from the frame origin (m).
+    radius: f64,
+}
+
+/// Largest length of `vertices` (m).
+fn vertex_radius(vertices: &[Vec2]) -> f64 {
+    vertices.iter().map(|v| v.length()).fold(0.0, f64::max)
 }
 
 impl ConvexPolygon {
@@ -113,11 +120,13 @@ impl ConvexPolygon {
         if (total - std::f64::consts::TAU).abs() > 1e-6 {
             return Err(PolygonError::NotConvex(0));
         }
+        let radius = vertex_radius(&vertices);
         Ok(Self {
             vertices,
             tangents,
             normals,
             lengths,
+            radius,
         })
     }
 
@@ -162,6 +171,12 @@ impl ConvexPolygon {
     pub fn lengths(&self) -> &[f64] {
         &self.lengths
     }
+    /// Largest distance of a vertex from the polygon's frame origin (m): the vertex radius that
+    /// bounds how far a rotation about the origin moves any point of the polygon.
+    #[inline]
+    pub fn radius(&self) -> f64 {
+        self.radius
+    }
     /// Index of the next vertex/edge, counter-clockwise.
     #[inline]
     pub fn next(&self, i: usize) -> usize {
@@ -186,6 +201,7 @@ impl ConvexPolygon {
         for v in &mut p.vertices {
             *v -= offset;
         }
+        p.radius = vertex_radius(&p.vertices);
         p
     }
     /// Bounding box in the polygon's own frame.
@@ -202,6 +218,16 @@ impl ConvexPolygon {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The cached vertex radius is the largest vertex distance from the frame origin, also after
+    /// a shift of the origin.
+    #[test]
+    fn radius_is_the_largest_vertex_distance() {
+        let r = ConvexPolygon::rectangle(0.04, 0.02).unwrap();
+        assert_eq!(r.radius(), Vec2::new(0.02, 0.01).length());
+        let s = r.shifted(Vec2::new(0.02, 0.01));
+        assert_eq!(s.radius(), Vec2::new(-0.04, -0.02).length());
+    }
 
     #[test]
     fn rectangle_features() {
