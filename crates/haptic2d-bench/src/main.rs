@@ -90,6 +90,11 @@ struct Args {
     /// Output folder for compare.json and compare.svg (default: <workspace>/target/bench).
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Also write every timed step's time of every engine to `steps.csv` in the output folder
+    /// (columns scene, n, engine, step, sample, us; `sample` is the engine's sample index since
+    /// the start, warm-up included).
+    #[arg(long)]
+    step_times: bool,
 }
 
 fn out_dir(args: &Args) -> PathBuf {
@@ -217,6 +222,7 @@ fn run(args: &Args) -> Result<(), String> {
         return Ok(());
     }
     let mut rows = Vec::new();
+    let mut step_csv = String::from("scene,n,engine,step,sample,us\n");
     for case in cases {
         let label = format!("{} n={}", case.scene, case.n);
         let mut h = case.haptic.world;
@@ -306,6 +312,11 @@ fn run(args: &Args) -> Result<(), String> {
             box2d.to_string(),
             format!("{box2d}_1sub"),
         ];
+        if args.step_times {
+            for (key, t) in keys.iter().zip(&samples) {
+                report::step_rows(&mut step_csv, case.scene, case.n, key, args.warmup, t);
+            }
+        }
         let states = [
             state::of(&h, &haptic_poses),
             state::of(&h, &r.poses()),
@@ -337,6 +348,11 @@ fn run(args: &Args) -> Result<(), String> {
     let svg = dir.join("compare.svg");
     report::svg(&rows, &svg)?;
     println!("wrote {} and {}", json.display(), svg.display());
+    if args.step_times {
+        let csv = dir.join("steps.csv");
+        std::fs::write(&csv, step_csv).map_err(|e| format!("{}: {e}", csv.display()))?;
+        println!("wrote {}", csv.display());
+    }
     Ok(())
 }
 

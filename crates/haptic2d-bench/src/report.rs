@@ -42,6 +42,21 @@ impl Row {
     }
 }
 
+/// Appends one CSV line per timed step of `engine` to `csv` (`scene,n,engine,step,sample,us`):
+/// `step` counts the timed steps, `sample` the engine's steps since the start (`warmup + step`).
+pub fn step_rows(
+    csv: &mut String,
+    scene: &str,
+    n: usize,
+    engine: &str,
+    warmup: usize,
+    t: &crate::timing::Samples,
+) {
+    for (i, us) in t.0.iter().enumerate() {
+        let _ = writeln!(csv, "{scene},{n},{engine},{i},{},{us:.3}", warmup + i);
+    }
+}
+
 /// The tables printed to stdout: step times with ratios (haptic2d / engine, median and p99), then the
 /// settle state after the run.
 pub fn table(rows: &[Row]) -> String {

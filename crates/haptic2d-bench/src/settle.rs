@@ -66,6 +66,8 @@ pub fn run(label: &str, w: &mut World, dt: f64, seconds: f64, every: f64, profil
     // Every profiled step: (CPU µs, step, sweeps, damped rows, contact events).
     let mut each: Vec<(f64, usize, u32, usize, usize)> = Vec::new();
     let (mut cpu, mut since) = (0.0, 0usize);
+    // Global updates published during the profiled steps: (count, in place, GJK iterations).
+    let mut updates = (0usize, 0usize, 0u64);
     for k in 1..=steps {
         let t0 = now(Clock::Cpu, origin);
         if k > first_profiled {
@@ -77,6 +79,12 @@ pub fn run(label: &str, w: &mut World, dt: f64, seconds: f64, every: f64, profil
         cpu += dt_cpu;
         if k > first_profiled {
             by_phase[(k - 1) % n_g].push(dt_cpu * 1e6);
+            if (k - 1) % n_g == 0 {
+                let b = w.broad_stats();
+                updates.0 += 1;
+                updates.1 += b.in_place as usize;
+                updates.2 += b.gjk_iterations;
+            }
             let d = w.chain_damper();
             each.push((
                 dt_cpu * 1e6,
@@ -123,6 +131,12 @@ pub fn run(label: &str, w: &mut World, dt: f64, seconds: f64, every: f64, profil
         w.contacts().entries().len(),
         w.contacts().contact_count(),
         w.chain_damper().last_rows
+    );
+    println!(
+        "{label}: global updates published after {profile_after} s: {}, {} of them in place (no sort), {:.1} GJK iterations per update",
+        updates.0,
+        updates.1,
+        updates.2 as f64 / updates.0.max(1) as f64
     );
     let all_steps = crate::timing::Samples(by_phase.iter().flatten().copied().collect());
     let (median, p99) = (all_steps.median(), all_steps.p99());

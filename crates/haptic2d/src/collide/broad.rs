@@ -80,6 +80,10 @@ pub struct BroadStats {
     /// Pairs whose side of `δ_prox` the bodies' motion could not have changed: GJK skipped, the
     /// last distance kept (module docs).
     pub reused_distances: usize,
+    /// The update tested exactly the last published update's pairs: its few new GJK distances
+    /// were written into the published result in place instead of sorting and copying every
+    /// pair again (a pile at rest, most updates).
+    pub in_place: bool,
 }
 
 /// One box in the sweep: the inflated box's x and y ranges and the collider index (the y range
@@ -173,8 +177,17 @@ pub struct BroadPhase {
     order: Vec<u32>,
     /// Pairs per first collider (counting sort of `order`).
     bucket: Vec<u32>,
-    /// The result of the update in progress is complete in `ready` (published by a swap).
+    /// The result of the update in progress is complete in `ready` (published by a swap), or in
+    /// `patches` (`in_place`).
     sorted: bool,
+    /// Every pair of the update in progress so far was in the published update.
+    all_published: bool,
+    /// The GJK results of the update in progress for published pairs: (index in the published
+    /// arrays, index in `tested`).
+    patches: Vec<(u32, u32)>,
+    /// The finished update in progress tested exactly the published pairs: publishing writes
+    /// `patches` into the published arrays.
+    in_place: bool,
     gjk_iterations: u64,
     reused_distances: usize,
     /// The published update: its pairs (sorted), caches, distances and odometer references, and
@@ -184,6 +197,8 @@ pub struct BroadPhase {
     distances: Vec<f64>,
     odo_refs: Vec<f64>,
     cache_start: Vec<u32>,
+    /// A copy of the published proximity set (handed out again by an update in place).
+    set: Vec<(u32, u32)>,
     /// The same for the update in progress, once sorted, with its proximity set.
     ready: Published,
     stats: BroadStats,
@@ -219,6 +234,9 @@ impl BroadPhase {
             order: Vec::new(),
             bucket: Vec::new(),
             sorted: false,
+            all_published: true,
+            patches: Vec::new(),
+            in_place: false,
             gjk_iterations: 0,
             reused_distances: 0,
             cache_pairs: Vec::new(),
@@ -226,6 +244,7 @@ impl BroadPhase {
             distances: Vec::new(),
             odo_refs: Vec::new(),
             cache_start: Vec::new(),
+            set: Vec::new(),
             ready: Published::default(),
             stats: BroadStats::default(),
         })
@@ -326,6 +345,9 @@ impl BroadPhase {
         }
         self.tested.clear();
         self.sorted = false;
+        self.all_published = true;
+        self.patches.clear();
+        self.in_place = false;
         self.gjk_iterations = 0;
         self.reused_distances = 0;
         self.next = Some(0);
@@ -381,6 +403,10 @@ impl BroadPhase {
                         continue;
                     }
                 }
+                match last {
+                    Some(k) => self.patches.push((k as u32, self.tested.len() as u32)),
+                    None => self.all_published = false,
+                }
                 let mut cache = last.map(|k| self.caches[k]).unwrap_or_default();
                 let g = gjk_distance(
                     self.snapshot.vertices(a),
@@ -398,8 +424,17 @@ impl BroadPhase {
         }
         self.next = Some(stop);
         if samples_left <= 1 && !self.sorted {
-            self.sort_tested();
-            self.fill_ready();
+            // Every tested pair is a published one (distinct ones: the sweep meets each pair
+            // once), so when the counts agree the tested pairs are exactly the published pairs:
+            // sorting them would rebuild the published arrays with the reused entries as they
+            // are and the `patches` written over theirs.
+            self.in_place = self.all_published
+                && self.tested.len() == self.cache_pairs.len()
+                && self.cache_start.len() == self.snapshot.colliders.len() + 1;
+            if !self.in_place {
+                self.sort_tested();
+                self.fill_ready();
+            }
             self.sorted = true;
         }
     }
@@ -484,7 +519,29 @@ impl BroadPhase {
             proximate_pairs: r.set.len(),
             gjk_iterations: self.gjk_iterations,
             reused_distances: self.reused_distances,
+            in_place: false,
         };
+    }
+
+    /// Writes the GJK results of an update in place (`patches`) into the published arrays; the
+    /// proximity set is rebuilt from the distances when a patched pair changed side of `δ_prox`.
+    fn patch(&mut self) {
+        let mut crossed = false;
+        for &(k, t) in &self.patches {
+            let (k, t) = (k as usize, &self.tested[t as usize]);
+            crossed |= (self.distances[k] < self.delta_prox) != (t.distance < self.delta_prox);
+            self.caches[k] = t.cache;
+            self.distances[k] = t.distance;
+            self.odo_refs[k] = t.odo_ref;
+        }
+        if crossed {
+            self.set.clear();
+            for (&p, &d) in self.cache_pairs.iter().zip(&self.distances) {
+                if d < self.delta_prox {
+                    self.set.push(p);
+                }
+            }
+        }
     }
 
     /// Finishes the update in progress (sweeps what is left) and writes its proximity set into
@@ -496,6 +553,18 @@ impl BroadPhase {
         }
         self.advance(1);
         self.next = None;
+        if self.in_place {
+            self.patch();
+            out.clone_from(&self.set);
+            self.stats = BroadStats {
+                aabb_pairs: self.tested.len(),
+                proximate_pairs: self.set.len(),
+                gjk_iterations: self.gjk_iterations,
+                reused_distances: self.reused_distances,
+                in_place: true,
+            };
+            return;
+        }
         // Everything was written by the last `advance`: publishing swaps the buffers.
         let r = &mut self.ready;
         std::mem::swap(out, &mut r.set);
@@ -504,6 +573,7 @@ impl BroadPhase {
         std::mem::swap(&mut self.distances, &mut r.distances);
         std::mem::swap(&mut self.odo_refs, &mut r.odo_refs);
         std::mem::swap(&mut self.cache_start, &mut r.start);
+        self.set.clone_from(out);
         self.stats = r.stats;
     }
 }
@@ -666,10 +736,8 @@ mod tests {
         let radius = 0.02 * 2f64.sqrt();
         let mut odometer = vec![0.0; cols.len()];
         let mut poses: Vec<Pose> = (0..cols.len()).map(|_| Pose::new(0.0, 0.0, 0.0)).collect();
-        let (mut fast, mut every) = (
-            BroadPhase::new(DEFAULT_DELTA_PROX).unwrap(),
-            BroadPhase::new(DEFAULT_DELTA_PROX).unwrap(),
-        );
+        let mut fast = BroadPhase::new(DEFAULT_DELTA_PROX).unwrap();
+        let mut every: BroadPhase;
         let (mut out_fast, mut out_every) = (Vec::new(), Vec::new());
         let mut reused = 0;
         for k in 0..60u64 {
@@ -690,6 +758,8 @@ mod tests {
                 cols[i].update(&Pose::new(h0.x + p.pos.x, h0.y + p.pos.y, p.angle));
             }
             fast.update_with_motion(&cols, &odometer, &mut out_fast);
+            // A new stage each time: GJK on every pair and the full path.
+            every = BroadPhase::new(DEFAULT_DELTA_PROX).unwrap();
             every.update(&cols, &mut out_every);
             assert_eq!(out_fast, out_every, "update {k}");
             assert_eq!(fast.stats().aabb_pairs, every.stats().aabb_pairs);
@@ -697,6 +767,104 @@ mod tests {
             reused += fast.stats().reused_distances;
         }
         assert!(reused > 1000, "reused {reused}");
+    }
+
+    /// An update that tests exactly the published pairs writes its few GJK results into the
+    /// published arrays in place (`BroadStats::in_place`) and publishes what a full sort would:
+    /// at rest (whole and spread), with a pair re-measured on the same side of `δ_prox` and one
+    /// that crosses it. A pair leaving the AABB test while every other is reused (a body drifting
+    /// away diagonally, farther than `δ_prox` throughout), or a new pair, takes the full path.
+    #[test]
+    fn an_update_testing_the_published_pairs_patches_them_in_place() {
+        // Body 1 near body 2 (10 mm: proximate); body 3 diagonal to body 1, 38 mm gaps in x and
+        // y: the boxes overlap (inflated by 21 mm each) but the squares are 53.7 mm apart.
+        let mut cols = vec![
+            square(0, false, 0.0, -1.0),
+            square(1, true, 0.0, 0.0),
+            square(2, true, -0.05, 0.0),
+            square(3, true, 0.078, 0.078),
+        ];
+        let mut odometer = vec![0.0; 4];
+        let mut fast = BroadPhase::new(DEFAULT_DELTA_PROX).unwrap();
+        // The oracle: a new stage each time (no published pairs, so always the full path).
+        let mut every: BroadPhase;
+        let (mut out, mut out_every) = (Vec::new(), Vec::new());
+        fast.update_with_motion(&cols, &odometer, &mut out);
+        assert!(!fast.stats().in_place);
+        let (pairs0, dist0) = (fast.tested_pairs().0.to_vec(), fast.tested_pairs().1.to_vec());
+        assert_eq!(out, vec![(1, 2)]);
+        assert_eq!(pairs0, vec![(1, 2), (1, 3)]);
+        // At rest: in place with nothing to write, whole and spread.
+        for spread in [false, true] {
+            let mut o = vec![(7, 8)];
+            if spread {
+                fast.begin_with_motion(&cols, &odometer);
+                fast.advance(3);
+                fast.advance(2);
+                fast.publish(&mut o);
+            } else {
+                fast.update_with_motion(&cols, &odometer, &mut o);
+            }
+            let st = fast.stats();
+            assert!(st.in_place, "spread {spread}");
+            assert_eq!((st.aabb_pairs, st.proximate_pairs, st.gjk_iterations), (2, 1, 0));
+            assert_eq!(o, out);
+            assert_eq!(fast.tested_pairs().0, pairs0.as_slice());
+            assert_eq!(fast.tested_pairs().1, dist0.as_slice());
+        }
+        // Body 2 goes 20 mm away and 15 mm back (odometer +35 mm): its pair needs GJK and stays
+        // proximate; body 3's keeps its distance.
+        cols[2].update(&Pose::new(-0.055, 0.0, 0.0));
+        odometer[2] += 0.035;
+        fast.update_with_motion(&cols, &odometer, &mut out);
+        every = BroadPhase::new(DEFAULT_DELTA_PROX).unwrap();
+        every.update(&cols, &mut out_every);
+        assert!(fast.stats().in_place && fast.stats().gjk_iterations > 0);
+        assert_eq!(out, out_every);
+        assert_eq!(fast.tested_pairs().0, pairs0.as_slice());
+        assert_eq!(fast.tested_pairs().1[0], every.tested_pairs().1[0]);
+        assert_eq!(fast.tested_pairs().1[1], dist0[1]);
+        // Body 3 comes 13 mm closer on both axes (35.4 mm apart): its pair crosses into the set.
+        cols[3].update(&Pose::new(0.065, 0.065, 0.0));
+        odometer[3] += 0.013 * 2f64.sqrt();
+        fast.update_with_motion(&cols, &odometer, &mut out);
+        every = BroadPhase::new(DEFAULT_DELTA_PROX).unwrap();
+        every.update(&cols, &mut out_every);
+        assert!(fast.stats().in_place);
+        assert_eq!(out, vec![(1, 2), (1, 3)]);
+        assert_eq!(out, out_every);
+        assert_eq!(fast.tested_pairs(), every.tested_pairs());
+        // Body 3 drifts away diagonally in 1 mm steps until its box leaves body 1's: that update
+        // must take the full path.
+        let (mut left, mut patched) = (false, 0);
+        for k in 1..=20 {
+            let x = 0.065 + 0.001 * k as f64;
+            cols[3].update(&Pose::new(x, x, 0.0));
+            odometer[3] += 0.001 * 2f64.sqrt();
+            fast.update_with_motion(&cols, &odometer, &mut out);
+            every = BroadPhase::new(DEFAULT_DELTA_PROX).unwrap();
+        every.update(&cols, &mut out_every);
+            assert_eq!(out, out_every, "step {k}");
+            assert_eq!(fast.tested_pairs().0, every.tested_pairs().0, "step {k}");
+            assert_eq!(fast.stats().proximate_pairs, out.len());
+            let dropped = fast.stats().aabb_pairs < 2;
+            if dropped && !left {
+                assert!(!fast.stats().in_place, "step {k}: a pair left");
+            }
+            patched += fast.stats().in_place as usize;
+            left |= dropped;
+        }
+        assert!(left, "body 3's box left body 1's");
+        assert!(patched > 10, "{patched} updates in place");
+        // A new pair (body 2 jumps 5 mm above body 3): the full path.
+        cols[2].update(&Pose::new(0.085, 0.13, 0.0));
+        odometer[2] += 0.2;
+        fast.update_with_motion(&cols, &odometer, &mut out);
+        every = BroadPhase::new(DEFAULT_DELTA_PROX).unwrap();
+        every.update(&cols, &mut out_every);
+        assert!(!fast.stats().in_place);
+        assert_eq!(out, out_every);
+        assert_eq!(fast.tested_pairs(), every.tested_pairs());
     }
 
     /// The sweep's insertion sort gives the order of a full sort, on nearly sorted input (the
