@@ -419,8 +419,8 @@ impl World {
     /// - every `N_g`-th sample with spreading: publish the update begun `N_g` samples ago (the
     ///   whole stage now if none is in progress: the first sample, or after an early update was
     ///   abandoned) and begin the next one for the current poses;
-    /// - with spreading, every sample: advance the update in progress by its share, so that it
-    ///   ends by the next `N_g`-th sample.
+    /// - with spreading, every sample that did not begin an update: advance the update in
+    ///   progress by its share, so that it ends by the next `N_g`-th sample.
     ///
     /// The poses of the set in use (`global_poses`) are those of the update that produced it, so
     /// `moved_past_margin` measures the motion since then whatever the delay.
@@ -448,7 +448,8 @@ impl World {
                 *g = b.pose;
             }
         }
-        if spread {
+        // The sample that began an update has done its share (`begin`, and publishing).
+        if spread && !(periodic || early) {
             self.broad.advance((n_g - phase) as usize);
         }
     }

@@ -32,10 +32,14 @@
 //! so the work can instead be spread over the `N_g` samples of a period (the world's default):
 //!
 //! ```text
-//! sample k·N_g      publish(set of (k−1)·N_g)   begin(poses of k·N_g)   advance: ⌈n/(N_g−1)⌉ boxes
-//! sample k·N_g + j  advance: ⌈remaining/(N_g−1−j)⌉ boxes                      j = 1 … N_g−2
-//! sample k·N_g + N_g−1   advance: sort the pairs (publish only copies them out)
+//! sample k·N_g           publish(set of (k−1)·N_g)   begin(poses of k·N_g)
+//! sample k·N_g + j       advance: ⌈remaining/(N_g−j)⌉ boxes                  j = 1 … N_g−2
+//! sample k·N_g + N_g−1   advance: the last boxes, then sort the pairs (publish only hands
+//!                        them over), or patch in place (below)
 //! ```
+//!
+//! The publishing sample sweeps nothing: publishing and `begin` (the snapshot, the boxes and
+//! their sort) are its share.
 //!
 //! `begin` copies the world vertices (the snapshot), so the set published at `(k+1)·N_g` is
 //! exactly the set [`BroadPhase::update`] would have computed at `k·N_g` (same pairs, distances
@@ -53,6 +57,14 @@
 //! side of `δ_prox` (by a 1 µm guard), the pair's side of the test is known: GJK is skipped and
 //! the pair keeps its distance, cache and odometer reference (`BroadStats::reused_distances`).
 //! A pile at rest moves micrometres per period, so its pairs are re-tested only in the sweep.
+//!
+//! # Patching in place
+//!
+//! When every pair an update tests is one of the published update's (every lookup found its
+//! entry, and the counts agree), sorting the tested pairs would rebuild the published arrays
+//! with a few entries changed: those that needed GJK. The update then writes just those entries
+//! over the published ones and rebuilds the set only if one of them changed side of `δ_prox`
+//! (`BroadStats::in_place`). A settled pile:1000 takes this path in 143 of 150 updates.
 
 use super::gjk::{gjk_distance, GjkCache};
 use super::Collider;
@@ -354,16 +366,16 @@ impl BroadPhase {
     }
 
     /// Advances the update in progress by one sample's share, `samples_left` being the number of
-    /// calls left before [`publish`](Self::publish) (this one included; at least 1): while
-    /// `samples_left ≥ 2` the remaining boxes are split evenly over `samples_left − 1` calls
-    /// (`⌈remaining / (samples_left − 1)⌉` boxes, each tested against the boxes that start before it
-    /// ends in x, GJK on every pair that overlaps); the last call (`samples_left = 1`) sweeps
-    /// whatever is left and sorts the pairs, so the publishing sample only copies them out. Does
-    /// nothing when no update is in progress.
+    /// calls left before [`publish`](Self::publish) (this one included; at least 1): the
+    /// remaining boxes are split evenly over the `samples_left` calls (`⌈remaining /
+    /// samples_left⌉` boxes, each tested against the boxes that start before it ends in x, GJK on
+    /// every pair that overlaps); the last call (`samples_left = 1`) sweeps whatever is left and
+    /// finishes the result (sorts the pairs, or marks them for patching in place), so the
+    /// publishing sample only hands it over. Does nothing when no update is in progress.
     pub fn advance(&mut self, samples_left: usize) {
         let Some(start) = self.next else { return };
         let n = self.sweep.len();
-        let share = (n - start).div_ceil(samples_left.saturating_sub(1).max(1));
+        let share = (n - start).div_ceil(samples_left.max(1));
         let stop = (start + share).min(n);
         // 2. Sweep on x, test y, filter same-body and fixed–fixed pairs; 3. warm-started GJK per
         //    pair (each pair's result depends on its own cache only, so the order of this loop
@@ -685,17 +697,19 @@ mod tests {
         let mut bp = BroadPhase::new(DEFAULT_DELTA_PROX).unwrap();
         bp.begin(&cols);
         let mut swept = Vec::new();
-        for j in 0..9 {
+        for j in 1..9 {
             bp.advance(10 - j);
             swept.push(bp.next.unwrap());
         }
-        // Nine even shares of the boxes, then the last sample sorts only.
+        // Nine even shares of the boxes over the samples after `begin`; the last one sorts too.
         let share = cols.len().div_ceil(9);
         assert_eq!(swept[0], share);
-        assert_eq!(bp.next, Some(cols.len()));
+        assert!(swept.windows(2).all(|w| w[1] - w[0] <= share));
         assert!(!bp.sorted);
-        let pairs = bp.tested.len();
         bp.advance(1);
+        assert_eq!(bp.next, Some(cols.len()));
+        assert!(cols.len() - swept[7] <= share);
+        let pairs = bp.tested.len();
         assert!(bp.sorted && bp.order.len() == pairs && pairs > 0);
         assert!(bp.ready.pairs.windows(2).all(|w| w[0] < w[1]));
         assert_eq!(bp.ready.pairs.len(), pairs);
@@ -791,7 +805,10 @@ mod tests {
         let (mut out, mut out_every) = (Vec::new(), Vec::new());
         fast.update_with_motion(&cols, &odometer, &mut out);
         assert!(!fast.stats().in_place);
-        let (pairs0, dist0) = (fast.tested_pairs().0.to_vec(), fast.tested_pairs().1.to_vec());
+        let (pairs0, dist0) = (
+            fast.tested_pairs().0.to_vec(),
+            fast.tested_pairs().1.to_vec(),
+        );
         assert_eq!(out, vec![(1, 2)]);
         assert_eq!(pairs0, vec![(1, 2), (1, 3)]);
         // At rest: in place with nothing to write, whole and spread.
@@ -807,7 +824,10 @@ mod tests {
             }
             let st = fast.stats();
             assert!(st.in_place, "spread {spread}");
-            assert_eq!((st.aabb_pairs, st.proximate_pairs, st.gjk_iterations), (2, 1, 0));
+            assert_eq!(
+                (st.aabb_pairs, st.proximate_pairs, st.gjk_iterations),
+                (2, 1, 0)
+            );
             assert_eq!(o, out);
             assert_eq!(fast.tested_pairs().0, pairs0.as_slice());
             assert_eq!(fast.tested_pairs().1, dist0.as_slice());
@@ -843,7 +863,7 @@ mod tests {
             odometer[3] += 0.001 * 2f64.sqrt();
             fast.update_with_motion(&cols, &odometer, &mut out);
             every = BroadPhase::new(DEFAULT_DELTA_PROX).unwrap();
-        every.update(&cols, &mut out_every);
+            every.update(&cols, &mut out_every);
             assert_eq!(out, out_every, "step {k}");
             assert_eq!(fast.tested_pairs().0, every.tested_pairs().0, "step {k}");
             assert_eq!(fast.stats().proximate_pairs, out.len());

@@ -362,7 +362,12 @@ impl LocalStage {
         // common head and tail stay where they are and only the middle is merged and spliced in,
         // instead of copying every pair's state (about 1.5 MB at 1000 bodies: a deadline spike).
         let (n_old, n_new) = (self.pairs.len(), pairs.len());
-        let head = self.pairs.iter().zip(pairs).take_while(|(a, b)| a == b).count();
+        let head = self
+            .pairs
+            .iter()
+            .zip(pairs)
+            .take_while(|(a, b)| a == b)
+            .count();
         let tail = self.pairs[head..]
             .iter()
             .rev()
@@ -443,11 +448,13 @@ impl LocalStage {
         self.old_gaps.clear();
         self.old_states.clear();
         self.old_candidates.clear();
-        self.old_pairs.extend_from_slice(&self.pairs[old_mid.clone()]);
+        self.old_pairs
+            .extend_from_slice(&self.pairs[old_mid.clone()]);
         self.old_trackers
             .extend_from_slice(&self.trackers[old_mid.clone()]);
         self.old_gaps.extend_from_slice(&self.gaps[old_mid.clone()]);
-        self.old_states.extend_from_slice(&self.states[old_mid.clone()]);
+        self.old_states
+            .extend_from_slice(&self.states[old_mid.clone()]);
         self.old_candidates
             .extend_from_slice(&self.candidates[old_mid.clone()]);
         let mut k = 0;
@@ -1197,7 +1204,11 @@ mod tests {
             let (mut out_fast, mut out_whole) = (Vec::new(), Vec::new());
             let mut spliced = 0;
             for k in 0..60 {
-                let flips = if k % 10 == 9 { 40 } else { rng.random_range(0..4) };
+                let flips = if k % 10 == 9 {
+                    40
+                } else {
+                    rng.random_range(0..4)
+                };
                 for _ in 0..flips {
                     let i = rng.random_range(0..all.len());
                     on[i] = !on[i];
@@ -1231,7 +1242,10 @@ mod tests {
                 assert_eq!(fast.states, whole.states, "seed {seed} update {k}");
                 assert_eq!(fast.candidates, whole.candidates, "seed {seed} update {k}");
             }
-            assert!(spliced > 0, "seed {seed}: some splices kept the assembled output");
+            assert!(
+                spliced > 0,
+                "seed {seed}: some splices kept the assembled output"
+            );
         }
     }
 
