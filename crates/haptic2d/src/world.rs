@@ -172,9 +172,12 @@ impl World {
             friction,
             params,
             contacts: ContactSet::new(params.contact),
-            broad: BroadPhase::new(params.delta_prox).unwrap_or_else(|_| {
-                BroadPhase::new(DEFAULT_DELTA_PROX).expect("the default margin is valid")
-            }),
+            broad: BroadPhase::with_capacity(params.delta_prox, 8 * colliders_len).unwrap_or_else(
+                |_| {
+                    BroadPhase::with_capacity(DEFAULT_DELTA_PROX, 8 * colliders_len)
+                        .expect("the default margin is valid")
+                },
+            ),
             local: {
                 let mut l = LocalStage::with_capacity(8 * colliders_len);
                 // An invalid tolerance keeps the default; scene validation reports it.

@@ -145,6 +145,13 @@ fn sort_sweep(sweep: &mut [SweepEntry]) {
     }
 }
 
+/// Grows `v`'s capacity to at least `n` (no allocation when it has that room already).
+fn room<T>(v: &mut Vec<T>, n: usize) {
+    if v.capacity() < n {
+        v.reserve(n - v.len());
+    }
+}
+
 /// Kept between a reused distance's interval and `δ_prox` (m): GJK's tolerance and the
 /// odometers' rounding are far below it.
 const REUSE_GUARD: f64 = 1e-6;
@@ -262,6 +269,31 @@ impl BroadPhase {
         })
     }
 
+    /// [`new`](Self::new) with room for `pairs` AABB-overlapping pairs, so that updates up to
+    /// that size never allocate once the per-collider buffers have grown (the world sizes it
+    /// like its local stage).
+    pub fn with_capacity(delta_prox: f64, pairs: usize) -> Result<Self, String> {
+        let mut b = Self::new(delta_prox)?;
+        b.tested.reserve(pairs);
+        b.order.reserve(pairs);
+        b.patches.reserve(pairs);
+        b.set.reserve(pairs);
+        for v in [&mut b.cache_pairs, &mut b.ready.pairs, &mut b.ready.set] {
+            v.reserve(pairs);
+        }
+        b.caches.reserve(pairs);
+        b.ready.caches.reserve(pairs);
+        for v in [
+            &mut b.distances,
+            &mut b.odo_refs,
+            &mut b.ready.distances,
+            &mut b.ready.odo_refs,
+        ] {
+            v.reserve(pairs);
+        }
+        Ok(b)
+    }
+
     /// The proximity distance `δ_prox` (m).
     pub fn delta_prox(&self) -> f64 {
         self.delta_prox
@@ -355,10 +387,17 @@ impl BroadPhase {
             }
             self.sweep.sort_unstable_by(sweep_order);
         }
+        // Both buffers of the per-collider starts, sized here (an update in place leaves them
+        // unswapped for many periods, so the second one would otherwise grow late).
+        room(&mut self.cache_start, colliders.len() + 1);
+        room(&mut self.ready.start, colliders.len() + 1);
         self.tested.clear();
         self.sorted = false;
         self.all_published = true;
         self.patches.clear();
+        // Room for every published pair, so that patching allocates only when the published
+        // update has grown (when the other buffers grow too).
+        self.patches.reserve(self.cache_pairs.len());
         self.in_place = false;
         self.gjk_iterations = 0;
         self.reused_distances = 0;
@@ -504,6 +543,7 @@ impl BroadPhase {
     fn fill_ready(&mut self) {
         let r = &mut self.ready;
         r.set.clear();
+        room(&mut r.set, self.tested.len());
         r.pairs.clear();
         r.caches.clear();
         r.distances.clear();
@@ -567,7 +607,9 @@ impl BroadPhase {
         self.next = None;
         if self.in_place {
             self.patch();
-            out.clone_from(&self.set);
+            if *out != self.set {
+                out.clone_from(&self.set);
+            }
             self.stats = BroadStats {
                 aabb_pairs: self.tested.len(),
                 proximate_pairs: self.set.len(),
@@ -585,7 +627,12 @@ impl BroadPhase {
         std::mem::swap(&mut self.distances, &mut r.distances);
         std::mem::swap(&mut self.odo_refs, &mut r.odo_refs);
         std::mem::swap(&mut self.cache_start, &mut r.start);
+        // An update in place has these pairs, so its set has at most as many: with this room in
+        // the copy and in both buffers that take turns as the caller's, it allocates nothing.
+        let most = self.cache_pairs.len();
         self.set.clone_from(out);
+        room(&mut self.set, most);
+        room(&mut r.set, most);
         self.stats = r.stats;
     }
 }
