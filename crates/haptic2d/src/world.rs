@@ -8,7 +8,7 @@
 use crate::body::Body;
 use crate::collide::{
     allowed_depth, body_thickness, polygon_radius, speed_limit, swept_put_back, BroadPhase,
-    Collider, LocalStage, SweepScratch, SweptShape, VeCandidate, DEFAULT_DELTA_PROX,
+    Collider, LocalStage, SweepScratch, SweptShape, DEFAULT_DELTA_PROX,
 };
 use crate::contact::{ContactParams, ContactSet, PastPoses, VeContact, Wrench2};
 use crate::geom::{Pose, Rot, Vec2};
@@ -87,7 +87,6 @@ pub struct World {
     broad: BroadPhase,
     local: LocalStage,
     pairs: Vec<(u32, u32)>,
-    candidates: Vec<VeCandidate>,
     drive: Vec<Wrench2>,
     contact_wrench: Vec<Wrench2>,
     /// Load wrench per body of the current sample.
@@ -186,7 +185,6 @@ impl World {
             },
             // Room for a typical contact load, so the first contacts do not allocate on the hot path.
             pairs: Vec::with_capacity(8 * colliders_len),
-            candidates: Vec::with_capacity(16 * colliders_len),
             drive: vec![Wrench2::default(); n],
             contact_wrench: vec![Wrench2::default(); n],
             held: vec![Wrench2::default(); n],
@@ -352,12 +350,11 @@ impl World {
         //    (separated pairs whose gap the bodies' relative motion cannot have closed are
         //    skipped, and penetrating pairs' vertex scans it cannot have changed are reused;
         //    `odometer_poses` are the bodies' poses now, the odometers having just been read).
-        self.local.update_with_motion(
+        self.local.update_in_place(
             &self.colliders,
             &self.pairs,
             self.params.delta_c,
             &self.odometer_poses,
-            &mut self.candidates,
         );
         // Loads are evaluated once per sample (held over it). Loads and drives enter the bodies'
         // accumulators before the contact forces so the classical friction model sees them (§4.1).
@@ -390,7 +387,7 @@ impl World {
         self.contacts.step(
             self.tick,
             dt,
-            &self.candidates,
+            self.local.candidates(),
             self.local.from_vertex_scan(),
             &self.colliders,
             &mut self.bodies,

@@ -534,6 +534,20 @@ impl LocalStage {
         poses: &[Pose],
         out: &mut Vec<VeCandidate>,
     ) {
+        self.update_in_place(colliders, pairs, delta_c, poses);
+        out.clone_from(&self.sorted);
+    }
+
+    /// [`update_with_motion`](Self::update_with_motion) without copying the candidates out:
+    /// they are [`candidates`](Self::candidates) until the next update (the world's tick reads
+    /// them there, instead of copying them every sample).
+    pub fn update_in_place(
+        &mut self,
+        colliders: &[Collider],
+        pairs: &[(u32, u32)],
+        delta_c: f64,
+        poses: &[Pose],
+    ) {
         if self.pairs.as_slice() != pairs {
             self.rebuild(pairs, colliders);
         }
@@ -589,7 +603,12 @@ impl LocalStage {
             self.assemble(&fresh, colliders.len());
         }
         self.fresh = fresh;
-        out.clone_from(&self.sorted);
+    }
+
+    /// The VE candidates of the last update, sorted and deduplicated (what
+    /// [`update_with_motion`](Self::update_with_motion) copies out).
+    pub fn candidates(&self) -> &[VeCandidate] {
+        &self.sorted
     }
 
     /// The sorted, deduplicated candidates of every pair (`sorted`, with `from_scan`), from the
