@@ -393,24 +393,36 @@ impl LocalStage {
         // One merge keeps the trackers (and gaps) of pairs that persist.
         let mut k = 0;
         for &p in pairs {
-            while k < self.old_pairs.len() && self.old_pairs[k] < p {
-                k += 1;
-            }
-            let (t, g, st, r) = if k < self.old_pairs.len() && self.old_pairs[k] == p {
-                (
-                    self.old_trackers[k],
-                    self.old_gaps[k],
-                    self.old_states[k],
-                    self.old_candidates[k],
-                )
-            } else {
-                Self::untracked(p, colliders)
-            };
+            let (t, g, st, r) = self.kept_or_new(p, &mut k, self.old_pairs.len(), colliders);
             self.pairs.push(p);
             self.trackers.push(t);
             self.gaps.push(g);
             self.states.push(st);
             self.candidates.push(r);
+        }
+    }
+
+    /// Pair `p`'s state from the old buffers' first `end` entries (sorted; `k` is the merge
+    /// position, advanced past the pairs before `p`), or a new pair's if it is not there.
+    fn kept_or_new(
+        &self,
+        p: (u32, u32),
+        k: &mut usize,
+        end: usize,
+        colliders: &[Collider],
+    ) -> (FeatureTracker, Gap, PairState, PairCandidates) {
+        while *k < end && self.old_pairs[*k] < p {
+            *k += 1;
+        }
+        if *k < end && self.old_pairs[*k] == p {
+            (
+                self.old_trackers[*k],
+                self.old_gaps[*k],
+                self.old_states[*k],
+                self.old_candidates[*k],
+            )
+        } else {
+            Self::untracked(p, colliders)
         }
     }
 
@@ -459,19 +471,7 @@ impl LocalStage {
             .extend_from_slice(&self.candidates[old_mid.clone()]);
         let mut k = 0;
         for &p in new_mid {
-            while k < m && self.old_pairs[k] < p {
-                k += 1;
-            }
-            let (t, g, st, r) = if k < m && self.old_pairs[k] == p {
-                (
-                    self.old_trackers[k],
-                    self.old_gaps[k],
-                    self.old_states[k],
-                    self.old_candidates[k],
-                )
-            } else {
-                Self::untracked(p, colliders)
-            };
+            let (t, g, st, r) = self.kept_or_new(p, &mut k, m, colliders);
             self.old_pairs.push(p);
             self.old_trackers.push(t);
             self.old_gaps.push(g);
