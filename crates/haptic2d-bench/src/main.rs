@@ -92,7 +92,7 @@ struct Args {
     out: Option<PathBuf>,
     /// Also write every timed step's time of every engine to `steps.csv` in the output folder
     /// (columns scene, n, engine, step, sample, us; `sample` is the engine's sample index since
-    /// the start, warm-up included).
+    /// the start, warm-up included) and plot them, one `steps_<scene>_<n>.svg` per case.
     #[arg(long)]
     step_times: bool,
 }
@@ -316,6 +316,10 @@ fn run(args: &Args) -> Result<(), String> {
             for (key, t) in keys.iter().zip(&samples) {
                 report::step_rows(&mut step_csv, case.scene, case.n, key, args.warmup, t);
             }
+            let dir = out_dir(args);
+            std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+            let svg = dir.join(format!("steps_{}_{}.svg", case.scene, case.n));
+            report::steps_svg(&label, &keys, &samples, &svg)?;
         }
         let states = [
             state::of(&h, &haptic_poses),
@@ -351,7 +355,10 @@ fn run(args: &Args) -> Result<(), String> {
     if args.step_times {
         let csv = dir.join("steps.csv");
         std::fs::write(&csv, step_csv).map_err(|e| format!("{}: {e}", csv.display()))?;
-        println!("wrote {}", csv.display());
+        println!(
+            "wrote {} and steps_<scene>_<n>.svg beside it",
+            csv.display()
+        );
     }
     Ok(())
 }

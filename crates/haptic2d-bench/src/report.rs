@@ -237,3 +237,74 @@ pub fn svg(rows: &[Row], path: &Path) -> Result<(), String> {
     root.present().map_err(|e| err(&e))?;
     Ok(())
 }
+
+/// Every timed step of every engine on one case, step time (µs, log scale) against the step
+/// index: the interleaved chunks' cold first steps, the machine's slow bursts and any periodic
+/// spike show as what they are. Written by `--step-times` as `steps_<scene>_<n>.svg`.
+pub fn steps_svg(
+    label: &str,
+    keys: &[String],
+    samples: &[crate::timing::Samples],
+    path: &Path,
+) -> Result<(), String> {
+    haptic2d_lab::plot::register_font();
+    let err = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
+    let all = samples.iter().flat_map(|s| s.0.iter().copied());
+    let t_lo = all
+        .clone()
+        .filter(|t| *t > 0.0)
+        .fold(f64::INFINITY, f64::min)
+        .max(1e-3);
+    let t_hi = all.fold(0.0, f64::max).max(t_lo * 10.0);
+    let steps = samples.iter().map(|s| s.0.len()).max().unwrap_or(1).max(2);
+    let root = SVGBackend::new(path, (960, 480)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| err(&e))?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(
+            format!("Every timed step, {label} (dt = 1 ms)"),
+            ("sans-serif", 20),
+        )
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(60)
+        .build_cartesian_2d(
+            0f64..steps as f64,
+            ((t_lo * 0.8)..(t_hi * 1.25)).log_scale(),
+        )
+        .map_err(|e| err(&e))?;
+    chart
+        .configure_mesh()
+        .x_desc("timed step")
+        .y_desc("step time (µs)")
+        .draw()
+        .map_err(|e| err(&e))?;
+    const COLORS: [RGBColor; 5] = [BLUE, RED, GREEN, MAGENTA, CYAN];
+    for (k, (key, s)) in keys.iter().zip(samples).enumerate() {
+        let color = COLORS[k % COLORS.len()];
+        let pts: Vec<(f64, f64)> =
+            s.0.iter()
+                .enumerate()
+                .filter(|(_, t)| **t > 0.0)
+                .map(|(i, &t)| (i as f64, t))
+                .collect();
+        let style = color.mix(0.7).stroke_width(1);
+        chart
+            .draw_series(LineSeries::new(pts, style))
+            .map_err(|e| err(&e))?
+            .label(format!(
+                "{key}: median {:.1} µs, p99 {:.1} µs",
+                s.median(),
+                s.p99()
+            ))
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()
+        .map_err(|e| err(&e))?;
+    root.present().map_err(|e| err(&e))?;
+    Ok(())
+}
