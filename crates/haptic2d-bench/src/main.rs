@@ -4,6 +4,7 @@
 //! ```text
 //! cargo run --release -p haptic2d-bench -- [--quick] [--steps 2000] [--warmup 1000] [--scenes pile,sliding] [--pile 10,100]
 //! cargo run --release -p haptic2d-bench --features box2d-avx2 -- ...   # Box2D's AVX2 build
+//! cargo run --release -p haptic2d-bench -- --step-times ...              # + steps.csv, steps_*.svg
 //! ```
 //!
 //! Prints a table of median and p99 step times per engine and their ratios (haptic2d / engine), the
