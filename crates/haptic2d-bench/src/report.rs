@@ -1,5 +1,6 @@
 //! Output of a comparison: the console table, `compare.json` and `compare.svg` (step time vs N).
 
+use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::prelude::*;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -164,16 +165,64 @@ pub fn json(rows: &[Row]) -> String {
     format!("[\n{}\n]\n", items.join(",\n"))
 }
 
-/// Writes `compare.svg`: median (solid) and p99 (thin) step time vs N for the `pile` rows, log–log.
-pub fn svg(rows: &[Row], path: &Path) -> Result<(), String> {
+/// Engine colours, in the order of a row's engines.
+const COLORS: [RGBColor; 5] = [BLUE, RED, GREEN, MAGENTA, CYAN];
+
+/// The chart both plots share, of `size` pixels at `path`: the caption, `x` with its description,
+/// step time on the y axis (µs, log scale over `t`), the series `draw` adds, and their legend at
+/// `legend`.
+fn plot<X>(
+    path: &Path,
+    size: (u32, u32),
+    caption: &str,
+    (x, x_desc): (X, &str),
+    t: std::ops::Range<f64>,
+    legend: SeriesLabelPosition,
+    draw: impl FnOnce(
+        &mut ChartContext<'_, SVGBackend<'_>, Cartesian2d<X::CoordDescType, LogCoord<f64>>>,
+    ) -> Result<(), String>,
+) -> Result<(), String>
+where
+    X: AsRangedCoord,
+    X::CoordDescType: ValueFormatter<<X::CoordDescType as Ranged>::ValueType>,
+{
     // With the workspace's plotters features unified (the lab enables ab_glyph), text needs a
     // registered font: use the lab's embedded one.
     haptic2d_lab::plot::register_font();
+    let err = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
+    let root = SVGBackend::new(path, size).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| err(&e))?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(caption, ("sans-serif", 20))
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(60)
+        .build_cartesian_2d(x, t.log_scale())
+        .map_err(|e| err(&e))?;
+    chart
+        .configure_mesh()
+        .x_desc(x_desc)
+        .y_desc("step time (µs)")
+        .draw()
+        .map_err(|e| err(&e))?;
+    draw(&mut chart).map_err(|e| err(&e))?;
+    chart
+        .configure_series_labels()
+        .position(legend)
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()
+        .map_err(|e| err(&e))?;
+    root.present().map_err(|e| err(&e))?;
+    Ok(())
+}
+
+/// Writes `compare.svg`: median (solid) and p99 (thin) step time vs N for the `pile` rows, log–log.
+pub fn svg(rows: &[Row], path: &Path) -> Result<(), String> {
     let pile: Vec<&Row> = rows.iter().filter(|r| r.scene == "pile").collect();
     if pile.is_empty() {
         return Ok(());
     }
-    let err = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
     let n_lo = pile.iter().map(|r| r.n).min().unwrap_or(1) as f64;
     let n_hi = pile.iter().map(|r| r.n).max().unwrap_or(1) as f64;
     let times = pile
@@ -181,61 +230,41 @@ pub fn svg(rows: &[Row], path: &Path) -> Result<(), String> {
         .flat_map(|r| r.engines.iter().flat_map(|e| [e.median_us, e.p99_us]));
     let t_lo = times.clone().fold(f64::INFINITY, f64::min).max(1e-3);
     let t_hi = times.fold(0.0, f64::max).max(t_lo * 10.0);
-    let root = SVGBackend::new(path, (720, 480)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| err(&e))?;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(
-            "Step time vs number of boxes (pile, dt = 1 ms)",
-            ("sans-serif", 20),
-        )
-        .margin(12)
-        .x_label_area_size(40)
-        .y_label_area_size(60)
-        .build_cartesian_2d(
-            ((n_lo * 0.8)..(n_hi * 1.25)).log_scale(),
-            ((t_lo * 0.5)..(t_hi * 2.0)).log_scale(),
-        )
-        .map_err(|e| err(&e))?;
-    chart
-        .configure_mesh()
-        .x_desc("boxes N")
-        .y_desc("step time (µs)")
-        .draw()
-        .map_err(|e| err(&e))?;
-    const COLORS: [RGBColor; 5] = [BLUE, RED, GREEN, MAGENTA, CYAN];
-    let n_eng = pile[0].engines.len();
-    for k in 0..n_eng {
-        let color = COLORS[k % COLORS.len()];
-        let key = pile[0].engines[k].key.clone();
-        for (what, width) in [("median", 2u32), ("p99", 1)] {
-            let pts: Vec<(f64, f64)> = pile
-                .iter()
-                .filter(|r| r.engines.len() == n_eng)
-                .map(|r| {
-                    let e = &r.engines[k];
-                    (r.n as f64, if width == 2 { e.median_us } else { e.p99_us })
-                })
-                .collect();
-            let style = color.stroke_width(width);
-            chart
-                .draw_series(LineSeries::new(pts.clone(), style))
-                .map_err(|e| err(&e))?
-                .label(format!("{key} {what}"))
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
-            chart
-                .draw_series(pts.iter().map(|&p| Circle::new(p, 3, color.filled())))
-                .map_err(|e| err(&e))?;
-        }
-    }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()
-        .map_err(|e| err(&e))?;
-    root.present().map_err(|e| err(&e))?;
-    Ok(())
+    plot(
+        path,
+        (720, 480),
+        "Step time vs number of boxes (pile, dt = 1 ms)",
+        (((n_lo * 0.8)..(n_hi * 1.25)).log_scale(), "boxes N"),
+        (t_lo * 0.5)..(t_hi * 2.0),
+        SeriesLabelPosition::UpperLeft,
+        |chart| {
+            let n_eng = pile[0].engines.len();
+            for k in 0..n_eng {
+                let color = COLORS[k % COLORS.len()];
+                let key = pile[0].engines[k].key.clone();
+                for (what, width) in [("median", 2u32), ("p99", 1)] {
+                    let pts: Vec<(f64, f64)> = pile
+                        .iter()
+                        .filter(|r| r.engines.len() == n_eng)
+                        .map(|r| {
+                            let e = &r.engines[k];
+                            (r.n as f64, if width == 2 { e.median_us } else { e.p99_us })
+                        })
+                        .collect();
+                    let style = color.stroke_width(width);
+                    chart
+                        .draw_series(LineSeries::new(pts.clone(), style))
+                        .map_err(|e| e.to_string())?
+                        .label(format!("{key} {what}"))
+                        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+                    chart
+                        .draw_series(pts.iter().map(|&p| Circle::new(p, 3, color.filled())))
+                        .map_err(|e| e.to_string())?;
+                }
+            }
+            Ok(())
+        },
+    )
 }
 
 /// Every timed step of every engine on one case, step time (µs, log scale) against the step
@@ -247,8 +276,6 @@ pub fn steps_svg(
     samples: &[crate::timing::Samples],
     path: &Path,
 ) -> Result<(), String> {
-    haptic2d_lab::plot::register_font();
-    let err = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
     let all = samples.iter().flat_map(|s| s.0.iter().copied());
     let t_lo = all
         .clone()
@@ -257,54 +284,35 @@ pub fn steps_svg(
         .max(1e-3);
     let t_hi = all.fold(0.0, f64::max).max(t_lo * 10.0);
     let steps = samples.iter().map(|s| s.0.len()).max().unwrap_or(1).max(2);
-    let root = SVGBackend::new(path, (960, 480)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| err(&e))?;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(
-            format!("Every timed step, {label} (dt = 1 ms)"),
-            ("sans-serif", 20),
-        )
-        .margin(12)
-        .x_label_area_size(40)
-        .y_label_area_size(60)
-        .build_cartesian_2d(
-            0f64..steps as f64,
-            ((t_lo * 0.8)..(t_hi * 1.25)).log_scale(),
-        )
-        .map_err(|e| err(&e))?;
-    chart
-        .configure_mesh()
-        .x_desc("timed step")
-        .y_desc("step time (µs)")
-        .draw()
-        .map_err(|e| err(&e))?;
-    const COLORS: [RGBColor; 5] = [BLUE, RED, GREEN, MAGENTA, CYAN];
-    for (k, (key, s)) in keys.iter().zip(samples).enumerate() {
-        let color = COLORS[k % COLORS.len()];
-        let pts: Vec<(f64, f64)> =
-            s.0.iter()
-                .enumerate()
-                .filter(|(_, t)| **t > 0.0)
-                .map(|(i, &t)| (i as f64, t))
-                .collect();
-        let style = color.mix(0.7).stroke_width(1);
-        chart
-            .draw_series(LineSeries::new(pts, style))
-            .map_err(|e| err(&e))?
-            .label(format!(
-                "{key}: median {:.1} µs, p99 {:.1} µs",
-                s.median(),
-                s.p99()
-            ))
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
-    }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()
-        .map_err(|e| err(&e))?;
-    root.present().map_err(|e| err(&e))?;
-    Ok(())
+    plot(
+        path,
+        (960, 480),
+        &format!("Every timed step, {label} (dt = 1 ms)"),
+        (0f64..steps as f64, "timed step"),
+        (t_lo * 0.8)..(t_hi * 1.25),
+        SeriesLabelPosition::UpperRight,
+        |chart| {
+            for (k, (key, s)) in keys.iter().zip(samples).enumerate() {
+                let color = COLORS[k % COLORS.len()];
+                // Log scale: a zero time (below the clock's resolution) cannot be drawn.
+                let pts: Vec<(f64, f64)> =
+                    s.0.iter()
+                        .enumerate()
+                        .filter(|(_, t)| **t > 0.0)
+                        .map(|(i, &t)| (i as f64, t))
+                        .collect();
+                let style = color.mix(0.7).stroke_width(1);
+                chart
+                    .draw_series(LineSeries::new(pts, style))
+                    .map_err(|e| e.to_string())?
+                    .label(format!(
+                        "{key}: median {:.1} µs, p99 {:.1} µs",
+                        s.median(),
+                        s.p99()
+                    ))
+                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
+            }
+            Ok(())
+        },
+    )
 }

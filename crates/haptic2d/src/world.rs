@@ -7,8 +7,8 @@
 
 use crate::body::Body;
 use crate::collide::{
-    allowed_depth, body_thickness, polygon_radius, speed_limit, swept_put_back, BroadPhase,
-    Collider, LocalStage, SweepScratch, SweptShape, DEFAULT_DELTA_PROX,
+    allowed_depth, body_thickness, speed_limit, swept_put_back, BroadPhase, Collider, LocalStage,
+    SweepScratch, SweptShape, DEFAULT_DELTA_PROX,
 };
 use crate::contact::{ContactParams, ContactSet, PastPoses, VeContact, Wrench2};
 use crate::geom::{Pose, Rot, Vec2};
@@ -156,7 +156,7 @@ impl World {
         let colliders_len = colliders.len().max(4);
         let mut radius = vec![0.0f64; n];
         for c in &colliders {
-            radius[c.body] = radius[c.body].max(polygon_radius(&c.local));
+            radius[c.body] = radius[c.body].max(c.local.radius());
         }
         let thickness: Vec<f64> = colliders.iter().map(|c| body_thickness(&c.local)).collect();
         let thinnest = thickness.iter().fold(f64::INFINITY, |a, &t| a.min(t));

@@ -19,11 +19,6 @@ use ve_support::ve;
 // Helpers
 // ---------------------------------------------------------------------------------------------
 
-/// Largest distance of a vertex from the polygon's frame origin (m).
-fn radius(p: &ConvexPolygon) -> f64 {
-    p.vertices().iter().map(|v| v.length()).fold(0.0, f64::max)
-}
-
 /// Distance from point `p` to segment `[a, b]` (m).
 fn point_segment(p: Vec2, a: Vec2, b: Vec2) -> f64 {
     let e = b - a;
@@ -135,7 +130,7 @@ fn t1_gjk_matches_brute_force() {
         let pb = random_polygon(&mut rng, 0.01, 0.05);
         let pose_a = random_pose(&mut rng, 0.1);
         // B around A, from deep overlap to well apart.
-        let reach = radius(&pa) + radius(&pb);
+        let reach = pa.radius() + pb.radius();
         let dir = unit(rng.random_range(0.0..TAU));
         let pos_b = pose_a.pos + dir * (reach * rng.random_range(0.2..1.4));
         let pose_b = Pose {
@@ -208,7 +203,7 @@ fn t2_tracker_matches_gjk() {
     for traj in 0..10 {
         let pa = random_polygon(&mut rng, 0.01, 0.05);
         let pb = random_polygon(&mut rng, 0.01, 0.05);
-        let reach = radius(&pa) + radius(&pb);
+        let reach = pa.radius() + pb.radius();
         let w_a = rng.random_range(-0.05..0.05);
         let w_b = rng.random_range(-0.05..0.05);
         let orbit = rng.random_range(-0.02..0.02);
@@ -282,7 +277,7 @@ fn t3_coherent_motion_is_o1() {
     for _ in 0..20 {
         let pa = random_polygon(&mut rng, 0.01, 0.05);
         let pb = random_polygon(&mut rng, 0.01, 0.05);
-        let reach = radius(&pa) + radius(&pb);
+        let reach = pa.radius() + pb.radius();
         // B orbits A at a centre distance between reach and reach + 2 cm (never overlapping), with a
         // tangential speed ≤ 0.7 mm/step, a radial speed ≤ 0.2 mm/step and a spin ≤ 0.01 rad/step.
         let rho_mid = reach + 0.01;
@@ -467,7 +462,7 @@ fn t5_trial(rng: &mut ChaCha8Rng, bp: &mut BroadPhase, pairs: &mut Vec<(u32, u32
     let pb = random_polygon(rng, 0.01, 0.05);
     let pose_a = random_pose(rng, 0.1);
     let a = Collider::new(0, false, pa, &pose_a);
-    let rb = radius(&pb);
+    let rb = pb.radius();
     let th_b = rng.random_range(-PI..PI);
     let dir = unit(rng.random_range(0.0..TAU));
     // Start gap uniform in [0, 0.08] m, placed by bisection along `dir` (the distance of two convex
@@ -599,7 +594,7 @@ fn local_stage_candidate_invariants() {
         let pa = random_polygon(&mut rng, 0.01, 0.05);
         let pb = random_polygon(&mut rng, 0.01, 0.05);
         let pose_a = random_pose(&mut rng, 0.1);
-        let reach = radius(&pa) + radius(&pb);
+        let reach = pa.radius() + pb.radius();
         let dir = unit(rng.random_range(0.0..TAU));
         let pose_b = Pose {
             pos: pose_a.pos + dir * (reach * rng.random_range(0.5..1.1)),

@@ -35,10 +35,7 @@ fn reused_vertex_scans_give_the_candidates_of_scanning_every_sample() {
         let shapes: Vec<ConvexPolygon> = (0..n)
             .map(|_| random_polygon(&mut rng, 0.02, 0.05))
             .collect();
-        let radius: Vec<f64> = shapes
-            .iter()
-            .map(|p| p.vertices().iter().map(|v| v.length()).fold(0.0, f64::max))
-            .collect();
+        let radius: Vec<f64> = shapes.iter().map(ConvexPolygon::radius).collect();
         let mut x = 0.0;
         let home: Vec<Pose> = (0..n)
             .map(|i| {
@@ -133,7 +130,6 @@ fn a_changed_contact_tolerance_drops_the_reused_scans() {
         .map(|i| Collider::new(i, i == 1, square.clone(), &poses[i]))
         .collect();
     let pairs = [(0u32, 1u32)];
-
     let (mut fast, mut every) = (LocalStage::new(), LocalStage::new());
     let (mut out_fast, mut out_every) = (Vec::new(), Vec::new());
     for (k, delta_c) in [2e-3, 2e-3, 2e-3, 2e-3, 0.04, 0.04, 2e-3]

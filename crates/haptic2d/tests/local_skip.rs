@@ -1,6 +1,6 @@
 //! The local stage may skip separated pairs whose certified gap the bodies' relative motion
-//! cannot have closed (`LocalStage::update_with_motion`, issue 17): the candidates must be exactly those of
-//! tracking every pair every sample, and the skipping must actually happen.
+//! cannot have closed (`LocalStage::update_with_motion`, issue 17): the candidates must be
+//! exactly those of tracking every pair every sample, and the skipping must actually happen.
 //!
 //! Both stages see the same colliders and proximate pairs of a world that is stepped normally:
 //! random convex polygons thrown around a closed box under gravity (seeded), and the landing

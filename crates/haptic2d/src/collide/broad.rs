@@ -397,7 +397,7 @@ impl BroadPhase {
         self.patches.clear();
         // Room for every published pair, so that patching allocates only when the published
         // update has grown (when the other buffers grow too).
-        self.patches.reserve(self.cache_pairs.len());
+        room(&mut self.patches, self.cache_pairs.len());
         self.in_place = false;
         self.gjk_iterations = 0;
         self.reused_distances = 0;

@@ -39,8 +39,8 @@
 //! 16 gives 2.15 s while a settled pile runs 1–4 sweeps. A stop at 1e-4 m/s (issue 17, session
 //! 9; the default) gives the same rest time and largest speed after 2.5 s (2.15 s, 6.7 mm/s) with
 //! 1.2 sweeps per sample over 1–5 s instead of 3.7, and the 25 aligned 10-box stacks of
-//! `tests/stack_corners.rs` at 8.3e-4 m/s after 2 s (6.4e-4 with 1e-5); 4 or 6 fixed sweeps left the 10-box
-//! stacks of `tests/stack_corners.rs` with contacts churning after 2 s (4: 3.9 cm/s, 6:
+//! `tests/stack_corners.rs` at 8.3e-4 m/s after 2 s (6.4e-4 with 1e-5); 4 or 6 fixed sweeps left
+//! the 10-box stacks of `tests/stack_corners.rs` with contacts churning after 2 s (4: 3.9 cm/s, 6:
 //! 7.7 mm/s), 8 passed (4.3 mm/s), 16 with the stop 0.64 mm/s.
 //! The sweeps matter beyond the pile: with 8 sweeps at τ = 0.2 ms the 25 aligned 10-box stacks
 //! of `tests/stack_corners.rs` kept rocking (2 cm/s, contacts churning after 2 s); with 16 they
