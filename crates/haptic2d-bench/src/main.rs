@@ -26,6 +26,7 @@
 
 mod box2d_world;
 mod rapier_world;
+mod reference;
 mod report;
 mod rest_time;
 mod scenes;
@@ -84,6 +85,13 @@ struct Args {
     /// for `valgrind --tool=callgrind --toggle-collect='*profiled_step*'`.
     #[arg(long, default_value_t = f64::INFINITY)]
     profile_after: f64,
+    /// With `--settle`: the steps after `--profile-after` of every other global period (10 samples)
+    /// run each right after a pause, through
+    /// `settle::cold_step`, and the summary prints the cold steps' median against the warm ones'
+    /// (what a chunk start of the interleaved bench costs). `evict`: write 8 MiB, evicting the
+    /// world from the L1 and L2 caches; `idle=MS`: compute for MS ms without touching memory.
+    #[arg(long)]
+    cold: Option<settle::Cold>,
     /// Law parameter overrides for haptic2d, comma-separated `normal.KEY=V` / `friction.KEY=V`
     /// (e.g. `--set normal.bc=200`); reported in the output.
     #[arg(long, value_delimiter = ',')]
@@ -160,6 +168,7 @@ fn run(args: &Args) -> Result<(), String> {
                 secs,
                 args.every,
                 args.profile_after,
+                args.cold,
             );
         }
         return Ok(());
@@ -262,17 +271,25 @@ fn run(args: &Args) -> Result<(), String> {
             box2d_world::BUILD,
             args.clock
         );
-        let samples = {
+        // The machine's own spread on a deterministic workload, interleaved like a fifth engine
+        // and sized during the warm-up to take haptic2d's median step (`reference.rs`).
+        let reference = std::cell::RefCell::new(reference::Reference::new(64 << 10));
+        let mut samples = {
             let (mut fh, mut fr, mut f4, mut f1) =
                 (|| h.step(), || r.step(), || b4.step(), || b1.step());
+            let mut fref = || reference.borrow_mut().step();
             timing::interleaved(
                 args.clock,
                 args.warmup,
                 args.steps,
                 args.chunk,
-                &mut [&mut fh, &mut fr, &mut f4, &mut f1],
+                &mut [&mut fh, &mut fr, &mut f4, &mut f1, &mut fref],
+                &mut |haptic, own| reference.borrow_mut().rescale(haptic, own),
             )
         };
+        let reference_samples = samples.pop().unwrap_or(timing::Samples(Vec::new()));
+        let reference_bytes = reference.borrow().bytes();
+        drop(reference);
         // Step `i` of the timed run is haptic2d's sample `warmup + i`: its median per phase of
         // the global stage's period shows a deadline spike (or its absence) directly.
         let n_g = h.params.proximity_every.max(1) as usize;
@@ -314,13 +331,16 @@ fn run(args: &Args) -> Result<(), String> {
             format!("{box2d}_1sub"),
         ];
         if args.step_times {
-            for (key, t) in keys.iter().zip(&samples) {
+            let mut all_keys = keys.to_vec();
+            all_keys.push(report::REFERENCE.to_string());
+            let all: Vec<&timing::Samples> = samples.iter().chain([&reference_samples]).collect();
+            for (key, t) in all_keys.iter().zip(&all) {
                 report::step_rows(&mut step_csv, case.scene, case.n, key, args.warmup, t);
             }
             let dir = out_dir(args);
             std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
             let svg = dir.join(format!("steps_{}_{}.svg", case.scene, case.n));
-            report::steps_svg(&label, &keys, &samples, &svg)?;
+            report::steps_svg(&label, &all_keys, &all, &svg)?;
         }
         let states = [
             state::of(&h, &haptic_poses),
@@ -343,6 +363,12 @@ fn run(args: &Args) -> Result<(), String> {
             scene: case.scene.to_string(),
             n: case.n,
             engines,
+            reference: report::ReferenceResult {
+                bytes: reference_bytes,
+                median_us: reference_samples.median(),
+                p99_us: reference_samples.p99(),
+                p99_warm_us: reference_samples.without_chunk_starts(args.chunk).p99(),
+            },
         });
     }
     print!("{}", report::table(&rows));

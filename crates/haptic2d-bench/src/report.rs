@@ -22,6 +22,21 @@ pub struct EngineResult {
     pub state: State,
 }
 
+/// Label of the reference workload in the table, `compare.json` and `steps.csv`.
+pub const REFERENCE: &str = "reference";
+
+/// The reference workload's result on one case (`reference.rs`): the machine's spread.
+pub struct ReferenceResult {
+    /// Bytes one step touches.
+    pub bytes: usize,
+    /// Median step time (µs).
+    pub median_us: f64,
+    /// 99th-percentile step time (µs).
+    pub p99_us: f64,
+    /// 99th-percentile step time (µs) without the first step of each interleaved chunk.
+    pub p99_warm_us: f64,
+}
+
 /// One line of the comparison: haptic2d first, then the other engines.
 pub struct Row {
     /// Scene label.
@@ -30,6 +45,8 @@ pub struct Row {
     pub n: usize,
     /// Results, haptic2d at index 0.
     pub engines: Vec<EngineResult>,
+    /// The reference workload, interleaved with the engines in the same run.
+    pub reference: ReferenceResult,
 }
 
 impl Row {
@@ -84,7 +101,29 @@ pub fn table(rows: &[Row]) -> String {
                 r.ratio_p99(k)
             );
         }
+        let e = &r.reference;
+        let _ = writeln!(
+            s,
+            "{:<13} {:>5} | {:<15} {:>10.2} {:>10.2} {:>7.2} {:>8.2} | {:>7} {:>7}",
+            r.scene,
+            r.n,
+            REFERENCE,
+            e.median_us,
+            e.p99_us,
+            e.p99_us / e.median_us,
+            e.p99_warm_us / e.median_us,
+            "—",
+            "—"
+        );
     }
+    let _ = writeln!(
+        s,
+        "\n{REFERENCE}: the same shuffled pass over one buffer every step, sized in the warm-up to take haptic2d's median warm-up step ({}); its spread is the machine's, not an engine's.",
+        rows.iter()
+            .map(|r| format!("{} {}: {} KiB", r.scene, r.n, r.reference.bytes >> 10))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
     let _ = writeln!(
         s,
         "\n{:<13} {:>5} | {:<15} {:>10} {:>8} {:>8} {:>11}",
@@ -122,7 +161,9 @@ fn num(x: f64) -> String {
 /// "ratio_box2d", "ratio_p99_box2d", ...}`: for every engine `K` but haptic2d `K_median_us`,
 /// `K_p99_us`, `ratio_K` and `ratio_p99_K` (`ratio` alone is rapier2d's, as before), for every
 /// engine `K_p99_warm_us` (the p99 without the first step of each interleaved chunk) and the settle
-/// state `K_max_speed`, `K_moving`, `K_mean_height`, `K_max_overlap` (SI units).
+/// state `K_max_speed`, `K_moving`, `K_mean_height`, `K_max_overlap` (SI units); and the reference
+/// workload's `reference_median_us`, `reference_p99_us`, `reference_p99_warm_us` and
+/// `reference_bytes`.
 pub fn json(rows: &[Row]) -> String {
     let items: Vec<String> = rows
         .iter()
@@ -159,6 +200,14 @@ pub fn json(rows: &[Row]) -> String {
                     num(e.state.max_overlap)
                 ));
             }
+            let e = &r.reference;
+            f.push(format!("\"{REFERENCE}_median_us\": {}", num(e.median_us)));
+            f.push(format!("\"{REFERENCE}_p99_us\": {}", num(e.p99_us)));
+            f.push(format!(
+                "\"{REFERENCE}_p99_warm_us\": {}",
+                num(e.p99_warm_us)
+            ));
+            f.push(format!("\"{REFERENCE}_bytes\": {}", e.bytes));
             format!("  {{{}}}", f.join(", "))
         })
         .collect();
@@ -273,7 +322,7 @@ pub fn svg(rows: &[Row], path: &Path) -> Result<(), String> {
 pub fn steps_svg(
     label: &str,
     keys: &[String],
-    samples: &[crate::timing::Samples],
+    samples: &[&crate::timing::Samples],
     path: &Path,
 ) -> Result<(), String> {
     let all = samples.iter().flat_map(|s| s.0.iter().copied());

@@ -50,9 +50,88 @@ pub fn profiled_step(w: &mut World) {
     w.step();
 }
 
+/// One step right after a [`Cold`] pause, through a function of its own, so a profiler can be
+/// limited to the cold steps (`valgrind --tool=callgrind --toggle-collect='*cold_step*'`).
+#[inline(never)]
+pub fn cold_step(w: &mut World) {
+    w.step();
+}
+
+/// Bytes written by [`Cold::Evict`]: four times the 2 MiB L2 of this machine
+/// (docs/PERFORMANCE.md), so that a step after it finds its data in the L3.
+pub const EVICT_BYTES: usize = 8 << 20;
+
+/// What runs before every other profiled step of `--settle --cold`: how a chunk start of the
+/// interleaved bench finds the world's data.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Cold {
+    /// Write [`EVICT_BYTES`], evicting the world from the L1 and L2 caches at once.
+    Evict,
+    /// Compute for this long (ms) without touching memory, as long as the other engines' chunks
+    /// take: whatever the world loses from the caches meanwhile, the machine's other tenants took.
+    Idle(f64),
+}
+
+impl std::str::FromStr for Cold {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.trim() {
+            "evict" => Ok(Cold::Evict),
+            x => match x.strip_prefix("idle=").map(|v| v.trim().parse::<f64>()) {
+                Some(Ok(ms)) if ms.is_finite() && ms > 0.0 => Ok(Cold::Idle(ms)),
+                _ => Err(format!(
+                    "{s:?}: expected evict or idle=MS (a positive time in ms)"
+                )),
+            },
+        }
+    }
+}
+
+impl Cold {
+    /// Runs the pause, with `buf` the [`EVICT_BYTES`]-long eviction buffer.
+    #[inline(never)]
+    fn pause(self, buf: &mut [u8]) {
+        match self {
+            Cold::Evict => {
+                for line in buf.chunks_mut(64) {
+                    line[0] = line[0].wrapping_add(1);
+                }
+                std::hint::black_box(buf);
+            }
+            Cold::Idle(ms) => {
+                let t = std::time::Instant::now();
+                let mut x = 1.0f64;
+                while t.elapsed().as_secs_f64() < ms * 1e-3 {
+                    for _ in 0..1000 {
+                        x = (x * 1.000_000_1).sqrt() + 0.5;
+                    }
+                }
+                std::hint::black_box(x);
+            }
+        }
+    }
+    fn describe(self) -> String {
+        match self {
+            Cold::Evict => format!("evicting the caches ({} MiB written)", EVICT_BYTES >> 20),
+            Cold::Idle(ms) => format!("{ms} ms of computing without touching memory"),
+        }
+    }
+}
+
 /// Runs `w` for `seconds` of simulated time at `dt` (s), printing the state every `every` seconds;
-/// steps after `profile_after` (s) go through [`profiled_step`].
-pub fn run(label: &str, w: &mut World, dt: f64, seconds: f64, every: f64, profile_after: f64) {
+/// steps after `profile_after` (s) go through [`profiled_step`]. With `cold`, the steps of every
+/// other global period (`N_g` samples) run right after that pause instead, each through
+/// [`cold_step`], and the summary compares the cold steps with the warm ones (the cost of a chunk
+/// start in the bench).
+pub fn run(
+    label: &str,
+    w: &mut World,
+    dt: f64,
+    seconds: f64,
+    every: f64,
+    profile_after: f64,
+    cold: Option<Cold>,
+) {
     let first_profiled = (profile_after / dt).round() as usize;
     let steps = (seconds / dt).round() as usize;
     let every = ((every / dt).round() as usize).max(1);
@@ -68,16 +147,31 @@ pub fn run(label: &str, w: &mut World, dt: f64, seconds: f64, every: f64, profil
     let (mut cpu, mut since) = (0.0, 0usize);
     // Global updates published during the profiled steps: (count, in place, GJK iterations).
     let mut updates = (0usize, 0usize, 0u64);
+    // With `cold`: the eviction buffer and the CPU time of every cold step (µs).
+    let mut evict_buf = match cold {
+        Some(Cold::Evict) => vec![0u8; EVICT_BYTES],
+        _ => Vec::new(),
+    };
+    let mut cold_times: Vec<f64> = Vec::new();
     for k in 1..=steps {
+        // Cold and warm steps alternate by whole global periods, so both cover every phase.
+        let is_cold = cold.is_some() && k > first_profiled && ((k - 1) / n_g) % 2 == 1;
+        if let (true, Some(c)) = (is_cold, cold) {
+            c.pause(&mut evict_buf);
+        }
         let t0 = now(Clock::Cpu, origin);
-        if k > first_profiled {
+        if is_cold {
+            cold_step(w);
+        } else if k > first_profiled {
             profiled_step(w);
         } else {
             w.step();
         }
         let dt_cpu = now(Clock::Cpu, origin) - t0;
         cpu += dt_cpu;
-        if k > first_profiled {
+        if is_cold {
+            cold_times.push(dt_cpu * 1e6);
+        } else if k > first_profiled {
             by_phase[(k - 1) % n_g].push(dt_cpu * 1e6);
             if (k - 1) % n_g == 0 {
                 let b = w.broad_stats();
@@ -139,6 +233,18 @@ pub fn run(label: &str, w: &mut World, dt: f64, seconds: f64, every: f64, profil
         updates.2 as f64 / updates.0.max(1) as f64
     );
     let all_steps = crate::timing::Samples(by_phase.iter().flatten().copied().collect());
+    if let Some(how) = cold {
+        let c = crate::timing::Samples(cold_times);
+        println!(
+            "{label}: CPU µs per step after {profile_after} s, right after {} / warm: median {:.1} / {:.1} (cold / warm {:.2}), p99 {:.1} / {:.1}",
+            how.describe(),
+            c.median(),
+            all_steps.median(),
+            c.median() / all_steps.median(),
+            c.p99(),
+            all_steps.p99()
+        );
+    }
     let (median, p99) = (all_steps.median(), all_steps.p99());
     println!(
         "{label}: CPU µs per step after {profile_after} s: median {median:.1}, p99 {p99:.1} (p99/median {:.2}), largest {:.1}",

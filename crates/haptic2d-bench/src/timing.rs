@@ -73,27 +73,60 @@ impl Samples {
     }
 }
 
-/// Runs `warmup` untimed steps of each engine, then `steps` timed steps of each, interleaved in chunks
-/// of `chunk` steps; the engine that goes first rotates every chunk. Returns one sample set per
+/// Most warm-up steps of each calibration window of [`interleaved`].
+pub const CALIBRATION_STEPS: usize = 200;
+
+/// Runs `warmup` steps of each engine, then `steps` timed steps of each, interleaved in chunks of
+/// `chunk` steps; the engine that goes first rotates every chunk. Returns one sample set per
 /// engine, in the order given.
+///
+/// `calibrate(first, last)` is called twice during the warm-up, at its middle and at its end,
+/// with the median times (µs) of the first and the last engine over the warm-up steps just before
+/// (at most [`CALIBRATION_STEPS`], and only when the warm-up has at least 8): the last engine can
+/// resize itself to the first one's time in the same interleaved conditions.
 pub fn interleaved(
     clock: Clock,
     warmup: usize,
     steps: usize,
     chunk: usize,
     engines: &mut [&mut dyn FnMut()],
+    calibrate: &mut dyn FnMut(f64, f64),
 ) -> Vec<Samples> {
-    for _ in 0..warmup {
-        for e in engines.iter_mut() {
-            e();
+    let origin = Instant::now();
+    let m = engines.len();
+    let window = if warmup >= 8 {
+        CALIBRATION_STEPS.min(warmup / 4)
+    } else {
+        0
+    };
+    let ends = [warmup / 2, warmup];
+    let (mut first, mut last) = (Vec::with_capacity(window), Vec::with_capacity(window));
+    for i in 0..warmup {
+        let timed = window > 0 && ends.iter().any(|&e| i < e && i + window >= e);
+        for (k, e) in engines.iter_mut().enumerate() {
+            if timed && (k == 0 || k + 1 == m) {
+                let t0 = now(clock, origin);
+                e();
+                let us = (now(clock, origin) - t0) * 1e6;
+                if k == 0 {
+                    first.push(us);
+                } else {
+                    last.push(us);
+                }
+            } else {
+                e();
+            }
+        }
+        if timed && ends.contains(&(i + 1)) {
+            let f = Samples(std::mem::take(&mut first)).median();
+            let l = Samples(std::mem::take(&mut last)).median();
+            calibrate(f, l);
         }
     }
     let chunk = chunk.max(1);
-    let m = engines.len();
     let mut out: Vec<Vec<f64>> = (0..m).map(|_| Vec::with_capacity(steps)).collect();
     let mut done = 0;
     let mut k = 0;
-    let origin = Instant::now();
     while done < steps {
         let n = chunk.min(steps - done);
         for r in 0..m {
