@@ -5,7 +5,7 @@
 //! fixed shuffled order: same instructions, same addresses, no branches that depend on data. The
 //! order is shuffled because engines gather their bodies' states by index, and the machine's slow
 //! phases raise the latency of such gathers; a sequential pass, which the prefetchers stream, hides
-//! them (in session 11 its chunk medians stayed within 1 % while haptic2d's and Box2D's rose 20–40 %
+//! them (in session 11 its chunk medians stayed within 3 % while haptic2d's and Box2D's rose 20–40 %
 //! together). Whatever spread its
 //! step times show (p99 / median above 1, slow first steps of a chunk) is the machine's: other
 //! tenants of the host, the hyperthread that shares the core's caches, interrupts, and the other
