@@ -2,17 +2,19 @@
 //! the engines like a fifth one.
 //!
 //! Every "step" of the reference is the same read–modify–write pass over one buffer of `f64`, in a
-//! fixed shuffled order: same instructions, same addresses, no branches that depend on data. The
-//! order is shuffled because engines gather their bodies' states by index, and the machine's slow
-//! phases raise the latency of such gathers; a sequential pass, which the prefetchers stream, hides
-//! them (in session 11 its chunk medians stayed within 3 % while haptic2d's and Box2D's rose 20–40 %
-//! together). Whatever spread its
-//! step times show (p99 / median above 1, slow first steps of a chunk) is the machine's: other
-//! tenants of the host, the hyperthread that shares the core's caches, interrupts, and the other
-//! engines' chunks in between. The buffer is sized during the warm-up, twice, by the
-//! ratio of haptic2d's median step time to its own in the same interleaved conditions, so that
-//! one pass takes about as long as a haptic2d step: the reference meets those sources over the
-//! same durations as haptic2d does (docs/PERFORMANCE.md, issue 17, session 11).
+//! fixed shuffled order: same instructions, same addresses, no branches that depend on data.
+//! Shuffled, as engines gather their bodies' states by index: a sequential pass, which the
+//! prefetchers stream, hid what the engines meet (in session 11, at pile:1000, its chunk starts
+//! cost 1.06 × its median and its p99 was 1.14–1.21 ×; shuffled, 1.52–1.80 × and 1.51–2.00 ×).
+//! Neither follows the long phases in which every engine speeds up or slows down together
+//! (presumably the core clock): both are bound by memory.
+//!
+//! Whatever spread its step times show (p99 / median above 1, slow first steps of a chunk) is the
+//! machine's: other tenants of the host, the hyperthread that shares the core's caches,
+//! interrupts, and the other engines' chunks in between. The buffer is sized during the warm-up,
+//! twice, by the ratio of haptic2d's median step time to its own in the same interleaved
+//! conditions, so that one pass takes about as long as a haptic2d step: the reference meets those
+//! sources over the same durations as haptic2d does (docs/PERFORMANCE.md, issue 17, session 11).
 
 /// Smallest reference buffer (bytes).
 pub const MIN_BYTES: usize = 1 << 10;
