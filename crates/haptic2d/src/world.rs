@@ -236,6 +236,12 @@ impl World {
     pub fn contacts(&self) -> &ContactSet {
         &self.contacts
     }
+
+    /// The contact set, for the crate's tests.
+    #[cfg(test)]
+    pub(crate) fn contacts_mut(&mut self) -> &mut ContactSet {
+        &mut self.contacts
+    }
     /// Whether impacts carry Coulomb friction (the scene's `contact.impact_friction`).
     pub fn impact_friction(&self) -> crate::contact::ImpactFriction {
         self.contacts.params.impact_friction

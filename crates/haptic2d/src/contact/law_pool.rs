@@ -1,38 +1,56 @@
 //! The pool of per-contact law states: one [`LawState`] slot per contact record, reused through a
-//! free list, so records stay small and creating or releasing a contact never allocates after warm-up.
+//! free list, so records stay small and creating or releasing a contact never allocates after
+//! warm-up.
+//!
+//! The slots are compact (136 bytes, `contact/compact_law.rs`) until a record needs the
+//! hysteretic wall; then every slot is widened once to the whole [`NormalModel`] (272 bytes) and
+//! the pool stays wide. Either way a slot holds the same law with the same state. Widening
+//! allocates once, in the sample that creates the first such record: in the warm-up for a scene
+//! whose prototype is the wall, later only if the prototype is switched to it mid-run.
 
-use super::record::{LawState, NO_LAW};
+use super::compact_law::CompactNormal;
+use super::record::{LawState, VeContact, NO_LAW};
 use crate::laws::friction::FrictionModel;
-use crate::laws::normal::{ContactNormal, NormalModel};
+use crate::laws::normal::{ContactNormal, NormalLaw, NormalModel};
 
-/// Slots of law states, addressed by [`VeContact::law`](super::VeContact::law).
-#[derive(Clone, Debug, Default)]
+/// Slots of law states, addressed by [`VeContact::law`].
+#[derive(Clone, Debug)]
 pub(crate) struct LawPool {
-    /// Every slot ever handed out (free ones hold stale states).
-    states: Vec<LawState>,
+    /// The slots, in one of their two forms.
+    slots: Slots,
     /// Free slots, reused last-in first-out.
     free: Vec<u32>,
-    /// The other buffer of [`repack`](Self::repack).
-    spare: Vec<LawState>,
 }
 
-impl LawPool {
-    /// An empty pool with room for `n` records.
-    pub(crate) fn with_capacity(n: usize) -> Self {
+/// The pool's slots: compact while no record needs the hysteretic wall, whole afterwards.
+#[derive(Clone, Debug)]
+pub(crate) enum Slots {
+    /// Every law but the hysteretic wall, 136 bytes a slot.
+    Compact(Store<CompactNormal>),
+    /// Any law, 272 bytes a slot.
+    Whole(Store<NormalModel>),
+}
+
+/// The slots of one form.
+#[derive(Clone, Debug)]
+pub(crate) struct Store<N> {
+    /// Every slot ever handed out (free ones hold stale states).
+    states: Vec<LawState<N>>,
+    /// The other buffer of [`repack`](LawPool::repack).
+    spare: Vec<LawState<N>>,
+}
+
+impl<N: NormalLaw + Copy> Store<N> {
+    fn with_capacity(n: usize) -> Self {
         Self {
             states: Vec::with_capacity(n),
-            free: Vec::with_capacity(n),
             spare: Vec::with_capacity(n),
         }
     }
 
-    /// A slot holding copies of the prototypes `normal` and `friction`.
-    pub(crate) fn acquire(&mut self, normal: &NormalModel, friction: &FrictionModel) -> u32 {
-        let fresh = LawState {
-            normal: ContactNormal::new(*normal),
-            friction: *friction,
-        };
-        match self.free.pop() {
+    /// Puts `fresh` in a free slot, or a new one.
+    fn put(&mut self, free: &mut Vec<u32>, fresh: LawState<N>) -> u32 {
+        match free.pop() {
             Some(slot) => {
                 self.states[slot as usize] = fresh;
                 slot
@@ -44,18 +62,8 @@ impl LawPool {
         }
     }
 
-    /// Returns `slot` to the pool; [`NO_LAW`] is ignored.
-    pub(crate) fn release(&mut self, slot: u32) {
-        if slot != NO_LAW {
-            self.free.push(slot);
-        }
-    }
-
-    /// Moves the states of `records` (every entry whose `law` is a slot) into slots `0, 1, 2, …`
-    /// in their order, and drops the free slots: the per-sample force pass, which walks the
-    /// records in key order, then reads the pool front to back instead of at random (a law state
-    /// is 272 bytes, a cache miss each when scattered). The states themselves are unchanged.
-    pub(crate) fn repack(&mut self, records: &mut [super::VeContact]) {
+    /// See [`LawPool::repack`].
+    fn repack(&mut self, records: &mut [VeContact]) {
         self.spare.clear();
         for e in records.iter_mut() {
             if e.law != NO_LAW {
@@ -64,19 +72,114 @@ impl LawPool {
             }
         }
         std::mem::swap(&mut self.states, &mut self.spare);
+    }
+
+    /// The state in `slot` (a slot handed out by [`LawPool::acquire`] and not released).
+    #[inline]
+    pub(crate) fn get_mut(&mut self, slot: u32) -> &mut LawState<N> {
+        &mut self.states[slot as usize]
+    }
+}
+
+impl LawPool {
+    /// An empty pool of compact slots with room for `n` records.
+    pub(crate) fn with_capacity(n: usize) -> Self {
+        Self {
+            slots: Slots::Compact(Store::with_capacity(n)),
+            free: Vec::with_capacity(n),
+        }
+    }
+
+    /// A slot holding copies of the prototypes `normal` and `friction`, begun at the god-object
+    /// entry point `s_entry` (m, [`LawState::begin`]). The first hysteretic wall widens the pool.
+    pub(crate) fn acquire(
+        &mut self,
+        normal: &NormalModel,
+        friction: &FrictionModel,
+        s_entry: f64,
+    ) -> u32 {
+        if let Slots::Compact(store) = &mut self.slots {
+            if let Some(model) = CompactNormal::from_model(normal) {
+                let mut fresh = LawState {
+                    friction: *friction,
+                    normal: ContactNormal::new(model),
+                };
+                fresh.begin(s_entry);
+                return store.put(&mut self.free, fresh);
+            }
+            self.widen();
+        }
+        let Slots::Whole(store) = &mut self.slots else {
+            unreachable!("widened above")
+        };
+        let mut fresh = LawState {
+            friction: *friction,
+            normal: ContactNormal::new(*normal),
+        };
+        fresh.begin(s_entry);
+        store.put(&mut self.free, fresh)
+    }
+
+    /// True while the slots are compact.
+    #[cfg(test)]
+    pub(crate) fn is_compact(&self) -> bool {
+        matches!(self.slots, Slots::Compact(_))
+    }
+
+    /// Converts every compact slot (free ones too, so slot numbers stay) to the whole form.
+    pub(crate) fn widen(&mut self) {
+        if let Slots::Compact(store) = &self.slots {
+            let room = store.states.capacity().max(store.spare.capacity());
+            let mut whole = Store::with_capacity(room);
+            whole
+                .states
+                .extend(store.states.iter().map(LawState::<CompactNormal>::widen));
+            self.slots = Slots::Whole(whole);
+        }
+    }
+
+    /// Returns `slot` to the pool; [`NO_LAW`] is ignored.
+    pub(crate) fn release(&mut self, slot: u32) {
+        if slot != NO_LAW {
+            self.free.push(slot);
+        }
+    }
+
+    /// The impact of the record holding `slot` was resolved, with its distance history `d` (m) and
+    /// valid length `hist` ([`ContactNormal::impact_resolved`]).
+    pub(crate) fn impact_resolved(&mut self, slot: u32, d: [f64; 3], hist: u8) {
+        match &mut self.slots {
+            Slots::Compact(s) => s.get_mut(slot).normal.impact_resolved(d, hist),
+            Slots::Whole(s) => s.get_mut(slot).normal.impact_resolved(d, hist),
+        }
+    }
+
+    /// Moves the states of `records` (every entry whose `law` is a slot) into slots `0, 1, 2, …`
+    /// in their order, and drops the free slots: the per-sample force pass, which walks the
+    /// records in key order, then reads the pool front to back instead of at random (a law state
+    /// is 136 or 272 bytes, 2–5 cache lines, missed each when scattered). The states themselves
+    /// are unchanged.
+    pub(crate) fn repack(&mut self, records: &mut [VeContact]) {
+        match &mut self.slots {
+            Slots::Compact(s) => s.repack(records),
+            Slots::Whole(s) => s.repack(records),
+        }
         self.free.clear();
     }
 
-    /// The state in `slot`, if it is one.
-    #[inline]
-    pub(crate) fn get(&self, slot: u32) -> Option<&LawState> {
-        self.states.get(slot as usize)
+    /// The state in `slot`, if it is one, in the whole form.
+    pub(crate) fn get(&self, slot: u32) -> Option<LawState> {
+        let i = slot as usize;
+        match &self.slots {
+            Slots::Compact(s) => s.states.get(i).map(LawState::<CompactNormal>::widen),
+            Slots::Whole(s) => s.states.get(i).copied(),
+        }
     }
 
-    /// The state in `slot` (a slot handed out by [`acquire`](Self::acquire) and not released).
+    /// The slots, for the force pass (which runs once per form, not per slot).
     #[inline]
-    pub(crate) fn get_mut(&mut self, slot: u32) -> &mut LawState {
-        &mut self.states[slot as usize]
+    pub(crate) fn slots_mut(&mut self) -> &mut Slots {
+        &mut self.slots
     }
 }
 
@@ -132,11 +235,11 @@ mod tests {
         let normal = |kc: f64| NormalModel::Paper(PaperLaw::new(kc, 1.0));
         // Slots handed out, some released and reused, so the records' slots are scattered.
         let mut slots: Vec<u32> = (0..6)
-            .map(|i| pool.acquire(&normal(100.0 + i as f64), &FrictionModel::None))
+            .map(|i| pool.acquire(&normal(100.0 + i as f64), &FrictionModel::None, 0.0))
             .collect();
         pool.release(slots[1]);
         pool.release(slots[4]);
-        slots[1] = pool.acquire(&normal(201.0), &FrictionModel::None);
+        slots[1] = pool.acquire(&normal(201.0), &FrictionModel::None, 0.0);
         slots.swap(0, 5);
         let kc_of = |pool: &LawPool, slot: u32| match pool.get(slot).unwrap().normal.model {
             NormalModel::Paper(l) => l.kc,
@@ -165,6 +268,54 @@ mod tests {
             .collect();
         assert_eq!(kcs, before);
         // The pool hands out new slots after the packed ones.
-        assert_eq!(pool.acquire(&normal(1.0), &FrictionModel::None), 6);
+        assert_eq!(pool.acquire(&normal(1.0), &FrictionModel::None, 0.0), 6);
+    }
+
+    /// The first hysteretic wall widens the pool: every slot keeps its number and its state
+    /// (offset, law, friction), free slots stay free, and both kinds of law get slots afterwards.
+    #[test]
+    fn a_hysteretic_wall_widens_the_pool_keeping_every_slot() {
+        use crate::laws::friction::ResetIntegrator;
+        use crate::laws::normal::HystereticLaw;
+        let mut pool = LawPool::with_capacity(2);
+        let friction = FrictionModel::ResetIntegrator(ResetIntegrator::per_contact());
+        let slots: Vec<u32> = (0..5)
+            .map(|i| {
+                let normal = NormalModel::Paper(PaperLaw::new(1e4 + i as f64, 3.0));
+                let friction = FrictionModel::ResetIntegrator(ResetIntegrator::new(
+                    2e3 + i as f64,
+                    0.5,
+                    0.4,
+                    9.0,
+                ));
+                pool.acquire(&normal, &friction, 0.01 * i as f64)
+            })
+            .collect();
+        pool.impact_resolved(slots[3], [-0.002, 0.001, 0.0], 3);
+        pool.release(slots[2]);
+        assert!(matches!(pool.slots, Slots::Compact(_)));
+        let Slots::Compact(store) = &pool.slots else {
+            unreachable!()
+        };
+        let before: Vec<LawState<CompactNormal>> = store.states.clone();
+        assert_eq!(before[3].normal.offset(), 0.002);
+        let wall = NormalModel::Hysteretic(HystereticLaw::per_contact());
+        // The released slot is reused by the wall; the others keep their states.
+        assert_eq!(pool.acquire(&wall, &friction, 0.5), slots[2]);
+        assert!(matches!(pool.slots, Slots::Whole(_)));
+        for (i, &s) in slots.iter().enumerate().filter(|(i, _)| *i != 2) {
+            let after = pool.get(s).unwrap();
+            assert_eq!(after.normal.offset(), before[i].normal.offset(), "slot {s}");
+            assert_eq!(
+                after.normal.model,
+                before[i].normal.model.to_model(),
+                "slot {s}"
+            );
+            assert_eq!(after.friction, before[i].friction, "slot {s}");
+        }
+        assert_eq!(pool.get(slots[2]).unwrap().normal.model, wall);
+        let paper = NormalModel::Paper(PaperLaw::new(7.0, 1.0));
+        assert_eq!(pool.acquire(&paper, &friction, 0.0), 5);
+        assert_eq!(pool.get(5).unwrap().normal.model, paper);
     }
 }

@@ -1,5 +1,6 @@
 //! Contact records, the contact state machine, god-objects and simultaneous impacts (§7, §8).
 
+mod compact_law;
 mod god_object;
 pub mod impact;
 pub mod impact_friction;

@@ -1,14 +1,15 @@
 //! The per-VE-pair record (§8.1): distance history, edge coordinate, god-object, and the slot of
 //! its law states.
 //!
-//! The law states ([`LawState`]: a [`NormalModel`](crate::laws::normal::NormalModel) and a [`FrictionModel`], about 270 bytes) live out
-//! of line in the contact set's pool, so the record that every per-sample pass walks stays small
-//! (the tracked pairs that are not contacts, the majority on a pile, need no law state at all).
+//! The law states ([`LawState`]: a [`NormalModel`] and a [`FrictionModel`], 136 or 272 bytes) live
+//! out of line in the contact set's pool, so the record that every per-sample pass walks stays
+//! small (the tracked pairs that are not contacts, the majority on a pile, need no law state at
+//! all).
 
 use crate::collide::VeCandidate;
 use crate::geom::Vec2;
 use crate::laws::friction::{FrictionLaw, FrictionModel};
-use crate::laws::normal::{ContactNormal, NormalLaw};
+use crate::laws::normal::{ContactNormal, NormalLaw, NormalModel};
 
 /// Sentinel of [`VeContact::law`] for an entry without law states (only tracked).
 pub const NO_LAW: u32 = u32::MAX;
@@ -17,16 +18,18 @@ pub const NO_LAW: u32 = u32::MAX;
 ///
 /// Laid out friction first, then the normal law's offset and model (`repr(C)` here and in
 /// [`ContactNormal`]): the common laws' fields (the reset integrator, 64 bytes; the paper law,
-/// 24) then sit in the first two cache lines of the 272-byte slot, which the force pass streams
-/// through every sample; the largest variant (the hysteretic wall's elements) fills the rest.
+/// 24) then sit in the first two cache lines of the slot, which the force pass streams through
+/// every sample. With the whole [`NormalModel`] (`N`, the default) a slot is 272 bytes, sized
+/// for the hysteretic wall's elements; the contact set's pool stores the other laws in 136-byte
+/// slots of a compact model instead (`contact/compact_law.rs`) while no record needs the wall.
 #[derive(Clone, Copy, Debug)]
 #[repr(C)]
-pub struct LawState {
+pub struct LawState<N = NormalModel> {
     /// Friction-model state (a copy of the world's prototype, taken when the record was created).
     pub friction: FrictionModel,
     /// Normal-law state (a copy of the world's prototype, taken when the record was created) with
     /// the surface offset of a resolved impact ([`ContactNormal`], docs/MODELS.md §F.7).
-    pub normal: ContactNormal,
+    pub normal: ContactNormal<N>,
 }
 
 /// The state of a VE pair that is in contact (§8.2). A pair that is only tracked has no state.
@@ -38,7 +41,7 @@ pub enum ContactState {
     Continuous,
 }
 
-impl LawState {
+impl<N: NormalLaw> LawState<N> {
     /// Starts a new contact whose god-object entry point is at edge coordinate `s_entry` (m): the
     /// normal law is reset and the friction model begins there (§8.3).
     #[inline]

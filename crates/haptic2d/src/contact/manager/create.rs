@@ -99,16 +99,14 @@ impl ContactSet {
                     Some(t) => {
                         let e = &mut self.entries[t];
                         start_record(e, p, tick, &mut self.events, false);
-                        e.law = self.laws.acquire(normal, friction);
-                        self.laws.get_mut(e.law).begin(e.s_g);
+                        e.law = self.laws.acquire(normal, friction, e.s_g);
                         self.new_count[e.body_a] += 1;
                     }
                     None => {
                         let key = VeCandidate { edge, ..key };
                         let mut e = new_entry(tick, key, colliders, bodies, past);
                         start_record(&mut e, p, tick, &mut self.events, false);
-                        e.law = self.laws.acquire(normal, friction);
-                        self.laws.get_mut(e.law).begin(e.s_g);
+                        e.law = self.laws.acquire(normal, friction, e.s_g);
                         self.new_count[e.body_a] += 1;
                         self.pending.push(e);
                     }
@@ -167,8 +165,7 @@ impl ContactSet {
                     if let Some(t) = pick {
                         let e = &mut self.entries[t];
                         start_record(e, p, tick, &mut self.events, true);
-                        e.law = self.laws.acquire(normal, friction);
-                        self.laws.get_mut(e.law).begin(e.s_g);
+                        e.law = self.laws.acquire(normal, friction, e.s_g);
                         self.new_count[e.body_a] += 1;
                     }
                 }

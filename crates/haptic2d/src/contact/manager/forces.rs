@@ -4,6 +4,7 @@
 use super::ContactSet;
 use super::Wrench2;
 use crate::body::Body;
+use crate::contact::law_pool::{Slots, Store};
 use crate::contact::record::{ContactState, LawState, LoadedContact, VeContact};
 use crate::geom::{cross, Vec2};
 use crate::laws::friction::{FrictionInput, FrictionLaw, FrictionModel};
@@ -21,24 +22,65 @@ impl ContactSet {
         for w in wrenches.iter_mut() {
             *w = Wrench2::default();
         }
-        // The classical model needs every normal force first (its stick force cancels the other
-        // forces on A); every other model runs normal then friction per contact in one pass.
-        let needs_ext = friction.uses_external_force();
+        let pass = ForcePass {
+            entries: &mut self.entries,
+            loaded: &mut self.loaded,
+            nonfric: &mut self.nonfric,
+            dt,
+            bodies,
+            needs_ext: friction.uses_external_force(),
+            wrenches,
+        };
+        // One pass per form of the law slots (`LawPool`), so the per-record loop has no branch on
+        // it.
+        let (stored, records, breaks) = match self.laws.slots_mut() {
+            Slots::Compact(store) => pass.run(store),
+            Slots::Whole(store) => pass.run(store),
+        };
+        self.stored = stored;
+        self.record_count = records;
+        // Scattered law slots cost a cache miss per record every sample: put them back in
+        // record order once an eighth of the records are out of sequence (new records take
+        // free or new slots).
+        if breaks > 1 && breaks * 8 > records {
+            self.laws.repack(&mut self.entries);
+        }
+    }
+}
+
+/// What the force pass reads and writes besides the law slots.
+struct ForcePass<'a> {
+    entries: &'a mut [VeContact],
+    loaded: &'a mut Vec<LoadedContact>,
+    nonfric: &'a mut [Vec2],
+    dt: f64,
+    bodies: &'a [Body],
+    /// The classical model needs every normal force first (its stick force cancels the other
+    /// forces on A); every other model runs normal then friction per contact in one pass.
+    needs_ext: bool,
+    wrenches: &'a mut [Wrench2],
+}
+
+impl ForcePass<'_> {
+    /// Runs the pass with the law slots `laws`: returns the stored energy (J), the number of
+    /// Continuous records, and how many of them have a law slot that does not follow the
+    /// previous record's (see `LawPool::repack`).
+    fn run<N: NormalLaw + Copy>(self, laws: &mut Store<N>) -> (f64, usize, usize) {
+        let (dt, bodies, needs_ext) = (self.dt, self.bodies, self.needs_ext);
+        let wrenches = self.wrenches;
         let mut stored = 0.0;
         // Every record is Continuous here (Colliding ones were resolved by the impacts of step 5).
         let mut records = 0;
-        // Records whose law slot does not follow the previous record's (see `LawPool::repack`).
         let (mut last_slot, mut breaks) = (u32::MAX, 0usize);
         self.loaded.clear();
-        for idx in 0..self.entries.len() {
-            if self.entries[idx].state != Some(ContactState::Continuous) {
+        for e in self.entries.iter_mut() {
+            if e.state != Some(ContactState::Continuous) {
                 continue;
             }
             records += 1;
-            let e = &mut self.entries[idx];
             breaks += (e.law != last_slot.wrapping_add(1)) as usize;
             last_slot = e.law;
-            let law = self.laws.get_mut(e.law);
+            let law = laws.get_mut(e.law);
             let input = NormalInput {
                 d: e.d,
                 hist: e.hist,
@@ -71,55 +113,48 @@ impl ContactSet {
                 if self.entries[idx].state != Some(ContactState::Continuous) {
                     continue;
                 }
-                let f_ext_t = self.external_share(idx);
+                let f_ext_t = external_share(self.entries, self.nonfric, idx);
                 let e = &mut self.entries[idx];
-                let law = self.laws.get_mut(e.law);
+                let law = laws.get_mut(e.law);
                 friction_step(e, law, dt, f_ext_t, wrenches, bodies);
                 stored += law.normal.stored_energy() + law.friction.stored_energy();
             }
         }
-        self.stored = stored;
-        self.record_count = records;
-        // Scattered law slots cost a cache miss per record every sample: put them back in
-        // record order once an eighth of the records are out of sequence (new records take
-        // free or new slots).
-        if breaks > 1 && breaks * 8 > records {
-            self.laws.repack(&mut self.entries);
-        }
+        (stored, records, breaks)
     }
+}
 
-    /// `F_ext,t,i` for the classical model (§4.1): the non-friction force on A along this
-    /// contact's tangent, shared by A's contacts with parallel tangents in proportion to their
-    /// normal forces, `(t·F_A^nonfric)·F_n,i/Σ F_n,j` (equally, `/n_t`, if none pushes). Each
-    /// contact then sticks iff `|t·F_A^nonfric| ≤ μ_s·Σ F_n,j`, rigid Coulomb's condition for the
-    /// body; the equal share let the unloaded corner of a tall block slip below it (issue 16,
-    /// docs/MODELS.md §4.1).
-    fn external_share(&self, idx: usize) -> f64 {
-        let e = &self.entries[idx];
-        let (mut n_t, mut fn_sum) = (0usize, 0.0);
-        for o in self.entries.iter().filter(|o| {
-            o.state == Some(ContactState::Continuous)
-                && o.body_a == e.body_a
-                && o.t().dot(e.t()).abs() > 0.99
-        }) {
-            n_t += 1;
-            fn_sum += o.f_n;
-        }
-        let demand = e.t().dot(self.nonfric[e.body_a]);
-        if fn_sum > 0.0 {
-            demand * (e.f_n / fn_sum)
-        } else {
-            demand / n_t.max(1) as f64
-        }
+/// `F_ext,t,i` for the classical model (§4.1): the non-friction force on A along this
+/// contact's tangent, shared by A's contacts with parallel tangents in proportion to their
+/// normal forces, `(t·F_A^nonfric)·F_n,i/Σ F_n,j` (equally, `/n_t`, if none pushes). Each
+/// contact then sticks iff `|t·F_A^nonfric| ≤ μ_s·Σ F_n,j`, rigid Coulomb's condition for the
+/// body; the equal share let the unloaded corner of a tall block slip below it (issue 16,
+/// docs/MODELS.md §4.1). `nonfric` holds every body's non-friction force (N).
+fn external_share(entries: &[VeContact], nonfric: &[Vec2], idx: usize) -> f64 {
+    let e = &entries[idx];
+    let (mut n_t, mut fn_sum) = (0usize, 0.0);
+    for o in entries.iter().filter(|o| {
+        o.state == Some(ContactState::Continuous)
+            && o.body_a == e.body_a
+            && o.t().dot(e.t()).abs() > 0.99
+    }) {
+        n_t += 1;
+        fn_sum += o.f_n;
+    }
+    let demand = e.t().dot(nonfric[e.body_a]);
+    if fn_sum > 0.0 {
+        demand * (e.f_n / fn_sum)
+    } else {
+        demand / n_t.max(1) as f64
     }
 }
 
 /// Friction force of one Continuous record for this sample (after its normal force), and its
 /// god-object (§8.3).
 #[inline(always)]
-fn friction_step(
+fn friction_step<N>(
     e: &mut VeContact,
-    law: &mut LawState,
+    law: &mut LawState<N>,
     dt: f64,
     f_ext_t: f64,
     wrenches: &mut [Wrench2],

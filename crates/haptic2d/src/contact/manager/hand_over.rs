@@ -71,15 +71,13 @@ impl ContactSet {
                 Ok(t) if !self.entries[t].is_contact() => {
                     let n = &mut self.entries[t];
                     start_handed_over(n, tick, &mut self.events);
-                    n.law = self.laws.acquire(normal, friction);
-                    self.laws.get_mut(n.law).begin(n.s_g);
+                    n.law = self.laws.acquire(normal, friction, n.s_g);
                 }
                 Ok(_) => {}
                 Err(_) => {
                     let mut n = new_entry(tick, key, colliders, bodies, past);
                     start_handed_over(&mut n, tick, &mut self.events);
-                    n.law = self.laws.acquire(normal, friction);
-                    self.laws.get_mut(n.law).begin(n.s_g);
+                    n.law = self.laws.acquire(normal, friction, n.s_g);
                     self.pending.push(n);
                 }
             }

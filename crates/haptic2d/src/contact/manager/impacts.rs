@@ -55,7 +55,7 @@ impl ContactSet {
                 // before the jump no longer predicts the motion, so the SEH estimate restarts from
                 // this sample (`δ̃ = δ` until three post-impact samples exist, §5.5).
                 if self.params.impact_surface_offset {
-                    self.laws.get_mut(e.law).normal.impact_resolved(e.d, e.hist);
+                    self.laws.impact_resolved(e.law, e.d, e.hist);
                     e.hist = 1;
                 }
                 self.events.push(ContactEvent {

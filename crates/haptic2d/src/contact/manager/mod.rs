@@ -139,9 +139,21 @@ impl ContactSet {
         self.entries.iter().filter(|e| e.is_contact())
     }
 
-    /// The law states of record `e` (an entry of [`entries`](Self::entries)); `None` for a pair that
-    /// is only tracked.
-    pub fn laws(&self, e: &VeContact) -> Option<&LawState> {
+    /// Stores the law states in the whole form from now on (`LawPool`), for the crate's tests.
+    #[cfg(test)]
+    pub(crate) fn widen_law_slots(&mut self) {
+        self.laws.widen();
+    }
+
+    /// True while the law states are in the compact form (`contact/compact_law.rs`).
+    #[cfg(test)]
+    pub(crate) fn law_slots_compact(&self) -> bool {
+        self.laws.is_compact()
+    }
+
+    /// A copy of the law states of record `e` (an entry of [`entries`](Self::entries)); `None` for
+    /// a pair that is only tracked.
+    pub fn laws(&self, e: &VeContact) -> Option<LawState> {
         if e.is_contact() {
             self.laws.get(e.law)
         } else {

@@ -25,21 +25,21 @@
 
 use super::{NormalInput, NormalLaw, NormalModel};
 
-/// A contact record's normal law ([`NormalModel`], the copy of the scene's prototype) and its
-/// impact surface offset `σ` (m, ≥ 0; 0 outside an impact's aftermath).
+/// A contact record's normal law ([`NormalModel`], the copy of the scene's prototype, or any other
+/// [`NormalLaw`] `M`) and its impact surface offset `σ` (m, ≥ 0; 0 outside an impact's aftermath).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C)]
-pub struct ContactNormal {
+pub struct ContactNormal<M = NormalModel> {
     /// Surface offset `σ` (m): the law acts on the depth beyond it (first: read every sample).
     offset: f64,
     /// The law and its per-contact state.
-    pub model: NormalModel,
+    pub model: M,
 }
 
-impl ContactNormal {
+impl<M: NormalLaw> ContactNormal<M> {
     /// The law `model` without offset.
     #[inline]
-    pub fn new(model: NormalModel) -> Self {
+    pub fn new(model: M) -> Self {
         Self { model, offset: 0.0 }
     }
 
@@ -47,6 +47,14 @@ impl ContactNormal {
     #[inline]
     pub fn offset(&self) -> f64 {
         self.offset
+    }
+
+    /// The same offset with the law converted by `f` (the contact set's compact and whole slots).
+    pub(crate) fn map<N>(self, f: impl FnOnce(M) -> N) -> ContactNormal<N> {
+        ContactNormal {
+            offset: self.offset,
+            model: f(self.model),
+        }
     }
 
     /// Called when the record's impact has been resolved at this sample, with the record's signed
@@ -64,7 +72,7 @@ impl ContactNormal {
     }
 }
 
-impl NormalLaw for ContactNormal {
+impl<M: NormalLaw> NormalLaw for ContactNormal<M> {
     fn reset(&mut self) {
         self.offset = 0.0;
         self.model.reset();

@@ -246,45 +246,43 @@ impl Default for NormalModel {
 // pass builds the `NormalInput` on the stack; a `force` compiled apart reads it back with loads that
 // straddle the caller's stores, a store-forwarding stall (~15 % of a pile step). Inlined, the input stays
 // in registers. A plain `#[inline]` hint was not always followed. Behaviour is unchanged.
-impl NormalLaw for NormalModel {
-    fn reset(&mut self) {
-        match self {
-            NormalModel::Paper(l) => l.reset(),
-            NormalModel::Zoh(l) => l.reset(),
-            NormalModel::Minsky(l) => l.reset(),
-            NormalModel::Colgate(l) => l.reset(),
-            NormalModel::Seh(l) => l.reset(),
-            NormalModel::MassiePi(l) => l.reset(),
-            NormalModel::BrakingPulse(l) => l.reset(),
-            NormalModel::Hysteretic(l) => l.reset(),
+/// Implements [`NormalLaw`] for an enum whose every variant wraps one law, by forwarding each
+/// method to the variant's law (used for [`NormalModel`] and for the contact set's compact slots,
+/// `contact/compact_law.rs`, which are the same laws without the hysteretic wall).
+macro_rules! normal_law_dispatch {
+    ($ty:ident { $($variant:ident),+ $(,)? }) => {
+        impl $crate::laws::normal::NormalLaw for $ty {
+            fn reset(&mut self) {
+                match self {
+                    $($ty::$variant(l) => l.reset(),)+
+                }
+            }
+            #[inline(always)]
+            fn force(&mut self, input: &$crate::laws::normal::NormalInput) -> f64 {
+                match self {
+                    $($ty::$variant(l) => l.force(input),)+
+                }
+            }
+            fn stored_energy(&self) -> f64 {
+                match self {
+                    $($ty::$variant(l) => l.stored_energy(),)+
+                }
+            }
         }
-    }
-    #[inline(always)]
-    fn force(&mut self, input: &NormalInput) -> f64 {
-        match self {
-            NormalModel::Paper(l) => l.force(input),
-            NormalModel::Zoh(l) => l.force(input),
-            NormalModel::Minsky(l) => l.force(input),
-            NormalModel::Colgate(l) => l.force(input),
-            NormalModel::Seh(l) => l.force(input),
-            NormalModel::MassiePi(l) => l.force(input),
-            NormalModel::BrakingPulse(l) => l.force(input),
-            NormalModel::Hysteretic(l) => l.force(input),
-        }
-    }
-    fn stored_energy(&self) -> f64 {
-        match self {
-            NormalModel::Paper(l) => l.stored_energy(),
-            NormalModel::Zoh(l) => l.stored_energy(),
-            NormalModel::Minsky(l) => l.stored_energy(),
-            NormalModel::Colgate(l) => l.stored_energy(),
-            NormalModel::Seh(l) => l.stored_energy(),
-            NormalModel::MassiePi(l) => l.stored_energy(),
-            NormalModel::BrakingPulse(l) => l.stored_energy(),
-            NormalModel::Hysteretic(l) => l.stored_energy(),
-        }
-    }
+    };
 }
+pub(crate) use normal_law_dispatch;
+
+normal_law_dispatch!(NormalModel {
+    Paper,
+    Zoh,
+    Minsky,
+    Colgate,
+    Seh,
+    MassiePi,
+    BrakingPulse,
+    Hysteretic,
+});
 
 #[cfg(test)]
 mod tests {
