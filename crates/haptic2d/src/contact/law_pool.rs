@@ -2,7 +2,7 @@
 //! free list, so records stay small and creating or releasing a contact never allocates after
 //! warm-up.
 //!
-//! The slots are compact (136 bytes, `contact/compact_law.rs`) until a record needs the
+//! The slots are compact (144 bytes, `contact/compact_law.rs`) until a record needs the
 //! hysteretic wall; then every slot is widened once to the whole [`NormalModel`] (272 bytes) and
 //! the pool stays wide. Either way a slot holds the same law with the same state. Widening
 //! allocates once, in the sample that creates the first such record: in the warm-up for a scene
@@ -25,7 +25,7 @@ pub(crate) struct LawPool {
 /// The pool's slots: compact while no record needs the hysteretic wall, whole afterwards.
 #[derive(Clone, Debug)]
 pub(crate) enum Slots {
-    /// Every law but the hysteretic wall, 136 bytes a slot.
+    /// Every law but the hysteretic wall, 144 bytes a slot.
     Compact(Store<CompactNormal>),
     /// Any law, 272 bytes a slot.
     Whole(Store<NormalModel>),
@@ -157,7 +157,7 @@ impl LawPool {
     /// Moves the states of `records` (every entry whose `law` is a slot) into slots `0, 1, 2, …`
     /// in their order, and drops the free slots: the per-sample force pass, which walks the
     /// records in key order, then reads the pool front to back instead of at random (a law state
-    /// is 136 or 272 bytes, 2–5 cache lines, missed each when scattered). The states themselves
+    /// is 144 or 272 bytes, 2–5 cache lines, missed each when scattered). The states themselves
     /// are unchanged.
     pub(crate) fn repack(&mut self, records: &mut [VeContact]) {
         match &mut self.slots {

@@ -1,7 +1,7 @@
 //! The per-VE-pair record (§8.1): distance history, edge coordinate, god-object, and the slot of
 //! its law states.
 //!
-//! The law states ([`LawState`]: a [`NormalModel`] and a [`FrictionModel`], 136 or 272 bytes) live
+//! The law states ([`LawState`]: a [`NormalModel`] and a [`FrictionModel`], 144 or 272 bytes) live
 //! out of line in the contact set's pool, so the record that every per-sample pass walks stays
 //! small (the tracked pairs that are not contacts, the majority on a pile, need no law state at
 //! all).
@@ -20,7 +20,7 @@ pub const NO_LAW: u32 = u32::MAX;
 /// [`ContactNormal`]): the common laws' fields (the reset integrator, 64 bytes; the paper law,
 /// 24) then sit in the first two cache lines of the slot, which the force pass streams through
 /// every sample. With the whole [`NormalModel`] (`N`, the default) a slot is 272 bytes, sized
-/// for the hysteretic wall's elements; the contact set's pool stores the other laws in 136-byte
+/// for the hysteretic wall's elements; the contact set's pool stores the other laws in 144-byte
 /// slots of a compact model instead (`contact/compact_law.rs`) while no record needs the wall.
 #[derive(Clone, Copy, Debug)]
 #[repr(C)]
