@@ -90,10 +90,10 @@ fn parry_distance(a: &Collider, pa: &Pose, b: &Collider, pb: &Pose) -> f64 {
 /// True if world point `p` lies on feature `f` of collider `c` (within `tol` m).
 fn on_feature(c: &Collider, f: Feature, p: Vec2, tol: f64) -> bool {
     match f {
-        Feature::Vertex(i) => (c.world_vertices[i as usize] - p).length() <= tol,
+        Feature::Vertex(i) => (c.world_vertices()[i as usize] - p).length() <= tol,
         Feature::Edge(i) => {
-            let a = c.world_vertices[i as usize];
-            let b = c.world_vertices[c.local.next(i as usize)];
+            let a = c.world_vertices()[i as usize];
+            let b = c.world_vertices()[c.local.next(i as usize)];
             point_segment(p, a, b) <= tol
         }
     }
@@ -140,9 +140,9 @@ fn t1_gjk_matches_brute_force() {
         let a = Collider::new(0, true, pa, &pose_a);
         let b = Collider::new(1, true, pb, &pose_b);
 
-        let brute = brute_distance(&a.world_vertices, &b.world_vertices);
-        let cold = gjk_distance(&a.world_vertices, &b.world_vertices, &mut GjkCache::new());
-        let hot = gjk_distance(&a.world_vertices, &b.world_vertices, &mut warm);
+        let brute = brute_distance(a.world_vertices(), b.world_vertices());
+        let cold = gjk_distance(a.world_vertices(), b.world_vertices(), &mut GjkCache::new());
+        let hot = gjk_distance(a.world_vertices(), b.world_vertices(), &mut warm);
         let parry = parry_distance(&a, &pose_a, &b, &pose_b);
 
         for g in [&cold, &hot] {
@@ -162,8 +162,8 @@ fn t1_gjk_matches_brute_force() {
             } else {
                 // Witness points realise the distance and lie on the polygons.
                 assert!(((g.point_a - g.point_b).length() - g.distance).abs() <= 1e-12);
-                assert!(point_polygon(&a.world_vertices, g.point_a) <= 1e-12);
-                assert!(point_polygon(&b.world_vertices, g.point_b) <= 1e-12);
+                assert!(point_polygon(a.world_vertices(), g.point_a) <= 1e-12);
+                assert!(point_polygon(b.world_vertices(), g.point_b) <= 1e-12);
             }
         }
         let err_parry = (cold.distance - parry).abs();
@@ -233,7 +233,7 @@ fn t2_tracker_matches_gjk() {
             let (qa, qb) = pose(k as f64);
             a.update(&qa);
             b.update(&qb);
-            let g = gjk_distance(&a.world_vertices, &b.world_vertices, &mut cache);
+            let g = gjk_distance(a.world_vertices(), b.world_vertices(), &mut cache);
             let t = tracker.update(&a, &b);
             steps += 1;
             let ctx = format!("trajectory {traj}, step {k}: GJK {g:?}, tracker {t:?}");
@@ -293,7 +293,7 @@ fn t3_coherent_motion_is_o1() {
         let mut tracker = FeatureTracker::new();
         let mut cache = GjkCache::new();
         tracker.update(&a, &b); // initialisation (GJK), not counted
-        gjk_distance(&a.world_vertices, &b.world_vertices, &mut cache);
+        gjk_distance(a.world_vertices(), b.world_vertices(), &mut cache);
         let (s0, t0) = (cache.stats, tracker.stats);
         let mut prev = pose_b(0.0);
         for k in 1..1000 {
@@ -302,7 +302,7 @@ fn t3_coherent_motion_is_o1() {
             prev = q;
             b.update(&q);
             tracker.update(&a, &b);
-            gjk_distance(&a.world_vertices, &b.world_vertices, &mut cache);
+            gjk_distance(a.world_vertices(), b.world_vertices(), &mut cache);
         }
         updates += tracker.stats.updates - t0.updates;
         iterations += tracker.stats.iterations - t0.iterations;
@@ -475,7 +475,7 @@ fn t5_trial(rng: &mut ChaCha8Rng, bp: &mut BroadPhase, pairs: &mut Vec<(u32, u32
             pos: pose_a.pos + dir * s,
             angle: th_b,
         });
-        gjk_distance(&a.world_vertices, &b.world_vertices, &mut cache).distance
+        gjk_distance(a.world_vertices(), b.world_vertices(), &mut cache).distance
     };
     let (mut lo, mut hi) = (0.0, 1.0);
     for _ in 0..60 {
@@ -505,7 +505,7 @@ fn t5_trial(rng: &mut ChaCha8Rng, bp: &mut BroadPhase, pairs: &mut Vec<(u32, u32
     let mut cache = GjkCache::new();
     for k in 1..=2 * N_G {
         b.update(&pose_b(k));
-        let d = gjk_distance(&a.world_vertices, &b.world_vertices, &mut cache).distance;
+        let d = gjk_distance(a.world_vertices(), b.world_vertices(), &mut cache).distance;
         if k <= N_G {
             min_ng = min_ng.min(d);
         }
@@ -617,7 +617,7 @@ fn local_stage_candidate_invariants() {
                 &cols[c.vertex_collider as usize],
                 &cols[c.edge_collider as usize],
             );
-            let p = cv.world_vertices[c.vertex as usize];
+            let p = cv.world_vertices()[c.vertex as usize];
             let e = c.edge as usize;
             let s = ce.edge_coordinate(e, p);
             assert!(
@@ -630,8 +630,8 @@ fn local_stage_candidate_invariants() {
             );
         }
         for (iv, ie) in [(0usize, 1usize), (1, 0)] {
-            for (v, p) in cols[iv].world_vertices.iter().enumerate() {
-                if inside(&cols[ie].world_vertices, *p, -1e-12) {
+            for (v, p) in cols[iv].world_vertices().iter().enumerate() {
+                if inside(cols[ie].world_vertices(), *p, -1e-12) {
                     inside_vertices += 1;
                     assert!(
                         out.iter()

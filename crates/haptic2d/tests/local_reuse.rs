@@ -99,7 +99,7 @@ fn reused_vertex_scans_give_the_candidates_of_scanning_every_sample() {
             assert_eq!(flags.len(), out_fast.len());
             assert_eq!(flags, every.from_vertex_scan(), "seed {seed}, sample {k}");
             for (c, _) in out_fast.iter().zip(flags).filter(|(_, &f)| f) {
-                let v = colliders[c.vertex_collider as usize].world_vertices[c.vertex as usize];
+                let v = colliders[c.vertex_collider as usize].world_vertices()[c.vertex as usize];
                 let b = &colliders[c.edge_collider as usize];
                 let d_e = b.edge_distance(c.edge as usize, v);
                 assert!(

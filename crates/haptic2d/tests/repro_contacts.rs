@@ -40,7 +40,7 @@ fn run(w: &mut World, seconds: f64) -> Run {
         for rec in w.contact_records() {
             let ca = &w.colliders[rec.key.vertex_collider as usize];
             let cb = &w.colliders[rec.key.edge_collider as usize];
-            let p = ca.world_vertices[rec.key.vertex as usize];
+            let p = ca.world_vertices()[rec.key.vertex as usize];
             let d_e = cb.edge_distance(rec.key.edge as usize, p);
             let (_, max_d) = nearest_line(cb, p);
             r.worst_invariant = r.worst_invariant.max(max_d - DEFAULT_DELTA_C - d_e);

@@ -54,7 +54,7 @@ fn throw(w: &mut World, seconds: f64) -> Throw {
         let c = &mut w.colliders[rod_collider].clone();
         c.update(&w.bodies[rod].pose);
         let x = c
-            .world_vertices
+            .world_vertices()
             .iter()
             .map(|v| v.x)
             .fold(f64::MIN, f64::max);

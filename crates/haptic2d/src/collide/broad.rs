@@ -364,10 +364,10 @@ impl BroadPhase {
         self.snapshot.odo.clear();
         for c in colliders {
             let s = self.snapshot.vertices.len() as u32;
-            self.snapshot.vertices.extend_from_slice(&c.world_vertices);
+            self.snapshot.vertices.extend_from_slice(c.world_vertices());
             self.snapshot
                 .colliders
-                .push((s, c.world_vertices.len() as u32));
+                .push((s, c.world_vertices().len() as u32));
             self.snapshot
                 .odo
                 .push(odometer.get(c.body).copied().unwrap_or(f64::NAN));
@@ -834,7 +834,7 @@ mod tests {
                 );
                 odometer[i] += (p.pos - last.pos).length() + (p.angle - last.angle).abs() * radius;
                 poses[i] = p;
-                let h0 = home[i].world_vertices[0] - home[i].local.vertices()[0];
+                let h0 = home[i].world_vertices()[0] - home[i].local.vertices()[0];
                 cols[i].update(&Pose::new(h0.x + p.pos.x, h0.y + p.pos.y, p.angle));
             }
             fast.update_with_motion(&cols, &odometer, &mut out_fast);

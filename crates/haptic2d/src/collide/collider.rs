@@ -12,10 +12,9 @@ pub struct Collider {
     pub dynamic: bool,
     /// The polygon in the body frame (m).
     pub local: ConvexPolygon,
-    /// Vertices in world coordinates (m), counter-clockwise.
-    pub world_vertices: Vec<Vec2>,
-    /// Outward unit edge normals in world coordinates.
-    pub world_normals: Vec<Vec2>,
+    /// World vertices `[0, n)` (m, counter-clockwise) and outward unit normals `[n, 2n)`, in one
+    /// allocation ([`world_vertices`](Self::world_vertices), [`world_normals`](Self::world_normals)).
+    world: Vec<Vec2>,
     /// World bounding box (m), not inflated.
     pub aabb: Aabb,
 }
@@ -28,8 +27,7 @@ impl Collider {
             body,
             dynamic,
             local,
-            world_vertices: vec![Vec2::ZERO; n],
-            world_normals: vec![Vec2::ZERO; n],
+            world: vec![Vec2::ZERO; 2 * n],
             aabb: Aabb::EMPTY,
         };
         c.update(pose);
@@ -45,10 +43,8 @@ impl Collider {
     pub fn update_with(&mut self, pose: &Pose, rot: Rot) {
         let mut aabb = Aabb::EMPTY;
         let local = (self.local.vertices(), self.local.normals());
-        let world = self
-            .world_vertices
-            .iter_mut()
-            .zip(self.world_normals.iter_mut());
+        let (world_vertices, world_normals) = self.world.split_at_mut(local.0.len());
+        let world = world_vertices.iter_mut().zip(world_normals.iter_mut());
         for ((v, n), (wv, wn)) in local.0.iter().zip(local.1).zip(world) {
             *wv = pose.pos + rot.apply(*v);
             *wn = rot.apply(*n);
@@ -57,12 +53,24 @@ impl Collider {
         self.aabb = aabb;
     }
 
+    /// Vertices in world coordinates (m), counter-clockwise.
+    #[inline]
+    pub fn world_vertices(&self) -> &[Vec2] {
+        &self.world[..self.local.len()]
+    }
+
+    /// Outward unit edge normals in world coordinates.
+    #[inline]
+    pub fn world_normals(&self) -> &[Vec2] {
+        &self.world[self.local.len()..]
+    }
+
     /// The unit tangent of edge `e` in world coordinates, `(−n_y, n_x)` of its outward normal:
     /// exactly the rotated polygon tangent (normals are `(t_y, −t_x)`, and a rotation keeps that
     /// relation bit for bit; only the sign of an exact zero can differ).
     #[inline]
     pub fn world_tangent(&self, e: usize) -> Vec2 {
-        let n = self.world_normals[e];
+        let n = self.world_normals()[e];
         Vec2::new(-n.y, n.x)
     }
 
@@ -81,12 +89,12 @@ impl Collider {
     /// Signed distance `d = n_e·(p − E0_e)` of world point `p` from the line of edge `e` (m), positive outside.
     #[inline]
     pub fn edge_distance(&self, e: usize, p: Vec2) -> f64 {
-        self.world_normals[e].dot(p - self.world_vertices[e])
+        self.world_normals()[e].dot(p - self.world_vertices()[e])
     }
 
     /// Edge coordinate `s = t_e·(p − E0_e)` of world point `p` along edge `e` (m).
     #[inline]
     pub fn edge_coordinate(&self, e: usize, p: Vec2) -> f64 {
-        self.world_tangent(e).dot(p - self.world_vertices[e])
+        self.world_tangent(e).dot(p - self.world_vertices()[e])
     }
 }

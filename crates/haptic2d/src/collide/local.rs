@@ -849,7 +849,7 @@ impl Ctx {
         e: usize,
         out: &mut Vec<VeCandidate>,
     ) -> bool {
-        let p = pv.c.world_vertices[v];
+        let p = pv.c.world_vertices()[v];
         let s = pe.c.edge_coordinate(e, p);
         let l = pe.c.local.lengths()[e];
         if s < -self.eps_s || s > l + self.eps_s || pe.c.edge_distance(e, p) > self.delta_c {
@@ -889,9 +889,9 @@ impl Ctx {
             }
             (Feature::Vertex(i), Feature::Vertex(j)) => {
                 let (i, j) = (i as usize, j as usize);
-                let eb = most_aligned_edge(b.c, j, a.c.world_vertices[i]);
+                let eb = most_aligned_edge(b.c, j, a.c.world_vertices()[i]);
                 self.push_if_valid(a, i, b, eb, out);
-                let ea = most_aligned_edge(a.c, i, b.c.world_vertices[j]);
+                let ea = most_aligned_edge(a.c, i, b.c.world_vertices()[j]);
                 self.push_if_valid(b, j, a, ea, out);
             }
             (Feature::Edge(i), Feature::Edge(j)) => {
@@ -922,8 +922,8 @@ impl Ctx {
         }
         let ea1 = a.c.local.next(ea);
         let eb1 = b.c.local.next(eb);
-        let s0 = b.c.edge_coordinate(eb, a.c.world_vertices[ea]);
-        let s1 = b.c.edge_coordinate(eb, a.c.world_vertices[ea1]);
+        let s0 = b.c.edge_coordinate(eb, a.c.world_vertices()[ea]);
+        let s1 = b.c.edge_coordinate(eb, a.c.world_vertices()[ea1]);
         let ((v_lo, s_lo), (v_hi, s_hi)) = if s0 <= s1 {
             ((ea, s0), (ea1, s1))
         } else {
@@ -1006,8 +1006,8 @@ impl Ctx {
         let reach = Vec2::new(self.delta_c + self.eps_s, self.delta_c + self.eps_s);
         let (lo, hi) = (b.c.aabb.min - reach, b.c.aabb.max + reach);
         // B's edges as (start, normal) pairs, read without bounds checks in the loop below.
-        let (b_starts, b_normals) = (&b.c.world_vertices, &b.c.world_normals);
-        'vertex: for (v, &p) in a.c.world_vertices.iter().enumerate() {
+        let (b_starts, b_normals) = (b.c.world_vertices(), b.c.world_normals());
+        'vertex: for (v, &p) in a.c.world_vertices().iter().enumerate() {
             if p.x < lo.x || p.x > hi.x || p.y < lo.y || p.y > hi.y {
                 slack.decided((lo - p).max(p - hi).max_element());
                 continue;
@@ -1077,7 +1077,7 @@ impl Ctx {
     /// and the choice between `e` and `e'` is the corner-on-corner rule's
     /// ([`corner_facing_edge`]); otherwise `e`.
     fn corner_edge(&self, a: &Collider, v: usize, b: &Collider, e: usize, max_d: f64) -> usize {
-        let p = a.world_vertices[v];
+        let p = a.world_vertices()[v];
         for e2 in [b.local.prev(e), b.local.next(e)] {
             let d = b.edge_distance(e2, p);
             let s = b.edge_coordinate(e2, p);
@@ -1116,9 +1116,9 @@ pub fn corner_facing_edge(
     e2: usize,
     cos_parallel: f64,
 ) -> Option<usize> {
-    let (na_out, na_in) = (a.world_normals[v], a.world_normals[a.local.prev(v)]);
+    let (na_out, na_in) = (a.world_normals()[v], a.world_normals()[a.local.prev(v)]);
     let faces = |e: usize| {
-        let n = b.world_normals[e];
+        let n = b.world_normals()[e];
         n.dot(na_out) < -cos_parallel || n.dot(na_in) < -cos_parallel
     };
     match (faces(e1), faces(e2)) {
@@ -1131,10 +1131,10 @@ pub fn corner_facing_edge(
 /// Of the two edges of `c` incident to vertex `v`, the one whose outward normal is most aligned
 /// with `p − V` (largest `n·(p − V)`; the outgoing edge on a tie).
 fn most_aligned_edge(c: &Collider, v: usize, p: Vec2) -> usize {
-    let r = p - c.world_vertices[v];
+    let r = p - c.world_vertices()[v];
     let e_out = v;
     let e_in = c.local.prev(v);
-    if c.world_normals[e_in].dot(r) > c.world_normals[e_out].dot(r) {
+    if c.world_normals()[e_in].dot(r) > c.world_normals()[e_out].dot(r) {
         e_in
     } else {
         e_out
@@ -1170,7 +1170,7 @@ pub fn sat_depth(a: &Collider, b: &Collider) -> f64 {
         for e in 0..p.len() {
             // Overlap along n_e: how far q's deepest vertex is behind p's edge line e.
             let min_d = q
-                .world_vertices
+                .world_vertices()
                 .iter()
                 .map(|&v| p.edge_distance(e, v))
                 .fold(f64::INFINITY, f64::min);

@@ -159,7 +159,7 @@ fn edge_len(c: &Collider, e: usize) -> f64 {
 #[inline]
 fn project_on_edge(c: &Collider, e: usize, p: Vec2) -> Vec2 {
     let s = c.edge_coordinate(e, p).clamp(0.0, edge_len(c, e));
-    c.world_vertices[e] + c.world_tangent(e) * s
+    c.world_vertices()[e] + c.world_tangent(e) * s
 }
 
 fn feature_valid(c: &Collider, f: Feature) -> bool {
@@ -172,24 +172,24 @@ fn feature_valid(c: &Collider, f: Feature) -> bool {
 fn closest_points(a: &Collider, fa: Feature, b: &Collider, fb: Feature) -> Step {
     match (fa, fb) {
         (Feature::Vertex(i), Feature::Vertex(j)) => Step::Points(
-            a.world_vertices[i as usize],
-            b.world_vertices[j as usize],
+            a.world_vertices()[i as usize],
+            b.world_vertices()[j as usize],
             false,
         ),
         (Feature::Vertex(i), Feature::Edge(j)) => {
-            let pa = a.world_vertices[i as usize];
+            let pa = a.world_vertices()[i as usize];
             Step::Points(pa, project_on_edge(b, j as usize, pa), false)
         }
         (Feature::Edge(i), Feature::Vertex(j)) => {
-            let pb = b.world_vertices[j as usize];
+            let pb = b.world_vertices()[j as usize];
             Step::Points(project_on_edge(a, i as usize, pb), pb, false)
         }
         (Feature::Edge(i), Feature::Edge(j)) => {
             let (ea, eb) = (i as usize, j as usize);
-            let a0 = a.world_vertices[ea];
-            let a1 = a.world_vertices[next(a, ea)];
-            let b0 = b.world_vertices[eb];
-            let b1 = b.world_vertices[next(b, eb)];
+            let a0 = a.world_vertices()[ea];
+            let a1 = a.world_vertices()[next(a, ea)];
+            let b0 = b.world_vertices()[eb];
+            let b1 = b.world_vertices()[next(b, eb)];
             if a.world_tangent(ea).dot(b.world_tangent(eb)).abs() > 1.0 - PARALLEL_TOL {
                 // Parallel: overlap of A's edge with B's edge in B's edge coordinate.
                 let s0 = b.edge_coordinate(eb, a0);
@@ -232,7 +232,7 @@ fn most_violated(c: &Collider, f: Feature, p: Vec2) -> Option<Across> {
     match f {
         Feature::Vertex(i) => {
             let i = i as usize;
-            let r = p - c.world_vertices[i];
+            let r = p - c.world_vertices()[i];
             // (p − V_i)·u_i ≤ 0, else → E_i.
             let out_next = r.dot(c.world_tangent(i));
             if out_next > worst {
@@ -248,7 +248,7 @@ fn most_violated(c: &Collider, f: Feature, p: Vec2) -> Option<Across> {
         }
         Feature::Edge(i) => {
             let i = i as usize;
-            let r = p - c.world_vertices[i];
+            let r = p - c.world_vertices()[i];
             let s = r.dot(c.world_tangent(i));
             // (p − V_i)·u_i ≥ 0, else → V_i.
             if -s > worst {
@@ -262,7 +262,7 @@ fn most_violated(c: &Collider, f: Feature, p: Vec2) -> Option<Across> {
                 across = Some(Across::Feature(Feature::Vertex(next(c, i) as u32)));
             }
             // (p − V_i)·n_i ≥ 0, else → interior.
-            let depth = -r.dot(c.world_normals[i]);
+            let depth = -r.dot(c.world_normals()[i]);
             if depth > worst {
                 across = Some(Across::Interior);
             }
@@ -367,7 +367,7 @@ impl FeatureTracker {
 
     /// Runs GJK (warm-started) and takes the features spanned by its simplex.
     fn start_from_gjk(&mut self, a: &Collider, b: &Collider, iterations: u32) -> ClosestFeatures {
-        let g: GjkOutput = gjk_distance(&a.world_vertices, &b.world_vertices, &mut self.gjk);
+        let g: GjkOutput = gjk_distance(a.world_vertices(), b.world_vertices(), &mut self.gjk);
         let n = g.simplex_count.max(1);
         let fa = feature_from_simplex(a, &g.index_a[..n], &g.weights[..n]);
         let fb = feature_from_simplex(b, &g.index_b[..n], &g.weights[..n]);

@@ -45,11 +45,13 @@ impl fmt::Display for PolygonError {
 impl std::error::Error for PolygonError {}
 
 /// A strictly convex polygon with counter-clockwise vertices in its own frame (m).
+///
+/// Its `n` vertices, normals and tangents share one allocation, in that order (a collider's
+/// update reads the first two back to back, and the struct is 56 bytes instead of 104).
 #[derive(Clone, Debug, PartialEq)]
 pub struct ConvexPolygon {
-    vertices: Vec<Vec2>,
-    tangents: Vec<Vec2>,
-    normals: Vec<Vec2>,
+    /// Vertices `[0, n)`, outward normals `[n, 2n)`, tangents `[2n, 3n)`.
+    features: Vec<Vec2>,
     lengths: Vec<f64>,
     /// Largest distance of a vertex from the frame origin (m).
     radius: f64,
@@ -121,10 +123,12 @@ impl ConvexPolygon {
             return Err(PolygonError::NotConvex(0));
         }
         let radius = vertex_radius(&vertices);
+        let mut features = vertices;
+        features.reserve_exact(2 * n);
+        features.extend_from_slice(&normals);
+        features.extend_from_slice(&tangents);
         Ok(Self {
-            vertices,
-            tangents,
-            normals,
+            features,
             lengths,
             radius,
         })
@@ -144,7 +148,7 @@ impl ConvexPolygon {
     /// Number of vertices (= number of edges).
     #[inline]
     pub fn len(&self) -> usize {
-        self.vertices.len()
+        self.lengths.len()
     }
     /// Always false: a valid polygon has at least 3 vertices.
     #[inline]
@@ -154,17 +158,18 @@ impl ConvexPolygon {
     /// Vertices, counter-clockwise (m).
     #[inline]
     pub fn vertices(&self) -> &[Vec2] {
-        &self.vertices
+        &self.features[..self.len()]
     }
     /// Unit edge tangents; edge `i` runs from vertex `i` to vertex `i+1`.
     #[inline]
     pub fn tangents(&self) -> &[Vec2] {
-        &self.tangents
+        &self.features[2 * self.len()..]
     }
     /// Outward unit edge normals `n_i = (t_y, −t_x)`.
     #[inline]
     pub fn normals(&self) -> &[Vec2] {
-        &self.normals
+        let n = self.len();
+        &self.features[n..2 * n]
     }
     /// Edge lengths (m).
     #[inline]
@@ -180,7 +185,7 @@ impl ConvexPolygon {
     /// Index of the next vertex/edge, counter-clockwise.
     #[inline]
     pub fn next(&self, i: usize) -> usize {
-        if i + 1 == self.vertices.len() {
+        if i + 1 == self.len() {
             0
         } else {
             i + 1
@@ -190,7 +195,7 @@ impl ConvexPolygon {
     #[inline]
     pub fn prev(&self, i: usize) -> usize {
         if i == 0 {
-            self.vertices.len() - 1
+            self.len() - 1
         } else {
             i - 1
         }
@@ -198,19 +203,20 @@ impl ConvexPolygon {
     /// The polygon translated by `-offset` (used to put a body's centre of mass at its frame origin).
     pub fn shifted(&self, offset: Vec2) -> Self {
         let mut p = self.clone();
-        for v in &mut p.vertices {
+        let n = p.len();
+        for v in &mut p.features[..n] {
             *v -= offset;
         }
-        p.radius = vertex_radius(&p.vertices);
+        p.radius = vertex_radius(p.vertices());
         p
     }
     /// Bounding box in the polygon's own frame.
     pub fn local_aabb(&self) -> Aabb {
-        Aabb::from_points(&self.vertices)
+        Aabb::from_points(self.vertices())
     }
     /// The parry shape of this polygon (for the global stage and as a test oracle).
     pub fn to_parry(&self) -> parry2d_f64::shape::ConvexPolygon {
-        parry2d_f64::shape::ConvexPolygon::from_convex_polyline_unmodified(self.vertices.clone())
+        parry2d_f64::shape::ConvexPolygon::from_convex_polyline_unmodified(self.vertices().to_vec())
             .expect("a validated convex polygon is a valid parry polygon")
     }
 }

@@ -86,10 +86,10 @@ pub fn overlaps(world: &World, min_depth: f64) -> (Vec<Overlap>, bool) {
                 continue;
             }
             let d = sat_depth(
-                &ci.world_vertices,
-                &ci.world_normals,
-                &cj.world_vertices,
-                &cj.world_normals,
+                ci.world_vertices(),
+                ci.world_normals(),
+                cj.world_vertices(),
+                cj.world_normals(),
             );
             if d > min_depth {
                 let key = (ci.body.min(cj.body), ci.body.max(cj.body));

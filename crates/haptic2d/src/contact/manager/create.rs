@@ -294,10 +294,10 @@ fn twin_has_record(
     let ca = &colliders[key.vertex_collider as usize];
     let cb = &colliders[key.edge_collider as usize];
     let (v, e) = (key.vertex as usize, key.edge as usize);
-    let n_e = cb.world_normals[e];
+    let n_e = cb.world_normals()[e];
     let twins = [(cb.local.next(e), v), (e, ca.local.prev(v))];
     twins.into_iter().any(|(w, e_a)| {
-        if n_e.dot(ca.world_normals[e_a]) >= -cos_parallel {
+        if n_e.dot(ca.world_normals()[e_a]) >= -cos_parallel {
             return false;
         }
         let twin = VeCandidate {
@@ -334,7 +334,7 @@ fn crossed_edge(
             ..key
         };
         let (_, e0, n, t, len) = geometry(k, colliders);
-        let v = ca.world_vertices[key.vertex as usize];
+        let v = ca.world_vertices()[key.vertex as usize];
         let (d_now, s_now) = (n.dot(v - e0), t.dot(v - e0));
         let (d_prev, s_prev) = past_ds(k, colliders, pa, pb);
         if d_prev > 0.0 && d_now <= 0.0 {

@@ -14,7 +14,7 @@ impl ContactSet {
         for e in self.entries.iter().filter(|e| e.is_contact()) {
             let ca = &colliders[e.key.vertex_collider as usize];
             let cb = &colliders[e.key.edge_collider as usize];
-            let p = ca.world_vertices[e.key.vertex as usize];
+            let p = ca.world_vertices()[e.key.vertex as usize];
             let d_e = cb.edge_distance(e.key.edge as usize, p);
             let (j, max_d) = nearest_line(cb, p);
             let face = face_on_face_ok(e.key, colliders, self.delta_c, self.cos_parallel);
@@ -48,7 +48,7 @@ pub(super) fn depth_ok(
 ) -> bool {
     let ca = &colliders[key.vertex_collider as usize];
     let cb = &colliders[key.edge_collider as usize];
-    let p = ca.world_vertices[key.vertex as usize];
+    let p = ca.world_vertices()[key.vertex as usize];
     cb.edge_distance(key.edge as usize, p) >= nearest_line(cb, p).1 - delta_c
         || face_on_face_ok(key, colliders, delta_c, cos_parallel)
 }
@@ -66,8 +66,8 @@ pub(super) fn face_on_face_ok(
     let ca = &colliders[key.vertex_collider as usize];
     let cb = &colliders[key.edge_collider as usize];
     let (v, e) = (key.vertex as usize, key.edge as usize);
-    let n = cb.world_normals[e];
-    let faces = n.dot(ca.world_normals[v]) < -cos_parallel
-        || n.dot(ca.world_normals[ca.local.prev(v)]) < -cos_parallel;
-    faces && -cb.edge_distance(e, ca.world_vertices[v]) <= sat_depth(ca, cb) + delta_c
+    let n = cb.world_normals()[e];
+    let faces = n.dot(ca.world_normals()[v]) < -cos_parallel
+        || n.dot(ca.world_normals()[ca.local.prev(v)]) < -cos_parallel;
+    faces && -cb.edge_distance(e, ca.world_vertices()[v]) <= sat_depth(ca, cb) + delta_c
 }

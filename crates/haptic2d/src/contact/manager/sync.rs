@@ -173,9 +173,9 @@ pub(super) fn geometry(key: VeCandidate, colliders: &[Collider]) -> (Vec2, Vec2,
     let cb = &colliders[key.edge_collider as usize];
     let e = key.edge as usize;
     (
-        ca.world_vertices[key.vertex as usize],
-        cb.world_vertices[e],
-        cb.world_normals[e],
+        ca.world_vertices()[key.vertex as usize],
+        cb.world_vertices()[e],
+        cb.world_normals()[e],
         cb.world_tangent(e),
         cb.local.lengths()[e],
     )
