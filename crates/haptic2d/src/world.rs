@@ -376,6 +376,12 @@ impl World {
         for ((b, d), h) in self.bodies.iter_mut().zip(&self.drive).zip(&self.held) {
             b.force = d.force + h.force;
             b.torque = d.torque + h.torque;
+            // A fixed body never moves, so its velocity is zero: one set through the public
+            // fields would make its surfaces move in the contacts' eyes and feed energy in.
+            if !b.is_dynamic() {
+                b.vel = Vec2::ZERO;
+                b.omega = 0.0;
+            }
         }
         if self.guard.is_some() {
             for (k, b) in self.ke_before.iter_mut().zip(&self.bodies) {

@@ -417,6 +417,22 @@ pub(super) fn build(
         ] {
             state_ok &= check_abs(&format!("{field}.{k}"), v, max, unit, &mut errs);
         }
+        // A fixed body never moves, but the contacts would read a velocity given to it as a
+        // moving surface and feed energy into every body resting on it.
+        if fixed && vel.iter().all(|v| v.is_finite()) && (vel[0] != 0.0 || vel[1] != 0.0) {
+            errs.push(SceneError::new(
+                format!("{field}.velocity"),
+                format!("a fixed body never moves, so its velocity must be 0, got {vel:?} m/s"),
+                "remove `velocity`, or make the body dynamic (kind = \"dynamic\") to give it one",
+            ));
+        }
+        if fixed && omega.is_finite() && omega != 0.0 {
+            errs.push(SceneError::new(
+                format!("{field}.omega"),
+                format!("a fixed body never moves, so its omega must be 0, got {omega} rad/s"),
+                "remove `omega`, or make the body dynamic (kind = \"dynamic\") to give it one",
+            ));
+        }
         // A bad pose or velocity has been reported; the body is still built (with its checked
         // fields) so that loads naming it do not report a second, misleading problem.
         let _ = state_ok;
