@@ -87,6 +87,9 @@ pub struct World {
     broad: BroadPhase,
     local: LocalStage,
     pairs: Vec<(u32, u32)>,
+    /// The global stage may have written `pairs` since the local stage last read them (set by
+    /// [`global_stage`](Self::global_stage), cleared by the local stage's update).
+    pairs_written: bool,
     drive: Vec<Wrench2>,
     contact_wrench: Vec<Wrench2>,
     /// Load wrench per body of the current sample.
@@ -185,6 +188,7 @@ impl World {
             },
             // Room for a typical contact load, so the first contacts do not allocate on the hot path.
             pairs: Vec::with_capacity(8 * colliders_len),
+            pairs_written: true,
             drive: vec![Wrench2::default(); n],
             contact_wrench: vec![Wrench2::default(); n],
             held: vec![Wrench2::default(); n],
@@ -356,12 +360,14 @@ impl World {
         //    (separated pairs whose gap the bodies' relative motion cannot have closed are
         //    skipped, and penetrating pairs' vertex scans it cannot have changed are reused;
         //    `odometer_poses` are the bodies' poses now, the odometers having just been read).
-        self.local.update_in_place(
+        self.local.update_known_pairs(
             &self.colliders,
             &self.pairs,
+            self.pairs_written,
             self.params.delta_c,
             &self.odometer_poses,
         );
+        self.pairs_written = false;
         // Loads are evaluated once per sample (held over it). Loads and drives enter the bodies'
         // accumulators before the contact forces so the classical friction model sees them (§4.1).
         let t = self.time();
@@ -445,12 +451,14 @@ impl World {
         if early || (periodic && !(spread && self.broad.in_progress())) {
             self.broad
                 .update_with_motion(&self.colliders, &self.odometer, &mut self.pairs);
+            self.pairs_written = true;
             for (g, b) in self.global_poses.iter_mut().zip(&self.bodies) {
                 *g = b.pose;
             }
             self.early_global_updates += early as u64;
         } else if periodic {
             self.broad.publish(&mut self.pairs);
+            self.pairs_written = true;
             std::mem::swap(&mut self.global_poses, &mut self.job_poses);
         }
         if spread && (periodic || early) {

@@ -70,3 +70,32 @@ fn spread_and_whole_stage_give_the_same_pile() {
         assert_eq!(x.vel, y.vel, "{}", x.name);
     }
 }
+
+/// The local stage tracks exactly the pairs of the global update in use after every sample, with
+/// spreading on and off, while pile:100 falls and its proximity set changes: the world tells the
+/// local stage when the global stage may have written the pairs, and the local stage compares
+/// them only then (issue 17; a world that failed to say so would track a stale list here, in
+/// release builds as in debug ones).
+#[test]
+fn the_local_stage_tracks_the_pairs_of_every_global_update() {
+    for spread in [true, false] {
+        let mut w = builtin("pile:100", Some(1000.0)).unwrap().unwrap().world;
+        w.params.proximity_spread = spread;
+        w.params.chain_tau = None;
+        let mut changes = 0;
+        let mut last = Vec::new();
+        for _ in 0..400 {
+            w.step();
+            assert_eq!(
+                w.local_stage().pairs(),
+                w.proximate_pairs(),
+                "tick {} (spread {spread})",
+                w.tick()
+            );
+            changes += (w.proximate_pairs() != last.as_slice()) as usize;
+            last.clear();
+            last.extend_from_slice(w.proximate_pairs());
+        }
+        assert!(changes > 10, "the set changed {changes} times only");
+    }
+}
