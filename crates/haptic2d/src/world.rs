@@ -88,7 +88,7 @@ pub struct World {
     local: LocalStage,
     pairs: Vec<(u32, u32)>,
     /// The global stage may have written `pairs` since the local stage last read them (set by
-    /// [`global_stage`](Self::global_stage), cleared by the local stage's update).
+    /// [`global_stage`](Self::global_stage), cleared once the local stage has read them).
     pairs_written: bool,
     drive: Vec<Wrench2>,
     contact_wrench: Vec<Wrench2>,
