@@ -54,22 +54,12 @@ pub const GJK_EPS_ABS: f64 = 1e-9;
 /// Iteration limit of §9.2.
 pub const GJK_MAX_ITERATIONS: u32 = 32;
 
-/// Work counters accumulated by a [`GjkCache`] over all calls that used it (for tests and profiling).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct GjkStats {
-    /// Number of [`gjk_distance`] calls.
-    pub calls: u64,
-    /// Number of GJK iterations (support points requested from `C`).
-    pub iterations: u64,
-    /// Number of polygon support queries `s_A` or `s_B` (two per iteration).
-    pub support_calls: u64,
-    /// Number of support-function evaluations: one dot product `(x_j − x_i)·d` per comparison of two
-    /// adjacent vertices during hill climbing.
-    pub support_evals: u64,
-}
-
 /// Warm-start state of GJK for one pair of polygons: the last simplex (vertex indices) and the last
-/// support vertices (hill-climbing hints). Small and `Copy`; keep one per pair.
+/// support vertices (hill-climbing hints). Small and `Copy` (36 bytes); keep one per pair.
+///
+/// It holds no work counters: the global stage keeps one cache per AABB pair and the local
+/// stage one per tracked pair, and both stream through them every update (issue 17: counters
+/// made it 72 bytes). Each call's counts are in its [`GjkOutput`].
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct GjkCache {
     /// Number of simplex points stored (0 = cold).
@@ -82,8 +72,6 @@ pub struct GjkCache {
     hint_a: u32,
     /// Last support vertex of B.
     hint_b: u32,
-    /// Work counters, accumulated over calls.
-    pub stats: GjkStats,
 }
 
 impl GjkCache {
@@ -92,7 +80,7 @@ impl GjkCache {
         Self::default()
     }
 
-    /// Forgets the simplex and hints (keeps the counters), so the next call starts cold.
+    /// Forgets the simplex and hints, so the next call starts cold.
     pub fn reset(&mut self) {
         self.count = 0;
         self.hint_a = 0;
@@ -119,8 +107,12 @@ pub struct GjkOutput {
     pub index_b: [u32; 3],
     /// Barycentric weights `λ_i` of the closest point in the final simplex (sum to 1).
     pub weights: [f64; 3],
-    /// Iterations used by this call.
+    /// Iterations used by this call (support points requested from `C`; each one queries the
+    /// support of A and of B).
     pub iterations: u32,
+    /// Support-function evaluations of this call: one dot product `(x_j − x_i)·d` per comparison
+    /// of two adjacent vertices during hill climbing.
+    pub support_evals: u32,
 }
 
 /// One simplex point: `w = a − b`, its vertices and its barycentric weight.
@@ -358,7 +350,6 @@ impl Simplex {
 /// vertex list gives an infinite distance and an empty simplex.
 pub fn gjk_distance(a: &[Vec2], b: &[Vec2], cache: &mut GjkCache) -> GjkOutput {
     let (na, nb) = (a.len(), b.len());
-    cache.stats.calls += 1;
     if na == 0 || nb == 0 {
         return GjkOutput {
             distance: f64::INFINITY,
@@ -370,6 +361,7 @@ pub fn gjk_distance(a: &[Vec2], b: &[Vec2], cache: &mut GjkCache) -> GjkOutput {
             index_b: [0; 3],
             weights: [0.0; 3],
             iterations: 0,
+            support_evals: 0,
         };
     }
 
@@ -399,6 +391,7 @@ pub fn gjk_distance(a: &[Vec2], b: &[Vec2], cache: &mut GjkCache) -> GjkOutput {
     let mut hint_a = cache.hint_a as usize;
     let mut hint_b = cache.hint_b as usize;
     let mut iterations = 0u32;
+    let mut support_evals = 0u64;
     let mut overlap = simplex.count == 3;
     while !overlap && iterations < GJK_MAX_ITERATIONS {
         let v = simplex.closest();
@@ -409,9 +402,8 @@ pub fn gjk_distance(a: &[Vec2], b: &[Vec2], cache: &mut GjkCache) -> GjkOutput {
         }
         // w = s_C(−v) = s_A(−v) − s_B(v).
         iterations += 1;
-        cache.stats.support_calls += 2;
-        hint_a = support_hill_climb(a, -v, hint_a, &mut cache.stats.support_evals);
-        hint_b = support_hill_climb(b, v, hint_b, &mut cache.stats.support_evals);
+        hint_a = support_hill_climb(a, -v, hint_a, &mut support_evals);
+        hint_b = support_hill_climb(b, v, hint_b, &mut support_evals);
         let w = a[hint_a] - b[hint_b];
         if vv - v.dot(w) <= GJK_EPS_REL * GJK_EPS_REL * vv {
             break;
@@ -434,7 +426,6 @@ pub fn gjk_distance(a: &[Vec2], b: &[Vec2], cache: &mut GjkCache) -> GjkOutput {
             break;
         }
     }
-    cache.stats.iterations += iterations as u64;
 
     // Save the warm-start state.
     cache.count = simplex.count as u8;
@@ -448,6 +439,7 @@ pub fn gjk_distance(a: &[Vec2], b: &[Vec2], cache: &mut GjkCache) -> GjkOutput {
         index_b: [0; 3],
         weights: [0.0; 3],
         iterations,
+        support_evals: support_evals.min(u32::MAX as u64) as u32,
     };
     for k in 0..simplex.count {
         cache.index_a[k] = simplex.v[k].ia;
@@ -496,6 +488,34 @@ mod tests {
         let o2 = gjk_distance(&a, &b, &mut c);
         assert!((o2.distance - 1.5).abs() < 1e-12);
         assert!(o2.iterations <= 1);
+    }
+
+    /// The cache is the warm-start state alone: 36 bytes, which the global stage keeps per AABB
+    /// pair and the local stage per tracked pair (it was 72 with the counters it used to carry).
+    #[test]
+    fn gjk_cache_is_36_bytes() {
+        assert_eq!(std::mem::size_of::<GjkCache>(), 36);
+    }
+
+    /// A call reports its own work: hill climbing from a cold hint over a 12-gon evaluates
+    /// several supports, and the warm call that follows needs fewer.
+    #[test]
+    fn a_call_counts_its_support_evaluations() {
+        let ngon = |cx: f64, n: usize| -> Vec<Vec2> {
+            (0..n)
+                .map(|k| {
+                    let t = std::f64::consts::TAU * k as f64 / n as f64;
+                    Vec2::new(cx + t.cos(), t.sin())
+                })
+                .collect()
+        };
+        let (a, b) = (ngon(0.0, 12), ngon(3.0, 12));
+        let mut c = GjkCache::new();
+        let cold = gjk_distance(&a, &b, &mut c);
+        let warm = gjk_distance(&a, &b, &mut c);
+        assert!(cold.support_evals >= 2 * cold.iterations, "{cold:?}");
+        assert!(cold.support_evals > 6, "{cold:?}");
+        assert!(warm.support_evals < cold.support_evals, "{warm:?}");
     }
 
     #[test]

@@ -27,7 +27,7 @@ mod tracker;
 pub use broad::{required_delta_prox, BroadPhase, BroadStats, DEFAULT_DELTA_PROX};
 pub use collider::Collider;
 pub use gjk::{
-    gjk_distance, support_hill_climb, GjkCache, GjkOutput, GjkStats, GJK_EPS_ABS, GJK_EPS_REL,
+    gjk_distance, support_hill_climb, GjkCache, GjkOutput, GJK_EPS_ABS, GJK_EPS_REL,
     GJK_MAX_ITERATIONS,
 };
 pub use local::{
