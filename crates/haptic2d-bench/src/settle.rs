@@ -279,7 +279,7 @@ pub fn run(
             .join("; ")
     );
     // The tail by phase as well: a phase whose work comes in bursts (a global update that is
-    // not in place sorts its pairs on its last share) shows in its p95, not in its median.
+    // not in place rebuilds its pairs on its last share) shows in its p95, not in its median.
     let p95: Vec<f64> = by_phase
         .iter()
         .map(|v| crate::timing::Samples(v.clone()).quantile(0.95))

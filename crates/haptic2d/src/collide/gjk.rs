@@ -35,7 +35,7 @@
 //!    `x·d`. The walk compares two adjacent vertices with one dot product of their edge vector,
 //!    `(x_{i+1} − x_i)·d`: the cached vertex `i` is the support iff `(x_{i+1} − x_i)·d ≤ 0` and
 //!    `(x_i − x_{i−1})·d ≥ 0`, which costs 2 evaluations, and every step along the boundary costs
-//!    one more. [`GjkStats::support_evals`] counts these dot products; a query that makes `k`
+//!    one more. [`GjkOutput::support_evals`] counts these dot products; a query that makes `k`
 //!    comparisons reads `k + 1` distinct vertices (the cached one and its two neighbours when it
 //!    is still the support).
 //! 2. **Warm start.** The final simplex (vertex indices) is kept in a [`GjkCache`] and re-evaluated
