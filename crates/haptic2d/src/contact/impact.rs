@@ -3,7 +3,7 @@
 //! The caller (the contact manager, §8.2) builds the impact set `𝒞`: every Colliding contact with
 //! restitution `e`, plus every Continuous contact touching a body of a colliding one with restitution 0.
 //! [`ImpactSolver::solve`] then runs §7.2 and applies the velocity jumps to the bodies. Friction is
-//! ignored during the impulse (§7, [REC]) unless [`ImpactSolver::set_friction`] selects
+//! ignored during the impulse (§7, \[REC\]) unless [`ImpactSolver::set_friction`] selects
 //! [`ImpactFriction::Coulomb`]: then every set goes to the frictional solver of issue 16
 //! ([`super::impact_friction`]).
 

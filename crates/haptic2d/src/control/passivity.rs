@@ -29,7 +29,7 @@ pub fn explicit_damping_limit(mass: f64, dt: f64) -> f64 {
 /// How the observer pairs force and motion.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum EnergyPairing {
-    /// ZOH-consistent pairing (default, [DER]): the force held over the previous interval times the
+    /// ZOH-consistent pairing (default, \[DER\]): the force held over the previous interval times the
     /// displacement it produced, `E_obs,k = E_obs,k−1 − F_out,k−1·(x_k − x_{k−1})`.
     #[default]
     ZohConsistent,

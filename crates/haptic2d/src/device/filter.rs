@@ -43,7 +43,7 @@ impl VelocityFilter {
     /// Like [`update`](Self::update), for a sample taken `elapsed` seconds after the previous one
     /// (a late tick): the difference is divided by the measured interval and the filter coefficient
     /// is that of the interval, `α = 1 − exp(−2π·f_v·elapsed)`, so a handle moving steadily reads the
-    /// same speed whether the tick came on time or late. `elapsed == T` is exactly [`update`]; a
+    /// same speed whether the tick came on time or late. `elapsed == T` is exactly [`update`](Self::update); a
     /// non-finite or non-positive `elapsed` is taken as `T`.
     pub fn update_elapsed(&mut self, x: &V3, elapsed: f64) -> V3 {
         if !self.initialized {

@@ -27,7 +27,7 @@ pub enum AdhesionMap {
 
 /// Hayward–Armstrong elasto-plastic friction (§2). Parameters are public; the state (`z`) is private.
 ///
-/// Load dependence [REC]: `z_max = μk·F_n/k`, `z_stick = r_stick·z_max`; the single force level is
+/// Load dependence \[REC\]: `z_max = μk·F_n/k`, `z_stick = r_stick·z_max`; the single force level is
 /// `k·z_max = μk·F_n` (no separate static peak, so `μs` is not a parameter).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct HaywardArmstrong {

@@ -8,7 +8,7 @@ use super::{check_nonneg, NormalInput, NormalLaw};
 /// The history uses the **signed** gap (`δ_j := −d_j` even outside), so at onset the previous samples
 /// are negative penetrations. With fewer than three samples of history `δ̃_k = δ_k`.
 ///
-/// Predictor–corrector option ([REC]): `F_w,k = max(0, K·(δ̃_k + δ̄_{k−1} − δ̃^{used}_{k−1}))`, where
+/// Predictor–corrector option (\[REC\]): `F_w,k = max(0, K·(δ̃_k + δ̄_{k−1} − δ̃^{used}_{k−1}))`, where
 /// `δ̄_{k−1} = (δ_{k−1} + δ_k)/2` is the mean penetration actually seen over the last interval
 /// (clamped penetrations, `δ_j = max(0, −d_j)`) and `δ̃^{used}_{k−1} = F_w,k−1/K` is the estimate that was
 /// actually held at `k−1` (0 if the wall was inactive then).

@@ -4,7 +4,7 @@ use super::{check_nonneg, NormalInput, NormalLaw};
 
 /// `F_w,k = K·δ_k`, held over the sample.
 ///
-/// Energy [DER]: the held force is `Kδ_k` but the spring energy changes as if the force were the
+/// Energy \[DER\]: the held force is `Kδ_k` but the spring energy changes as if the force were the
 /// average `K(δ_k + δ_{k+1})/2`, so the wall returns `½K(δ_{k+1} − δ_k)²` more energy than it absorbed
 /// every sample: it is active.
 #[derive(Clone, Copy, Debug, PartialEq)]
