@@ -5,7 +5,7 @@
 //!   linkages on one board's 4 ports), DEVICES §1–§3.
 //! - [`udp`]: the open UDP device protocol for custom hardware and other programs
 //!   (docs/DEVICE-PROTOCOL.md).
-//! - [`inverse3`] (feature `inverse3`): Haply's Inverse3 through its Inverse Service and the `haply`
+//! - `inverse3` (feature `inverse3`): Haply's Inverse3 through its Inverse Service and the `haply`
 //!   client crate, in planar mode, and an emulator of the service (DEVICES §4).
 #![warn(missing_docs)]
 

@@ -90,7 +90,7 @@ pub struct Fig5Params {
     /// viscous friction `f_v` of `haptic.device` is replaced by the value that gives the handle an x
     /// damping `b_x = f_v·(J_aᵀJ_a)_xx = m·K·T/2` at its start pose, `K` = [`WALL_STIFFNESS`], `T` the
     /// control period (see [`colgate_joint_damping`]); `None`: `haptic.device.f_v` as given (the spec's
-    /// [REC] 1e-4 N·m·s/rad by default, i.e. m ≈ 0.014). Default `None` (the spec device);
+    /// \[REC\] 1e-4 N·m·s/rad by default, i.e. m ≈ 0.014). Default `None` (the spec device);
     /// [`Fig5Params::calibrated_damping`] uses 2.
     pub colgate_margin: Option<f64>,
     /// The haptic system's safety settings (start-up ramp, stall limit, torque trip margin).
