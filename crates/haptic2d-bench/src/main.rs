@@ -47,7 +47,10 @@ struct Args {
     /// Timed steps per engine and scene (1 ms each).
     #[arg(long, default_value_t = 2000)]
     steps: usize,
-    /// Untimed steps per engine before timing (the pile settles in them).
+    /// Untimed steps per engine before timing. With the default (1 s), pile:100 is at rest
+    /// before timing starts (every engine from 0.16 s at most), but pile:1000 is still settling:
+    /// haptic2d's comes to rest at 2.15 s, Box2D's (4 substeps) at 3.03 s, rapier2d's at 3.31 s
+    /// (`--rest-time`).
     #[arg(long, default_value_t = 1000)]
     warmup: usize,
     /// Steps per interleaved chunk (engines alternate every chunk).
