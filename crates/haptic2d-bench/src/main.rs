@@ -359,6 +359,7 @@ fn run(args: &Args) -> Result<(), String> {
                 median_us: t.median(),
                 p99_us: t.p99(),
                 p99_warm_us: t.without_chunk_starts(args.chunk).p99(),
+                chunk_start_us: t.chunk_starts(args.chunk).median(),
                 state,
             })
             .collect();
@@ -371,6 +372,7 @@ fn run(args: &Args) -> Result<(), String> {
                 median_us: reference_samples.median(),
                 p99_us: reference_samples.p99(),
                 p99_warm_us: reference_samples.without_chunk_starts(args.chunk).p99(),
+                chunk_start_us: reference_samples.chunk_starts(args.chunk).median(),
             },
         });
     }

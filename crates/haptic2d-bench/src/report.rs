@@ -18,6 +18,10 @@ pub struct EngineResult {
     /// 99th-percentile step time (µs) without the first step of each interleaved chunk (the
     /// step that runs right after the other engines, with its data evicted from the caches).
     pub p99_warm_us: f64,
+    /// Median of the first steps of the interleaved chunks (µs): what a step costs right after
+    /// the other engines ran. They are `1/chunk` of the steps (2 % by default), so when they
+    /// cost more than the others they alone set the p99.
+    pub chunk_start_us: f64,
     /// Settle state after the run.
     pub state: State,
 }
@@ -35,6 +39,8 @@ pub struct ReferenceResult {
     pub p99_us: f64,
     /// 99th-percentile step time (µs) without the first step of each interleaved chunk.
     pub p99_warm_us: f64,
+    /// Median of the first steps of the interleaved chunks (µs).
+    pub chunk_start_us: f64,
 }
 
 /// One line of the comparison: haptic2d first, then the other engines.
@@ -81,15 +87,24 @@ pub fn table(rows: &[Row]) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "{:<13} {:>5} | {:<15} {:>10} {:>10} {:>7} {:>8} | {:>7} {:>7}",
-        "scene", "n", "engine", "median µs", "p99 µs", "p99/med", "warm/med", "ratio", "p99 rat"
+        "{:<13} {:>5} | {:<15} {:>10} {:>10} {:>7} {:>8} {:>9} | {:>7} {:>7}",
+        "scene",
+        "n",
+        "engine",
+        "median µs",
+        "p99 µs",
+        "p99/med",
+        "warm/med",
+        "start/med",
+        "ratio",
+        "p99 rat"
     );
-    let _ = writeln!(s, "{}", "-".repeat(95));
+    let _ = writeln!(s, "{}", "-".repeat(105));
     for r in rows {
         for (k, e) in r.engines.iter().enumerate() {
             let _ = writeln!(
                 s,
-                "{:<13} {:>5} | {:<15} {:>10.2} {:>10.2} {:>7.2} {:>8.2} | {:>7.3} {:>7.3}",
+                "{:<13} {:>5} | {:<15} {:>10.2} {:>10.2} {:>7.2} {:>8.2} {:>9.2} | {:>7.3} {:>7.3}",
                 r.scene,
                 r.n,
                 e.key,
@@ -97,6 +112,7 @@ pub fn table(rows: &[Row]) -> String {
                 e.p99_us,
                 e.p99_us / e.median_us,
                 e.p99_warm_us / e.median_us,
+                e.chunk_start_us / e.median_us,
                 r.ratio(k),
                 r.ratio_p99(k)
             );
@@ -104,7 +120,7 @@ pub fn table(rows: &[Row]) -> String {
         let e = &r.reference;
         let _ = writeln!(
             s,
-            "{:<13} {:>5} | {:<15} {:>10.2} {:>10.2} {:>7.2} {:>8.2} | {:>7} {:>7}",
+            "{:<13} {:>5} | {:<15} {:>10.2} {:>10.2} {:>7.2} {:>8.2} {:>9.2} | {:>7} {:>7}",
             r.scene,
             r.n,
             REFERENCE,
@@ -112,6 +128,7 @@ pub fn table(rows: &[Row]) -> String {
             e.p99_us,
             e.p99_us / e.median_us,
             e.p99_warm_us / e.median_us,
+            e.chunk_start_us / e.median_us,
             "—",
             "—"
         );
@@ -160,10 +177,11 @@ fn num(x: f64) -> String {
 /// "rapier2d_median_us", "rapier2d_p99_us", "ratio", "box2d_median_us", "box2d_p99_us",
 /// "ratio_box2d", "ratio_p99_box2d", ...}`: for every engine `K` but haptic2d `K_median_us`,
 /// `K_p99_us`, `ratio_K` and `ratio_p99_K` (`ratio` alone is rapier2d's, as before), for every
-/// engine `K_p99_warm_us` (the p99 without the first step of each interleaved chunk) and the settle
-/// state `K_max_speed`, `K_moving`, `K_mean_height`, `K_max_overlap` (SI units); and the reference
-/// workload's `reference_median_us`, `reference_p99_us`, `reference_p99_warm_us` and
-/// `reference_bytes`.
+/// engine `K_p99_warm_us` (the p99 without the first step of each interleaved chunk),
+/// `K_chunk_start_us` (the median of those first steps) and the settle state `K_max_speed`,
+/// `K_moving`, `K_mean_height`, `K_max_overlap` (SI units); and the reference workload's
+/// `reference_median_us`, `reference_p99_us`, `reference_p99_warm_us`,
+/// `reference_chunk_start_us` and `reference_bytes`.
 pub fn json(rows: &[Row]) -> String {
     let items: Vec<String> = rows
         .iter()
@@ -176,6 +194,11 @@ pub fn json(rows: &[Row]) -> String {
                 f.push(format!("\"{}_median_us\": {}", e.key, num(e.median_us)));
                 f.push(format!("\"{}_p99_us\": {}", e.key, num(e.p99_us)));
                 f.push(format!("\"{}_p99_warm_us\": {}", e.key, num(e.p99_warm_us)));
+                f.push(format!(
+                    "\"{}_chunk_start_us\": {}",
+                    e.key,
+                    num(e.chunk_start_us)
+                ));
                 if k > 0 {
                     if e.key == "rapier2d" {
                         f.push(format!("\"ratio\": {}", num(r.ratio(k))));
@@ -206,6 +229,10 @@ pub fn json(rows: &[Row]) -> String {
             f.push(format!(
                 "\"{REFERENCE}_p99_warm_us\": {}",
                 num(e.p99_warm_us)
+            ));
+            f.push(format!(
+                "\"{REFERENCE}_chunk_start_us\": {}",
+                num(e.chunk_start_us)
             ));
             f.push(format!("\"{REFERENCE}_bytes\": {}", e.bytes));
             format!("  {{{}}}", f.join(", "))

@@ -71,6 +71,12 @@ impl Samples {
                 .collect(),
         )
     }
+    /// The first step of each chunk of these samples (see
+    /// [`without_chunk_starts`](Self::without_chunk_starts)): what a step costs right after the
+    /// other engines ran.
+    pub fn chunk_starts(&self, chunk: usize) -> Samples {
+        Samples(self.0.iter().step_by(chunk.max(1)).copied().collect())
+    }
 }
 
 /// Most warm-up steps of each calibration window of [`interleaved`].
