@@ -202,8 +202,8 @@ pub struct BroadPhase {
     /// The pairs of the update in progress that ran GJK (or were not in the published update).
     tested: Vec<Tested>,
     /// The pairs of the update in progress whose published distance was reused: their index in
-    /// the published arrays, whose cache, distance and odometer reference they keep (copied into
-    /// `tested` only if the update is not done in place).
+    /// the published arrays, whose cache, distance and odometer reference they keep (read from
+    /// there by the merge of `fill_ready` when the update is not done in place).
     kept: Vec<u32>,
     /// The pairs of the update in progress that the published update did not have: their
     /// indices in `tested`, in the order met.

@@ -360,7 +360,7 @@ impl FeatureTracker {
         Some((self.feature_a?, self.feature_b?))
     }
 
-    /// The GJK warm-start cache of this pair (its counters include the initialisations).
+    /// The GJK warm-start cache of this pair.
     pub fn gjk_cache(&self) -> &GjkCache {
         &self.gjk
     }
