@@ -2,33 +2,71 @@
 //! free list, so records stay small and creating or releasing a contact never allocates after
 //! warm-up.
 //!
-//! The slots are compact (144 bytes, `contact/compact_law.rs`) until a record needs the
-//! hysteretic wall; then every slot is widened once to the whole [`NormalModel`] (272 bytes) and
-//! the pool stays wide. Either way a slot holds the same law with the same state. Widening
-//! allocates once, in the sample that creates the first such record: in the warm-up for a scene
-//! whose prototype is the wall, later only if the prototype is switched to it mid-run.
+//! The slots come in three forms, each holding the same laws with the same states:
+//! - **lean** (40 bytes, `contact/lean_law.rs`): while every live record has the paper's pair of
+//!   laws ([`PaperLaw`] and [`ResetIntegrator`]) with the same parameters, kept once;
+//! - **compact** (144 bytes, `contact/compact_law.rs`): any law but the hysteretic wall;
+//! - **whole** (272 bytes): any law.
+//!
+//! The pool starts lean and moves on to the next form when the prototypes need it (another law,
+//! or other parameters while records live, in a lean pool; the hysteretic wall in a compact one),
+//! converting every slot once and keeping slot numbers; it never moves back. Converting allocates
+//! once, at the start of the sample that first runs with such prototypes
+//! ([`LawPool::prepare`]): a scene's first sample, or the one after the prototypes are changed
+//! mid-run.
 
 use super::compact_law::CompactNormal;
+use super::lean_law::LeanStore;
 use super::record::{LawState, VeContact, NO_LAW};
-use crate::laws::friction::FrictionModel;
-use crate::laws::normal::{ContactNormal, NormalLaw, NormalModel};
+use crate::laws::friction::{FrictionLaw, FrictionModel, ResetIntegrator};
+use crate::laws::normal::{ContactNormal, NormalLaw, NormalModel, PaperLaw};
 
 /// Slots of law states, addressed by [`VeContact::law`].
 #[derive(Clone, Debug)]
 pub(crate) struct LawPool {
-    /// The slots, in one of their two forms.
+    /// The slots, in one of their three forms.
     slots: Slots,
     /// Free slots, reused last-in first-out.
     free: Vec<u32>,
 }
 
-/// The pool's slots: compact while no record needs the hysteretic wall, whole afterwards.
+/// The pool's slots: lean while every live record has the paper's laws with the same parameters,
+/// compact while no record needs the hysteretic wall, whole afterwards.
 #[derive(Clone, Debug)]
 pub(crate) enum Slots {
+    /// The paper's pair of laws with shared parameters, 40 bytes a slot.
+    Lean(LeanStore),
     /// Every law but the hysteretic wall, 144 bytes a slot.
     Compact(Store<CompactNormal>),
     /// Any law, 272 bytes a slot.
     Whole(Store<NormalModel>),
+}
+
+/// The form of the slots (for tests).
+#[cfg(test)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum SlotForm {
+    /// [`Slots::Lean`].
+    Lean,
+    /// [`Slots::Compact`].
+    Compact,
+    /// [`Slots::Whole`].
+    Whole,
+}
+
+/// What the force pass needs of a form of slots: the laws of a slot, lent to `f`.
+pub(crate) trait SlotAccess {
+    /// The normal law's type in this form.
+    type Normal: NormalLaw + Copy;
+    /// The friction model's type in this form.
+    type Friction: FrictionLaw + Copy;
+    /// Runs `f` on the laws of `slot` (a slot handed out by [`LawPool::acquire`] and not
+    /// released), keeping what it changes.
+    fn with<R>(
+        &mut self,
+        slot: u32,
+        f: impl FnOnce(&mut LawState<Self::Normal, Self::Friction>) -> R,
+    ) -> R;
 }
 
 /// The slots of one form.
@@ -81,23 +119,59 @@ impl<N: NormalLaw + Copy> Store<N> {
     }
 }
 
+impl<N: NormalLaw + Copy> SlotAccess for Store<N> {
+    type Normal = N;
+    type Friction = FrictionModel;
+    #[inline(always)]
+    fn with<R>(&mut self, slot: u32, f: impl FnOnce(&mut LawState<N>) -> R) -> R {
+        f(self.get_mut(slot))
+    }
+}
+
+impl SlotAccess for LeanStore {
+    type Normal = PaperLaw;
+    type Friction = ResetIntegrator;
+    #[inline(always)]
+    fn with<R>(
+        &mut self,
+        slot: u32,
+        f: impl FnOnce(&mut LawState<PaperLaw, ResetIntegrator>) -> R,
+    ) -> R {
+        let mut laws = self.laws(slot);
+        let r = f(&mut laws);
+        self.store(slot, &laws);
+        r
+    }
+}
+
 impl LawPool {
-    /// An empty pool of compact slots with room for `n` records.
+    /// An empty pool of lean slots with room for `n` records.
     pub(crate) fn with_capacity(n: usize) -> Self {
         Self {
-            slots: Slots::Compact(Store::with_capacity(n)),
+            slots: Slots::Lean(LeanStore::with_capacity(n)),
             free: Vec::with_capacity(n),
         }
     }
 
     /// A slot holding copies of the prototypes `normal` and `friction`, begun at the god-object
-    /// entry point `s_entry` (m, [`LawState::begin`]). The first hysteretic wall widens the pool.
+    /// entry point `s_entry` (m, [`LawState::begin`]). A record that the slots' form cannot hold
+    /// moves the pool on to the next form (module docs).
     pub(crate) fn acquire(
         &mut self,
         normal: &NormalModel,
         friction: &FrictionModel,
         s_entry: f64,
     ) -> u32 {
+        if let Slots::Lean(store) = &mut self.slots {
+            if let (NormalModel::Paper(paper), FrictionModel::ResetIntegrator(reset)) =
+                (normal, friction)
+            {
+                if store.takes(paper, reset, self.free.len()) {
+                    return store.put(&mut self.free, paper, reset, s_entry);
+                }
+            }
+            self.leave_lean();
+        }
         if let Slots::Compact(store) = &mut self.slots {
             if let Some(model) = CompactNormal::from_model(normal) {
                 let mut fresh = LawState {
@@ -120,14 +194,51 @@ impl LawPool {
         store.put(&mut self.free, fresh)
     }
 
-    /// True while the slots are compact.
-    #[cfg(test)]
-    pub(crate) fn is_compact(&self) -> bool {
-        matches!(self.slots, Slots::Compact(_))
+    /// Moves the pool on to the form that records with the prototypes `normal` and `friction`
+    /// need, unless it is in that form or a later one already. The contact set calls it at the
+    /// start of every sample, so that a conversion (which allocates once) happens in a scene's
+    /// first sample, before any contact, or in the sample where the prototypes change, not in
+    /// the sample that creates the first record needing it.
+    pub(crate) fn prepare(&mut self, normal: &NormalModel, friction: &FrictionModel) {
+        if let Slots::Lean(store) = &self.slots {
+            let fits = match (normal, friction) {
+                (NormalModel::Paper(paper), FrictionModel::ResetIntegrator(reset)) => {
+                    store.takes(paper, reset, self.free.len())
+                }
+                _ => false,
+            };
+            if !fits {
+                self.leave_lean();
+            }
+        }
+        if matches!(self.slots, Slots::Compact(_)) && CompactNormal::from_model(normal).is_none() {
+            self.widen();
+        }
     }
 
-    /// Converts every compact slot (free ones too, so slot numbers stay) to the whole form.
+    /// The form of the slots.
+    #[cfg(test)]
+    pub(crate) fn form(&self) -> SlotForm {
+        match self.slots {
+            Slots::Lean(_) => SlotForm::Lean,
+            Slots::Compact(_) => SlotForm::Compact,
+            Slots::Whole(_) => SlotForm::Whole,
+        }
+    }
+
+    /// Converts every lean slot (free ones too, so slot numbers stay) to the compact form.
+    pub(crate) fn leave_lean(&mut self) {
+        if let Slots::Lean(store) = &self.slots {
+            let mut compact = Store::with_capacity(store.capacity());
+            compact.states.extend(store.compact());
+            self.slots = Slots::Compact(compact);
+        }
+    }
+
+    /// Converts every lean or compact slot (free ones too, so slot numbers stay) to the whole
+    /// form.
     pub(crate) fn widen(&mut self) {
+        self.leave_lean();
         if let Slots::Compact(store) = &self.slots {
             let room = store.states.capacity().max(store.spare.capacity());
             let mut whole = Store::with_capacity(room);
@@ -149,6 +260,7 @@ impl LawPool {
     /// valid length `hist` ([`ContactNormal::impact_resolved`]).
     pub(crate) fn impact_resolved(&mut self, slot: u32, d: [f64; 3], hist: u8) {
         match &mut self.slots {
+            Slots::Lean(s) => s.with(slot, |l| l.normal.impact_resolved(d, hist)),
             Slots::Compact(s) => s.get_mut(slot).normal.impact_resolved(d, hist),
             Slots::Whole(s) => s.get_mut(slot).normal.impact_resolved(d, hist),
         }
@@ -157,10 +269,11 @@ impl LawPool {
     /// Moves the states of `records` (every entry whose `law` is a slot) into slots `0, 1, 2, …`
     /// in their order, and drops the free slots: the per-sample force pass, which walks the
     /// records in key order, then reads the pool front to back instead of at random (a law state
-    /// is 144 or 272 bytes, 2–5 cache lines, missed each when scattered). The states themselves
-    /// are unchanged.
+    /// is 40, 144 or 272 bytes, up to 5 cache lines, missed each when scattered). The states
+    /// themselves are unchanged.
     pub(crate) fn repack(&mut self, records: &mut [VeContact]) {
         match &mut self.slots {
+            Slots::Lean(s) => s.repack(records),
             Slots::Compact(s) => s.repack(records),
             Slots::Whole(s) => s.repack(records),
         }
@@ -171,6 +284,7 @@ impl LawPool {
     pub(crate) fn get(&self, slot: u32) -> Option<LawState> {
         let i = slot as usize;
         match &self.slots {
+            Slots::Lean(s) => s.whole(slot),
             Slots::Compact(s) => s.states.get(i).map(LawState::<CompactNormal>::widen),
             Slots::Whole(s) => s.states.get(i).copied(),
         }
@@ -269,6 +383,64 @@ mod tests {
         assert_eq!(kcs, before);
         // The pool hands out new slots after the packed ones.
         assert_eq!(pool.acquire(&normal(1.0), &FrictionModel::None, 0.0), 6);
+    }
+
+    fn paper_pair(kr: f64) -> (NormalModel, FrictionModel) {
+        (
+            NormalModel::Paper(PaperLaw::new(1e5, 40.0)),
+            FrictionModel::ResetIntegrator(ResetIntegrator::new(kr, 0.5, 0.45, 20.0)),
+        )
+    }
+
+    /// A record whose prototype has other parameters moves a lean pool to the compact form:
+    /// every slot keeps its number and its state (offset, law, friction), free slots stay free,
+    /// and the new slot has the new parameters.
+    #[test]
+    fn a_changed_prototype_leaves_the_lean_form_keeping_every_slot() {
+        let mut pool = LawPool::with_capacity(2);
+        let (normal, friction) = paper_pair(5e4);
+        let slots: Vec<u32> = (0..5)
+            .map(|i| pool.acquire(&normal, &friction, 0.01 * i as f64))
+            .collect();
+        assert_eq!(pool.form(), SlotForm::Lean);
+        pool.impact_resolved(slots[3], [-0.002, 0.001, 0.0], 3);
+        pool.release(slots[2]);
+        let before: Vec<LawState> = slots.iter().map(|&s| pool.get(s).unwrap()).collect();
+        assert_eq!(before[3].normal.offset(), 0.002);
+        let (_, other) = paper_pair(4e4);
+        assert_eq!(pool.acquire(&normal, &other, 0.5), slots[2]);
+        assert_eq!(pool.form(), SlotForm::Compact);
+        for (i, &s) in slots.iter().enumerate().filter(|(i, _)| *i != 2) {
+            let after = pool.get(s).unwrap();
+            assert_eq!(after.normal.offset(), before[i].normal.offset(), "slot {s}");
+            assert_eq!(after.normal.model, before[i].normal.model, "slot {s}");
+            assert_eq!(after.friction, before[i].friction, "slot {s}");
+        }
+        assert_eq!(pool.get(slots[2]).unwrap().friction, other);
+        // A record with the first parameters still gets a slot, now compact.
+        assert_eq!(pool.acquire(&normal, &friction, 0.0), 5);
+        assert_eq!(pool.get(5).unwrap().friction, friction);
+    }
+
+    /// A lean pool with no live slot takes the next record's parameters and stays lean; with a
+    /// live slot it does not.
+    #[test]
+    fn a_lean_pool_without_live_slots_takes_new_parameters() {
+        let mut pool = LawPool::with_capacity(2);
+        let (normal, friction) = paper_pair(5e4);
+        let (_, other) = paper_pair(4e4);
+        let (a, b) = (
+            pool.acquire(&normal, &friction, 0.0),
+            pool.acquire(&normal, &friction, 0.0),
+        );
+        pool.release(a);
+        pool.release(b);
+        let c = pool.acquire(&normal, &other, 0.0);
+        assert_eq!(pool.form(), SlotForm::Lean);
+        assert_eq!(pool.get(c).unwrap().friction, other);
+        pool.acquire(&normal, &friction, 0.0);
+        assert_eq!(pool.form(), SlotForm::Compact);
+        assert_eq!(pool.get(c).unwrap().friction, other);
     }
 
     /// The first hysteretic wall widens the pool: every slot keeps its number and its state

@@ -7,6 +7,7 @@ pub mod impact_friction;
 pub mod impact_mlcp;
 mod law_pool;
 pub mod lcp;
+mod lean_law;
 mod manager;
 mod params;
 mod record;

@@ -22,11 +22,15 @@ pub const NO_LAW: u32 = u32::MAX;
 /// every sample. With the whole [`NormalModel`] (`N`, the default) a slot is 272 bytes, sized
 /// for the hysteretic wall's elements; the contact set's pool stores the other laws in 144-byte
 /// slots of a compact model instead (`contact/compact_law.rs`) while no record needs the wall.
+///
+/// `F` is the friction model's type: [`FrictionModel`] (the default) in the pool's compact and
+/// whole slots; the lean slots (`contact/lean_law.rs`) hand the force pass the reset integrator
+/// itself.
 #[derive(Clone, Copy, Debug)]
 #[repr(C)]
-pub struct LawState<N = NormalModel> {
+pub struct LawState<N = NormalModel, F = FrictionModel> {
     /// Friction-model state (a copy of the world's prototype, taken when the record was created).
-    pub friction: FrictionModel,
+    pub friction: F,
     /// Normal-law state (a copy of the world's prototype, taken when the record was created) with
     /// the surface offset of a resolved impact ([`ContactNormal`], docs/MODELS.md §F.7).
     pub normal: ContactNormal<N>,
@@ -41,7 +45,7 @@ pub enum ContactState {
     Continuous,
 }
 
-impl<N: NormalLaw> LawState<N> {
+impl<N: NormalLaw, F: FrictionLaw> LawState<N, F> {
     /// Starts a new contact whose god-object entry point is at edge coordinate `s_entry` (m): the
     /// normal law is reset and the friction model begins there (§8.3).
     #[inline]

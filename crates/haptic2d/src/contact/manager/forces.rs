@@ -4,7 +4,7 @@
 use super::ContactSet;
 use super::Wrench2;
 use crate::body::Body;
-use crate::contact::law_pool::{Slots, Store};
+use crate::contact::law_pool::{SlotAccess, Slots};
 use crate::contact::record::{ContactState, LawState, LoadedContact, VeContact};
 use crate::geom::{cross, Vec2};
 use crate::laws::friction::{FrictionInput, FrictionLaw, FrictionModel};
@@ -34,6 +34,7 @@ impl ContactSet {
         // One pass per form of the law slots (`LawPool`), so the per-record loop has no branch on
         // it.
         let (stored, records, breaks) = match self.laws.slots_mut() {
+            Slots::Lean(store) => pass.run(store),
             Slots::Compact(store) => pass.run(store),
             Slots::Whole(store) => pass.run(store),
         };
@@ -65,7 +66,7 @@ impl ForcePass<'_> {
     /// Runs the pass with the law slots `laws`: returns the stored energy (J), the number of
     /// Continuous records, and how many of them have a law slot that does not follow the
     /// previous record's (see `LawPool::repack`).
-    fn run<N: NormalLaw + Copy>(self, laws: &mut Store<N>) -> (f64, usize, usize) {
+    fn run<S: SlotAccess>(self, laws: &mut S) -> (f64, usize, usize) {
         let (dt, bodies, needs_ext) = (self.dt, self.bodies, self.needs_ext);
         let wrenches = self.wrenches;
         let mut stored = 0.0;
@@ -80,7 +81,6 @@ impl ForcePass<'_> {
             records += 1;
             breaks += (e.law != last_slot.wrapping_add(1)) as usize;
             last_slot = e.law;
-            let law = laws.get_mut(e.law);
             let input = NormalInput {
                 d: e.d,
                 hist: e.hist,
@@ -88,7 +88,19 @@ impl ForcePass<'_> {
                 dt,
                 m_eff: e.m_eff,
             };
-            e.f_n = law.normal.force(&input);
+            // Normal force, then (one pass per contact unless the model needs every normal force
+            // first) friction, on the slot's laws.
+            let energy = laws.with(e.law, |law| {
+                e.f_n = law.normal.force(&input);
+                if needs_ext {
+                    return None;
+                }
+                friction_step(e, law, dt, 0.0);
+                Some(law.normal.stored_energy() + law.friction.stored_energy())
+            });
+            if let Some(u) = energy {
+                stored += u;
+            }
             if e.f_n > 0.0 {
                 self.loaded.push(LoadedContact {
                     key: e.key,
@@ -100,9 +112,8 @@ impl ForcePass<'_> {
                 });
             }
             add_force(wrenches, bodies, e.body_a, e.body_b, e.n * e.f_n, e.point);
-            if !needs_ext {
-                friction_step(e, law, dt, 0.0, wrenches, bodies);
-                stored += law.normal.stored_energy() + law.friction.stored_energy();
+            if !needs_ext && e.f_t != 0.0 {
+                add_force(wrenches, bodies, e.body_a, e.body_b, e.t() * e.f_t, e.point);
             }
         }
         if needs_ext {
@@ -115,9 +126,13 @@ impl ForcePass<'_> {
                 }
                 let f_ext_t = external_share(self.entries, self.nonfric, idx);
                 let e = &mut self.entries[idx];
-                let law = laws.get_mut(e.law);
-                friction_step(e, law, dt, f_ext_t, wrenches, bodies);
-                stored += law.normal.stored_energy() + law.friction.stored_energy();
+                stored += laws.with(e.law, |law| {
+                    friction_step(e, law, dt, f_ext_t);
+                    law.normal.stored_energy() + law.friction.stored_energy()
+                });
+                if e.f_t != 0.0 {
+                    add_force(wrenches, bodies, e.body_a, e.body_b, e.t() * e.f_t, e.point);
+                }
             }
         }
         (stored, records, breaks)
@@ -149,16 +164,14 @@ fn external_share(entries: &[VeContact], nonfric: &[Vec2], idx: usize) -> f64 {
     }
 }
 
-/// Friction force of one Continuous record for this sample (after its normal force), and its
-/// god-object (§8.3).
+/// Friction force of one Continuous record for this sample (after its normal force), into
+/// `e.f_t`, and its god-object (§8.3).
 #[inline(always)]
-fn friction_step<N>(
+fn friction_step<N, F: FrictionLaw>(
     e: &mut VeContact,
-    law: &mut LawState<N>,
+    law: &mut LawState<N, F>,
     dt: f64,
     f_ext_t: f64,
-    wrenches: &mut [Wrench2],
-    bodies: &[Body],
 ) {
     let input = FrictionInput {
         ds: e.s - e.s_prev,
@@ -170,9 +183,6 @@ fn friction_step<N>(
     };
     e.f_t = law.friction.update(&input);
     e.s_g = law.friction.anchor(e.s).unwrap_or(e.s.clamp(0.0, e.len));
-    if e.f_t != 0.0 {
-        add_force(wrenches, bodies, e.body_a, e.body_b, e.t() * e.f_t, e.point);
-    }
 }
 
 #[inline(always)]

@@ -145,10 +145,16 @@ impl ContactSet {
         self.laws.widen();
     }
 
-    /// True while the law states are in the compact form (`contact/compact_law.rs`).
+    /// Stores the law states in the compact form from now on (`LawPool`), for the crate's tests.
     #[cfg(test)]
-    pub(crate) fn law_slots_compact(&self) -> bool {
-        self.laws.is_compact()
+    pub(crate) fn compact_law_slots(&mut self) {
+        self.laws.leave_lean();
+    }
+
+    /// The form the law states are stored in (`LawPool`).
+    #[cfg(test)]
+    pub(crate) fn law_slot_form(&self) -> crate::contact::law_pool::SlotForm {
+        self.laws.form()
     }
 
     /// A copy of the law states of record `e` (an entry of [`entries`](Self::entries)); `None` for
@@ -232,6 +238,7 @@ impl ContactSet {
         self.events.clear();
         self.last_impact_loss = 0.0;
         self.resize_body_buffers(bodies.len());
+        self.laws.prepare(normal, friction);
         self.sync(tick, candidates, from_scan, colliders, bodies, rots, past);
         self.release(tick);
         self.hand_over(tick, colliders, bodies, past, normal, friction);

@@ -102,6 +102,26 @@ impl ResetIntegrator {
     pub fn strain(&self) -> f64 {
         self.p
     }
+    /// The per-contact state: strain `p` (m), the stiffness of the last sample (N/m) and the
+    /// mode (the lean law slots keep only this, `contact/lean_law.rs`).
+    #[inline(always)]
+    pub(crate) fn state(&self) -> (f64, f64, FrictionMode) {
+        (self.p, self.k_used, self.mode)
+    }
+    /// These parameters with the per-contact state `(p, k_used, mode)` of [`state`](Self::state).
+    #[inline(always)]
+    pub(crate) fn with_state(mut self, (p, k_used, mode): (f64, f64, FrictionMode)) -> Self {
+        self.p = p;
+        self.k_used = k_used;
+        self.mode = mode;
+        self
+    }
+    /// True if `other` has bit for bit the same parameters (`Kr`, `μs`, `μk`, `β`, load scaling
+    /// and fixed `p0`), whatever either's state.
+    pub(crate) fn same_params(&self, other: &Self) -> bool {
+        let bits = |m: &Self| [m.kr, m.mu_s, m.mu_k, m.beta, m.p0_fixed].map(f64::to_bits);
+        bits(self) == bits(other) && self.scaling == other.scaling
+    }
     /// The parameter keys accepted by [`ResetIntegrator::set_param`] (`p0` is the fixed strain limit of
     /// [`LoadScaling::Stiffness`]).
     pub const KEYS: &'static [&'static str] = &["kr", "mu_s", "mu_k", "beta", "p0"];

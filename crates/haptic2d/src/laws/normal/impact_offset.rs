@@ -49,6 +49,13 @@ impl<M: NormalLaw> ContactNormal<M> {
         self.offset
     }
 
+    /// The law `model` with surface offset `offset` (m; the lean law slots keep the offset apart
+    /// from the law, `contact/lean_law.rs`).
+    #[inline(always)]
+    pub(crate) fn with_offset(model: M, offset: f64) -> Self {
+        Self { model, offset }
+    }
+
     /// The same offset with the law converted by `f` (the contact set's compact and whole slots).
     pub(crate) fn map<N>(self, f: impl FnOnce(M) -> N) -> ContactNormal<N> {
         ContactNormal {

@@ -39,6 +39,22 @@ impl PaperLaw {
     pub fn per_contact() -> Self {
         Self::new(1000.0, 5.0)
     }
+    /// The per-contact state: the stored energy of the last sample (J; the lean law slots keep
+    /// only this, `contact/lean_law.rs`).
+    #[inline(always)]
+    pub(crate) fn state(&self) -> f64 {
+        self.stored
+    }
+    /// These parameters with the per-contact state `stored` of [`state`](Self::state).
+    #[inline(always)]
+    pub(crate) fn with_state(mut self, stored: f64) -> Self {
+        self.stored = stored;
+        self
+    }
+    /// True if `other` has bit for bit the same `Kc` and `Bc`, whatever either's state.
+    pub(crate) fn same_params(&self, other: &Self) -> bool {
+        self.kc.to_bits() == other.kc.to_bits() && self.bc.to_bits() == other.bc.to_bits()
+    }
     /// Checks the parameters; the error names the bad one.
     pub fn validate(&self) -> Result<(), String> {
         check_nonneg("paper", "kc", self.kc)?;
