@@ -316,6 +316,7 @@ mod tests {
             },
             body_a: 0,
             nearest_edge: false,
+            loaded: false,
             body_b: 1,
             state: None,
             d: [0.0; 3],

@@ -17,5 +17,5 @@ pub use impact_friction::{default_impact_mu, ImpactFriction};
 pub use manager::{ContactSet, PastPoses, Wrench2};
 pub use params::ContactParams;
 pub use record::{
-    ContactEvent, ContactState, EventKind, LawState, LoadedContact, VeContact, NO_LAW,
+    ContactEvent, ContactState, EventKind, LawState, Loaded, LoadedContact, VeContact, NO_LAW,
 };

@@ -77,6 +77,9 @@ pub struct VeContact {
     /// is its vertex's nearest edge line (or the corner rule's, within `δ_c`), so the record
     /// satisfies the depth invariant and the hand-over has nothing to check. Set by the merge.
     pub nearest_edge: bool,
+    /// The last force pass listed the record among the loaded ones
+    /// ([`ContactSet::loaded`](super::ContactSet::loaded): Continuous, `f_n > 0`).
+    pub loaded: bool,
     /// Edge coordinate `s^B_k` (m).
     pub s: f64,
     /// Previous edge coordinate `s^B_{k−1}` (m).
@@ -150,11 +153,10 @@ impl VeContact {
 }
 
 /// A Continuous record whose normal law pushed in the last sample (`f_n > 0`), as the force pass
-/// lists them for later passes (the chain damper): 64 bytes instead of the whole record.
+/// lists them for later passes (the chain damper): 48 bytes instead of the whole record. The
+/// keys are listed apart ([`Loaded::keys`]), rewritten only when they change.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LoadedContact {
-    /// The record's key (its place in key order).
-    pub key: VeCandidate,
     /// Body owning the vertex ("A").
     pub body_a: u32,
     /// Body owning the edge ("B").
@@ -165,6 +167,20 @@ pub struct LoadedContact {
     pub n: Vec2,
     /// Normal force of the sample (N, > 0).
     pub f_n: f64,
+}
+
+/// The loaded records of the last sample ([`ContactSet::loaded`](super::ContactSet::loaded)), in
+/// key order: what the chain damper reads of them.
+#[derive(Clone, Copy, Debug)]
+pub struct Loaded<'a> {
+    /// The records' geometry and normal forces.
+    pub contacts: &'a [LoadedContact],
+    /// Their keys (parallel to `contacts`).
+    pub keys: &'a [VeCandidate],
+    /// A number that changes whenever `keys` do (1, 2, …; it may also change when they do not):
+    /// equal numbers mean the same keys in the same order, so a reader can keep what it built
+    /// for the last sample's list without comparing them.
+    pub generation: u64,
 }
 
 /// One transition of the contact state machine, for the trace that tests assert on (§8.2).

@@ -61,7 +61,7 @@
 
 use crate::body::Body;
 use crate::collide::VeCandidate;
-use crate::contact::{LoadedContact, Wrench2};
+use crate::contact::{Loaded, LoadedContact, Wrench2};
 use crate::geom::{cross, Vec2};
 
 /// No partner yet (per-body scratch).
@@ -179,10 +179,12 @@ pub struct ChainDamping {
     src: Vec<u32>,
     /// Loaded-list index of each row of `rows` (key order).
     row_src: Vec<u32>,
-    /// Keys of the last sample's loaded list (all of it, chain or not), and which bodies are
-    /// dynamic (this sample's, once step 1 has run; the last sample's before): when both are
-    /// unchanged and the last build dropped no chain contact, the rows are refreshed in place.
-    loaded_keys: Vec<VeCandidate>,
+    /// The generation and length of the loaded list the rows were built from ([`Loaded`]; 0 =
+    /// none), and which bodies are dynamic (this sample's, once step 1 has run; the last sample's
+    /// before): when all are unchanged and the last build dropped no chain contact, the rows are
+    /// refreshed in place.
+    generation: u64,
+    loaded_len: usize,
     dynamic: Vec<bool>,
     /// The last build dropped a chain contact whose effective mass was not finite and positive.
     dropped: bool,
@@ -231,7 +233,8 @@ impl Default for ChainDamping {
             slot: Vec::with_capacity(64),
             src: Vec::with_capacity(64),
             row_src: Vec::with_capacity(64),
-            loaded_keys: Vec::with_capacity(64),
+            generation: 0,
+            loaded_len: 0,
             dynamic: Vec::new(),
             dropped: false,
             colour: Vec::with_capacity(64),
@@ -252,7 +255,8 @@ impl ChainDamping {
     /// Adds the chain dampers' forces of this sample to `wrenches` and to the bodies' held
     /// `force`/`torque` (which must hold every other force of the sample), given the loaded
     /// contacts of this sample (`loaded`, from
-    /// [`ContactSet::loaded`](crate::contact::ContactSet::loaded)) and the sample period `dt`
+    /// [`ContactSet::loaded`](crate::contact::ContactSet::loaded); its keys must be sorted) and
+    /// the sample period `dt`
     /// (s), with damping time `tau` (s: a chain contact's damper is `B_c = m_c/τ`, N·s/m; `None`
     /// = off) and at most `sweeps` Gauss–Seidel sweeps (each one passive; they stop once a sweep
     /// changes no row's relative velocity by more than 2e-4 m/s). Returns the kinetic energy the
@@ -269,8 +273,9 @@ impl ChainDamping {
     /// dynamic body) and swept colour by colour: the updates of a colour are independent, so the
     /// processor overlaps them instead of waiting on the body a row just wrote. Deterministic.
     ///
-    /// **Refresh.** When the loaded contacts are those of the last sample (same keys in the same
-    /// order, same dynamic bodies: most samples of a pile at rest), so are the chain contacts,
+    /// **Refresh.** When the loaded contacts are those of the last sample (same generation of
+    /// keys, same length, same dynamic bodies: most samples of a pile at rest), so are the chain
+    /// contacts,
     /// their colours and their order; the rows are then refreshed in place from the new geometry
     /// instead of being matched by key, coloured and sorted again (`last_refreshed`).
     pub fn apply(
@@ -278,7 +283,7 @@ impl ChainDamping {
         tau: Option<f64>,
         sweeps: u32,
         dt: f64,
-        loaded: &[LoadedContact],
+        loaded: Loaded<'_>,
         bodies: &mut [Body],
         wrenches: &mut [Wrench2],
     ) -> f64 {
@@ -306,7 +311,7 @@ impl ChainDamping {
             self.dynamic.resize(n, false);
             self.forget();
         }
-        if loaded.is_empty() {
+        if loaded.contacts.is_empty() || loaded.keys.len() != loaded.contacts.len() {
             self.forget();
             return 0.0;
         }
@@ -347,12 +352,12 @@ impl ChainDamping {
         let same = same_bodies
             && !self.dropped
             && !self.sorted.is_empty()
-            && loaded.len() == self.loaded_keys.len()
-            && loaded
-                .iter()
-                .zip(&self.loaded_keys)
-                .all(|(e, k)| e.key == *k);
-        let (g, h) = match same.then(|| self.refresh_rows(r, dt, loaded)).flatten() {
+            && loaded.generation == self.generation
+            && loaded.contacts.len() == self.loaded_len;
+        let (g, h) = match same
+            .then(|| self.refresh_rows(r, dt, loaded.contacts))
+            .flatten()
+        {
             Some(gh) => {
                 self.last_refreshed = true;
                 gh
@@ -412,13 +417,14 @@ impl ChainDamping {
         self.slot.clear();
         self.src.clear();
         self.keys.clear();
-        self.loaded_keys.clear();
+        self.generation = 0;
+        self.loaded_len = 0;
     }
 
     /// Steps 2–3 from scratch: the chain contacts of `loaded` in key order (`rows`, `keys`), each
     /// with its colour and its warm-start impulse, the last sample's impulse of the same key
     /// within this sample's bound, applied to `solver`. Returns `g = λ₀ᵀ·J·v*`.
-    fn build_rows(&mut self, r: f64, dt: f64, loaded: &[LoadedContact]) -> f64 {
+    fn build_rows(&mut self, r: f64, dt: f64, loaded: Loaded<'_>) -> f64 {
         // The last sample's impulses by key (its rows keep them in colour order).
         std::mem::swap(&mut self.prev_keys, &mut self.keys);
         self.prev_lambda.clear();
@@ -430,7 +436,7 @@ impl ChainDamping {
         // 2. Which dynamic bodies touch two or more other bodies.
         self.partner.fill(NONE);
         self.multi.fill(false);
-        for e in loaded {
+        for e in loaded.contacts {
             for (x, y) in [(e.body_a, e.body_b), (e.body_b, e.body_a)] {
                 if !dynamic[x as usize] {
                     continue;
@@ -454,21 +460,21 @@ impl ChainDamping {
         self.colour.clear();
         self.per_colour.fill(0);
         self.used.fill(0);
-        self.loaded_keys.clear();
+        self.generation = loaded.generation;
+        self.loaded_len = loaded.contacts.len();
         self.dropped = false;
         let mut g = 0.0;
         let mut j = 0;
-        for (i, e) in loaded.iter().enumerate() {
-            self.loaded_keys.push(e.key);
+        for (i, (e, &key)) in loaded.contacts.iter().zip(loaded.keys).enumerate() {
             let (a, b) = (e.body_a as usize, e.body_b as usize);
             let (dyn_a, dyn_b) = (dynamic[a], dynamic[b]);
             if !((dyn_a && self.multi[a]) || (dyn_b && self.multi[b])) {
                 continue;
             }
-            while j < self.prev_keys.len() && self.prev_keys[j] < e.key {
+            while j < self.prev_keys.len() && self.prev_keys[j] < key {
                 j += 1;
             }
-            let prev = if j < self.prev_keys.len() && self.prev_keys[j] == e.key {
+            let prev = if j < self.prev_keys.len() && self.prev_keys[j] == key {
                 self.prev_lambda[j]
             } else {
                 0.0
@@ -492,7 +498,7 @@ impl ChainDamping {
             self.colour.push(c);
             self.per_colour[c as usize] += 1;
             self.rows.push(row);
-            self.keys.push(e.key);
+            self.keys.push(key);
             self.row_src.push(i as u32);
         }
         g
@@ -631,7 +637,7 @@ mod tests {
 
     /// A column of three 1 kg boxes (0.1 m) on a fixed floor: contacts floor–1, 1–2, 2–3 at the
     /// boxes' bottom faces, each pushing with 10 N.
-    fn column() -> (Vec<Body>, Vec<LoadedContact>) {
+    fn column() -> (Vec<Body>, Column) {
         let mut bodies = vec![Body::fixed("floor", Pose::new(0.0, -0.05, 0.0))];
         for i in 0..3 {
             let y = 0.05 + 0.1 * i as f64;
@@ -642,14 +648,16 @@ mod tests {
                 Pose::new(0.0, y, 0.0),
             ));
         }
-        let loaded = (0..3u32)
+        let keys = (0..3u32)
+            .map(|i| VeCandidate {
+                vertex_collider: i + 1,
+                vertex: 0,
+                edge_collider: i,
+                edge: 2,
+            })
+            .collect();
+        let contacts = (0..3u32)
             .map(|i| LoadedContact {
-                key: VeCandidate {
-                    vertex_collider: i + 1,
-                    vertex: 0,
-                    edge_collider: i,
-                    edge: 2,
-                },
                 body_a: i + 1,
                 body_b: i,
                 point: Vec2::new(0.0, 0.1 * i as f64),
@@ -657,7 +665,24 @@ mod tests {
                 f_n: 10.0,
             })
             .collect();
-        (bodies, loaded)
+        (bodies, Column { contacts, keys })
+    }
+
+    /// A loaded list of the column's contacts, and its keys.
+    struct Column {
+        contacts: Vec<LoadedContact>,
+        keys: Vec<VeCandidate>,
+    }
+
+    impl Column {
+        /// The first `n` contacts as the contact set lists them, with keys of generation `g`.
+        fn view(&self, n: usize, g: u64) -> Loaded<'_> {
+            Loaded {
+                contacts: &self.contacts[..n],
+                keys: &self.keys[..n],
+                generation: g,
+            }
+        }
     }
 
     fn kinetic_of(bodies: &[Body]) -> f64 {
@@ -678,7 +703,14 @@ mod tests {
             b.vel = Vec2::new(0.0, -0.1 * i as f64);
         }
         let before = kinetic_of(&bodies);
-        let removed = chain.apply(Some(2e-4), 16, dt, &loaded, &mut bodies, &mut wrenches);
+        let removed = chain.apply(
+            Some(2e-4),
+            16,
+            dt,
+            loaded.view(3, 1),
+            &mut bodies,
+            &mut wrenches,
+        );
         assert!(
             removed > 0.0 && removed <= before,
             "removed {removed} of {before} J"
@@ -695,7 +727,14 @@ mod tests {
             b.force = Vec2::ZERO;
             b.torque = 0.0;
         }
-        let removed = chain.apply(Some(2e-4), 0, dt, &loaded, &mut bodies, &mut wrenches);
+        let removed = chain.apply(
+            Some(2e-4),
+            0,
+            dt,
+            loaded.view(3, 1),
+            &mut bodies,
+            &mut wrenches,
+        );
         assert!(
             chain.last_warm_scale < 1.0,
             "scale {}",
@@ -703,7 +742,14 @@ mod tests {
         );
         assert!(removed >= 0.0, "removed {removed} J");
         // And with sweeps the dampers pull nothing (F ≥ −f_n) and still only remove energy.
-        let removed = chain.apply(Some(2e-4), 16, dt, &loaded, &mut bodies, &mut wrenches);
+        let removed = chain.apply(
+            Some(2e-4),
+            16,
+            dt,
+            loaded.view(3, 1),
+            &mut bodies,
+            &mut wrenches,
+        );
         assert!(removed >= 0.0, "removed {removed} J");
     }
 
@@ -722,10 +768,24 @@ mod tests {
             }
         };
         set(&mut bodies);
-        chain.apply(Some(2e-4), 64, 1e-3, &loaded, &mut bodies, &mut wrenches);
+        chain.apply(
+            Some(2e-4),
+            64,
+            1e-3,
+            loaded.view(3, 1),
+            &mut bodies,
+            &mut wrenches,
+        );
         let cold = chain.last_sweeps;
         set(&mut bodies);
-        let removed = chain.apply(Some(2e-4), 64, 1e-3, &loaded, &mut bodies, &mut wrenches);
+        let removed = chain.apply(
+            Some(2e-4),
+            64,
+            1e-3,
+            loaded.view(3, 1),
+            &mut bodies,
+            &mut wrenches,
+        );
         assert_eq!(chain.last_warm_scale, 1.0);
         assert!(
             chain.last_sweeps < cold,
@@ -754,10 +814,24 @@ mod tests {
                     b.torque = 0.0;
                 }
             }
-            // Forgetting the loaded keys (but not the impulses) forces a rebuild every sample.
-            full.loaded_keys.clear();
-            let r_fast = fast.apply(Some(2e-4), 3, dt, &loaded, &mut b_fast, &mut wrenches);
-            let r_full = full.apply(Some(2e-4), 3, dt, &loaded, &mut b_full, &mut wrenches);
+            // A new generation of the same keys (the impulses are kept by key) forces a rebuild
+            // every sample.
+            let r_fast = fast.apply(
+                Some(2e-4),
+                3,
+                dt,
+                loaded.view(3, 1),
+                &mut b_fast,
+                &mut wrenches,
+            );
+            let r_full = full.apply(
+                Some(2e-4),
+                3,
+                dt,
+                loaded.view(3, 100 + k),
+                &mut b_full,
+                &mut wrenches,
+            );
             assert!(
                 (r_fast - r_full).abs() <= 1e-12 * r_full.abs().max(1e-9),
                 "{k}: {r_fast} {r_full}"
@@ -777,7 +851,7 @@ mod tests {
         }
         // One fewer contact: rebuilt (the top box is no longer a chain's end, two rows remain).
         let mut b = b_fast.clone();
-        fast.apply(Some(2e-4), 3, dt, &loaded[..2], &mut b, &mut wrenches);
+        fast.apply(Some(2e-4), 3, dt, loaded.view(2, 2), &mut b, &mut wrenches);
         assert_eq!((fast.last_rows, fast.last_refreshed), (2, false));
         // A body that became fixed: rebuilt too (box 1 fixed: the floor–box 1 contact joins two
         // fixed bodies and is no row; box 2 still touches boxes 1 and 3).
@@ -785,14 +859,15 @@ mod tests {
             Some(2e-4),
             3,
             dt,
-            &loaded,
+            loaded.view(3, 3),
             &mut b_fast.clone(),
             &mut wrenches,
         );
         assert_eq!((fast.last_rows, fast.last_refreshed), (3, false));
         let mut b = b_fast.clone();
         b[1] = Body::fixed("now fixed", b[1].pose);
-        fast.apply(Some(2e-4), 3, dt, &loaded, &mut b, &mut wrenches);
+        // (The same generation of keys: only the bodies changed.)
+        fast.apply(Some(2e-4), 3, dt, loaded.view(3, 3), &mut b, &mut wrenches);
         assert_eq!((fast.last_rows, fast.last_refreshed), (2, false));
     }
 }

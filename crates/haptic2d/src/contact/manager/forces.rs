@@ -4,6 +4,7 @@
 use super::ContactSet;
 use super::Wrench2;
 use crate::body::Body;
+use crate::collide::VeCandidate;
 use crate::contact::law_pool::{SlotAccess, Slots};
 use crate::contact::record::{ContactState, LawState, LoadedContact, VeContact};
 use crate::geom::{cross, Vec2};
@@ -22,9 +23,14 @@ impl ContactSet {
         for w in wrenches.iter_mut() {
             *w = Wrench2::default();
         }
+        // Without a contact event the records and their order are the last sample's, so the
+        // loaded keys are too up to the first record whose `f_n > 0` flips; with one, every
+        // key is written again.
         let pass = ForcePass {
             entries: &mut self.entries,
             loaded: &mut self.loaded,
+            keys: &mut self.loaded_keys,
+            rewrite: !self.events.is_empty(),
             nonfric: &mut self.nonfric,
             dt,
             bodies,
@@ -33,13 +39,16 @@ impl ContactSet {
         };
         // One pass per form of the law slots (`LawPool`), so the per-record loop has no branch on
         // it.
-        let (stored, records, breaks) = match self.laws.slots_mut() {
+        let (stored, records, breaks, rewritten) = match self.laws.slots_mut() {
             Slots::Lean(store) => pass.run(store),
             Slots::Compact(store) => pass.run(store),
             Slots::Whole(store) => pass.run(store),
         };
         self.stored = stored;
         self.record_count = records;
+        if rewritten {
+            self.loaded_generation += 1;
+        }
         // Scattered law slots cost a cache miss per record every sample: put them back in
         // record order once an eighth of the records are out of sequence (new records take
         // free or new slots).
@@ -53,6 +62,9 @@ impl ContactSet {
 struct ForcePass<'a> {
     entries: &'a mut [VeContact],
     loaded: &'a mut Vec<LoadedContact>,
+    /// The keys of `loaded` (rewritten from the first change on) and whether to rewrite them all.
+    keys: &'a mut Vec<VeCandidate>,
+    rewrite: bool,
     nonfric: &'a mut [Vec2],
     dt: f64,
     bodies: &'a [Body],
@@ -64,9 +76,9 @@ struct ForcePass<'a> {
 
 impl ForcePass<'_> {
     /// Runs the pass with the law slots `laws`: returns the stored energy (J), the number of
-    /// Continuous records, and how many of them have a law slot that does not follow the
-    /// previous record's (see `LawPool::repack`).
-    fn run<S: SlotAccess>(self, laws: &mut S) -> (f64, usize, usize) {
+    /// Continuous records, how many of them have a law slot that does not follow the previous
+    /// record's (see `LawPool::repack`), and whether the loaded keys were rewritten.
+    fn run<S: SlotAccess>(self, laws: &mut S) -> (f64, usize, usize, bool) {
         let (dt, bodies, needs_ext) = (self.dt, self.bodies, self.needs_ext);
         let wrenches = self.wrenches;
         let mut stored = 0.0;
@@ -74,6 +86,10 @@ impl ForcePass<'_> {
         let mut records = 0;
         let (mut last_slot, mut breaks) = (u32::MAX, 0usize);
         self.loaded.clear();
+        let mut rewrite = self.rewrite;
+        if rewrite {
+            self.keys.clear();
+        }
         for e in self.entries.iter_mut() {
             if e.state != Some(ContactState::Continuous) {
                 continue;
@@ -101,9 +117,18 @@ impl ForcePass<'_> {
             if let Some(u) = energy {
                 stored += u;
             }
-            if e.f_n > 0.0 {
+            let loaded = e.f_n > 0.0;
+            if loaded != e.loaded && !rewrite {
+                // The first change: the keys before it are the last sample's.
+                rewrite = true;
+                self.keys.truncate(self.loaded.len());
+            }
+            e.loaded = loaded;
+            if loaded {
+                if rewrite {
+                    self.keys.push(e.key);
+                }
                 self.loaded.push(LoadedContact {
-                    key: e.key,
                     body_a: e.body_a as u32,
                     body_b: e.body_b as u32,
                     point: e.point,
@@ -135,7 +160,7 @@ impl ForcePass<'_> {
                 }
             }
         }
-        (stored, records, breaks)
+        (stored, records, breaks, rewrite)
     }
 }
 
@@ -191,4 +216,79 @@ fn add_force(w: &mut [Wrench2], bodies: &[Body], a: usize, b: usize, f: Vec2, p:
     w[a].torque += cross(p - bodies[a].pose.pos, f);
     w[b].force -= f;
     w[b].torque -= cross(p - bodies[b].pose.pos, f);
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::contact::ContactState;
+
+    /// The loaded list's keys are every sample those of the Continuous records with `f_n > 0`, in
+    /// key order, and their generation changes whenever they do, on a pile:20 shoved sideways at
+    /// step 300 and with its top box tossed up at step 700: records are created and released,
+    /// and some records' normal force drops to zero and comes back without an event (the keys
+    /// are then rewritten from that record on). Without an event, the generation changes
+    /// exactly when the keys do, so a pile at rest keeps its damper rows.
+    #[test]
+    fn the_loaded_keys_and_their_generation_follow_the_loaded_records() {
+        let mut w = crate::scene::builtin("pile:20", None)
+            .unwrap()
+            .unwrap()
+            .world;
+        let (mut prev_keys, mut prev_generation) = (Vec::new(), 0);
+        let (mut changes, mut flips_without_events) = (0, 0);
+        for k in 0..1500 {
+            if k == 300 {
+                for (i, b) in w.bodies.iter_mut().enumerate() {
+                    if b.inv_mass > 0.0 {
+                        b.vel.x += 0.05 * (i % 3) as f64;
+                    }
+                }
+            }
+            if k == 700 {
+                let top = (0..w.bodies.len())
+                    .filter(|&i| w.bodies[i].inv_mass > 0.0)
+                    .max_by(|&i, &j| w.bodies[i].pose.pos.y.total_cmp(&w.bodies[j].pose.pos.y))
+                    .unwrap();
+                w.bodies[top].vel.y += 0.5;
+            }
+            w.step();
+            let c = w.contacts();
+            let expected: Vec<_> = c
+                .records()
+                .filter(|e| e.state == Some(ContactState::Continuous) && e.f_n > 0.0)
+                .collect();
+            let loaded = c.loaded();
+            let keys: Vec<_> = expected.iter().map(|e| e.key).collect();
+            assert_eq!(loaded.keys, &keys[..], "step {k}");
+            assert_eq!(loaded.contacts.len(), expected.len(), "step {k}");
+            for (l, e) in loaded.contacts.iter().zip(&expected) {
+                assert_eq!(
+                    (l.body_a as usize, l.body_b as usize, l.f_n),
+                    (e.body_a, e.body_b, e.f_n),
+                    "step {k}"
+                );
+            }
+            if c.events().is_empty() {
+                // Without an event the generation changes exactly when the keys do.
+                assert_eq!(
+                    loaded.generation != prev_generation,
+                    keys != prev_keys,
+                    "step {k}"
+                );
+            }
+            if keys != prev_keys {
+                assert_ne!(loaded.generation, prev_generation, "step {k}: keys changed");
+                changes += 1;
+                if c.events().is_empty() {
+                    flips_without_events += 1;
+                }
+            }
+            (prev_keys, prev_generation) = (keys, loaded.generation);
+        }
+        assert!(changes > 10, "{changes} changes of the loaded keys");
+        assert!(
+            flips_without_events > 0,
+            "no record's normal force dropped to zero without an event"
+        );
+    }
 }

@@ -23,7 +23,7 @@ use crate::collide::{Collider, VeCandidate, DEFAULT_DELTA_C, NEAR_PARALLEL_ANGLE
 use crate::contact::impact::{ImpactRow, ImpactSolver};
 use crate::contact::law_pool::LawPool;
 use crate::contact::params::ContactParams;
-use crate::contact::record::{ContactEvent, LawState, LoadedContact, VeContact};
+use crate::contact::record::{ContactEvent, LawState, Loaded, LoadedContact, VeContact};
 use crate::geom::{Pose, Rot, Vec2};
 use crate::laws::friction::FrictionModel;
 use crate::laws::normal::NormalModel;
@@ -51,8 +51,11 @@ pub struct ContactSet {
     /// Thresholds and options.
     pub params: ContactParams,
     entries: Vec<VeContact>,
-    /// The Continuous records that pushed in the last force pass, in key order.
+    /// The Continuous records that pushed in the last force pass, in key order, their keys, and
+    /// the number of the keys' version ([`Loaded`]).
     loaded: Vec<LoadedContact>,
+    loaded_keys: Vec<VeCandidate>,
+    loaded_generation: u64,
     /// Law states of the records, addressed by [`VeContact::law`].
     laws: LawPool,
     merged: Vec<VeContact>,
@@ -89,6 +92,8 @@ impl ContactSet {
             params,
             entries: Vec::with_capacity(64),
             loaded: Vec::with_capacity(64),
+            loaded_keys: Vec::with_capacity(64),
+            loaded_generation: 0,
             laws: LawPool::with_capacity(64),
             merged: Vec::with_capacity(64),
             pending: Vec::with_capacity(16),
@@ -130,8 +135,12 @@ impl ContactSet {
     /// The Continuous records whose normal law pushed in the last sample (`f_n > 0`), in key
     /// order, with what later passes need of them (the chain damper).
     #[inline]
-    pub fn loaded(&self) -> &[LoadedContact] {
-        &self.loaded
+    pub fn loaded(&self) -> Loaded<'_> {
+        Loaded {
+            contacts: &self.loaded,
+            keys: &self.loaded_keys,
+            generation: self.loaded_generation,
+        }
     }
 
     /// The contact records (Colliding or Continuous), sorted by key.

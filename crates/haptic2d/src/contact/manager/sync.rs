@@ -148,6 +148,7 @@ pub(super) fn new_entry(
         d,
         hist,
         nearest_edge: false,
+        loaded: false,
         s: s0,
         s_prev,
         len,
