@@ -372,23 +372,34 @@ impl ChainDamping {
             }
         };
         self.last_rows = self.sorted.len();
-        self.last_warm_scale = self.scale_warm_start(g, h);
-        // 5. Projected Gauss–Seidel on F = −B_c·v⁺_n, F ≥ −f_n, until converged.
+        let s = self.scale_warm_start(g, h);
+        self.last_warm_scale = s;
+        // 5. Projected Gauss–Seidel on F = −B_c·v⁺_n, F ≥ −f_n, until converged. The rows still
+        //    hold the whole warm impulses: the first sweep scales each by `s` as it reads it.
         let solver = &mut self.solver;
+        let mut scale = s;
         for _ in 0..sweeps {
             // Largest change of a row's relative velocity in this sweep (m/s).
             let mut largest = 0.0f64;
             for row in self.sorted.iter_mut() {
+                let lambda = row.lambda * scale;
                 let v_rel = row.v_rel(solver);
-                let new = (-row.c * (v_rel - row.w * row.lambda)).max(row.lo);
-                let d = new - row.lambda;
+                let new = (-row.c * (v_rel - row.w * lambda)).max(row.lo);
+                let d = new - lambda;
                 row.lambda = new;
                 row.apply(d, solver);
                 largest = largest.max((d * row.w).abs());
             }
+            scale = 1.0;
             self.last_sweeps += 1;
             if largest <= CONVERGED {
                 break;
+            }
+        }
+        if scale != 1.0 {
+            // No sweep ran: the scaled warm impulses are the result.
+            for row in self.sorted.iter_mut() {
+                row.lambda *= scale;
             }
         }
         let removed = ke_star - kinetic(&self.solver, bodies);
@@ -561,7 +572,9 @@ impl ChainDamping {
 
     /// Scales the warm start `λ₀` (applied whole to `solver` as the rows were built; `g =
     /// λ₀ᵀ·J·v*`, `h = λ₀ᵀ·(W + K⁻¹)·λ₀`) by the `s ∈ [0, 1]` minimising `Φ(s·λ₀) = s·g +
-    /// ½s²·h`; returns `s`.
+    /// ½s²·h` in the working velocities, `v = v* + s·(v₀ − v*)` body by body (the momentum the
+    /// warm impulses gave each body, scaled); returns `s`. The rows keep `λ₀`: the caller scales
+    /// them (the first sweep, as it reads them).
     fn scale_warm_start(&mut self, g: f64, h: f64) -> f64 {
         let s = if h > 0.0 && g.is_finite() && h.is_finite() {
             (-g / h).clamp(0.0, 1.0)
@@ -570,14 +583,12 @@ impl ChainDamping {
         } else {
             0.0
         };
-        if s < 1.0 {
-            // v = v* + s·(v₀ − v*): from v* again, with the scaled impulses.
+        if s == 0.0 {
             self.solver.copy_from_slice(&self.star);
-            for row in self.sorted.iter_mut() {
-                row.lambda *= s;
-                if row.lambda != 0.0 {
-                    row.apply(row.lambda, &mut self.solver);
-                }
+        } else if s < 1.0 {
+            for (v, star) in self.solver.iter_mut().zip(&self.star) {
+                v.v = star.v + (v.v - star.v) * s;
+                v.omega = star.omega + (v.omega - star.omega) * s;
             }
         }
         s
