@@ -136,10 +136,14 @@ impl ForcePass<'_> {
                     f_n: e.f_n,
                 });
             }
-            add_force(wrenches, bodies, e.body_a, e.body_b, e.n * e.f_n, e.point);
-            if !needs_ext && e.f_t != 0.0 {
-                add_force(wrenches, bodies, e.body_a, e.body_b, e.t() * e.f_t, e.point);
-            }
+            // The normal and the friction force act at the same point: one wrench (the classical
+            // model adds its friction in the second loop below, after every normal force).
+            let f = if needs_ext {
+                e.n * e.f_n
+            } else {
+                e.n * e.f_n + e.t() * e.f_t
+            };
+            add_force(wrenches, bodies, e.body_a, e.body_b, f, e.point);
         }
         if needs_ext {
             for (i, b) in bodies.iter().enumerate() {
