@@ -145,7 +145,11 @@ impl ForcePass<'_> {
             };
             add_force(wrenches, bodies, e.body_a, e.body_b, f, e.point);
         }
-        debug_assert_eq!(self.keys.len(), self.loaded.len(), "one key per loaded record");
+        debug_assert_eq!(
+            self.keys.len(),
+            self.loaded.len(),
+            "one key per loaded record"
+        );
         if needs_ext {
             for (i, b) in bodies.iter().enumerate() {
                 self.nonfric[i] = b.force + wrenches[i].force;
