@@ -154,6 +154,7 @@ mod tests {
     #[test]
     fn widening_the_law_slots_mid_run_changes_no_trajectory() {
         use crate::contact::law_pool::SlotForm;
+        use crate::contact::test_pile::{assert_same_poses, shove, toss_top_box};
         use crate::laws::normal::HystereticLaw;
         let world = crate::scene::builtin("pile:20", None)
             .unwrap()
@@ -165,13 +166,8 @@ mod tests {
         for k in 0..1500 {
             if k == 300 {
                 // A shove that loads the records' friction springs before the switch.
-                for w in [&mut compact, &mut whole] {
-                    for (i, b) in w.bodies.iter_mut().enumerate() {
-                        if b.inv_mass > 0.0 {
-                            b.vel.x += 0.05 * (i % 3) as f64;
-                        }
-                    }
-                }
+                shove(&mut compact);
+                shove(&mut whole);
             }
             if k == SWITCH {
                 assert_ne!(compact.contacts().law_slot_form(), SlotForm::Whole);
@@ -184,22 +180,12 @@ mod tests {
                 whole.normal = wall;
                 // The top box is tossed up: the others keep their records, and it lands
                 // (creating new records, so widening the slots) while they are live.
-                for w in [&mut compact, &mut whole] {
-                    let top = (0..w.bodies.len())
-                        .filter(|&i| w.bodies[i].inv_mass > 0.0)
-                        .max_by(|&i, &j| w.bodies[i].pose.pos.y.total_cmp(&w.bodies[j].pose.pos.y))
-                        .unwrap();
-                    w.bodies[top].vel.y += 0.5;
-                }
+                toss_top_box(&mut compact);
+                toss_top_box(&mut whole);
             }
             compact.step();
             whole.step();
-            for (a, b) in compact.bodies.iter().zip(&whole.bodies) {
-                let bits = |p: &crate::geom::Pose| {
-                    (p.pos.x.to_bits(), p.pos.y.to_bits(), p.angle.to_bits())
-                };
-                assert_eq!(bits(&a.pose), bits(&b.pose), "step {k}");
-            }
+            assert_same_poses(&compact, &whole, k);
         }
         assert_eq!(
             compact.contacts().law_slot_form(),

@@ -16,7 +16,7 @@
 //! mid-run.
 
 use super::compact_law::CompactNormal;
-use super::lean_law::LeanStore;
+use super::lean_law::{lean_pair, LeanStore};
 use super::record::{LawState, VeContact, NO_LAW};
 use crate::laws::friction::{FrictionLaw, FrictionModel, ResetIntegrator};
 use crate::laws::normal::{ContactNormal, NormalLaw, NormalModel, PaperLaw};
@@ -37,9 +37,9 @@ pub(crate) enum Slots {
     /// The paper's pair of laws with shared parameters, 40 bytes a slot.
     Lean(LeanStore),
     /// Every law but the hysteretic wall, 144 bytes a slot.
-    Compact(Store<CompactNormal>),
+    Compact(Store<LawState<CompactNormal>>),
     /// Any law, 272 bytes a slot.
-    Whole(Store<NormalModel>),
+    Whole(Store<LawState>),
 }
 
 /// The form of the slots (for tests).
@@ -69,17 +69,17 @@ pub(crate) trait SlotAccess {
     ) -> R;
 }
 
-/// The slots of one form.
+/// The slots of one form (`T`: a [`LawState`], or the lean form's per-slot state).
 #[derive(Clone, Debug)]
-pub(crate) struct Store<N> {
+pub(crate) struct Store<T> {
     /// Every slot ever handed out (free ones hold stale states).
-    states: Vec<LawState<N>>,
+    pub(crate) states: Vec<T>,
     /// The other buffer of [`repack`](LawPool::repack).
-    spare: Vec<LawState<N>>,
+    spare: Vec<T>,
 }
 
-impl<N: NormalLaw + Copy> Store<N> {
-    fn with_capacity(n: usize) -> Self {
+impl<T: Copy> Store<T> {
+    pub(crate) fn with_capacity(n: usize) -> Self {
         Self {
             states: Vec::with_capacity(n),
             spare: Vec::with_capacity(n),
@@ -87,7 +87,7 @@ impl<N: NormalLaw + Copy> Store<N> {
     }
 
     /// Puts `fresh` in a free slot, or a new one.
-    fn put(&mut self, free: &mut Vec<u32>, fresh: LawState<N>) -> u32 {
+    pub(crate) fn put(&mut self, free: &mut Vec<u32>, fresh: T) -> u32 {
         match free.pop() {
             Some(slot) => {
                 self.states[slot as usize] = fresh;
@@ -101,7 +101,7 @@ impl<N: NormalLaw + Copy> Store<N> {
     }
 
     /// See [`LawPool::repack`].
-    fn repack(&mut self, records: &mut [VeContact]) {
+    pub(crate) fn repack(&mut self, records: &mut [VeContact]) {
         self.spare.clear();
         for e in records.iter_mut() {
             if e.law != NO_LAW {
@@ -114,12 +114,17 @@ impl<N: NormalLaw + Copy> Store<N> {
 
     /// The state in `slot` (a slot handed out by [`LawPool::acquire`] and not released).
     #[inline]
-    pub(crate) fn get_mut(&mut self, slot: u32) -> &mut LawState<N> {
+    pub(crate) fn get_mut(&mut self, slot: u32) -> &mut T {
         &mut self.states[slot as usize]
+    }
+
+    /// Room for the slots and the repack buffer (what a store of another form needs).
+    pub(crate) fn capacity(&self) -> usize {
+        self.states.capacity().max(self.spare.capacity())
     }
 }
 
-impl<N: NormalLaw + Copy> SlotAccess for Store<N> {
+impl<N: NormalLaw + Copy> SlotAccess for Store<LawState<N>> {
     type Normal = N;
     type Friction = FrictionModel;
     #[inline(always)]
@@ -163,12 +168,11 @@ impl LawPool {
         s_entry: f64,
     ) -> u32 {
         if let Slots::Lean(store) = &mut self.slots {
-            if let (NormalModel::Paper(paper), FrictionModel::ResetIntegrator(reset)) =
-                (normal, friction)
+            let free = self.free.len();
+            if let Some((paper, reset)) =
+                lean_pair(normal, friction).filter(|(p, r)| store.takes(p, r, free))
             {
-                if store.takes(paper, reset, self.free.len()) {
-                    return store.put(&mut self.free, paper, reset, s_entry);
-                }
+                return store.put(&mut self.free, paper, reset, s_entry);
             }
             self.leave_lean();
         }
@@ -201,13 +205,8 @@ impl LawPool {
     /// the sample that creates the first record needing it.
     pub(crate) fn prepare(&mut self, normal: &NormalModel, friction: &FrictionModel) {
         if let Slots::Lean(store) = &self.slots {
-            let fits = match (normal, friction) {
-                (NormalModel::Paper(paper), FrictionModel::ResetIntegrator(reset)) => {
-                    store.takes(paper, reset, self.free.len())
-                }
-                _ => false,
-            };
-            if !fits {
+            let free = self.free.len();
+            if !lean_pair(normal, friction).is_some_and(|(p, r)| store.takes(p, r, free)) {
                 self.leave_lean();
             }
         }
@@ -240,8 +239,7 @@ impl LawPool {
     pub(crate) fn widen(&mut self) {
         self.leave_lean();
         if let Slots::Compact(store) = &self.slots {
-            let room = store.states.capacity().max(store.spare.capacity());
-            let mut whole = Store::with_capacity(room);
+            let mut whole = Store::with_capacity(store.capacity());
             whole
                 .states
                 .extend(store.states.iter().map(LawState::<CompactNormal>::widen));

@@ -11,6 +11,8 @@ mod lean_law;
 mod manager;
 mod params;
 mod record;
+#[cfg(test)]
+mod test_pile;
 
 pub use god_object::entry_point;
 pub use impact_friction::{default_impact_mu, ImpactFriction};

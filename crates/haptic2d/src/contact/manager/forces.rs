@@ -229,6 +229,7 @@ fn add_force(w: &mut [Wrench2], bodies: &[Body], a: usize, b: usize, f: Vec2, p:
 
 #[cfg(test)]
 mod tests {
+    use crate::contact::test_pile::{shove, toss_top_box};
     use crate::contact::ContactState;
 
     /// The loaded list's keys are every sample those of the Continuous records with `f_n > 0`, in
@@ -247,18 +248,10 @@ mod tests {
         let (mut changes, mut flips_without_events) = (0, 0);
         for k in 0..1500 {
             if k == 300 {
-                for (i, b) in w.bodies.iter_mut().enumerate() {
-                    if b.inv_mass > 0.0 {
-                        b.vel.x += 0.05 * (i % 3) as f64;
-                    }
-                }
+                shove(&mut w);
             }
             if k == 700 {
-                let top = (0..w.bodies.len())
-                    .filter(|&i| w.bodies[i].inv_mass > 0.0)
-                    .max_by(|&i, &j| w.bodies[i].pose.pos.y.total_cmp(&w.bodies[j].pose.pos.y))
-                    .unwrap();
-                w.bodies[top].vel.y += 0.5;
+                toss_top_box(&mut w);
             }
             w.step();
             let c = w.contacts();
