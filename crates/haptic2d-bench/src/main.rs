@@ -92,7 +92,11 @@ struct Args {
     /// run each right after a pause, through
     /// `settle::cold_step`, and the summary prints the cold steps' median against the warm ones'
     /// (what a chunk start of the interleaved bench costs). `evict`: write 8 MiB, evicting the
-    /// world from the L1 and L2 caches; `idle=MS`: compute for MS ms without touching memory.
+    /// world from the L1 and L2 caches; `evict=MIB`: write MIB MiB (above the 32 MiB L3: to
+    /// memory); `idle=MS`: compute for MS ms without touching memory. A trailing `,code` (e.g.
+    /// `idle=100,code`) then steps a copy of the world once, untimed: the step's code is warm and
+    /// only the world's data is cold. Built with `--features stage-timing`, the summary also
+    /// shows each stage's wall time, warm and cold.
     #[arg(long)]
     cold: Option<settle::Cold>,
     /// Law parameter overrides for haptic2d, comma-separated `normal.KEY=V` / `friction.KEY=V`

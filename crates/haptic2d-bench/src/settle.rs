@@ -3,6 +3,7 @@
 //! every `--every` seconds of simulated time: largest speed, bodies above 1 cm/s, mean height,
 //! largest overlap. Used to find why the pile keeps moving (docs/PERFORMANCE.md, issue 17).
 
+use haptic2d::stage_time::{self, Stage, StageTimes};
 use haptic2d::world::World;
 
 use crate::state;
@@ -59,16 +60,32 @@ pub fn cold_step(w: &mut World) {
     std::hint::black_box(0xc01d_u32);
 }
 
-/// Bytes written by [`Cold::Evict`]: four times the 2 MiB L2 of this machine
-/// (docs/PERFORMANCE.md), so that a step after it finds its data in the L3.
+/// Bytes written by [`Pause::Evict`] when no size is given: four times the 2 MiB L2 of this
+/// machine (docs/PERFORMANCE.md), so that a step after it finds its data in the L3.
 pub const EVICT_BYTES: usize = 8 << 20;
 
+/// Largest eviction buffer (MiB).
+const MAX_EVICT_MIB: usize = 4096;
+
 /// What runs before every other profiled step of `--settle --cold`: how a chunk start of the
-/// interleaved bench finds the world's data.
+/// interleaved bench finds the world's data and code.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Cold {
-    /// Write [`EVICT_BYTES`], evicting the world from the L1 and L2 caches at once.
-    Evict,
+pub struct Cold {
+    /// The pause itself.
+    pub pause: Pause,
+    /// After the pause, step a copy of the world once (untimed, made when profiling starts): the
+    /// step's code, the branch predictors and the instruction TLB are warm again, while the
+    /// world's own data stays as the pause left it. The difference to the same pause without it
+    /// is the share of a cold step's cost that is code.
+    pub warm_code: bool,
+}
+
+/// The pause of a [`Cold`] step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Pause {
+    /// Write this many bytes, one byte per 64-byte line: the default [`EVICT_BYTES`] evicts the
+    /// world from the L1 and L2 caches; more than the 32 MiB L3 evicts it to memory.
+    Evict(usize),
     /// Compute for this long (ms) without touching memory, as long as the other engines' chunks
     /// take: whatever the world loses from the caches meanwhile, the machine's other tenants took.
     Idle(f64),
@@ -77,30 +94,59 @@ pub enum Cold {
 impl std::str::FromStr for Cold {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        match s.trim() {
-            "evict" => Ok(Cold::Evict),
-            x => match x.strip_prefix("idle=").map(|v| v.trim().parse::<f64>()) {
-                Some(Ok(ms)) if ms.is_finite() && ms > 0.0 => Ok(Cold::Idle(ms)),
-                _ => Err(format!(
-                    "{s:?}: expected evict or idle=MS (a positive time in ms)"
-                )),
-            },
-        }
+        let err = || {
+            format!(
+                "{s:?}: expected evict, evict=MIB (1–{MAX_EVICT_MIB}) or idle=MS (a positive time \
+                 in ms), optionally followed by ,code (e.g. idle=100,code)"
+            )
+        };
+        let t = s.trim();
+        let (p, warm_code) = match t.strip_suffix(",code") {
+            Some(p) => (p.trim(), true),
+            None => (t, false),
+        };
+        let pause = match p {
+            "evict" => Pause::Evict(EVICT_BYTES),
+            x => {
+                if let Some(v) = x.strip_prefix("evict=") {
+                    match v.trim().parse::<usize>() {
+                        Ok(mib) if (1..=MAX_EVICT_MIB).contains(&mib) => Pause::Evict(mib << 20),
+                        _ => return Err(err()),
+                    }
+                } else if let Some(v) = x.strip_prefix("idle=") {
+                    match v.trim().parse::<f64>() {
+                        Ok(ms) if ms.is_finite() && ms > 0.0 => Pause::Idle(ms),
+                        _ => return Err(err()),
+                    }
+                } else {
+                    return Err(err());
+                }
+            }
+        };
+        Ok(Cold { pause, warm_code })
     }
 }
 
 impl Cold {
-    /// Runs the pause, with `buf` the [`EVICT_BYTES`]-long eviction buffer.
+    /// Bytes of the eviction buffer the pause needs (0 for an idle pause).
+    fn buffer_bytes(self) -> usize {
+        match self.pause {
+            Pause::Evict(b) => b,
+            Pause::Idle(_) => 0,
+        }
+    }
+
+    /// Runs the pause, with `buf` the eviction buffer ([`Cold::buffer_bytes`] long).
     #[inline(never)]
     fn pause(self, buf: &mut [u8]) {
-        match self {
-            Cold::Evict => {
+        match self.pause {
+            Pause::Evict(_) => {
                 for line in buf.chunks_mut(64) {
                     line[0] = line[0].wrapping_add(1);
                 }
                 std::hint::black_box(buf);
             }
-            Cold::Idle(ms) => {
+            Pause::Idle(ms) => {
                 let t = std::time::Instant::now();
                 let mut x = 1.0f64;
                 while t.elapsed().as_secs_f64() < ms * 1e-3 {
@@ -112,10 +158,16 @@ impl Cold {
             }
         }
     }
+
     fn describe(self) -> String {
-        match self {
-            Cold::Evict => format!("evicting the caches ({} MiB written)", EVICT_BYTES >> 20),
-            Cold::Idle(ms) => format!("{ms} ms of computing without touching memory"),
+        let p = match self.pause {
+            Pause::Evict(b) => format!("evicting the caches ({} MiB written)", b >> 20),
+            Pause::Idle(ms) => format!("{ms} ms of computing without touching memory"),
+        };
+        if self.warm_code {
+            format!("{p} and one step of a copy of the world (code warm, data cold)")
+        } else {
+            p
         }
     }
 }
@@ -150,16 +202,24 @@ pub fn run(
     // Global updates published during the profiled steps: (count, in place, GJK iterations).
     let mut updates = (0usize, 0usize, 0u64);
     // With `cold`: the eviction buffer and the CPU time of every cold step (µs).
-    let mut evict_buf = match cold {
-        Some(Cold::Evict) => vec![0u8; EVICT_BYTES],
-        _ => Vec::new(),
-    };
+    let mut evict_buf = vec![0u8; cold.map_or(0, Cold::buffer_bytes)];
     let mut cold_times: Vec<f64> = Vec::new();
+    // With `cold` and its `warm_code`: the copy of the world stepped after each pause.
+    let mut twin: Option<World> = None;
+    // Per-stage wall time summed over the warm and the cold profiled steps (ns), and their
+    // counts (with the `stage-timing` feature).
+    let mut stages = [(0usize, StageTimes::default()); 2];
     for k in 1..=steps {
+        if k == first_profiled && cold.is_some_and(|c| c.warm_code) {
+            twin = Some(w.clone());
+        }
         // Cold and warm steps alternate by whole global periods, so both cover every phase.
         let is_cold = cold.is_some() && k > first_profiled && ((k - 1) / n_g) % 2 == 1;
         if let (true, Some(c)) = (is_cold, cold) {
             c.pause(&mut evict_buf);
+            if let Some(t) = twin.as_mut() {
+                t.step();
+            }
         }
         let t0 = now(Clock::Cpu, origin);
         if is_cold {
@@ -170,6 +230,13 @@ pub fn run(
             w.step();
         }
         let dt_cpu = now(Clock::Cpu, origin) - t0;
+        if k > first_profiled {
+            let (count, sum) = &mut stages[is_cold as usize];
+            *count += 1;
+            for (s, x) in sum.ns.iter_mut().zip(w.stage_times().ns) {
+                *s += x;
+            }
+        }
         cpu += dt_cpu;
         if is_cold {
             cold_times.push(dt_cpu * 1e6);
@@ -247,6 +314,9 @@ pub fn run(
             all_steps.p99()
         );
     }
+    if stage_time::ENABLED {
+        print_stages(label, profile_after, &stages, cold);
+    }
     let (median, p99) = (all_steps.median(), all_steps.p99());
     println!(
         "{label}: CPU µs per step after {profile_after} s: median {median:.1}, p99 {p99:.1} (p99/median {:.2}), largest {:.1}",
@@ -302,4 +372,50 @@ pub fn run(
             .collect::<Vec<_>>()
             .join(" "),
     );
+}
+
+/// The mean wall time of each stage over the warm profiled steps, and over the cold ones with
+/// `cold` (`stages[0]` warm, `stages[1]` cold: step counts and summed times).
+fn print_stages(
+    label: &str,
+    profile_after: f64,
+    stages: &[(usize, StageTimes); 2],
+    cold: Option<Cold>,
+) {
+    let mean = |(n, t): &(usize, StageTimes), s: Stage| t.get(s) as f64 / (*n).max(1) as f64 / 1e3;
+    let [warm, cold_sum] = stages;
+    match cold {
+        Some(c) => println!(
+            "{label}: wall µs per stage after {profile_after} s (stage-timing build), warm ({} steps) / right after {} ({} steps) / difference:",
+            warm.0,
+            c.describe(),
+            cold_sum.0
+        ),
+        None => println!(
+            "{label}: wall µs per stage after {profile_after} s (stage-timing build, {} steps):",
+            warm.0
+        ),
+    }
+    let mut total = [0.0; 2];
+    for s in Stage::ALL {
+        let (w, c) = (mean(warm, s), mean(cold_sum, s));
+        total[0] += w;
+        total[1] += c;
+        if cold.is_some() {
+            println!("{label}:   {:<10} {w:8.1} {c:8.1} {:+8.1}", s.name(), c - w);
+        } else {
+            println!("{label}:   {:<10} {w:8.1}", s.name());
+        }
+    }
+    if cold.is_some() {
+        println!(
+            "{label}:   {:<10} {:8.1} {:8.1} {:+8.1}",
+            "step",
+            total[0],
+            total[1],
+            total[1] - total[0]
+        );
+    } else {
+        println!("{label}:   {:<10} {:8.1}", "step", total[0]);
+    }
 }

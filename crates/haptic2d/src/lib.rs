@@ -21,4 +21,5 @@ pub mod laws;
 pub mod load;
 pub mod metrics;
 pub mod scene;
+pub mod stage_time;
 pub mod world;

@@ -19,6 +19,7 @@ use crate::integrate::{
 use crate::laws::friction::FrictionModel;
 use crate::laws::normal::NormalModel;
 use crate::load::Load;
+use crate::stage_time::{Lap, Stage, StageTimes};
 
 /// Rates, margins and options of a world.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -97,6 +98,8 @@ pub struct World {
     prev: Vec<Pose>,
     prev2: Vec<Pose>,
     ledger: EnergyLedger,
+    /// Wall time of each stage of the last step (zero without the `stage-timing` feature).
+    stage_times: StageTimes,
     chain: ChainDamping,
     guard: Option<PassivityGuard>,
     ke_before: Vec<f64>,
@@ -195,6 +198,7 @@ impl World {
             prev: Vec::with_capacity(n),
             prev2: Vec::with_capacity(n),
             ledger: EnergyLedger::default(),
+            stage_times: StageTimes::default(),
             chain: ChainDamping::default(),
             ke_before: vec![0.0; n],
             rots: vec![Rot::IDENTITY; n],
@@ -234,6 +238,13 @@ impl World {
     #[inline]
     pub fn ledger(&self) -> &EnergyLedger {
         &self.ledger
+    }
+    /// Wall time of each stage of the last step (ns), for profiling: all zero unless the crate
+    /// is built with the `stage-timing` feature ([`crate::stage_time`]). A step split by
+    /// [`World::prime`] times its two halves separately, each when it runs.
+    #[inline]
+    pub fn stage_times(&self) -> &StageTimes {
+        &self.stage_times
     }
     /// The contact set (tracked pairs and records).
     #[inline]
@@ -335,6 +346,8 @@ impl World {
         }
         self.begun = true;
         let dt = self.params.dt;
+        self.stage_times = StageTimes::default();
+        let mut lap = Lap::start();
         // 0. Body rotations and the world-frame features of every collider at the current poses.
         for (r, b) in self.rots.iter_mut().zip(&self.bodies) {
             *r = b.pose.rot();
@@ -355,7 +368,9 @@ impl World {
         }
         // 3. Global proximity stage: AABB sort-and-sweep + GJK, every N_g samples, and early when
         //    a body may have outrun the margin (`moved_past_margin`).
+        lap.charge(&mut self.stage_times, Stage::Poses);
         self.global_stage();
+        lap.charge(&mut self.stage_times, Stage::Global);
         // 4. Local stage: closest-feature tracking and VE candidates for proximate pairs
         //    (separated pairs whose gap the bodies' relative motion cannot have closed are
         //    skipped, and penetrating pairs' vertex scans it cannot have changed are reused;
@@ -368,6 +383,7 @@ impl World {
             &self.odometer_poses,
         );
         self.pairs_written = false;
+        lap.charge(&mut self.stage_times, Stage::Local);
         // Loads are evaluated once per sample (held over it). Loads and drives enter the bodies'
         // accumulators before the contact forces so the classical friction model sees them (§4.1).
         let t = self.time();
@@ -398,6 +414,7 @@ impl World {
         // (Parameters are re-read every sample, so edits to `params.contact` take effect at once.)
         self.contacts.params = self.params.contact;
         self.contacts.set_delta_c(self.params.delta_c);
+        lap.charge(&mut self.stage_times, Stage::Loads);
         let past = PastPoses {
             prev: &self.prev,
             prev2: &self.prev2,
@@ -414,7 +431,9 @@ impl World {
             &self.normal,
             &self.friction,
             &mut self.contact_wrench,
+            &mut self.stage_times,
         );
+        let mut lap = Lap::start();
         self.ledger.impact_loss += self.contacts.last_impact_loss;
         self.ledger.impact_energy_fallbacks = self.contacts.impact_energy_fallbacks();
         if let Some(g) = self.guard.as_mut() {
@@ -427,6 +446,7 @@ impl World {
         if self.tick == 0 {
             self.ledger.initial = self.ledger.kinetic + self.contacts.stored_energy();
         }
+        lap.charge(&mut self.stage_times, Stage::ContactEvents);
     }
 
     /// §0.5 step 3, the global proximity stage (`collide/broad.rs`), scheduled by sample:
@@ -603,6 +623,7 @@ impl World {
     pub fn finish_step(&mut self) {
         self.begun = false;
         let dt = self.params.dt;
+        let mut lap = Lap::start();
         // Remember the poses of k−1 and k−2 (buffers reused).
         std::mem::swap(&mut self.prev, &mut self.prev2);
         self.prev.clear();
@@ -615,6 +636,7 @@ impl World {
             b.force = self.held[i].force + self.drive[i].force + cw.force;
             b.torque = self.held[i].torque + self.drive[i].torque + cw.torque;
         }
+        lap.charge(&mut self.stage_times, Stage::Assemble);
         // Implicit chain damper on the end-of-sample velocities (adds to forces and contact wrench).
         if self.params.mode == IntegrationMode::SemiImplicit {
             self.ledger.chain_damping_loss += self.chain.apply(
@@ -626,6 +648,7 @@ impl World {
                 &mut self.contact_wrench,
             );
         }
+        lap.charge(&mut self.stage_times, Stage::ChainDamper);
         for i in 0..self.bodies.len() {
             let b = &mut self.bodies[i];
             if !b.is_dynamic() {
@@ -665,6 +688,7 @@ impl World {
         self.ledger.kinetic = self.bodies.iter().map(|b| b.kinetic_energy()).sum();
         self.ledger.stored = self.contacts.stored_energy();
         self.tick += 1;
+        lap.charge(&mut self.stage_times, Stage::Integrate);
     }
 }
 

@@ -27,6 +27,7 @@ use crate::contact::record::{ContactEvent, LawState, Loaded, LoadedContact, VeCo
 use crate::geom::{Pose, Rot, Vec2};
 use crate::laws::friction::FrictionModel;
 use crate::laws::normal::NormalModel;
+use crate::stage_time::{Lap, Stage, StageTimes};
 
 /// Per-body contact wrench of one sample: force (N) and torque about the COM (N·m).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -243,12 +244,15 @@ impl ContactSet {
         normal: &NormalModel,
         friction: &FrictionModel,
         wrenches: &mut [Wrench2],
+        times: &mut StageTimes,
     ) {
+        let mut lap = Lap::start();
         self.events.clear();
         self.last_impact_loss = 0.0;
         self.resize_body_buffers(bodies.len());
         self.laws.prepare(normal, friction);
         self.sync(tick, candidates, from_scan, colliders, bodies, rots, past);
+        lap.charge(times, Stage::ContactSync);
         self.release(tick);
         self.hand_over(tick, colliders, bodies, past, normal, friction);
         let any_colliding = self.create(tick, dt, colliders, bodies, past, normal, friction);
@@ -259,7 +263,9 @@ impl ContactSet {
             self.solver.set_friction(self.params.impact_friction, mu);
             self.resolve_impacts(tick, bodies);
         }
+        lap.charge(times, Stage::ContactEvents);
         self.forces(dt, bodies, friction, wrenches);
+        lap.charge(times, Stage::ContactForces);
         #[cfg(debug_assertions)]
         self.assert_depth_invariant(colliders);
     }
