@@ -1,8 +1,9 @@
 //! Wall time of each stage of a world step, for profiling (docs/PERFORMANCE.md, issue 17).
 //!
-//! Compiled in only with the crate feature `stage-timing`: without it [`Lap`] is empty, charging a
-//! lap does nothing and [`World::stage_times`](crate::world::World::stage_times) stays zero, so
-//! the step reads no clock. With it, each stage boundary reads the monotonic clock once (about
+//! Compiled in only with the crate feature `stage-timing`: without it the stopwatch (`Lap`) is
+//! empty, charging a lap does nothing and
+//! [`World::stage_times`](crate::world::World::stage_times) stays zero, so the step reads no
+//! clock. With it, each stage boundary reads the monotonic clock once (about
 //! 20 ns on Linux, through the vDSO): the timed step is that much slower, and the stages show
 //! where a step's time goes, warm or right after the caches were emptied
 //! (`haptic2d-bench --settle … --cold …`).
