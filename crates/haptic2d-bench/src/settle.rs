@@ -209,6 +209,8 @@ pub fn run(
     // Per-stage wall time summed over the warm and the cold profiled steps (ns), and their
     // counts (with the `stage-timing` feature).
     let mut stages = [(0usize, StageTimes::default()); 2];
+    // Every warm profiled step: whether the damper rebuilt its rows, its sweeps and times.
+    let mut kinds: Vec<StepKind> = Vec::new();
     for k in 1..=steps {
         if k == first_profiled && cold.is_some_and(|c| c.warm_code) {
             twin = Some(w.clone());
@@ -249,6 +251,12 @@ pub fn run(
                 updates.2 += b.gjk_iterations;
             }
             let d = w.chain_damper();
+            kinds.push(StepKind {
+                rebuilt: !d.last_refreshed,
+                sweeps: d.last_sweeps,
+                step_us: dt_cpu * 1e6,
+                damper_us: w.stage_times().get(Stage::ChainDamper) as f64 / 1e3,
+            });
             each.push((
                 dt_cpu * 1e6,
                 k,
@@ -317,6 +325,7 @@ pub fn run(
     if stage_time::ENABLED {
         print_stages(label, profile_after, &stages, cold);
     }
+    print_damper_kinds(label, profile_after, &kinds);
     let (median, p99) = (all_steps.median(), all_steps.p99());
     println!(
         "{label}: CPU µs per step after {profile_after} s: median {median:.1}, p99 {p99:.1} (p99/median {:.2}), largest {:.1}",
@@ -417,5 +426,61 @@ fn print_stages(
         );
     } else {
         println!("{label}:   {:<10} {:8.1}", "step", total[0]);
+    }
+}
+
+/// One warm profiled step, as [`print_damper_kinds`] groups it.
+struct StepKind {
+    /// The chain damper built its rows from scratch (the loaded contacts or the dynamic bodies
+    /// changed) instead of refreshing them in place.
+    rebuilt: bool,
+    /// The damper's sweeps.
+    sweeps: u32,
+    /// The step's CPU time (µs).
+    step_us: f64,
+    /// The damper stage's wall time (µs; 0 without the `stage-timing` feature).
+    damper_us: f64,
+}
+
+/// The warm steps grouped by what the chain damper did (rows refreshed or rebuilt; 1, 2, 3 or 4+
+/// sweeps): how many, their median step, and with the `stage-timing` feature the damper's
+/// median. The slowest 1 % of steps, the p99, is where these groups' shares and costs meet.
+fn print_damper_kinds(label: &str, profile_after: f64, kinds: &[StepKind]) {
+    if kinds.is_empty() {
+        return;
+    }
+    println!(
+        "{label}: warm steps after {profile_after} s by the chain damper's work (rows, sweeps: steps, share, median CPU µs per step{}):",
+        if stage_time::ENABLED { ", median damper wall µs" } else { "" }
+    );
+    for rebuilt in [false, true] {
+        for sweeps in 0..=4u32 {
+            let group: Vec<&StepKind> = kinds
+                .iter()
+                .filter(|k| k.rebuilt == rebuilt && k.sweeps.min(4) == sweeps)
+                .collect();
+            if group.is_empty() {
+                continue;
+            }
+            let step = crate::timing::Samples(group.iter().map(|k| k.step_us).collect()).median();
+            let damper = if stage_time::ENABLED {
+                let d = crate::timing::Samples(group.iter().map(|k| k.damper_us).collect());
+                format!(", {:8.1}", d.median())
+            } else {
+                String::new()
+            };
+            println!(
+                "{label}:   {:<9}, sweeps {:>2}: {:5}, {:5.1} %, {:8.1}{damper}",
+                if rebuilt { "rebuilt" } else { "refreshed" },
+                if sweeps == 4 {
+                    "4+".to_string()
+                } else {
+                    sweeps.to_string()
+                },
+                group.len(),
+                100.0 * group.len() as f64 / kinds.len() as f64,
+                step
+            );
+        }
     }
 }
