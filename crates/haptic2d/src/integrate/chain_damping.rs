@@ -101,6 +101,19 @@ struct SolverBody {
 }
 
 impl Row {
+    /// A placeholder, overwritten before any sweep reads it.
+    const NONE: Row = Row {
+        a: 0,
+        b: 0,
+        n: Vec2::ZERO,
+        rna: 0.0,
+        rnb: 0.0,
+        w: 0.0,
+        c: 0.0,
+        lo: 0.0,
+        lambda: 0.0,
+    };
+
     /// The row of chain contact `e` between solver bodies `a` and `b` (body positions `pos`,
     /// velocities and inverse masses `star`; `r = T/τ`, `dt = T` in s), warm-started from the
     /// impulse `prev` (N·s) within this sample's bound. Its effective mass may be not finite
@@ -171,14 +184,11 @@ pub struct ChainDamping {
     star: Vec<SolverBody>,
     /// Body positions (m).
     pos: Vec<Vec2>,
-    /// Rows in contact-key order, then (after colouring) `sorted` in colour order.
-    rows: Vec<Row>,
+    /// Rows in colour order (each colour's rows in contact-key order).
     sorted: Vec<Row>,
     /// Key-order index of each row of `sorted`, and its index in the sample's loaded list.
     slot: Vec<u32>,
     src: Vec<u32>,
-    /// Loaded-list index of each row of `rows` (key order).
-    row_src: Vec<u32>,
     /// The generation and length of the loaded list the rows were built from ([`Loaded`]; 0 =
     /// none), and which bodies are dynamic (this sample's, once step 1 has run; the last sample's
     /// before): when all are unchanged and the last build dropped no chain contact, the rows are
@@ -188,7 +198,8 @@ pub struct ChainDamping {
     dynamic: Vec<bool>,
     /// The last build dropped a chain contact whose effective mass was not finite and positive.
     dropped: bool,
-    /// Colour of each row (key order), rows per colour, and colours used per body.
+    /// Colour of each row (key order), rows per colour (then each colour's next position in
+    /// `sorted`), and colours used per body.
     colour: Vec<u32>,
     per_colour: Vec<u32>,
     used: Vec<u64>,
@@ -228,11 +239,9 @@ impl Default for ChainDamping {
             solver: Vec::new(),
             star: Vec::new(),
             pos: Vec::new(),
-            rows: Vec::with_capacity(64),
             sorted: Vec::with_capacity(64),
             slot: Vec::with_capacity(64),
             src: Vec::with_capacity(64),
-            row_src: Vec::with_capacity(64),
             generation: 0,
             loaded_len: 0,
             dynamic: Vec::new(),
@@ -363,12 +372,12 @@ impl ChainDamping {
                 gh
             }
             None => {
-                let g = self.build_rows(r, dt, loaded);
-                if self.rows.is_empty() {
+                let gh = self.build_rows(r, dt, loaded);
+                if self.sorted.is_empty() {
                     self.forget();
                     return 0.0;
                 }
-                (g, self.sort_by_colour(r))
+                gh
             }
         };
         self.last_rows = self.sorted.len();
@@ -432,10 +441,16 @@ impl ChainDamping {
         self.loaded_len = 0;
     }
 
-    /// Steps 2–3 from scratch: the chain contacts of `loaded` in key order (`rows`, `keys`), each
-    /// with its colour and its warm-start impulse, the last sample's impulse of the same key
-    /// within this sample's bound, applied to `solver`. Returns `g = λ₀ᵀ·J·v*`.
-    fn build_rows(&mut self, r: f64, dt: f64, loaded: Loaded<'_>) -> f64 {
+    /// Steps 2–4 from scratch: the chain contacts of `loaded` (`keys` in key order), each with
+    /// its colour, as rows in colour order (`sorted`, with `slot` the key-order index of each and
+    /// `src` its loaded-list index), each warm-started from the last sample's impulse of the same
+    /// key within this sample's bound, applied to `solver`. Returns `(g, h)` of
+    /// [`scale_warm_start`](Self::scale_warm_start): `g = λ₀ᵀ·J·v*` and `h = λ₀ᵀ·(W + K⁻¹)·λ₀`
+    /// (see [`curvature`](Self::curvature); `r = T/τ`).
+    ///
+    /// Two passes over the contacts, the colours first, so that each row is written once, to its
+    /// place in colour order; the sums and the warm impulses go in key order.
+    fn build_rows(&mut self, r: f64, dt: f64, loaded: Loaded<'_>) -> (f64, f64) {
         // The last sample's impulses by key (its rows keep them in colour order).
         std::mem::swap(&mut self.prev_keys, &mut self.keys);
         self.prev_lambda.clear();
@@ -461,25 +476,57 @@ impl ChainDamping {
             }
         }
         // 3. The chain contacts in key order, each with its colour (greedy: the lowest colour
-        //    neither body has yet; fixed bodies take any number) and its warm-start impulse:
-        //    the last sample's impulse of the same key (a merge of two key-sorted lists), within
-        //    this sample's bound.
-        self.solver.copy_from_slice(&self.star);
-        self.rows.clear();
-        self.keys.clear();
-        self.row_src.clear();
+        //    neither body has yet; fixed bodies take any number). A contact whose effective mass
+        //    is not finite and positive is no row and takes no colour.
         self.colour.clear();
         self.per_colour.fill(0);
         self.used.fill(0);
         self.generation = loaded.generation;
         self.loaded_len = loaded.contacts.len();
         self.dropped = false;
-        let mut g = 0.0;
-        let mut j = 0;
-        for (i, (e, &key)) in loaded.contacts.iter().zip(loaded.keys).enumerate() {
+        for e in loaded.contacts {
             let (a, b) = (e.body_a as usize, e.body_b as usize);
             let (dyn_a, dyn_b) = (dynamic[a], dynamic[b]);
             if !((dyn_a && self.multi[a]) || (dyn_b && self.multi[b])) {
+                continue;
+            }
+            if !Row::build(e, a as u32, b as u32, &self.pos, star, r, dt, 0.0).valid() {
+                self.dropped = true;
+                continue;
+            }
+            let taken = if dyn_a { self.used[a] } else { 0 } | if dyn_b { self.used[b] } else { 0 };
+            let c = (!taken).trailing_zeros().min(COLOURS);
+            if c < COLOURS {
+                self.used[a] |= (dyn_a as u64) << c;
+                self.used[b] |= (dyn_b as u64) << c;
+            }
+            self.colour.push(c);
+            self.per_colour[c as usize] += 1;
+        }
+        // 4. The rows, still in key order, written straight to their places in colour order
+        //    (`per_colour` becomes each colour's next position: a stable counting sort), each
+        //    warm-started from the last sample's impulse of the same key (a merge of two
+        //    key-sorted lists) within this sample's bound, and that impulse applied to `solver`.
+        let mut at = 0u32;
+        for k in self.per_colour.iter_mut() {
+            let count = *k;
+            *k = at;
+            at += count;
+        }
+        let n = self.colour.len();
+        self.sorted.clear();
+        self.sorted.resize(n, Row::NONE);
+        self.slot.clear();
+        self.slot.resize(n, 0);
+        self.src.clear();
+        self.src.resize(n, 0);
+        self.keys.clear();
+        self.solver.copy_from_slice(&self.star);
+        let (mut g, mut k) = (0.0, 0.0);
+        let mut j = 0;
+        for (i, (e, &key)) in loaded.contacts.iter().zip(loaded.keys).enumerate() {
+            let (a, b) = (e.body_a as usize, e.body_b as usize);
+            if !((dynamic[a] && self.multi[a]) || (dynamic[b] && self.multi[b])) {
                 continue;
             }
             while j < self.prev_keys.len() && self.prev_keys[j] < key {
@@ -492,7 +539,6 @@ impl ChainDamping {
             };
             let row = Row::build(e, a as u32, b as u32, &self.pos, star, r, dt, prev);
             if !row.valid() {
-                self.dropped = true;
                 continue;
             }
             // g = λ₀ᵀ·J·v* (see `scale_warm_start`), and the warm impulse applied.
@@ -500,27 +546,23 @@ impl ChainDamping {
                 g += row.lambda * row.v_rel(star);
                 row.apply(row.lambda, &mut self.solver);
             }
-            let taken = if dyn_a { self.used[a] } else { 0 } | if dyn_b { self.used[b] } else { 0 };
-            let c = (!taken).trailing_zeros().min(COLOURS);
-            if c < COLOURS {
-                self.used[a] |= (dyn_a as u64) << c;
-                self.used[b] |= (dyn_b as u64) << c;
-            }
-            self.colour.push(c);
-            self.per_colour[c as usize] += 1;
-            self.rows.push(row);
+            k += row.lambda * row.lambda * row.w;
+            let index = self.keys.len();
+            let p = &mut self.per_colour[self.colour[index] as usize];
+            self.sorted[*p as usize] = row;
+            self.slot[*p as usize] = index as u32;
+            self.src[*p as usize] = i as u32;
+            *p += 1;
             self.keys.push(key);
-            self.row_src.push(i as u32);
         }
-        g
+        (g, self.curvature(k / r))
     }
 
     /// Steps 2–4 when `loaded` holds the same contacts as the last sample (same keys in the same
     /// order, same dynamic bodies): the chain contacts, their colours and order are then those of
     /// the last sample, so its rows (colour order) are refreshed in place from the new
     /// geometry, each warm-started from its own last impulse within this sample's bound — what
-    /// [`build_rows`](Self::build_rows) and [`sort_by_colour`](Self::sort_by_colour) would build,
-    /// without the key merge, the colouring and the sort. Returns `(g, h)` of
+    /// [`build_rows`](Self::build_rows) would build, without the key merge and the colouring. Returns `(g, h)` of
     /// [`scale_warm_start`](Self::scale_warm_start), or `None` (the caller builds from scratch)
     /// if a row's effective mass is no longer finite.
     fn refresh_rows(&mut self, r: f64, dt: f64, loaded: &[LoadedContact]) -> Option<(f64, f64)> {
@@ -592,35 +634,6 @@ impl ChainDamping {
             }
         }
         s
-    }
-
-    /// A stable counting sort of the rows by colour into `sorted`, with `slot` the key-order
-    /// index of each and `src` its loaded-list index; returns `h = λ₀ᵀ·(W + K⁻¹)·λ₀` of the warm
-    /// impulses `λ₀` (already applied to `solver`; see [`curvature`](Self::curvature); `r = T/τ`).
-    fn sort_by_colour(&mut self, r: f64) -> f64 {
-        // Exclusive prefix sums: the first position of each colour.
-        let mut at = 0u32;
-        for k in self.per_colour.iter_mut() {
-            let count = *k;
-            *k = at;
-            at += count;
-        }
-        self.sorted.clear();
-        self.sorted.resize(self.rows.len(), self.rows[0]);
-        self.slot.clear();
-        self.slot.resize(self.rows.len(), 0);
-        self.src.clear();
-        self.src.resize(self.rows.len(), 0);
-        let mut k = 0.0;
-        for (i, (row, &c)) in self.rows.iter().zip(&self.colour).enumerate() {
-            k += row.lambda * row.lambda * row.w;
-            let p = &mut self.per_colour[c as usize];
-            self.sorted[*p as usize] = *row;
-            self.slot[*p as usize] = i as u32;
-            self.src[*p as usize] = self.row_src[i];
-            *p += 1;
-        }
-        self.curvature(k / r)
     }
 }
 
