@@ -458,7 +458,7 @@ impl ChainDamping {
         for (row, &k) in self.sorted.iter().zip(&self.slot) {
             self.prev_lambda[k as usize] = row.lambda;
         }
-        let (star, dynamic) = (&self.star, &self.dynamic);
+        let dynamic = &self.dynamic;
         // 2. Which dynamic bodies touch two or more other bodies.
         self.partner.fill(NONE);
         self.multi.fill(false);
@@ -475,38 +475,73 @@ impl ChainDamping {
                 }
             }
         }
-        // 3. The chain contacts in key order, each with its colour (greedy: the lowest colour
-        //    neither body has yet; fixed bodies take any number). A contact whose effective mass
-        //    is not finite and positive is no row and takes no colour.
+        self.generation = loaded.generation;
+        self.loaded_len = loaded.contacts.len();
+        // 3–4. The colours, then the rows in their places. The colouring first takes every
+        //      chain contact's effective mass as finite and positive, as it nearly always is; if
+        //      placing the rows meets one that is not, both run again with the check, so that
+        //      such a contact takes no colour.
+        self.colour_rows(r, dt, loaded.contacts, false);
+        let (g, k) = match self.place_rows(r, dt, loaded, true) {
+            Some(gk) => gk,
+            None => {
+                self.colour_rows(r, dt, loaded.contacts, true);
+                let gk = self.place_rows(r, dt, loaded, false);
+                debug_assert!(gk.is_some(), "a checked colouring places every row");
+                gk.unwrap_or_default()
+            }
+        };
+        (g, self.curvature(k / r))
+    }
+
+    /// Step 3 of [`build_rows`](Self::build_rows): the colour of each chain contact of `loaded`
+    /// in key order (`colour`, and `per_colour` the rows of each), greedy: the lowest colour
+    /// neither body has yet (fixed bodies take any number). With `check`, a contact whose
+    /// effective mass is not finite and positive is no row: it takes no colour and sets
+    /// `dropped`.
+    fn colour_rows(&mut self, r: f64, dt: f64, loaded: &[LoadedContact], check: bool) {
         self.colour.clear();
         self.per_colour.fill(0);
         self.used.fill(0);
-        self.generation = loaded.generation;
-        self.loaded_len = loaded.contacts.len();
         self.dropped = false;
-        for e in loaded.contacts {
+        let (dynamic, multi, used) = (&self.dynamic, &self.multi, &mut self.used);
+        for e in loaded {
             let (a, b) = (e.body_a as usize, e.body_b as usize);
             let (dyn_a, dyn_b) = (dynamic[a], dynamic[b]);
-            if !((dyn_a && self.multi[a]) || (dyn_b && self.multi[b])) {
+            if !((dyn_a && multi[a]) || (dyn_b && multi[b])) {
                 continue;
             }
-            if !Row::build(e, a as u32, b as u32, &self.pos, star, r, dt, 0.0).valid() {
+            if check
+                && !Row::build(e, a as u32, b as u32, &self.pos, &self.star, r, dt, 0.0).valid()
+            {
                 self.dropped = true;
                 continue;
             }
-            let taken = if dyn_a { self.used[a] } else { 0 } | if dyn_b { self.used[b] } else { 0 };
+            let taken = if dyn_a { used[a] } else { 0 } | if dyn_b { used[b] } else { 0 };
             let c = (!taken).trailing_zeros().min(COLOURS);
             if c < COLOURS {
-                self.used[a] |= (dyn_a as u64) << c;
-                self.used[b] |= (dyn_b as u64) << c;
+                used[a] |= (dyn_a as u64) << c;
+                used[b] |= (dyn_b as u64) << c;
             }
             self.colour.push(c);
             self.per_colour[c as usize] += 1;
         }
-        // 4. The rows, still in key order, written straight to their places in colour order
-        //    (`per_colour` becomes each colour's next position: a stable counting sort), each
-        //    warm-started from the last sample's impulse of the same key (a merge of two
-        //    key-sorted lists) within this sample's bound, and that impulse applied to `solver`.
+    }
+
+    /// Step 4 of [`build_rows`](Self::build_rows): the rows, in key order, written straight to
+    /// their places in colour order (`per_colour` becomes each colour's next position: a stable
+    /// counting sort), each warm-started from the last sample's impulse of the same key (a merge
+    /// of two key-sorted lists) within this sample's bound, and that impulse applied to
+    /// `solver`. Returns `g = λ₀ᵀ·J·v*` and `Σ λ₀ᵢ²·wᵢ`; `None` if `abort_on_invalid` and a
+    /// chain contact's effective mass is not finite and positive (the colours did not leave it
+    /// out), else such a contact is skipped.
+    fn place_rows(
+        &mut self,
+        r: f64,
+        dt: f64,
+        loaded: Loaded<'_>,
+        abort_on_invalid: bool,
+    ) -> Option<(f64, f64)> {
         let mut at = 0u32;
         for k in self.per_colour.iter_mut() {
             let count = *k;
@@ -522,11 +557,12 @@ impl ChainDamping {
         self.src.resize(n, 0);
         self.keys.clear();
         self.solver.copy_from_slice(&self.star);
+        let (star, dynamic, multi) = (&self.star, &self.dynamic, &self.multi);
         let (mut g, mut k) = (0.0, 0.0);
         let mut j = 0;
         for (i, (e, &key)) in loaded.contacts.iter().zip(loaded.keys).enumerate() {
             let (a, b) = (e.body_a as usize, e.body_b as usize);
-            if !((dynamic[a] && self.multi[a]) || (dynamic[b] && self.multi[b])) {
+            if !((dynamic[a] && multi[a]) || (dynamic[b] && multi[b])) {
                 continue;
             }
             while j < self.prev_keys.len() && self.prev_keys[j] < key {
@@ -539,6 +575,9 @@ impl ChainDamping {
             };
             let row = Row::build(e, a as u32, b as u32, &self.pos, star, r, dt, prev);
             if !row.valid() {
+                if abort_on_invalid {
+                    return None;
+                }
                 continue;
             }
             // g = λ₀ᵀ·J·v* (see `scale_warm_start`), and the warm impulse applied.
@@ -555,7 +594,7 @@ impl ChainDamping {
             *p += 1;
             self.keys.push(key);
         }
-        (g, self.curvature(k / r))
+        Some((g, k))
     }
 
     /// Steps 2–4 when `loaded` holds the same contacts as the last sample (same keys in the same
@@ -817,6 +856,70 @@ mod tests {
             chain.last_sweeps
         );
         assert!(removed > 0.0);
+    }
+
+    /// A chain contact whose effective mass is not finite (here a NaN point, between two bodies
+    /// that already touch) is no row and takes no colour: the rows, their order and the
+    /// result are those of the list without it, bit for bit, and the next sample rebuilds. (The
+    /// colouring first assumes every mass valid; placing the rows meets the NaN and runs both
+    /// again with the check.)
+    #[test]
+    fn a_degenerate_chain_contact_takes_no_colour() {
+        let (bodies0, loaded) = column();
+        let mut degenerate = Column {
+            contacts: loaded.contacts.clone(),
+            keys: loaded.keys.clone(),
+        };
+        // Between box 1 and box 2 (as contact 1), keyed between contacts 1 and 2.
+        let mut key = loaded.keys[1];
+        key.vertex = 1;
+        degenerate.keys.insert(2, key);
+        degenerate.contacts.insert(
+            2,
+            LoadedContact {
+                point: Vec2::new(f64::NAN, 0.1),
+                ..loaded.contacts[1]
+            },
+        );
+        let (mut plain, mut with) = (ChainDamping::default(), ChainDamping::default());
+        let (mut b_plain, mut b_with) = (bodies0.clone(), bodies0.clone());
+        let mut wrenches = vec![Wrench2::default(); bodies0.len()];
+        for k in 0..4u64 {
+            for bodies in [&mut b_plain, &mut b_with] {
+                for (i, b) in bodies.iter_mut().enumerate().skip(1) {
+                    b.vel = Vec2::new(0.02 * k as f64, -0.1 * i as f64);
+                    b.omega = 0.1 * (k as f64 - i as f64);
+                    b.force = Vec2::new(0.0, -9.81);
+                    b.torque = 0.0;
+                }
+            }
+            // The plain list comes with a new generation every sample, so it is rebuilt; the one
+            // with the degenerate contact keeps its generation, and is rebuilt because a
+            // contact was dropped (else it would be refreshed, which rounds differently).
+            let r_plain = plain.apply(
+                Some(2e-4),
+                3,
+                1e-3,
+                loaded.view(3, 100 + k),
+                &mut b_plain,
+                &mut wrenches,
+            );
+            let r_with = with.apply(
+                Some(2e-4),
+                3,
+                1e-3,
+                degenerate.view(4, 1),
+                &mut b_with,
+                &mut wrenches,
+            );
+            assert_eq!((plain.last_rows, with.last_rows), (3, 3), "sample {k}");
+            assert!(!with.last_refreshed && !plain.last_refreshed, "sample {k}");
+            assert_eq!(r_plain.to_bits(), r_with.to_bits(), "sample {k}");
+            for (a, b) in b_plain.iter().zip(&b_with) {
+                assert_eq!(a.force, b.force, "sample {k}");
+                assert_eq!(a.torque.to_bits(), b.torque.to_bits(), "sample {k}");
+            }
+        }
     }
 
     /// A sample whose loaded contacts are those of the last one refreshes the rows in place; it
