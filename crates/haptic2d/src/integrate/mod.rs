@@ -1,7 +1,7 @@
 //! Passive numerical integration (§6): per-DOF integrators, minimum mass, the energy ledger and the
 //! optional passivity guard.
 
-pub mod chain_damping;
+mod chain_damping;
 mod guard;
 mod ledger;
 mod step;
