@@ -196,8 +196,8 @@ pub fn run(
     // CPU time of every step after `profile_after`, by sample phase of the global period.
     let n_g = w.params.proximity_every.max(1) as usize;
     let mut by_phase: Vec<Vec<f64>> = vec![Vec::new(); n_g];
-    // Every profiled step: (CPU µs, step, sweeps, damped rows, contact events).
-    let mut each: Vec<(f64, usize, u32, usize, usize)> = Vec::new();
+    // Every warm profiled step.
+    let mut each: Vec<ProfiledStep> = Vec::new();
     let (mut cpu, mut since) = (0.0, 0usize);
     // Global updates published during the profiled steps: (count, in place, GJK iterations).
     let mut updates = (0usize, 0usize, 0u64);
@@ -209,8 +209,6 @@ pub fn run(
     // Per-stage wall time summed over the warm and the cold profiled steps (ns), and their
     // counts (with the `stage-timing` feature).
     let mut stages = [(0usize, StageTimes::default()); 2];
-    // Every warm profiled step: whether the damper rebuilt its rows, its sweeps and times.
-    let mut kinds: Vec<StepKind> = Vec::new();
     for k in 1..=steps {
         if k == first_profiled && cold.is_some_and(|c| c.warm_code) {
             twin = Some(w.clone());
@@ -251,19 +249,15 @@ pub fn run(
                 updates.2 += b.gjk_iterations;
             }
             let d = w.chain_damper();
-            kinds.push(StepKind {
-                rebuilt: !d.last_refreshed,
-                sweeps: d.last_sweeps,
+            each.push(ProfiledStep {
                 step_us: dt_cpu * 1e6,
+                k,
+                sweeps: d.last_sweeps,
+                rows: d.last_rows,
+                events: w.contacts().events().len(),
+                rebuilt: !d.last_refreshed,
                 damper_us: w.stage_times().get(Stage::ChainDamper) as f64 / 1e3,
             });
-            each.push((
-                dt_cpu * 1e6,
-                k,
-                d.last_sweeps,
-                d.last_rows,
-                w.contacts().events().len(),
-            ));
         }
         since += 1;
         if k % every == 0 || k == steps {
@@ -325,7 +319,7 @@ pub fn run(
     if stage_time::ENABLED {
         print_stages(label, profile_after, &stages, cold);
     }
-    print_damper_kinds(label, profile_after, &kinds);
+    print_damper_kinds(label, profile_after, &each);
     let (median, p99) = (all_steps.median(), all_steps.p99());
     println!(
         "{label}: CPU µs per step after {profile_after} s: median {median:.1}, p99 {p99:.1} (p99/median {:.2}), largest {:.1}",
@@ -334,8 +328,8 @@ pub fn run(
     );
     // How many chain-damper sweeps the profiled steps ran (the sweeps stop once converged).
     let mut sweeps = [0usize; 5];
-    for &(_, _, n, _, _) in &each {
-        sweeps[match n {
+    for e in &each {
+        sweeps[match e.sweeps {
             0..=1 => 0,
             2..=3 => 1,
             4..=7 => 2,
@@ -343,17 +337,25 @@ pub fn run(
             _ => 4,
         }] += 1;
     }
-    let mean = each.iter().map(|e| e.2 as f64).sum::<f64>() / each.len().max(1) as f64;
+    let mean = each.iter().map(|e| e.sweeps as f64).sum::<f64>() / each.len().max(1) as f64;
     println!(
         "{label}: chain damper sweeps per step after {profile_after} s: mean {mean:.1}; steps with 0–1 / 2–3 / 4–7 / 8–15 / 16+: {} / {} / {} / {} / {}",
         sweeps[0], sweeps[1], sweeps[2], sweeps[3], sweeps[4]
     );
-    each.sort_by(|a, b| b.0.total_cmp(&a.0));
+    each.sort_by(|a, b| b.step_us.total_cmp(&a.step_us));
     println!(
         "{label}: slowest steps (µs @ step: phase mod {n_g}, chain sweeps, damped rows, contact events): {}",
         each.iter()
             .take(8)
-            .map(|(t, k, s, r, e)| format!("{t:.0} @ {k}: {}, {s}, {r}, {e}", (k - 1) % n_g))
+            .map(|e| format!(
+                "{:.0} @ {}: {}, {}, {}, {}",
+                e.step_us,
+                e.k,
+                (e.k - 1) % n_g,
+                e.sweeps,
+                e.rows,
+                e.events
+            ))
             .collect::<Vec<_>>()
             .join("; ")
     );
@@ -429,15 +431,20 @@ fn print_stages(
     }
 }
 
-/// One warm profiled step, as [`print_damper_kinds`] groups it.
-struct StepKind {
+/// One warm profiled step of [`run`].
+struct ProfiledStep {
+    /// The step's CPU time (µs).
+    step_us: f64,
+    /// The step's number (from 1).
+    k: usize,
+    /// The chain damper's sweeps and rows.
+    sweeps: u32,
+    rows: usize,
+    /// Contact events of the step.
+    events: usize,
     /// The chain damper built its rows from scratch (the loaded contacts or the dynamic bodies
     /// changed) instead of refreshing them in place.
     rebuilt: bool,
-    /// The damper's sweeps.
-    sweeps: u32,
-    /// The step's CPU time (µs).
-    step_us: f64,
     /// The damper stage's wall time (µs; 0 without the `stage-timing` feature).
     damper_us: f64,
 }
@@ -445,7 +452,7 @@ struct StepKind {
 /// The warm steps grouped by what the chain damper did (rows refreshed or rebuilt; 1, 2, 3 or 4+
 /// sweeps): how many, their median step, and with the `stage-timing` feature the damper's
 /// median. The slowest 1 % of steps, the p99, is where these groups' shares and costs meet.
-fn print_damper_kinds(label: &str, profile_after: f64, kinds: &[StepKind]) {
+fn print_damper_kinds(label: &str, profile_after: f64, kinds: &[ProfiledStep]) {
     if kinds.is_empty() {
         return;
     }
@@ -455,7 +462,7 @@ fn print_damper_kinds(label: &str, profile_after: f64, kinds: &[StepKind]) {
     );
     for rebuilt in [false, true] {
         for sweeps in 0..=4u32 {
-            let group: Vec<&StepKind> = kinds
+            let group: Vec<&ProfiledStep> = kinds
                 .iter()
                 .filter(|k| k.rebuilt == rebuilt && k.sweeps.min(4) == sweeps)
                 .collect();

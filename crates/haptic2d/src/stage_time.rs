@@ -21,7 +21,8 @@ pub enum Stage {
     Loads,
     /// Contact records: merge with the candidates and measure every pair.
     ContactSync,
-    /// Contact events: release, hand-over, creation and simultaneous impacts.
+    /// Contact events: release, hand-over, creation and simultaneous impacts, and the energy
+    /// ledger's impact accounting after them.
     ContactEvents,
     /// Continuous-contact forces (the force pass).
     ContactForces,

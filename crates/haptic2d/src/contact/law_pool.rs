@@ -73,7 +73,7 @@ pub(crate) trait SlotAccess {
 #[derive(Clone, Debug)]
 pub(crate) struct Store<T> {
     /// Every slot ever handed out (free ones hold stale states).
-    pub(crate) states: Vec<T>,
+    states: Vec<T>,
     /// The other buffer of [`repack`](LawPool::repack).
     spare: Vec<T>,
 }
@@ -112,7 +112,19 @@ impl<T: Copy> Store<T> {
         std::mem::swap(&mut self.states, &mut self.spare);
     }
 
+    /// Slots handed out so far (free ones included).
+    #[inline]
+    pub(crate) fn len(&self) -> usize {
+        self.states.len()
+    }
+
     /// The state in `slot` (a slot handed out by [`LawPool::acquire`] and not released).
+    #[inline]
+    pub(crate) fn get(&self, slot: u32) -> &T {
+        &self.states[slot as usize]
+    }
+
+    /// The state in `slot`, to change (see [`get`](Self::get)).
     #[inline]
     pub(crate) fn get_mut(&mut self, slot: u32) -> &mut T {
         &mut self.states[slot as usize]

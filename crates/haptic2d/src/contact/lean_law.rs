@@ -85,7 +85,7 @@ impl LeanStore {
     /// are the paper's pair of laws, and either they have this store's parameters or no slot is
     /// live (`free` of them are free), so the store can take theirs.
     pub(crate) fn takes(&self, normal: &PaperLaw, friction: &ResetIntegrator, free: usize) -> bool {
-        free == self.slots.states.len()
+        free == self.slots.len()
             || (self.paper.same_params(normal) && self.friction.same_params(friction))
     }
 
@@ -112,7 +112,7 @@ impl LeanStore {
     /// The laws of `slot`: the shared parameters with the slot's state.
     #[inline(always)]
     pub(crate) fn laws(&self, slot: u32) -> LawState<PaperLaw, ResetIntegrator> {
-        let s = &self.slots.states[slot as usize];
+        let s = self.slots.get(slot);
         LawState {
             friction: self.friction.with_state((s.p, s.k_used, s.mode)),
             normal: ContactNormal::with_offset(self.paper.with_state(s.stored), s.offset),
@@ -127,7 +127,7 @@ impl LeanStore {
 
     /// The laws of `slot` in the whole form.
     pub(crate) fn whole(&self, slot: u32) -> Option<LawState> {
-        ((slot as usize) < self.slots.states.len()).then(|| {
+        ((slot as usize) < self.slots.len()).then(|| {
             let l = self.laws(slot);
             LawState {
                 friction: FrictionModel::ResetIntegrator(l.friction),
@@ -138,7 +138,7 @@ impl LeanStore {
 
     /// Every slot (free ones too, so slot numbers stay) in the compact form.
     pub(crate) fn compact(&self) -> Vec<LawState<CompactNormal>> {
-        (0..self.slots.states.len() as u32)
+        (0..self.slots.len() as u32)
             .map(|slot| {
                 let l = self.laws(slot);
                 LawState {
@@ -174,10 +174,10 @@ mod tests {
     /// A world whose law slots are lean moves bit for bit like one whose slots are compact, and
     /// keeps doing so when it leaves the lean form mid-run, with live records, because the
     /// friction prototype changes (pile:20, whose laws are the paper's pair, thrown down at
-    /// 1 m/s at step 0, shoved sideways at step 300 so that the friction springs carry load; at step 700 `Kr` drops by a fifth and the
-    /// top box is tossed up, so that it lands with the new prototype while the others keep
-    /// their records). With the impact surface offset on (docs/MODELS.md §F.7), the landings'
-    /// impacts leave some slots with an offset.
+    /// 1 m/s at step 0, shoved sideways at step 300 so that the friction springs carry load; at
+    /// step 700 `Kr` drops by a fifth and the top box is tossed up, so that it lands with the new
+    /// prototype while the others keep their records). With the impact surface offset on
+    /// (docs/MODELS.md §F.7), the landings' impacts leave some slots with an offset.
     #[test]
     fn leaving_the_lean_slots_mid_run_changes_no_trajectory() {
         let world = crate::scene::builtin("pile:20", None)

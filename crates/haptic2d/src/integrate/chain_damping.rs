@@ -37,10 +37,10 @@
 //! Those are cold sweeps (from zero). Warm-started (session 7): at most 4 / 6 / 8 / 16 sweeps
 //! gave rest from 2.35 / 2.05 / 2.65 / 2.15 s, and with the convergence stop (1e-5 m/s) at most
 //! 16 gives 2.15 s while a settled pile runs 1–4 sweeps. A stop at 1e-4 m/s (issue 17, session
-//! 9; the default until session 15) gives the same rest time and largest speed after 2.5 s (2.15 s, 6.7 mm/s) with
-//! 1.2 sweeps per sample over 1–5 s instead of 3.7, and the 25 aligned 10-box stacks of
-//! `tests/stack_corners.rs` at 8.3e-4 m/s after 2 s (6.4e-4 with 1e-5). A stop at 2e-4 m/s
-//! (session 15; the default) halves the samples that need four sweeps or more, the slowest
+//! 9; the default until session 15) gives the same rest time and largest speed after 2.5 s
+//! (2.15 s, 6.7 mm/s) with 1.2 sweeps per sample over 1–5 s instead of 3.7, and the 25 aligned
+//! 10-box stacks of `tests/stack_corners.rs` at 8.3e-4 m/s after 2 s (6.4e-4 with 1e-5). A stop
+//! at 2e-4 m/s (session 15; the default) halves the samples that need four sweeps or more, the slowest
 //! samples of a settling pile (pile:1000 over 1–3 s: 38 of 2000 samples, then 19; pile:5000 over
 //! 1–5 s: 23 of 4000, then 15), with the same rest times (pile:100 0.16 s, pile:1000 2.15 s,
 //! pile:5000 1.62 s then 1.61 s, pyramid 0.19 s: `--rest-time 5`), the same settle table to four
@@ -507,10 +507,10 @@ impl ChainDamping {
         let (dynamic, multi, used) = (&self.dynamic, &self.multi, &mut self.used);
         for e in loaded {
             let (a, b) = (e.body_a as usize, e.body_b as usize);
-            let (dyn_a, dyn_b) = (dynamic[a], dynamic[b]);
-            if !((dyn_a && multi[a]) || (dyn_b && multi[b])) {
+            if !is_chain(dynamic, multi, a, b) {
                 continue;
             }
+            let (dyn_a, dyn_b) = (dynamic[a], dynamic[b]);
             if check
                 && !Row::build(e, a as u32, b as u32, &self.pos, &self.star, r, dt, 0.0).valid()
             {
@@ -562,7 +562,7 @@ impl ChainDamping {
         let mut j = 0;
         for (i, (e, &key)) in loaded.contacts.iter().zip(loaded.keys).enumerate() {
             let (a, b) = (e.body_a as usize, e.body_b as usize);
-            if !((dynamic[a] && multi[a]) || (dynamic[b] && multi[b])) {
+            if !is_chain(dynamic, multi, a, b) {
                 continue;
             }
             while j < self.prev_keys.len() && self.prev_keys[j] < key {
@@ -601,9 +601,9 @@ impl ChainDamping {
     /// order, same dynamic bodies): the chain contacts, their colours and order are then those of
     /// the last sample, so its rows (colour order) are refreshed in place from the new
     /// geometry, each warm-started from its own last impulse within this sample's bound — what
-    /// [`build_rows`](Self::build_rows) would build, without the key merge and the colouring. Returns `(g, h)` of
-    /// [`scale_warm_start`](Self::scale_warm_start), or `None` (the caller builds from scratch)
-    /// if a row's effective mass is no longer finite.
+    /// [`build_rows`](Self::build_rows) would build, without the key merge and the colouring.
+    /// Returns `(g, h)` of [`scale_warm_start`](Self::scale_warm_start), or `None` (the caller
+    /// builds from scratch) if a row's effective mass is no longer finite.
     fn refresh_rows(&mut self, r: f64, dt: f64, loaded: &[LoadedContact]) -> Option<(f64, f64)> {
         self.solver.copy_from_slice(&self.star);
         let star = &self.star;
@@ -674,6 +674,14 @@ impl ChainDamping {
         }
         s
     }
+}
+
+/// Whether the contact between bodies `a` and `b` is a chain contact: one of them is dynamic and
+/// touches two or more other bodies (`multi`). The colouring and the placing of the rows must
+/// agree on it contact by contact, so both ask here.
+#[inline(always)]
+fn is_chain(dynamic: &[bool], multi: &[bool], a: usize, b: usize) -> bool {
+    (dynamic[a] && multi[a]) || (dynamic[b] && multi[b])
 }
 
 /// Kinetic energy of the working velocities `s` of `bodies` (J; fixed bodies count none).
