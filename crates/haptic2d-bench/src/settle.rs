@@ -255,7 +255,13 @@ pub fn run(
                 sweeps: d.last_sweeps,
                 rows: d.last_rows,
                 events: w.contacts().events().len(),
-                rebuilt: !d.last_refreshed,
+                rows_by: if d.last_refreshed {
+                    RowsBy::Refresh
+                } else if d.last_patched {
+                    RowsBy::Patch
+                } else {
+                    RowsBy::Build
+                },
                 damper_us: w.stage_times().get(Stage::ChainDamper) as f64 / 1e3,
             });
         }
@@ -442,14 +448,22 @@ struct ProfiledStep {
     rows: usize,
     /// Contact events of the step.
     events: usize,
-    /// The chain damper built its rows from scratch (the loaded contacts or the dynamic bodies
-    /// changed) instead of refreshing them in place.
-    rebuilt: bool,
+    /// How the chain damper made its rows.
+    rows_by: RowsBy,
     /// The damper stage's wall time (µs; 0 without the `stage-timing` feature).
     damper_us: f64,
 }
 
-/// The warm steps grouped by what the chain damper did (rows refreshed or rebuilt; 1, 2, 3 or 4+
+/// How the chain damper made a step's rows: refreshed in place (the loaded contacts were the
+/// last step's), patched (a few changed) or built from scratch.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum RowsBy {
+    Refresh,
+    Patch,
+    Build,
+}
+
+/// The warm steps grouped by what the chain damper did (rows refreshed, patched or rebuilt; 1, 2, 3 or 4+
 /// sweeps): how many, their median step, and with the `stage-timing` feature the damper's
 /// median. The slowest 1 % of steps, the p99, is where these groups' shares and costs meet.
 fn print_damper_kinds(label: &str, profile_after: f64, kinds: &[ProfiledStep]) {
@@ -460,11 +474,11 @@ fn print_damper_kinds(label: &str, profile_after: f64, kinds: &[ProfiledStep]) {
         "{label}: warm steps after {profile_after} s by the chain damper's work (rows, sweeps: steps, share, median CPU µs per step{}):",
         if stage_time::ENABLED { ", median damper wall µs" } else { "" }
     );
-    for rebuilt in [false, true] {
+    for rows_by in [RowsBy::Refresh, RowsBy::Patch, RowsBy::Build] {
         for sweeps in 0..=4u32 {
             let group: Vec<&ProfiledStep> = kinds
                 .iter()
-                .filter(|k| k.rebuilt == rebuilt && k.sweeps.min(4) == sweeps)
+                .filter(|k| k.rows_by == rows_by && k.sweeps.min(4) == sweeps)
                 .collect();
             if group.is_empty() {
                 continue;
@@ -478,7 +492,11 @@ fn print_damper_kinds(label: &str, profile_after: f64, kinds: &[ProfiledStep]) {
             };
             println!(
                 "{label}:   {:<9}, sweeps {:>2}: {:5}, {:5.1} %, {:8.1}{damper}",
-                if rebuilt { "rebuilt" } else { "refreshed" },
+                match rows_by {
+                    RowsBy::Refresh => "refreshed",
+                    RowsBy::Patch => "patched",
+                    RowsBy::Build => "rebuilt",
+                },
                 if sweeps == 4 {
                     "4+".to_string()
                 } else {

@@ -184,11 +184,23 @@ pub struct ChainDamping {
     star: Vec<SolverBody>,
     /// Body positions (m).
     pos: Vec<Vec2>,
-    /// Rows in colour order (each colour's rows in contact-key order).
+    /// Rows in colour order (each colour's rows in contact-key order) as built; a patch leaves
+    /// holes (no-op rows) where rows died, fills them with new rows of their colour and appends
+    /// the others (see [`patch_rows`](Self::patch_rows)).
     sorted: Vec<Row>,
-    /// Key-order index of each row of `sorted`, and its index in the sample's loaded list.
-    slot: Vec<u32>,
+    /// Index in the sample's loaded list of each row of `sorted` (`NONE`: a hole), its colour,
+    /// and the next hole of the same colour (`NONE`: the last).
     src: Vec<u32>,
+    colour_of: Vec<u32>,
+    hole_next: Vec<u32>,
+    /// The first hole of each colour (`NONE`: none), the holes, and the rows appended after the
+    /// colour buckets, since the last build.
+    hole_head: Vec<u32>,
+    holes: usize,
+    appended: usize,
+    /// Whether a change in the loaded contacts may patch the rows instead of building them
+    /// (tests turn it off to compare with a build).
+    patching: bool,
     /// The generation and length of the loaded list the rows were built from ([`Loaded`]; 0 =
     /// none), and which bodies are dynamic (this sample's, once step 1 has run; the last sample's
     /// before): when all are unchanged and the last build dropped no chain contact, the rows are
@@ -203,16 +215,26 @@ pub struct ChainDamping {
     colour: Vec<u32>,
     per_colour: Vec<u32>,
     used: Vec<u64>,
-    /// Keys of this sample's rows (key order) and the last sample's keys and impulses, for the
-    /// warm start.
+    /// Keys of this sample's rows (key order) and the place of each in `sorted`; the last
+    /// sample's keys and impulses, for the warm start of a build; and the new keys, places and
+    /// rows of a patch (scratch).
     keys: Vec<VeCandidate>,
+    place: Vec<u32>,
     prev_keys: Vec<VeCandidate>,
     prev_lambda: Vec<f64>,
+    new_place: Vec<u32>,
+    dead: Vec<u32>,
+    born: Vec<(u32, u32)>,
     /// Chain contacts damped in the last sample.
     pub last_rows: usize,
     /// Whether the last sample refreshed the rows of the sample before in place (its loaded
     /// contacts were the same) instead of building them.
     pub last_refreshed: bool,
+    /// Whether the last sample patched the rows of the sample before (a few of its loaded
+    /// contacts changed: see [`patch_rows`](Self::patch_rows)) instead of building them.
+    pub last_patched: bool,
+    /// The rows that died and the rows that were born in the last sample's patch.
+    pub last_patch_size: (usize, usize),
     /// Sweeps run in the last sample (at most the `sweeps` asked for; fewer once converged).
     pub last_sweeps: u32,
     /// Scale `s ∈ [0, 1]` of the warm start in the last sample (1 = the last sample's impulses
@@ -240,8 +262,13 @@ impl Default for ChainDamping {
             star: Vec::new(),
             pos: Vec::new(),
             sorted: Vec::with_capacity(64),
-            slot: Vec::with_capacity(64),
             src: Vec::with_capacity(64),
+            colour_of: Vec::with_capacity(64),
+            hole_next: Vec::with_capacity(64),
+            hole_head: vec![NONE; COLOURS as usize + 1],
+            holes: 0,
+            appended: 0,
+            patching: true,
             generation: 0,
             loaded_len: 0,
             dynamic: Vec::new(),
@@ -250,10 +277,16 @@ impl Default for ChainDamping {
             per_colour: vec![0; COLOURS as usize + 1],
             used: Vec::new(),
             keys: Vec::with_capacity(64),
+            place: Vec::with_capacity(64),
             prev_keys: Vec::with_capacity(64),
             prev_lambda: Vec::with_capacity(64),
+            new_place: Vec::with_capacity(64),
+            dead: Vec::with_capacity(64),
+            born: Vec::with_capacity(64),
             last_rows: 0,
             last_refreshed: false,
+            last_patched: false,
+            last_patch_size: (0, 0),
             last_sweeps: 0,
             last_warm_scale: 0.0,
         }
@@ -298,6 +331,8 @@ impl ChainDamping {
     ) -> f64 {
         self.last_rows = 0;
         self.last_refreshed = false;
+        self.last_patched = false;
+        self.last_patch_size = (0, 0);
         self.last_sweeps = 0;
         self.last_warm_scale = 0.0;
         let tau = match tau {
@@ -356,31 +391,35 @@ impl ChainDamping {
             self.dynamic[i] = d;
         }
         // 2–4. The rows: refreshed in place when the loaded contacts are those of the last
-        //      sample (a pile at rest, most samples), built from scratch otherwise.
+        //      sample (a pile at rest, most samples), patched when a few of them changed, built
+        //      from scratch otherwise.
         let r = dt / tau;
-        let same = same_bodies
-            && !self.dropped
-            && !self.sorted.is_empty()
+        let kept = same_bodies && !self.dropped && !self.keys.is_empty();
+        let same = kept
             && loaded.generation == self.generation
             && loaded.contacts.len() == self.loaded_len;
-        let (g, h) = match same
-            .then(|| self.refresh_rows(r, dt, loaded.contacts))
-            .flatten()
-        {
-            Some(gh) => {
-                self.last_refreshed = true;
-                gh
+        let mut partners_found = false;
+        let mut gh = None;
+        if same {
+            gh = self.refresh_rows(r, dt, loaded.contacts);
+            self.last_refreshed = gh.is_some();
+        } else if kept && self.patching {
+            self.find_partners(loaded.contacts);
+            partners_found = true;
+            if self.patch_rows(loaded) {
+                gh = self.refresh_rows(r, dt, loaded.contacts);
+                self.last_patched = gh.is_some();
             }
-            None => {
-                let gh = self.build_rows(r, dt, loaded);
-                if self.sorted.is_empty() {
-                    self.forget();
-                    return 0.0;
-                }
-                gh
-            }
+        }
+        let (g, h) = match gh {
+            Some(gh) => gh,
+            None => self.build_rows(r, dt, loaded, partners_found),
         };
-        self.last_rows = self.sorted.len();
+        if self.keys.is_empty() {
+            self.forget();
+            return 0.0;
+        }
+        self.last_rows = self.keys.len();
         let s = self.scale_warm_start(g, h);
         self.last_warm_scale = s;
         // 5. Projected Gauss–Seidel on F = −B_c·v⁺_n, F ≥ −f_n, until converged. The rows still
@@ -434,46 +473,43 @@ impl ChainDamping {
     /// Drops the rows of the last sample: the next sample starts cold.
     fn forget(&mut self) {
         self.sorted.clear();
-        self.slot.clear();
         self.src.clear();
+        self.colour_of.clear();
+        self.hole_next.clear();
+        self.hole_head.fill(NONE);
+        self.holes = 0;
+        self.appended = 0;
         self.keys.clear();
+        self.place.clear();
         self.generation = 0;
         self.loaded_len = 0;
     }
 
-    /// Steps 2–4 from scratch: the chain contacts of `loaded` (`keys` in key order), each with
-    /// its colour, as rows in colour order (`sorted`, with `slot` the key-order index of each and
-    /// `src` its loaded-list index), each warm-started from the last sample's impulse of the same
-    /// key within this sample's bound, applied to `solver`. Returns `(g, h)` of
+    /// Steps 2–4 from scratch: the chain contacts of `loaded` (`keys` in key order, `place` the
+    /// place of each in `sorted`), each with its colour, as rows in colour order (`sorted`, with
+    /// `src` the loaded-list index of each), each warm-started from the last sample's impulse of
+    /// the same key within this sample's bound, applied to `solver`. `partners_found`: step 2
+    /// ([`find_partners`](Self::find_partners)) already ran for `loaded`. Returns `(g, h)` of
     /// [`scale_warm_start`](Self::scale_warm_start): `g = λ₀ᵀ·J·v*` and `h = λ₀ᵀ·(W + K⁻¹)·λ₀`
     /// (see [`curvature`](Self::curvature); `r = T/τ`).
     ///
     /// Two passes over the contacts, the colours first, so that each row is written once, to its
     /// place in colour order; the sums and the warm impulses go in key order.
-    fn build_rows(&mut self, r: f64, dt: f64, loaded: Loaded<'_>) -> (f64, f64) {
-        // The last sample's impulses by key (its rows keep them in colour order).
+    fn build_rows(
+        &mut self,
+        r: f64,
+        dt: f64,
+        loaded: Loaded<'_>,
+        partners_found: bool,
+    ) -> (f64, f64) {
+        // The last sample's impulses by key.
         std::mem::swap(&mut self.prev_keys, &mut self.keys);
         self.prev_lambda.clear();
-        self.prev_lambda.resize(self.prev_keys.len(), 0.0);
-        for (row, &k) in self.sorted.iter().zip(&self.slot) {
-            self.prev_lambda[k as usize] = row.lambda;
-        }
-        let dynamic = &self.dynamic;
-        // 2. Which dynamic bodies touch two or more other bodies.
-        self.partner.fill(NONE);
-        self.multi.fill(false);
-        for e in loaded.contacts {
-            for (x, y) in [(e.body_a, e.body_b), (e.body_b, e.body_a)] {
-                if !dynamic[x as usize] {
-                    continue;
-                }
-                let p = &mut self.partner[x as usize];
-                if *p == NONE {
-                    *p = y;
-                } else if *p != y {
-                    self.multi[x as usize] = true;
-                }
-            }
+        let sorted = &self.sorted;
+        self.prev_lambda
+            .extend(self.place.iter().map(|&p| sorted[p as usize].lambda));
+        if !partners_found {
+            self.find_partners(loaded.contacts);
         }
         self.generation = loaded.generation;
         self.loaded_len = loaded.contacts.len();
@@ -494,6 +530,27 @@ impl ChainDamping {
         (g, self.curvature(k / r))
     }
 
+    /// Step 2: which dynamic bodies touch two or more other bodies through the contacts of
+    /// `loaded` (`multi`; `partner` is scratch).
+    fn find_partners(&mut self, loaded: &[LoadedContact]) {
+        let dynamic = &self.dynamic;
+        self.partner.fill(NONE);
+        self.multi.fill(false);
+        for e in loaded {
+            for (x, y) in [(e.body_a, e.body_b), (e.body_b, e.body_a)] {
+                if !dynamic[x as usize] {
+                    continue;
+                }
+                let p = &mut self.partner[x as usize];
+                if *p == NONE {
+                    *p = y;
+                } else if *p != y {
+                    self.multi[x as usize] = true;
+                }
+            }
+        }
+    }
+
     /// Step 3 of [`build_rows`](Self::build_rows): the colour of each chain contact of `loaded`
     /// in key order (`colour`, and `per_colour` the rows of each), greedy: the lowest colour
     /// neither body has yet (fixed bodies take any number). With `check`, a contact whose
@@ -507,7 +564,7 @@ impl ChainDamping {
         let (dynamic, multi, used) = (&self.dynamic, &self.multi, &mut self.used);
         for e in loaded {
             let (a, b) = (e.body_a as usize, e.body_b as usize);
-            if !is_chain(dynamic, multi, a, b) {
+            if !is_chain(multi, a, b) {
                 continue;
             }
             let (dyn_a, dyn_b) = (dynamic[a], dynamic[b]);
@@ -551,18 +608,23 @@ impl ChainDamping {
         let n = self.colour.len();
         self.sorted.clear();
         self.sorted.resize(n, Row::NONE);
-        self.slot.clear();
-        self.slot.resize(n, 0);
         self.src.clear();
         self.src.resize(n, 0);
+        self.colour_of.clear();
+        self.colour_of.resize(n, 0);
+        self.hole_next.clear();
+        self.hole_next.resize(n, NONE);
+        self.hole_head.fill(NONE);
+        (self.holes, self.appended) = (0, 0);
         self.keys.clear();
+        self.place.clear();
         self.solver.copy_from_slice(&self.star);
-        let (star, dynamic, multi) = (&self.star, &self.dynamic, &self.multi);
+        let (star, multi) = (&self.star, &self.multi);
         let (mut g, mut k) = (0.0, 0.0);
         let mut j = 0;
         for (i, (e, &key)) in loaded.contacts.iter().zip(loaded.keys).enumerate() {
             let (a, b) = (e.body_a as usize, e.body_b as usize);
-            if !is_chain(dynamic, multi, a, b) {
+            if !is_chain(multi, a, b) {
                 continue;
             }
             while j < self.prev_keys.len() && self.prev_keys[j] < key {
@@ -587,14 +649,136 @@ impl ChainDamping {
             }
             k += row.lambda * row.lambda * row.w;
             let index = self.keys.len();
-            let p = &mut self.per_colour[self.colour[index] as usize];
+            let colour = self.colour[index];
+            let p = &mut self.per_colour[colour as usize];
             self.sorted[*p as usize] = row;
-            self.slot[*p as usize] = index as u32;
             self.src[*p as usize] = i as u32;
+            self.colour_of[*p as usize] = colour;
+            self.place.push(*p);
             *p += 1;
             self.keys.push(key);
         }
         Some((g, k))
+    }
+
+    /// Steps 3–4 when a few loaded contacts changed (after step 2,
+    /// [`find_partners`](Self::find_partners), for `loaded`): a merge of the last sample's keys
+    /// with the new ones. A row whose contact is still a chain contact keeps its place and its
+    /// colour (its loaded index is updated). A row whose contact is gone, or no longer a chain
+    /// contact, becomes a hole: a no-op row (zero normal, lever arms, mass and bound, so a sweep
+    /// leaves every velocity as it was) that gives back its colour. A new chain contact takes
+    /// the lowest colour neither body has, and a hole of that colour or else a new place after
+    /// the colour buckets. The caller then refreshes the rows
+    /// ([`refresh_rows`](Self::refresh_rows)): the new ones start from a zero impulse, as a
+    /// build would start them, and every other row from its own last impulse, so the rows are a
+    /// build's, in another order.
+    ///
+    /// Returns `false`, having changed nothing a build reads, when the holes and appended rows
+    /// since the last build could exceed an eighth of the rows (at least 16): the sweeps would
+    /// then lose the colour order that lets the processor overlap their updates, so the caller
+    /// builds the rows from scratch.
+    fn patch_rows(&mut self, loaded: Loaded<'_>) -> bool {
+        self.new_place.clear();
+        self.dead.clear();
+        self.born.clear();
+        // The new keys go to `prev_keys`, which a build overwrites.
+        self.prev_keys.clear();
+        let (old_keys, old_place) = (&self.keys[..], &self.place[..]);
+        let (new_keys, new_place) = (&mut self.prev_keys, &mut self.new_place);
+        let (src, dead, born, multi) = (&mut self.src, &mut self.dead, &mut self.born, &self.multi);
+        let mut j = 0;
+        for (i, (e, &key)) in loaded.contacts.iter().zip(loaded.keys).enumerate() {
+            // Most keys are the next old one; otherwise old keys before this one died.
+            let mut old = NONE;
+            if old_keys.get(j) == Some(&key) {
+                old = old_place[j];
+                j += 1;
+            } else {
+                while j < old_keys.len() && old_keys[j] < key {
+                    dead.push(old_place[j]);
+                    j += 1;
+                }
+                if old_keys.get(j) == Some(&key) {
+                    old = old_place[j];
+                    j += 1;
+                }
+            }
+            if is_chain(multi, e.body_a as usize, e.body_b as usize) {
+                if old == NONE {
+                    born.push((i as u32, new_place.len() as u32));
+                } else {
+                    // A build rewrites every `src`, so this write is safe if the patch gives up.
+                    src[old as usize] = i as u32;
+                }
+                new_place.push(old);
+                new_keys.push(key);
+            } else if old != NONE {
+                dead.push(old);
+            }
+        }
+        dead.extend_from_slice(&old_place[j..]);
+        let dynamic = &self.dynamic;
+        let budget = (self.new_place.len() / 8).max(16);
+        if self.holes + self.appended + self.dead.len() + self.born.len() > budget {
+            return false;
+        }
+        let used = &mut self.used;
+        for &p in &self.dead {
+            let p = p as usize;
+            let (row, c) = (self.sorted[p], self.colour_of[p]);
+            if c < COLOURS {
+                for x in [row.a as usize, row.b as usize] {
+                    if dynamic[x] {
+                        used[x] &= !(1u64 << c);
+                    }
+                }
+            }
+            self.sorted[p] = Row::NONE;
+            self.src[p] = NONE;
+            self.hole_next[p] = self.hole_head[c as usize];
+            self.hole_head[c as usize] = p as u32;
+            self.holes += 1;
+        }
+        for &(i, k) in &self.born {
+            let e = &loaded.contacts[i as usize];
+            let (a, b) = (e.body_a as usize, e.body_b as usize);
+            let (dyn_a, dyn_b) = (dynamic[a], dynamic[b]);
+            let taken = if dyn_a { used[a] } else { 0 } | if dyn_b { used[b] } else { 0 };
+            let c = (!taken).trailing_zeros().min(COLOURS);
+            if c < COLOURS {
+                used[a] |= (dyn_a as u64) << c;
+                used[b] |= (dyn_b as u64) << c;
+            }
+            let head = self.hole_head[c as usize];
+            let p = if head != NONE {
+                self.hole_head[c as usize] = self.hole_next[head as usize];
+                self.hole_next[head as usize] = NONE;
+                self.holes -= 1;
+                head as usize
+            } else {
+                self.sorted.push(Row::NONE);
+                self.src.push(NONE);
+                self.colour_of.push(c);
+                self.hole_next.push(NONE);
+                self.appended += 1;
+                self.sorted.len() - 1
+            };
+            // The refresh builds the row from the contact, from a zero impulse.
+            self.sorted[p] = Row {
+                a: a as u32,
+                b: b as u32,
+                ..Row::NONE
+            };
+            self.src[p] = i;
+            self.colour_of[p] = c;
+            self.new_place[k as usize] = p as u32;
+        }
+        self.last_patch_size = (self.dead.len(), self.born.len());
+        std::mem::swap(&mut self.keys, &mut self.prev_keys);
+        std::mem::swap(&mut self.place, &mut self.new_place);
+        self.generation = loaded.generation;
+        self.loaded_len = loaded.contacts.len();
+        true
     }
 
     /// Steps 2–4 when `loaded` holds the same contacts as the last sample (same keys in the same
@@ -613,6 +797,9 @@ impl ChainDamping {
         // which `build_rows` maps the same way.
         let mut valid = true;
         for (row, &i) in self.sorted.iter_mut().zip(&self.src) {
+            if i == NONE {
+                continue; // a hole left by a patch: a no-op row
+            }
             *row = Row::build(
                 &loaded[i as usize],
                 row.a,
@@ -677,11 +864,12 @@ impl ChainDamping {
 }
 
 /// Whether the contact between bodies `a` and `b` is a chain contact: one of them is dynamic and
-/// touches two or more other bodies (`multi`). The colouring and the placing of the rows must
-/// agree on it contact by contact, so both ask here.
+/// touches two or more other bodies (`multi`, which
+/// [`find_partners`](ChainDamping::find_partners) sets for dynamic bodies only). The colouring,
+/// the placing of the rows and a patch must agree on it contact by contact, so all ask here.
 #[inline(always)]
-fn is_chain(dynamic: &[bool], multi: &[bool], a: usize, b: usize) -> bool {
-    (dynamic[a] && multi[a]) || (dynamic[b] && multi[b])
+fn is_chain(multi: &[bool], a: usize, b: usize) -> bool {
+    multi[a] || multi[b]
 }
 
 /// Kinetic energy of the working velocities `s` of `bodies` (J; fixed bodies count none).
@@ -890,6 +1078,7 @@ mod tests {
             },
         );
         let (mut plain, mut with) = (ChainDamping::default(), ChainDamping::default());
+        plain.patching = false;
         let (mut b_plain, mut b_with) = (bodies0.clone(), bodies0.clone());
         let mut wrenches = vec![Wrench2::default(); bodies0.len()];
         for k in 0..4u64 {
@@ -901,7 +1090,8 @@ mod tests {
                     b.torque = 0.0;
                 }
             }
-            // The plain list comes with a new generation every sample, so it is rebuilt; the one
+            // The plain list comes with a new generation every sample, so it is rebuilt (it may
+            // not patch its rows); the one
             // with the degenerate contact keeps its generation, and is rebuilt because a
             // contact was dropped (else it would be refreshed, which rounds differently).
             let r_plain = plain.apply(
@@ -938,6 +1128,7 @@ mod tests {
         let (bodies0, loaded) = column();
         let dt = 1e-3;
         let (mut fast, mut full) = (ChainDamping::default(), ChainDamping::default());
+        (fast.patching, full.patching) = (false, false);
         let (mut b_fast, mut b_full) = (bodies0.clone(), bodies0.clone());
         let mut wrenches = vec![Wrench2::default(); bodies0.len()];
         for k in 0..6 {
@@ -1004,5 +1195,187 @@ mod tests {
         // (The same generation of keys: only the bodies changed.)
         fast.apply(Some(2e-4), 3, dt, loaded.view(3, 3), &mut b, &mut wrenches);
         assert_eq!((fast.last_rows, fast.last_refreshed), (2, false));
+    }
+
+    /// A tall column of boxes on a fixed floor, two contacts (the bottom corners) at each
+    /// interface: the whole loaded list, in key order.
+    fn tall_column(boxes: u32) -> (Vec<Body>, Column) {
+        let mut bodies = vec![Body::fixed("floor", Pose::new(0.0, -0.05, 0.0))];
+        for i in 0..boxes {
+            let y = 0.05 + 0.1 * i as f64;
+            bodies.push(Body::dynamic(
+                "box",
+                1.0,
+                1.0 / 600.0,
+                Pose::new(0.0, y, 0.0),
+            ));
+        }
+        let (mut contacts, mut keys) = (Vec::new(), Vec::new());
+        for i in 0..boxes {
+            for corner in 0..2u32 {
+                keys.push(VeCandidate {
+                    vertex_collider: i + 1,
+                    vertex: corner,
+                    edge_collider: i,
+                    edge: 2,
+                });
+                contacts.push(LoadedContact {
+                    body_a: i + 1,
+                    body_b: i,
+                    point: Vec2::new(0.1 * corner as f64 - 0.05, 0.1 * i as f64),
+                    n: Vec2::new(0.0, 1.0),
+                    f_n: 5.0 + i as f64 + corner as f64,
+                });
+            }
+        }
+        (bodies, Column { contacts, keys })
+    }
+
+    /// The live rows of a damper by key: (key, row), in key order.
+    fn rows_by_key(d: &ChainDamping) -> Vec<(VeCandidate, Row)> {
+        d.keys
+            .iter()
+            .zip(&d.place)
+            .map(|(&k, &p)| (k, d.sorted[p as usize]))
+            .collect()
+    }
+
+    /// When a few loaded contacts change, the rows are patched: rows of contacts that left
+    /// become exact no-op holes, new ones take a hole of their colour or a new place, and the
+    /// live rows are bit for bit those a build from scratch gives, key by key (the warm
+    /// impulses differ by the rounding of the warm start's scale only). With sweeps, the result
+    /// stays passive. Too many changes since the last build rebuild the rows.
+    #[test]
+    fn rows_patched_are_the_rows_a_build_gives() {
+        let (bodies0, all) = tall_column(30);
+        let dt = 1e-3;
+        let mut rng = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move || {
+            rng ^= rng << 13;
+            rng ^= rng >> 7;
+            rng ^= rng << 17;
+            rng
+        };
+        for sweeps in [0, 4] {
+            let (mut patched, mut built) = (ChainDamping::default(), ChainDamping::default());
+            built.patching = false;
+            let (mut b_p, mut b_b) = (bodies0.clone(), bodies0.clone());
+            let mut wrenches = vec![Wrench2::default(); bodies0.len()];
+            let mut present = vec![true; all.keys.len()];
+            let (mut patches, mut builds, mut holes_filled) = (0, 0, 0);
+            for k in 0..200u64 {
+                // Most samples toggle one or two contacts; every 50th toggles a fifth of them.
+                let toggles = if k % 50 == 49 {
+                    12
+                } else {
+                    1 + (next() % 2) as usize
+                };
+                if k > 0 {
+                    for _ in 0..toggles {
+                        let i = (next() % present.len() as u64) as usize;
+                        present[i] = !present[i];
+                    }
+                }
+                let list = Column {
+                    contacts: (0..present.len())
+                        .filter(|&i| present[i])
+                        .map(|i| all.contacts[i])
+                        .collect(),
+                    keys: (0..present.len())
+                        .filter(|&i| present[i])
+                        .map(|i| all.keys[i])
+                        .collect(),
+                };
+                for bodies in [&mut b_p, &mut b_b] {
+                    for (i, b) in bodies.iter_mut().enumerate().skip(1) {
+                        let phase = 0.1 * k as f64 + i as f64;
+                        b.vel = Vec2::new(0.01 * phase.sin(), -0.05 * phase.cos());
+                        b.omega = 0.2 * (phase * 0.7).sin();
+                        b.force = Vec2::new(0.0, -9.81);
+                        b.torque = 0.0;
+                    }
+                }
+                let holes_before = patched.holes;
+                let n = list.keys.len();
+                let r_p = patched.apply(
+                    Some(2e-4),
+                    sweeps,
+                    dt,
+                    list.view(n, k + 1),
+                    &mut b_p,
+                    &mut wrenches,
+                );
+                let r_b = built.apply(
+                    Some(2e-4),
+                    sweeps,
+                    dt,
+                    list.view(n, k + 1),
+                    &mut b_b,
+                    &mut wrenches,
+                );
+                assert!(!built.last_patched, "{k}");
+                assert!(r_p >= -1e-12 && r_b >= -1e-12, "{k}: passive: {r_p} {r_b}");
+                assert_eq!(patched.last_rows, built.last_rows, "{k}");
+                if patched.last_patched {
+                    patches += 1;
+                    let (died, born) = patched.last_patch_size;
+                    holes_filled += (holes_before + died)
+                        .saturating_sub(patched.holes)
+                        .min(born);
+                } else if !patched.last_refreshed {
+                    builds += 1;
+                }
+                // Every place that is no row is an exact no-op hole.
+                let live: std::collections::BTreeSet<u32> = patched.place.iter().copied().collect();
+                assert_eq!(live.len(), patched.keys.len());
+                for (p, row) in patched.sorted.iter().enumerate() {
+                    if !live.contains(&(p as u32)) {
+                        assert_eq!(patched.src[p], NONE, "{k}: hole {p}");
+                        assert_eq!((row.w, row.c, row.lo, row.lambda), (0.0, 0.0, 0.0, 0.0));
+                        assert_eq!((row.n, row.rna, row.rnb), (Vec2::ZERO, 0.0, 0.0));
+                    }
+                }
+                assert_eq!(
+                    patched.sorted.len() - patched.keys.len(),
+                    patched.holes,
+                    "{k}"
+                );
+                if sweeps > 0 {
+                    continue;
+                }
+                // Without sweeps the rows are the warm start: the same rows key by key.
+                let (rp, rb) = (rows_by_key(&patched), rows_by_key(&built));
+                assert_eq!(rp.len(), rb.len(), "{k}");
+                for ((kp, p), (kb, b)) in rp.iter().zip(&rb) {
+                    assert_eq!(kp, kb, "{k}");
+                    assert_eq!((p.a, p.b, p.n), (b.a, b.b, b.n), "{k}: {kp:?}");
+                    for (x, y) in [
+                        (p.rna, b.rna),
+                        (p.rnb, b.rnb),
+                        (p.w, b.w),
+                        (p.c, b.c),
+                        (p.lo, b.lo),
+                    ] {
+                        assert_eq!(x.to_bits(), y.to_bits(), "{k}: {kp:?}");
+                    }
+                    assert!(
+                        (p.lambda - b.lambda).abs() <= 1e-12 * b.lambda.abs().max(1e-12),
+                        "{k}: {kp:?}: {} {}",
+                        p.lambda,
+                        b.lambda
+                    );
+                }
+                for (a, b) in b_p.iter().zip(&b_b) {
+                    assert!((a.force - b.force).length() <= 1e-9, "{k}");
+                    assert!((a.torque - b.torque).abs() <= 1e-9, "{k}");
+                }
+            }
+            assert!(patches > 150, "sweeps {sweeps}: {patches} patches");
+            assert!(builds >= 4, "sweeps {sweeps}: {builds} builds");
+            assert!(
+                holes_filled > 10,
+                "sweeps {sweeps}: {holes_filled} holes filled"
+            );
+        }
     }
 }
