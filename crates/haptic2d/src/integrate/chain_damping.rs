@@ -231,7 +231,7 @@ pub struct ChainDamping {
     /// contacts were the same) instead of building them.
     pub last_refreshed: bool,
     /// Whether the last sample patched the rows of the sample before (a few of its loaded
-    /// contacts changed: see [`patch_rows`](Self::patch_rows)) instead of building them.
+    /// contacts changed: see [`apply`](Self::apply)) instead of building them.
     pub last_patched: bool,
     /// The rows that died and the rows that were born in the last sample's patch.
     pub last_patch_size: (usize, usize),
@@ -317,9 +317,17 @@ impl ChainDamping {
     ///
     /// **Refresh.** When the loaded contacts are those of the last sample (same generation of
     /// keys, same length, same dynamic bodies: most samples of a pile at rest), so are the chain
-    /// contacts,
-    /// their colours and their order; the rows are then refreshed in place from the new geometry
-    /// instead of being matched by key, coloured and sorted again (`last_refreshed`).
+    /// contacts, their colours and their order; the rows are then refreshed in place from the new
+    /// geometry instead of being matched by key, coloured and sorted again (`last_refreshed`).
+    ///
+    /// **Patch.** When some loaded contacts changed but the dynamic bodies did not, the rows are
+    /// patched (`last_patched`): the rows of contacts that left
+    /// become no-op holes, new chain contacts take a colour and a hole of it or a place after the
+    /// colour buckets, and then every row is refreshed. The rows are those a build gives, in
+    /// another order, so the sweeps reach another point within the same convergence tolerance:
+    /// deterministic, but dependent on the history of the contacts, not only on this sample's
+    /// list. Past an eighth of the rows (at least 16) in holes and appended rows since the last
+    /// build, the rows are built from scratch again, in colour order.
     pub fn apply(
         &mut self,
         tau: Option<f64>,
