@@ -35,3 +35,26 @@ fn world_step_does_not_allocate_once_warm() {
     assert_eq!(step_allocations("peg-in-hole", 50, 2500), 0, "peg-in-hole");
     assert_eq!(step_allocations("pile:25", 200, 500), 0, "pile:25");
 }
+
+/// The chain damper's patches (a few loaded contacts changed: rows become holes, new rows fill
+/// holes or are appended) allocate nothing either: its builds leave room for what the patches may
+/// append before the next build. pile:1000 after its fall (1 s), through 0.5 s of the contact
+/// changes of a settling pile.
+#[test]
+fn chain_damper_patches_do_not_allocate() {
+    let mut w = builtin("pile:1000", None).unwrap().unwrap().world;
+    for _ in 0..1000 {
+        w.step();
+    }
+    let before = allocations();
+    let mut patches = 0;
+    for _ in 0..500 {
+        w.step();
+        patches += w.chain_damper().last_patched as usize;
+    }
+    assert_eq!(allocations() - before, 0, "{patches} patches");
+    assert!(
+        patches >= 3,
+        "only {patches} patches: the window tests too little"
+    );
+}

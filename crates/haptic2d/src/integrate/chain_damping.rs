@@ -626,6 +626,22 @@ impl ChainDamping {
         (self.holes, self.appended) = (0, 0);
         self.keys.clear();
         self.place.clear();
+        // Room for the rows the patches may append before the next build (`patch_rows`' budget:
+        // at most an eighth of the rows, at least 16), so that a patch allocates nothing.
+        let room = n / 7 + 20;
+        self.sorted.reserve(room);
+        self.src.reserve(room);
+        self.colour_of.reserve(room);
+        self.hole_next.reserve(room);
+        for keys in [&mut self.keys, &mut self.prev_keys] {
+            keys.reserve(n + room);
+        }
+        self.place.reserve(n + room);
+        self.new_place.reserve(n + room);
+        self.dead.clear();
+        self.dead.reserve(room);
+        self.born.clear();
+        self.born.reserve(room);
         self.solver.copy_from_slice(&self.star);
         let (star, multi) = (&self.star, &self.multi);
         let (mut g, mut k) = (0.0, 0.0);
@@ -694,6 +710,12 @@ impl ChainDamping {
         let (old_keys, old_place) = (&self.keys[..], &self.place[..]);
         let (new_keys, new_place) = (&mut self.prev_keys, &mut self.new_place);
         let (src, dead, born, multi) = (&mut self.src, &mut self.dead, &mut self.born, &self.multi);
+        // The budget below cannot exceed this one (the new rows are at most the loaded
+        // contacts), so the merge gives up as soon as the changes pass it.
+        let (spent, limit) = (
+            self.holes + self.appended,
+            (loaded.contacts.len() / 8).max(16),
+        );
         let mut j = 0;
         for (i, (e, &key)) in loaded.contacts.iter().zip(loaded.keys).enumerate() {
             // Most keys are the next old one; otherwise old keys before this one died.
@@ -705,6 +727,9 @@ impl ChainDamping {
                 while j < old_keys.len() && old_keys[j] < key {
                     dead.push(old_place[j]);
                     j += 1;
+                }
+                if spent + dead.len() + born.len() > limit {
+                    return false;
                 }
                 if old_keys.get(j) == Some(&key) {
                     old = old_place[j];
@@ -1384,6 +1409,55 @@ mod tests {
                 holes_filled > 10,
                 "sweeps {sweeps}: {holes_filled} holes filled"
             );
+        }
+    }
+
+    /// The capacities of a damper's row buffers (a change means a reallocation).
+    fn capacities(d: &ChainDamping) -> [usize; 8] {
+        [
+            d.sorted.capacity(),
+            d.src.capacity(),
+            d.colour_of.capacity(),
+            d.hole_next.capacity(),
+            d.keys.capacity(),
+            d.prev_keys.capacity(),
+            d.place.capacity(),
+            d.new_place.capacity(),
+        ]
+    }
+
+    /// A build leaves room for every row the patches may append before the next build, so a
+    /// patch never reallocates in the tick: 60 rows built, then one new contact per sample,
+    /// each appended (no holes to fill) until the budget (16) forces a build.
+    #[test]
+    fn a_patch_appends_within_the_room_a_build_left() {
+        let (bodies0, all) = tall_column(40);
+        let mut d = ChainDamping::default();
+        let mut bodies = bodies0.clone();
+        let mut wrenches = vec![Wrench2::default(); bodies0.len()];
+        let mut built = None;
+        for k in 0..18usize {
+            let n = 60 + k;
+            d.apply(
+                Some(2e-4),
+                2,
+                1e-3,
+                all.view(n, k as u64 + 1),
+                &mut bodies,
+                &mut wrenches,
+            );
+            assert_eq!(d.last_rows, n);
+            if k == 0 {
+                assert!(!d.last_patched && !d.last_refreshed);
+                built = Some(capacities(&d));
+            } else if k <= 16 {
+                assert!(d.last_patched, "sample {k}");
+                assert_eq!(d.last_patch_size, (0, 1), "sample {k}");
+                assert_eq!(Some(capacities(&d)), built, "sample {k}: reallocated");
+            } else {
+                // The 17th append would pass the budget.
+                assert!(!d.last_patched, "sample {k}: past the budget, built again");
+            }
         }
     }
 }
