@@ -11,7 +11,7 @@ use crate::timing::{now, Clock};
 
 /// Applies `law.key=value` overrides (`normal.bc=200`, `friction.beta=40`) to the prototypes of the
 /// world's laws (every contact created afterwards gets them), and the world options
-/// `world.proximity_spread=0/1`, `world.chain_tau=SECONDS` (0 = chain damper off) and
+/// `world.proximity_spread=0/1`, `world.proximity_skip=0/1`, `world.chain_tau=SECONDS` (0 = chain damper off) and
 /// `world.chain_sweeps=N`.
 pub fn apply(w: &mut World, sets: &[String]) -> Result<(), String> {
     for s in sets {
@@ -25,6 +25,10 @@ pub fn apply(w: &mut World, sets: &[String]) -> Result<(), String> {
         let r = match k.trim().split_once('.') {
             Some(("normal", key)) => w.normal.set_param(key, v),
             Some(("friction", key)) => w.friction.set_param(key, v),
+            Some(("world", "proximity_skip")) => {
+                w.params.proximity_skip = v != 0.0;
+                Ok(())
+            }
             Some(("world", "proximity_spread")) => {
                 w.params.proximity_spread = v != 0.0;
                 Ok(())
@@ -37,7 +41,7 @@ pub fn apply(w: &mut World, sets: &[String]) -> Result<(), String> {
                 w.params.chain_sweeps = v as u32;
                 Ok(())
             }
-            _ => Err("expected normal.KEY, friction.KEY or world.{proximity_spread, chain_tau, chain_sweeps} (chain_sweeps a whole number)".into()),
+            _ => Err("expected normal.KEY, friction.KEY or world.{proximity_spread, proximity_skip, chain_tau, chain_sweeps} (chain_sweeps a whole number)".into()),
         };
         r.map_err(|e| format!("--set {s}: {e}"))?;
     }
@@ -199,8 +203,10 @@ pub fn run(
     // Every warm profiled step.
     let mut each: Vec<ProfiledStep> = Vec::new();
     let (mut cpu, mut since) = (0.0, 0usize);
-    // Global updates published during the profiled steps: (count, in place, GJK iterations).
-    let mut updates = (0usize, 0usize, 0u64);
+    // Global updates published during the profiled steps: (count, in place, GJK iterations,
+    // periods whose update was skipped), and the world's count of skipped updates.
+    let mut updates = (0usize, 0usize, 0u64, 0usize);
+    let mut skips = w.skipped_global_updates();
     // With `cold`: the eviction buffer and the CPU time of every cold step (µs).
     let mut evict_buf = vec![0u8; cold.map_or(0, Cold::buffer_bytes)];
     let mut cold_times: Vec<f64> = Vec::new();
@@ -244,9 +250,15 @@ pub fn run(
             by_phase[(k - 1) % n_g].push(dt_cpu * 1e6);
             if (k - 1) % n_g == 0 {
                 let b = w.broad_stats();
-                updates.0 += 1;
-                updates.1 += b.in_place as usize;
-                updates.2 += b.gjk_iterations;
+                let skipped = w.skipped_global_updates() > skips;
+                skips = w.skipped_global_updates();
+                if skipped {
+                    updates.3 += 1;
+                } else {
+                    updates.0 += 1;
+                    updates.1 += b.in_place as usize;
+                    updates.2 += b.gjk_iterations;
+                }
             }
             let d = w.chain_damper();
             each.push(ProfiledStep {
@@ -304,10 +316,11 @@ pub fn run(
         w.chain_damper().last_rows
     );
     println!(
-        "{label}: global updates published after {profile_after} s: {}, {} of them in place (no sort), {:.1} GJK iterations per update",
+        "{label}: global updates published after {profile_after} s: {}, {} of them in place (no sort), {:.1} GJK iterations per update; {} periods skipped their update (the set still exact)",
         updates.0,
         updates.1,
-        updates.2 as f64 / updates.0.max(1) as f64
+        updates.2 as f64 / updates.0.max(1) as f64,
+        updates.3
     );
     let all_steps = crate::timing::Samples(by_phase.iter().flatten().copied().collect());
     if let Some(how) = cold {

@@ -33,6 +33,12 @@ pub struct WorldParams {
     /// deadline spike), and the set in use describes the poses one period earlier, which the
     /// §9.1 margin allows (`collide/broad.rs`). Early updates for fast bodies still run whole.
     pub proximity_spread: bool,
+    /// Skip a periodic global update when the colliders cannot have changed the proximity set
+    /// since the published one (default): the vertices have moved less than half the smallest
+    /// slack of that update's decisions ([`BroadPhase::still_exact`](crate::collide::BroadPhase::still_exact)).
+    /// The set in use is then exactly what the update would compute, so trajectories are those
+    /// of running it, up to the round-off of GJK's warm starts.
+    pub proximity_skip: bool,
     /// Proximity margin `δ_prox` (m), §9.1.
     pub delta_prox: f64,
     /// Contact distance tolerance `δ_c` (m), §9.5.
@@ -48,7 +54,7 @@ pub struct WorldParams {
     /// end-of-sample velocity, so stacks come to rest. `None` = off. Default 0.2 ms.
     pub chain_tau: Option<f64>,
     /// Gauss–Seidel sweeps of the chain damper per sample, at most (they stop once no row's
-    /// velocity changes by more than 1e-5 m/s; warm-started, a settled pile needs 1–4); default 16.
+    /// velocity changes by more than 2e-4 m/s; warm-started, a settled pile needs 1–4); default 16.
     pub chain_sweeps: u32,
 }
 
@@ -58,6 +64,7 @@ impl Default for WorldParams {
             dt: 0.002,
             proximity_every: 10,
             proximity_spread: true,
+            proximity_skip: true,
             delta_prox: 0.042,
             delta_c: 0.002,
             mode: IntegrationMode::SemiImplicit,
@@ -135,6 +142,10 @@ pub struct World {
     swept_hits: u64,
     /// Number of global updates run early because a body had moved far (see `begin_step`).
     early_global_updates: u64,
+    /// Periodic global updates skipped because the published set was still exact, and whether
+    /// the last periodic one was.
+    skipped_global_updates: u64,
+    skipped_last_period: bool,
     /// Steps 3–6 of the current tick have run ([`World::begin_step`] or [`World::prime`]) and
     /// [`World::finish_step`] has not yet.
     begun: bool,
@@ -217,6 +228,8 @@ impl World {
             sweep: SweepScratch::with_capacity(max_vertices),
             swept_hits: 0,
             early_global_updates: 0,
+            skipped_global_updates: 0,
+            skipped_last_period: false,
             begun: false,
         };
         w.ledger.kinetic = w.bodies.iter().map(|b| b.kinetic_energy()).sum();
@@ -468,7 +481,33 @@ impl World {
         let periodic = phase == 0;
         let early = !periodic && self.moved_past_margin();
         let spread = self.params.proximity_spread && n_g > 1;
-        if early || (periodic && !(spread && self.broad.in_progress())) {
+        let mut published = false;
+        if periodic && spread && self.broad.in_progress() {
+            self.broad.publish(&mut self.pairs);
+            self.pairs_written = true;
+            std::mem::swap(&mut self.global_poses, &mut self.job_poses);
+            published = true;
+        }
+        if !(periodic || early) {
+            // The sample that began an update has done its share (`begin`, and publishing).
+            if spread {
+                self.broad.advance((n_g - phase) as usize);
+            }
+            return;
+        }
+        // A periodic update whose result the colliders cannot have changed since the published
+        // one is skipped (`BroadPhase::still_exact`): the set in use is what it would compute.
+        // `global_poses` keep the poses of the published update, which only makes the early
+        // update's check stricter than it needs to be.
+        if periodic && self.params.proximity_skip && self.broad.still_exact(&self.colliders) {
+            self.skipped_global_updates += 1;
+            self.skipped_last_period = true;
+            return;
+        }
+        // After a skip, the set in use is what the update of the last period would have
+        // published now, so a spread update just begins, as after a publication.
+        let after_skip = std::mem::take(&mut self.skipped_last_period) && periodic && spread;
+        if !published && !after_skip {
             self.broad
                 .update_with_motion(&self.colliders, &self.odometer, &mut self.pairs);
             self.pairs_written = true;
@@ -476,21 +515,13 @@ impl World {
                 *g = b.pose;
             }
             self.early_global_updates += early as u64;
-        } else if periodic {
-            self.broad.publish(&mut self.pairs);
-            self.pairs_written = true;
-            std::mem::swap(&mut self.global_poses, &mut self.job_poses);
         }
-        if spread && (periodic || early) {
+        if spread {
             self.broad
                 .begin_with_motion(&self.colliders, &self.odometer);
             for (g, b) in self.job_poses.iter_mut().zip(&self.bodies) {
                 *g = b.pose;
             }
-        }
-        // The sample that began an update has done its share (`begin`, and publishing).
-        if spread && !(periodic || early) {
-            self.broad.advance((n_g - phase) as usize);
         }
     }
 
@@ -544,6 +575,12 @@ impl World {
             }
         }
         out
+    }
+
+    /// Periodic global updates skipped so far because the proximity set in use was still exact
+    /// ([`BroadPhase::still_exact`](crate::collide::BroadPhase::still_exact)).
+    pub fn skipped_global_updates(&self) -> u64 {
+        self.skipped_global_updates
     }
 
     /// Samples at which the swept test put a body back, and global updates run early, so far.

@@ -99,3 +99,49 @@ fn the_local_stage_tracks_the_pairs_of_every_global_update() {
         assert!(changes > 10, "the set changed {changes} times only");
     }
 }
+
+/// A periodic update whose result the colliders cannot have changed is skipped
+/// (`WorldParams::proximity_skip`, `BroadPhase::still_exact`), and that changes nothing: with
+/// skipping on and off, pile:100 falls, lands and rests through the same poses bit for bit,
+/// spread or whole, and after every skip a new stage run on the colliders of that sample gives
+/// the set in use.
+#[test]
+fn skipped_global_updates_change_no_trajectory() {
+    for spread in [true, false] {
+        let mut on = builtin("pile:100", Some(1000.0)).unwrap().unwrap().world;
+        on.params.proximity_spread = spread;
+        assert!(on.params.proximity_skip, "skipping is the default");
+        let mut off = on.clone();
+        off.params.proximity_skip = false;
+        let mut checked = 0;
+        for k in 0..800 {
+            let before = on.skipped_global_updates();
+            on.step();
+            off.step();
+            for (a, b) in on.bodies.iter().zip(&off.bodies) {
+                assert_eq!(a.pose, b.pose, "spread {spread}, sample {k}");
+                assert_eq!(
+                    (a.vel, a.omega),
+                    (b.vel, b.omega),
+                    "spread {spread}, sample {k}"
+                );
+            }
+            if on.skipped_global_updates() > before {
+                // The colliders are where this sample's stages saw them.
+                let mut now = Vec::new();
+                BroadPhase::new(DEFAULT_DELTA_PROX)
+                    .unwrap()
+                    .update(&on.colliders, &mut now);
+                assert_eq!(
+                    on.proximate_pairs(),
+                    &now[..],
+                    "spread {spread}, sample {k}"
+                );
+                checked += 1;
+            }
+        }
+        assert_eq!(off.skipped_global_updates(), 0);
+        // pile:100 rests from 0.16 s: nearly every period after that skips.
+        assert!(checked > 50, "spread {spread}: {checked} skips");
+    }
+}

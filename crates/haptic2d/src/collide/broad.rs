@@ -174,6 +174,8 @@ struct Snapshot {
     colliders: Vec<(u32, u32)>,
     /// The odometer of each collider's body (m; NaN if not given).
     odo: Vec<f64>,
+    /// Each collider's body and dynamic flag (`body << 1 | dynamic`, as in [`SweepEntry`]).
+    bodies: Vec<u32>,
 }
 
 impl Snapshot {
@@ -228,6 +230,10 @@ pub struct BroadPhase {
     in_place: bool,
     gjk_iterations: u64,
     reused_distances: usize,
+    /// The certificate of the update in progress so far, and of the published update
+    /// ([`still_exact`](Self::still_exact)).
+    progress: Certificate,
+    certificate: Certificate,
     /// The published update: its pairs (sorted), caches, distances and odometer references, and
     /// where each first collider's pairs start (`cache_pairs[cache_start[a]..cache_start[a + 1]]`).
     cache_pairs: Vec<(u32, u32)>,
@@ -241,6 +247,36 @@ pub struct BroadPhase {
     ready: Published,
     stats: BroadStats,
 }
+
+/// How far the bodies may move before an update could give another proximity set than the one
+/// computed ([`BroadPhase::still_exact`]): the smallest slack (m) of the update's decisions, as
+/// its sweep makes them.
+#[derive(Clone, Copy, Debug)]
+struct Certificate {
+    /// Smallest gap between the inflated boxes of two colliders the sweep did not pair (and
+    /// that are not of one body or both fixed).
+    gap: f64,
+    /// Smallest distance of a paired collider pair's GJK distance interval from `δ_prox`,
+    /// beyond the reuse guard.
+    slack: f64,
+}
+
+impl Certificate {
+    /// Nothing decided yet.
+    const OPEN: Certificate = Certificate {
+        gap: f64::INFINITY,
+        slack: f64::INFINITY,
+    };
+    /// No certificate (the next update runs).
+    const NONE: Certificate = Certificate {
+        gap: 0.0,
+        slack: 0.0,
+    };
+}
+
+/// Sweep entries looked at beyond a box's end in x to find one it could be paired with (not of
+/// its body, not both fixed): the gap to it bounds every later box's ([`Certificate::gap`]).
+const GAP_LOOKAHEAD: usize = 8;
 
 /// The result of an update, as [`BroadPhase::publish`] hands it over.
 #[derive(Clone, Debug, Default)]
@@ -328,6 +364,8 @@ impl BroadPhase {
             in_place: false,
             gjk_iterations: 0,
             reused_distances: 0,
+            progress: Certificate::NONE,
+            certificate: Certificate::NONE,
             cache_pairs: Vec::new(),
             caches: Vec::new(),
             distances: Vec::new(),
@@ -382,6 +420,55 @@ impl BroadPhase {
         (&self.cache_pairs, &self.distances)
     }
 
+    /// Whether an update now, for the current world features of `colliders`, would compute the
+    /// proximity set the last published update computed, so that it may be skipped (issue 17).
+    /// False while an update is in progress, or for colliders other than the published
+    /// update's (count, vertex counts, bodies and dynamic flags).
+    ///
+    /// **Why it holds.** Let `M` be the largest distance a vertex has moved since the published
+    /// update's snapshot (the snapshot keeps the vertices). Every point of a convex polygon is a
+    /// convex combination of its vertices, so it has moved by at most `M` as well: a pair's
+    /// distance, and each side of its colliders' boxes, changed by at most `2·M`.
+    /// - A pair the sweep paired has a GJK distance interval (its distance at its odometer
+    ///   reference, grown by the motion up to the snapshot) that was `slack` away from `δ_prox`
+    ///   (beyond the reuse guard): while `2·M < slack`, it is on the same side of `δ_prox`, so in
+    ///   the set or out of it as before.
+    /// - A pair the sweep did not pair (of two bodies, not both fixed) had inflated boxes `gap` or
+    ///   more apart in x or in y, so the colliders were more than `δ_prox + gap` apart: while
+    ///   `2·M < gap` they are still more than `δ_prox` apart, and out of the set.
+    ///
+    /// So while `2·M < min(slack, gap)`, every pair is in the set exactly when it was, and an
+    /// update would give the same set (its internal distances and caches aside). The published
+    /// set is then as good as a new one for the margin rule (module docs). Costs one pass over
+    /// the colliders' world vertices.
+    pub fn still_exact(&self, colliders: &[Collider]) -> bool {
+        let (c, snap) = (self.certificate, &self.snapshot);
+        if self.next.is_some()
+            || colliders.len() != snap.colliders.len()
+            || !(c.gap > 0.0 && c.slack > 0.0)
+        {
+            return false;
+        }
+        let limit = 0.5 * c.gap.min(c.slack);
+        let limit_sq = limit * limit;
+        for (i, col) in colliders.iter().enumerate() {
+            let now = col.world_vertices();
+            let then = snap.vertices(i as u32);
+            let code = (col.body as u32) << 1 | col.dynamic as u32;
+            if now.len() != then.len() || code != snap.bodies[i] {
+                return false;
+            }
+            for (p, q) in now.iter().zip(then) {
+                // A NaN vertex fails too.
+                let moved_sq = (*p - *q).length_squared();
+                if moved_sq >= limit_sq || moved_sq.is_nan() {
+                    return false;
+                }
+            }
+        }
+        true
+    }
+
     /// Whether a spread update is in progress (between [`begin`](Self::begin) and
     /// [`publish`](Self::publish)).
     pub fn in_progress(&self) -> bool {
@@ -425,6 +512,7 @@ impl BroadPhase {
         self.snapshot.vertices.clear();
         self.snapshot.colliders.clear();
         self.snapshot.odo.clear();
+        self.snapshot.bodies.clear();
         for c in colliders {
             let s = self.snapshot.vertices.len() as u32;
             self.snapshot.vertices.extend_from_slice(c.world_vertices());
@@ -434,7 +522,11 @@ impl BroadPhase {
             self.snapshot
                 .odo
                 .push(odometer.get(c.body).copied().unwrap_or(f64::NAN));
+            self.snapshot
+                .bodies
+                .push((c.body as u32) << 1 | c.dynamic as u32);
         }
+        self.progress = Certificate::OPEN;
         // 1. Inflated boxes, sorted by (min.x, index): in the last update's order, which is
         //    nearly sorted when the bodies move little between updates (insertion sort), or by
         //    index (a full sort) when the colliders changed.
@@ -496,19 +588,38 @@ impl BroadPhase {
         // 2. Sweep on x, test y, filter same-body and fixed–fixed pairs; 3. warm-started GJK per
         //    pair (each pair's result depends on its own cache only, so the order of this loop
         //    does not change any result).
+        // Same body, or both fixed (the dynamic flags are the low bits): never a pair.
+        let unpaired = |p: &SweepEntry, q: &SweepEntry| {
+            p.body >> 1 == q.body >> 1 || (p.body | q.body) & 1 == 0
+        };
+        let mut cert = self.progress;
         for i in start..stop {
             let ei = self.sweep[i];
-            for ej in &self.sweep[i + 1..] {
+            for (j, ej) in self.sweep[i + 1..].iter().enumerate() {
                 if ej.min_x > ei.max_x {
+                    // Every later box starts at least this far beyond `ei`'s end (the gap to
+                    // the first one it could be paired with, looking a few entries ahead).
+                    let rest = &self.sweep[i + 1 + j..];
+                    let beyond = rest
+                        .iter()
+                        .take(GAP_LOOKAHEAD)
+                        .find(|e| !unpaired(&ei, e))
+                        .or(rest.get(GAP_LOOKAHEAD - 1));
+                    if let Some(e) = beyond {
+                        cert.gap = cert.gap.min(e.min_x - ei.max_x);
+                    }
                     break;
                 }
                 // `ej` starts before `ei` ends; the rest of `Aabb::overlaps` (closed intervals),
                 // from the entries alone: in y first, which rejects most of a pile's column.
                 if !(ej.min_y <= ei.max_y && ei.min_y <= ej.max_y && ei.min_x <= ej.max_x) {
+                    if !unpaired(&ei, ej) {
+                        let gap = (ej.min_y - ei.max_y).max(ei.min_y - ej.max_y);
+                        cert.gap = cert.gap.min(gap);
+                    }
                     continue;
                 }
-                // Same body, or both fixed (the dynamic flags are the low bits).
-                if ei.body >> 1 == ej.body >> 1 || (ei.body | ej.body) & 1 == 0 {
+                if unpaired(&ei, ej) {
                     continue;
                 }
                 let (a, b) = (ei.index.min(ej.index), ei.index.max(ej.index));
@@ -517,9 +628,10 @@ impl BroadPhase {
                 if let Some(k) = last {
                     // The pair's side of δ_prox is known from its last distance and the motion.
                     let (d, moved) = (self.distances[k], odo - self.odo_refs[k]);
-                    if d + moved < self.delta_prox - REUSE_GUARD
-                        || d - moved > self.delta_prox + REUSE_GUARD
-                    {
+                    let below = (self.delta_prox - REUSE_GUARD) - (d + moved);
+                    let above = (d - moved) - (self.delta_prox + REUSE_GUARD);
+                    if below > 0.0 || above > 0.0 {
+                        cert.slack = cert.slack.min(below.max(above));
                         self.reused_distances += 1;
                         self.kept.push(k as u32);
                         continue;
@@ -539,6 +651,9 @@ impl BroadPhase {
                     &mut cache,
                 );
                 self.gjk_iterations += g.iterations as u64;
+                cert.slack = cert
+                    .slack
+                    .min((g.distance - self.delta_prox).abs() - REUSE_GUARD);
                 self.tested.push(Tested {
                     pair: (a, b),
                     cache,
@@ -547,6 +662,7 @@ impl BroadPhase {
                 });
             }
         }
+        self.progress = cert;
         self.next = Some(stop);
         if samples_left <= 1 && !self.sorted {
             // Every tested pair is a published one (distinct ones: the sweep meets each pair
@@ -698,6 +814,7 @@ impl BroadPhase {
         }
         self.advance(1);
         self.next = None;
+        self.certificate = self.progress;
         if self.in_place {
             self.patch();
             if *out != self.set {
@@ -1098,5 +1215,132 @@ mod tests {
             let order = |v: &[SweepEntry]| v.iter().map(|e| e.index).collect::<Vec<_>>();
             assert_eq!(order(&sweep), order(&full), "n {n}, jitter {jitter}");
         }
+    }
+
+    /// `still_exact` is sound: whenever it says the published set still holds, a new stage run
+    /// on the moved colliders computes that very set. Seeded random scenes: 24 rectangles of
+    /// 1–8 cm, a quarter of them fixed, some sharing a body, in a square of 0.3–3 m (dense scenes
+    /// are bound by the paired pairs' slack, sparse ones by the unpaired boxes' gap), published
+    /// once, then moved by up to a random scale from 1 µm to 3 cm and checked against a fresh
+    /// update. Half the trials move every body straight towards the middle by the whole scale
+    /// (pairs close at up to twice the scale, the bound's worst case); the others move them at
+    /// random, with a rotation.
+    #[test]
+    fn a_still_exact_set_is_what_an_update_now_computes() {
+        let mut rng = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = move || {
+            rng ^= rng << 13;
+            rng ^= rng >> 7;
+            rng ^= rng << 17;
+            (rng >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (mut held, mut changed, mut failed_same) = (0, 0, 0);
+        let (mut gap_bound, mut tight) = (0, 0);
+        for trial in 0..2000 {
+            let (n, bodies) = (24, 20);
+            let side = 0.3 * 10f64.powf(next());
+            let mut poses = Vec::new();
+            let mut cols = Vec::new();
+            for i in 0..n {
+                let body = if i < bodies { i } else { i - bodies };
+                let dynamic = body % 4 != 0;
+                let (w, h) = (0.01 + 0.07 * next(), 0.01 + 0.07 * next());
+                let pose = Pose::new(side * next(), side * next(), 6.0 * next());
+                let shape = ConvexPolygon::rectangle(w, h).unwrap();
+                cols.push(Collider::new(body, dynamic, shape, &pose));
+                poses.push(pose);
+            }
+            let odometer = vec![0.0; bodies];
+            let mut stage = BroadPhase::new(DEFAULT_DELTA_PROX).unwrap();
+            let mut published = Vec::new();
+            stage.update_with_motion(&cols, &odometer, &mut published);
+            // (Unmoved it holds unless a pair sits within the guard of δ_prox.)
+            let c = stage.certificate;
+            assert_eq!(
+                stage.still_exact(&cols),
+                c.gap > 0.0 && c.slack > 0.0,
+                "{trial}"
+            );
+            gap_bound += (c.gap < c.slack) as usize;
+            // One scale per trial, 1 µm to 3 cm (log-uniform).
+            let scale = 1e-6 * (3e4f64).powf(next());
+            let inward = trial % 2 == 0;
+            let mut moves = Vec::new();
+            for b in 0..bodies {
+                let p = poses
+                    .iter()
+                    .zip(&cols)
+                    .find(|(_, c)| c.body == b)
+                    .unwrap()
+                    .0;
+                moves.push(if inward {
+                    // Straight to the middle by the whole scale (a body off its origin only
+                    // translates, so every vertex moves by exactly `scale`).
+                    let to = Vec2::new(0.5 * side, 0.5 * side) - p.pos;
+                    let d = to * (scale / to.length().max(1e-12));
+                    (d.x, d.y, 0.0)
+                } else {
+                    let u = |x: f64| scale * (2.0 * x - 1.0);
+                    (u(next()), u(next()), 20.0 * u(next()))
+                });
+            }
+            for (c, p) in cols.iter_mut().zip(&poses) {
+                let (dx, dy, da) = moves[c.body];
+                c.update(&Pose::new(p.pos.x + dx, p.pos.y + dy, p.angle + da));
+            }
+            let mut fresh = Vec::new();
+            BroadPhase::new(DEFAULT_DELTA_PROX)
+                .unwrap()
+                .update(&cols, &mut fresh);
+            let exact = stage.still_exact(&cols);
+            if exact {
+                held += 1;
+                tight += (4.0 * scale > c.gap.min(c.slack)) as usize;
+                assert_eq!(
+                    fresh, published,
+                    "{trial}: still_exact, but the set changed"
+                );
+            } else if fresh == published {
+                failed_same += 1;
+            } else {
+                changed += 1;
+            }
+        }
+        assert!(
+            held > 500 && changed > 200 && gap_bound > 100 && tight > 50,
+            "held {held} ({tight} with the motion past half the bound), changed {changed}, \
+             neither {failed_same}, bound by the gap {gap_bound}"
+        );
+    }
+
+    /// The gap in y counts: a column of boxes 1 cm farther apart than `δ_prox` (their inflated
+    /// boxes overlap in x and are 1 cm apart in y, so the sweep tests them in y and pairs none).
+    /// Moving each box 4 mm towards the middle one keeps the set (empty) exact; 6 mm brings
+    /// neighbours within `δ_prox`, and the certificate must fail.
+    #[test]
+    fn the_gap_between_unpaired_boxes_in_y_bounds_the_motion() {
+        let pitch = 0.04 + DEFAULT_DELTA_PROX + 0.01;
+        let place = |shift: f64| -> Vec<Collider> {
+            (0..5)
+                .map(|i| {
+                    let y = pitch * i as f64;
+                    let toward = (2.0 * pitch - y).signum() * shift;
+                    square(i, true, 0.0, y + toward)
+                })
+                .collect()
+        };
+        let mut stage = BroadPhase::new(DEFAULT_DELTA_PROX).unwrap();
+        let mut set = Vec::new();
+        stage.update_with_motion(&place(0.0), &[0.0; 5], &mut set);
+        assert!(set.is_empty());
+        assert!((stage.certificate.gap - 0.01).abs() < 1e-12);
+        assert!(stage.still_exact(&place(0.004)));
+        let near = place(0.006);
+        assert!(!stage.still_exact(&near));
+        let mut fresh = Vec::new();
+        BroadPhase::new(DEFAULT_DELTA_PROX)
+            .unwrap()
+            .update(&near, &mut fresh);
+        assert!(!fresh.is_empty(), "the moved boxes are within δ_prox");
     }
 }
