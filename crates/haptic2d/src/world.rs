@@ -496,10 +496,11 @@ impl World {
             return;
         }
         // A periodic update whose result the colliders cannot have changed since the published
-        // one is skipped (`BroadPhase::still_exact`): the set in use is what it would compute.
+        // one is skipped (`BroadPhase::still_exact`, `skip_update`): the set in use is what it
+        // would compute.
         // `global_poses` keep the poses of the published update, which only makes the early
         // update's check stricter than it needs to be.
-        if periodic && self.params.proximity_skip && self.broad.still_exact(&self.colliders) {
+        if periodic && self.params.proximity_skip && self.broad.skip_update(&self.colliders) {
             self.skipped_global_updates += 1;
             self.skipped_last_period = true;
             return;

@@ -234,6 +234,11 @@ pub struct BroadPhase {
     /// ([`still_exact`](Self::still_exact)).
     progress: Certificate,
     certificate: Certificate,
+    /// Whether the update in progress computes its certificate, and the updates to begin
+    /// without one (the backoff after failed checks; see [`skip_update`](Self::skip_update)).
+    certifying: bool,
+    backoff: u32,
+    wait: u32,
     /// The published update: its pairs (sorted), caches, distances and odometer references, and
     /// where each first collider's pairs start (`cache_pairs[cache_start[a]..cache_start[a + 1]]`).
     cache_pairs: Vec<(u32, u32)>,
@@ -273,6 +278,10 @@ impl Certificate {
         slack: 0.0,
     };
 }
+
+/// Most updates begun without a certificate after a failed check (see
+/// [`BroadPhase::skip_update`]): the backoff doubles from 1 up to this.
+const MAX_BACKOFF: u32 = 16;
 
 /// Sweep entries looked at beyond a box's end in x to find one it could be paired with (not of
 /// its body, not both fixed): the gap to it bounds every later box's ([`Certificate::gap`]).
@@ -366,6 +375,9 @@ impl BroadPhase {
             reused_distances: 0,
             progress: Certificate::NONE,
             certificate: Certificate::NONE,
+            certifying: true,
+            backoff: 0,
+            wait: 0,
             cache_pairs: Vec::new(),
             caches: Vec::new(),
             distances: Vec::new(),
@@ -469,6 +481,27 @@ impl BroadPhase {
         true
     }
 
+    /// [`still_exact`](Self::still_exact), with a backoff for worlds where it keeps failing
+    /// (a settling pile:1000 has thousands of pairs, and one of them near a threshold is
+    /// enough): after a failed check the next 1, 2, 4, … (at most [`MAX_BACKOFF`]) updates
+    /// compute no certificate, so their sweep records no slack and no check reads the vertices;
+    /// a check that holds resets it. Returns whether the periodic update may be skipped.
+    pub fn skip_update(&mut self, colliders: &[Collider]) -> bool {
+        let c = self.certificate;
+        if c.gap == Certificate::NONE.gap && c.slack == Certificate::NONE.slack {
+            return false; // no certificate to check
+        }
+        if self.still_exact(colliders) {
+            self.backoff = 0;
+            return true;
+        }
+        self.backoff = (2 * self.backoff).clamp(1, MAX_BACKOFF);
+        self.wait = self.backoff;
+        // Checked once: the next update makes a new one, if any.
+        self.certificate = Certificate::NONE;
+        false
+    }
+
     /// Whether a spread update is in progress (between [`begin`](Self::begin) and
     /// [`publish`](Self::publish)).
     pub fn in_progress(&self) -> bool {
@@ -526,7 +559,13 @@ impl BroadPhase {
                 .bodies
                 .push((c.body as u32) << 1 | c.dynamic as u32);
         }
-        self.progress = Certificate::OPEN;
+        self.certifying = self.wait == 0;
+        self.wait = self.wait.saturating_sub(1);
+        self.progress = if self.certifying {
+            Certificate::OPEN
+        } else {
+            Certificate::NONE
+        };
         // 1. Inflated boxes, sorted by (min.x, index): in the last update's order, which is
         //    nearly sorted when the bodies move little between updates (insertion sort), or by
         //    index (a full sort) when the colliders changed.
@@ -585,6 +624,31 @@ impl BroadPhase {
         let n = self.sweep.len();
         let share = (n - start).div_ceil(samples_left.max(1));
         let stop = (start + share).min(n);
+        if self.certifying {
+            self.sweep_boxes::<true>(start, stop);
+        } else {
+            self.sweep_boxes::<false>(start, stop);
+        }
+        self.next = Some(stop);
+        if samples_left <= 1 && !self.sorted {
+            // Every tested pair is a published one (distinct ones: the sweep meets each pair
+            // once), so when the counts agree the tested pairs are exactly the published pairs:
+            // sorting them would rebuild the published arrays with the reused entries as they
+            // are and the `patches` written over theirs.
+            self.in_place = self.all_published
+                && self.tested.len() + self.kept.len() == self.cache_pairs.len()
+                && self.cache_start.len() == self.snapshot.colliders.len() + 1;
+            if !self.in_place {
+                self.sort_fresh();
+                self.fill_ready();
+            }
+            self.sorted = true;
+        }
+    }
+
+    /// Steps 2–3 of an update for the sweep entries `start..stop`; with `CERTIFY`, the
+    /// [`Certificate`] of the update in progress takes in each decision's slack.
+    fn sweep_boxes<const CERTIFY: bool>(&mut self, start: usize, stop: usize) {
         // 2. Sweep on x, test y, filter same-body and fixed–fixed pairs; 3. warm-started GJK per
         //    pair (each pair's result depends on its own cache only, so the order of this loop
         //    does not change any result).
@@ -597,6 +661,9 @@ impl BroadPhase {
             let ei = self.sweep[i];
             for (j, ej) in self.sweep[i + 1..].iter().enumerate() {
                 if ej.min_x > ei.max_x {
+                    if !CERTIFY {
+                        break;
+                    }
                     // Every later box starts at least this far beyond `ei`'s end (the gap to
                     // the first one it could be paired with, looking a few entries ahead).
                     let rest = &self.sweep[i + 1 + j..];
@@ -613,7 +680,7 @@ impl BroadPhase {
                 // `ej` starts before `ei` ends; the rest of `Aabb::overlaps` (closed intervals),
                 // from the entries alone: in y first, which rejects most of a pile's column.
                 if !(ej.min_y <= ei.max_y && ei.min_y <= ej.max_y && ei.min_x <= ej.max_x) {
-                    if !unpaired(&ei, ej) {
+                    if CERTIFY && !unpaired(&ei, ej) {
                         let gap = (ej.min_y - ei.max_y).max(ei.min_y - ej.max_y);
                         cert.gap = cert.gap.min(gap);
                     }
@@ -631,7 +698,9 @@ impl BroadPhase {
                     let below = (self.delta_prox - REUSE_GUARD) - (d + moved);
                     let above = (d - moved) - (self.delta_prox + REUSE_GUARD);
                     if below > 0.0 || above > 0.0 {
-                        cert.slack = cert.slack.min(below.max(above));
+                        if CERTIFY {
+                            cert.slack = cert.slack.min(below.max(above));
+                        }
                         self.reused_distances += 1;
                         self.kept.push(k as u32);
                         continue;
@@ -663,21 +732,6 @@ impl BroadPhase {
             }
         }
         self.progress = cert;
-        self.next = Some(stop);
-        if samples_left <= 1 && !self.sorted {
-            // Every tested pair is a published one (distinct ones: the sweep meets each pair
-            // once), so when the counts agree the tested pairs are exactly the published pairs:
-            // sorting them would rebuild the published arrays with the reused entries as they
-            // are and the `patches` written over theirs.
-            self.in_place = self.all_published
-                && self.tested.len() + self.kept.len() == self.cache_pairs.len()
-                && self.cache_start.len() == self.snapshot.colliders.len() + 1;
-            if !self.in_place {
-                self.sort_fresh();
-                self.fill_ready();
-            }
-            self.sorted = true;
-        }
     }
 
     /// Where pair `(a, b)` is in the published update (its cache, distance and odometer
@@ -1342,5 +1396,49 @@ mod tests {
             .unwrap()
             .update(&near, &mut fresh);
         assert!(!fresh.is_empty(), "the moved boxes are within δ_prox");
+    }
+
+    /// After a failed check the next updates compute no certificate (1, then 2, 4, … up to
+    /// `MAX_BACKOFF`), and a check that holds resets the backoff.
+    #[test]
+    fn a_failed_check_backs_off() {
+        let home: Vec<Collider> = (0..3)
+            .map(|i| square(i, true, 0.2 * i as f64, 0.0))
+            .collect();
+        let mut moved = home.clone();
+        moved[1].update(&Pose::new(0.3, 0.0, 0.0)); // 10 cm: past the certificate (gaps 11.8 cm)
+        let mut stage = BroadPhase::new(DEFAULT_DELTA_PROX).unwrap();
+        let mut set = Vec::new();
+        let update = |stage: &mut BroadPhase, cols: &[Collider], set: &mut Vec<(u32, u32)>| {
+            stage.update_with_motion(cols, &[0.0; 3], set);
+        };
+        update(&mut stage, &home, &mut set);
+        assert!(stage.skip_update(&home), "unmoved");
+        // Fail once: the next update has no certificate.
+        assert!(!stage.skip_update(&moved));
+        update(&mut stage, &home, &mut set);
+        assert!(
+            !stage.skip_update(&home),
+            "no certificate while backing off"
+        );
+        // The one after has one again; failing now waits two updates.
+        update(&mut stage, &home, &mut set);
+        assert!(!stage.skip_update(&moved));
+        for _ in 0..2 {
+            update(&mut stage, &home, &mut set);
+            assert!(!stage.skip_update(&home), "backing off");
+        }
+        update(&mut stage, &home, &mut set);
+        assert!(stage.skip_update(&home), "certified again");
+        assert_eq!((stage.backoff, stage.wait), (0, 0));
+        // The backoff stops growing at MAX_BACKOFF.
+        for _ in 0..20 {
+            stage.backoff = MAX_BACKOFF;
+            update(&mut stage, &home, &mut set);
+            stage.wait = 0;
+        }
+        update(&mut stage, &home, &mut set);
+        assert!(!stage.skip_update(&moved));
+        assert_eq!(stage.wait, MAX_BACKOFF);
     }
 }
