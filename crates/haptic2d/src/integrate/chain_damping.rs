@@ -927,11 +927,10 @@ mod tests {
     use super::*;
     use crate::geom::Pose;
 
-    /// A column of three 1 kg boxes (0.1 m) on a fixed floor: contacts floor–1, 1–2, 2–3 at the
-    /// boxes' bottom faces, each pushing with 10 N.
-    fn column() -> (Vec<Body>, Column) {
+    /// A fixed floor (body 0) and `boxes` 1 kg boxes of 0.1 m stacked on it (bodies 1, 2, …).
+    fn column_bodies(boxes: u32) -> Vec<Body> {
         let mut bodies = vec![Body::fixed("floor", Pose::new(0.0, -0.05, 0.0))];
-        for i in 0..3 {
+        for i in 0..boxes {
             let y = 0.05 + 0.1 * i as f64;
             bodies.push(Body::dynamic(
                 "box",
@@ -940,6 +939,13 @@ mod tests {
                 Pose::new(0.0, y, 0.0),
             ));
         }
+        bodies
+    }
+
+    /// A column of three 1 kg boxes (0.1 m) on a fixed floor: contacts floor–1, 1–2, 2–3 at the
+    /// boxes' bottom faces, each pushing with 10 N.
+    fn column() -> (Vec<Body>, Column) {
+        let bodies = column_bodies(3);
         let keys = (0..3u32)
             .map(|i| VeCandidate {
                 vertex_collider: i + 1,
@@ -1233,16 +1239,7 @@ mod tests {
     /// A tall column of boxes on a fixed floor, two contacts (the bottom corners) at each
     /// interface: the whole loaded list, in key order.
     fn tall_column(boxes: u32) -> (Vec<Body>, Column) {
-        let mut bodies = vec![Body::fixed("floor", Pose::new(0.0, -0.05, 0.0))];
-        for i in 0..boxes {
-            let y = 0.05 + 0.1 * i as f64;
-            bodies.push(Body::dynamic(
-                "box",
-                1.0,
-                1.0 / 600.0,
-                Pose::new(0.0, y, 0.0),
-            ));
-        }
+        let bodies = column_bodies(boxes);
         let (mut contacts, mut keys) = (Vec::new(), Vec::new());
         for i in 0..boxes {
             for corner in 0..2u32 {
