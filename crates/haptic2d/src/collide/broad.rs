@@ -244,12 +244,11 @@ pub struct BroadPhase {
     gjk_iterations: u64,
     reused_distances: usize,
     /// The certificate of the update in progress so far, and of the published update
-    /// ([`still_exact`](Self::still_exact)).
-    progress: Certificate,
-    certificate: Certificate,
-    /// Whether the update in progress computes its certificate, and the updates to begin
-    /// without one (the backoff after failed checks; see [`skip_update`](Self::skip_update)).
-    certifying: bool,
+    /// ([`still_exact`](Self::still_exact)); `None` for an update begun without one.
+    progress: Option<Certificate>,
+    certificate: Option<Certificate>,
+    /// The updates to begin without a certificate, and how many after the next failed check
+    /// (the backoff; see [`skip_update`](Self::skip_update)).
     backoff: u32,
     wait: u32,
     /// The published update: its pairs (sorted), caches, distances and odometer references, and
@@ -285,11 +284,12 @@ impl Certificate {
         gap: f64::INFINITY,
         slack: f64::INFINITY,
     };
-    /// No certificate (the next update runs).
-    const NONE: Certificate = Certificate {
-        gap: 0.0,
-        slack: 0.0,
-    };
+}
+
+/// A collider's body and dynamic flag in one word, `body << 1 | dynamic` (as [`SweepEntry`] and
+/// the [`Snapshot`] keep them).
+fn body_code(c: &Collider) -> u32 {
+    (c.body as u32) << 1 | c.dynamic as u32
 }
 
 /// Most updates begun without a certificate after a failed check (see
@@ -386,9 +386,8 @@ impl BroadPhase {
             in_place: false,
             gjk_iterations: 0,
             reused_distances: 0,
-            progress: Certificate::NONE,
-            certificate: Certificate::NONE,
-            certifying: true,
+            progress: None,
+            certificate: None,
             backoff: 0,
             wait: 0,
             cache_pairs: Vec::new(),
@@ -467,7 +466,10 @@ impl BroadPhase {
     /// set is then as good as a new one for the margin rule (module docs). Costs one pass over
     /// the colliders' world vertices.
     pub fn still_exact(&self, colliders: &[Collider]) -> bool {
-        let (c, snap) = (self.certificate, &self.snapshot);
+        let snap = &self.snapshot;
+        let Some(c) = self.certificate else {
+            return false;
+        };
         if self.next.is_some()
             || colliders.len() != snap.colliders.len()
             || !(c.gap > 0.0 && c.slack > 0.0)
@@ -479,8 +481,7 @@ impl BroadPhase {
         for (i, col) in colliders.iter().enumerate() {
             let now = col.world_vertices();
             let then = snap.vertices(i as u32);
-            let code = (col.body as u32) << 1 | col.dynamic as u32;
-            if now.len() != then.len() || code != snap.bodies[i] {
+            if now.len() != then.len() || body_code(col) != snap.bodies[i] {
                 return false;
             }
             for (p, q) in now.iter().zip(then) {
@@ -500,8 +501,7 @@ impl BroadPhase {
     /// compute no certificate, so their sweep records no slack and no check reads the vertices;
     /// a check that holds resets it. Returns whether the periodic update may be skipped.
     pub fn skip_update(&mut self, colliders: &[Collider]) -> bool {
-        let c = self.certificate;
-        if c.gap == Certificate::NONE.gap && c.slack == Certificate::NONE.slack {
+        if self.certificate.is_none() {
             return false; // no certificate to check
         }
         if self.still_exact(colliders) {
@@ -511,7 +511,7 @@ impl BroadPhase {
         self.backoff = (2 * self.backoff).clamp(1, MAX_BACKOFF);
         self.wait = self.backoff;
         // Checked once: the next update makes a new one, if any.
-        self.certificate = Certificate::NONE;
+        self.certificate = None;
         false
     }
 
@@ -568,17 +568,10 @@ impl BroadPhase {
             self.snapshot
                 .odo
                 .push(odometer.get(c.body).copied().unwrap_or(f64::NAN));
-            self.snapshot
-                .bodies
-                .push((c.body as u32) << 1 | c.dynamic as u32);
+            self.snapshot.bodies.push(body_code(c));
         }
-        self.certifying = self.wait == 0;
+        self.progress = (self.wait == 0).then_some(Certificate::OPEN);
         self.wait = self.wait.saturating_sub(1);
-        self.progress = if self.certifying {
-            Certificate::OPEN
-        } else {
-            Certificate::NONE
-        };
         // 1. Inflated boxes, sorted by (min.x, index): in the last update's order, which is
         //    nearly sorted when the bodies move little between updates (insertion sort), or by
         //    index (a full sort) when the colliders changed.
@@ -590,7 +583,7 @@ impl BroadPhase {
                 min_y: bx.min.y,
                 max_y: bx.max.y,
                 index: i as u32,
-                body: (c.body as u32) << 1 | c.dynamic as u32,
+                body: body_code(c),
             }
         };
         if self.sweep.len() == colliders.len() {
@@ -637,10 +630,11 @@ impl BroadPhase {
         let n = self.sweep.len();
         let share = (n - start).div_ceil(samples_left.max(1));
         let stop = (start + share).min(n);
-        if self.certifying {
-            self.sweep_boxes::<true>(start, stop);
-        } else {
-            self.sweep_boxes::<false>(start, stop);
+        match self.progress {
+            Some(cert) => self.progress = Some(self.sweep_boxes::<true>(start, stop, cert)),
+            None => {
+                self.sweep_boxes::<false>(start, stop, Certificate::OPEN);
+            }
         }
         self.next = Some(stop);
         if samples_left <= 1 && !self.sorted {
@@ -659,9 +653,15 @@ impl BroadPhase {
         }
     }
 
-    /// Steps 2–3 of an update for the sweep entries `start..stop`; with `CERTIFY`, the
-    /// [`Certificate`] of the update in progress takes in each decision's slack.
-    fn sweep_boxes<const CERTIFY: bool>(&mut self, start: usize, stop: usize) {
+    /// Steps 2–3 of an update for the sweep entries `start..stop`. With `CERTIFY`, returns the
+    /// certificate `cert` of the update so far with each of these decisions' slack taken in
+    /// (without, `cert` unchanged).
+    fn sweep_boxes<const CERTIFY: bool>(
+        &mut self,
+        start: usize,
+        stop: usize,
+        mut cert: Certificate,
+    ) -> Certificate {
         // 2. Sweep on x, test y, filter same-body and fixed–fixed pairs; 3. warm-started GJK per
         //    pair (each pair's result depends on its own cache only, so the order of this loop
         //    does not change any result).
@@ -669,7 +669,6 @@ impl BroadPhase {
         let unpaired = |p: &SweepEntry, q: &SweepEntry| {
             p.body >> 1 == q.body >> 1 || (p.body | q.body) & 1 == 0
         };
-        let mut cert = self.progress;
         for i in start..stop {
             let ei = self.sweep[i];
             for (j, ej) in self.sweep[i + 1..].iter().enumerate() {
@@ -733,9 +732,10 @@ impl BroadPhase {
                     &mut cache,
                 );
                 self.gjk_iterations += g.iterations as u64;
-                cert.slack = cert
-                    .slack
-                    .min((g.distance - self.delta_prox).abs() - REUSE_GUARD);
+                if CERTIFY {
+                    let slack = (g.distance - self.delta_prox).abs() - REUSE_GUARD;
+                    cert.slack = cert.slack.min(slack);
+                }
                 self.tested.push(Tested {
                     pair: (a, b),
                     cache,
@@ -744,7 +744,7 @@ impl BroadPhase {
                 });
             }
         }
-        self.progress = cert;
+        cert
     }
 
     /// Where pair `(a, b)` is in the published update (its cache, distance and odometer
@@ -1322,7 +1322,7 @@ mod tests {
             let mut published = Vec::new();
             stage.update_with_motion(&cols, &odometer, &mut published);
             // (Unmoved it holds unless a pair sits within the guard of δ_prox.)
-            let c = stage.certificate;
+            let c = stage.certificate.expect("an update with a certificate");
             assert_eq!(
                 stage.still_exact(&cols),
                 c.gap > 0.0 && c.slack > 0.0,
@@ -1400,7 +1400,7 @@ mod tests {
         let mut set = Vec::new();
         stage.update_with_motion(&place(0.0), &[0.0; 5], &mut set);
         assert!(set.is_empty());
-        assert!((stage.certificate.gap - 0.01).abs() < 1e-12);
+        assert!((stage.certificate.unwrap().gap - 0.01).abs() < 1e-12);
         assert!(stage.still_exact(&place(0.004)));
         let near = place(0.006);
         assert!(!stage.still_exact(&near));

@@ -575,19 +575,13 @@ impl ChainDamping {
             if !is_chain(multi, a, b) {
                 continue;
             }
-            let (dyn_a, dyn_b) = (dynamic[a], dynamic[b]);
             if check
                 && !Row::build(e, a as u32, b as u32, &self.pos, &self.star, r, dt, 0.0).valid()
             {
                 self.dropped = true;
                 continue;
             }
-            let taken = if dyn_a { used[a] } else { 0 } | if dyn_b { used[b] } else { 0 };
-            let c = (!taken).trailing_zeros().min(COLOURS);
-            if c < COLOURS {
-                used[a] |= (dyn_a as u64) << c;
-                used[b] |= (dyn_b as u64) << c;
-            }
+            let c = take_colour(dynamic, used, a, b);
             self.colour.push(c);
             self.per_colour[c as usize] += 1;
         }
@@ -775,13 +769,7 @@ impl ChainDamping {
         for &(i, k) in &self.born {
             let e = &loaded.contacts[i as usize];
             let (a, b) = (e.body_a as usize, e.body_b as usize);
-            let (dyn_a, dyn_b) = (dynamic[a], dynamic[b]);
-            let taken = if dyn_a { used[a] } else { 0 } | if dyn_b { used[b] } else { 0 };
-            let c = (!taken).trailing_zeros().min(COLOURS);
-            if c < COLOURS {
-                used[a] |= (dyn_a as u64) << c;
-                used[b] |= (dyn_b as u64) << c;
-            }
+            let c = take_colour(dynamic, used, a, b);
             let head = self.hole_head[c as usize];
             let p = if head != NONE {
                 self.hole_head[c as usize] = self.hole_next[head as usize];
@@ -903,6 +891,21 @@ impl ChainDamping {
 #[inline(always)]
 fn is_chain(multi: &[bool], a: usize, b: usize) -> bool {
     multi[a] || multi[b]
+}
+
+/// The greedy colour of a row between bodies `a` and `b`: the lowest colour neither dynamic body
+/// has yet (`used`, one bit per colour; fixed bodies take any number), now taken by both; or the
+/// overflow colour [`COLOURS`] when none is free.
+#[inline(always)]
+fn take_colour(dynamic: &[bool], used: &mut [u64], a: usize, b: usize) -> u32 {
+    let (dyn_a, dyn_b) = (dynamic[a], dynamic[b]);
+    let taken = if dyn_a { used[a] } else { 0 } | if dyn_b { used[b] } else { 0 };
+    let c = (!taken).trailing_zeros().min(COLOURS);
+    if c < COLOURS {
+        used[a] |= (dyn_a as u64) << c;
+        used[b] |= (dyn_b as u64) << c;
+    }
+    c
 }
 
 /// Kinetic energy of the working velocities `s` of `bodies` (J; fixed bodies count none).
