@@ -251,11 +251,20 @@ impl ContactSet {
         self.last_impact_loss = 0.0;
         self.resize_body_buffers(bodies.len());
         self.laws.prepare(normal, friction);
-        self.sync(tick, candidates, from_scan, colliders, bodies, rots, past);
+        let work = self.sync(tick, candidates, from_scan, colliders, bodies, rots, past);
         lap.charge(times, Stage::ContactSync);
-        self.release(tick);
-        self.hand_over(tick, colliders, bodies, past, normal, friction);
-        let any_colliding = self.create(tick, dt, colliders, bodies, past, normal, friction);
+        // Each of the next three stages is a pass over every record; the merge's pass has
+        // already seen whether it would change anything (`StageWork`).
+        if work.release {
+            self.release(tick);
+        }
+        if work.hand_over {
+            self.hand_over(tick, colliders, bodies, past, normal, friction);
+        }
+        // `create` also runs after a release or hand-over event: a vertex that lost its record
+        // may start another one in the same sample.
+        let any_colliding = (work.create || !self.events.is_empty())
+            && self.create(tick, dt, colliders, bodies, past, normal, friction);
         if any_colliding {
             // Impact friction mode and coefficient (default μ = the friction model's μ_k; docs/MODELS.md §F).
             let mu = (self.params.impact_mu)

@@ -5,16 +5,34 @@
 use super::ContactSet;
 use super::PastPoses;
 use crate::body::Body;
-use crate::collide::{Collider, VeCandidate};
-use crate::contact::record::{LocalGeom, VeContact, NO_LAW};
+use crate::collide::{nearest_line, Collider, VeCandidate};
+use crate::contact::record::{ContactState, LocalGeom, VeContact, NO_LAW};
 use crate::geom::{Pose, Rot, Vec2};
+
+/// What the stages after the merge may find to do this sample, as the merge's measuring pass
+/// saw it: a stage whose flag is false would change nothing, so [`ContactSet::step`] skips its
+/// pass over the records (on a pile at rest, all three). Each flag may be true without work;
+/// it is false only when the stage's own tests fail for every entry.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(super) struct StageWork {
+    /// Some Continuous record meets the release or re-collision rule (`release`).
+    pub release: bool,
+    /// Some Continuous record that stays, not from this sample's vertex scan, has another line of
+    /// its edge polygon nearer than its own by more than `δ_c` (`hand_over`, which also checks
+    /// the face-on-face exception), or the merge changed the set.
+    pub hand_over: bool,
+    /// Some tracked pair without a record touches (`d ≤ δ_on`, in range), or the merge changed
+    /// the set (`create` also runs after any release or hand-over event).
+    pub create: bool,
+}
 
 impl ContactSet {
     /// Merges the sorted candidates with the tracked set: existing entries are re-measured (history
     /// shifted), new candidates get a fresh entry whose history is rebuilt from the past poses, tracked
     /// pairs that are neither candidates nor records are dropped. Every entry's `nearest_edge` is
     /// its candidate's `from_scan` flag (parallel to `candidates`; false for a record that is not a
-    /// candidate, or if `from_scan` is not parallel).
+    /// candidate, or if `from_scan` is not parallel). Returns what the later stages may find to
+    /// do ([`StageWork`]), seen in the same pass.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn sync(
         &mut self,
@@ -25,7 +43,7 @@ impl ContactSet {
         bodies: &[Body],
         rots: &[Rot],
         past: &PastPoses<'_>,
-    ) {
+    ) -> StageWork {
         // Every tracked entry is re-measured in place (one pass over the set), checking on the way
         // whether merging would keep exactly the current entries: every candidate is tracked already,
         // and every tracked pair is a candidate or a record. That is the steady-contact case, and then
@@ -34,22 +52,43 @@ impl ContactSet {
         let flag = |j: usize| flags.is_some_and(|f| f[j]);
         let mut same = true;
         let mut j = 0;
+        let p = self.params;
+        let recollide = p.v_re.filter(|_| p.impacts);
+        let mut work = StageWork::default();
         for e in self.entries.iter_mut() {
             measure(e, bodies, rots);
             e.nearest_edge = false;
-            if !same {
-                continue;
+            if same {
+                if j < candidates.len() && e.key == candidates[j] {
+                    e.nearest_edge = flag(j);
+                    j += 1;
+                } else if !e.is_contact() || (j < candidates.len() && candidates[j] < e.key) {
+                    same = false;
+                }
             }
-            if j < candidates.len() && e.key == candidates[j] {
-                e.nearest_edge = flag(j);
-                j += 1;
-            } else if !e.is_contact() || (j < candidates.len() && candidates[j] < e.key) {
-                same = false;
+            // The tests of `release`, `hand_over` and `create`, on this sample's measures.
+            match e.state {
+                Some(ContactState::Continuous) => {
+                    if e.d[0] > p.delta_off
+                        || !e.in_range(p.eps_s)
+                        || recollide.is_some_and(|v_re| e.c0 < -v_re)
+                    {
+                        work.release = true;
+                    } else if same && !e.nearest_edge && !work.hand_over {
+                        let cb = &colliders[e.key.edge_collider as usize];
+                        work.hand_over = e.d[0] < nearest_line(cb, e.point).1 - self.delta_c;
+                    }
+                }
+                Some(ContactState::Colliding) => {}
+                None => work.create |= e.d[0] <= p.delta_on && e.in_range(p.eps_s),
             }
         }
         if same && j == candidates.len() {
-            return;
+            return work;
         }
+        // The merge adds pairs and sets `nearest_edge` anew: the later stages look at them all.
+        work.hand_over = true;
+        work.create = true;
         self.merged.clear();
         let (mut i, mut j) = (0, 0);
         let old = std::mem::take(&mut self.entries);
@@ -78,6 +117,7 @@ impl ContactSet {
         }
         self.entries = old;
         std::mem::swap(&mut self.entries, &mut self.merged);
+        work
     }
 }
 
