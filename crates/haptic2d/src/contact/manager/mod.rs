@@ -59,7 +59,8 @@ pub struct ContactSet {
     loaded_generation: u64,
     /// Law states of the records, addressed by [`VeContact::law`].
     laws: LawPool,
-    merged: Vec<VeContact>,
+    /// The differences the last merge found (`sync`), reused.
+    changes: Vec<sync::Change>,
     pending: Vec<VeContact>,
     events: Vec<ContactEvent>,
     rows: Vec<ImpactRow>,
@@ -84,6 +85,12 @@ pub struct ContactSet {
     cos_parallel: f64,
     /// Contact distance tolerance `δ_c` (m): also the tolerance of the depth invariant.
     delta_c: f64,
+    /// Run release, hand-over and create every sample, whatever the merge saw (for tests).
+    #[cfg(test)]
+    every_stage: bool,
+    /// Samples in which the merge saw nothing for release, hand-over and create (for tests).
+    #[cfg(test)]
+    idle_samples: u64,
 }
 
 impl ContactSet {
@@ -96,7 +103,7 @@ impl ContactSet {
             loaded_keys: Vec::with_capacity(64),
             loaded_generation: 0,
             laws: LawPool::with_capacity(64),
-            merged: Vec::with_capacity(64),
+            changes: Vec::with_capacity(64),
             pending: Vec::with_capacity(16),
             events: Vec::with_capacity(64),
             rows: Vec::with_capacity(16),
@@ -115,6 +122,10 @@ impl ContactSet {
             impacts_solved: 0,
             cos_parallel: NEAR_PARALLEL_ANGLE.cos(),
             delta_c: DEFAULT_DELTA_C,
+            #[cfg(test)]
+            every_stage: false,
+            #[cfg(test)]
+            idle_samples: 0,
         }
     }
 
@@ -159,6 +170,19 @@ impl ContactSet {
     #[cfg(test)]
     pub(crate) fn compact_law_slots(&mut self) {
         self.laws.leave_lean();
+    }
+
+    /// Runs release, hand-over and create in every sample from now on, as if the merge had seen
+    /// work for each (`StageWork`), for the crate's tests.
+    #[cfg(test)]
+    pub(crate) fn run_every_stage(&mut self) {
+        self.every_stage = true;
+    }
+
+    /// Samples so far in which the merge saw nothing for release, hand-over and create.
+    #[cfg(test)]
+    pub(crate) fn idle_samples(&self) -> u64 {
+        self.idle_samples
     }
 
     /// The form the law states are stored in (`LawPool`).
@@ -251,8 +275,20 @@ impl ContactSet {
         self.last_impact_loss = 0.0;
         self.resize_body_buffers(bodies.len());
         self.laws.prepare(normal, friction);
-        let work = self.sync(tick, candidates, from_scan, colliders, bodies, rots, past);
+        #[allow(unused_mut)]
+        let mut work = self.sync(tick, candidates, from_scan, colliders, bodies, rots, past);
         lap.charge(times, Stage::ContactSync);
+        #[cfg(test)]
+        {
+            self.idle_samples += u64::from(work == sync::StageWork::default());
+            if self.every_stage {
+                work = sync::StageWork {
+                    release: true,
+                    hand_over: true,
+                    create: true,
+                };
+            }
+        }
         // Each of the next three stages is a pass over every record; the merge's pass has
         // already seen whether it would change anything (`StageWork`).
         if work.release {
@@ -287,4 +323,115 @@ impl ContactSet {
             self.nonfric.resize(n, Vec2::ZERO);
         }
     }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::contact::record::EventKind;
+    use crate::contact::test_pile::{assert_same_poses, shove, toss_top_box};
+    use crate::world::World;
+
+    /// Steps `fast` (stages skipped when the merge saw nothing for them) and `every` (every
+    /// stage every sample) `n` times, applying `poke` to both before step `k`, and asserts
+    /// that their tracked pairs, records and events are the same, sample by sample. Returns the
+    /// samples in which `fast` skipped all three stages, and the events `every` saw.
+    fn same_with_every_stage(
+        world: World,
+        n: usize,
+        poke: impl Fn(usize, &mut World),
+    ) -> (u64, Vec<EventKind>) {
+        let (mut fast, mut every) = (world.clone(), world);
+        every.contacts_mut().run_every_stage();
+        let mut kinds = Vec::new();
+        for k in 0..n {
+            poke(k, &mut fast);
+            poke(k, &mut every);
+            fast.step();
+            every.step();
+            let (a, b) = (fast.contacts(), every.contacts());
+            assert_eq!(a.events(), b.events(), "events at step {k}");
+            assert_eq!(
+                format!("{:?}", a.entries()),
+                format!("{:?}", b.entries()),
+                "entries at step {k}"
+            );
+            assert_same_poses(&fast, &every, k);
+            kinds.extend(b.events().iter().map(|e| e.kind));
+        }
+        assert_eq!(
+            every.contacts().idle_samples(),
+            fast.contacts().idle_samples()
+        );
+        (fast.contacts().idle_samples(), kinds)
+    }
+
+    /// Skipping release, hand-over and create where the merge's pass saw nothing for them changes
+    /// no record, event or pose: a pile:20 that falls, settles, is shoved sideways and has its
+    /// top box tossed up (impacts, releases, creations), and 50 random polygons dropped in a
+    /// box (the repro of issue 10's energy gain: hand-overs at polygon corners).
+    #[test]
+    fn skipping_stages_with_nothing_to_do_changes_no_record() {
+        let pile = crate::scene::builtin("pile:20", None)
+            .unwrap()
+            .unwrap()
+            .world;
+        let (idle, kinds) = same_with_every_stage(pile, 2500, |k, w| match k {
+            1200 => shove(w),
+            1800 => toss_top_box(w),
+            _ => {}
+        });
+        let count = |f: fn(&EventKind) -> bool| kinds.iter().filter(|k| f(k)).count();
+        assert!(count(|k| matches!(k, EventKind::Released)) > 0, "releases");
+        assert!(
+            count(|k| matches!(k, EventKind::Created(_))) > 20,
+            "creations"
+        );
+        assert!(
+            idle > 1000,
+            "the settled pile skips the stages ({idle} samples)"
+        );
+
+        let text = include_str!("../../../tests/repro/r8-polygon-drop-energy.toml");
+        let polygons = crate::scene::Scene::from_toml(text, "r8", None)
+            .unwrap()
+            .world;
+        let (idle, kinds) = same_with_every_stage(polygons, 1500, |_, _| {});
+        assert!(kinds.len() > 20, "{} events", kinds.len());
+        assert!(
+            idle > 100,
+            "polygons at rest skip the stages ({idle} samples)"
+        );
+
+        // A hand-over: the tip of a triangle resting on a square's top edge is carried 11 mm
+        // below it, 1 mm inside the right edge (`tests/repro_contacts.rs`).
+        let text = r#"
+            [world]
+            rate = 1000
+            [contact]
+            impacts = false
+            [[body]]
+            name = "square"
+            kind = "fixed"
+            box = [0.1, 0.1]
+            [[body]]
+            name = "tri"
+            mass = 0.5
+            polygon = [[0.045, 0.0505], [0.065, 0.0705], [0.025, 0.0705]]
+            velocity = [0.0, -0.01]
+        "#;
+        let tri = crate::scene::Scene::from_toml(text, "hand-over", None)
+            .unwrap()
+            .world;
+        let (_, kinds) = same_with_every_stage(tri, 200, |k, w| {
+            if k == 100 {
+                w.bodies[1].pose.pos += crate::geom::Vec2::new(0.004, -0.0115);
+                w.bodies[1].vel = crate::geom::Vec2::ZERO;
+            }
+        });
+        assert!(
+            kinds.contains(&EventKind::Created(ContactState::Continuous)),
+            "handed over: {kinds:?}"
+        );
+    }
+    use crate::contact::record::ContactState;
 }

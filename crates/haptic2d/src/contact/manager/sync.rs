@@ -19,11 +19,22 @@ pub(super) struct StageWork {
     pub release: bool,
     /// Some Continuous record that stays, not from this sample's vertex scan, has another line of
     /// its edge polygon nearer than its own by more than `δ_c` (`hand_over`, which also checks
-    /// the face-on-face exception), or the merge changed the set.
+    /// the face-on-face exception).
     pub hand_over: bool,
-    /// Some tracked pair without a record touches (`d ≤ δ_on`, in range), or the merge changed
-    /// the set (`create` also runs after any release or hand-over event).
+    /// Some tracked pair without a record, old or new, touches (`d ≤ δ_on`, in range; `create`
+    /// also runs after any release or hand-over event).
     pub create: bool,
+}
+
+/// One difference between the tracked set and the candidates, found by the merge's walk
+/// ([`ContactSet::sync`]), in order: positions are indices of the set before the merge.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Change {
+    /// Entry `i` is neither a candidate nor a record: it leaves the set.
+    Drop(u32),
+    /// Candidate `cand` (an index of the candidates) is new: it enters just before entry `at`
+    /// (`at` = the set's length: at the end).
+    Insert { at: u32, cand: u32 },
 }
 
 impl ContactSet {
@@ -33,6 +44,11 @@ impl ContactSet {
     /// its candidate's `from_scan` flag (parallel to `candidates`; false for a record that is not a
     /// candidate, or if `from_scan` is not parallel). Returns what the later stages may find to
     /// do ([`StageWork`]), seen in the same pass.
+    ///
+    /// One pass measures every entry and walks the candidates beside it, listing the differences
+    /// ([`Change`]); the set is then changed in place, moving only the entries between changes
+    /// (a candidate exchanged for another, the usual change on a settling pile, moves the
+    /// entries between the two).
     #[allow(clippy::too_many_arguments)]
     pub(super) fn sync(
         &mut self,
@@ -44,27 +60,30 @@ impl ContactSet {
         rots: &[Rot],
         past: &PastPoses<'_>,
     ) -> StageWork {
-        // Every tracked entry is re-measured in place (one pass over the set), checking on the way
-        // whether merging would keep exactly the current entries: every candidate is tracked already,
-        // and every tracked pair is a candidate or a record. That is the steady-contact case, and then
-        // nothing is copied. (An entry that the merge drops is measured for nothing; that is harmless.)
         let flags = (from_scan.len() == candidates.len()).then_some(from_scan);
         let flag = |j: usize| flags.is_some_and(|f| f[j]);
-        let mut same = true;
-        let mut j = 0;
         let p = self.params;
+        let delta_c = self.delta_c;
         let recollide = p.v_re.filter(|_| p.impacts);
         let mut work = StageWork::default();
-        for e in self.entries.iter_mut() {
+        self.changes.clear();
+        let mut j = 0;
+        for (i, e) in self.entries.iter_mut().enumerate() {
             measure(e, bodies, rots);
             e.nearest_edge = false;
-            if same {
-                if j < candidates.len() && e.key == candidates[j] {
-                    e.nearest_edge = flag(j);
-                    j += 1;
-                } else if !e.is_contact() || (j < candidates.len() && candidates[j] < e.key) {
-                    same = false;
-                }
+            while j < candidates.len() && candidates[j] < e.key {
+                self.changes.push(Change::Insert {
+                    at: i as u32,
+                    cand: j as u32,
+                });
+                j += 1;
+            }
+            if j < candidates.len() && e.key == candidates[j] {
+                e.nearest_edge = flag(j);
+                j += 1;
+            } else if !e.is_contact() {
+                self.changes.push(Change::Drop(i as u32));
+                continue;
             }
             // The tests of `release`, `hand_over` and `create`, on this sample's measures.
             match e.state {
@@ -74,51 +93,124 @@ impl ContactSet {
                         || recollide.is_some_and(|v_re| e.c0 < -v_re)
                     {
                         work.release = true;
-                    } else if same && !e.nearest_edge && !work.hand_over {
+                    } else if !e.nearest_edge && !work.hand_over {
                         let cb = &colliders[e.key.edge_collider as usize];
-                        work.hand_over = e.d[0] < nearest_line(cb, e.point).1 - self.delta_c;
+                        work.hand_over = e.d[0] < nearest_line(cb, e.point).1 - delta_c;
                     }
                 }
                 Some(ContactState::Colliding) => {}
                 None => work.create |= e.d[0] <= p.delta_on && e.in_range(p.eps_s),
             }
         }
-        if same && j == candidates.len() {
-            return work;
+        let len = self.entries.len() as u32;
+        for j in j..candidates.len() {
+            self.changes.push(Change::Insert {
+                at: len,
+                cand: j as u32,
+            });
         }
-        // The merge adds pairs and sets `nearest_edge` anew: the later stages look at them all.
-        work.hand_over = true;
-        work.create = true;
-        self.merged.clear();
-        let (mut i, mut j) = (0, 0);
-        let old = std::mem::take(&mut self.entries);
-        while i < old.len() || j < candidates.len() {
-            let take_old = j >= candidates.len() || (i < old.len() && old[i].key <= candidates[j]);
-            if take_old {
-                let same = j < candidates.len() && old[i].key == candidates[j];
-                if same || old[i].is_contact() {
-                    self.merged.push(VeContact {
-                        nearest_edge: same && flag(j),
-                        ..old[i]
-                    });
-                }
-                if same {
-                    j += 1;
-                }
-                i += 1;
-            } else {
-                let e = new_entry(tick, candidates[j], colliders, bodies, past);
-                self.merged.push(VeContact {
-                    nearest_edge: flag(j),
-                    ..e
-                });
-                j += 1;
-            }
+        if !self.changes.is_empty() {
+            self.apply_changes(tick, candidates, flags, colliders, bodies, past, &mut work);
         }
-        self.entries = old;
-        std::mem::swap(&mut self.entries, &mut self.merged);
         work
     }
+
+    /// Applies the merge's changes (`self.changes`) to the set in place ([`merge_in_place`]),
+    /// the new entries measured from the poses.
+    #[allow(clippy::too_many_arguments)]
+    fn apply_changes(
+        &mut self,
+        tick: u64,
+        candidates: &[VeCandidate],
+        flags: Option<&[bool]>,
+        colliders: &[Collider],
+        bodies: &[Body],
+        past: &PastPoses<'_>,
+        work: &mut StageWork,
+    ) {
+        let p = self.params;
+        merge_in_place(&mut self.entries, &self.changes, |cand| {
+            let j = cand as usize;
+            let e = new_entry(tick, candidates[j], colliders, bodies, past);
+            work.create |= e.d[0] <= p.delta_on && e.in_range(p.eps_s);
+            VeContact {
+                nearest_edge: flags.is_some_and(|f| f[j]),
+                ..e
+            }
+        });
+    }
+}
+
+/// Applies a merge's `changes` (in order, positions in `v` as it is) to `v` in place, with
+/// `fill(cand)` the new element of an insertion. Only the runs between changes move, each by the
+/// number of insertions less drops before it: first those moving toward the front, front to
+/// back, then those moving toward the back, back to front, so that no element is overwritten
+/// before it has moved (the map from old to new places is increasing). Then the new elements are
+/// written into the gaps (`fill` is called once per insertion, in order).
+pub(super) fn merge_in_place<T: Copy>(
+    v: &mut Vec<T>,
+    changes: &[Change],
+    mut fill: impl FnMut(u32) -> T,
+) {
+    let old_len = v.len();
+    let inserts = changes
+        .iter()
+        .filter(|c| matches!(c, Change::Insert { .. }))
+        .count();
+    let new_len = old_len + inserts - (changes.len() - inserts);
+    if new_len > old_len {
+        // Room at the end, filled with any element: every slot past the kept ones is
+        // overwritten below.
+        let Some(&filler) = v.first() else {
+            v.extend(changes.iter().map(|c| match *c {
+                Change::Insert { cand, .. } => fill(cand),
+                Change::Drop(_) => unreachable!("nothing to drop from an empty set"),
+            }));
+            return;
+        };
+        v.resize(new_len, filler);
+    }
+    // Front to back: the runs that move toward the front.
+    let (mut shift, mut start) = (0isize, 0usize);
+    for &c in changes {
+        let (end, next_start, step) = match c {
+            Change::Drop(i) => (i as usize, i as usize + 1, -1),
+            Change::Insert { at, .. } => (at as usize, at as usize, 1),
+        };
+        if shift < 0 && start < end {
+            v.copy_within(start..end, start - shift.unsigned_abs());
+        }
+        shift += step;
+        start = next_start;
+    }
+    if shift < 0 && start < old_len {
+        v.copy_within(start..old_len, start - shift.unsigned_abs());
+    }
+    // Back to front: the runs that move toward the back.
+    let mut end = old_len;
+    for &c in changes.iter().rev() {
+        let (run_start, prev_end, step) = match c {
+            Change::Drop(i) => (i as usize + 1, i as usize, -1),
+            Change::Insert { at, .. } => (at as usize, at as usize, 1),
+        };
+        if shift > 0 && run_start < end {
+            v.copy_within(run_start..end, run_start + shift as usize);
+        }
+        shift -= step;
+        end = prev_end;
+    }
+    debug_assert_eq!(shift, 0);
+    // The new elements, in the gaps.
+    for &c in changes {
+        match c {
+            Change::Drop(_) => shift -= 1,
+            Change::Insert { at, cand } => {
+                v[(at as isize + shift) as usize] = fill(cand);
+                shift += 1;
+            }
+        }
+    }
+    v.truncate(new_len);
 }
 
 /// Re-measures an existing entry: shifts the histories and refreshes geometry and velocities from
@@ -241,4 +333,80 @@ pub(super) fn past_ds(
         rot.apply(cb.local.normals()[e]).dot(rel),
         rot.apply(cb.local.tangents()[e]).dot(rel),
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{merge_in_place, Change};
+
+    /// A small deterministic generator (xorshift64*).
+    struct Rng(u64);
+    impl Rng {
+        fn next(&mut self) -> u64 {
+            self.0 ^= self.0 >> 12;
+            self.0 ^= self.0 << 25;
+            self.0 ^= self.0 >> 27;
+            self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
+        }
+        fn below(&mut self, n: u64) -> u64 {
+            self.next() % n
+        }
+    }
+
+    /// The merge by copy that `merge_in_place` replaced: keep, drop or insert, into a new list.
+    fn merged_by_copy(v: &[u32], changes: &[Change], new: impl Fn(u32) -> u32) -> Vec<u32> {
+        let mut out = Vec::new();
+        let mut c = changes.iter().peekable();
+        for i in 0..=v.len() {
+            let mut dropped = false;
+            while let Some(&&ch) = c.peek() {
+                match ch {
+                    Change::Insert { at, cand } if at as usize == i => out.push(new(cand)),
+                    Change::Drop(d) if d as usize == i => dropped = true,
+                    _ => break,
+                }
+                c.next();
+            }
+            if i < v.len() && !dropped {
+                out.push(v[i]);
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn a_merge_in_place_gives_the_merge_by_copy() {
+        let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+        let mut changed = 0;
+        for case in 0..4000 {
+            let len = rng.below(if case % 4 == 0 { 4 } else { 60 }) as usize;
+            let v: Vec<u32> = (0..len as u32).map(|i| 1000 + i).collect();
+            // Changes in the order the walk finds them: before each entry (and at the end)
+            // some insertions, then perhaps the entry's drop.
+            let rate = 1 + rng.below(6);
+            let mut changes = Vec::new();
+            let mut cand = 0;
+            for i in 0..=len {
+                while rng.below(10) < rate.min(4) && rng.below(3) == 0 {
+                    changes.push(Change::Insert { at: i as u32, cand });
+                    cand += 1;
+                }
+                if i < len && rng.below(10) < rate {
+                    changes.push(Change::Drop(i as u32));
+                }
+            }
+            changed += usize::from(!changes.is_empty());
+            let new = |c: u32| 5000 + c;
+            let want = merged_by_copy(&v, &changes, new);
+            let mut got = v.clone();
+            let mut calls = Vec::new();
+            merge_in_place(&mut got, &changes, |c| {
+                calls.push(c);
+                new(c)
+            });
+            assert_eq!(got, want, "case {case}: {v:?} with {changes:?}");
+            assert_eq!(calls, (0..cand).collect::<Vec<_>>(), "case {case}");
+        }
+        assert!(changed > 3000, "the cases change the list ({changed})");
+    }
 }
