@@ -275,6 +275,8 @@ pub fn run(
                     RowsBy::Build
                 },
                 damper_us: w.stage_times().get(Stage::ChainDamper) as f64 / 1e3,
+                merge_changes: w.contacts().last_merge_changes(),
+                sync_us: w.stage_times().get(Stage::ContactSync) as f64 / 1e3,
             });
         }
         since += 1;
@@ -338,6 +340,7 @@ pub fn run(
     if stage_time::ENABLED {
         print_stages(label, profile_after, &stages, cold);
     }
+    print_merges(label, profile_after, &each);
     print_damper_kinds(label, profile_after, &each);
     let (median, p99) = (all_steps.median(), all_steps.p99());
     println!(
@@ -465,6 +468,41 @@ struct ProfiledStep {
     rows_by: RowsBy,
     /// The damper stage's wall time (µs; 0 without the `stage-timing` feature).
     damper_us: f64,
+    /// Pairs the contact merge dropped or added.
+    merge_changes: usize,
+    /// The sync stage's wall time (merge and measure; µs; 0 without the `stage-timing` feature).
+    sync_us: f64,
+}
+
+/// The warm steps whose contact merge changed the tracked set against the others: how many,
+/// their median number of changes, their median step and, with the `stage-timing` feature, the
+/// sync stage's median.
+fn print_merges(label: &str, profile_after: f64, kinds: &[ProfiledStep]) {
+    let median = |group: &[&ProfiledStep], f: fn(&ProfiledStep) -> f64| {
+        crate::timing::Samples(group.iter().map(|k| f(k)).collect()).median()
+    };
+    let (merged, kept): (Vec<&ProfiledStep>, Vec<&ProfiledStep>) =
+        kinds.iter().partition(|k| k.merge_changes > 0);
+    if merged.is_empty() || kept.is_empty() {
+        return;
+    }
+    let sync = |group: &[&ProfiledStep]| {
+        if stage_time::ENABLED {
+            format!(", sync stage {:.1} µs wall", median(group, |k| k.sync_us))
+        } else {
+            String::new()
+        }
+    };
+    println!(
+        "{label}: warm steps after {profile_after} s whose contact merge changed the set: {} ({:.1} %, median {} changes), median {:.1} CPU µs per step{}; the others {:.1}{}",
+        merged.len(),
+        100.0 * merged.len() as f64 / kinds.len() as f64,
+        median(&merged, |k| k.merge_changes as f64),
+        median(&merged, |k| k.step_us),
+        sync(&merged),
+        median(&kept, |k| k.step_us),
+        sync(&kept),
+    );
 }
 
 /// How the chain damper made a step's rows: refreshed in place (the loaded contacts were the

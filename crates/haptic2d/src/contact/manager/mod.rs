@@ -208,6 +208,14 @@ impl ContactSet {
         self.record_count
     }
 
+    /// Number of differences the last sample's merge found between the tracked pairs and the
+    /// local stage's candidates (pairs dropped plus pairs added; 0 when the set was kept as it
+    /// was), for profiling.
+    #[inline]
+    pub fn last_merge_changes(&self) -> usize {
+        self.changes.len()
+    }
+
     /// The state transitions of the last sample.
     #[inline]
     pub fn events(&self) -> &[ContactEvent] {
