@@ -9,6 +9,12 @@
 //! [`ContactSet::step`]): [`sync`] (merge and measure), [`release`] (§8.2 rules 4–5), [`hand_over`]
 //! (the depth invariant), [`create`] (§8.2 rules 1–2, §8.3), [`impacts`] (§7), [`forces`] (§1–§4,
 //! §5.9); [`invariant`] holds the depth invariant's checks.
+//!
+//! The merge's pass, which measures every pair, also applies the tests of release, hand-over
+//! and create to what it measured (`sync::StageWork`); a stage none of whose tests passes is not
+//! run, so a contact set at rest makes two passes over its records a sample (merge and measure,
+//! forces) instead of five. The merge changes the set in place, moving only the entries
+//! between its changes.
 
 mod create;
 mod forces;
