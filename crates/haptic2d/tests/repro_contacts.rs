@@ -125,21 +125,7 @@ fn t0_primed_peg_in_hole_reports_its_initial_contacts_and_stored_energy() {
 /// its stored energy follows the vertex's real depth down instead of staying that of the far line.
 #[test]
 fn long_lived_record_is_handed_to_the_nearer_edge_and_stores_less() {
-    let text = r#"
-[world]
-rate = 1000
-[contact]
-impacts = false
-[[body]]
-name = "square"
-kind = "fixed"
-box = [0.1, 0.1]
-[[body]]
-name = "tri"
-mass = 0.5
-polygon = [[0.045, 0.0505], [0.065, 0.0705], [0.025, 0.0705]]
-velocity = [0.0, -0.01]
-"#;
+    let text = include_str!("repro/hand-over-triangle.toml");
     let mut w = Scene::from_toml(text, "handover", None)
         .expect("valid")
         .world;

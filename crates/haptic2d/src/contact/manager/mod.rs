@@ -418,21 +418,7 @@ mod tests {
 
         // A hand-over: the tip of a triangle resting on a square's top edge is carried 11 mm
         // below it, 1 mm inside the right edge (`tests/repro_contacts.rs`).
-        let text = r#"
-            [world]
-            rate = 1000
-            [contact]
-            impacts = false
-            [[body]]
-            name = "square"
-            kind = "fixed"
-            box = [0.1, 0.1]
-            [[body]]
-            name = "tri"
-            mass = 0.5
-            polygon = [[0.045, 0.0505], [0.065, 0.0705], [0.025, 0.0705]]
-            velocity = [0.0, -0.01]
-        "#;
+        let text = include_str!("../../../tests/repro/hand-over-triangle.toml");
         let tri = crate::scene::Scene::from_toml(text, "hand-over", None)
             .unwrap()
             .world;
