@@ -1016,7 +1016,8 @@ mod tests {
     /// The sweep pairs exactly the colliders whose inflated boxes overlap (closed), once each,
     /// leaving out same-body and fixed–fixed pairs, against a test of every pair: random scenes
     /// from 1 to 400 colliders, some stacked in narrow columns so that a box's x run is longer
-    /// than one or two of the sweep's 64-box blocks, some touching exactly, some sharing a body.
+    /// than one or two of the sweep's 64-box blocks, some touching exactly, some sharing a body;
+    /// with the certificate's bookkeeping and without it.
     #[test]
     fn the_sweep_pairs_every_overlapping_pair_once() {
         let mut rng = 0x2545_f491_4f6c_dd1du64;
@@ -1027,11 +1028,11 @@ mod tests {
             (rng >> 11) as f64 / (1u64 << 53) as f64
         };
         let half = 0.5 * DEFAULT_DELTA_PROX;
-        let mut longest_run = 0;
+        let (mut longest_run, mut plain_updates) = (0, 0);
         for trial in 0..300 {
             let n = 1 + (400.0 * next() * next()) as usize;
             let columns = 1 + (6.0 * next()) as usize;
-            let mut cols = Vec::new();
+            let (mut cols, mut poses) = (Vec::new(), Vec::new());
             for i in 0..n {
                 let body = if next() < 0.1 && i > 0 { i - 1 } else { i };
                 let dynamic = next() < 0.8;
@@ -1048,9 +1049,8 @@ mod tests {
                 };
                 let shape = ConvexPolygon::rectangle(w, h).unwrap();
                 cols.push(Collider::new(body, dynamic, shape, &pose));
+                poses.push(pose);
             }
-            let mut stage = BroadPhase::new(DEFAULT_DELTA_PROX).unwrap();
-            stage.update(&cols, &mut Vec::new());
             let mut want = Vec::new();
             for a in 0..n {
                 let run = (a + 1..n)
@@ -1069,13 +1069,42 @@ mod tests {
                     }
                 }
             }
+            // The sweep with the certificate's bookkeeping (a first update), and without it
+            // (an update after a failed skip check, which backs off from certifying).
+            let mut certifying = BroadPhase::new(DEFAULT_DELTA_PROX).unwrap();
+            certifying.update(&cols, &mut Vec::new());
+            assert!(certifying.certificate.is_some());
             assert_eq!(
-                stage.tested_pairs().0,
+                certifying.tested_pairs().0,
                 &want[..],
-                "trial {trial}, {n} colliders"
+                "trial {trial}, {n} boxes"
             );
+            let mut plain = BroadPhase::new(DEFAULT_DELTA_PROX).unwrap();
+            plain.update(&cols, &mut Vec::new());
+            let moved: Vec<Collider> = cols
+                .iter()
+                .zip(&poses)
+                .map(|(c, p)| {
+                    let mut c = c.clone();
+                    c.update(&Pose::new(p.pos.x + 0.3, p.pos.y, p.angle + 0.5));
+                    c
+                })
+                .collect();
+            if !plain.skip_update(&moved) {
+                plain.update(&cols, &mut Vec::new());
+                plain_updates += usize::from(plain.certificate.is_none());
+                assert_eq!(
+                    plain.tested_pairs().0,
+                    &want[..],
+                    "trial {trial}, {n} boxes"
+                );
+            }
         }
         assert!(longest_run > 128, "x runs over two blocks ({longest_run})");
+        assert!(
+            plain_updates > 200,
+            "updates without the certificate: {plain_updates}"
+        );
     }
 
     /// The spread update publishes exactly the set, distances, caches and counters of the whole
