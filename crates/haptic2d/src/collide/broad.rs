@@ -1013,6 +1013,17 @@ mod tests {
         cols
     }
 
+    /// A seeded xorshift generator of uniform numbers in `[0, 1)`.
+    fn uniform(seed: u64) -> impl FnMut() -> f64 {
+        let mut rng = seed;
+        move || {
+            rng ^= rng << 13;
+            rng ^= rng >> 7;
+            rng ^= rng << 17;
+            (rng >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
     /// The sweep pairs exactly the colliders whose inflated boxes overlap (closed), once each,
     /// leaving out same-body and fixed–fixed pairs, against a test of every pair: random scenes
     /// from 1 to 400 colliders, some stacked in narrow columns so that a box's x run is longer
@@ -1020,13 +1031,7 @@ mod tests {
     /// with the certificate's bookkeeping and without it.
     #[test]
     fn the_sweep_pairs_every_overlapping_pair_once() {
-        let mut rng = 0x2545_f491_4f6c_dd1du64;
-        let mut next = move || {
-            rng ^= rng << 13;
-            rng ^= rng >> 7;
-            rng ^= rng << 17;
-            (rng >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = uniform(0x2545_f491_4f6c_dd1du64);
         let half = 0.5 * DEFAULT_DELTA_PROX;
         let (mut longest_run, mut plain_updates) = (0, 0);
         for trial in 0..300 {
@@ -1425,13 +1430,7 @@ mod tests {
     /// random, with a rotation.
     #[test]
     fn a_still_exact_set_is_what_an_update_now_computes() {
-        let mut rng = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = move || {
-            rng ^= rng << 13;
-            rng ^= rng >> 7;
-            rng ^= rng << 17;
-            (rng >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = uniform(0x9e37_79b9_7f4a_7c15u64);
         let (mut held, mut changed, mut failed_same) = (0, 0, 0);
         let (mut gap_bound, mut tight) = (0, 0);
         for trial in 0..2000 {
