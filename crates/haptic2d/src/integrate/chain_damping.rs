@@ -458,15 +458,19 @@ impl ChainDamping {
                 row.lambda *= scale;
             }
         }
-        let removed = ke_star - kinetic(&self.solver, bodies);
         // 6. The impulses as forces held over the sample (the rows keep them for the next warm
         //    start). A dynamic body's share is the momentum the sweeps gave it, `m·(v − v*)/T`
-        //    and `I·(ω − ω*)/T`: one pass over the bodies instead of four writes per row. A fixed
-        //    body's velocity does not change; its share (the reaction, which its wrench reports)
-        //    is summed over the rows that touch it.
+        //    and `I·(ω − ω*)/T`: one pass over the bodies instead of four writes per row, which
+        //    also sums the kinetic energy the sweeps left. A fixed body's velocity does not
+        //    change; its share (the reaction, which its wrench reports) is summed over the rows
+        //    that touch it.
         let inv_dt = 1.0 / dt;
+        let mut ke = 0.0;
         for (i, b) in bodies.iter_mut().enumerate() {
             let (s, v) = (&self.solver[i], &self.star[i]);
+            if b.is_dynamic() {
+                ke += kinetic_of(b, s.v, s.omega);
+            }
             let f = if v.inv_mass > 0.0 {
                 (s.v - v.v) * (b.mass * inv_dt)
             } else {
@@ -482,6 +486,7 @@ impl ChainDamping {
             b.force += f;
             b.torque += t;
         }
+        let removed = ke_star - ke;
         let dynamic = &self.dynamic;
         for row in &self.sorted {
             let (a, b) = (row.a as usize, row.b as usize);
@@ -935,17 +940,6 @@ fn take_colour(dynamic: &[bool], used: &mut [u64], a: usize, b: usize) -> u32 {
         used[b] |= (dyn_b as u64) << c;
     }
     c
-}
-
-/// Kinetic energy of the working velocities `s` of `bodies` (J; fixed bodies count none).
-fn kinetic(s: &[SolverBody], bodies: &[Body]) -> f64 {
-    let mut ke = 0.0;
-    for (sb, b) in s.iter().zip(bodies) {
-        if b.is_dynamic() {
-            ke += kinetic_of(b, sb.v, sb.omega);
-        }
-    }
-    ke
 }
 
 /// Kinetic energy of body `b` at velocity `v` (m/s) and spin `omega` (rad/s) (J).
