@@ -440,11 +440,11 @@ impl ChainDamping {
             for row in self.sorted.iter_mut() {
                 let lambda = row.lambda * scale;
                 let v_rel = row.v_rel(solver);
-                let new = (-row.c * (v_rel - row.w * lambda)).max(row.lo);
+                let new = select_max(-row.c * (v_rel - row.w * lambda), row.lo);
                 let d = new - lambda;
                 row.lambda = new;
                 row.apply(d, solver);
-                largest = largest.max((d * row.w).abs());
+                largest = select_max((d * row.w).abs(), largest);
             }
             scale = 1.0;
             self.last_sweeps += 1;
@@ -915,6 +915,17 @@ impl ChainDamping {
             }
         }
         s
+    }
+}
+
+/// `max(x, y)` as one `maxsd`: `x` if `x > y`, else `y` (so `y` if `x` is NaN, as
+/// [`f64::max`] gives when `y` is not NaN, without its NaN fix-up).
+#[inline(always)]
+fn select_max(x: f64, y: f64) -> f64 {
+    if x > y {
+        x
+    } else {
+        y
     }
 }
 
