@@ -4,11 +4,13 @@ mod aabb;
 mod mass;
 mod polygon;
 mod pose;
+mod trig;
 
 pub use aabb::Aabb;
 pub use mass::MassProperties;
 pub use polygon::{ConvexPolygon, PolygonError};
 pub use pose::{Pose, Rot};
+pub use trig::sin_cos;
 
 /// A 2-D vector of `f64` (glam's `DVec2`, as re-exported by parry2d-f64). Units depend on use (m, m/s, N).
 pub type Vec2 = parry2d_f64::math::Vector;

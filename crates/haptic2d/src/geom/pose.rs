@@ -12,10 +12,11 @@ pub struct Rot {
 }
 
 impl Rot {
-    /// The rotation by `angle` (rad).
+    /// The rotation by `angle` (rad), from [`sin_cos`](super::sin_cos) (the same bits on every
+    /// platform).
     #[inline]
     pub fn new(angle: f64) -> Self {
-        let (s, c) = angle.sin_cos();
+        let (s, c) = super::sin_cos(angle);
         Self { c, s }
     }
     /// The identity rotation.
