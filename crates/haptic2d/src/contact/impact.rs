@@ -10,7 +10,7 @@
 use super::impact_friction::{FrictionalImpactSolver, ImpactFriction, PhaseMethod};
 use super::lcp::{LcpReport, LcpSolver};
 use crate::body::Body;
-use crate::geom::{cross, Vec2};
+use crate::geom::{cross, select_max, Vec2};
 
 /// Default constraint-check tolerance `ε_v` (m/s): after restitution, a row with `b⁺_i < −ε_v`
 /// triggers the plastic correction (§7.2 step 3).
@@ -116,8 +116,11 @@ pub struct ImpactSolver {
     jac: Vec<[f64; 6]>,
     /// Delassus matrix `A = G M⁻¹ Gᵀ`, row-major `n × n` (dense path only).
     a: Vec<f64>,
-    /// Diagonal `A_ii` (sparse path).
+    /// Diagonal `A_ii` and its inverse `1/A_ii` (0 where `A_ii ≤ 0`) (sparse path): the sweeps
+    /// multiply by the inverse instead of dividing, so that a row's update does not wait on a
+    /// division (about 13 cycles against 3 on this machine) at every sweep.
     diag: Vec<f64>,
+    inv_diag: Vec<f64>,
     /// Pre-impact normal velocities `b⁻` (m/s).
     b_pre: Vec<f64>,
     /// Post-restitution normal velocities, before any plastic correction (m/s).
@@ -163,6 +166,7 @@ impl ImpactSolver {
             jac: Vec::new(),
             a: Vec::new(),
             diag: Vec::new(),
+            inv_diag: Vec::new(),
             b_pre: Vec::new(),
             b_mid: Vec::new(),
             b_post: Vec::new(),
@@ -234,6 +238,7 @@ impl ImpactSolver {
             self.a.resize(dense * dense, 0.0);
         }
         self.diag.resize(rows, 0.0);
+        self.inv_diag.resize(rows, 0.0);
         for v in [
             &mut self.b_pre,
             &mut self.b_mid,
@@ -417,6 +422,7 @@ impl ImpactSolver {
                     + b.inv_inertia * j[off + 2] * j[off + 2];
             }
             self.diag[i] = d;
+            self.inv_diag[i] = if d > 0.0 { 1.0 / d } else { 0.0 };
         }
         self.normal_velocities(rows, bodies, Buf::Pre);
         // 1. Compression: PGS on the bodies' twists, starting from λ = 0.
@@ -502,11 +508,11 @@ impl ImpactSolver {
                     Buf::Step => &mut self.step[i],
                     _ => &mut self.lambda[i],
                 };
-                let new = (*acc - w / self.diag[i]).max(0.0);
+                let new = select_max(*acc - w * self.inv_diag[i], 0.0);
                 let delta = new - *acc;
                 *acc = new;
                 if delta != 0.0 {
-                    max_delta = max_delta.max(delta.abs());
+                    max_delta = select_max(delta.abs(), max_delta);
                     for (off, bi) in [(0usize, row.body_a), (3, row.body_b)] {
                         let b = &mut bodies[bi];
                         if b.is_dynamic() {

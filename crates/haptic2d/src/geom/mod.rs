@@ -21,6 +21,19 @@ pub fn cross(a: Vec2, b: Vec2) -> f64 {
     a.x * b.y - a.y * b.x
 }
 
+/// The larger of `x` and `y` as one compare-select (`maxsd`): `x` if `x > y`, else `y` (so `y`
+/// when `x` is NaN). [`f64::max`] gives the same for a `y` that is not NaN, but adds a NaN fix-up
+/// that, on a maximum carried from one loop iteration to the next, lengthens every iteration's
+/// dependency chain (the chain damper's sweep and the impact sweeps).
+#[inline(always)]
+pub fn select_max(x: f64, y: f64) -> f64 {
+    if x > y {
+        x
+    } else {
+        y
+    }
+}
+
 /// `perp(a) = (−a_y, a_x)`: `a` rotated by +90° (§0.3).
 #[inline]
 pub fn perp(a: Vec2) -> Vec2 {

@@ -62,7 +62,7 @@
 use crate::body::Body;
 use crate::collide::VeCandidate;
 use crate::contact::{Loaded, LoadedContact, Wrench2};
-use crate::geom::{cross, Vec2};
+use crate::geom::{cross, select_max, Vec2};
 
 /// No partner yet (per-body scratch).
 const NONE: u32 = u32::MAX;
@@ -915,17 +915,6 @@ impl ChainDamping {
             }
         }
         s
-    }
-}
-
-/// `max(x, y)` as one `maxsd`: `x` if `x > y`, else `y` (so `y` if `x` is NaN, as
-/// [`f64::max`] gives when `y` is not NaN, without its NaN fix-up).
-#[inline(always)]
-fn select_max(x: f64, y: f64) -> f64 {
-    if x > y {
-        x
-    } else {
-        y
     }
 }
 
