@@ -74,8 +74,9 @@ pub fn sin_cos(x: f64) -> (f64, f64) {
     }
 }
 
-/// The largest `|x|` the kernels take unreduced: fdlibm's bound, `0x3FE921FB_FFFFFFFF`, just
-/// below `π/4` rounded up.
+/// The largest `|x|` the kernels take unreduced: fdlibm's bound, `0x3FE921FB_FFFFFFFF`, the
+/// largest double with `π/4`'s high word (a little above `π/4 = 0x3FE921FB_54442D18`; the
+/// kernels hold there too).
 const FRAC_PI_4_BELOW: f64 = f64::from_bits(0x3FE9_21FB_FFFF_FFFF);
 /// Below `2⁻²⁷`, `sin x = x` and `cos x = 1` after rounding.
 const TINY: f64 = f64::from_bits(0x3E40_0000_0000_0000);

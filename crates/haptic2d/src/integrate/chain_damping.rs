@@ -471,6 +471,9 @@ impl ChainDamping {
             if b.is_dynamic() {
                 ke += kinetic_of(b, s.v, s.omega);
             }
+            if !self.dynamic[i] {
+                continue; // summed over its rows below
+            }
             let f = if v.inv_mass > 0.0 {
                 (s.v - v.v) * (b.mass * inv_dt)
             } else {
