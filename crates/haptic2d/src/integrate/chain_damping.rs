@@ -100,6 +100,35 @@ struct SolverBody {
     inv_inertia: f64,
 }
 
+/// A body as the rows are built: its velocity without the dampers and inverse masses
+/// ([`SolverBody`]), and its position (m), in one record, so that building a row reads one
+/// place per body.
+#[derive(Clone, Copy, Debug, Default)]
+struct StarBody {
+    s: SolverBody,
+    pos: Vec2,
+}
+
+/// Read access to a body's [`SolverBody`], for the row operations on the sweeps' working
+/// velocities and on the velocities without the dampers alike.
+trait AsSolver {
+    fn solver(&self) -> &SolverBody;
+}
+
+impl AsSolver for SolverBody {
+    #[inline(always)]
+    fn solver(&self) -> &SolverBody {
+        self
+    }
+}
+
+impl AsSolver for StarBody {
+    #[inline(always)]
+    fn solver(&self) -> &SolverBody {
+        &self.s
+    }
+}
+
 impl Row {
     /// A placeholder, overwritten before any sweep reads it.
     const NONE: Row = Row {
@@ -114,7 +143,7 @@ impl Row {
         lambda: 0.0,
     };
 
-    /// The row of chain contact `e` between solver bodies `a` and `b` (body positions `pos`,
+    /// The row of chain contact `e` between solver bodies `a` and `b` (body positions,
     /// velocities and inverse masses `star`; `r = T/τ`, `dt = T` in s), warm-started from the
     /// impulse `prev` (N·s) within this sample's bound. Its effective mass may be not finite
     /// and positive: [`valid`](Self::valid) says.
@@ -124,18 +153,20 @@ impl Row {
         e: &LoadedContact,
         a: u32,
         b: u32,
-        pos: &[Vec2],
-        star: &[SolverBody],
+        star: &[StarBody],
         r: f64,
         dt: f64,
         prev: f64,
     ) -> Row {
-        let (sa, sb) = (&star[a as usize], &star[b as usize]);
-        let rna = cross(e.point - pos[a as usize], e.n);
-        let rnb = cross(e.point - pos[b as usize], e.n);
+        let (xa, xb) = (&star[a as usize], &star[b as usize]);
+        let (sa, sb) = (&xa.s, &xb.s);
+        let rna = cross(e.point - xa.pos, e.n);
+        let rnb = cross(e.point - xb.pos, e.n);
         let w = sa.inv_mass + sb.inv_mass + sa.inv_inertia * rna * rna + sb.inv_inertia * rnb * rnb;
         let lo = -dt * e.f_n;
-        let warm = prev.max(lo);
+        // `prev > lo ? prev : lo`: what `f64::max` gives for a bound that is never NaN (a loaded
+        // contact has `f_n > 0`), a NaN `prev` included (both give `lo`), in one instruction.
+        let warm = select_max(prev, lo);
         Row {
             a,
             b,
@@ -157,8 +188,8 @@ impl Row {
 
     /// Relative normal velocity of the row's points (m/s; positive separating).
     #[inline(always)]
-    fn v_rel(&self, s: &[SolverBody]) -> f64 {
-        let (a, b) = (&s[self.a as usize], &s[self.b as usize]);
+    fn v_rel<B: AsSolver>(&self, s: &[B]) -> f64 {
+        let (a, b) = (s[self.a as usize].solver(), s[self.b as usize].solver());
         (a.v - b.v).dot(self.n) + a.omega * self.rna - b.omega * self.rnb
     }
 
@@ -179,11 +210,10 @@ impl Row {
 pub struct ChainDamping {
     partner: Vec<u32>,
     multi: Vec<bool>,
+    /// The sweeps' working velocities (`v*` as step 1 leaves them, then with the impulses).
     solver: Vec<SolverBody>,
-    /// The velocities without the dampers, `v*` (semi-implicit Euler).
-    star: Vec<SolverBody>,
-    /// Body positions (m).
-    pos: Vec<Vec2>,
+    /// The velocities without the dampers, `v*` (semi-implicit Euler), and the positions.
+    star: Vec<StarBody>,
     /// Rows in colour order (each colour's rows in contact-key order) as built; a patch leaves
     /// holes (no-op rows) where rows died, fills them with new rows of their colour and appends
     /// the others (see [`patch_rows`](Self::patch_rows)).
@@ -260,7 +290,6 @@ impl Default for ChainDamping {
             multi: Vec::new(),
             solver: Vec::new(),
             star: Vec::new(),
-            pos: Vec::new(),
             sorted: Vec::with_capacity(64),
             src: Vec::with_capacity(64),
             colour_of: Vec::with_capacity(64),
@@ -357,8 +386,7 @@ impl ChainDamping {
             self.partner.resize(n, NONE);
             self.multi.resize(n, false);
             self.solver.resize(n, SolverBody::default());
-            self.star.resize(n, SolverBody::default());
-            self.pos.resize(n, Vec2::ZERO);
+            self.star.resize(n, StarBody::default());
             self.used.resize(n, 0);
             self.dynamic.resize(n, false);
             self.forget();
@@ -368,12 +396,12 @@ impl ChainDamping {
             return 0.0;
         }
         // 1. The velocities the integrator would reach without the dampers (semi-implicit
-        //    Euler), with the inverse masses the impulses act through (none for fixed bodies).
+        //    Euler), with the inverse masses the impulses act through (none for fixed bodies);
+        //    the sweeps' working velocities start there.
         let mut ke_star = 0.0;
         let mut same_bodies = true;
         for (i, b) in bodies.iter().enumerate() {
-            self.pos[i] = b.pose.pos;
-            self.star[i] = if b.is_dynamic() {
+            let s = if b.is_dynamic() {
                 let f = b.force - b.vel * b.damping;
                 let (v, omega) = (
                     b.vel + f * (dt * b.inv_mass),
@@ -394,7 +422,9 @@ impl ChainDamping {
                     inv_inertia: 0.0,
                 }
             };
-            let d = self.star[i].inv_mass > 0.0 || self.star[i].inv_inertia > 0.0;
+            self.star[i] = StarBody { s, pos: b.pose.pos };
+            self.solver[i] = s;
+            let d = s.inv_mass > 0.0 || s.inv_inertia > 0.0;
             same_bodies &= self.dynamic[i] == d;
             self.dynamic[i] = d;
         }
@@ -467,7 +497,7 @@ impl ChainDamping {
         let inv_dt = 1.0 / dt;
         let mut ke = 0.0;
         for (i, b) in bodies.iter_mut().enumerate() {
-            let (s, v) = (&self.solver[i], &self.star[i]);
+            let (s, v) = (&self.solver[i], &self.star[i].s);
             if b.is_dynamic() {
                 ke += kinetic_of(b, s.v, s.omega);
             }
@@ -612,9 +642,7 @@ impl ChainDamping {
             if !is_chain(multi, a, b) {
                 continue;
             }
-            if check
-                && !Row::build(e, a as u32, b as u32, &self.pos, &self.star, r, dt, 0.0).valid()
-            {
+            if check && !Row::build(e, a as u32, b as u32, &self.star, r, dt, 0.0).valid() {
                 self.dropped = true;
                 continue;
             }
@@ -673,7 +701,8 @@ impl ChainDamping {
         self.dead.reserve(room);
         self.born.clear();
         self.born.reserve(room);
-        self.solver.copy_from_slice(&self.star);
+        // A refresh that gave up may have applied impulses: start again from `v*`.
+        self.reset_solver();
         let (star, multi) = (&self.star, &self.multi);
         let (mut g, mut k) = (0.0, 0.0);
         let mut j = 0;
@@ -690,7 +719,7 @@ impl ChainDamping {
             } else {
                 0.0
             };
-            let row = Row::build(e, a as u32, b as u32, &self.pos, star, r, dt, prev);
+            let row = Row::build(e, a as u32, b as u32, star, r, dt, prev);
             if !row.valid() {
                 if abort_on_invalid {
                     return None;
@@ -847,7 +876,7 @@ impl ChainDamping {
     /// Returns `(g, h)` of [`scale_warm_start`](Self::scale_warm_start), or `None` (the caller
     /// builds from scratch) if a row's effective mass is no longer finite.
     fn refresh_rows(&mut self, r: f64, dt: f64, loaded: &[LoadedContact]) -> Option<(f64, f64)> {
-        self.solver.copy_from_slice(&self.star);
+        // `solver` holds `v*` (step 1): nothing has applied an impulse to it yet.
         let star = &self.star;
         let (mut g, mut k) = (0.0, 0.0);
         // Checked once at the end (no branch per row): if a row failed, the caller rebuilds from
@@ -858,16 +887,7 @@ impl ChainDamping {
             if i == NONE {
                 continue; // a hole left by a patch: a no-op row
             }
-            *row = Row::build(
-                &loaded[i as usize],
-                row.a,
-                row.b,
-                &self.pos,
-                star,
-                r,
-                dt,
-                row.lambda,
-            );
+            *row = Row::build(&loaded[i as usize], row.a, row.b, star, r, dt, row.lambda);
             valid &= row.valid();
             if row.lambda != 0.0 {
                 g += row.lambda * row.v_rel(star);
@@ -885,6 +905,7 @@ impl ChainDamping {
     fn curvature(&self, k_part: f64) -> f64 {
         let mut h = k_part;
         for (s, v) in self.solver.iter().zip(&self.star) {
+            let v = &v.s;
             if v.inv_mass > 0.0 {
                 h += (s.v - v.v).length_squared() / v.inv_mass;
             }
@@ -910,14 +931,22 @@ impl ChainDamping {
             0.0
         };
         if s == 0.0 {
-            self.solver.copy_from_slice(&self.star);
+            self.reset_solver();
         } else if s < 1.0 {
             for (v, star) in self.solver.iter_mut().zip(&self.star) {
+                let star = &star.s;
                 v.v = star.v + (v.v - star.v) * s;
                 v.omega = star.omega + (v.omega - star.omega) * s;
             }
         }
         s
+    }
+
+    /// The sweeps' working velocities back to `v*`.
+    fn reset_solver(&mut self) {
+        for (s, star) in self.solver.iter_mut().zip(&self.star) {
+            *s = star.s;
+        }
     }
 }
 
