@@ -87,7 +87,7 @@ pub fn table(rows: &[Row]) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "{:<13} {:>5} | {:<15} {:>10} {:>10} {:>7} {:>8} {:>9} | {:>7} {:>7}",
+        "{:<13} {:>5} | {:<15} {:>10} {:>10} {:>7} {:>8} {:>9} {:>10} | {:>7} {:>7}",
         "scene",
         "n",
         "engine",
@@ -96,15 +96,16 @@ pub fn table(rows: &[Row]) -> String {
         "p99/med",
         "warm/med",
         "start/med",
+        "start +µs",
         "ratio",
         "p99 rat"
     );
-    let _ = writeln!(s, "{}", "-".repeat(105));
+    let _ = writeln!(s, "{}", "-".repeat(116));
     for r in rows {
         for (k, e) in r.engines.iter().enumerate() {
             let _ = writeln!(
                 s,
-                "{:<13} {:>5} | {:<15} {:>10.2} {:>10.2} {:>7.2} {:>8.2} {:>9.2} | {:>7.3} {:>7.3}",
+                "{:<13} {:>5} | {:<15} {:>10.2} {:>10.2} {:>7.2} {:>8.2} {:>9.2} {:>+10.2} | {:>7.3} {:>7.3}",
                 r.scene,
                 r.n,
                 e.key,
@@ -113,6 +114,7 @@ pub fn table(rows: &[Row]) -> String {
                 e.p99_us / e.median_us,
                 e.p99_warm_us / e.median_us,
                 e.chunk_start_us / e.median_us,
+                e.chunk_start_us - e.median_us,
                 r.ratio(k),
                 r.ratio_p99(k)
             );
@@ -120,7 +122,7 @@ pub fn table(rows: &[Row]) -> String {
         let e = &r.reference;
         let _ = writeln!(
             s,
-            "{:<13} {:>5} | {:<15} {:>10.2} {:>10.2} {:>7.2} {:>8.2} {:>9.2} | {:>7} {:>7}",
+            "{:<13} {:>5} | {:<15} {:>10.2} {:>10.2} {:>7.2} {:>8.2} {:>9.2} {:>+10.2} | {:>7} {:>7}",
             r.scene,
             r.n,
             REFERENCE,
@@ -129,6 +131,7 @@ pub fn table(rows: &[Row]) -> String {
             e.p99_us / e.median_us,
             e.p99_warm_us / e.median_us,
             e.chunk_start_us / e.median_us,
+            e.chunk_start_us - e.median_us,
             "—",
             "—"
         );
