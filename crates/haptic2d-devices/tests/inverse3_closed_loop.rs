@@ -47,7 +47,7 @@ fn the_box_hits_the_wall_and_the_emulated_cursor_is_pushed_back() {
         }),
         ..Emulator3Config::default()
     });
-    let file = file_for(&emu, 50.0);
+    let file = file_for(&emu, NOT_THE_TIMEOUT_UNDER_TEST);
     let mut dev = open(&file);
     let scene = haptic2d::scene::builtin("box-in-walls", Some(1000.0))
         .unwrap()

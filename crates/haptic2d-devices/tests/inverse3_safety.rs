@@ -48,7 +48,7 @@ fn force_starts_at_zero_and_the_plane_spring_ramps_in() {
         hand: Some(Hand3::hold(start, 20_000.0, 50.0)),
         ..Emulator3Config::default()
     });
-    let file = file_for(&emu, 50.0);
+    let file = file_for(&emu, NOT_THE_TIMEOUT_UNDER_TEST);
     let mut dev = open(&file);
     // Opened, nothing written yet: the client has sent zero force only.
     std::thread::sleep(Duration::from_millis(30));
@@ -93,7 +93,7 @@ fn every_force_is_clamped_to_the_file_limit() {
         hand: Some(Hand3::hold([0.0; 3], 20_000.0, 50.0)),
         ..Emulator3Config::default()
     });
-    let file = file_for(&emu, 50.0);
+    let file = file_for(&emu, NOT_THE_TIMEOUT_UNDER_TEST);
     assert_eq!(file.force_limit, 5.0);
     let mut dev = open(&file);
     // 100 N·m on a 0.5 m virtual link asks hundreds of newtons.
@@ -121,7 +121,7 @@ fn a_zero_command_latches_zero_force() {
         hand: Some(Hand3::hold([0.0; 3], 20_000.0, 50.0)),
         ..Emulator3Config::default()
     });
-    let file = file_for(&emu, 50.0);
+    let file = file_for(&emu, NOT_THE_TIMEOUT_UNDER_TEST);
     let mut dev = open(&file);
     drive(&mut dev, &emu, [1.0, 1.0], 100);
     assert!(norm(emu.plant().f_cmd) > 0.1);
@@ -205,14 +205,14 @@ fn the_versegrip_orientation_reaches_the_driver_as_the_handle_angle() {
         grip: Some([(a / 2.0).cos(), 0.0, 0.0, (a / 2.0).sin()]),
         ..Emulator3Config::default()
     });
-    let mut dev = open(&file_for(&emu, 50.0));
+    let mut dev = open(&file_for(&emu, NOT_THE_TIMEOUT_UNDER_TEST));
     drive(&mut dev, &emu, [0.0; 2], 20);
     let th = dev.grip_angle().expect("a VerseGrip is reported");
     // The quaternion crosses the wire as f32.
     assert!((th - a).abs() < 1e-6, "{th}");
     // Without a grip: none.
     let emu2 = emulator(Emulator3Config::default());
-    let mut dev2 = open(&file_for(&emu2, 50.0));
+    let mut dev2 = open(&file_for(&emu2, NOT_THE_TIMEOUT_UNDER_TEST));
     drive(&mut dev2, &emu2, [0.0; 2], 20);
     assert_eq!(dev2.grip_angle(), None);
 }
