@@ -13,7 +13,7 @@ pub struct Rot {
 
 impl Rot {
     /// The rotation by `angle` (rad), from [`sin_cos`](super::sin_cos) (the same bits on every
-    /// platform).
+    /// platform for `|angle| < 2¹⁹·π/2`, about 8·10⁵ rad).
     #[inline]
     pub fn new(angle: f64) -> Self {
         let (s, c) = super::sin_cos(angle);

@@ -109,26 +109,6 @@ struct StarBody {
     pos: Vec2,
 }
 
-/// Read access to a body's [`SolverBody`], for the row operations on the sweeps' working
-/// velocities and on the velocities without the dampers alike.
-trait AsSolver {
-    fn solver(&self) -> &SolverBody;
-}
-
-impl AsSolver for SolverBody {
-    #[inline(always)]
-    fn solver(&self) -> &SolverBody {
-        self
-    }
-}
-
-impl AsSolver for StarBody {
-    #[inline(always)]
-    fn solver(&self) -> &SolverBody {
-        &self.s
-    }
-}
-
 impl Row {
     /// A placeholder, overwritten before any sweep reads it.
     const NONE: Row = Row {
@@ -186,10 +166,22 @@ impl Row {
         self.w > 0.0 && self.w.is_finite()
     }
 
-    /// Relative normal velocity of the row's points (m/s; positive separating).
+    /// Relative normal velocity of the row's points (m/s; positive separating) in the working
+    /// velocities `s`.
     #[inline(always)]
-    fn v_rel<B: AsSolver>(&self, s: &[B]) -> f64 {
-        let (a, b) = (s[self.a as usize].solver(), s[self.b as usize].solver());
+    fn v_rel(&self, s: &[SolverBody]) -> f64 {
+        self.v_rel_of(&s[self.a as usize], &s[self.b as usize])
+    }
+
+    /// Relative normal velocity of the row's points (m/s) in the velocities without the dampers.
+    #[inline(always)]
+    fn v_rel_star(&self, star: &[StarBody]) -> f64 {
+        self.v_rel_of(&star[self.a as usize].s, &star[self.b as usize].s)
+    }
+
+    /// Relative normal velocity of the row's points (m/s) with A and B moving as `a` and `b`.
+    #[inline(always)]
+    fn v_rel_of(&self, a: &SolverBody, b: &SolverBody) -> f64 {
         (a.v - b.v).dot(self.n) + a.omega * self.rna - b.omega * self.rnb
     }
 
@@ -728,7 +720,7 @@ impl ChainDamping {
             }
             // g = λ₀ᵀ·J·v* (see `scale_warm_start`), and the warm impulse applied.
             if row.lambda != 0.0 {
-                g += row.lambda * row.v_rel(star);
+                g += row.lambda * row.v_rel_star(star);
                 row.apply(row.lambda, &mut self.solver);
             }
             k += row.lambda * row.lambda * row.w;
@@ -890,7 +882,7 @@ impl ChainDamping {
             *row = Row::build(&loaded[i as usize], row.a, row.b, star, r, dt, row.lambda);
             valid &= row.valid();
             if row.lambda != 0.0 {
-                g += row.lambda * row.v_rel(star);
+                g += row.lambda * row.v_rel_star(star);
                 k += row.lambda * row.lambda * row.w;
                 row.apply(row.lambda, &mut self.solver);
             }
