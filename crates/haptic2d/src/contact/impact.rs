@@ -316,16 +316,34 @@ impl ImpactSolver {
     /// # Panics
     /// If a row's `body_a` or `body_b` is not an index into `bodies` (a bug in the caller).
     pub fn solve(&mut self, rows: &[ImpactRow], bodies: &mut [Body]) -> ImpactOutcome {
+        self.solve_with(rows, bodies, Totals::Summed)
+    }
+
+    /// [`solve`](Self::solve) for one island of a world's impact set (`contact/manager`): the same
+    /// velocity jumps, bit for bit, without the outcome's kinetic-energy totals. Those are sums
+    /// over every body of the slice, so a world that solved its islands through `solve` paid two
+    /// passes over all its bodies per island: O(islands × bodies) a sample, the largest part of
+    /// the impact stage of a landing pile:5000 (its islands' rows are a few hundred).
+    pub(crate) fn solve_island(&mut self, rows: &[ImpactRow], bodies: &mut [Body]) {
+        self.solve_with(rows, bodies, Totals::Skipped);
+    }
+
+    fn solve_with(
+        &mut self,
+        rows: &[ImpactRow],
+        bodies: &mut [Body],
+        totals: Totals,
+    ) -> ImpactOutcome {
         let n = rows.len();
         self.reserve(n);
         self.n = n;
         if self.friction == ImpactFriction::Coulomb && self.mu > 0.0 && n > 0 {
-            return self.solve_frictional(rows, bodies);
+            return self.solve_frictional(rows, bodies, totals);
         }
         if n > DENSE_MAX_ROWS {
-            return self.solve_sparse(rows, bodies);
+            return self.solve_sparse(rows, bodies, totals);
         }
-        let ke_before: f64 = bodies.iter().map(Body::kinetic_energy).sum();
+        let ke_before = totals.kinetic(bodies);
 
         // Jacobian rows and pre-impact velocities b⁻ = G u⁻.
         for (i, row) in rows.iter().enumerate() {
@@ -398,7 +416,7 @@ impl ImpactSolver {
             self.normal_velocities(rows, bodies, Buf::Post);
         }
 
-        self.outcome(bodies, ke_before, passes, compression, correction)
+        self.outcome(bodies, totals, ke_before, passes, compression, correction)
     }
 
     /// The sparse path for large impact sets (`n > DENSE_MAX_ROWS`, e.g. a pile landing): the same
@@ -406,9 +424,14 @@ impl ImpactSolver {
     /// but with `A_i·λ + b_i = G_i·u` read from the bodies' current twists, to which every impulse
     /// increment is applied at once ("sequential impulses"). Each row update then costs O(1) instead
     /// of O(n), and no `n × n` matrix is built. Iterates are identical to dense PGS.
-    fn solve_sparse(&mut self, rows: &[ImpactRow], bodies: &mut [Body]) -> ImpactOutcome {
+    fn solve_sparse(
+        &mut self,
+        rows: &[ImpactRow],
+        bodies: &mut [Body],
+        totals: Totals,
+    ) -> ImpactOutcome {
         let n = rows.len();
-        let ke_before: f64 = bodies.iter().map(Body::kinetic_energy).sum();
+        let ke_before = totals.kinetic(bodies);
         for (i, row) in rows.iter().enumerate() {
             self.jac[i] = row.jacobian(bodies);
             let j = &self.jac[i];
@@ -446,13 +469,18 @@ impl ImpactSolver {
             }
             self.normal_velocities(rows, bodies, Buf::Post);
         }
-        self.outcome(bodies, ke_before, passes, compression, correction)
+        self.outcome(bodies, totals, ke_before, passes, compression, correction)
     }
 
     /// Issue 16: the frictional solve; the per-row buffers report its normal impulses.
-    fn solve_frictional(&mut self, rows: &[ImpactRow], bodies: &mut [Body]) -> ImpactOutcome {
+    fn solve_frictional(
+        &mut self,
+        rows: &[ImpactRow],
+        bodies: &mut [Body],
+        totals: Totals,
+    ) -> ImpactOutcome {
         let n = rows.len();
-        let ke_before: f64 = bodies.iter().map(Body::kinetic_energy).sum();
+        let ke_before = totals.kinetic(bodies);
         for (i, row) in rows.iter().enumerate() {
             self.jac[i] = row.jacobian(bodies);
         }
@@ -472,6 +500,7 @@ impl ImpactSolver {
         };
         let mut o = self.outcome(
             bodies,
+            totals,
             ke_before,
             out.correction_passes,
             empty_report(n),
@@ -539,6 +568,7 @@ impl ImpactSolver {
     fn outcome(
         &self,
         bodies: &[Body],
+        totals: Totals,
         ke_before: f64,
         passes: usize,
         compression: LcpReport,
@@ -548,7 +578,7 @@ impl ImpactSolver {
         ImpactOutcome {
             rows: n,
             kinetic_energy_before: ke_before,
-            kinetic_energy_after: bodies.iter().map(Body::kinetic_energy).sum(),
+            kinetic_energy_after: totals.kinetic(bodies),
             plastic_correction: passes > 0,
             correction_passes: passes,
             compression,
@@ -606,6 +636,26 @@ pub const DENSE_MAX_ROWS: usize = 24;
 
 /// Sweep limit of the sparse PGS (§7.3: 200).
 const PGS_MAX_SWEEPS: usize = 200;
+
+/// Whether a solve sums the kinetic energy of every body for its [`ImpactOutcome`].
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Totals {
+    /// Summed: [`ImpactSolver::solve`].
+    Summed,
+    /// Skipped (the outcome's totals read 0): [`ImpactSolver::solve_island`], whose caller
+    /// discards the outcome.
+    Skipped,
+}
+
+impl Totals {
+    /// The total kinetic energy of `bodies` (J), or 0 when skipped.
+    fn kinetic(self, bodies: &[Body]) -> f64 {
+        match self {
+            Totals::Summed => bodies.iter().map(Body::kinetic_energy).sum(),
+            Totals::Skipped => 0.0,
+        }
+    }
+}
 
 /// Internal buffer selector.
 #[derive(Clone, Copy)]
@@ -705,5 +755,79 @@ mod tests {
             s.solve(&[row, row], &mut bodies);
         }
         assert_eq!((s.a.as_ptr(), s.impulse.as_ptr()), (pa, pb));
+    }
+
+    /// A column of boxes landing on a floor with a third box beside it (a second island), its
+    /// impact rows: `columns` columns of `boxes` boxes, two corner rows per interface.
+    fn landing(columns: usize, boxes: usize) -> (Vec<Body>, Vec<ImpactRow>) {
+        let inertia = 2.0 * (0.05f64.powi(2) * 2.0) / 12.0;
+        let mut bodies = vec![Body::fixed("floor", Pose::IDENTITY)];
+        let mut rows = Vec::new();
+        for c in 0..columns {
+            let x0 = 0.2 * c as f64;
+            for k in 0..boxes {
+                let mut b = Body::dynamic(
+                    format!("b{c}_{k}"),
+                    2.0,
+                    inertia,
+                    Pose::new(x0, 0.025 + 0.05 * k as f64, 0.0),
+                );
+                b.vel = Vec2::new(0.01 * k as f64 - 0.02 * c as f64, -0.5 - 0.1 * k as f64);
+                b.omega = 0.3 * (k as f64 - 2.0);
+                let upper = bodies.len();
+                bodies.push(b);
+                let lower = if k == 0 { 0 } else { upper - 1 };
+                for dx in [-0.025, 0.025] {
+                    let p = Vec2::new(x0 + dx, 0.05 * k as f64);
+                    rows.push(ImpactRow {
+                        body_a: upper,
+                        body_b: lower,
+                        n: Vec2::new(0.0, 1.0),
+                        r_a: p - bodies[upper].pose.pos,
+                        r_b: p - bodies[lower].pose.pos,
+                        restitution: if k % 2 == 0 { 0.5 } else { 0.0 },
+                    });
+                }
+            }
+        }
+        (bodies, rows)
+    }
+
+    /// `solve_island` (a world's islands) leaves the bodies exactly as `solve` does, on the
+    /// dense, the sparse and the frictional paths, and reports the same impulses; only the
+    /// outcome's kinetic-energy totals, over every body of the slice, are skipped.
+    #[test]
+    fn an_island_solve_gives_the_bodies_of_a_full_solve_bit_for_bit() {
+        for (boxes, friction) in [
+            (3, ImpactFriction::None),
+            (16, ImpactFriction::None),
+            (3, ImpactFriction::Coulomb),
+            (16, ImpactFriction::Coulomb),
+        ] {
+            let (start, rows) = landing(2, boxes);
+            assert_eq!(rows.len() > DENSE_MAX_ROWS, boxes == 16);
+            let island = &rows[..2 * boxes];
+            let mut full = ImpactSolver::new();
+            let mut quiet = ImpactSolver::new();
+            full.set_friction(friction, 0.5);
+            quiet.set_friction(friction, 0.5);
+            let (mut a, mut b) = (start.clone(), start.clone());
+            let out = full.solve(island, &mut a);
+            quiet.solve_island(island, &mut b);
+            for (x, y) in a.iter().zip(&b) {
+                assert_eq!(
+                    (x.vel.x.to_bits(), x.vel.y.to_bits(), x.omega.to_bits()),
+                    (y.vel.x.to_bits(), y.vel.y.to_bits(), y.omega.to_bits()),
+                    "{boxes} boxes, {friction:?}: {}",
+                    x.name
+                );
+            }
+            assert_eq!(full.impulses(), quiet.impulses());
+            // The other column is untouched, and the full solve's totals count it.
+            assert_eq!(a[boxes + 1..], start[boxes + 1..]);
+            let all: f64 = start.iter().map(Body::kinetic_energy).sum();
+            assert_eq!(out.kinetic_energy_before, all);
+            assert!(out.kinetic_energy_after < all);
+        }
     }
 }

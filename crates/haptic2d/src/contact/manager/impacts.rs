@@ -127,7 +127,7 @@ impl ContactSet {
                 self.island_rows.push(self.rows[self.row_order[k] as usize]);
                 k += 1;
             }
-            self.solver.solve(&self.island_rows, bodies);
+            self.solver.solve_island(&self.island_rows, bodies);
         }
     }
 }
