@@ -322,8 +322,8 @@ impl ImpactSolver {
     /// [`solve`](Self::solve) for one island of a world's impact set (`contact/manager`): the same
     /// velocity jumps, bit for bit, without the outcome's kinetic-energy totals. Those are sums
     /// over every body of the slice, so a world that solved its islands through `solve` paid two
-    /// passes over all its bodies per island: O(islands × bodies) a sample, the largest part of
-    /// the impact stage of a landing pile:5000 (its islands' rows are a few hundred).
+    /// passes over all its bodies per island: O(islands × bodies) a sample, about a tenth of the
+    /// contact events stage of a landing pile:5000 (docs/PERFORMANCE.md, session 21).
     pub(crate) fn solve_island(&mut self, rows: &[ImpactRow], bodies: &mut [Body]) {
         self.solve_with(rows, bodies, Totals::Skipped);
     }
@@ -757,8 +757,8 @@ mod tests {
         assert_eq!((s.a.as_ptr(), s.impulse.as_ptr()), (pa, pb));
     }
 
-    /// A column of boxes landing on a floor with a third box beside it (a second island), its
-    /// impact rows: `columns` columns of `boxes` boxes, two corner rows per interface.
+    /// `columns` columns of `boxes` boxes landing on a fixed floor (each column its own island),
+    /// and their impact rows, two corner rows per interface.
     fn landing(columns: usize, boxes: usize) -> (Vec<Body>, Vec<ImpactRow>) {
         let inertia = 2.0 * (0.05f64.powi(2) * 2.0) / 12.0;
         let mut bodies = vec![Body::fixed("floor", Pose::IDENTITY)];
