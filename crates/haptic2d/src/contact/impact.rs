@@ -638,7 +638,7 @@ pub const DENSE_MAX_ROWS: usize = 24;
 const PGS_MAX_SWEEPS: usize = 200;
 
 /// Whether a solve sums the kinetic energy of every body for its [`ImpactOutcome`].
-#[derive(Clone, Copy, PartialEq, Eq)]
+#[derive(Clone, Copy)]
 enum Totals {
     /// Summed: [`ImpactSolver::solve`].
     Summed,
