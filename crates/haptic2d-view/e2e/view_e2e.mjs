@@ -85,6 +85,30 @@ try {
   check(start.slave !== null, "the scene has no slave body");
   check(start.control, "the page has no control (token?)");
 
+  // 1b. A first visit explains the page; every control fits inside the panel at common widths (a grid
+  //     item is as wide as its longest option unless told otherwise); "Got it" hides the hint for good.
+  check(await page.isVisible("#first-visit"), "no first-visit hint on a first visit");
+  const overflow = [];
+  for (const width of [1280, 1400, 1920]) {
+    await page.setViewportSize({ width, height: 900 });
+    await page.waitForTimeout(100);
+    const bad = await page.evaluate(() => {
+      const panel = document.getElementById("panel").getBoundingClientRect();
+      return [...document.querySelectorAll("#panel select, #panel button")]
+        .filter((el) => el.offsetParent !== null)
+        .map((el) => ({ id: el.id || el.textContent, r: el.getBoundingClientRect() }))
+        .filter((x) => x.r.right > panel.right - 1 || x.r.left < panel.left)
+        .map((x) => `${x.id}: ${x.r.left.toFixed(0)}..${x.r.right.toFixed(0)} vs panel ${panel.left.toFixed(0)}..${panel.right.toFixed(0)}`);
+    });
+    for (const b of bad) overflow.push(`${width} px: ${b}`);
+  }
+  check(overflow.length === 0, `controls overflow the panel: ${JSON.stringify(overflow)}`);
+  result.layout_widths_checked = [1280, 1400, 1920];
+  await page.setViewportSize({ width: 1400, height: 900 });
+  await page.click("#btn-hint-ok");
+  check(!(await page.isVisible("#first-visit")), "the hint stays after Got it");
+  check(await page.evaluate(() => localStorage.getItem("haptic2d.hint-seen") === "1"), "the hint's dismissal is not kept");
+
   // 2. The canvas is not blank: pixel variance of a screenshot of it, decoded by the browser.
   const canvasShot = await page.locator("#world").screenshot();
   const stats = await page.evaluate(async (b64) => {
@@ -249,6 +273,15 @@ try {
   const errors = await page.evaluate(() => window.__haptic2d.errors);
   check(errors.length === 0, `error frames: ${JSON.stringify(errors)}`);
   check(pageErrors.length === 0, `page errors: ${JSON.stringify(pageErrors)}`);
+  // Acknowledgements read as information, not as errors: not in the error colour. (Setting the
+  // wall law it already has is acknowledged and changes nothing.)
+  const law = await page.evaluate(() => window.__haptic2d.lastFrame.wall_law);
+  await page.evaluate((w) => window.__haptic2d.send({ type: "set_wall_law", name: w }), law);
+  await page.waitForFunction(() => window.__haptic2d.acks.length > 0, null, { timeout: 10_000 });
+  const ackColours = await page.evaluate(() =>
+    [...document.querySelectorAll("#errors div:not(.err)")].map((d) => getComputedStyle(d).color));
+  check(ackColours.length > 0, "no acknowledgement line in Messages");
+  check(ackColours.every((c) => c !== "rgb(201, 42, 42)"), `acknowledgements in red: ${JSON.stringify(ackColours)}`);
   result.frames_received = await page.evaluate(() => window.__haptic2d.framesReceived);
 
   if (screenshotPath) {

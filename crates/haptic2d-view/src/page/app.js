@@ -38,8 +38,13 @@
   function logMessage(text, isError) {
     const line = `${new Date().toLocaleTimeString()} ${text}`;
     if (isError) state.errors.push(text);
+    // Newest first; errors in red, acknowledgements in the neutral text colour; at most 60 lines.
     const pre = $("errors");
-    pre.textContent = (line + "\n" + pre.textContent).slice(0, 4000);
+    const div = document.createElement("div");
+    div.textContent = line;
+    if (isError) div.className = "err";
+    pre.prepend(div);
+    while (pre.childElementCount > 60) pre.lastElementChild.remove();
   }
 
   function connect() {
@@ -537,6 +542,17 @@
 
   $("btn-pause").onclick = () => send({ type: state.lastFrame && state.lastFrame.paused ? "resume" : "pause" });
   $("btn-reset").onclick = () => send({ type: "reset" });
+  // A first-visit hint: what to do with the page, until the person says they have seen it.
+  (() => {
+    let seen = false;
+    try { seen = localStorage.getItem("haptic2d.hint-seen") === "1"; } catch (e) { /* storage blocked */ }
+    const hint = $("first-visit");
+    hint.hidden = seen;
+    $("btn-hint-ok").onclick = () => {
+      hint.hidden = true;
+      try { localStorage.setItem("haptic2d.hint-seen", "1"); } catch (e) { /* storage blocked */ }
+    };
+  })();
   window.addEventListener("resize", () => fitView(state.lastFrame));
 
   // ---------------------------------------------------------------- render loop
