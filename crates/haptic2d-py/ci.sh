@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# CI for the Python API, as a user installs it: a fresh virtual environment (target/py-venv),
-# `pip install ./crates/haptic2d-py` (pip fetches maturin as the build backend), then pytest.
+# CI for the Python API, as a user of a published wheel installs it: `maturin build --release`
+# builds the abi3 wheel once (target/wheels), a fresh virtual environment (target/py-venv) installs
+# that wheel with pip, then stubtest and pytest run against the installed package (docs/PYTHON.md).
 # The Rust build shares the repository's target directory (CARGO_TARGET_DIR), so a second run
 # rebuilds only what changed. Exits non-zero on any failure, including "no tests ran" (pytest 5).
 set -euo pipefail
@@ -17,10 +18,17 @@ stage "cargo fmt --check and clippy (crates/haptic2d-py is its own workspace)"
 cargo fmt --manifest-path "$crate/Cargo.toml" -- --check
 cargo clippy --manifest-path "$crate/Cargo.toml" --all-targets -- -D warnings
 
-stage "fresh venv at $venv"
+stage "build the abi3 wheel: maturin build --release (in its own venv)"
+buildenv="$CARGO_TARGET_DIR/py-build"
+python3 -m venv --clear "$buildenv"
+"$buildenv/bin/python" -m pip install --quiet --disable-pip-version-check "maturin>=1.7,<2"
+wheels="$CARGO_TARGET_DIR/wheels"
+rm -rf "$wheels"
+"$buildenv/bin/maturin" build --release --manifest-path "$crate/Cargo.toml" --out "$wheels"
+wheel=$(ls "$wheels"/haptic2d-*-abi3-*.whl)
+stage "fresh venv at $venv; pip install $(basename "$wheel")"
 python3 -m venv --clear "$venv"
-stage "pip install ./$crate"
-"$venv/bin/python" -m pip install --quiet --disable-pip-version-check "./$crate"
+"$venv/bin/python" -m pip install --quiet --disable-pip-version-check "$wheel"
 "$venv/bin/python" -m pip install --quiet --disable-pip-version-check pytest "dask[distributed]" mypy
 
 # The equality tests compare with the `haptic2d` binary's own output.
