@@ -1,0 +1,142 @@
+#!/usr/bin/env python3
+"""Checks that the project's cross-references resolve (CI runs it: .ci/run).
+
+1. Relative Markdown links `[text](path)` and `[text](path#anchor)` in every tracked *.md file name a
+   file that exists, and an anchor names a heading of that file (GitHub's slug rules).
+2. Section references in code, docs, scenes and device files:
+   - `DESIGN §N[.M]`   -> a numbered heading of docs/ARCHITECTURE.md,
+   - `DEVICES §N[.M]`  -> a numbered heading of docs/DEVICES.md,
+   - `MODELS §X` and a bare `§X` -> a numbered heading of docs/MODELS.md (`## 7.`, `### 7.3`, and the
+     appendices' letters: `§A`, `§F`),
+   where a reference to `§7.3.2` is satisfied by `7.3.2`, and one to a section whose number exists only
+   as a part of a heading list (e.g. `§1–§4`) is checked number by number.
+   References to the paper's own sections are written `paper §N` and are not checked.
+
+Prints every broken reference as `file:line: what` and exits 1 if there is any; 0 otherwise.
+Usage: python3 scripts/check_refs.py [--verbose]
+"""
+
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+SKIP_DIRS = ("docs/archive/",)
+
+
+def tracked(pattern_suffixes):
+    out = subprocess.run(
+        ["git", "ls-files"], cwd=ROOT, check=True, capture_output=True, text=True
+    ).stdout.split("\n")
+    return [
+        ROOT / p
+        for p in out
+        if p and p.endswith(pattern_suffixes) and not p.startswith(SKIP_DIRS)
+    ]
+
+
+def slug(heading):
+    """GitHub's anchor for a heading: lower case, punctuation dropped, spaces to hyphens."""
+    s = heading.strip().lower()
+    s = re.sub(r"[^\w\- ]", "", s, flags=re.UNICODE)
+    return s.replace(" ", "-")
+
+
+def headings(path):
+    """(slugs, section numbers) of a Markdown file."""
+    slugs, numbers = set(), set()
+    counts = {}
+    in_code = False
+    for line in path.read_text(encoding="utf-8").split("\n"):
+        if line.startswith("```"):
+            in_code = not in_code
+            continue
+        if in_code:
+            continue
+        m = re.match(r"^(#{1,6})\s+(.*?)\s*#*\s*$", line)
+        if not m:
+            continue
+        text = m.group(2)
+        base = slug(re.sub(r"`", "", text))
+        n = counts.get(base, 0)
+        counts[base] = n + 1
+        slugs.add(base if n == 0 else f"{base}-{n}")
+        # "7.3 The LCP solver", "0. Conventions", "Appendix F. Frictional impacts", "F. …"
+        num = re.match(r"^(?:Part\s+)?(?:Appendix\s+)?([0-9]+(?:\.[0-9]+)*|[A-Z])[.\s:]", text)
+        if num:
+            numbers.add(num.group(1).rstrip("."))
+    return slugs, numbers
+
+
+def main():
+    verbose = "--verbose" in sys.argv
+    problems = []
+    md_files = tracked((".md",))
+    cache = {}
+
+    def heads(p):
+        if p not in cache:
+            cache[p] = headings(p)
+        return cache[p]
+
+    # 1. Markdown links.
+    link = re.compile(r"\[[^\]]*\]\(([^)\s]+)(?:\s+\"[^\"]*\")?\)")
+    for f in md_files:
+        in_code = False
+        for i, line in enumerate(f.read_text(encoding="utf-8").split("\n"), 1):
+            if line.startswith("```"):
+                in_code = not in_code
+                continue
+            if in_code:
+                continue
+            for target in link.findall(line):
+                if re.match(r"^[a-z][a-z0-9+.-]*:", target) or target.startswith("<"):
+                    continue  # http:, https:, mailto:
+                path, _, anchor = target.partition("#")
+                dest = f if path == "" else (f.parent / path)
+                if not dest.exists():
+                    problems.append(f"{f.relative_to(ROOT)}:{i}: link to a missing file `{target}`")
+                    continue
+                if anchor and dest.suffix == ".md" and anchor not in heads(dest.resolve())[0]:
+                    problems.append(f"{f.relative_to(ROOT)}:{i}: no heading `#{anchor}` in {path or f.name}")
+
+    # 2. Section references.
+    docs = {
+        "DESIGN": ROOT / "docs/ARCHITECTURE.md",
+        "DEVICES": ROOT / "docs/DEVICES.md",
+        "MODELS": ROOT / "docs/MODELS.md",
+    }
+    # A book's own sections are cited with the book: "Stronge §4.3", "Impact Mechanics, §4.3",
+    # "*Numerical Recipes* §11.5" (EXTERNAL); `§N` is a placeholder in prose about the references.
+    ref = re.compile(r"(?:(DESIGN|DEVICES|MODELS|paper|Paper|PAPER|STYLE|EXTERNAL)\s+)?§\s?([0-9]+(?:\.[0-9]+)*|[A-F]\b)")
+    external = re.compile(r"(Stronge|Impact Mechanics\*?,?( 2000,)?|Numerical Recipes\*?|Brogliato|Glocker)\s*$")
+    sources = tracked((".rs", ".md", ".toml", ".py", ".pyi", ".js", ".html", ".c", ".h", ".sh"))
+    count = 0
+    for f in sources:
+        text = f.read_text(encoding="utf-8", errors="replace")
+        for i, line in enumerate(text.split("\n"), 1):
+            for m in ref.finditer(line):
+                kind, num = m.group(1) or "", m.group(2)
+                if kind.lower() in ("paper", "style", "external") or external.search(line[: m.start()]):
+                    continue
+                doc = docs[kind or "MODELS"]
+                count += 1
+                if not doc.exists():
+                    problems.append(f"{f.relative_to(ROOT)}:{i}: `{kind} §{num}` points at {doc.relative_to(ROOT)}, which does not exist")
+                    continue
+                numbers = heads(doc)[1]
+                # A reference resolves to its own section or, failing that, to the nearest enclosing one
+                # that exists (§6.7.2 → 6.7 when 6.7 has no numbered subsections).
+                if num not in numbers:
+                    problems.append(f"{f.relative_to(ROOT)}:{i}: `{(kind + ' ') if kind else ''}§{num}`: no section {num} in {doc.relative_to(ROOT)}")
+    if verbose:
+        print(f"check_refs: {len(md_files)} Markdown files, {count} section references")
+    for p in problems:
+        print(p)
+    print(f"check_refs: {len(problems)} broken reference(s)")
+    return 1 if problems else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
