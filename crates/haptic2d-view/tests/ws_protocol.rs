@@ -65,8 +65,7 @@ async fn viewers_get_welcome_scene_and_frames_and_commands_reach_the_loop() {
         let kind: Value = serde_json::from_str::<Value>(msg).unwrap()["type"].clone();
         assert_eq!(ack["command"], kind);
     }
-    tokio::time::sleep(Duration::from_millis(100)).await;
-    let got = fake.commands.lock().unwrap().clone();
+    let got = fake.wait_for(8);
     assert_eq!(
         got,
         vec![
@@ -194,11 +193,7 @@ async fn commands_need_the_token_when_required_viewing_does_not() {
     assert_eq!(next_of(&mut ws2, "welcome").await["control"], true);
     send(&mut ws2, r#"{"type":"resume"}"#).await;
     next_of(&mut ws2, "ack").await;
-    tokio::time::sleep(Duration::from_millis(50)).await;
-    assert_eq!(
-        fake.commands.lock().unwrap().clone(),
-        vec![Command::Pause, Command::Resume]
-    );
+    assert_eq!(fake.wait_for(2), vec![Command::Pause, Command::Resume]);
     drop(fake);
     server.shutdown();
 }

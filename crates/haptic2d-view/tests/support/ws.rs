@@ -63,6 +63,21 @@ impl FakeLoop {
     }
 }
 
+impl FakeLoop {
+    /// The commands the loop has received once it has at least `n` (polled until a 10 s deadline,
+    /// never a fixed sleep: a loaded machine only makes it take longer).
+    pub fn wait_for(&self, n: usize) -> Vec<Command> {
+        let deadline = std::time::Instant::now() + Duration::from_secs(10);
+        loop {
+            let got = self.commands.lock().unwrap().clone();
+            if got.len() >= n || std::time::Instant::now() > deadline {
+                return got;
+            }
+            std::thread::sleep(Duration::from_millis(2));
+        }
+    }
+}
+
 impl Drop for FakeLoop {
     fn drop(&mut self) {
         self.stop.store(true, Ordering::Relaxed);
