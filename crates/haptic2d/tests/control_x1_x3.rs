@@ -424,7 +424,8 @@ fn released_pp(ctrl: Controller, hand: HandForce) -> (Trace, f64) {
 #[test]
 fn x2_default_configuration_released() {
     for hand in [HandForce::Applied, HandForce::Observer] {
-        for k_m in [500.0] {
+        {
+            let k_m = 500.0;
             let (tr, pp) = released_pp(default_four_channel(k_m), hand);
             let i_rel = (RELEASE_AT / T).round() as usize;
             let xm = tr.x_m.last().copied().unwrap_or(0.0);
