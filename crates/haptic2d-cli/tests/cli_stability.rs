@@ -143,3 +143,41 @@ fn stability_refuses_a_bad_controller_file_naming_the_field() {
         text(&o)
     );
 }
+
+/// `run` and `reproduce` take `--controller-file` too: `run` names the controller on its start line
+/// and runs; `reproduce fig8` carries the claims with the file's controller, labelled by the file.
+#[test]
+fn run_and_reproduce_accept_a_controller_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = common::root();
+    let soft = root.join("controllers/coupling-soft.toml");
+    let o = haptic2d(&[
+        "run",
+        "--headless",
+        "--no-rt",
+        "--duration",
+        "0.2",
+        "--controller-file",
+        soft.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(text(&o).contains("controller coupling"), "{}", text(&o));
+    let out = dir.path().join("repro");
+    let o = haptic2d(&[
+        "reproduce",
+        "fig8",
+        "--out",
+        out.to_str().unwrap(),
+        "--controller-file",
+        soft.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let report = std::fs::read_to_string(out.join("fig8/report.md")).unwrap();
+    assert!(
+        report.contains("| coupling-soft/classical | yes |"),
+        "{report}"
+    );
+    let o = haptic2d(&["run", "--controller-file", "/nonexistent.toml"]);
+    assert!(!o.status.success());
+    assert!(text(&o).contains("controller file"), "{}", text(&o));
+}
