@@ -1,13 +1,25 @@
-//! `haptic2d reproduce [all|fig4|fig5|fig7|fig8] [--out DIR]`: the paper's figures as data, plots,
-//! metrics and a report (see the `haptic2d-lab` crate).
+//! `haptic2d reproduce [all|fig4|fig5|fig7|fig8] [--out DIR] [--controller-file FILE.toml]`: the
+//! paper's figures as data, plots, metrics and a report (see the `haptic2d-lab` crate).
 
 use std::path::Path;
 
 /// Runs the selected figure(s), writes `DIR/<figure>/` and `DIR/REPORT.md`, prints a summary. Every
 /// case's verdict is in its `metrics.json` (`pass`) and in the report; with `strict`, the command also
-/// fails (after writing everything) if any case does not pass.
-pub fn run(figure: &str, out: &Path, strict: bool) -> Result<(), String> {
-    let s = haptic2d_lab::reproduce(figure, out, true)?;
+/// fails (after writing everything) if any case does not pass. With `controller_file`, that
+/// controller carries the claims of the device-in-the-loop figures (Figs. 5–6 and 8–11) instead of
+/// the default; Figs. 4 and 7 do not use a controller.
+pub fn run(
+    figure: &str,
+    out: &Path,
+    strict: bool,
+    controller_file: Option<&Path>,
+) -> Result<(), String> {
+    let controller = match controller_file {
+        Some(p) => Some(crate::controller_file::resolve("four-channel", Some(p))?),
+        None => None,
+    };
+    let controller = controller.map(|(kind, label)| (label, kind));
+    let s = haptic2d_lab::reproduce_with(figure, out, true, controller)?;
     for f in &s.figures {
         let extra = if f.comparisons > 0 {
             format!(", +{} comparison runs", f.comparisons)

@@ -47,6 +47,10 @@ pub struct RunArgs {
     /// four-channel-spec (the paper's gains, unstable released), four-channel-damped or coupling.
     #[arg(long, default_value = "four-channel")]
     pub controller: String,
+    /// Controller architecture and gains from a file (wins over --controller; examples in
+    /// controllers/, e.g. controllers/paper-4ch.toml).
+    #[arg(long, value_name = "FILE.toml")]
+    pub controller_file: Option<PathBuf>,
     /// Passivity observer/controller on the device port (§12).
     #[arg(long)]
     pub passivity: bool,
@@ -291,8 +295,8 @@ fn validate_options(a: &RunArgs) -> Result<RunOptions, Failure> {
         )
     })?;
     let foxglove = a.foxglove.as_deref().map(parse_foxglove).transpose()?;
-    let controller =
-        ControllerKind::from_name(&a.controller).map_err(|e| format!("--controller: {e}"))?;
+    let (controller, _) =
+        crate::controller_file::resolve(&a.controller, a.controller_file.as_deref())?;
     let device = DeviceChoice::parse(&a.device)?;
     let hand = match (&device, &a.hand) {
         (DeviceChoice::Replay(_), Some(_)) => {

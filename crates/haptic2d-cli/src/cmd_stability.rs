@@ -26,6 +26,10 @@ pub struct StabilityArgs {
     /// Controller: four-channel (default), four-channel-spec, four-channel-damped or coupling.
     #[arg(long, default_value = "four-channel")]
     pub controller: String,
+    /// Controller architecture and gains from a file (wins over --controller; examples in
+    /// controllers/).
+    #[arg(long, value_name = "FILE.toml")]
+    pub controller_file: Option<PathBuf>,
     /// Device parameters (TOML; template devices/twin-pantograph.toml), or a Haply device file
     /// (devices/haply-*.toml: a 2DIY gives the x and y axes of the 2-DOF device).
     #[arg(long, value_name = "FILE.toml")]
@@ -62,8 +66,8 @@ pub fn run(a: &StabilityArgs) -> Result<(), String> {
     if a.delay > 1 {
         return Err(format!("--delay must be 0 or 1, got {}", a.delay));
     }
-    let controller =
-        ControllerKind::from_name(&a.controller).map_err(|e| format!("--controller: {e}"))?;
+    let (controller, label) =
+        crate::controller_file::resolve(&a.controller, a.controller_file.as_deref())?;
     // A Haply device file (a top-level `kind`): the 2DIY's x and y, or the twin with its θ gains
     // matched to the crank.
     let haply = match a.device_file.as_deref() {
@@ -75,7 +79,14 @@ pub fn run(a: &StabilityArgs) -> Result<(), String> {
             linkage, center, ..
         } = &f.kind
         {
-            return run_planar2(a, f, &f.controller_for(controller), linkage, *center);
+            return run_planar2(
+                a,
+                &label,
+                f,
+                &f.controller_for(controller),
+                linkage,
+                *center,
+            );
         }
     }
     let controller = haply
@@ -99,7 +110,7 @@ pub fn run(a: &StabilityArgs) -> Result<(), String> {
         scale: a.scale,
         ..HapticConfig::default()
     };
-    let report = analyse_config(&config, &scene.world, a.rate, a.delay, &a.controller)?;
+    let report = analyse_config(&config, &scene.world, a.rate, a.delay, &label)?;
     println!(
         "stability of scene {} with device from {} (scale {}):",
         scene.name, device.origin, a.scale
@@ -108,10 +119,10 @@ pub fn run(a: &StabilityArgs) -> Result<(), String> {
     let files = write_pole_plot(
         &report.model,
         &a.out,
-        &format!("poles-{}", a.controller),
+        &format!("poles-{label}"),
         &format!(
-            "{}: growth rate vs hand impedance ({}, {} Hz)",
-            a.controller, scene.name, a.rate
+            "{label}: growth rate vs hand impedance ({}, {} Hz)",
+            scene.name, a.rate
         ),
     )?;
     for f in files {
@@ -157,6 +168,7 @@ fn five_bar_dynamics(linkage: &Pantograph2, center: [f64; 2]) -> Result<FiveBarD
 /// `haptic2d stability --device-file HAPLY.toml` for a 2DIY: the x and y axes.
 fn run_planar2(
     a: &StabilityArgs,
+    label: &str,
     file: &haptic2d_devices::haply::HaplyDeviceFile,
     controller: &ControllerKind,
     linkage: &Pantograph2,
@@ -176,7 +188,7 @@ fn run_planar2(
         "stability of scene {} with the 2-DOF device of {} (x and y of the grasp point; the rotation is left to the world), controller {} at {} Hz ({} extra output sample{}):",
         scene.name,
         file.source,
-        a.controller,
+        label,
         a.rate,
         a.delay,
         if a.delay == 1 { "" } else { "s" }

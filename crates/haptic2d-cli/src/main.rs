@@ -11,6 +11,7 @@ mod cmd_scenes;
 mod cmd_simulate;
 mod cmd_stability;
 mod cmd_sweep;
+mod controller_file;
 mod csv_out;
 mod device_arg;
 mod exit;
@@ -106,6 +107,10 @@ enum Command {
         /// Exit with an error if any case does not reproduce the paper's claim.
         #[arg(long)]
         strict: bool,
+        /// The controller that carries the claims of Figs. 5–6 and 8–11 instead of the default
+        /// (architecture and gains from a file; examples in controllers/).
+        #[arg(long, value_name = "FILE.toml")]
+        controller_file: Option<PathBuf>,
     },
     /// The loop's stability per axis with the hand held and released: right-most poles, sampled-data
     /// growth rate and a verdict, plus a plot of the poles against the hand's impedance.
@@ -181,7 +186,13 @@ fn main() -> ExitCode {
             figure,
             out,
             strict,
-        } => runtime(cmd_reproduce::run(&figure, &out, strict)),
+            controller_file,
+        } => runtime(cmd_reproduce::run(
+            &figure,
+            &out,
+            strict,
+            controller_file.as_deref(),
+        )),
         Command::Log(cmd) => cmd_log::run(&cmd),
         Command::Sweep {
             target,

@@ -62,3 +62,122 @@ fn stability_rejects_bad_options_with_a_message() {
         assert!(text(&o).contains(needle), "{}", text(&o));
     }
 }
+
+/// `--controller-file`: the shipped paper file is the §11.1 table (unstable released on the peg at
+/// scale 2, like `--controller four-channel-spec`), the default file gives the default's verdicts, and
+/// the plot is named after the file.
+#[test]
+fn stability_reads_a_controller_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = common::root();
+    let paper = root.join("controllers/paper-4ch.toml");
+    let s = stability(
+        &[
+            "peg-in-hole",
+            "--controller-file",
+            paper.to_str().unwrap(),
+            "--scale",
+            "2",
+        ],
+        dir.path(),
+    );
+    assert!(s.contains("UNSTABLE with the hand released"), "{s}");
+    assert!(s.contains("controller paper-4ch at"), "{s}");
+    assert!(dir.path().join("poles-paper-4ch.svg").is_file());
+    let default = root.join("controllers/default.toml");
+    let s = stability(
+        &["--controller-file", default.to_str().unwrap()],
+        dir.path(),
+    );
+    assert_eq!(s.matches("verdict: stable").count(), 3, "{s}");
+}
+
+/// A bad controller file is refused with the file, the field and the fix; unknown keys are refused.
+#[test]
+fn stability_refuses_a_bad_controller_file_naming_the_field() {
+    let dir = tempfile::tempdir().unwrap();
+    for (body, needles) in [
+        (
+            "architecture = \"four-channel\"\nc5 = [1.0, 1.0]\n",
+            vec!["c5", "expected 3 values", "fix:"],
+        ),
+        (
+            "architecture = \"four-channel\"\nd_m = [1.0, -1.0, 0.0]\n",
+            vec!["d_m[1]", ">= 0", "fix:"],
+        ),
+        (
+            "architecture = \"four-channel\"\nc7 = [0, 0, 0]\n",
+            vec!["c7", "unknown key", "c5", "fix:"],
+        ),
+        (
+            "architecture = \"coupling\"\nk_m = [1, 1, 1]\n",
+            vec!["k_m", "unknown key for a coupling", "fix:"],
+        ),
+        ("c5 = [0, 0, 0]\n", vec!["architecture", "missing", "fix:"]),
+        (
+            "architecture = \"four-chanel\"\n",
+            vec!["architecture", "unknown architecture", "fix:"],
+        ),
+    ] {
+        let f = dir.path().join("bad.toml");
+        std::fs::write(&f, body).unwrap();
+        let o = haptic2d(&[
+            "stability",
+            "--controller-file",
+            f.to_str().unwrap(),
+            "--out",
+            dir.path().to_str().unwrap(),
+        ]);
+        assert!(!o.status.success(), "{body}");
+        let t = text(&o);
+        assert!(t.contains("bad.toml"), "{t}");
+        for n in needles {
+            assert!(t.contains(n), "{n} in {t}");
+        }
+    }
+    let o = haptic2d(&["stability", "--controller-file", "/nonexistent/c.toml"]);
+    assert!(!o.status.success());
+    assert!(
+        text(&o).contains("controllers/paper-4ch.toml"),
+        "{}",
+        text(&o)
+    );
+}
+
+/// `run` and `reproduce` take `--controller-file` too: `run` names the controller on its start line
+/// and runs; `reproduce fig8` carries the claims with the file's controller, labelled by the file.
+#[test]
+fn run_and_reproduce_accept_a_controller_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = common::root();
+    let soft = root.join("controllers/coupling-soft.toml");
+    let o = haptic2d(&[
+        "run",
+        "--headless",
+        "--no-rt",
+        "--duration",
+        "0.2",
+        "--controller-file",
+        soft.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(text(&o).contains("controller coupling"), "{}", text(&o));
+    let out = dir.path().join("repro");
+    let o = haptic2d(&[
+        "reproduce",
+        "fig8",
+        "--out",
+        out.to_str().unwrap(),
+        "--controller-file",
+        soft.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let report = std::fs::read_to_string(out.join("fig8/report.md")).unwrap();
+    assert!(
+        report.contains("| coupling-soft/classical | yes |"),
+        "{report}"
+    );
+    let o = haptic2d(&["run", "--controller-file", "/nonexistent.toml"]);
+    assert!(!o.status.success());
+    assert!(text(&o).contains("controller file"), "{}", text(&o));
+}

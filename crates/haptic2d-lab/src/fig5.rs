@@ -1,9 +1,11 @@
 //! Figs. 5–6: the walls with the device in the loop (`crate::experiments::fig5`): a 0.5 kg box held on
 //! the simulated twin pantograph, released 0.02 m from the left wall and pushed into it by a constant
-//! 2 N, 500 Hz, 10 s, one case per wall (SEH, ZOH, braking pulse, hysteretic). The claims are carried
-//! by the four-channel controller with its released-stable default gains on the spec's device;
-//! comparison runs: the §11.1 table on the same device, the §11.1 table on a device damped at twice
-//! Colgate's bound, and the virtual coupling. A sweep of the device damping under the §11.1 table
+//! 2 N, 500 Hz, 10 s, one case per wall (SEH, ZOH, braking pulse, hysteretic). Each claim is carried
+//! by a named configuration on the spec's device, with its reason and `haptic2d stability`'s verdict
+//! ([`carrier`]): the hysteretic wall by the default, the pulse wall by the former default, SEH and
+//! ZOH by the §11.1 table (unstable released there, refused on a real device). Comparison runs: every
+//! other configuration on every wall, the §11.1 table on a device damped at twice Colgate's bound and
+//! the virtual coupling. A sweep of the device damping under the §11.1 table
 //! ([`crate::fig5_sweep`]) shows where that table's claims hold.
 //!
 //! Pass criteria (the paper's claim; numbers from the spec's W6/W7 with W7's 0.06 m/s taken relative to
@@ -24,21 +26,60 @@ use crate::schema::{CaseMetrics, Check, Dimension, Fig4Measured, FigureMetrics, 
 use rayon::prelude::*;
 use std::fmt::Write as _;
 
-/// The runs: `(name, parameters, comparison)`. The first (the four-channel controller with its
-/// released-stable default gains, on the spec's device) carries the claims; the others are comparison
-/// runs: the §11.1 table on the same device, the §11.1 table on a device damped at twice Colgate's
-/// bound (the former claim carrier), and the virtual coupling.
-fn controllers() -> [(&'static str, Fig5Params, bool); 4] {
-    [
-        ("four-channel", Fig5Params::default(), false),
-        ("four-channel-spec", Fig5Params::paper_controller(), true),
+/// The runs: `(name, parameters)`: the default controller on the spec's device, the §11.1 table on
+/// the same device, the §11.1 table on a device damped at twice Colgate's bound, the virtual
+/// coupling, and the former default (master-side local force feedback only). Which run carries which wall's claim: [`carrier`].
+fn controllers(ctx: Option<&FigureContext>) -> Vec<(String, Fig5Params)> {
+    let mut v = vec![
+        ("four-channel".to_string(), Fig5Params::default()),
         (
-            "four-channel-spec-damped-device",
-            Fig5Params::calibrated_damping(),
-            true,
+            "four-channel-spec".to_string(),
+            Fig5Params::paper_controller(),
         ),
-        ("coupling", Fig5Params::coupling(), true),
-    ]
+        (
+            "four-channel-spec-damped-device".to_string(),
+            Fig5Params::calibrated_damping(),
+        ),
+        ("coupling".to_string(), Fig5Params::coupling()),
+        (
+            "former-default".to_string(),
+            Fig5Params {
+                haptic: haptic2d::haptic::HapticConfig {
+                    controller: haptic2d::haptic::ControllerKind::FourChannel(
+                        haptic2d::control::four_channel::FourChannelGains::master_force_feedback(),
+                    ),
+                    ..haptic2d::haptic::HapticConfig::default()
+                },
+                ..Fig5Params::default()
+            },
+        ),
+    ];
+    // `reproduce --controller-file`: that controller carries the claims.
+    if let Some((label, kind)) = ctx.and_then(|c| c.controller.as_ref()) {
+        v[0].0 = label.clone();
+        v[0].1.haptic.controller = *kind;
+    }
+    v
+}
+
+/// Why the default carries the Fig. 6 claims (pulse, hysteretic walls).
+const DEFAULT_REASON: &str = "the default controller, stable held and released with margin (`haptic2d stability`): a wall that settles the box needs no energy from the loop, so the configuration a real device may run carries it";
+
+/// Why the paper's configuration carries the Fig. 5 claims (SEH, ZOH keep bouncing).
+const BOUNCE_REASON: &str = "the paper's configuration (§11.1 table, force reflection C2 = 1) on the simulated device: the bouncing is the energy a marginally passive (SEH) or active (ZOH) wall returns, and only a loop that reflects the wall force to the handle lets the handle stop with the box and push it off again. `haptic2d stability` calls this configuration unstable with the hand released against this wall, so `haptic2d run` refuses it on a real device (--allow-unstable overrides): a released handle would oscillate with growing amplitude. Every released-stable design of the study (MODELS.md §11.4) settles on these walls";
+
+/// Why the former default carries the pulse claim.
+const PULSE_REASON: &str = "local force feedback at the master only (C6 = -1, C5 = 0, D_m = 2 N·s/m; the default before issue 36's study, `controllers/former-default.toml`), stable held and released with margin on this wall (`haptic2d stability`). The default's slave force feedback C5 = 2 passes the push to the box amplified, so the box reaches the wall more than twice as fast (first entry about 0.27 m/s against 0.11) and the pulse no longer settles it at the first impact; with C5 = 0 the hand-force path feels 2.3 kg and the box arrives slowly enough. No design of the study passes both this claim and the slip claims of Figs. 8–11 (MODELS.md §11.4)";
+
+/// Which run carries wall `wall`'s claim (`i` indexes [`controllers`]) and why; `None` for a
+/// comparison run.
+fn carrier(i: usize, wall: &str) -> Option<&'static str> {
+    match (i, wall) {
+        (0, "hysteretic") => Some(DEFAULT_REASON),
+        (1, "seh" | "zoh") => Some(BOUNCE_REASON),
+        (4, "pulse") => Some(PULSE_REASON),
+        _ => None,
+    }
 }
 
 /// Wall labels for the plots.
@@ -120,10 +161,10 @@ impl Figure for Fig5 {
         "Figs. 5–6: a box pushed into undamped walls with the device in the loop"
     }
     fn jobs(&self) -> u64 {
-        ((controllers().len() + fig5_sweep::MARGINS.len()) * FIG5_CASES.len()) as u64
+        ((controllers(None).len() + fig5_sweep::MARGINS.len()) * FIG5_CASES.len()) as u64
     }
     fn run(&self, ctx: &FigureContext) -> Result<FigureReport, String> {
-        let ctrl = controllers();
+        let ctrl = controllers(Some(ctx));
         let jobs: Vec<(usize, usize)> = (0..ctrl.len())
             .flat_map(|i| (0..FIG5_CASES.len()).map(move |j| (i, j)))
             .collect();
@@ -140,16 +181,26 @@ impl Figure for Fig5 {
         let mut files = Vec::new();
         let mut cases = Vec::new();
         for (i, j, c) in &done {
-            let model = format!("{}/{}", ctrl[*i].0, FIG5_CASES[*j].0);
-            cases.push(
-                CaseMetrics::new(
-                    &model,
-                    Dimension::TwoD,
-                    Measured::Fig4(measured(c)),
-                    vec![check(c)],
-                )
-                .with_comparison(ctrl[*i].2),
+            let (wall, normal, _) = FIG5_CASES[*j];
+            let model = format!("{}/{}", ctrl[*i].0, wall);
+            let p = &ctrl[*i].1;
+            let stability = crate::design::verdict_line(
+                &p.haptic_config()?,
+                &crate::experiments::fig5::wall_world(normal, p.rate)?,
+                p.rate,
             );
+            let mut case = CaseMetrics::new(
+                &model,
+                Dimension::TwoD,
+                Measured::Fig4(measured(c)),
+                vec![check(c)],
+            )
+            .with_comparison(carrier(*i, wall).is_none())
+            .with_stability(stability);
+            if let Some(why) = carrier(*i, wall) {
+                case = case.with_carrier(format!("{}: {why}", ctrl[*i].0));
+            }
+            cases.push(case);
             let r = &c.records;
             let col = |f: &dyn Fn(usize) -> f64| (0..r.len()).map(f).collect::<Vec<f64>>();
             let x0 = (r[0].x_s[0], r[0].x_m[0]);
@@ -204,7 +255,7 @@ impl Figure for Fig5 {
                         } else {
                             Stroke::Dashed
                         };
-                        Series::new(ctrl[*i].0, pts, *i, stroke)
+                        Series::new(&ctrl[*i].0, pts, *i, stroke)
                     })
                     .collect(),
                 h_lines: vec![0.0],
@@ -247,20 +298,24 @@ fn report(m: &FigureMetrics, sweep: &str) -> String {
         "## fig5\n\nFigs. 5–6 with the device in the loop: the `box-in-walls` box (0.5 kg) driven by the \
          simulated twin pantograph at 500 Hz; the hand holds the handle for 0.5 s, then is replaced by a \
          constant 2 N push toward the wall (y and θ stay gripped); 10 s; impacts off, each wall's \
-         per-contact defaults (K = 2000 N/m on the face), no wall damping. The claims are carried by the \
-         four-channel controller with its released-stable default gains (local force feedback C6 = −1 \
-         and 2 N·s/m of master damping injection, `FourChannelGains::local_force_feedback`) on the \
-         spec's device as given (§10.2, `f_v = 1e-4`, no calibrated damping). Comparison runs: the \
-         §11.1 table on the same device (`four-channel-spec`), the §11.1 table on a device damped at \
-         twice Colgate's bound (`four-channel-spec-damped-device`, `f_v = 1.44e-2 N·m·s/rad`, the former \
-         claim carrier) and the virtual coupling (§11.2). Pass: SEH/ZOH \
+         per-contact defaults (K = 2000 N/m on the face), no wall damping. Each claim is carried by a \
+         named configuration on the spec's device as given (§10.2, `f_v = 1e-4`), listed with its \
+         reason and `haptic2d stability`'s verdict in the first table: the default controller \
+         (`four-channel`: C6 = −1, C5 = 2, D_m = 1 N·s/m), the former default (`former-default`: \
+         C6 = −1, D_m = 2 N·s/m) and the paper's §11.1 table (`four-channel-spec`). Comparison runs: \
+         the other configurations on every wall, the §11.1 table on a device damped at twice \
+         Colgate's bound (`four-channel-spec-damped-device`, `f_v = 1.44e-2 N·m·s/rad`) and the \
+         virtual coupling (§11.2). Pass: SEH/ZOH \
          keep bouncing (≥ 2 separations in the last 2 s, never settles); pulse stable at the first \
          impact (first contact ratio ≤ 0.4 — none if the box never leaves the wall —, entries after \
          the 2nd impact < 0.15·v1, none in the last 2 s; W7); hysteretic stable soon (first 3 ratios < \
          0.85, ≤ 6 separations; W6).\n\n\
          ![positions](fig5/positions.png)\n\n\
+         ### Which configuration reproduces each claim\n\n{}\n\
+         ### Every run\n\n\
          | controller/wall | separations | entry speeds (m/s) | contact ratios | settle (s) | check | pass |\n\
-         |---|---|---|---|---|---|---|"
+         |---|---|---|---|---|---|---|",
+        crate::figure::claims_table(m)
     );
     for c in &m.cases {
         let Measured::Fig4(x) = &c.measured else {
@@ -288,14 +343,14 @@ fn report(m: &FigureMetrics, sweep: &str) -> String {
          active (SEH contact ratios above 1) and why the pulse and hysteretic walls fail there; \
          Colgate's `b > K·T/2` is not the mechanism. The calibrated device damping passes the four \
          walls because it moves those poles left (stable above b ≈ 2.65 N·s/m), a property of this \
-         device model, not a measured one. The stable default (C6 = −1, C2 = 0) does not reflect the \
-         wall force to the handle: at each impact the box stops but the handle does not, and its \
-         momentum is dissipated in the PD and slave dampers. The box stays at the wall from the first \
-         impact (0 separations), so the pulse and hysteretic claims hold but SEH and ZOH cannot keep \
-         bouncing: their bouncing needs the handle to stop with the box, i.e. C2 = 1, which is the \
-         released-unstable path. No configuration found has both: of 15 variants (C6 from −1 to \
-         −0.5, C5 = ±0.5, damping injection 0–10 N·s/m; `haptic2d-lab/tests/design_search.rs`), \
-         none that is stable released keeps bouncing.\n\n\
+         device model, not a measured one. The released-stable designs (C6 = −1, C2 = 0) do not \
+         reflect the wall force to the handle: at each impact the box stops but the handle does not, \
+         and its momentum is dissipated in the PD and slave dampers, so SEH and ZOH cannot keep \
+         bouncing — their bouncing needs the handle to stop with the box, i.e. C2 = 1, the \
+         released-unstable path. Of the 700+ designs of the design study (issue 36, \
+         `haptic2d-lab/tests/design_search.rs`, MODELS.md §11.4), none that is stable with margin \
+         keeps bouncing; the pulse wall settles at the first impact only with little slave-side force \
+         feedback (C5 ≤ 1), which loses the slips of Figs. 8–11.\n\n\
          ### Device-damping sweep (§11.1 table)\n\n\
          Every wall at damping margins `b_x/(K·T/2)` from 0.25 to 4 (`fig5/sweep.csv`; ✓/✗ = the \
          wall's claim, separations in 10 s and in the last 2 s):\n\n\

@@ -2,9 +2,10 @@
 //! 0.2 kg peg of `peg-in-hole` (1 mm interference, 1 N per corner), one friction model per case, the
 //! simulated twin pantograph at 1 kHz with mapping scale 2; the hand grips the handle for 1 s, then
 //! lets go and `F_pk (1 − cos 2πt)/2` with `F_pk = 2.1 N` (world) pushes the handle along x; y and θ
-//! are free. The claims are carried by the four-channel controller with its released-stable default
-//! gains (`C6 = −1`, damping injection); comparison runs: the virtual coupling (§11.2) and the §11.1
-//! table (unstable with the hand released, §11.4).
+//! are free. The claims are carried by the default controller (`C6 = −1`, `C5 = 2`, damping
+//! injection; [`carrier`] gives the reason the report prints beside `haptic2d stability`'s verdict);
+//! comparison runs: the virtual coupling (§11.2), the §11.1 table (unstable with the hand released,
+//! §11.4), and the default at the paper's setting (500 Hz, mapping scale 1), a named variant.
 //!
 //! Pass criteria (§13.2 thresholds on the cycles after the release): the run ends without a safety
 //! stop; every `advance_k > 5e-3 m` (F7-3); classical `min creep_k ≥ 5e-4 m` (F7-1, drift), the others
@@ -23,12 +24,41 @@ use std::fmt::Write as _;
 /// The controllers compared: `(name, parameters, comparison)`. The four-channel controller with its
 /// released-stable default gains carries the claims; the virtual coupling and the §11.1 table are
 /// comparison runs.
-fn controllers() -> [(&'static str, Fig8Params, bool); 3] {
-    [
-        ("four-channel", Fig8Params::default(), false),
-        ("coupling", Fig8Params::coupling(), true),
-        ("four-channel-spec", Fig8Params::paper_controller(), true),
-    ]
+fn controllers(ctx: Option<&FigureContext>) -> Vec<(String, Fig8Params)> {
+    let mut v = vec![
+        ("four-channel".to_string(), Fig8Params::default()),
+        ("coupling".to_string(), Fig8Params::coupling()),
+        (
+            "four-channel-spec".to_string(),
+            Fig8Params::paper_controller(),
+        ),
+        // The paper's setting (issue 36 item 2), a named variant: 500 Hz and mapping scale 1, where
+        // the device's world-side inertia is four times that at scale 2.
+        (
+            "four-channel-500hz-scale1".to_string(),
+            Fig8Params {
+                rate: 500.0,
+                scale: 1.0,
+                ..Fig8Params::default()
+            },
+        ),
+    ];
+    // `reproduce --controller-file`: that controller carries the claims (and runs the variant).
+    if let Some((label, kind)) = ctx.and_then(|c| c.controller.as_ref()) {
+        v[0].0 = label.clone();
+        v[0].1.haptic.controller = *kind;
+        v[3].0 = format!("{label}-500hz-scale1");
+        v[3].1.haptic.controller = *kind;
+    }
+    v
+}
+
+/// Why the default carries the Figs. 8–11 claims.
+const DEFAULT_REASON: &str = "the default controller, stable held and released with margin on the peg (`haptic2d stability peg-in-hole`): its slave-side local force feedback C5 makes the hand's push reach the peg without reflecting the contact force to a released handle";
+
+/// Which run carries the claims (`i` indexes [`controllers`]) and why; `None` for a comparison run.
+fn carrier(i: usize) -> Option<&'static str> {
+    (i == 0).then_some(DEFAULT_REASON)
 }
 
 fn label(model: &str) -> &'static str {
@@ -105,10 +135,10 @@ impl Figure for Fig8 {
         "Figs. 8–11: a peg pushed in a tight hole with the device in the loop"
     }
     fn jobs(&self) -> u64 {
-        (2 * FIG8_CASES.len()) as u64
+        (controllers(None).len() * FIG8_CASES.len()) as u64
     }
     fn run(&self, ctx: &FigureContext) -> Result<FigureReport, String> {
-        let ctrl = controllers();
+        let ctrl = controllers(Some(ctx));
         let jobs: Vec<(usize, usize)> = (0..ctrl.len())
             .flat_map(|i| (0..FIG8_CASES.len()).map(move |j| (i, j)))
             .collect();
@@ -124,18 +154,22 @@ impl Figure for Fig8 {
             .collect::<Result<_, _>>()?;
         let mut files = Vec::new();
         let mut cases = Vec::new();
-        for (i, _, c) in &done {
+        for (i, j, c) in &done {
             let p = &ctrl[*i].1;
             let model = format!("{}/{}", ctrl[*i].0, c.name);
-            cases.push(
-                CaseMetrics::new(
-                    &model,
-                    Dimension::TwoD,
-                    Measured::Fig7(measured(p, c)),
-                    checks(c),
-                )
-                .with_comparison(ctrl[*i].2),
-            );
+            let (world, haptic) = crate::experiments::fig8::case_world(p, FIG8_CASES[*j].1)?;
+            let mut case = CaseMetrics::new(
+                &model,
+                Dimension::TwoD,
+                Measured::Fig7(measured(p, c)),
+                checks(c),
+            )
+            .with_comparison(carrier(*i).is_none())
+            .with_stability(crate::design::verdict_line(&haptic, &world, p.rate));
+            if let Some(why) = carrier(*i) {
+                case = case.with_carrier(format!("{}: {why}", ctrl[*i].0));
+            }
+            cases.push(case);
             let r = &c.records;
             let col = |f: &dyn Fn(usize) -> f64| (0..r.len()).map(f).collect::<Vec<f64>>();
             let x0 = (r[0].x_s[0], r[0].x_m[0]);
@@ -180,11 +214,11 @@ impl Figure for Fig8 {
                     .map(|(i, _, c)| {
                         let pts = c.records.iter().map(|r| (r.t, r.x_s[0] * 1e3)).collect();
                         let (stroke, lbl) = match (*i, &c.stopped) {
-                            (0, _) => (Stroke::Solid, ctrl[*i].0.to_string()),
+                            (0, _) => (Stroke::Solid, ctrl[*i].0.clone()),
                             (_, Some(_)) => {
                                 (Stroke::Dashed, format!("{} (safety stop)", ctrl[*i].0))
                             }
-                            _ => (Stroke::Dashed, ctrl[*i].0.to_string()),
+                            _ => (Stroke::Dashed, ctrl[*i].0.clone()),
                         };
                         Series::new(lbl, pts, *i, stroke)
                     })
@@ -220,14 +254,20 @@ fn report(m: &FigureMetrics) -> String {
         "## fig8\n\nFigs. 8–11 with the device in the loop: the `peg-in-hole` peg (0.2 kg, 1 mm \
          interference, 1 N per corner, SEH stiffness without damping) driven by the simulated twin \
          pantograph at 1 kHz, mapping scale 2; the hand holds the handle for 1 s, then lets go and \
-         `2.1 N (1 − cos 2πt)/2` (world) pushes the handle along x, y and θ free. Two controllers: the \
-         virtual coupling (§11.2) and the paper's four-channel (§11.1). Pass: no safety stop; \
+         `2.1 N (1 − cos 2πt)/2` (world) pushes the handle along x, y and θ free. The claims are carried \
+         by the default controller (C6 = −1, C5 = 2, D_m = 1 N·s/m); comparison runs: the virtual \
+         coupling (§11.2), the paper's §11.1 table, and the default at the paper's own setting, \
+         500 Hz and mapping scale 1 (`four-channel-500hz-scale1`: the device's world-side inertia \
+         four times that at scale 2; the claims do not hold there, MODELS.md §11.4). Pass: no safety stop; \
          classical `min creep_k ≥ 5e-4 m` (F7-1, drift), the others `max creep_k ≤ 2e-4 m` (F7-2, \
          stick); every `advance_k > 5e-3 m` (F7-3, slip). `creep_k = x(k + 0.2) − x(k − 0.1)`, \
          `advance_k = x(k + 0.9) − x(k − 0.1)`, k counted in seconds after the release.\n\n\
          ![positions](fig8/positions.png)\n\n\
+         ### Which configuration reproduces each claim\n\n{}\n\
+         ### Every run\n\n\
          | controller/model | creep_k (m) | advance_k (m) | max abs y (m) | max abs θ (rad) | pass |\n\
-         |---|---|---|---|---|---|"
+         |---|---|---|---|---|---|",
+        crate::figure::claims_table(m)
     );
     for c in &m.cases {
         let Measured::Fig7(x) = &c.measured else {
@@ -260,18 +300,16 @@ fn report(m: &FigureMetrics) -> String {
          is unstable in continuous time: for the y axis at scale 2 (handle inertia divided by 4, peg \
          0.2 kg, 4 × 1000 N/m) the §11.4 polynomial has roots +30 ± 185j — the rattle of the \
          `four-channel-spec` runs, which end in safety stops at every rate; Colgate's `b > K·T/2` is \
-         not the mechanism and device damping is not the cure. The default gains (C6 = −1, so C2 = 0, \
-         and 2 N·s/m of master damping injection) are stable on every axis with the hand held or \
-         released (`haptic2d stability peg-in-hole --scale 2`): no safety stop, and the non-classical \
-         models stick. But the push now reaches the peg through the hand-force estimate (C3 = 1) while \
-         the handle follows through the PD, so every slip is braked by the handle's inertia and the \
-         coupling's dampers: the advance per cycle stays below the 5 mm of F7-3, and the classical \
-         model's creep is slightly negative instead of drifting (F7-1). Of 15 variants (C6 from −1 \
-         to −0.5, C5 = ±0.5, damping injection 0–10 N·s/m; `haptic2d-lab/tests/design_search.rs`), \
-         none that is stable released with the real-device output delay passes a slip claim; those \
-         that pass one keep part of the force reflection (C2 > 0) and grow at +2 to +28 1/s \
-         released on the peg. The virtual coupling (comparison) meets every claim: it sends no \
-         force channel to the device and drives the peg with the spring K_vc alone."
+         not the mechanism and device damping is not the cure. With local force feedback at the master \
+         (C6 = −1, so C2 = 0) every axis is stable with the hand held or released (`haptic2d \
+         stability peg-in-hole --scale 2`). With C5 = 0 (the former default) the push reaches the peg \
+         through the hand-force estimate (C3 = 1) while the handle follows through the PD, so every \
+         slip is braked by the handle's inertia and the coupling's dampers (advances below the 5 mm \
+         of F7-3, no classical drift). The default's slave-side local force feedback C5 = 2 drives the \
+         peg with 3·f_h − 2·f_e: the push arrives amplified and the contact force is fed back at the \
+         slave only, so the peg slips while a released handle still feels no contact force. The \
+         virtual coupling (comparison) meets every claim too: it sends no force channel to the \
+         device and drives the peg with the spring K_vc alone."
     );
     s
 }

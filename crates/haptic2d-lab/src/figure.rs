@@ -6,6 +6,7 @@
 //! `DIR/REPORT.md` from the sections of every registered figure found in `DIR`.
 
 use crate::schema::FigureMetrics;
+use haptic2d::haptic::ControllerKind;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -16,6 +17,10 @@ pub struct FigureContext<'a> {
     pub dir: PathBuf,
     /// Progress bar; a figure advances it by one per finished job (see [`Figure::jobs`]).
     pub progress: &'a ProgressBar,
+    /// The controller that carries the claims of the device-in-the-loop figures instead of the
+    /// default (`reproduce --controller-file`): its label and configuration. Figs. 4 and 7 do not
+    /// use a controller.
+    pub controller: Option<(String, ControllerKind)>,
 }
 
 /// What a figure returns.
@@ -94,6 +99,17 @@ impl ReproduceSummary {
 /// Runs figure `which` (`all` or a registered name) and writes the outputs under `out`. With
 /// `show_progress`, a progress bar is drawn on stderr.
 pub fn reproduce(which: &str, out: &Path, show_progress: bool) -> Result<ReproduceSummary, String> {
+    reproduce_with(which, out, show_progress, None)
+}
+
+/// [`reproduce`] with the claims of the device-in-the-loop figures carried by `controller` (label,
+/// configuration) instead of the default.
+pub fn reproduce_with(
+    which: &str,
+    out: &Path,
+    show_progress: bool,
+    controller: Option<(String, ControllerKind)>,
+) -> Result<ReproduceSummary, String> {
     let all = registry();
     let selected: Vec<&dyn Figure> = if which == "all" {
         all.iter().map(|f| f.as_ref()).collect()
@@ -143,6 +159,7 @@ pub fn reproduce(which: &str, out: &Path, show_progress: bool) -> Result<Reprodu
         let ctx = FigureContext {
             dir: dir.clone(),
             progress: &bar,
+            controller: controller.clone(),
         };
         let rep = fig.run(&ctx)?;
         let json = serde_json::to_string_pretty(&rep.metrics)
@@ -209,4 +226,23 @@ fn assemble_report(out: &Path, all: &[Box<dyn Figure>]) -> Result<String, String
         body.push('\n');
     }
     Ok(format!("{head}\n{body}"))
+}
+
+/// The claims of a device-in-the-loop figure as a Markdown table: each claim case, whether it is
+/// reproduced, the configuration that carries it and why, and `haptic2d stability`'s verdict for
+/// that configuration on that case's scene.
+pub fn claims_table(m: &FigureMetrics) -> String {
+    let mut s = String::from(
+        "| claim case | reproduced | configuration and why | `stability` verdict |\n|---|---|---|---|\n",
+    );
+    for c in m.claims() {
+        s.push_str(&format!(
+            "| {} | {} | {} | {} |\n",
+            c.model,
+            c.verdict(),
+            c.carrier.as_deref().unwrap_or("—"),
+            c.stability.as_deref().unwrap_or("—")
+        ));
+    }
+    s
 }

@@ -16,6 +16,7 @@
 #![warn(missing_docs)]
 
 pub mod csv;
+pub mod design;
 pub mod experiments;
 pub mod fig4;
 pub mod fig5;
@@ -30,5 +31,7 @@ pub mod stability;
 pub mod sweep;
 pub mod world2d;
 
-pub use figure::{registry, reproduce, Figure, FigureContext, FigureReport, ReproduceSummary};
+pub use figure::{
+    registry, reproduce, reproduce_with, Figure, FigureContext, FigureReport, ReproduceSummary,
+};
 pub use schema::{CaseMetrics, Check, Dimension, FigureMetrics, Measured};

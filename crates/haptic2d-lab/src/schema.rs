@@ -114,6 +114,15 @@ pub struct CaseMetrics {
     pub comparison: bool,
     /// The spec tests evaluated on this case.
     pub checks: Vec<Check>,
+    /// Device-in-the-loop claim cases: the configuration that carries this claim and why it is
+    /// the one (absent for Figs. 4 and 7, which use no controller).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub carrier: Option<String>,
+    /// Device-in-the-loop cases: `haptic2d stability`'s verdict for this case's configuration on
+    /// this case's scene and rate, for the simulated device and for a real one (one sample of
+    /// output delay).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stability: Option<String>,
 }
 
 impl CaseMetrics {
@@ -126,6 +135,8 @@ impl CaseMetrics {
             pass: !checks.is_empty() && checks.iter().all(|c| c.pass),
             comparison: false,
             checks,
+            carrier: None,
+            stability: None,
         }
     }
 
@@ -137,6 +148,22 @@ impl CaseMetrics {
             (false, false) => "**NO**",
             (true, true) => "yes (comparison)",
             (false, true) => "no (comparison)",
+        }
+    }
+
+    /// This case with the configuration that carries its claim and the reason.
+    pub fn with_carrier(self, carrier: impl Into<String>) -> Self {
+        Self {
+            carrier: Some(carrier.into()),
+            ..self
+        }
+    }
+
+    /// This case with the stability analysis's verdict for its configuration.
+    pub fn with_stability(self, stability: impl Into<String>) -> Self {
+        Self {
+            stability: Some(stability.into()),
+            ..self
         }
     }
 

@@ -76,8 +76,13 @@ fn saturated_torques_are_booked_as_applied() {
         ..DeviceParams::default()
     };
     let world = builtin("box-in-walls", Some(RATE)).unwrap().unwrap().world;
+    // The former default (C5 = 0): with the default's slave-side force feedback C5 = 2 the slave
+    // chases the teleported handle three times harder and the coupling never stretches to 2 cm.
     let config = HapticConfig {
         device,
+        controller: haptic2d::haptic::ControllerKind::FourChannel(
+            haptic2d::control::four_channel::FourChannelGains::master_force_feedback(),
+        ),
         ..pc_config()
     };
     let safety = SafetyConfig {

@@ -22,13 +22,15 @@
 //! - settles soon (W6): each of the first three contact ratios (those that exist) < 0.85 and at most
 //!   6 separations.
 //!
-//! **Which runs carry the claims (issue 11).** The claims are carried by the four-channel controller
-//! with the released-stable default gains (`FourChannelGains::local_force_feedback`: `C6 = −1`, a
-//! small master damping injection) on the spec's device as given (§10.2, joint `f_v = 1e-4`, no
-//! calibrated damping) — [`Fig5Params::default`]. Comparison runs: the §11.1 table on the same device
-//! ([`Fig5Params::paper_controller`]), the §11.1 table on a device damped at twice Colgate's bound
-//! ([`Fig5Params::calibrated_damping`], the former default) and the virtual coupling
-//! ([`Fig5Params::coupling`]).
+//! **Which runs carry the claims (issue 36).** Each claim is carried by a named configuration on the
+//! spec's device (§10.2, joint `f_v = 1e-4`, no calibrated damping), chosen for a reason the report
+//! states beside `haptic2d stability`'s verdict (see `crate::fig5`): the hysteretic wall by the
+//! default controller ([`Fig5Params::default`]: `FourChannelGains::local_force_feedback`, `C6 = −1`,
+//! `C5 = 2`), the pulse wall by the former default (`C6 = −1`, `C5 = 0`, `D_m = 2`), and the SEH and
+//! ZOH bouncing by the paper's §11.1 table ([`Fig5Params::paper_controller`]), which is unstable
+//! released against these walls and refused on a real device. Comparison runs: the §11.1 table on a
+//! device damped at twice Colgate's bound ([`Fig5Params::calibrated_damping`]) and the virtual
+//! coupling ([`Fig5Params::coupling`]).
 //!
 //! **The mechanism.** After the release the hand is a constant force: the handle is *released* in the
 //! sense of §11.4 (no hand impedance). With the §11.1 table (`C2 = 1`) the released loop of handle,
@@ -41,11 +43,10 @@
 //! (`C2 = 0`) the environment force no longer reaches the handle; the handle follows the box through
 //! the PD `(K_m, B_m)` and the slave's `(K_s, B_s)`, and at each impact the handle's momentum is
 //! dissipated in those dampers (the box stops, the handle does not). So the stable design is
-//! dissipative at the wall: the box bounces at most once (first ratio ≈ 0.37 with no injection, no
-//! separation at all with the default's `D_m = 2 N·s/m`), so the "keeps bouncing" claims of SEH and
-//! ZOH fail while the pulse and hysteretic walls pass. The bouncing claim needs the handle to stop
-//! with the box, i.e. force reflection `C2 = 1`, which is exactly the released-unstable path; no
-//! configuration found has both (`tests/design_search.rs`: 15 variants of `C6`, `C5`, `D_m`).
+//! dissipative at the wall: the box bounces at most once, so the "keeps bouncing" claims of SEH and
+//! ZOH fail while the hysteretic wall passes. The bouncing claim needs the handle to stop with the
+//! box, i.e. force reflection `C2 = 1`, which is exactly the released-unstable path; no design of
+//! the study of issue 36 (`tests/design_search.rs`, 700+ candidates, MODELS.md §11.4) has both.
 
 use haptic2d::control::coupling::CouplingGains;
 use haptic2d::control::four_channel::FourChannelGains;
@@ -295,6 +296,16 @@ fn walls_toml(normal: &str, extra: &str) -> Result<String, String> {
         return Err("box-in-walls: `impacts = true` not found".into());
     }
     Ok(out.replace("impacts = true", "impacts = false"))
+}
+
+/// The world of one wall (`normal` = a §5 law name, per-contact defaults, impacts off) at `rate`
+/// (Hz): what the stability analysis of a Figs. 5–6 case is run against.
+pub fn wall_world(normal: &str, rate: f64) -> Result<haptic2d::world::World, String> {
+    Ok(
+        Scene::from_toml(&walls_toml(normal, "")?, "fig5", Some(rate))
+            .map_err(|e| e.to_string())?
+            .world,
+    )
 }
 
 /// Runs one wall (`normal` = a §5 law name).

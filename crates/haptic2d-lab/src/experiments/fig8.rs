@@ -10,25 +10,24 @@
 //! the push `F_pk·(1 − cos 2πft)/2` along +x acts on the handle (the phase is measured from t = 0, so
 //! it starts from zero at a whole number of periods); y and θ of the handle are then free.
 //!
-//! **Which runs carry the claims (issue 11).** The four-channel controller with the released-stable
-//! default gains (`FourChannelGains::local_force_feedback`: `C6 = −1`, master damping injection
-//! 2 N·s/m in world units) — [`Fig8Params::default`]. Comparison runs: the virtual coupling
-//! ([`Fig8Params::coupling`], the former claim carrier) and the §11.1 table
-//! ([`Fig8Params::paper_controller`]).
+//! **Which runs carry the claims (issue 36).** The default controller
+//! (`FourChannelGains::local_force_feedback`: `C6 = −1`, slave-side local force feedback `C5 = 2`,
+//! master damping injection 1 N·s/m) — [`Fig8Params::default`]. Comparison runs: the virtual
+//! coupling ([`Fig8Params::coupling`]) and the §11.1 table ([`Fig8Params::paper_controller`]).
 //!
 //! **The mechanism.** After the release nothing holds the handle: with the §11.1 table (`C2 = 1`) the
 //! released loop of handle, peg and the squeezed corner springs is unstable in continuous time — for
 //! the y axis at scale 2 (handle inertia divided by 4, peg 0.2 kg, 4 × 1000 N/m) the §11.4
-//! polynomial has roots `+30 ± 185j` (the 30 Hz rattle; the runs end in safety stops at 1.6–1.9 s at
-//! every rate). Sampling faster changes nothing and device damping is not the cure (Colgate's
-//! `b > K·T/2` is not the mechanism). With `C6 = −1` the environment force does not reach the handle
-//! and every axis decays with the hand held or released (`haptic2d stability peg-in-hole --scale 2`):
-//! no safety stop, and the non-classical models stick (`|creep| ≤ 2e-4 m`). But the push now reaches
-//! the peg through the hand-force estimate (`C3 = 1`), and the handle follows through the PD: each
-//! slip is braked by the handle's inertia and the coupling's dampers, so the advance per cycle is
-//! 0.2–5 mm instead of > 5 mm (F7-3 fails), and the classical model's creep is slightly negative
-//! (≈ −2e-4 m, F7-1 fails). The virtual coupling meets every claim because it sends no force channel
-//! to the device and the peg is driven by the spring `K_vc` alone.
+//! polynomial has roots `+30 ± 185j` (the 30 Hz rattle; the runs end in safety stops). With
+//! `C6 = −1` the environment force does not reach the handle and every axis decays with the hand
+//! held or released (`haptic2d stability peg-in-hole --scale 2`). With `C5 = 0` (the former default)
+//! the push reaches the peg through the hand-force estimate (`C3 = 1`) while the handle follows
+//! through the PD, so each slip is braked by the handle's inertia and the coupling's dampers
+//! (advance 0.2–5 mm per cycle, F7-3 fails; no classical drift, F7-1 fails). The slave-side local
+//! force feedback `C5 = 2` drives the peg with `3·f_h − 2·f_e`: the push reaches it amplified and
+//! the contact force is fed back at the slave only, so the peg slips its 5 mm and more while the
+//! released handle still sees no contact force. The virtual coupling meets every claim too: it sends
+//! no force channel to the device and drives the peg with the spring `K_vc` alone.
 //!
 //! Metrics as §13.2, on the peg's x, for the cycles after the release: `creep_k = x(k + 0.2) −
 //! x(k − 0.1)` (the push is ≤ 0.73 N: any motion is drift or elastic presliding) and `advance_k =
@@ -52,9 +51,9 @@ use haptic2d::haptic::system::HapticSystem;
 /// Settings of the Figs. 8–11 experiment.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Fig8Params {
-    /// Control rate (Hz). Default 1000: at 500 Hz the peg's 3.3e-5 kg·m² is below 1.5× the minimum
-    /// mass of the default four-channel rotational gains (§6.4), and the classical model's creep turns
-    /// negative with the coupling.
+    /// Control rate (Hz). Default 1000 (the paper ran at 500 Hz): at 500 Hz the peg's 3.3e-5 kg·m²
+    /// is below 1.5× the minimum mass of the §11.1 table's rotational gains (§6.4; the default's θ
+    /// gains accept it), and the classical model's creep turns negative with the coupling.
     pub rate: f64,
     /// Start of the optional push-in (s). Default 0.7.
     pub t_hold: f64,
@@ -199,6 +198,22 @@ fn peg_toml(friction: &str) -> Result<String, String> {
         &text[..start],
         &text[end..]
     ))
+}
+
+/// The peg-in-hole world with friction model `friction` at `rate` (Hz), and the haptic settings a
+/// run of `p` uses (its start pose and mapping scale): what the stability analysis of a Figs. 8–11
+/// case is run against.
+pub fn case_world(
+    p: &Fig8Params,
+    friction: &str,
+) -> Result<(haptic2d::world::World, HapticConfig), String> {
+    let world = Scene::from_toml(&peg_toml(friction)?, "fig8", Some(p.rate))
+        .map_err(|e| e.to_string())?
+        .world;
+    let mut cfg = p.haptic.clone();
+    cfg.device_origin = Some([p.start_x, cfg.device.workspace_center_y, 0.0]);
+    cfg.scale = p.scale;
+    Ok((world, cfg))
 }
 
 /// Runs one friction model (`friction` = a model name of [`FrictionModel::NAMES`]).

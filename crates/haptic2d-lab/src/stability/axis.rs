@@ -18,11 +18,12 @@
 //!
 //! ```text
 //! f_cm =  k_m·e + b_m·ė + g_mh·r + g_me·f_e − d_m·v̂_m
-//! f_cs = −k_s·e − b_s·ė + g_sh·r + g_se·f_e
+//! f_cs = −k_s·e − b_s·ė + g_sh·r + g_se·f_e − d_s·v_s
 //! ```
 //!
 //! Four-channel (§11.1): `g_mh = C6`, `g_me = −(1 + C6)`, `g_sh = 1 + C5`, `g_se = −C5`, and `d_m` the
-//! master damping injection. Virtual coupling (§11.2): `k_m = k_s = K_vc`, `b_m = b_s = B_vc`, no force
+//! master damping injection, `d_s` the slave damping injection (`C2`, `C3` overrides replace
+//! `−g_me`, `g_sh`). Virtual coupling (§11.2): `k_m = k_s = K_vc`, `b_m = b_s = B_vc`, no force
 //! channels.
 //!
 //! **Continuous time** (the ideal loop: `v̂_m = v_m`, and the momentum observer as the first-order lag
@@ -67,6 +68,8 @@ pub struct AxisController {
     pub g_se: f64,
     /// Master damping injection `d_m` (N·s/m or N·m·s/rad): `−d_m·v̂_m` in `f_cm`.
     pub d_m: f64,
+    /// Slave damping injection `d_s` (N·s/m or N·m·s/rad): `−d_s·v_s` in `f_cs`.
+    pub d_s: f64,
 }
 
 /// One axis of the loop, in world units (kg or kg·m², N/m or N·m/rad, …).
@@ -118,7 +121,7 @@ impl AxisModel {
             let f_e = self.k_e * x_s + self.b_e * v_s;
             let (e, de) = (x_s - x_m, v_s - v_m);
             let f_cm = c.k_m * e + c.b_m * de + c.g_mh * r + c.g_me * f_e - c.d_m * v_m;
-            let f_cs = -c.k_s * e - c.b_s * de + c.g_sh * r + c.g_se * f_e;
+            let f_cs = -c.k_s * e - c.b_s * de + c.g_sh * r + c.g_se * f_e - c.d_s * v_s;
             vec![
                 v_m,
                 (f_cm - self.b * v_m + f_h) / self.m,
@@ -188,7 +191,7 @@ impl AxisModel {
             let f_e = s.k_e * x_s + s.b_e * v_s;
             let (e, de) = (x_s - x_m, v_s - v_k);
             let f_cm = c.k_m * e + c.b_m * de + c.g_mh * r_k + c.g_me * f_e - c.d_m * v_k;
-            let f_cs = -c.k_s * e - c.b_s * de + c.g_sh * r_k + c.g_se * f_e;
+            let f_cs = -c.k_s * e - c.b_s * de + c.g_sh * r_k + c.g_se * f_e - c.d_s * v_s;
             // Step 9: the wrench applied over [kT, (k+1)T).
             let (u, pend) = if delay == 0 {
                 (f_cm, 0.0)

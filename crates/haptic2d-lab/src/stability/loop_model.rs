@@ -113,6 +113,7 @@ pub fn axis_controller(kind: &ControllerKind, i: usize) -> AxisController {
             g_sh: 0.0,
             g_se: 0.0,
             d_m: 0.0,
+            d_s: 0.0,
         },
     }
 }
@@ -124,10 +125,11 @@ fn four_channel_axis(g: &FourChannelGains, i: usize) -> AxisController {
         k_s: g.k_s[i],
         b_s: g.b_s[i],
         g_mh: g.c6[i],
-        g_me: -(1.0 + g.c6[i]),
-        g_sh: 1.0 + g.c5[i],
+        g_me: -g.c2.map_or(1.0 + g.c6[i], |c| c[i]),
+        g_sh: g.c3.map_or(1.0 + g.c5[i], |c| c[i]),
         g_se: -g.c5[i],
         d_m: g.d_m[i],
+        d_s: g.d_s[i],
     }
 }
 

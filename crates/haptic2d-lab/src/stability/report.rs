@@ -122,7 +122,7 @@ pub fn check_released_stability(config: &HapticConfig, world: &World) -> Result<
         if a.verdict() == Verdict::UnstableReleased {
             let p = a.released.rightmost();
             return Err(format!(
-                "the {} controller is unstable on axis {} with the hand released (sampled growth {:+.1} 1/s at {} Hz, right-most pole {}): a released handle would oscillate with growing amplitude. Fix: use `--controller four-channel` (the default: local force feedback C6 = -1 with a small damping injection), check with `haptic2d stability`, or pass --allow-unstable to override",
+                "the {} controller is unstable on axis {} with the hand released (sampled growth {:+.1} 1/s at {} Hz, right-most pole {}): a released handle would oscillate with growing amplitude. Fix: use `--controller four-channel` (the default: local force feedback C6 = -1, C5 = 2, with a small damping injection), check with `haptic2d stability`, or pass --allow-unstable to override",
                 config.controller.name(),
                 a.axis,
                 a.released.growth,

@@ -7,12 +7,16 @@
 //!
 //! ```text
 //! f_cm = K_m·(x_s − x_m) + B_m·(v_s − v_m) + C6·f_h − (1 + C6)·f_e − D_m·v_m  [+ M̂_x·a_s]
-//! f_cs = K_s·(x_m − x_s) + B_s·(v_m − v_s) + (1 + C5)·f_h − C5·f_e  [+ M_s·â_m]
+//! f_cs = K_s·(x_m − x_s) + B_s·(v_m − v_s) + (1 + C5)·f_h − C5·f_e − D_s·v_s  [+ M_s·â_m]
 //! ```
 //!
+//! (`C1`, `C4` are the PD blocks `(K_s, B_s)`, `(K_m, B_m)` plus the optional mass feedforwards;
+//! `C2`, `C3` may be overridden, [`FourChannelGains::c2`], [`FourChannelGains::c3`], at the price of
+//! transparency.)
+//!
 //! which with `C5 = C6 = 0`, `D_m = 0` is the spec's discrete law ([`FourChannelGains::spec`]). The
-//! default is [`FourChannelGains::local_force_feedback`] (`C6 = −1` plus a small damping injection),
-//! stable with the hand released (§11.4; see its derivation). All gains are diagonal (per DOF
+//! default is [`FourChannelGains::local_force_feedback`] (`C6 = −1`, `C5 = 2`, a small damping
+//! injection), stable with the hand released (§11.4; see its derivation). All gains are diagonal (per DOF
 //! x, y, θ); θ position errors are wrapped to `(−π, π]`.
 
 use serde::{Deserialize, Serialize};
@@ -56,21 +60,30 @@ pub fn pose_error(x_a: &V3, x_b: &V3) -> V3 {
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct FourChannelGains {
-    /// Master position gain `K_m` (N/m, N/m, N·m/rad). Default (500, 500, 1.0).
+    /// Master position gain `K_m` (N/m, N/m, N·m/rad). Default (500, 500, 0.5) (spec: θ 1.0).
     pub k_m: V3,
-    /// Master damping `B_m` (N·s/m, N·s/m, N·m·s/rad). Default (5, 5, 0.01).
+    /// Master damping `B_m` (N·s/m, N·s/m, N·m·s/rad). Default (5, 5, 0.002) (spec: θ 0.01).
     pub b_m: V3,
-    /// Slave position gain `K_s` (N/m, N/m, N·m/rad). Default (2000, 2000, 4).
+    /// Slave position gain `K_s` (N/m, N/m, N·m/rad). Default (2000, 2000, 1.0) (spec: θ 4).
     pub k_s: V3,
-    /// Slave damping `B_s` (N·s/m, N·s/m, N·m·s/rad). Default (30, 30, 0.03).
+    /// Slave damping `B_s` (N·s/m, N·s/m, N·m·s/rad). Default (30, 30, 0.003) (spec: θ 0.03).
     pub b_s: V3,
-    /// Slave local force feedback `C5` (dimensionless). Default 0.
+    /// Slave local force feedback `C5` (dimensionless). Default (2, 2, 0) (spec: 0).
     pub c5: V3,
     /// Master local force feedback `C6` (dimensionless). Default −1 (spec: 0).
     pub c6: V3,
     /// Master damping injection `D_m` (N·s/m, N·s/m, N·m·s/rad): a local damper `−D_m·v̂_m` on the
-    /// device command, on top of `B_m` (which acts on the velocity error). Default (2, 2, 0.002) (spec: 0).
+    /// device command, on top of `B_m` (which acts on the velocity error). Default (1, 1, 0.004) (spec: 0).
     pub d_m: V3,
+    /// Slave damping injection `D_s` (N·s/m, N·s/m, N·m·s/rad): a local damper `−D_s·v_s` on the slave
+    /// drive, on top of `B_s` (which acts on the velocity error). Default 0.
+    pub d_s: V3,
+    /// Environment-force channel `C2` (dimensionless) when it is not the transparent `1 + C6`:
+    /// `None` (default) uses `1 + C6`. Setting it breaks §11.1's transparency conditions.
+    pub c2: Option<V3>,
+    /// Hand-force channel `C3` (dimensionless) when it is not the transparent `1 + C5`: `None`
+    /// (default) uses `1 + C5`. Setting it breaks §11.1's transparency conditions.
+    pub c3: Option<V3>,
     /// Add the master-mass feedforward `M̂_x·a_s` to `f_cm`. Default off.
     pub master_feedforward: bool,
     /// Add the slave-mass feedforward `M_s·â_m` to `f_cs` (amplifies encoder noise). Default off.
@@ -91,7 +104,14 @@ impl Default for FourChannelGains {
 
 /// Master damping injection of the default configuration in world units (N·s/m, N·s/m, N·m·s/rad);
 /// see [`FourChannelGains::local_force_feedback`].
-pub const DEFAULT_DAMPING_INJECTION: V3 = [2.0, 2.0, 0.002];
+pub const DEFAULT_DAMPING_INJECTION: V3 = [1.0, 1.0, 0.004];
+
+/// Slave local force feedback `C5` of the default configuration (x, y, θ; dimensionless).
+pub const DEFAULT_SLAVE_FORCE_FEEDBACK: V3 = [2.0, 2.0, 0.0];
+
+/// θ gains of the default configuration `[K_s, B_s, K_m, B_m]` (N·m/rad, N·m·s/rad, N·m/rad,
+/// N·m·s/rad).
+pub const DEFAULT_THETA_GAINS: [f64; 4] = [1.0, 0.003, 0.5, 0.002];
 
 /// Master damping injection of [`FourChannelGains::damped`] (N·s/m, N·s/m, N·m·s/rad).
 pub const SPEC_DAMPING_INJECTION: V3 = [40.0, 40.0, 0.04];
@@ -114,6 +134,9 @@ impl FourChannelGains {
             c5: [0.0; 3],
             c6: [0.0; 3],
             d_m: [0.0; 3],
+            d_s: [0.0; 3],
+            c2: None,
+            c3: None,
             master_feedforward: false,
             slave_feedforward: false,
             slave_mass: [0.5, 0.5, 1e-4],
@@ -121,27 +144,50 @@ impl FourChannelGains {
         }
     }
 
-    /// The default (`four-channel`): the §11.1 gains with **local force feedback `C6 = −1`** at the
-    /// master and a small master damping injection `D_m` = [`DEFAULT_DAMPING_INJECTION`].
+    /// The default (`four-channel`), chosen by the design study of issue 36 (MODELS.md §11.4,
+    /// `haptic2d-lab/tests/design_search.rs`): the §11.1 PD gains on x and y with **local force
+    /// feedback at both ends** — `C6 = −1` at the master (so `C2 = 0`: the wall force is not reflected
+    /// to a released handle) and `C5` = [`DEFAULT_SLAVE_FORCE_FEEDBACK`] at the slave (so `C3 = 1 + C5`:
+    /// the hand's push reaches the slave amplified, against `−C5·f_e`) — plus a master damping
+    /// injection `D_m` = [`DEFAULT_DAMPING_INJECTION`], and θ gains [`DEFAULT_THETA_GAINS`].
     ///
-    /// Derivation. With `C6 = −1` the transparency conditions of §11.1 give `C2 = 1 + C6 = 0`: the
-    /// environment force no longer reaches the device directly, and the hand-force estimate is
-    /// cancelled at the master (`f_cm = K_m·e + B_m·ė − Ŵ_h`) and passed to the slave (`C3 = 1`) —
-    /// Hashtrudi-Zaad and Salcudean's three-channel form, still transparent in steady contact
-    /// (`f_e = f_h`, `x_s = x_m`, so X1 and X3 hold). With the handle released, the loop is then a
-    /// master on the PD `(K_m, B_m)` to a slave held by `K_s + K_e`, whose released poles are all in
-    /// the left half plane; but the master's mode is lightly damped (for the spec device on the Fig. 4
-    /// box: right-most pole `−1.3 ± 23j`, sampled growth `−0.9 1/s` at 500 Hz, below the
-    /// 2 1/s margin of the stability verdict). `D_m = 2 N·s/m` (world units) moves it to a decay of
-    /// `≥ 2.6 1/s` on every axis, hand held or released, at 0.5, 1, 2 and 10 kHz with or without one
-    /// sample of output delay, on box-in-walls (Fig. 4 walls, 2000 N/m) and peg-in-hole at scale 2
-    /// (1 kHz and up; the peg's 3.3e-5 kg·m² is below the θ minimum mass at 500 Hz), and costs
-    /// `D_m·v` of drag in free motion (0.2 N at 0.1 m/s). The θ injection follows the ratio `B_m,θ /
-    /// B_m,x`. Figures from `haptic2d_lab::stability` (test `stability_defaults.rs`).
+    /// Still transparent by §11.1's conditions: in steady contact `f_e = f_h`, `x_s = x_m` (X1, X3).
+    /// What the study measured (spec device; stability analysis on every built-in scene, the peg
+    /// also at scale 2, at 0.5, 1 and 2 kHz with and without one sample of output delay): slowest
+    /// decay 11.3 1/s held and 4.1 1/s released (the verdict "stable" needs 2), 6 of the 9 claims of
+    /// Figs. 5–6 and 8–11 (every Figs. 8–11 claim and the hysteretic wall; not the pulse wall, and
+    /// not the SEH/ZOH bouncing, which no released-stable design reproduces), and quasi-statically a
+    /// free-motion drag of 1.37 N·s/m and a felt mass of 0.76 kg for the 0.5 kg box (the former
+    /// default `C5 = 0`, `D_m = 2`: 8.1 N·s/m and 2.28 kg), the wall felt at its 2000 N/m.
+    ///
+    /// θ: the §11.1 table's θ slave PD (4 N·m/rad, 0.03 N·m·s/rad) is refused on the peg at 500 Hz
+    /// (§6.4: the peg's 3.3e-5 kg·m² is below 1.5 × its minimum mass) and grows there against the
+    /// contacts' friction-stick spring; the study picked θ gains by stability alone (the claims are
+    /// on x): slowest θ decay 25 1/s.
     pub fn local_force_feedback() -> Self {
+        let spec = Self::spec();
+        let [k_s, b_s, k_m, b_m] = DEFAULT_THETA_GAINS;
         Self {
+            k_m: [spec.k_m[0], spec.k_m[1], k_m],
+            b_m: [spec.b_m[0], spec.b_m[1], b_m],
+            k_s: [spec.k_s[0], spec.k_s[1], k_s],
+            b_s: [spec.b_s[0], spec.b_s[1], b_s],
+            c5: DEFAULT_SLAVE_FORCE_FEEDBACK,
             c6: [-1.0; 3],
             d_m: DEFAULT_DAMPING_INJECTION,
+            ..spec
+        }
+    }
+
+    /// The former default (before issue 36's study; `controllers/former-default.toml`): the §11.1
+    /// gains with local force feedback `C6 = −1` at the master only and `D_m = (2, 2, 0.002)`.
+    /// Stable released on box-in-walls and on the peg at 1 kHz and up, but its θ slave PD is refused
+    /// on the peg at 500 Hz; 2 of the 9 claims (the pulse and hysteretic walls): the push reaches
+    /// the peg through `C3 = 1` while the handle's inertia and the dampers brake every slip.
+    pub fn master_force_feedback() -> Self {
+        Self {
+            c6: [-1.0; 3],
+            d_m: [2.0, 2.0, 0.002],
             ..Self::spec()
         }
     }
@@ -202,9 +248,15 @@ impl FourChannelGains {
         check_finite_nonneg("k_s", &self.k_s)?;
         check_finite_nonneg("b_s", &self.b_s)?;
         check_finite_nonneg("d_m", &self.d_m)?;
+        check_finite_nonneg("d_s", &self.d_s)?;
         check_finite_nonneg("slave_mass", &self.slave_mass)?;
-        for (name, c) in [("c5", &self.c5), ("c6", &self.c6)] {
-            if !c.iter().all(|v| v.is_finite()) {
+        for (name, c) in [
+            ("c5", Some(&self.c5)),
+            ("c6", Some(&self.c6)),
+            ("c2", self.c2.as_ref()),
+            ("c3", self.c3.as_ref()),
+        ] {
+            if c.is_some_and(|c| !c.iter().all(|v| v.is_finite())) {
                 return Err(format!("controller.{name} must be finite"));
             }
         }
@@ -311,8 +363,18 @@ impl FourChannel {
         let mut f_cs = [0.0; 3];
         for i in 0..3 {
             let dv = s.v_s[i] - s.v_m[i];
+            // C2 and C3 default to the transparent 1 + C6 and 1 + C5 (computed as before, so a
+            // configuration without overrides runs bit for bit as it did).
+            let c2 = match &g.c2 {
+                Some(c) => c[i],
+                None => 1.0 + g.c6[i],
+            };
+            let c3 = match &g.c3 {
+                Some(c) => c[i],
+                None => 1.0 + g.c5[i],
+            };
             f_cm[i] = g.k_m[i] * e[i] + g.b_m[i] * dv + g.c6[i] * s.f_h[i]
-                - (1.0 + g.c6[i]) * s.f_e[i]
+                - c2 * s.f_e[i]
                 - g.d_m[i] * s.v_m[i]
                 + ff_m[i];
             let ff_s = if g.slave_feedforward {
@@ -320,9 +382,10 @@ impl FourChannel {
             } else {
                 0.0
             };
-            f_cs[i] = -g.k_s[i] * e[i] - g.b_s[i] * dv + (1.0 + g.c5[i]) * s.f_h[i]
-                - g.c5[i] * s.f_e[i]
-                + ff_s;
+            f_cs[i] = -g.k_s[i] * e[i] - g.b_s[i] * dv + c3 * s.f_h[i] - g.c5[i] * s.f_e[i] + ff_s;
+            if g.d_s[i] != 0.0 {
+                f_cs[i] -= g.d_s[i] * s.v_s[i];
+            }
         }
         (f_cm, f_cs)
     }

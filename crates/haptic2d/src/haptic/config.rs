@@ -9,6 +9,7 @@ use crate::device::{DeviceParams, ObserverKind};
 
 /// Which teleoperation controller couples the device to the slave (§11).
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[allow(clippy::large_enum_variant)] // a configuration value, copied at setup, never stored in bulk
 pub enum ControllerKind {
     /// Lawrence's four-channel controller (§11.1), the default (with the released-stable gains of
     /// [`FourChannelGains::local_force_feedback`]).
