@@ -94,7 +94,7 @@
   // `refused` maps a name to the reason it cannot be chosen (greyed out, the reason as tooltip).
   // What the comparison controllers are (the names are those of `haptic2d run --controller`).
   const NOTES = {
-    "four-channel": ["", "default: local force feedback C6 = -1 + damping injection, stable with the hand released"],
+    "four-channel": ["", "default: slave- and master-side local force feedback (C5 = 2, C6 = -1) with master damping, from the design study of docs/MODELS.md §11.4; stable with the hand released"],
     "four-channel-spec": ["(unstable released)", "the paper's §11.1 gains: unstable with the hand released against a stiff contact (comparison)"],
     "four-channel-damped": ["(comparison)", "the §11.1 gains with 40 N·s/m of master damping injection (comparison)"],
   };
