@@ -25,6 +25,9 @@
 
 #else
 
+/* Uncomment once the lists below are your board's pins: */
+/* #define H2DF_PINS_VERIFIED 1 */
+
 #if !defined(H2DF_PINS_VERIFIED)
 #error "haptic2d firmware: fill in board_pins.h from your board's schematic, then define H2DF_PINS_VERIFIED (docs/FIRMWARE.md)"
 #endif

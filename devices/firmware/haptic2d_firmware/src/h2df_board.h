@@ -3,12 +3,12 @@
  * SPDX-License-Identifier: MIT OR Apache-2.0
  *
  * Selected by -DH2DF_BOARD_M0 or -DH2DF_BOARD_M3, else from the Arduino core's chip macros
- * (SAMD51 → M3, SAMD21 → M0). The native build defaults to M3. */
+ * (SAMD51 or SAM3X8E → M3, SAMD21 → M0). The native build defaults to M3. */
 #ifndef H2DF_BOARD_H
 #define H2DF_BOARD_H
 
 #if !defined(H2DF_BOARD_M0) && !defined(H2DF_BOARD_M3)
-#if defined(__SAMD51__)
+#if defined(__SAMD51__) || defined(__SAM3X8E__)
 #define H2DF_BOARD_M3 1
 #elif defined(__SAMD21__) || defined(__SAMD21G18A__) || defined(__SAMD21E18A__) || \
     defined(__SAMD21J18A__)
