@@ -3,7 +3,9 @@
  *
  * SPDX-License-Identifier: MIT OR Apache-2.0
  *
- *   h2df-native [--motor-log FILE]          (or the environment variable H2DF_MOTOR_LOG=FILE)
+ *   h2df-native [--motor-log FILE] [--hand-move START_MS,DURATION_MS,C1,C2,C3,C4]
+ *
+ * (the motor log may also be given as the environment variable H2DF_MOTOR_LOG=FILE).
  *
  * The first line of standard output is `pty: /dev/pts/N`: open it as the board's serial port.
  * The slave side is held open here, so the firmware keeps running (as a board does) when a host
@@ -21,8 +23,12 @@
  * µs since the program started. An E line tells what the firmware did (`write` after the write's
  * motor outputs were set).
  *
- * The encoders are static: no interrupt ever fires, so the handle stays where the last setup put
- * it (the rest pose) and every angle reads trunc(offset·resolution/360)·360/resolution.
+ * The encoders: the handle is held by a simulated hand, kinematically (the motors do not move it).
+ * Without --hand-move it stays where the last setup put it (the rest pose): every angle reads
+ * trunc(offset·resolution/360)·360/resolution. With --hand-move, START_MS after each setup the hand
+ * moves encoder port k (port 1 first) by Ck counts at a steady rate over DURATION_MS, then holds it
+ * there: the stub turns the motion into A/B quadrature edges on the encoder pins and calls the
+ * interrupt handlers board.c attached, so the board's own decoder counts them.
  * analogRead(pin) returns 4·pin. */
 #define _GNU_SOURCE
 #include <errno.h>
@@ -52,6 +58,16 @@ static long logged[4];
 static bool logged_any;
 static const uint8_t port_pwm[4] = H2DF_PINS_PWM;
 static const uint8_t port_dir[4] = H2DF_PINS_DIR;
+static const uint8_t port_enc_a[4] = H2DF_PINS_ENC_A;
+static const uint8_t port_enc_b[4] = H2DF_PINS_ENC_B;
+static void (*isr_of_pin[NPINS])(void);
+
+/* The simulated hand: encoder positions (counts), the move after each setup. */
+static long enc_pos[4];
+static long enc_pos_at_setup[4];
+static uint64_t t_setup_us;
+static bool hand_moves, hand_armed; /* armed by the first setup */
+static long hand_start_ms, hand_duration_ms, hand_counts[4];
 
 static uint64_t now_us(void)
 {
@@ -132,10 +148,43 @@ unsigned long millis(void)
 
 void attachInterrupt(uint32_t pin, void (*callback)(void), uint32_t mode)
 {
-    /* Static encoders: the handle never moves, no edge ever comes. */
-    (void)pin;
-    (void)callback;
-    (void)mode;
+    (void)mode; /* CHANGE: every edge of the pin */
+    if (pin < NPINS) isr_of_pin[pin] = callback;
+}
+
+/* A/B levels of encoder position n: 00, 01, 11, 10, ... (one pin changes per count). */
+static void quad_levels(long n, uint8_t *a, uint8_t *b)
+{
+    static const uint8_t gray[4] = {0u, 1u, 3u, 2u};
+    uint8_t g = gray[((n % 4) + 4) % 4];
+    *a = (uint8_t)(g >> 1);
+    *b = (uint8_t)(g & 1u);
+}
+
+/* Moves encoder `port` one count towards `dir` (+1/-1): the pin that changes, then its interrupt. */
+static void enc_step(unsigned port, int dir)
+{
+    uint8_t a0, b0, a1, b1;
+    quad_levels(enc_pos[port], &a0, &b0);
+    enc_pos[port] += dir;
+    quad_levels(enc_pos[port], &a1, &b1);
+    uint8_t pin = a1 != a0 ? port_enc_a[port] : port_enc_b[port];
+    dig_level[port_enc_a[port]] = a1;
+    dig_level[port_enc_b[port]] = b1;
+    if (isr_of_pin[pin]) isr_of_pin[pin]();
+}
+
+/* The hand: where each encoder should be now; the edges to get there. */
+static void hand_update(void)
+{
+    if (!hand_moves || !hand_armed) return;
+    double t_ms = (double)(now_us() - t_setup_us) / 1000.0;
+    double f = (t_ms - (double)hand_start_ms) / (double)(hand_duration_ms > 0 ? hand_duration_ms : 1);
+    f = f < 0.0 ? 0.0 : (f > 1.0 ? 1.0 : f);
+    for (unsigned p = 0; p < H2DF_PORTS; p++) {
+        long target = enc_pos_at_setup[p] + (long)((double)hand_counts[p] * f);
+        while (enc_pos[p] != target) enc_step(p, target > enc_pos[p] ? 1 : -1);
+    }
 }
 
 void noInterrupts(void) {}
@@ -181,6 +230,12 @@ void h2df_serial_write(const uint8_t *bytes, size_t n)
 
 void h2df_hal_event(uint8_t event)
 {
+    if (event == H2DF_EV_SETUP) {
+        /* The setup put the handle at the rest pose: the hand starts from here. */
+        memcpy(enc_pos_at_setup, enc_pos, sizeof enc_pos);
+        t_setup_us = now_us();
+        hand_armed = true;
+    }
     static const char *const names[] = {"reset", "setup", "write", "identify", "watchdog",
                                         "bad-byte", "stale-frame"};
     if (!motor_log || event >= sizeof names / sizeof names[0]) return;
@@ -218,8 +273,16 @@ int main(int argc, char **argv)
     for (int i = 1; i < argc; i++) {
         if (strcmp(argv[i], "--motor-log") == 0 && i + 1 < argc) {
             log_path = argv[++i];
+        } else if (strcmp(argv[i], "--hand-move") == 0 && i + 1 < argc &&
+                   sscanf(argv[i + 1], "%ld,%ld,%ld,%ld,%ld,%ld", &hand_start_ms,
+                          &hand_duration_ms, &hand_counts[0], &hand_counts[1], &hand_counts[2],
+                          &hand_counts[3]) >= 3) {
+            hand_moves = true;
+            i++;
         } else {
-            fprintf(stderr, "usage: %s [--motor-log FILE]\n", argv[0]);
+            fprintf(stderr,
+                    "usage: %s [--motor-log FILE] [--hand-move START_MS,DURATION_MS,C1,C2,C3,C4]\n",
+                    argv[0]);
             return 2;
         }
     }
@@ -251,6 +314,7 @@ int main(int argc, char **argv)
     fflush(stdout);
 
     for (;;) {
+        hand_update();
         h2df_poll(&fw);
         /* Idle until a byte comes, at most 200 µs (the watchdog's check interval while idle). */
         struct pollfd pfd = {.fd = master, .events = POLLIN};
