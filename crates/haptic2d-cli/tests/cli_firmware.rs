@@ -6,8 +6,9 @@
 //! its PWM and direction pins, and every write it received).
 //!
 //! The device file is the shipped gen 3 file made patient about a loaded machine's timing (as in
-//! `cli_haply.rs`): a run that trips on its own timing zeroes the torques itself and would not test
-//! the board. The native firmware's simulated hand holds the handle at the rest pose the setup gives
+//! `cli_haply.rs`, with a 1 s reply timeout: under a load of 5 on 2 cores the native firmware, a
+//! normal process, was seen to answer 100 ms late): a run that trips on its own timing zeroes the
+//! torques itself and would not test the board. The native firmware's simulated hand holds the handle at the rest pose the setup gives
 //! (so a start-up check of the pose passes), then moves it into the workspace and presses the
 //! box of box-in-walls into the left wall: the coupling pulls the handle back with a steady torque
 //! (see [`HAND_MOVE`]).
@@ -118,11 +119,15 @@ impl Log {
             .map_or([0.0; 4], |m| m.2)
     }
 
-    /// Largest |τ| held at any write later than `t` µs.
-    fn peak_after(&self, t: u64) -> f64 {
-        self.writes
-            .iter()
-            .filter(|w| w.1 > t)
+    /// Largest |τ| held at any write from log line `from` on that is `after_us` or later after the
+    /// first of those writes.
+    fn peak_after(&self, from: usize, after_us: u64) -> f64 {
+        let mut writes = self.writes.iter().filter(|w| w.0 >= from);
+        let Some(&(_, first)) = writes.next() else {
+            return 0.0;
+        };
+        writes
+            .filter(|w| w.1 >= first + after_us)
             .flat_map(|w| self.at(w.0))
             .fold(0.0, |m: f64, x| m.max(x.abs()))
     }
@@ -159,47 +164,62 @@ fn kill_9_of_run_against_our_firmware_zeroes_the_motors_within_the_watchdog_time
 
     let file = patient_device_file(
         "haply-2diy-gen3.toml",
-        ("3", "100"),
+        ("3", "1000"),
         "firmware",
         "gen3.toml",
     );
     let run_out = dir.join("run.txt");
-    let run = Command::new(BIN)
-        .args(["run", "--device", &format!("haply:{pty}"), "--device-file"])
-        .arg(&file)
-        .args(["--headless", "--duration", "10", "--no-rt"])
-        .stdout(std::fs::File::create(&run_out).unwrap())
-        .stderr(std::fs::File::create(dir.join("run-err.txt")).unwrap())
-        .spawn()
-        .unwrap();
-    let mut run = Killed(run);
+    let run_err = dir.join("run-err.txt");
+    let start_run = || {
+        Command::new(BIN)
+            .args(["run", "--device", &format!("haply:{pty}"), "--device-file"])
+            .arg(&file)
+            .args(["--headless", "--duration", "10", "--no-rt"])
+            .stdout(std::fs::File::create(&run_out).unwrap())
+            .stderr(std::fs::File::create(&run_err).unwrap())
+            .spawn()
+            .unwrap()
+    };
 
-    // Torques flow: with the ramp over and the box against the wall, the board holds a clear torque.
-    let t0 = Instant::now();
-    loop {
-        let log = Log::read(&motor_log);
-        if let Some(&(_, first)) = log.writes.first() {
-            if log.peak_after(first + PRESSING_AFTER_US) > 0.02 {
-                break;
+    // Torques flow: with the ramp over and the box against the wall, the board holds a clear
+    // torque. Up to 3 tries: under heavy load a pty's bytes were seen to sit a second in the kernel,
+    // and a run that loses the device that way (exit 4) before torques flow is started again (the
+    // board keeps running, as a real one would); any other end of the run fails the test.
+    let mut attempt = 1;
+    let mut run = loop {
+        let from = Log::read(&motor_log).text.lines().count();
+        let mut run = Killed(start_run());
+        let t0 = Instant::now();
+        let ended = loop {
+            let log = Log::read(&motor_log);
+            if log.peak_after(from, PRESSING_AFTER_US) > 0.02 {
+                break None;
             }
-        }
-        if let Some(status) = run.0.try_wait().unwrap() {
-            panic!(
-                "run ended ({status}) before torques flowed:\n{}\n{}\nmotor log:\n{}",
+            if let Some(status) = run.0.try_wait().unwrap() {
+                break Some((status, log));
+            }
+            assert!(
+                t0.elapsed() < Duration::from_secs(8),
+                "no torque after the ramp within 8 s:\n{}\n{}\nmotor log:\n{}",
                 text_of(&run_out),
-                text_of(&dir.join("run-err.txt")),
+                text_of(&run_err),
                 log.tail()
             );
-        }
+            std::thread::sleep(Duration::from_millis(5));
+        };
+        let Some((status, log)) = ended else {
+            break run;
+        };
+        let out = format!("{}\n{}", text_of(&run_out), text_of(&run_err));
+        let lost = status.code() == Some(4) && out.contains("device lost");
         assert!(
-            t0.elapsed() < Duration::from_secs(8),
-            "no torque after the ramp within 8 s:\n{}\n{}\nmotor log:\n{}",
-            text_of(&run_out),
-            text_of(&dir.join("run-err.txt")),
+            lost && attempt < 3,
+            "run ended ({status}) before torques flowed (try {attempt}):\n{out}\nmotor log:\n{}",
             log.tail()
         );
-        std::thread::sleep(Duration::from_millis(5));
-    }
+        eprintln!("try {attempt}: the run lost the device before torques flowed; again:\n{out}");
+        attempt += 1;
+    };
 
     // kill -9: no zero write, no goodbye; the board keeps what it was last sent.
     run.0.kill().unwrap();

@@ -81,11 +81,17 @@ struct Firmware {
 
 impl Firmware {
     fn start(board: Board, tag: &str) -> Self {
+        Self::start_with(board, tag, &[])
+    }
+
+    /// Started with extra arguments (e.g. `--hand-move`).
+    fn start_with(board: Board, tag: &str, args: &[&str]) -> Self {
         let exe = firmware_exe(board);
         let log = exe.with_file_name(format!("motors-{tag}.txt"));
         let mut child = Command::new(&exe)
             .arg("--motor-log")
             .arg(&log)
+            .args(args)
             .stdout(Stdio::piped())
             .stderr(Stdio::inherit())
             .spawn()
@@ -132,6 +138,9 @@ impl Drop for Firmware {
     fn drop(&mut self) {
         let _ = self.child.kill();
         let _ = self.child.wait();
+        if !std::thread::panicking() {
+            let _ = std::fs::remove_file(&self.log);
+        }
     }
 }
 
@@ -578,4 +587,49 @@ fn an_m0_board_drives_2_ports_and_answers_a_4_port_setup_short() {
     assert!((tau[0] - 0.05).abs() < 0.123 / 1023.0, "{tau:?}");
     assert!((tau[1] - 0.05).abs() < 0.123 / 1023.0, "{tau:?}");
     assert_eq!(tau[2..], [0.0, 0.0]);
+}
+
+#[test]
+fn encoder_motion_is_counted_from_the_setup_count_in_the_direction_the_setup_names() {
+    // The stub's hand turns encoder port 1 by +100 and port 2 by -40 counts, 500 ms after each
+    // setup (quadrature edges into board.c's decoder). Port 1 is set up counter-clockwise (counts add),
+    // port 2 clockwise (counts subtract).
+    let fw = Firmware::start_with(
+        Board::M3,
+        "encoders",
+        &["--hand-move", "500,20,100,-40,0,0"],
+    );
+    let mut port = fw.port();
+    let mut setup = setup_frame(0b11, &[], &GEN3);
+    setup[7] = 0; // enc_dir of port 2: clockwise
+    assert_eq!(&setup[3..8], &[1, 1, 0b11, 1, 0]);
+    send(&mut port, &setup);
+    let angles = |port: &mut TTYPort| {
+        send(port, &write_frame(&[0.0, 0.0]));
+        let r = read_n(port, 9, WAIT);
+        assert_eq!(r.len(), 9, "reply {r:?}");
+        f32s(&r[1..])
+    };
+    let count = |o: f32, r: f32| (o * r / 360.0).trunc();
+    let (c1, c2) = (count(GEN3[0].0, GEN3[0].1), count(GEN3[1].0, GEN3[1].1));
+    let want = [
+        360.0 * (c1 + 100.0) / GEN3[0].1,
+        360.0 * (c2 + 40.0) / GEN3[1].1,
+    ];
+    let t0 = Instant::now();
+    let mut got = angles(&mut port);
+    while got != want && t0.elapsed() < WAIT {
+        std::thread::sleep(Duration::from_millis(5));
+        got = angles(&mut port);
+    }
+    assert_eq!(got, want, "angles after the hand's move");
+    // A new setup puts the count back to the setup count wherever the handle is (DEVICES §1).
+    send(&mut port, &setup_frame(0b11, &[], &GEN3));
+    assert_eq!(
+        angles(&mut port),
+        [
+            truncated_angle(GEN3[0].0, GEN3[0].1),
+            truncated_angle(GEN3[1].0, GEN3[1].1)
+        ]
+    );
 }
