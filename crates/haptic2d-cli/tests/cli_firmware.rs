@@ -139,7 +139,8 @@ fn text_of(path: &Path) -> String {
 
 #[test]
 fn kill_9_of_run_against_our_firmware_zeroes_the_motors_within_the_watchdog_time() {
-    let dir = std::env::temp_dir().join(format!("haptic2d-cli-firmware-{}", std::process::id()));
+    let dir =
+        Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("cli-firmware-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let exe = compile_firmware(&dir);
     let motor_log = dir.join("motors.txt");

@@ -39,7 +39,8 @@ fn compile(board: Board) -> PathBuf {
     let fw = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../devices/firmware");
     let src = fw.join("haptic2d_firmware/src");
     let native = fw.join("native");
-    let dir = std::env::temp_dir().join(format!("haptic2d-fw-native-{}", std::process::id()));
+    let dir =
+        Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("fw-native-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let exe = dir.join(format!("h2df-native-{board:?}").to_lowercase());
     let cc = std::env::var("CC").unwrap_or_else(|_| "cc".into());
