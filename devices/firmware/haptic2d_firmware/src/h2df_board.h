@@ -16,7 +16,7 @@
 #elif defined(H2DF_NATIVE)
 #define H2DF_BOARD_M3 1
 #else
-#error "haptic2d firmware: unknown board; build for a SAMD21 (M0) or SAMD51 (M3), or define H2DF_BOARD_M0 / H2DF_BOARD_M3"
+#error "haptic2d firmware: unknown board; build for a SAMD21 (M0) or a SAMD51/SAM3X8E (M3), or define H2DF_BOARD_M0 / H2DF_BOARD_M3"
 #endif
 #endif
 
