@@ -272,8 +272,9 @@ pub fn key_bytes(raw: &[u8]) -> Vec<u8> {
         .copied()
         .filter(|c| !c.is_ascii_whitespace())
         .collect();
-    let hex =
-        digits.len() >= 32 && digits.len() % 2 == 0 && digits.iter().all(u8::is_ascii_hexdigit);
+    let hex = digits.len() >= 32
+        && digits.len().is_multiple_of(2)
+        && digits.iter().all(u8::is_ascii_hexdigit);
     if !hex {
         return raw.to_vec();
     }
