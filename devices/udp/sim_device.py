@@ -1,12 +1,18 @@
 #!/usr/bin/env python3
-"""A simulated 2-DOF pantograph speaking haptic2d's open UDP device protocol, version 1.
+"""A simulated 2-DOF pantograph speaking haptic2d's open UDP device protocol, version 2 (and 1).
 
-The template a device builder copies: everything a device must do is in `serve()` and the two
-`pack_*`/`unpack_*` functions (docs/DEVICE-PROTOCOL.md has the byte table). Python standard
-library only.
+The template a device builder copies: everything a device must do is in `serve()`, the class
+`Session` and the `pack_*`/`unpack_*` functions (docs/DEVICE-PROTOCOL.md has the byte tables).
+Python standard library only (`hmac`, `hashlib`, `os.urandom`).
 
-    python3 devices/udp/sim_device.py --bind 127.0.0.1:5005
-    haptic2d run --device udp:127.0.0.1:5005 --headless --duration 3
+    python3 devices/udp/sim_device.py --bind 127.0.0.1:5005 --key-file udp.key   # version 2
+    haptic2d run --device udp:127.0.0.1:5005 --device-file my-device.toml --headless --duration 3
+
+With --key-file (a file of hex or raw key bytes, mode 600, the same key as the host's device
+file's protocol.key_file) the device speaks version 2: it opens a session only for a HELLO with a
+valid MAC, acts only on commands with a valid MAC, of the current session, with a sequence number
+newer than the last one it acted on, and MACs every state. Without a key it speaks version 1 and
+binds only to a loopback address (with a warning).
 
 The simulated device: the end point of the pantograph (devices/udp-pantograph.toml geometry) is a
 point mass held by a hand, a spring-damper towards the start point, plus an optional constant
@@ -17,8 +23,13 @@ command arrives for --watchdog-ms; the first line on stdout is `listening on ADD
 """
 
 import argparse
+import hashlib
+import hmac
+import ipaddress
 import math
+import os
 import socket
+import stat
 import struct
 import sys
 import time
@@ -49,6 +60,102 @@ def unpack_command(data):
 def pack_state(seq, echo_seq, status, device_ns, echo_host_ns, position, velocity, force):
     return STATE.pack(MAGIC, VERSION, KIND_STATE, seq & 0xFFFFFFFF, echo_seq, status,
                       device_ns, echo_host_ns, *position, *velocity, *force)
+
+
+# --- protocol v2: authentication (docs/DEVICE-PROTOCOL.md §3) --------------------------------
+VERSION2, KIND_HELLO, KIND_WELCOME = 2, 3, 4
+MAC_LEN, NONCE_LEN, HEADER2 = 16, 16, 12
+HELLO_LEN = HEADER2 + NONCE_LEN + MAC_LEN  # 44
+COMMAND2_LEN = HEADER2 + COMMAND.size - 4 + MAC_LEN  # 68
+MIN_KEY = 16
+
+
+def read_key(path):
+    """Key bytes from a key file: hex (whitespace ignored, >= 32 digits) or raw bytes. Refused
+    when group or others have any permission on the file."""
+    st = os.stat(path)
+    if st.st_mode & 0o077:
+        raise ValueError(f"key file {path} is open to group or others "
+                         f"(mode {stat.S_IMODE(st.st_mode):03o}); fix: chmod 600 {path}")
+    with open(path, "rb") as f:
+        raw = f.read(4097)
+    digits = bytes(c for c in raw if not chr(c).isspace())
+    try:
+        key = bytes.fromhex(digits.decode()) if len(digits) >= 32 else raw
+    except ValueError:
+        key = raw
+    if len(key) < MIN_KEY:
+        raise ValueError(f"key file {path}: a key of {len(key)} bytes is too short "
+                         f"(at least {MIN_KEY})")
+    return key
+
+
+def mac(key, data):
+    """HMAC-SHA256(key, data), first 16 bytes."""
+    return hmac.new(key, data, hashlib.sha256).digest()[:MAC_LEN]
+
+
+def mac_ok(key, datagram):
+    return len(datagram) > MAC_LEN and hmac.compare_digest(
+        mac(key, datagram[:-MAC_LEN]), datagram[-MAC_LEN:])
+
+
+def session_id(key, host_nonce, device_nonce):
+    sid = struct.unpack("<Q", mac(key, b"H2v2 session" + host_nonce + device_nonce)[:8])[0]
+    return max(sid, 1)
+
+
+class Session:
+    """The device's side of version 2: the active session (the one it acts for), a pending one
+    (answered with a WELCOME, active from its first authentic command), and the replay window:
+    a command acts only if its seq is newer than the last one acted on in that session."""
+
+    def __init__(self, key):
+        self.key = key
+        self.active = None  # session id
+        self.pending = None
+        self.last_seq = 0
+        self.drops = {"bad_mac": 0, "wrong_session": 0, "stale": 0, "malformed": 0}
+
+    def receive(self, data, peer, sock):
+        """The v1 command bytes of an authentic, fresh command (or None); answers a HELLO."""
+        if len(data) < HEADER2 + MAC_LEN or data[:2] != MAGIC or data[2] != VERSION2:
+            self.drops["malformed"] += 1
+            return None
+        if not mac_ok(self.key, data):
+            self.drops["bad_mac"] += 1
+            return None
+        kind, sid = data[3], struct.unpack_from("<Q", data, 4)[0]
+        if kind == KIND_HELLO and len(data) == HELLO_LEN and sid == 0:
+            host_nonce, device_nonce = data[HEADER2:HEADER2 + NONCE_LEN], os.urandom(NONCE_LEN)
+            self.pending = session_id(self.key, host_nonce, device_nonce)
+            w = MAGIC + bytes([VERSION2, KIND_WELCOME]) + struct.pack("<Q", self.pending) + \
+                host_nonce + device_nonce
+            sock.sendto(w + mac(self.key, w), peer)
+            return None
+        if kind != KIND_COMMAND or len(data) != COMMAND2_LEN:
+            self.drops["malformed"] += 1
+            return None
+        if sid == self.pending and sid is not None:
+            # The host proved it holds the key and saw our nonce: this session becomes the one.
+            self.active, self.pending, self.last_seq = sid, None, 0
+        elif sid != self.active or sid is None:
+            self.drops["wrong_session"] += 1
+            return None
+        seq = struct.unpack_from("<I", data, HEADER2)[0]
+        if seq <= self.last_seq:
+            self.drops["stale"] += 1
+            return None
+        v1 = MAGIC + bytes([VERSION, KIND_COMMAND]) + data[HEADER2:-MAC_LEN]
+        if unpack_command(v1) is None:
+            self.drops["malformed"] += 1
+            return None
+        self.last_seq = seq
+        return v1
+
+    def seal_state(self, v1_state):
+        b = MAGIC + bytes([VERSION2, KIND_STATE]) + struct.pack("<Q", self.active) + v1_state[4:]
+        return b + mac(self.key, b)
 
 
 # --- the pantograph (DEVICES §2): motor 1 at (0, 0), motor 2 at (d, 0) -----------------------
@@ -88,6 +195,14 @@ def solve2(m, v):
 
 def serve(args):
     host, _, port = args.bind.rpartition(":")
+    session = Session(read_key(args.key_file)) if args.key_file else None
+    if session is None:
+        if not ipaddress.ip_address(host.strip("[]")).is_loopback:
+            print(f"error: --bind {args.bind}: protocol version 1 (no --key-file) is "
+                  "unauthenticated and allowed on loopback only; give --key-file", file=sys.stderr)
+            sys.exit(2)
+        print("warning: protocol version 1 (no --key-file): any local process can command this "
+              "device", file=sys.stderr, flush=True)
     sock = socket.socket(socket.AF_INET6 if ":" in host else socket.AF_INET, socket.SOCK_DGRAM)
     sock.bind((host.strip("[]"), int(port)))
     bound = sock.getsockname()
@@ -132,11 +247,17 @@ def serve(args):
         except socket.timeout:
             data = None
         now = time.monotonic()
-        # Device watchdog: no command for --watchdog-ms -> motors off.
+        # Device watchdog: no valid command for --watchdog-ms -> motors off.
         if last_cmd is not None and now - last_cmd > args.watchdog_ms * 1e-3:
+            if args.trace and command != (0.0, 0.0):
+                print("watchdog 0 0", file=args.trace, flush=True)
             command = (0.0, 0.0)
         if data is None:
             continue
+        if session is not None:
+            data = session.receive(data, peer, sock)  # verify before acting
+            if data is None:
+                continue
         cmd = unpack_command(data)
         if cmd is None:
             continue  # malformed: ignore, never answer
@@ -163,8 +284,11 @@ def serve(args):
             position, velocity = (q[0], q[1], 0.0), (qd[0], qd[1], 0.0)
         seq += 1
         device_ns = int((now - t0) * 1e9)
-        sock.sendto(pack_state(seq, cmd["seq"], status, device_ns, cmd["host_ns"],
-                               position, velocity, (0.0, 0.0, 0.0)), peer)
+        state = pack_state(seq, cmd["seq"], status, device_ns, cmd["host_ns"],
+                           position, velocity, (0.0, 0.0, 0.0))
+        sock.sendto(session.seal_state(state) if session else state, peer)
+        if args.trace:
+            print(f"applied {command[0]:.6f} {command[1]:.6f}", file=args.trace, flush=True)
 
 
 def pair(text):
@@ -190,11 +314,18 @@ def main():
     p.add_argument("--force-limit", type=float, default=5.0, help="wrench limit (N)")
     p.add_argument("--watchdog-ms", type=float, default=100.0, help="motors off after (ms)")
     p.add_argument("--duration", type=float, default=None, help="exit after (s)")
+    p.add_argument("--key-file", default=None,
+                   help="protocol v2: the shared key (hex or raw bytes, mode 600)")
+    p.add_argument("--trace", type=argparse.FileType("w"), default=None,
+                   help="append each command the device acts on to this file (tests)")
     args = p.parse_args()
     try:
         serve(args)
     except KeyboardInterrupt:
         pass
+    except ValueError as e:  # the key file
+        print(f"error: {e}", file=sys.stderr)
+        sys.exit(2)
     except OSError as e:
         print(f"error: {args.bind}: {e}", file=sys.stderr)
         sys.exit(1)

@@ -54,6 +54,10 @@ pub struct EmulateArgs {
     /// angle 0 at the start); the loop turns the slave with it. Default: no VerseGrip.
     #[arg(long, allow_hyphen_values = true)]
     pub grip_rate: Option<f64>,
+    /// inverse3: a fault of the service, for tests: every state after the first N lacks the
+    /// cursor position (the driver must treat it as a lost device).
+    #[arg(long, value_name = "N")]
+    pub drop_position_after: Option<u64>,
 }
 
 /// Runs the emulator.
@@ -180,6 +184,7 @@ fn run_inverse3(a: &EmulateArgs) -> Result<u8, (u8, String)> {
         hand,
         grip: a.grip_rate.map(|_| [1.0, 0.0, 0.0, 0.0]),
         grip_rate: a.grip_rate.unwrap_or(0.0),
+        drop_position_after: a.drop_position_after,
         ..Emulator3Config::default()
     };
     let stop = install_ctrlc_stop().map_err(|e| (exit::ERROR, e))?;

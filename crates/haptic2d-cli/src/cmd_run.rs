@@ -110,6 +110,10 @@ pub struct RunArgs {
     /// hand released.
     #[arg(long)]
     pub allow_unstable: bool,
+    /// Let `--device udp:ADDR:PORT` be beyond loopback (a warning is printed; the device file
+    /// needs a protocol.key_file). Multicast and broadcast addresses are refused regardless.
+    #[arg(long)]
+    pub allow_remote_device: bool,
 }
 
 /// `--duration` upper bound (s): about 116 days, far beyond any session, and small enough that the
@@ -148,7 +152,9 @@ pub fn run(a: &RunArgs) -> Result<Status, Failure> {
     }
     // A real device's --device-file is its own (e.g. a Haply file): read and checked now, opened
     // after the stability gate.
-    let real = opts.device.load_real(a.device_file.as_deref())?;
+    let real = opts
+        .device
+        .load_real(a.device_file.as_deref(), a.allow_remote_device)?;
     let device_setting = match &real {
         Some(r) => device_arg::DeviceSetting {
             params: match &r.model {

@@ -103,11 +103,20 @@ impl DeviceChoice {
 
     /// For a real device, reads and checks its device file `device_file` (nothing is opened yet);
     /// `None` for the simulated device and a replay. Errors name the file, the field and the fix.
-    pub fn load_real(&self, device_file: Option<&Path>) -> Result<Option<RealDevice>, String> {
+    /// `allow_remote` (`--allow-remote-device`) lets a UDP device be beyond loopback.
+    pub fn load_real(
+        &self,
+        device_file: Option<&Path>,
+        allow_remote: bool,
+    ) -> Result<Option<RealDevice>, String> {
         Ok(match self {
             DeviceChoice::Sim | DeviceChoice::Replay(_) => None,
             DeviceChoice::Haply(port) => Some(crate::haply_arg::real_device(port, device_file)?),
-            DeviceChoice::Udp(addr) => Some(crate::udp_arg::real_device(addr, device_file)?),
+            DeviceChoice::Udp(addr) => Some(crate::udp_arg::real_device(
+                addr,
+                device_file,
+                allow_remote,
+            )?),
             DeviceChoice::Inverse3(url) => Some(crate::inverse3_arg::real_device(
                 url.as_deref(),
                 device_file,

@@ -4,12 +4,18 @@
 //! pantograph, devices/udp-pantograph.toml) says whether joints or a pose come in, what goes out
 //! and which linkage applies; the system is the 2-DOF pantograph system. When the device closes
 //! (end of the run, a lost device, Ctrl-C) the network counters are printed on stdout:
-//! `udp: N sent, N received: … fresh, … late, … lost, … reordered, … duplicate, … malformed; …`.
+//! `udp: N sent, N received: … fresh, … late, … lost, … reordered, … duplicate, … malformed; …;
+//! dropped: … bad MAC, … wrong session, … wrong source, … seq jumps`.
+//!
+//! Addresses: a multicast, broadcast or unspecified address is refused (it would command every
+//! device on the segment); an address beyond loopback needs `--allow-remote-device` and prints a
+//! warning; without `protocol.key_file` (protocol version 1, unauthenticated) only loopback is
+//! allowed, with a warning.
 
 use crate::run_rig::{DeviceModel, RealDevice};
 use haptic2d_devices::udp::{UdpDevice, UdpDeviceFile};
 use haptic2d_rt::{DeviceError, DeviceIo};
-use std::net::{SocketAddr, ToSocketAddrs};
+use std::net::{IpAddr, SocketAddr, ToSocketAddrs};
 use std::path::Path;
 
 /// The device address of `ADDR:PORT` (the part after `udp:`; a name is resolved once, here).
@@ -28,17 +34,67 @@ pub fn address_of(addr: &str) -> Result<SocketAddr, String> {
         .ok_or_else(|| format!("--device udp:{addr}: no address; {hint}"))
 }
 
-/// The UDP device of `--device udp:ADDR:PORT` for the rig of `haptic2d run`: the address resolved,
-/// the device file read and checked, nothing opened yet.
-pub fn real_device(addr: &str, device_file: Option<&Path>) -> Result<RealDevice, String> {
+/// Checks a device address: multicast, broadcast and unspecified addresses are refused; one beyond
+/// loopback needs `allow_remote`. Returns the warning to print (`None` on loopback).
+pub fn check_address(addr: SocketAddr, allow_remote: bool) -> Result<Option<String>, String> {
+    let ip = addr.ip();
+    let what = match ip {
+        IpAddr::V4(v4) if v4.is_broadcast() => Some("the broadcast address"),
+        _ if ip.is_multicast() => Some("a multicast address"),
+        _ if ip.is_unspecified() => Some("the unspecified address"),
+        _ => None,
+    };
+    if let Some(what) = what {
+        return Err(format!(
+            "--device udp:{addr}: {what} is not a device: commands sent there reach every host that listens\n    fix: give the device's own (unicast) address"
+        ));
+    }
+    if ip.is_loopback() {
+        return Ok(None);
+    }
+    if !allow_remote {
+        return Err(format!(
+            "--device udp:{addr}: a device beyond loopback drives motors over the network\n    fix: add --allow-remote-device if that is what you mean (and give the device file a protocol.key_file)"
+        ));
+    }
+    Ok(Some(format!(
+        "warning: --device udp:{addr}: the device is beyond loopback; torque commands go over the network (authenticated, protocol version 2)"
+    )))
+}
+
+/// The UDP device of `--device udp:ADDR:PORT` for the rig of `haptic2d run`: the address resolved
+/// and checked ([`check_address`]; `allow_remote` is `--allow-remote-device`), the device file read
+/// and checked (a file without a key is refused beyond loopback), nothing opened yet. Warnings go
+/// to stderr.
+pub fn real_device(
+    addr: &str,
+    device_file: Option<&Path>,
+    allow_remote: bool,
+) -> Result<RealDevice, String> {
     let addr = address_of(addr)?;
+    let warning = check_address(addr, allow_remote)?;
     let file = match device_file {
         Some(p) => UdpDeviceFile::from_path(p)?,
         None => UdpDeviceFile::reference(),
     };
+    if file.key.is_none() {
+        if !addr.ip().is_loopback() {
+            return Err(format!(
+                "--device udp:{addr}: {} has no protocol.key_file; protocol version 1 (unauthenticated) is allowed on loopback only\n    fix: give the device and the device file a shared key (docs/DEVICE-PROTOCOL.md §6)",
+                file.source
+            ));
+        }
+        eprintln!(
+            "warning: udp:{addr} speaks protocol version 1 (no protocol.key_file in {}): datagrams are not authenticated, any local process could send states; set protocol.key_file for version 2",
+            file.source
+        );
+    }
+    if let Some(w) = warning {
+        eprintln!("{w}");
+    }
     let name = format!("udp:{addr}");
     let summary = format!(
-        "{}, 2-DOF pantograph, {} in, {} out, torque limit {} N·m",
+        "{}, 2-DOF pantograph, {} in, {} out, torque limit {} N·m, protocol version {}",
         file.source,
         if file.pose_input { "pose" } else { "joints" },
         if file.wrench_output {
@@ -46,7 +102,8 @@ pub fn real_device(addr: &str, device_file: Option<&Path>) -> Result<RealDevice,
         } else {
             "torques"
         },
-        file.torque_limit
+        file.torque_limit,
+        if file.key.is_some() { 2 } else { 1 }
     );
     let open_name = name.clone();
     Ok(RealDevice {
@@ -127,10 +184,54 @@ mod tests {
 
     #[test]
     fn the_reference_device_is_a_five_bar_with_its_limits() {
-        let r = real_device("127.0.0.1:5005", None).unwrap();
+        let r = real_device("127.0.0.1:5005", None, false).unwrap();
         assert_eq!(r.name, "udp:127.0.0.1:5005");
         assert!(matches!(r.model, DeviceModel::FiveBar { tau_max, .. } if tau_max == 0.123));
         assert_eq!(r.wait_periods, 3.0);
         assert_eq!(r.max_missed_run, Some(10));
+    }
+
+    #[test]
+    fn multicast_broadcast_and_unspecified_addresses_are_refused() {
+        for a in [
+            "224.0.0.1:5005",
+            "239.1.2.3:5005",
+            "255.255.255.255:5005",
+            "0.0.0.0:5005",
+            "[ff02::1]:5005",
+            "[::]:5005",
+        ] {
+            let e = check_address(a.parse().unwrap(), true).unwrap_err();
+            assert!(
+                e.contains("is not a device") && e.contains("unicast"),
+                "{a}: {e}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_remote_address_needs_the_flag_and_warns() {
+        let a: SocketAddr = "192.0.2.7:5005".parse().unwrap();
+        let e = check_address(a, false).unwrap_err();
+        assert!(e.contains("--allow-remote-device"), "{e}");
+        let w = check_address(a, true).unwrap().unwrap();
+        assert!(
+            w.starts_with("warning:") && w.contains("beyond loopback"),
+            "{w}"
+        );
+        assert_eq!(
+            check_address("127.0.0.1:5005".parse().unwrap(), false),
+            Ok(None)
+        );
+        assert_eq!(
+            check_address("[::1]:5005".parse().unwrap(), false),
+            Ok(None)
+        );
+        // Allowed beyond loopback, but a file without a key is still refused (version 1).
+        let e = real_device("192.0.2.7:5005", None, true).err().unwrap();
+        assert!(
+            e.contains("protocol.key_file") && e.contains("loopback"),
+            "{e}"
+        );
     }
 }

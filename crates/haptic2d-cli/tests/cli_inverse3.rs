@@ -172,6 +172,24 @@ fn service_killed_mid_run_exits_4_naming_the_device() {
     assert!(!out.contains("panicked"), "{out}");
 }
 
+/// Regression (issue 34, finding 9): a service state without a cursor position was read as
+/// (0, 0, 0), the handle jumped 20 mm and the run exited 0. It is a lost device: exit 4, the
+/// message names the missing field.
+#[test]
+fn a_state_without_a_cursor_position_exits_4_naming_the_field() {
+    let _t = turn();
+    let emu = emulator(&["--drop-position-after", "1500"]);
+    let file = device_file("noposition");
+    let o = run(&emu.1, &file, "10").output().unwrap();
+    let out = text(&o);
+    assert_eq!(o.status.code(), Some(4), "{out}");
+    assert!(
+        out.contains("state.cursor_position") && out.contains("zero force latched"),
+        "{out}"
+    );
+    assert!(!out.contains("panicked"), "{out}");
+}
+
 #[test]
 fn no_service_and_bad_urls_are_clear_errors() {
     let _t = turn();

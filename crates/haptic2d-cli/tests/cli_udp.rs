@@ -197,6 +197,87 @@ fn run_against_the_python_reference_device_for_3_s_exits_clean() {
     assert!(counter(&out, "fresh") * 10 >= sent * 9, "{out}");
     assert_eq!(counter(&out, "malformed"), 0, "{out}");
     assert!(!out.contains("panicked"), "{out}");
+    // No key file: version 1, on loopback, with a warning.
+    assert!(out.contains("protocol version 1"), "{out}");
+}
+
+/// Protocol version 2 end to end: the device file names a key file (mode 600), the reference
+/// device has the same key; the run opens a session, and nothing is dropped.
+#[test]
+fn run_with_a_key_file_speaks_version_2_and_drops_nothing() {
+    use std::os::unix::fs::PermissionsExt;
+    let _t = turn();
+    let file = device_file("v2");
+    let key = file.with_file_name("udp.key");
+    std::fs::write(
+        &key,
+        "00112233445566778899aabbccddeeff0123456789abcdef0123456789abcdef\n",
+    )
+    .unwrap();
+    std::fs::set_permissions(&key, std::fs::Permissions::from_mode(0o600)).unwrap();
+    let toml = std::fs::read_to_string(&file).unwrap();
+    std::fs::write(
+        &file,
+        toml.replace("[protocol]\n", "[protocol]\nkey_file = \"udp.key\"\n"),
+    )
+    .unwrap();
+    let Some(dev) = sim_device(&["--key-file", key.to_str().unwrap()]) else {
+        eprintln!("python3 not found: skipped");
+        return;
+    };
+    let o = run(dev.1, &file, "2").output().unwrap();
+    let out = text(&o);
+    assert_eq!(o.status.code(), Some(0), "{out}");
+    assert!(out.contains("protocol version 2"), "{out}");
+    assert!(!out.contains("protocol version 1"), "{out}");
+    let sent = counter(&out, "sent");
+    assert!(sent > 300, "{out}");
+    assert!(counter(&out, "fresh") * 10 >= sent * 9, "{out}");
+    for why in ["bad MAC", "wrong session", "wrong source", "malformed"] {
+        assert_eq!(counter(&out, why), 0, "{why}: {out}");
+    }
+    // A key file others can read is refused before anything is sent, with the fix.
+    std::fs::set_permissions(&key, std::fs::Permissions::from_mode(0o644)).unwrap();
+    let o = run(dev.1, &file, "1").output().unwrap();
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(text(&o).contains("chmod 600"), "{}", text(&o));
+}
+
+/// Issue 38 item 5: `--device udp:224.0.0.1:5005` sent zero-torque datagrams to every host on the
+/// segment. Multicast and broadcast are refused; beyond loopback needs --allow-remote-device and a
+/// key. Every case is refused before a socket is opened (nothing is sent anywhere).
+#[test]
+fn multicast_broadcast_and_remote_addresses_are_refused_or_need_the_flag() {
+    let _t = turn();
+    let file = device_file("addr");
+    for (addr, says) in [
+        ("224.0.0.1:5005", "multicast"),
+        ("255.255.255.255:5005", "broadcast"),
+        ("[ff02::1]:5005", "multicast"),
+        ("0.0.0.0:5005", "unspecified"),
+    ] {
+        let o = run(addr.parse().unwrap(), &file, "1")
+            .arg("--allow-remote-device")
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2), "{addr}: {}", text(&o));
+        assert!(text(&o).contains(says), "{addr}: {}", text(&o));
+    }
+    let remote: SocketAddr = "192.0.2.1:5005".parse().unwrap();
+    let o = run(remote, &file, "1").output().unwrap();
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(text(&o).contains("--allow-remote-device"), "{}", text(&o));
+    // With the flag: warned, and still refused without a key (version 1 is loopback only).
+    let o = run(remote, &file, "1")
+        .arg("--allow-remote-device")
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(
+        text(&o).contains("key_file") && text(&o).contains("loopback only"),
+        "{}",
+        text(&o)
+    );
 }
 
 /// Closed loop over UDP: the reference device's hand (no spring, a constant 0.8 N push towards

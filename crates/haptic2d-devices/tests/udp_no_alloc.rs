@@ -9,7 +9,7 @@ use haptic2d_rt::DeviceIo;
 
 #[path = "support/udp_echo.rs"]
 mod udp_echo;
-use udp_echo::spawn_echo_device;
+use udp_echo::{spawn_echo_device, spawn_echo_device_v2};
 
 #[path = "../../haptic2d/tests/support/counting_alloc.rs"]
 mod counting_alloc;
@@ -17,8 +17,22 @@ use counting_alloc::allocations;
 
 #[test]
 fn the_exchange_allocates_nothing_once_open() {
-    let addr = spawn_echo_device(Duration::ZERO);
+    exchange_allocates_nothing(
+        spawn_echo_device(Duration::ZERO),
+        UdpDeviceFile::reference(),
+    );
+}
+
+/// Version 2: the MAC of every command and the check of every state allocate nothing either.
+#[test]
+fn the_authenticated_exchange_allocates_nothing_once_open() {
+    let key = haptic2d_devices::udp::UdpKey::from_bytes(&[0x42; 32]).unwrap();
     let mut file = UdpDeviceFile::reference();
+    file.key = Some(key.clone());
+    exchange_allocates_nothing(spawn_echo_device_v2(key), file);
+}
+
+fn exchange_allocates_nothing(addr: std::net::SocketAddr, mut file: UdpDeviceFile) {
     file.timeout_periods = 100.0;
     let mut dev = UdpDevice::open(addr, &file, Duration::from_millis(1), "udp:alloc").unwrap();
     for _ in 0..20 {

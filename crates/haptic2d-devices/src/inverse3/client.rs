@@ -9,7 +9,9 @@
 //! command), clamped to the force limit. Zero force is sent before the first valid state, when the
 //! loop has latched, when the newest state is older than the timeout, and when the driver stops the
 //! client (then the connection is closed). A failed send closes the client with its reason; the
-//! loop sees it (and, in any case, a state older than its timeout) as a lost device.
+//! loop sees it (and, in any case, a state older than its timeout) as a lost device. So does a
+//! state without a cursor position (DEVICES §4: a missing field is a fault, never a zero): the
+//! client sends zero force, closes naming the field, and the driver latches.
 //!
 //! Pacing. The `haply` listener task loops without yielding once its stream has ended (its
 //! `listen` retries `next()`, which returns at once), and a worker stuck in one poll also stops
@@ -137,11 +139,15 @@ async fn run(cfg: ClientConfig, mut ends: ClientEnds, ready: mpsc::Sender<Result
             next = now;
         }
         let stopping = status.stop.load(Ordering::Acquire);
-        // (1) The newest state.
+        // (1) The newest state. One without a cursor position is a fault, never (0, 0, 0)
+        // (issue 34: read as the origin, it made the handle jump 20 mm in one sample).
+        let mut missing: Option<String> = None;
         {
             let g = dev.state.lock().await;
             if let Some(d) = g.data.inverse3.first() {
-                if last != Some(g.timestamp) {
+                if last != Some(g.timestamp) && d.state.cursor_position.is_none() {
+                    missing = Some(d.device_id.clone());
+                } else if last != Some(g.timestamp) {
                     let p = d.state.cursor_position.unwrap_or_default();
                     let p = [p.x as f64, p.y as f64, p.z as f64];
                     let rx_ns = now_ns().saturating_sub(g.timestamp.elapsed().as_nanos() as u64);
@@ -181,6 +187,22 @@ async fn run(cfg: ClientConfig, mut ends: ClientEnds, ready: mpsc::Sender<Result
                     }
                 }
             }
+        }
+        if let Some(id) = missing {
+            // Zero force first, then the reason: the driver reads it as a lost device.
+            let zero = ForceInput {
+                device_id: id.clone(),
+                forces: Force {
+                    x: 0.0,
+                    y: 0.0,
+                    z: 0.0,
+                },
+            };
+            let _ = dev.update_force(vec![zero], Some(true), Some(true)).await;
+            status.close(format!(
+                "the Inverse Service sent a state of Inverse3 `{id}` without its cursor position (field `state.cursor_position`); a state without a position is a fault, not (0, 0, 0)"
+            ));
+            break;
         }
         // (2) The loop's command, (3) the force.
         let cmd = *ends.command.read();

@@ -1,14 +1,21 @@
 //! A stand-in for Haply's Inverse Service on loopback (`haptic2d emulate inverse3`): a WebSocket
-//! server speaking the messages the `haply` crate sends and parses — serialised and parsed with the
-//! crate's own serde types — in front of a simulated 3-DOF device pushed by a simulated hand.
+//! and HTTP server speaking the messages the `haply` crate sends and parses — serialised and parsed
+//! with the crate's own serde types — in front of a simulated 3-DOF device pushed by a simulated
+//! hand.
 //!
-//! Protocol as the `haply` client uses it: the client sends a `ServiceMsg` (JSON text frame) per
-//! tick; the service answers each with the device state. A message asking for
-//! `session.force_render_full_state` (the client's first, and `send_force_full_render`) gets the
-//! full payload, a `ServiceData` whose devices carry their `config`; every other message gets a
-//! state-only `ServiceState`. `set_cursor_force` of our device id is applied (zero-order hold until
-//! the next); messages that do not parse are counted and ignored. A plain HTTP request (not a
-//! WebSocket upgrade) gets `404` with a JSON note: the emulator serves only the WebSocket.
+//! The session, as Haply documents the Inverse Service 3.x (DEVICES §4): WebSocket and HTTP on the
+//! same port. When a client connects, the service first pushes an **inventory**: a full payload, a
+//! `ServiceData` whose devices carry their `config` and state. After that it sends **exactly one
+//! state message per message received, nothing unprompted**: a message asking for
+//! `session.force_render_full_state` gets the full payload again, every other one a state-only
+//! `ServiceState`. `set_cursor_force` of our device id is applied (zero-order hold until the next);
+//! `probe_position` is answered like any message, with the state (the cursor's position). Messages
+//! that do not parse are counted and answered with nothing. HTTP (a request without a WebSocket
+//! upgrade): `GET /version` (a `VersionResponse`) and `GET /devices` (the inventory) answer `200`
+//! with JSON; any other path `404` with a JSON note.
+//!
+//! Hazards the real service can show, on request: [`Emulator3Config::drop_position_after`] makes the
+//! states after that many replies lack `cursor_position` (a state without a field the driver needs).
 //!
 //! Device: per axis `m·a = F_cmd + F_hand − b·v`, `|F_cmd|` clamped to the emulated force limit,
 //! stepped by semi-implicit Euler in ≤ 0.1 ms sub-steps over the wall-clock time since the last
@@ -26,7 +33,7 @@ use std::time::{Duration, Instant};
 use haply::device_model::{
     DeviceConfig, Inverse3Device as WireInverse3, Inverse3Message, Inverse3State, Inverse3Status,
     ServiceData, ServiceMsg, ServiceState, VGConfig, Vec3D, Vec4D, VerseGripDevice,
-    VerseGripMessage, VerseGripState, VerseGripStatus,
+    VerseGripMessage, VerseGripState, VerseGripStatus, VersionResponse,
 };
 use tungstenite::Message;
 
@@ -133,6 +140,9 @@ pub struct Emulator3Config {
     /// The VerseGrip turns about the device's z axis at this rate (rad/s of simulated time), from
     /// `grip` at t = 0. Default 0.
     pub grip_rate: f64,
+    /// A fault: every state message after this many (the inventory counts) lacks
+    /// `cursor_position`. `None` (default): every state has it.
+    pub drop_position_after: Option<u64>,
 }
 
 impl Default for Emulator3Config {
@@ -145,6 +155,7 @@ impl Default for Emulator3Config {
             hand: None,
             grip: None,
             grip_rate: 0.0,
+            drop_position_after: None,
         }
     }
 }
@@ -194,6 +205,12 @@ pub struct Emulator3Counters {
     pub states: AtomicU64,
     /// Force commands applied.
     pub forces: AtomicU64,
+    /// Inventories pushed on connection.
+    pub inventories: AtomicU64,
+    /// `probe_position` commands answered.
+    pub probes: AtomicU64,
+    /// HTTP requests answered (any status).
+    pub http: AtomicU64,
 }
 
 /// What the emulator saw, for reports and tests.
@@ -209,6 +226,12 @@ pub struct Emulator3Report {
     pub states: u64,
     /// Force commands applied.
     pub forces: u64,
+    /// Inventories pushed on connection.
+    pub inventories: u64,
+    /// `probe_position` commands answered.
+    pub probes: u64,
+    /// HTTP requests answered.
+    pub http: u64,
 }
 
 struct Shared {
@@ -219,6 +242,23 @@ struct Shared {
 }
 
 impl Shared {
+    /// True when the state about to be sent must lack its cursor position (the fault of
+    /// [`Emulator3Config::drop_position_after`]).
+    fn position_dropped(&self) -> bool {
+        self.cfg
+            .drop_position_after
+            .is_some_and(|n| self.counters.states.load(Ordering::Relaxed) >= n)
+    }
+
+    fn without_position(&self, mut d: ServiceData) -> ServiceData {
+        if self.position_dropped() {
+            for dev in &mut d.inverse3 {
+                dev.state.cursor_position = None;
+            }
+        }
+        d
+    }
+
     /// Steps the plant to now; applies `force` if given; returns the state.
     fn advance(&self, force: Option<[f64; 3]>) -> Plant3 {
         let mut g = self.plant.lock().unwrap_or_else(|e| e.into_inner());
@@ -294,6 +334,9 @@ impl Inverse3Emulator {
             malformed: c.malformed.load(Ordering::Relaxed),
             states: c.states.load(Ordering::Relaxed),
             forces: c.forces.load(Ordering::Relaxed),
+            inventories: c.inventories.load(Ordering::Relaxed),
+            probes: c.probes.load(Ordering::Relaxed),
+            http: c.http.load(Ordering::Relaxed),
         }
     }
 
@@ -380,7 +423,8 @@ fn serve_connection(stream: TcpStream, shared: Arc<Shared>) {
         std::thread::sleep(Duration::from_millis(1));
     };
     if !is_upgrade(&head[..n]) {
-        plain_http(stream);
+        shared.counters.http.fetch_add(1, Ordering::Relaxed);
+        plain_http(stream, &shared);
         return;
     }
     let _ = stream.set_read_timeout(Some(Duration::from_secs(2)));
@@ -391,6 +435,16 @@ fn serve_connection(stream: TcpStream, shared: Arc<Shared>) {
         .get_ref()
         .set_read_timeout(Some(Duration::from_millis(20)));
     shared.counters.connections.fetch_add(1, Ordering::Relaxed);
+    // The service's first message on a new session: the inventory, unprompted.
+    let plant = shared.advance(None);
+    let inventory =
+        serde_json::to_string(&shared.without_position(full_payload(&shared.cfg, &plant)))
+            .unwrap_or_else(|_| "{}".into());
+    if ws.send(Message::text(inventory)).is_err() {
+        return;
+    }
+    shared.counters.inventories.fetch_add(1, Ordering::Relaxed);
+    shared.counters.states.fetch_add(1, Ordering::Relaxed);
     while !shared.stop.load(Ordering::Relaxed) {
         let msg = match ws.read() {
             Ok(m) => m,
@@ -424,13 +478,43 @@ fn serve_connection(stream: TcpStream, shared: Arc<Shared>) {
     // Stopped: drop the connection without a close handshake, as a killed service would.
 }
 
-fn plain_http(mut stream: TcpStream) {
+/// The HTTP side: `GET /version`, `GET /devices` (the inventory); 404 with a JSON note otherwise.
+fn plain_http(mut stream: TcpStream, shared: &Shared) {
     let mut buf = [0u8; 4096];
-    let _ = stream.read(&mut buf);
-    let body = "{\"error\":\"haptic2d's Inverse Service emulator serves only the WebSocket (the state stream and commands)\"}";
+    let n = stream.read(&mut buf).unwrap_or(0);
+    let head = String::from_utf8_lossy(&buf[..n]);
+    let mut words = head.split_whitespace();
+    let (method, target) = (words.next().unwrap_or(""), words.next().unwrap_or(""));
+    let path = target.split('?').next().unwrap_or("");
+    let (status, body) = match (method, path) {
+        ("GET", "/version") => (
+            "200 OK",
+            serde_json::to_string(&VersionResponse {
+                project_name: "haptic2d Inverse Service emulator".into(),
+                project_version: env!("CARGO_PKG_VERSION").into(),
+                ..Default::default()
+            })
+            .unwrap_or_default(),
+        ),
+        ("GET", "/devices") => {
+            let plant = shared.advance(None);
+            (
+                "200 OK",
+                serde_json::to_string(&full_payload(&shared.cfg, &plant)).unwrap_or_default(),
+            )
+        }
+        _ => (
+            "404 Not Found",
+            format!(
+                "{{\"error\":\"haptic2d's Inverse Service emulator serves GET /version, GET /devices and the WebSocket; not {} {}\"}}",
+                method.escape_default(),
+                path.escape_default()
+            ),
+        ),
+    };
     let _ = write!(
         stream,
-        "HTTP/1.1 404 Not Found\r\nContent-Type: application/json\r\nContent-Length: {}\r\nConnection: close\r\n\r\n{body}",
+        "HTTP/1.1 {status}\r\nContent-Type: application/json\r\nContent-Length: {}\r\nConnection: close\r\n\r\n{body}",
         body.len()
     );
 }
@@ -459,17 +543,38 @@ pub fn cursor_force(cmd: &ServiceMsg) -> Option<[f64; 3]> {
         .map(|c| [c.vector.x as f64, c.vector.y as f64, c.vector.z as f64])
 }
 
+/// True when the command probes our device's position.
+pub fn probes_position(cmd: &ServiceMsg) -> bool {
+    cmd.inverse3
+        .iter()
+        .filter(|d| d.device_id == EMULATED_ID)
+        .any(|d| {
+            d.commands
+                .as_ref()
+                .is_some_and(|c| c.probe_position.is_some())
+        })
+}
+
 fn answer(shared: &Shared, cmd: &ServiceMsg) -> String {
     let force = cursor_force(cmd);
     if force.is_some() {
         shared.counters.forces.fetch_add(1, Ordering::Relaxed);
     }
+    if probes_position(cmd) {
+        shared.counters.probes.fetch_add(1, Ordering::Relaxed);
+    }
     let plant = shared.advance(force);
     let full = cmd.session.force_render_full_state.is_some();
     let text = if full {
-        serde_json::to_string(&full_payload(&shared.cfg, &plant))
+        serde_json::to_string(&shared.without_position(full_payload(&shared.cfg, &plant)))
     } else {
-        serde_json::to_string(&state_payload(&shared.cfg, &plant))
+        let mut s = state_payload(&shared.cfg, &plant);
+        if shared.position_dropped() {
+            for d in &mut s.inverse3 {
+                d.state.cursor_position = None;
+            }
+        }
+        serde_json::to_string(&s)
     };
     text.unwrap_or_else(|_| "{}".into())
 }

@@ -297,7 +297,7 @@ mod tests {
         }
     }
 
-    /// The worked example of docs/DEVICE-PROTOCOL.md §4 (command).
+    /// The worked example of docs/DEVICE-PROTOCOL.md §5 (command).
     #[test]
     fn command_byte_vector() {
         let mut b = [0u8; COMMAND_LEN];
@@ -309,7 +309,7 @@ mod tests {
         assert_eq!(Command::decode(&b), Ok(example_command()));
     }
 
-    /// The worked example of docs/DEVICE-PROTOCOL.md §4 (state).
+    /// The worked example of docs/DEVICE-PROTOCOL.md §5 (state).
     #[test]
     fn state_byte_vector() {
         let mut b = [0u8; STATE_LEN];

@@ -13,6 +13,8 @@
 //! torque_limit = 0.123          # N·m on each joint, enforced by the host
 //! max_missed_deadlines = 10     # watchdog: consecutive missed deadlines (0 = off)
 //! max_stall_periods = 5         # the loop's own delay between two ticks that trips (periods)
+//! key_file = "udp.key"          # protocol version 2: the shared key (hex or raw, mode 600),
+//!                               # relative to this file; without it version 1, loopback only
 //! [linkage]                     # the 2-DOF pantograph (DEVICES §2), device frame
 //! d = 0.038                     # m
 //! l1 = 0.07                     # m
@@ -27,6 +29,9 @@
 use haptic2d::device::pantograph2::Pantograph2;
 use haptic2d::scene::{SceneError, SceneErrors};
 use serde::Deserialize;
+use std::path::{Path, PathBuf};
+
+use super::auth::UdpKey;
 
 /// The template named in error messages.
 pub const UDP_TEMPLATE: &str = "devices/udp-pantograph.toml";
@@ -57,6 +62,11 @@ pub struct UdpDeviceFile {
     pub max_stall_periods: f64,
     /// The linkage (m).
     pub linkage: Pantograph2,
+    /// Protocol version 2: the shared key read from `protocol.key_file`. `None`: version 1
+    /// (unauthenticated), allowed on loopback only.
+    pub key: Option<UdpKey>,
+    /// Where the key was read from (for messages).
+    pub key_file: Option<PathBuf>,
 }
 
 #[derive(Deserialize)]
@@ -87,6 +97,8 @@ struct RawProtocol {
     max_missed_deadlines: i64,
     #[serde(default = "five")]
     max_stall_periods: f64,
+    #[serde(default)]
+    key_file: Option<String>,
 }
 
 impl Default for RawProtocol {
@@ -99,6 +111,7 @@ impl Default for RawProtocol {
             torque_limit: limit(),
             max_missed_deadlines: ten(),
             max_stall_periods: five(),
+            key_file: None,
         }
     }
 }
@@ -140,14 +153,21 @@ impl UdpDeviceFile {
             .expect("the shipped reference file is valid (tested)")
     }
 
-    /// Reads and parses the file at `path`.
-    pub fn from_path(path: &std::path::Path) -> Result<Self, String> {
+    /// Reads and parses the file at `path` (a relative `key_file` is relative to its directory).
+    pub fn from_path(path: &Path) -> Result<Self, String> {
         let (text, source) = crate::device_toml::read(path, "a UDP device file", UDP_TEMPLATE)?;
-        Self::from_toml(&text, &source).map_err(|e| e.to_string())
+        let dir = path.parent().unwrap_or(Path::new("."));
+        Self::from_toml_in(&text, &source, dir).map_err(|e| e.to_string())
     }
 
-    /// Parses a device file's text; `source` names it in messages.
+    /// Parses a device file's text; `source` names it in messages; a relative `key_file` is
+    /// relative to the working directory.
     pub fn from_toml(text: &str, source: &str) -> Result<Self, SceneErrors> {
+        Self::from_toml_in(text, source, Path::new(""))
+    }
+
+    /// Parses a device file's text; a relative `key_file` is relative to `dir`.
+    pub fn from_toml_in(text: &str, source: &str, dir: &Path) -> Result<Self, SceneErrors> {
         let fail = |errors| SceneErrors {
             source: source.to_string(),
             errors,
@@ -224,6 +244,23 @@ impl UdpDeviceFile {
                 "give the loop's longest delay between two ticks in periods, ≥ 1 (default 5)",
             ));
         }
+        let (key, key_file) = match &p.key_file {
+            None => (None, None),
+            Some(k) => {
+                let path = dir.join(k);
+                match UdpKey::from_file(&path) {
+                    Ok(key) => (Some(key), Some(path)),
+                    Err(e) => {
+                        errs.push(SceneError::new(
+                            "protocol.key_file",
+                            e,
+                            "give a file of at least 16 key bytes (hex or raw), mode 600, that the device has too (docs/DEVICE-PROTOCOL.md §6)",
+                        ));
+                        (None, None)
+                    }
+                }
+            }
+        };
         let l = &raw.linkage;
         let linkage = match Pantograph2::new(l.d, l.l1, l.l2) {
             Ok(k) => Some(k),
@@ -250,6 +287,8 @@ impl UdpDeviceFile {
                     .filter(|n| *n > 0),
                 max_stall_periods: p.max_stall_periods,
                 linkage,
+                key,
+                key_file,
             }),
             _ => Err(fail(errs)),
         }

@@ -12,7 +12,12 @@
 //! Safety in the driver itself: torques are zero until the first valid state; every torque is
 //! clamped to the device file's `torque_limit`; a non-finite torque sends a zero command and fails;
 //! [`zero_torques`](DeviceIo::zero_torques) sends a [`FLAG_LATCHED`] zero command and `Drop` a
-//! [`FLAG_BYE`]. Nothing allocates on the exchange (only the error paths format messages).
+//! [`FLAG_BYE`]. Nothing allocates on the exchange, the MAC check included (only the error paths
+//! format messages).
+//!
+//! Authentication: with a key (`protocol.key_file`) the driver speaks version 2 — a session
+//! handshake before the first poll, a MAC on every datagram, every drop counted by reason. Without
+//! one it speaks version 1, which [`UdpDevice::open`] allows only towards a loopback address.
 
 use std::net::SocketAddr;
 use std::time::{Duration, Instant};
@@ -51,7 +56,13 @@ impl UdpDevice {
         period: Duration,
         name: &str,
     ) -> Result<Self, String> {
-        let transport = UdpTransport::connect(addr)
+        if file.key.is_none() && !addr.ip().is_loopback() {
+            return Err(format!(
+                "{name}: {} has no protocol.key_file, and protocol version 1 (unauthenticated: anyone on the network could send states or commands) is allowed on loopback only\n    fix: give the device and {} a shared key (protocol.key_file, docs/DEVICE-PROTOCOL.md §6)",
+                file.source, file.source
+            ));
+        }
+        let transport = UdpTransport::connect_with(addr, file.key.clone())
             .map_err(|e| format!("{name}: cannot open a UDP socket towards {addr}: {e}"))?;
         let mut dev = Self {
             transport,
@@ -66,6 +77,23 @@ impl UdpDevice {
         };
         let start = Instant::now();
         let io = |e: std::io::Error| format!("{name}: UDP error: {e}");
+        if !dev
+            .transport
+            .handshake(start + OPEN_TIMEOUT, Duration::from_millis(50))
+            .map_err(io)?
+        {
+            let c = dev.transport.counters();
+            let why = if c.bad_mac > 0 {
+                "answers came with a MAC that does not match: the device has another key"
+            } else {
+                "no answer to the session handshake"
+            };
+            return Err(format!(
+                "{name}: no session with the device within {} ms: {why} ({c})\n    check: that the device runs at {addr} with the same key as {} (protocol version 2, e.g. devices/udp/sim_device.py --bind {addr} --key-file KEY), and that a firewall lets UDP through",
+                OPEN_TIMEOUT.as_millis(),
+                file.source
+            ));
+        }
         while start.elapsed() < OPEN_TIMEOUT {
             dev.transport.send(0, [0.0; 3]).map_err(io)?;
             if dev
@@ -78,9 +106,10 @@ impl UdpDevice {
         }
         let Some(s) = dev.transport.latest().copied() else {
             return Err(format!(
-                "{name}: no state from the device within {} ms ({})\n    check: that the device runs and listens at {addr} (try devices/udp/sim_device.py --bind {addr}), that a firewall lets UDP through, and that it speaks protocol version 1 (docs/DEVICE-PROTOCOL.md)",
+                "{name}: no state from the device within {} ms ({})\n    check: that the device runs and listens at {addr} (try devices/udp/sim_device.py --bind {addr}), that a firewall lets UDP through, and that it speaks protocol version {} (docs/DEVICE-PROTOCOL.md)",
                 OPEN_TIMEOUT.as_millis(),
-                dev.transport.counters()
+                dev.transport.counters(),
+                dev.transport.version()
             ));
         };
         if s.is_pose() != file.pose_input {

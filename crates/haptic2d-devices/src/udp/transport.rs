@@ -1,28 +1,45 @@
-//! The host side of the UDP protocol: one `std::net::UdpSocket` connected to the device, the
-//! sequence numbers and timestamps, and the accounting of what the network did to the datagrams.
+//! The host side of the UDP protocol: one `std::net::UdpSocket` that talks to the device, the
+//! session (version 2: the handshake and the MAC of every datagram, [`super::auth`]), the sequence
+//! numbers and timestamps, and the accounting of what the network did to the datagrams.
 //!
 //! One exchange: the host [`send`](UdpTransport::send)s command `k`, the device answers with one
 //! state whose `echo_seq = k`; [`wait_answer`](UdpTransport::wait_answer) reads datagrams until that
 //! answer arrives or a deadline passes (a blocking `recv` with a read timeout of the time left, so
-//! the thread sleeps in the kernel, never longer than the deadline). Every datagram is classified:
+//! the thread sleeps in the kernel, never longer than the deadline). Every datagram is classified,
+//! in this order:
 //!
-//! - *malformed*: the codec rejects it (size, magic, version, kind, bits, non-finite numbers), or it
+//! - *wrong source*: not from the device's address and port → counted, ignored (the socket is not
+//!   `connect`ed, so these are seen and counted rather than dropped silently by the kernel);
+//! - *malformed*: wrong size, magic, version or kind, undefined bits, non-finite numbers, or it
 //!   echoes a command never sent → counted, ignored;
-//! - *duplicate* / *reordered*: its device `seq` is equal to / below the highest seen → counted,
-//!   ignored (its data is older than what the host has);
-//! - *late*: newer than anything seen but answering an older command than the one pending (it
+//! - *bad MAC* (version 2): the MAC does not match the key → counted, ignored;
+//! - *wrong session* (version 2): authentic but of another session (a replay from an earlier run)
+//!   → counted, ignored;
+//! - *duplicate* / *reordered* (stale or replayed): it answers a command no newer than the one the
+//!   newest used state answered (equal / older) → counted, ignored;
+//! - *late*: answering a newer command than any answer used, but older than the pending one (it
 //!   arrived after the host stopped waiting for it) → counted, and its data is used;
 //! - *fresh*: the answer to the pending command → used; its round trip is measured from the echoed
 //!   host timestamp.
 //!
-//! Loss: a jump in the device's `seq` counts the missing states as gaps; a reordered datagram fills
-//! one, so `lost = gaps − reordered`. Nothing here allocates after [`connect`](UdpTransport::connect).
+//! Freshness is decided by `echo_seq`, the host's own command number, which the host bounds (an
+//! answer to a command never sent is malformed): no datagram can move the window beyond what the
+//! host itself sent, so a forged or corrupt device `seq` (even 2³¹ ahead) cannot make the real
+//! device's states look old. The device's `seq` only counts loss: a jump of `1 ..= MAX_SEQ_JUMP`
+//! counts the missing states as gaps (a reordered datagram fills one, so `lost = gaps − reordered`);
+//! a larger jump is counted as a *seq jump* and re-anchors the count. Nothing here allocates after
+//! [`handshake`](UdpTransport::handshake) (which reads its nonce from the system).
 
 use std::io::ErrorKind;
 use std::net::{SocketAddr, UdpSocket};
 use std::time::{Duration, Instant};
 
-use super::codec::{Command, State, COMMAND_LEN};
+use super::auth::{self, Drop2, UdpKey, COMMAND2_LEN, HELLO_LEN, STATE2_LEN};
+use super::codec::{Command, State, COMMAND_LEN, KIND_STATE, STATE_LEN};
+
+/// The largest forward jump of the device's `seq` counted as lost states; a larger one is a *seq
+/// jump* (a device restart, or a corrupt number) and re-anchors the loss count.
+pub const MAX_SEQ_JUMP: u32 = 1 << 16;
 
 /// What the network did, counted since the transport was opened.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -47,6 +64,14 @@ pub struct UdpCounters {
     pub timeouts: u64,
     /// "Connection refused" reports (ICMP port unreachable: nothing listens at the address).
     pub refused: u64,
+    /// Version 2: datagrams whose MAC did not match (forged or corrupt; ignored).
+    pub bad_mac: u64,
+    /// Version 2: authentic datagrams of another session (replayed from an earlier one; ignored).
+    pub wrong_session: u64,
+    /// Datagrams from another address or port than the device's (ignored).
+    pub wrong_source: u64,
+    /// Forward jumps of the device's `seq` beyond [`MAX_SEQ_JUMP`] (not counted as loss).
+    pub seq_jumps: u64,
 }
 
 impl UdpCounters {
@@ -54,13 +79,23 @@ impl UdpCounters {
     pub fn lost(&self) -> u64 {
         self.gaps.saturating_sub(self.reordered)
     }
+
+    /// Every datagram dropped, whatever the reason.
+    pub fn dropped(&self) -> u64 {
+        self.malformed
+            + self.bad_mac
+            + self.wrong_session
+            + self.wrong_source
+            + self.duplicates
+            + self.reordered
+    }
 }
 
 impl std::fmt::Display for UdpCounters {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "{} sent, {} received: {} fresh, {} late, {} lost, {} reordered, {} duplicate, {} malformed; {} replies timed out",
+            "{} sent, {} received: {} fresh, {} late, {} lost, {} reordered, {} duplicate, {} malformed; {} replies timed out; dropped: {} bad MAC, {} wrong session, {} wrong source, {} seq jumps",
             self.sent,
             self.received,
             self.fresh,
@@ -69,7 +104,11 @@ impl std::fmt::Display for UdpCounters {
             self.reordered,
             self.duplicates,
             self.malformed,
-            self.timeouts
+            self.timeouts,
+            self.bad_mac,
+            self.wrong_session,
+            self.wrong_source,
+            self.seq_jumps
         )
     }
 }
@@ -78,10 +117,14 @@ impl std::fmt::Display for UdpCounters {
 #[derive(Debug)]
 pub struct UdpTransport {
     socket: UdpSocket,
+    device: SocketAddr,
+    key: Option<UdpKey>,
+    session: u64,
     origin: Instant,
     seq: u32,
     pending: Option<u32>,
     highest: Option<u32>,
+    newest_echo: u32,
     latest: Option<State>,
     latest_at: Option<Instant>,
     unanswered_since: Option<Instant>,
@@ -90,26 +133,43 @@ pub struct UdpTransport {
     rtt_new: bool,
     counters: UdpCounters,
     out: [u8; COMMAND_LEN],
+    out2: [u8; COMMAND2_LEN],
+    v1: [u8; STATE_LEN],
     buf: [u8; 256],
 }
 
 impl UdpTransport {
-    /// Binds an ephemeral port of `device`'s address family and connects the socket to `device`
-    /// (so only its datagrams are received).
+    /// Binds an ephemeral port of `device`'s address family for protocol version 1 (no
+    /// authentication; [`UdpDevice::open`](super::UdpDevice::open) allows it on loopback only).
+    /// Datagrams from any other address or port are counted as *wrong source* and ignored.
     pub fn connect(device: SocketAddr) -> std::io::Result<Self> {
-        let local: SocketAddr = if device.is_ipv4() {
-            "0.0.0.0:0".parse().expect("literal address")
-        } else {
-            "[::]:0".parse().expect("literal address")
-        };
+        Self::connect_with(device, None)
+    }
+
+    /// Binds an ephemeral port for `device`: version 2 with `key` (then
+    /// [`handshake`](Self::handshake) before the first command), version 1 without.
+    pub fn connect_with(device: SocketAddr, key: Option<UdpKey>) -> std::io::Result<Self> {
+        // A device on loopback is answered from loopback only: nothing from the network reaches
+        // this socket at all.
+        let local: SocketAddr = match (device.is_ipv4(), device.ip().is_loopback()) {
+            (true, true) => "127.0.0.1:0",
+            (true, false) => "0.0.0.0:0",
+            (false, true) => "[::1]:0",
+            (false, false) => "[::]:0",
+        }
+        .parse()
+        .expect("literal address");
         let socket = UdpSocket::bind(local)?;
-        socket.connect(device)?;
         Ok(Self {
             socket,
+            device,
+            key,
+            session: 0,
             origin: Instant::now(),
             seq: 0,
             pending: None,
             highest: None,
+            newest_echo: 0,
             latest: None,
             latest_at: None,
             unanswered_since: None,
@@ -118,8 +178,99 @@ impl UdpTransport {
             rtt_new: false,
             counters: UdpCounters::default(),
             out: [0; COMMAND_LEN],
+            out2: [0; COMMAND2_LEN],
+            v1: [0; STATE_LEN],
             buf: [0; 256],
         })
+    }
+
+    /// The protocol version spoken: 2 with a key, else 1.
+    pub fn version(&self) -> u8 {
+        if self.key.is_some() {
+            2
+        } else {
+            1
+        }
+    }
+
+    /// The session id (version 2, after the handshake; 0 before and in version 1).
+    pub fn session(&self) -> u64 {
+        self.session
+    }
+
+    /// Version 2: opens a session. Sends a `HELLO` with a fresh host nonce every `retry` until a
+    /// `WELCOME` answering it arrives (authentic, echoing this nonce) or `deadline` passes. Returns
+    /// whether the session is open; what else arrives meanwhile is counted. Version 1: `true`.
+    pub fn handshake(&mut self, deadline: Instant, retry: Duration) -> std::io::Result<bool> {
+        let Some(key) = self.key.clone() else {
+            return Ok(true);
+        };
+        let hn = auth::nonce()?;
+        let hello: [u8; HELLO_LEN] = key.hello(&hn);
+        loop {
+            let now = Instant::now();
+            if now >= deadline {
+                return Ok(false);
+            }
+            self.send_raw_hello(&hello)?;
+            let until = (now + retry).min(deadline);
+            while let Some(n) = self.recv_until(until)? {
+                let b = &self.buf[..n];
+                match key.check_welcome(b, &hn) {
+                    Ok(sid) => {
+                        self.session = sid;
+                        return Ok(true);
+                    }
+                    Err(Drop2::BadMac) => self.counters.bad_mac += 1,
+                    Err(Drop2::WrongSession) => self.counters.wrong_session += 1,
+                    Err(Drop2::Malformed) => self.counters.malformed += 1,
+                }
+            }
+        }
+    }
+
+    fn send_raw_hello(&mut self, hello: &[u8]) -> std::io::Result<()> {
+        match self.socket.send_to(hello, self.device) {
+            Ok(_) => Ok(()),
+            Err(e) if e.kind() == ErrorKind::ConnectionRefused => {
+                self.counters.refused += 1;
+                Ok(())
+            }
+            Err(e) => Err(e),
+        }
+    }
+
+    /// Receives one datagram from the device before `until` (its length in `buf`), counting and
+    /// skipping those from elsewhere; `None` at the deadline.
+    fn recv_until(&mut self, until: Instant) -> std::io::Result<Option<usize>> {
+        loop {
+            let now = Instant::now();
+            if now >= until {
+                return Ok(None);
+            }
+            self.socket
+                .set_read_timeout(Some((until - now).max(Duration::from_micros(1))))?;
+            match self.socket.recv_from(&mut self.buf) {
+                Ok((n, from)) => {
+                    self.counters.received += 1;
+                    if from != self.device {
+                        self.counters.wrong_source += 1;
+                        continue;
+                    }
+                    return Ok(Some(n));
+                }
+                Err(e)
+                    if matches!(
+                        e.kind(),
+                        ErrorKind::WouldBlock | ErrorKind::TimedOut | ErrorKind::Interrupted
+                    ) => {}
+                Err(e) if e.kind() == ErrorKind::ConnectionRefused => {
+                    self.counters.refused += 1;
+                    std::thread::sleep(until.saturating_duration_since(Instant::now()));
+                }
+                Err(e) => return Err(e),
+            }
+        }
     }
 
     /// Host clock (ns since the transport was opened), the timestamp put in commands.
@@ -146,7 +297,14 @@ impl UdpTransport {
         if self.unanswered_since.is_none() {
             self.unanswered_since = Some(Instant::now());
         }
-        match self.socket.send(&self.out) {
+        let sent = match &self.key {
+            Some(key) => {
+                key.command2(self.session, &self.out, &mut self.out2);
+                self.socket.send_to(&self.out2, self.device)
+            }
+            None => self.socket.send_to(&self.out, self.device),
+        };
+        match sent {
             Ok(_) => Ok(self.seq),
             // A previous datagram's ICMP "port unreachable" surfaces on the next call.
             Err(e) if e.kind() == ErrorKind::ConnectionRefused => {
@@ -183,8 +341,8 @@ impl UdpTransport {
             self.socket
                 .set_read_timeout(Some((deadline - now).max(Duration::from_micros(1))))?;
             self.socket.set_nonblocking(false)?;
-            match self.socket.recv(&mut self.buf) {
-                Ok(n) => self.classify(n),
+            match self.socket.recv_from(&mut self.buf) {
+                Ok((n, from)) => self.classify(n, from),
                 // Interrupted: a signal, or SIGSTOP/SIGCONT (job control, a suspended VM) on a
                 // socket with a read timeout; the loop re-checks the deadline.
                 Err(e)
@@ -206,15 +364,15 @@ impl UdpTransport {
     fn drain_one(&mut self) -> std::io::Result<bool> {
         self.socket.set_nonblocking(true)?;
         let r = loop {
-            match self.socket.recv(&mut self.buf) {
+            match self.socket.recv_from(&mut self.buf) {
                 Err(e) if e.kind() == ErrorKind::Interrupted => continue,
                 r => break r,
             }
         };
         self.socket.set_nonblocking(false)?;
         match r {
-            Ok(n) => {
-                self.classify(n);
+            Ok((n, from)) => {
+                self.classify(n, from);
                 Ok(true)
             }
             Err(e) if e.kind() == ErrorKind::WouldBlock => Ok(false),
@@ -226,29 +384,60 @@ impl UdpTransport {
         }
     }
 
-    fn classify(&mut self, n: usize) {
+    fn classify(&mut self, n: usize, from: SocketAddr) {
         self.counters.received += 1;
-        let s = match State::decode(&self.buf[..n.min(self.buf.len())]) {
-            Ok(s) if s.echo_seq <= self.seq => s,
+        if from != self.device {
+            self.counters.wrong_source += 1;
+            return;
+        }
+        let b = &self.buf[..n.min(self.buf.len())];
+        let decoded = match &self.key {
+            Some(key) => match key.open2(b, KIND_STATE, STATE2_LEN, self.session, &mut self.v1) {
+                Ok(()) => State::decode(&self.v1),
+                Err(Drop2::BadMac) => {
+                    self.counters.bad_mac += 1;
+                    return;
+                }
+                Err(Drop2::WrongSession) => {
+                    self.counters.wrong_session += 1;
+                    return;
+                }
+                Err(Drop2::Malformed) => {
+                    self.counters.malformed += 1;
+                    return;
+                }
+            },
+            None => State::decode(b),
+        };
+        // An answer to a command this host never sent (seq 0, or ahead of its own counter).
+        let s = match decoded {
+            Ok(s) if s.echo_seq != 0 && s.echo_seq <= self.seq => s,
             _ => {
                 self.counters.malformed += 1;
                 return;
             }
         };
+        // Stale or replayed: it answers a command no newer than the newest state used did.
+        if s.echo_seq == self.newest_echo {
+            self.counters.duplicates += 1;
+            return;
+        }
+        if s.echo_seq < self.newest_echo {
+            self.counters.reordered += 1;
+            return;
+        }
         if let Some(h) = self.highest {
-            if s.seq == h {
-                self.counters.duplicates += 1;
-                return;
-            }
-            // Sequence arithmetic modulo 2³²: "older" means less than half the range behind.
+            // Sequence arithmetic modulo 2³²: a gap of 1 ..= MAX_SEQ_JUMP is loss, anything else
+            // (a restart, a corrupt or forged number) re-anchors.
             let ahead = s.seq.wrapping_sub(h);
-            if ahead > u32::MAX / 2 {
-                self.counters.reordered += 1;
-                return;
+            if (1..=MAX_SEQ_JUMP).contains(&ahead) {
+                self.counters.gaps += u64::from(ahead - 1);
+            } else {
+                self.counters.seq_jumps += 1;
             }
-            self.counters.gaps += u64::from(ahead - 1);
         }
         self.highest = Some(s.seq);
+        self.newest_echo = s.echo_seq;
         let now = Instant::now();
         if Some(s.echo_seq) == self.pending {
             self.pending = None;
@@ -305,6 +494,11 @@ impl UdpTransport {
 
     /// The device's address.
     pub fn peer(&self) -> std::io::Result<SocketAddr> {
-        self.socket.peer_addr()
+        Ok(self.device)
+    }
+
+    /// This end's own address (the host's port; tests send to it).
+    pub fn local_addr(&self) -> std::io::Result<SocketAddr> {
+        self.socket.local_addr()
     }
 }

@@ -43,3 +43,53 @@ pub fn spawn_echo_device(delay: Duration) -> SocketAddr {
     });
     addr
 }
+
+/// The same device speaking protocol version 2 with `key`: answers a HELLO with a WELCOME, and
+/// every authentic command of its session with an authentic state.
+#[allow(dead_code)]
+pub fn spawn_echo_device_v2(key: haptic2d_devices::udp::UdpKey) -> SocketAddr {
+    use haptic2d_devices::udp::auth::{COMMAND2_LEN, HELLO_LEN, NONCE_LEN, STATE2_LEN};
+    use haptic2d_devices::udp::codec::{COMMAND_LEN, KIND_COMMAND};
+    let sock = UdpSocket::bind("127.0.0.1:0").unwrap();
+    let addr = sock.local_addr().unwrap();
+    thread::spawn(move || {
+        let mut buf = [0u8; 256];
+        let (mut seq, mut session) = (0, 0);
+        while let Ok((n, peer)) = sock.recv_from(&mut buf) {
+            if n == HELLO_LEN && key.verify(&buf[..n]) {
+                let mut hn = [0u8; NONCE_LEN];
+                hn.copy_from_slice(&buf[12..12 + NONCE_LEN]);
+                session = key.session_id(&hn, &[7; NONCE_LEN]);
+                let _ = sock.send_to(&key.welcome(&hn, &[7; NONCE_LEN]), peer);
+                continue;
+            }
+            let mut v1 = [0u8; COMMAND_LEN];
+            if key
+                .open2(&buf[..n], KIND_COMMAND, COMMAND2_LEN, session, &mut v1)
+                .is_err()
+            {
+                continue;
+            }
+            let Ok(c) = Command::decode(&v1) else {
+                continue;
+            };
+            seq += 1;
+            let mut out = [0u8; STATE_LEN];
+            State {
+                seq,
+                echo_seq: c.seq,
+                status: 0,
+                device_time_ns: 0,
+                echo_host_ns: c.host_time_ns,
+                position: ECHO_POSITION,
+                velocity: [0.0; 3],
+                force: [0.0; 3],
+            }
+            .encode(&mut out);
+            let mut out2 = [0u8; STATE2_LEN];
+            key.state2(session, &out, &mut out2);
+            let _ = sock.send_to(&out2, peer);
+        }
+    });
+    addr
+}
