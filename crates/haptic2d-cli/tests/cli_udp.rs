@@ -182,8 +182,9 @@ fn proxy(device: SocketAddr, mischief: Mischief) -> Proxy {
 fn run_against_the_python_reference_device_for_3_s_exits_clean() {
     let _t = turn();
     let Some(dev) = sim_device(&[]) else {
-        eprintln!("python3 not found: skipped");
-        return;
+        panic!(
+            "python3 not found: this test needs it (bash scripts/install-test-deps.sh installs it)"
+        );
     };
     let file = device_file("clean");
     let o = run(dev.1, &file, "3").output().unwrap();
@@ -222,8 +223,9 @@ fn run_with_a_key_file_speaks_version_2_and_drops_nothing() {
     )
     .unwrap();
     let Some(dev) = sim_device(&["--key-file", key.to_str().unwrap()]) else {
-        eprintln!("python3 not found: skipped");
-        return;
+        panic!(
+            "python3 not found: this test needs it (bash scripts/install-test-deps.sh installs it)"
+        );
     };
     let o = run(dev.1, &file, "2").output().unwrap();
     let out = text(&o);
@@ -291,8 +293,9 @@ fn multicast_broadcast_and_remote_addresses_are_refused_or_need_the_flag() {
 fn a_pushed_handle_drives_the_box_into_the_wall_and_feels_it() {
     let _t = turn();
     let Some(dev) = sim_device(&["--push=-0.8,0", "--push-after", "0.3", "--k-hand", "0"]) else {
-        eprintln!("python3 not found: skipped");
-        return;
+        panic!(
+            "python3 not found: this test needs it (bash scripts/install-test-deps.sh installs it)"
+        );
     };
     let file = device_file("wall");
     let log = file.with_file_name("wall.csv");
@@ -352,8 +355,9 @@ fn a_pushed_handle_drives_the_box_into_the_wall_and_feels_it() {
 fn loss_and_reordering_through_a_proxy_are_counted_and_survived() {
     let _t = turn();
     let Some(dev) = sim_device(&[]) else {
-        eprintln!("python3 not found: skipped");
-        return;
+        panic!(
+            "python3 not found: this test needs it (bash scripts/install-test-deps.sh installs it)"
+        );
     };
     let p = proxy(dev.1, Mischief::LossAndReorder { drop: 17, swap: 23 });
     let file = device_file("loss");
@@ -374,8 +378,9 @@ fn loss_and_reordering_through_a_proxy_are_counted_and_survived() {
 fn malformed_datagrams_are_counted_and_ignored() {
     let _t = turn();
     let Some(dev) = sim_device(&[]) else {
-        eprintln!("python3 not found: skipped");
-        return;
+        panic!(
+            "python3 not found: this test needs it (bash scripts/install-test-deps.sh installs it)"
+        );
     };
     let p = proxy(dev.1, Mischief::Garbage { every: 3 });
     let file = device_file("garbage");
@@ -402,8 +407,9 @@ fn malformed_datagrams_are_counted_and_ignored() {
 fn device_killed_mid_run_exits_4_naming_the_device() {
     let _t = turn();
     let Some(mut dev) = sim_device(&[]) else {
-        eprintln!("python3 not found: skipped");
-        return;
+        panic!(
+            "python3 not found: this test needs it (bash scripts/install-test-deps.sh installs it)"
+        );
     };
     let file = device_file("kill");
     let child = run(dev.1, &file, "20")

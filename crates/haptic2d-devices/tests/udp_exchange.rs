@@ -1,6 +1,6 @@
 //! The UDP driver against devices on loopback: an in-test device (a thread speaking the protocol,
 //! which can drop, reorder, garble or stop answering) and the reference device
-//! devices/udp/sim_device.py in another process (skipped when `python3` is missing).
+//! devices/udp/sim_device.py in another process (a missing `python3` fails the test with the install hint).
 
 use std::net::{SocketAddr, UdpSocket};
 use std::process::{Child, Command as Process, Stdio};
@@ -304,8 +304,9 @@ fn sim_device(extra: &[&str]) -> Option<(Python, SocketAddr)> {
 #[test]
 fn the_python_reference_device_answers_at_its_start_pose() {
     let Some((_py, addr)) = sim_device(&[]) else {
-        eprintln!("python3 not found: skipped");
-        return;
+        panic!(
+            "python3 not found: this test needs it (bash scripts/install-test-deps.sh installs it)"
+        );
     };
     // A patient timeout: a Python process descheduled for a few ms on a loaded machine is not
     // what this test is about.
@@ -327,8 +328,9 @@ fn the_python_reference_device_answers_at_its_start_pose() {
 #[test]
 fn the_python_reference_device_in_pose_mode_gives_the_same_angles() {
     let Some((_py, addr)) = sim_device(&["--pose"]) else {
-        eprintln!("python3 not found: skipped");
-        return;
+        panic!(
+            "python3 not found: this test needs it (bash scripts/install-test-deps.sh installs it)"
+        );
     };
     let mut file = UdpDeviceFile::reference();
     file.timeout_periods = 50.0;
@@ -392,8 +394,7 @@ fn c_device() -> Option<(Python, SocketAddr)> {
 #[test]
 fn the_c_reference_device_builds_and_answers_like_the_python_one() {
     let Some((_c, addr)) = c_device() else {
-        eprintln!("cc not found: skipped");
-        return;
+        panic!("cc not found: this test builds the C reference device (bash scripts/install-test-deps.sh installs gcc)");
     };
     let mut file = UdpDeviceFile::reference();
     file.timeout_periods = 50.0;
