@@ -58,7 +58,8 @@ pub struct ContactSet {
     /// Thresholds and options.
     pub params: ContactParams,
     entries: Vec<VeContact>,
-    /// The Continuous records that pushed in the last force pass, in key order, their keys, and
+    /// The Continuous records that pushed in the last force pass (not struck in it, not approaching
+    /// faster than `v_c`), in key order, their keys, and
     /// the number of the keys' version ([`Loaded`]).
     loaded: Vec<LoadedContact>,
     loaded_keys: Vec<VeCandidate>,
@@ -163,7 +164,8 @@ impl ContactSet {
         &self.entries
     }
 
-    /// The Continuous records whose normal law pushed in the last sample (`f_n > 0`), in key
+    /// The Continuous records whose normal law pushed in the last sample (`f_n > 0`), were not
+    /// struck in it and do not approach faster than `v_c` (issue 35, docs/MODELS.md §7.6), in key
     /// order, with what later passes need of them (the chain damper).
     #[inline]
     pub fn loaded(&self) -> Loaded<'_> {
