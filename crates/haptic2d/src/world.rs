@@ -447,6 +447,9 @@ impl World {
             &mut self.stage_times,
         );
         let mut lap = Lap::start();
+        // Issue 35: the contacts struck in this sample carry its loads (docs/MODELS.md §7.6).
+        self.contacts
+            .carry_forces(dt, &mut self.bodies, &self.held, &mut self.contact_wrench);
         self.ledger.impact_loss += self.contacts.last_impact_loss;
         self.ledger.impact_energy_fallbacks = self.contacts.impact_energy_fallbacks();
         if let Some(g) = self.guard.as_mut() {

@@ -93,13 +93,16 @@ fn tall_column_comes_to_rest_within_5_s() {
     let v = max_speed(&w);
     eprintln!("column of 40, chain damper on, after 5 s: largest speed {v:.5} m/s");
     assert!(
-        v < REST_SPEED,
+        v < REST_SPEED / 10.0,
         "column of 40 after 5 s: largest speed {v} m/s"
     );
 }
 
-/// The same column with the chain damper off does not come to rest in 5 s: the failure this
-/// damper fixes (so the test above can fail).
+/// The same column with the chain damper off is still moving after 5 s: the failure this
+/// damper fixes (so the test above can fail). Since issue 35 the impacts of the landing take the
+/// whole column (docs/MODELS.md §7.6) and pump it far less: the undamped column is at 3.5 mm/s
+/// after 5 s (7.9 mm/s at 2.5 s; above 1 cm/s before), the damped one at 4e-7 m/s (8e-4 m/s at
+/// 2 s), so the pair is told apart at `REST_SPEED / 10` = 1 mm/s.
 #[test]
 fn tall_column_without_chain_damper_keeps_moving() {
     let mut w = column(40);
@@ -108,7 +111,7 @@ fn tall_column_without_chain_damper_keeps_moving() {
     let v = max_speed(&w);
     eprintln!("column of 40, chain damper off, after 5 s: largest speed {v:.5} m/s");
     assert!(
-        v > REST_SPEED,
+        v > REST_SPEED / 10.0,
         "column of 40 without the damper after 5 s: {v} m/s"
     );
 }

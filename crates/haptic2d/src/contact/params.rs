@@ -25,11 +25,14 @@ pub struct ContactParams {
     pub impact_friction: super::ImpactFriction,
     /// Impact friction coefficient `μ` (dimensionless); `None` = the contact friction model's `μ_k`.
     pub impact_mu: Option<f64>,
-    /// Whether a resolved impact's record starts its normal law at the depth found at detection
-    /// (issue 16, docs/MODELS.md §F.7): `false` (default) is §7.2 step 4, the §5.9 law acts on the
-    /// whole remaining penetration from the impact sample on; `true` moves the law's surface in to
-    /// the depth gained in the detection sample and restarts its SEH history, so the rebound is the
-    /// restitution law's alone ([`ContactNormal`](crate::laws::normal::ContactNormal)).
+    /// Whether the restitution law alone sets the rebound (issue 35; default `true`,
+    /// docs/MODELS.md §7.6): a resolved impact's record starts its normal law at the depth found
+    /// at detection (the law's surface moves in to the depth gained in the detection sample and
+    /// its SEH history restarts, [`ContactNormal`](crate::laws::normal::ContactNormal)), so no
+    /// spring pays that depth back, and the struck contacts carry the impact sample's other forces
+    /// (loads, drive), so the sample ends at `−e` times the arrival velocity. `false` is the
+    /// paper's §7.2 step 4 (the §5.9 law acts on the whole remaining penetration from the impact
+    /// sample on; the Fig. 4 2-D reproduction uses it, as its 1-D harness does).
     pub impact_surface_offset: bool,
 }
 
@@ -46,7 +49,7 @@ impl Default for ContactParams {
             eps_v: 1e-6,
             impact_friction: super::ImpactFriction::None,
             impact_mu: None,
-            impact_surface_offset: false,
+            impact_surface_offset: true,
         }
     }
 }

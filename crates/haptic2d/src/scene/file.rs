@@ -85,8 +85,9 @@ pub struct ContactSection {
     pub impact_friction: Option<String>,
     /// Impact friction coefficient μ (dimensionless, ≥ 0); default the friction model's μ_k.
     pub impact_mu: Option<f64>,
-    /// Impact records start their normal law at the detection depth (default false, §7.2 step 4;
-    /// docs/MODELS.md §F.7).
+    /// The restitution law alone sets the rebound: impact records start their normal law at the
+    /// detection depth and the struck contacts carry the impact sample's loads (default true since
+    /// issue 35, docs/MODELS.md §7.6; false = §7.2 step 4 as written).
     pub impact_surface_offset: Option<bool>,
 }
 

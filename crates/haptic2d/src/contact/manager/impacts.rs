@@ -1,48 +1,104 @@
 //! Stage 5 of the contact step (§7): the impact set (Colliding records, and Continuous ones touching
 //! a colliding body), solved island by island; velocity jumps applied to the bodies now.
 
-use super::ContactSet;
+use super::{ContactSet, Wrench2};
 use crate::body::Body;
 use crate::contact::impact::ImpactRow;
 use crate::contact::record::{ContactEvent, ContactState, EventKind};
+use crate::contact::ImpactFriction;
+use crate::geom::cross;
 
 impl ContactSet {
-    /// §7: every Colliding record (restitution `e`) and every Continuous record touching a body of a
-    /// colliding one (restitution 0) form the impact set; velocity jumps are applied to `bodies` now.
+    /// §7: every Colliding record (restitution `e`) and every Continuous record of the same island
+    /// of touching bodies (restitution 0; issue 35: the whole island, not one level of
+    /// neighbours, §7.1) form the impact set; velocity jumps are applied to `bodies` now.
     pub(super) fn resolve_impacts(&mut self, tick: u64, bodies: &mut [Body]) {
+        // Islands of touching bodies: union–find over every record between two dynamic bodies
+        // (fixed bodies connect nothing); an island is struck if one of its records collides.
+        for (i, p) in self.parent.iter_mut().enumerate() {
+            *p = i as u32;
+        }
+        for e in &self.entries {
+            if e.state.is_some() && bodies[e.body_a].is_dynamic() && bodies[e.body_b].is_dynamic() {
+                let (a, b) = (
+                    find(&mut self.parent, e.body_a as u32),
+                    find(&mut self.parent, e.body_b as u32),
+                );
+                if a != b {
+                    let (lo, hi) = if a < b { (a, b) } else { (b, a) };
+                    self.parent[hi as usize] = lo;
+                }
+            }
+        }
         for f in self.body_flag.iter_mut() {
             *f = false;
         }
         for e in &self.entries {
             if e.state == Some(ContactState::Colliding) {
-                self.body_flag[e.body_a] |= bodies[e.body_a].is_dynamic();
-                self.body_flag[e.body_b] |= bodies[e.body_b].is_dynamic();
+                let b = if bodies[e.body_a].is_dynamic() {
+                    e.body_a
+                } else {
+                    e.body_b
+                };
+                let root = find(&mut self.parent, b as u32) as usize;
+                self.body_flag[root] = true;
             }
         }
         self.rows.clear();
         self.row_entry.clear();
-        for (idx, e) in self.entries.iter().enumerate() {
+        self.struck_entry.clear();
+        self.carry_rows.clear();
+        // An island can hold every record: room for all of them, grown with the records (whose
+        // own growth allocates anyway), so a landing pile's impacts allocate nothing new.
+        let most = self.entries.len();
+        self.rows.reserve(most);
+        self.row_entry.reserve(most);
+        self.carry_rows.reserve(most);
+        self.struck_entry.reserve(most);
+        self.island_rows.reserve(most);
+        self.row_order.reserve(most);
+        self.row_island.reserve(most);
+        self.solver.reserve(most);
+        for idx in 0..self.entries.len() {
+            let e = &self.entries[idx];
             let restitution = match e.state {
                 Some(ContactState::Colliding) => self.params.restitution,
-                Some(ContactState::Continuous)
-                    if self.body_flag[e.body_a] || self.body_flag[e.body_b] =>
-                {
+                Some(ContactState::Continuous) => {
+                    let b = if bodies[e.body_a].is_dynamic() {
+                        e.body_a
+                    } else {
+                        e.body_b
+                    };
+                    if !bodies[b].is_dynamic()
+                        || !self.body_flag[find(&mut self.parent, b as u32) as usize]
+                    {
+                        continue;
+                    }
                     0.0
                 }
                 _ => continue,
             };
-            self.rows.push(ImpactRow {
+            let e = &self.entries[idx];
+            let row = ImpactRow {
                 body_a: e.body_a,
                 body_b: e.body_b,
                 n: e.n,
                 r_a: e.point - bodies[e.body_a].pose.pos,
                 r_b: e.point - bodies[e.body_b].pose.pos,
                 restitution,
-            });
+            };
+            if e.state == Some(ContactState::Colliding) {
+                self.struck_entry.push(idx);
+                self.carry_rows.push(ImpactRow {
+                    restitution: 0.0,
+                    ..row
+                });
+            }
+            self.rows.push(row);
             self.row_entry.push(idx);
         }
         let before: f64 = bodies.iter().map(|b| b.kinetic_energy()).sum();
-        self.solve_islands(bodies);
+        self.solve_islands(bodies, None);
         let after: f64 = bodies.iter().map(|b| b.kinetic_energy()).sum();
         self.last_impact_loss = before - after;
         self.impacts_solved += 1;
@@ -72,22 +128,72 @@ impl ContactSet {
         }
     }
 
+    /// Issue 35 item 3 (with `impact_surface_offset`, docs/MODELS.md §7.6): the contacts struck
+    /// in this sample carry the sample's other forces, so the restitution law sets the velocity
+    /// at the *end* of the impact sample, `u_{k+1} = −e·u_k` on each colliding contact, instead
+    /// of `−e·u_k` less the sample's loads (`e·|v| − g·T` for a drop).
+    ///
+    /// Called by the world after the contact step (`World::begin_step`), with the sample's load
+    /// wrenches `loads` (N, N·m per body) and the contact wrenches `wrenches` of the force pass:
+    /// with `Δu = T·M⁻¹·F` the velocity change those forces and the plant damping would give the
+    /// bodies over the sample, the carried impulses `p ≥ 0` on the colliding rows solve the
+    /// compression LCP `w = G·Δu + A·p ≥ 0`, `p ⟂ w` (the impact solver, restitution 0, frictionless),
+    /// so no colliding contact's normal velocity drops over the sample while `p > 0`, and `p = 0`
+    /// where the forces already separate it. They are added to `wrenches` as forces `p/T` held over
+    /// the sample (the contact wrench a device reads includes them). The bodies' velocities are
+    /// restored: only the wrenches change. Nothing to do unless this sample resolved an impact
+    /// (and `impact_surface_offset` is on: the paper's §7.2 step 4 carries nothing).
+    ///
+    /// The drive (a device's coupling force `f_cs`, §11) is not carried: it is the hand's push on
+    /// the slave, which the impact sample should feel, and carrying it would let the contact do
+    /// work on the device port (the box-in-walls coupling run's passivity observer went to
+    /// −0.04 J with it).
+    pub fn carry_forces(
+        &mut self,
+        dt: f64,
+        bodies: &mut [Body],
+        loads: &[Wrench2],
+        wrenches: &mut [Wrench2],
+    ) {
+        if self.carry_rows.is_empty() || dt <= 0.0 || !self.params.impact_surface_offset {
+            return;
+        }
+        self.carry_saved.clear();
+        self.carry_delta.clear();
+        for ((b, w), l) in bodies.iter_mut().zip(wrenches.iter()).zip(loads) {
+            self.carry_saved.push((b.vel, b.omega));
+            if b.is_dynamic() {
+                let f = l.force + w.force - b.vel * b.damping;
+                b.vel = f * (dt * b.inv_mass);
+                b.omega = (l.torque + w.torque) * dt * b.inv_inertia;
+            }
+            self.carry_delta.push((b.vel, b.omega));
+        }
+        std::mem::swap(&mut self.rows, &mut self.carry_rows);
+        // Frictionless: the carry is normal only (the next impact sets the mode again).
+        self.solver.set_friction(ImpactFriction::None, 0.0);
+        self.solve_islands(bodies, Some((&mut *wrenches, dt)));
+        std::mem::swap(&mut self.rows, &mut self.carry_rows);
+        let inv_dt = 1.0 / dt;
+        for (i, b) in bodies.iter_mut().enumerate() {
+            let ((v, omega), (dv, domega)) = (self.carry_saved[i], self.carry_delta[i]);
+            if b.is_dynamic() {
+                wrenches[i].force += (b.vel - dv) * (b.mass * inv_dt);
+                wrenches[i].torque += (b.omega - domega) * (b.inertia * inv_dt);
+            }
+            b.vel = v;
+            b.omega = omega;
+        }
+    }
+
     /// Solves the impact set island by island: rows that share no dynamic body are independent (the
     /// Delassus matrix is block diagonal), so each connected component is its own small LCP. Islands
     /// are taken in the order of their root body, rows in key order: the result is deterministic and
     /// identical to solving the whole set at once.
-    fn solve_islands(&mut self, bodies: &mut [Body]) {
+    fn solve_islands(&mut self, bodies: &mut [Body], mut reactions: Option<(&mut [Wrench2], f64)>) {
         // Union–find over dynamic bodies (fixed bodies connect nothing).
         for (i, p) in self.parent.iter_mut().enumerate() {
             *p = i as u32;
-        }
-        fn find(parent: &mut [u32], mut i: u32) -> u32 {
-            while parent[i as usize] != i {
-                let g = parent[parent[i as usize] as usize];
-                parent[i as usize] = g;
-                i = g;
-            }
-            i
         }
         for r in &self.rows {
             if bodies[r.body_a].is_dynamic() && bodies[r.body_b].is_dynamic() {
@@ -128,6 +234,30 @@ impl ContactSet {
                 k += 1;
             }
             self.solver.solve_island(&self.island_rows, bodies);
+            // Fixed bodies' share of the impulses, as forces held over `T` (the carry).
+            if let Some((w, dt)) = reactions.as_mut() {
+                for (r, &p) in self.island_rows.iter().zip(self.solver.impulses()) {
+                    let f = r.n * (p / *dt);
+                    if !bodies[r.body_a].is_dynamic() {
+                        w[r.body_a].force += f;
+                        w[r.body_a].torque += cross(r.r_a, f);
+                    }
+                    if !bodies[r.body_b].is_dynamic() {
+                        w[r.body_b].force -= f;
+                        w[r.body_b].torque -= cross(r.r_b, f);
+                    }
+                }
+            }
         }
     }
+}
+
+/// The root of `i` in the union–find forest `parent` (path halving).
+fn find(parent: &mut [u32], mut i: u32) -> u32 {
+    while parent[i as usize] != i {
+        let g = parent[parent[i as usize] as usize];
+        parent[i as usize] = g;
+        i = g;
+    }
+    i
 }

@@ -58,7 +58,8 @@ pub struct ContactSet {
     /// Thresholds and options.
     pub params: ContactParams,
     entries: Vec<VeContact>,
-    /// The Continuous records that pushed in the last force pass, in key order, their keys, and
+    /// The Continuous records that pushed in the last force pass (not struck in it, not approaching
+    /// faster than `v_c`), in key order, their keys, and
     /// the number of the keys' version ([`Loaded`]).
     loaded: Vec<LoadedContact>,
     loaded_keys: Vec<VeCandidate>,
@@ -70,7 +71,16 @@ pub struct ContactSet {
     pending: Vec<VeContact>,
     events: Vec<ContactEvent>,
     rows: Vec<ImpactRow>,
+    /// The entries (indices) of this sample's impact set, ascending (empty without an impact).
     row_entry: Vec<usize>,
+    /// The entries of this sample's colliding records, ascending: the chain damper leaves them
+    /// alone (issue 35).
+    struck_entry: Vec<usize>,
+    /// The colliding rows of this sample's impact set with restitution 0: the contacts that carry
+    /// the sample's forces (`carry_forces`), and scratch twists of the carry.
+    carry_rows: Vec<ImpactRow>,
+    carry_saved: Vec<(Vec2, f64)>,
+    carry_delta: Vec<(Vec2, f64)>,
     solver: ImpactSolver,
     body_flag: Vec<bool>,
     parent: Vec<u32>,
@@ -114,6 +124,10 @@ impl ContactSet {
             events: Vec::with_capacity(64),
             rows: Vec::with_capacity(16),
             row_entry: Vec::with_capacity(16),
+            struck_entry: Vec::with_capacity(16),
+            carry_rows: Vec::with_capacity(16),
+            carry_saved: Vec::new(),
+            carry_delta: Vec::new(),
             solver: ImpactSolver::new(),
             body_flag: Vec::new(),
             parent: Vec::new(),
@@ -150,7 +164,8 @@ impl ContactSet {
         &self.entries
     }
 
-    /// The Continuous records whose normal law pushed in the last sample (`f_n > 0`), in key
+    /// The Continuous records whose normal law pushed in the last sample (`f_n > 0`), were not
+    /// struck in it and do not approach faster than `v_c` (issue 35, docs/MODELS.md §7.6), in key
     /// order, with what later passes need of them (the chain damper).
     #[inline]
     pub fn loaded(&self) -> Loaded<'_> {
@@ -302,6 +317,9 @@ impl ContactSet {
         let mut lap = Lap::start();
         self.events.clear();
         self.last_impact_loss = 0.0;
+        self.row_entry.clear();
+        self.struck_entry.clear();
+        self.carry_rows.clear();
         self.resize_body_buffers(bodies.len());
         self.laws.prepare(normal, friction);
         let work = self.sync(tick, candidates, from_scan, colliders, bodies, rots, past);
@@ -340,6 +358,8 @@ impl ContactSet {
             self.parent.resize(n, 0);
             self.new_count.resize(n, 0);
             self.nonfric.resize(n, Vec2::ZERO);
+            self.carry_saved.reserve(n);
+            self.carry_delta.reserve(n);
         }
     }
 }
