@@ -227,9 +227,9 @@ impl ReplayDevice {
             Some(i) => (i, columns),
             None if columns == DEFAULT_REPLAY_COLUMNS => match find(&LOGGED_ENCODER_COLUMNS) {
                 Some(i) => (i, LOGGED_ENCODER_COLUMNS),
-                None => return Err(no_columns(label, &header)),
+                None => return Err(no_columns(label, &header, &columns)),
             },
-            None => return Err(no_columns(label, &header)),
+            None => return Err(no_columns(label, &header, &columns)),
         };
         let mut samples = Vec::new();
         let mut rec = csv::StringRecord::new();
@@ -296,11 +296,18 @@ impl ReplayDevice {
     }
 }
 
-/// The error of a replay CSV without encoder columns: what it has, what it needs, where to get it.
-fn no_columns(label: &str, header: &csv::StringRecord) -> String {
+/// The error of a replay CSV without encoder columns: which are missing, what it has, where to get
+/// them.
+fn no_columns(label: &str, header: &csv::StringRecord, columns: &[&str; 4]) -> String {
     let found: Vec<&str> = header.iter().take(40).collect();
+    let missing: Vec<String> = columns
+        .iter()
+        .filter(|c| !header.iter().any(|h| h == **c))
+        .map(|c| format!("`{c}`"))
+        .collect();
     format!(
-        "{label}: no encoder columns: a replay reads q1,q2,q3,q4 or encoders.q1..encoders.q4 (rad), found: {}{}\n    fix: `haptic2d log convert RUN.mcap RUN.csv` writes encoders.q1..q4 from an MCAP run log, or replay the MCAP log itself (--device replay:RUN.mcap)",
+        "{label}: no column {} (a replay reads the encoder angles q1,q2,q3,q4 or encoders.q1..encoders.q4, rad); columns found: {}{}\n    fix: `haptic2d log convert RUN.mcap RUN.csv` writes encoders.q1..q4 from an MCAP run log, or replay the MCAP log itself (--device replay:RUN.mcap)",
+        missing.join(", "),
         found.join(", "),
         if header.len() > found.len() { ", …" } else { "" }
     )
@@ -392,7 +399,7 @@ mod replay_cap_tests {
     fn replay_without_encoder_columns_names_what_it_needs_and_where_to_get_it() {
         let e = ReplayDevice::from_reader(&b"t,x\n0,1\n"[..], "run.csv", COLS, ReplayEnd::Error)
             .expect_err("no encoders");
-        assert!(e.contains("found: t, x"), "{e}");
+        assert!(e.contains("columns found: t, x"), "{e}");
         assert!(e.contains("log convert RUN.mcap RUN.csv"), "{e}");
         assert!(
             !e.contains("column option"),
