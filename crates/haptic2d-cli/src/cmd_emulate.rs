@@ -145,7 +145,18 @@ fn run_inner(a: &EmulateArgs) -> Result<u8, (u8, String)> {
     Ok(exit::CLEAN)
 }
 
+/// `haptic2d emulate inverse3` in a build without the `inverse3` feature: refused, with the command
+/// that builds it.
+#[cfg(not(feature = "inverse3"))]
+fn run_inverse3(_a: &EmulateArgs) -> Result<u8, (u8, String)> {
+    Err((
+        exit::BAD_INPUT,
+        format!("emulate inverse3: {}", crate::inverse3_arg::NOT_BUILT),
+    ))
+}
+
 /// `haptic2d emulate inverse3`.
+#[cfg(feature = "inverse3")]
 fn run_inverse3(a: &EmulateArgs) -> Result<u8, (u8, String)> {
     use haptic2d_devices::inverse3::{Emulator3Config, Hand3, Inverse3Emulator};
     let bad = |m: String| (exit::BAD_INPUT, m);

@@ -8,10 +8,11 @@
 use crate::exit::{Failure, Status};
 use crate::run_log::is_mcap;
 use haptic2d_rt::mcap::columns::{
-    column_index, parse_cell, TickRow, Val, LOOP_COLUMN_COUNT, TICK_TABLE, TICK_TABLE_LEN,
+    column_index, TickRow, Val, LOOP_COLUMN_COUNT, TICK_TABLE, TICK_TABLE_LEN,
 };
 use haptic2d_rt::mcap::reader::{read_file, read_info, read_ticks, LogInfo};
 use haptic2d_rt::mcap::schemas::TOPIC_TICK;
+use haptic2d_rt::mcap::tick_csv::read_tick_csv;
 use haptic2d_rt::mcap::world_csv::{read_world_tables, WorldTable};
 use haptic2d_rt::mcap::{McapSetup, McapSink};
 use std::collections::BTreeMap;
@@ -130,50 +131,9 @@ fn print_info(label: &str, size: usize, info: &LogInfo) {
     }
 }
 
-/// A CSV tick log: the table column of each CSV column, and the rows.
+/// A CSV tick log: the table column of each CSV column, and the rows (bounded: 1 GiB, 1 MiB a line).
 fn read_csv(path: &Path) -> Result<(Vec<usize>, Vec<Vec<Val>>), Failure> {
-    let label = path.display().to_string();
-    let mut rdr = csv::ReaderBuilder::new()
-        .from_path(path)
-        .map_err(|e| format!("cannot read the CSV log {label}: {e}"))?;
-    let header = rdr
-        .headers()
-        .map_err(|e| format!("{label}: cannot read the CSV header: {e}"))?
-        .clone();
-    let mut cols = Vec::with_capacity(header.len());
-    for h in header.iter() {
-        let k = column_index(h.trim()).ok_or_else(|| {
-            format!(
-                "{label}: column `{h}` is not a tick-log column\n    fix: `log convert` converts tick logs of `haptic2d run --log` (columns: docs/LOGS.md); a world CSV of `simulate` converts by re-running `simulate --out FILE.mcap`"
-            )
-        })?;
-        if cols.contains(&k) {
-            return Err(format!("{label}: column `{h}` appears twice").into());
-        }
-        cols.push(k);
-    }
-    let mut rows = Vec::new();
-    for (i, rec) in rdr.records().enumerate() {
-        let line = i + 2;
-        let rec = rec.map_err(|e| format!("{label}: line {line}: {e}"))?;
-        let mut row = Vec::with_capacity(cols.len());
-        for (&k, field) in cols.iter().zip(rec.iter()) {
-            row.push(
-                parse_cell(&TICK_TABLE[k], field)
-                    .map_err(|e| format!("{label}: line {line}: {e}"))?,
-            );
-        }
-        if row.len() != cols.len() {
-            return Err(format!(
-                "{label}: line {line} has {} fields, the header {}",
-                row.len(),
-                cols.len()
-            )
-            .into());
-        }
-        rows.push(row);
-    }
-    Ok((cols, rows))
+    Ok(read_tick_csv(path)?)
 }
 
 fn convert(input: &Path, output: &Path) -> Result<Status, Failure> {
@@ -216,6 +176,9 @@ fn convert(input: &Path, output: &Path) -> Result<Status, Failure> {
             let bytes = read_file(input)?;
             let (rows, info) = read_ticks(&bytes, &inl)?;
             let (tables, _) = read_world_tables(&bytes, &inl)?;
+            if let Some(cut) = &info.damage {
+                eprintln!("warning: {inl} was cut short ({cut}): converting the records before the cut");
+            }
             if rows.is_empty() {
                 if tables.iter().all(|t| t.messages == 0) {
                     return Err(format!("{inl} has no {TOPIC_TICK}, bodies, contacts or energy messages: nothing to convert to CSV").into());
@@ -253,7 +216,7 @@ fn convert(input: &Path, output: &Path) -> Result<Status, Failure> {
             w.flush().map_err(|e| Failure::error(format!("cannot write {outl}: {e}")))?;
             let written = write_world_tables(output, &tables)?;
             let world: u64 = tables.iter().map(|t| t.messages).sum();
-            let skipped = info.messages - rows.len() as u64 - world;
+            let skipped = info.messages.saturating_sub(rows.len() as u64 + world);
             println!(
                 "{inl} → {outl}: {} ticks, {} columns{}{}",
                 rows.len(),

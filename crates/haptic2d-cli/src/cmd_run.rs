@@ -98,6 +98,10 @@ pub struct RunArgs {
     /// loopback; alone: 127.0.0.1:8765), decimated to --foxglove-rate. See docs/LOGS.md.
     #[arg(long, value_name = "ADDR:PORT", num_args = 0..=1, default_missing_value = "127.0.0.1:8765")]
     pub foxglove: Option<String>,
+    /// Let --foxglove listen beyond loopback (e.g. 0.0.0.0:8765): anyone who can reach the machine
+    /// can then read the telemetry, the scene and the device files (a warning is printed).
+    #[arg(long)]
+    pub foxglove_allow_remote: bool,
     /// Rate of the Foxglove live view (Hz, at most 1000).
     #[arg(long, default_value_t = crate::foxglove_live::DEFAULT_LIVE_RATE_HZ, allow_negative_numbers = true)]
     pub foxglove_rate: f64,
@@ -212,7 +216,7 @@ pub fn run(a: &RunArgs) -> Result<Status, Failure> {
         (None, None)
     } else {
         let (server, view) = run_view::start(opts.bind, &rig, loaded, a.rate, a.require_token)?;
-        println!("{}", server.banner());
+        crate::outln!("{}", server.banner());
         (Some(server), Some(view))
     };
     let scene_meta = run_log::scene_strings(
@@ -231,8 +235,17 @@ pub fn run(a: &RunArgs) -> Result<Status, Failure> {
     let (tx, logger, latest) = start_telemetry(a, rig.system.world(), scene_meta)?;
     let foxglove = match opts.foxglove {
         Some(addr) => {
-            let f = FoxgloveServer::start(addr, latest, live_setup, a.foxglove_rate)?;
-            println!("{}", f.banner());
+            let f = FoxgloveServer::start(
+                addr,
+                latest,
+                live_setup,
+                a.foxglove_rate,
+                a.foxglove_allow_remote,
+            )?;
+            if let Some(w) = crate::foxglove_live::remote_warning(f.addr()) {
+                eprintln!("{w}");
+            }
+            crate::outln!("{}", f.banner());
             Some(f)
         }
         None => None,
@@ -240,7 +253,7 @@ pub fn run(a: &RunArgs) -> Result<Status, Failure> {
     let watchdog = make_watchdog(&rig)?;
     let stop = install_stop()?;
     let loop_config = make_loop_config(a)?;
-    println!(
+    crate::outln!(
         "running {scene_name}: device {} (parameters: {}), controller {}{}, hand {hand_name}, {} Hz{}; Ctrl-C stops",
         rig.io.name(),
         device_setting.origin,
@@ -278,7 +291,7 @@ pub fn run(a: &RunArgs) -> Result<Status, Failure> {
         s.shutdown();
     }
     if let Some(f) = foxglove {
-        f.shutdown();
+        crate::outln!("{}", f.shutdown());
     }
     report(a, &rig, &summary, end, stop.load(Ordering::SeqCst), logger)
 }
@@ -301,6 +314,9 @@ fn validate_options(a: &RunArgs) -> Result<RunOptions, Failure> {
         )
     })?;
     let foxglove = a.foxglove.as_deref().map(parse_foxglove).transpose()?;
+    if let Some(addr) = foxglove {
+        crate::foxglove_live::check_address(addr, a.foxglove_allow_remote)?;
+    }
     let (controller, _) =
         crate::controller_file::resolve(&a.controller, a.controller_file.as_deref())?;
     let device = DeviceChoice::parse(&a.device)?;
@@ -431,6 +447,13 @@ impl LoopState<'_> {
         let paused = self.view.as_ref().is_some_and(|v| v.paused());
         let (q, lost) = match self.rig.read() {
             Ok(q) => (q, None),
+            // A replay's data ended: a clean end, decided before the system runs (a tick on the
+            // missing sample's NaN joints would trip the latch with "non-finite device input").
+            Err(DeviceError::EndOfData) => {
+                self.rig.io.zero_torques();
+                self.end = Some(LoopEnd::ReplayEnded);
+                return TickControl::Stop;
+            }
             Err(e) => ([f64::NAN; 4], Some(e)),
         };
         let out = self.rig.tick_system(&q, info, paused);
@@ -532,8 +555,8 @@ fn report(
     if let Some(w) = summary.rt.as_ref().and_then(|r| r.warning()) {
         eprintln!("{w}");
     }
-    println!("{summary}");
-    println!(
+    crate::outln!("{summary}");
+    crate::outln!(
         "on time: {:.3} % of {} deadlines ({} ticks, {} skipped, {} overruns)",
         summary.on_time_fraction * 100.0,
         summary.deadlines,
@@ -548,16 +571,16 @@ fn report(
         let lost_reading = matches!(end, Some(LoopEnd::DeviceLost(_)))
             && matches!(trip.reason, SafetyReason::Device(DeviceFault::NonFinite));
         if !lost_reading {
-            println!("{trip}");
+            crate::outln!("{trip}");
         }
     }
     let (status, why) = end_status(end.as_ref(), interrupted);
     if let Some(why) = why {
-        println!("stopped: {why}");
+        crate::outln!("stopped: {why}");
     }
     let w = system.world();
     let b = &w.bodies[system.slave()];
-    println!(
+    crate::outln!(
         "final: t = {:.3} s, {} at ({:.5} m, {:.5} m, {:.4} rad), {} contacts, kinetic {:.3e} J",
         w.time(),
         b.name,
@@ -569,7 +592,7 @@ fn report(
     );
     if let Some(l) = logger {
         let report = l.finish(summary).map_err(Failure::error)?;
-        println!(
+        crate::outln!(
             "{report} to {}",
             a.log
                 .as_ref()

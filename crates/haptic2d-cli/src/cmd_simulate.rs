@@ -93,7 +93,9 @@ pub fn run(a: &SimulateArgs) -> Result<Status, Failure> {
     let mut done = 0u64;
     let mut status = Status::Clean;
     for k in 1..=ticks {
-        if stop.load(Ordering::Relaxed) {
+        // SIGPIPE under `--out` stops like SIGTERM (the file is finished below, then the process
+        // ends of SIGPIPE: pipe.rs).
+        if stop.load(Ordering::Relaxed) || crate::pipe::sigpipe_seen() {
             status = Status::Interrupted;
             break;
         }
@@ -103,6 +105,7 @@ pub fn run(a: &SimulateArgs) -> Result<Status, Failure> {
             if let Some(c) = csv.take() {
                 c.finish()
                     .map_err(|e| Failure::error(format!("cannot write CSV: {e}")))?;
+                crate::pipe::restore_after_output();
             }
             bar.finish_and_clear();
             eprintln!(
@@ -137,6 +140,8 @@ pub fn run(a: &SimulateArgs) -> Result<Status, Failure> {
     if let Some(c) = csv {
         c.finish()
             .map_err(|e| Failure::error(format!("cannot write CSV: {e}")))?;
+        // The file is whole: a SIGPIPE that stopped the run ends the process now (status 141).
+        crate::pipe::restore_after_output();
     }
     let wall = start.elapsed().as_secs_f64();
     let e = world.ledger();

@@ -5,6 +5,7 @@
 //! hand's impedance to `OUT/poles-<controller>.svg|png`.
 
 use crate::device_arg;
+use crate::exit::Failure;
 use crate::run_rig::DeviceModel;
 use crate::scene_arg;
 use haptic2d::device::pantograph2::Pantograph2;
@@ -49,22 +50,25 @@ pub struct StabilityArgs {
     pub out: PathBuf,
 }
 
-/// Runs the analysis and prints it.
-pub fn run(a: &StabilityArgs) -> Result<(), String> {
-    if !(a.rate.is_finite() && a.rate > 0.0) {
+/// Runs the analysis and prints it. Rejected options, scenes and device files are bad input (exit
+/// 2); a plot that cannot be written is a runtime failure (exit 1).
+pub fn run(a: &StabilityArgs) -> Result<(), Failure> {
+    if !(a.rate.is_finite() && a.rate > 0.0 && a.rate <= haptic2d::scene::MAX_RATE_HZ) {
         return Err(format!(
-            "--rate must be a positive number of Hz, got {}",
+            "--rate must be a positive number of Hz up to {:e}, got {}\n    fix: e.g. --rate 1000",
+            haptic2d::scene::MAX_RATE_HZ,
             a.rate
-        ));
+        )
+        .into());
+    }
+    if a.out.exists() && !a.out.is_dir() {
+        return Err(format!("--out: `{}` exists and is not a folder", a.out.display()).into());
     }
     if !(a.scale.is_finite() && a.scale > 0.0) {
-        return Err(format!(
-            "--scale must be a positive number, got {}",
-            a.scale
-        ));
+        return Err(format!("--scale must be a positive number, got {}", a.scale).into());
     }
     if a.delay > 1 {
-        return Err(format!("--delay must be 0 or 1, got {}", a.delay));
+        return Err(format!("--delay must be 0 or 1, got {}", a.delay).into());
     }
     let (controller, label) =
         crate::controller_file::resolve(&a.controller, a.controller_file.as_deref())?;
@@ -79,14 +83,14 @@ pub fn run(a: &StabilityArgs) -> Result<(), String> {
             linkage, center, ..
         } = &f.kind
         {
-            return run_planar2(
+            return Ok(run_planar2(
                 a,
                 &label,
                 f,
                 &f.controller_for(controller),
                 linkage,
                 *center,
-            );
+            )?);
         }
     }
     let controller = haply
@@ -124,7 +128,8 @@ pub fn run(a: &StabilityArgs) -> Result<(), String> {
             "{label}: growth rate vs hand impedance ({}, {} Hz)",
             scene.name, a.rate
         ),
-    )?;
+    )
+    .map_err(Failure::error)?;
     for f in files {
         println!("wrote {}", f.display());
     }

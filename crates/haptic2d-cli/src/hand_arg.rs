@@ -44,6 +44,33 @@ pub enum HandSpec {
     },
 }
 
+/// Largest force of a simulated hand, per component (N): far beyond any person's push on a desktop
+/// haptic device (a strong arm push is a few hundred newtons); a larger one is a typo, refused.
+pub const MAX_HAND_FORCE_N: f64 = 1000.0;
+
+/// Largest torque of a simulated hand (N·m), as [`MAX_HAND_FORCE_N`].
+pub const MAX_HAND_TORQUE_NM: f64 = 100.0;
+
+/// Largest frequency of `sine` (Hz): ten times a hand's bandwidth, below any control rate.
+pub const MAX_HAND_FREQUENCY_HZ: f64 = 100.0;
+
+/// Checks a wrench `(FX, FY, TAU)` of `--hand KIND:BODY` against the documented bounds.
+fn check_wrench(kind: &str, body: &str, w: &[f64]) -> Result<(), String> {
+    for (i, &v) in w.iter().enumerate() {
+        let (cap, unit, name) = if i % 3 == 2 {
+            (MAX_HAND_TORQUE_NM, "N·m", "torque")
+        } else {
+            (MAX_HAND_FORCE_N, "N", "force")
+        };
+        if v.abs() > cap {
+            return Err(format!(
+                "--hand {kind}:{body}: a {name} of {v:?} {unit} is beyond the simulated hand's bound of {cap} {unit}\n    fix: e.g. --hand constant:-2,0,0 (2 N into the left wall)"
+            ));
+        }
+    }
+    Ok(())
+}
+
 const FORMS: &str = "follow | free | constant:FX,FY,TAU | sine:FPK,FREQ[,DIRX,DIRY] | script:HOLD,FX,FY,TAU,PUSH[,RFX,RFY,RTAU]";
 
 fn numbers(kind: &str, body: &str, min: usize, max: usize) -> Result<Vec<f64>, String> {
@@ -79,6 +106,7 @@ impl HandSpec {
             "free" if body.is_empty() => Ok(HandSpec::Free),
             "constant" => {
                 let v = numbers(kind, body, 3, 3)?;
+                check_wrench(kind, body, &v)?;
                 Ok(HandSpec::Constant([v[0], v[1], v[2]]))
             }
             "sine" => {
@@ -89,9 +117,10 @@ impl HandSpec {
                         v[0]
                     ));
                 }
-                if v[1] <= 0.0 {
+                check_wrench(kind, body, &v[..1])?;
+                if v[1] <= 0.0 || v[1] > MAX_HAND_FREQUENCY_HZ {
                     return Err(format!(
-                        "--hand sine: the frequency must be > 0 Hz (got {})",
+                        "--hand sine: the frequency must be > 0 Hz and at most {MAX_HAND_FREQUENCY_HZ} Hz (got {})",
                         v[1]
                     ));
                 }
@@ -104,7 +133,7 @@ impl HandSpec {
                         )
                     }
                 };
-                let n = (d[0] * d[0] + d[1] * d[1]).sqrt();
+                let n = d[0].hypot(d[1]);
                 if n == 0.0 {
                     return Err("--hand sine: the direction (DIRX, DIRY) must not be zero".into());
                 }
@@ -126,6 +155,10 @@ impl HandSpec {
                     return Err(
                         "--hand script: HOLD and PUSH are durations and must be >= 0 s".into(),
                     );
+                }
+                check_wrench(kind, body, &v[1..4])?;
+                if v.len() == 8 {
+                    check_wrench(kind, body, &v[5..8])?;
                 }
                 Ok(HandSpec::Script {
                     hold: v[0],
@@ -214,8 +247,25 @@ mod tests {
             "push",
             "script:1,2,3",
             "sine:1,1,0,0",
+            "constant:1e300,0,0",
+            "constant:0,-1001,0",
+            "constant:0,0,101",
+            "sine:1e4,1",
+            "sine:1,1e300",
+            "script:1,1e9,0,0,1",
+            "script:1,1,0,0,1,0,0,1e5",
         ] {
             assert!(HandSpec::parse(bad).is_err(), "{bad}");
         }
+        // At the bounds: accepted.
+        assert!(HandSpec::parse("constant:1000,-1000,100").is_ok());
+        // A huge direction is normalised, not overflowed to zero.
+        assert!(matches!(
+            HandSpec::parse("sine:1,1,1e300,0").unwrap(),
+            HandSpec::Sine {
+                direction: [1.0, 0.0],
+                ..
+            }
+        ));
     }
 }

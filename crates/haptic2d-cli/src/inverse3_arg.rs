@@ -6,12 +6,37 @@
 //! devices/inverse3.toml) maps two device axes to the world plane and holds the third; the system is
 //! the 2-DOF system on the driver's virtual five-bar (see `haptic2d_devices::inverse3::planar`).
 
-use crate::run_rig::{DeviceModel, RealDevice};
+//!
+//! The driver is behind the `inverse3` feature of haptic2d-cli (off by default: it brings Haply's
+//! client with its HTTP/TLS stack); without it `--device inverse3` is refused as bad input with the
+//! command that builds it ([`NOT_BUILT`]).
+
+#[cfg(feature = "inverse3")]
+use crate::run_rig::DeviceModel;
+use crate::run_rig::RealDevice;
+#[cfg(feature = "inverse3")]
 use haptic2d_devices::inverse3::planar::{virtual_center, virtual_linkage, virtual_torque_limit};
+#[cfg(feature = "inverse3")]
 use haptic2d_devices::inverse3::{Inverse3Device, Inverse3DeviceFile};
+#[cfg(feature = "inverse3")]
 use haptic2d_rt::io::Joints2;
+#[cfg(feature = "inverse3")]
 use haptic2d_rt::DeviceIo;
 use std::path::Path;
+
+/// Why `--device inverse3` and `emulate inverse3` are refused by a build without the `inverse3`
+/// feature, and how to get them.
+#[cfg_attr(feature = "inverse3", allow(dead_code))]
+pub const NOT_BUILT: &str = "the Haply Inverse3 driver is not in this build (the `inverse3` feature is off by default: it needs Haply's client with its HTTP/TLS stack and OpenSSL headers)\n    fix: cargo install --path crates/haptic2d-cli --features inverse3   (or cargo run --release --features inverse3 -- run --device inverse3)";
+
+/// Without the `inverse3` feature: the URL is checked, then the device refused ([`NOT_BUILT`]).
+#[cfg(not(feature = "inverse3"))]
+pub fn real_device(url: Option<&str>, _device_file: Option<&Path>) -> Result<RealDevice, String> {
+    if let Some(u) = url {
+        service_urls(u)?;
+    }
+    Err(format!("--device inverse3: {NOT_BUILT}"))
+}
 
 /// The service addresses `(http, ws)` of the `URL` of `inverse3:URL`: `http://HOST:PORT[/]`,
 /// `ws://HOST:PORT[/]` or a bare `HOST:PORT`.
@@ -36,6 +61,7 @@ pub fn service_urls(url: &str) -> Result<(String, String), String> {
 
 /// The Inverse3 of `--device inverse3[:URL]` for the rig of `haptic2d run`: the device file read and
 /// checked, the service address resolved, nothing opened yet.
+#[cfg(feature = "inverse3")]
 pub fn real_device(url: Option<&str>, device_file: Option<&Path>) -> Result<RealDevice, String> {
     let mut file = match device_file {
         Some(p) => Inverse3DeviceFile::from_path(p)?,
@@ -90,6 +116,20 @@ mod tests {
     use super::*;
 
     #[test]
+    #[cfg(not(feature = "inverse3"))]
+    fn without_the_feature_inverse3_is_refused_with_the_build_command() {
+        let Err(e) = real_device(None, None) else {
+            panic!("refused")
+        };
+        assert!(e.contains("--features inverse3"), "{e}");
+        // A malformed URL still says the form first.
+        let Err(e) = real_device(Some("h:1/x"), None) else {
+            panic!("refused")
+        };
+        assert!(e.contains("inverse3:http://HOST:PORT"), "{e}");
+    }
+
+    #[test]
     fn service_urls_parse_and_bad_ones_say_the_form() {
         let w = |a: &str, b: &str| (a.to_string(), b.to_string());
         assert_eq!(
@@ -118,6 +158,7 @@ mod tests {
     }
 
     #[test]
+    #[cfg(feature = "inverse3")]
     fn the_shipped_file_is_a_virtual_five_bar_with_the_file_limits() {
         let r = real_device(Some("http://127.0.0.1:1234"), None).unwrap();
         assert_eq!(r.name, "inverse3:http://127.0.0.1:1234");

@@ -20,6 +20,7 @@ mod grip_twist;
 mod hand_arg;
 mod haply_arg;
 mod inverse3_arg;
+mod pipe;
 mod rig_system;
 mod run_log;
 mod run_rig;
@@ -135,25 +136,16 @@ enum Command {
     },
 }
 
-/// A command that only prints (no sockets of its own) ends quietly of `SIGPIPE` when its reader closes
-/// the pipe (`haptic2d simulate … | head -1`), as `cat` does (status 141 in the shell), instead of
-/// panicking in `println!`. `run` and `emulate` keep Rust's default (`SIGPIPE` ignored): their sockets
-/// and serial ports must see `EPIPE` as an error they handle, not a signal that kills the loop.
-fn quiet_on_closed_pipe() {
-    #[cfg(unix)]
-    // SAFETY: called once at start-up, before any thread exists; SIG_DFL is a valid disposition.
-    unsafe {
-        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
-    }
-}
-
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    if !matches!(cli.command, Command::Run(_) | Command::Emulate(_)) {
-        quiet_on_closed_pipe();
+    // Broken pipes (pipe.rs): `run` and `emulate` keep SIGPIPE ignored (their sockets and ports
+    // see EPIPE as an error they handle; `run` prints through `outln!` and ends of SIGPIPE after its
+    // cleanup); `simulate --out` finishes its file first; printing commands just end quietly.
+    match &cli.command {
+        Command::Run(_) | Command::Emulate(_) => {}
+        Command::Simulate { out: Some(_), .. } => pipe::stop_on_sigpipe(),
+        _ => pipe::quiet_on_closed_pipe(),
     }
-    // Commands this module does not own report failures as plain strings: exit 1.
-    let runtime = |r: Result<(), String>| r.map(|()| Status::Clean).map_err(Failure::error);
     let result = match cli.command {
         Command::Emulate(args) => return cmd_emulate::run(&args),
         Command::Devices => return cmd_devices::run(),
@@ -177,7 +169,7 @@ fn main() -> ExitCode {
         Command::Scenes => cmd_scenes::run()
             .map(|()| Status::Clean)
             .map_err(Failure::from),
-        Command::Stability(args) => runtime(cmd_stability::run(&args)),
+        Command::Stability(args) => cmd_stability::run(&args).map(|()| Status::Clean),
         Command::Check {
             scene,
             allow_overlap,
@@ -187,20 +179,18 @@ fn main() -> ExitCode {
             out,
             strict,
             controller_file,
-        } => runtime(cmd_reproduce::run(
-            &figure,
-            &out,
-            strict,
-            controller_file.as_deref(),
-        )),
+        } => cmd_reproduce::run(&figure, &out, strict, controller_file.as_deref())
+            .map(|()| Status::Clean),
         Command::Log(cmd) => cmd_log::run(&cmd),
         Command::Sweep {
             target,
             rate,
             points,
             out,
-        } => runtime(cmd_sweep::run(&target, rate, points, &out)),
+        } => cmd_sweep::run(&target, rate, points, &out).map(|()| Status::Clean),
     };
+    // `run`'s output was closed (`| head -1`): everything is finished, end as the pipe says.
+    pipe::end_if_broken();
     match result {
         Ok(status) => status.into(),
         Err(f) => {

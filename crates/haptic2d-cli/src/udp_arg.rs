@@ -161,7 +161,7 @@ impl DeviceIo for Counted {
 
 impl Drop for Counted {
     fn drop(&mut self) {
-        println!("udp: {}", self.0.counters());
+        crate::outln!("udp: {}", self.0.counters());
     }
 }
 

@@ -276,3 +276,193 @@ fn a_safety_stop_in_run_exits_3() {
 fn clap_usage_errors_exit_2() {
     assert_exit(&["simulate", "box-in-walls", "--bogus"], 2, "--bogus");
 }
+
+/// The regression logs of issue 38 (kept with the reader's tests in haptic2d-rt).
+fn repro(name: &str) -> String {
+    common::root()
+        .join("crates/haptic2d-rt/tests/data")
+        .join(name)
+        .to_str()
+        .unwrap()
+        .to_string()
+}
+
+/// Issue 38 item 3 and issue 39 items 5 and 7: every command into every ending, with its code and
+/// the message that says why. (Exit 4 is unit-tested in `cmd_run`; 141 is in tests/cli_pipe.rs;
+/// 130 in tests/cli_signals.rs and tests/mcap_log.rs.)
+#[test]
+fn every_command_ends_with_its_documented_exit_code_and_message() {
+    let dir = tempfile::tempdir().unwrap();
+    let zero_replay = write(&dir, "zero.csv", "q1,q2,q3,q4\n0,0,0,0\n0,0,0,0\n");
+    let out_file = write(&dir, "a-file", "not a folder");
+    let cut = repro("replay-nan-safety-exit0.mcap");
+    let len_max = repro("len-max.mcap");
+    let csv_out = dir.path().join("out.csv");
+    let csv_out = csv_out.to_str().unwrap();
+    let replay_cut = format!("replay:{cut}");
+    let replay_len_max = format!("replay:{len_max}");
+    let replay_zero = format!("replay:{zero_replay}");
+    let run = |extra: &[&'static str]| -> Vec<String> {
+        let mut v: Vec<String> = ["run", "--headless", "--no-rt"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        v.extend(extra.iter().map(|s| s.to_string()));
+        v
+    };
+    let own = |a: &[&str]| a.iter().map(|s| s.to_string()).collect::<Vec<String>>();
+    #[allow(unused_mut)]
+    let mut table: Vec<(Vec<String>, i32, &str)> = vec![
+        // 0: ran to the end.
+        (
+            own(&["simulate", "box-in-walls", "--duration", "0.2"]),
+            0,
+            "samples",
+        ),
+        (run(&["--duration", "0.2"]), 0, "on time"),
+        (own(&["log", "info", &cut]), 0, "NOT finished"),
+        // A replay that reaches its end: "the replay ended", and no safety stop (issue 39 item 5).
+        (
+            own(&["run", "--headless", "--no-rt", "--device", &replay_cut]),
+            0,
+            "stopped: the replay ended",
+        ),
+        // 1: a runtime failure.
+        (
+            own(&[
+                "simulate",
+                "box-in-walls",
+                "--duration",
+                "0.1",
+                "--out",
+                "/nonexistent-dir/x.csv",
+            ]),
+            1,
+            "cannot write",
+        ),
+        // 2: bad input, nothing ran.
+        (own(&["reproduce", "fig6"]), 2, "unknown figure `fig6`"),
+        (
+            own(&["reproduce", "fig4", "--out", &out_file]),
+            2,
+            "is not a folder",
+        ),
+        (
+            own(&["stability", "--rate", "-5"]),
+            2,
+            "--rate must be a positive number",
+        ),
+        (
+            own(&["stability", "--delay", "7"]),
+            2,
+            "--delay must be 0 or 1",
+        ),
+        (
+            own(&["stability", "--controller", "nope"]),
+            2,
+            "--controller",
+        ),
+        (own(&["sweep", "ripples"]), 2, "unknown sweep `ripples`"),
+        (own(&["sweep", "walls", "--points", "1"]), 2, "points"),
+        (
+            own(&["sweep", "walls", "--out", &out_file]),
+            2,
+            "is not a folder",
+        ),
+        (
+            run(&["--hand", "constant:1e300,0,0"]),
+            2,
+            "beyond the simulated hand's bound",
+        ),
+        (
+            run(&["--foxglove", "0.0.0.0:0", "--duration", "0.1"]),
+            2,
+            "--foxglove-allow-remote",
+        ),
+        (
+            own(&["log", "info", &len_max]),
+            2,
+            "declares a length of 18446744073709551615 bytes",
+        ),
+        (
+            own(&["log", "convert", &len_max, csv_out]),
+            2,
+            "declares a length of 18446744073709551615 bytes",
+        ),
+        (
+            own(&["run", "--headless", "--no-rt", "--device", &replay_len_max]),
+            2,
+            "declares a length of 18446744073709551615 bytes",
+        ),
+        (own(&["log", "info", "/dev/zero.mcap"]), 2, "cannot read"),
+        // 3: a safety stop (a replay whose recorded angles are no pose of the device).
+        (
+            own(&[
+                "run",
+                "--headless",
+                "--no-rt",
+                "--device",
+                &replay_zero,
+                "--duration",
+                "1",
+            ]),
+            3,
+            "safety stop at tick 0",
+        ),
+    ];
+    #[cfg(not(feature = "inverse3"))]
+    {
+        table.push((run(&["--device", "inverse3"]), 2, "--features inverse3"));
+        table.push((own(&["emulate", "inverse3"]), 2, "--features inverse3"));
+    }
+    let mut failures = Vec::new();
+    for (args, want, needle) in &table {
+        let a: Vec<&str> = args.iter().map(String::as_str).collect();
+        let o = haptic2d(&a);
+        let out = text(&o);
+        let got = o.status.code();
+        let mut bad = got != Some(*want) || !out.contains(needle) || out.contains("panicked");
+        // A replay that ended is not a safety stop.
+        if args.iter().any(|s| s == &replay_cut) {
+            bad |= out.contains("safety stop");
+        }
+        if bad {
+            failures.push(format!(
+                "{a:?}: exit {got:?} (want {want}), missing `{needle}`?\n{out}"
+            ));
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n---\n"));
+}
+
+#[test]
+fn dev_zero_as_a_log_is_refused_at_once() {
+    let t0 = std::time::Instant::now();
+    // As a CSV log (no .mcap extension): its first byte is a NUL.
+    assert_exit(&["log", "info", "/dev/zero"], 2, "NUL byte");
+    let dir = tempfile::tempdir().unwrap();
+    let link = dir.path().join("zero.mcap");
+    std::os::unix::fs::symlink("/dev/zero", &link).unwrap();
+    // As an MCAP log: its first 8 bytes are not the magic.
+    assert_exit(
+        &["log", "info", link.to_str().unwrap()],
+        2,
+        "not an MCAP file",
+    );
+    assert_exit(
+        &[
+            "run",
+            "--headless",
+            "--no-rt",
+            "--device",
+            &format!("replay:{}", link.display()),
+        ],
+        2,
+        "not an MCAP file",
+    );
+    assert!(
+        t0.elapsed() < std::time::Duration::from_secs(20),
+        "{:?}",
+        t0.elapsed()
+    );
+}

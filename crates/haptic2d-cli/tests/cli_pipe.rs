@@ -46,3 +46,29 @@ fn printing_commands_end_quietly_when_the_reader_closes_the_pipe() {
         );
     }
 }
+
+#[test]
+fn run_ends_quietly_of_sigpipe_after_finishing_its_log_when_the_reader_is_gone() {
+    // `haptic2d run … | head -1` panicked with exit 101 (issue 39); the run now finishes as it
+    // would (torques zeroed, the MCAP log's footer written), then ends of SIGPIPE (shell 141).
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("run.mcap");
+    let (signal, code, stderr) = run_into_closed_pipe(&[
+        "run",
+        "--headless",
+        "--no-rt",
+        "--duration",
+        "0.3",
+        "--log",
+        log.to_str().unwrap(),
+    ]);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert_eq!(signal, Some(libc::SIGPIPE), "exit code {code:?}\n{stderr}");
+    let bytes = haptic2d_rt::mcap::reader::read_file(&log).unwrap();
+    let info = haptic2d_rt::mcap::reader::read_info(&bytes, "run.mcap").unwrap();
+    assert!(info.complete, "the log has its footer: {info:?}");
+    assert!(
+        info.metadata("haptic2d.timing").is_some(),
+        "and the timing summary"
+    );
+}

@@ -559,3 +559,57 @@ fn read_retrying(ws: &mut tungstenite::WebSocket<std::net::TcpStream>) -> tungst
         }
     }
 }
+
+/// `simulate --out FILE.mcap` stopped by `sig` while it writes: the file is finished (summary and
+/// footer), readable by our reader and by the `mcap` crate's; returns (exit code, signal).
+fn simulate_mcap_then(sig: libc::c_int) -> (Option<i32>, Option<i32>) {
+    use std::os::unix::process::ExitStatusExt;
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("sim.mcap");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_haptic2d"))
+        .args(["simulate", "box-in-walls", "--duration", "5000", "--out"])
+        .arg(&out)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let t0 = std::time::Instant::now();
+    while std::fs::metadata(&out).map_or(0, |m| m.len()) < 200_000 {
+        assert!(child.try_wait().unwrap().is_none(), "exited early");
+        assert!(
+            t0.elapsed() < Duration::from_secs(60),
+            "no output after 60 s"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    // SAFETY: kill(2) on the pid of a child we spawned and have not reaped.
+    assert_eq!(unsafe { libc::kill(child.id() as libc::pid_t, sig) }, 0);
+    let Some((status, text)) = common::wait_with_limit(child, Duration::from_secs(30)) else {
+        panic!("did not exit within 30 s of the signal");
+    };
+    assert!(!text.contains("panicked"), "{text}");
+    let bytes = read_file(&out).unwrap();
+    let info = read_info(&bytes, "sim.mcap").unwrap();
+    assert!(
+        info.complete,
+        "summary and footer written: {info:?}\n{text}"
+    );
+    assert!(info.count(TOPIC_BODIES) > 100, "{info:?}");
+    // An unrelated reader agrees (it needs the summary section and end magic).
+    let n = mcap::MessageStream::new(&bytes).unwrap().count() as u64;
+    assert_eq!(n, info.messages);
+    (status.code(), status.signal())
+}
+
+#[test]
+fn sigpipe_during_simulate_out_mcap_leaves_a_readable_mcap_then_ends_of_sigpipe() {
+    assert_eq!(
+        simulate_mcap_then(libc::SIGPIPE),
+        (None, Some(libc::SIGPIPE))
+    );
+}
+
+#[test]
+fn sigterm_during_simulate_out_mcap_leaves_a_readable_mcap_and_exits_130() {
+    assert_eq!(simulate_mcap_then(libc::SIGTERM).0, Some(130));
+}

@@ -139,6 +139,11 @@ pub enum ReplayEnd {
 /// The default encoder columns of a replay CSV.
 pub const DEFAULT_REPLAY_COLUMNS: [&str; 4] = ["q1", "q2", "q3", "q4"];
 
+/// The encoder columns of a tick log converted to CSV (`haptic2d log convert RUN.mcap RUN.csv`),
+/// which a replay with [`DEFAULT_REPLAY_COLUMNS`] takes when the file has no `q1..q4`.
+pub const LOGGED_ENCODER_COLUMNS: [&str; 4] =
+    ["encoders.q1", "encoders.q2", "encoders.q3", "encoders.q4"];
+
 /// A device that plays back recorded joint angles and discards torques.
 ///
 /// The whole file is read at construction, so reading a sample on the RT
@@ -153,15 +158,17 @@ pub struct ReplayDevice {
     last_torques: [f64; 4],
 }
 
-/// Largest replay read (bytes): 1 GiB, about 10 million rows of a tick log (17 min at 10 kHz, 2.8 h at
-/// 1 kHz), held in memory as 32 bytes a row. Bounds a hostile or mistaken input (a pipe, `/dev/zero`,
-/// one endless line) before it exhausts memory.
-pub const MAX_REPLAY_BYTES: u64 = 1 << 30;
+/// Largest replay read (bytes): the log cap [`MAX_LOG_BYTES`](crate::mcap::limits::MAX_LOG_BYTES),
+/// 1 GiB, about 10 million rows of a tick log (17 min at 10 kHz, 2.8 h at 1 kHz), held in memory as
+/// 32 bytes a row. Bounds a hostile or mistaken input (a pipe, `/dev/zero`, one endless line)
+/// before it exhausts memory; lines are capped too
+/// ([`MAX_CSV_LINE_BYTES`](crate::mcap::limits::MAX_CSV_LINE_BYTES)).
+pub const MAX_REPLAY_BYTES: u64 = crate::mcap::limits::MAX_LOG_BYTES;
 
 impl ReplayDevice {
     /// Loads `path`, taking the four joint angles (radians) from the columns
-    /// named `columns` (e.g. [`DEFAULT_REPLAY_COLUMNS`]); other columns are
-    /// ignored. Errors name the file, the column or the row.
+    /// named `columns` (e.g. [`DEFAULT_REPLAY_COLUMNS`]; with those, a file without them but with
+    /// [`LOGGED_ENCODER_COLUMNS`] is read from those); other columns are ignored. Errors name the file, the column or the row.
     /// Files above [`MAX_REPLAY_BYTES`] are refused before anything is read.
     pub fn from_path(path: &Path, columns: [&str; 4], end: ReplayEnd) -> Result<Self, String> {
         let file = std::fs::File::open(path)
@@ -195,23 +202,35 @@ impl ReplayDevice {
         end: ReplayEnd,
         cap: u64,
     ) -> Result<Self, String> {
-        // The byte cap also bounds a reader with no length (a pipe, /dev/zero) and one endless line.
+        // The byte cap also bounds a reader with no length (a pipe, /dev/zero); the line cap one
+        // endless line, and a NUL byte ends a binary file at once.
+        let guard = crate::mcap::limits::TextGuard::with_caps(
+            reader,
+            cap,
+            crate::mcap::limits::MAX_CSV_LINE_BYTES,
+        );
         let mut rdr = csv::ReaderBuilder::new()
             .trim(csv::Trim::All)
-            .from_reader(std::io::Read::take(reader, cap + 1));
+            .from_reader(guard);
         let header = rdr
             .headers()
             .map_err(|e| format!("{label}: cannot read the CSV header: {e}"))?
             .clone();
-        let mut idx = [0usize; 4];
-        for (k, col) in columns.iter().enumerate() {
-            idx[k] = header.iter().position(|h| h == *col).ok_or_else(|| {
-                format!(
-                    "{label}: no column named `{col}` (columns found: {}); choose the encoder columns with the replay column option",
-                    header.iter().collect::<Vec<_>>().join(", ")
-                )
-            })?;
-        }
+        let find = |cols: &[&str; 4]| -> Option<[usize; 4]> {
+            let mut idx = [0usize; 4];
+            for (k, col) in cols.iter().enumerate() {
+                idx[k] = header.iter().position(|h| h == *col)?;
+            }
+            Some(idx)
+        };
+        let (idx, columns) = match find(&columns) {
+            Some(i) => (i, columns),
+            None if columns == DEFAULT_REPLAY_COLUMNS => match find(&LOGGED_ENCODER_COLUMNS) {
+                Some(i) => (i, LOGGED_ENCODER_COLUMNS),
+                None => return Err(no_columns(label, &header, &columns)),
+            },
+            None => return Err(no_columns(label, &header, &columns)),
+        };
         let mut samples = Vec::new();
         let mut rec = csv::StringRecord::new();
         // Row numbers as a person counts them in the file: header is line 1.
@@ -219,12 +238,9 @@ impl ReplayDevice {
         loop {
             line += 1;
             let more = rdr.read_record(&mut rec);
-            if rdr.position().byte() > cap {
-                return Err(format!(
-                    "{label}: the replay is above the cap of {cap} bytes (about 10 million rows at 1 GiB)\n    fix: cut the recording to the part to replay"
-                ));
-            }
-            if !more.map_err(|e| format!("{label}: line {line}: {e}"))? {
+            if !more.map_err(|e| {
+                format!("{label}: line {line}: {e}\n    fix: cut the recording to the part to replay (about 10 million rows fit the 1 GiB cap)")
+            })? {
                 break;
             }
             let mut q = [0.0; 4];
@@ -278,6 +294,23 @@ impl ReplayDevice {
     pub fn last_torques(&self) -> [f64; 4] {
         self.last_torques
     }
+}
+
+/// The error of a replay CSV without encoder columns: which are missing, what it has, where to get
+/// them.
+fn no_columns(label: &str, header: &csv::StringRecord, columns: &[&str; 4]) -> String {
+    let found: Vec<&str> = header.iter().take(40).collect();
+    let missing: Vec<String> = columns
+        .iter()
+        .filter(|c| !header.iter().any(|h| h == **c))
+        .map(|c| format!("`{c}`"))
+        .collect();
+    format!(
+        "{label}: no column {} (a replay reads the encoder angles q1,q2,q3,q4 or encoders.q1..encoders.q4, rad); columns found: {}{}\n    fix: `haptic2d log convert RUN.mcap RUN.csv` writes encoders.q1..q4 from an MCAP run log, or replay the MCAP log itself (--device replay:RUN.mcap)",
+        missing.join(", "),
+        found.join(", "),
+        if header.len() > found.len() { ", …" } else { "" }
+    )
 }
 
 impl DeviceIo for ReplayDevice {
@@ -352,5 +385,32 @@ mod replay_cap_tests {
         )
         .expect("under the cap");
         assert_eq!(d.name(), "replay:long");
+    }
+
+    #[test]
+    fn replay_reads_the_encoder_columns_log_convert_writes() {
+        let text = "t,encoders.q1,encoders.q2,encoders.q3,encoders.q4\n0,0.1,0.2,0.3,0.4\n";
+        let d = ReplayDevice::from_reader(text.as_bytes(), "conv", COLS, ReplayEnd::Error)
+            .expect("encoders.q1..q4 are read");
+        assert_eq!(d.samples(), &[[0.1, 0.2, 0.3, 0.4]]);
+    }
+
+    #[test]
+    fn replay_without_encoder_columns_names_what_it_needs_and_where_to_get_it() {
+        let e = ReplayDevice::from_reader(&b"t,x\n0,1\n"[..], "run.csv", COLS, ReplayEnd::Error)
+            .expect_err("no encoders");
+        assert!(e.contains("columns found: t, x"), "{e}");
+        assert!(e.contains("log convert RUN.mcap RUN.csv"), "{e}");
+        assert!(
+            !e.contains("column option"),
+            "names no option that does not exist: {e}"
+        );
+    }
+
+    #[test]
+    fn replay_of_binary_data_is_refused_at_its_first_nul_byte() {
+        let r = std::io::Read::chain(&b"q1,q2,q3,q4\n"[..], std::io::repeat(0));
+        let e = ReplayDevice::from_reader(r, "zero", COLS, ReplayEnd::Error).unwrap_err();
+        assert!(e.contains("NUL byte"), "{e}");
     }
 }

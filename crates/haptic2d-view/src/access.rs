@@ -197,6 +197,50 @@ fn is_literal_host(host_header: &str) -> bool {
         || lower.ends_with(".localhost")
 }
 
+/// True when the serialized origin `origin` (`http[s]://host[:port]`) is a page on this machine's
+/// loopback: `127.0.0.0/8`, `[::1]`, `localhost` or `*.localhost` (which browsers resolve to
+/// loopback themselves).
+pub fn origin_is_loopback(origin: &str) -> bool {
+    let Some((host, _)) = origin_authority(origin).and_then(|(s, a)| split_host_port(a, s)) else {
+        return false;
+    };
+    let lower = host.to_ascii_lowercase();
+    host.parse::<std::net::Ipv4Addr>()
+        .is_ok_and(|a| a.is_loopback())
+        || host
+            .parse::<std::net::Ipv6Addr>()
+            .is_ok_and(|a| a.is_loopback())
+        || lower == "localhost"
+        || lower.ends_with(".localhost")
+}
+
+/// The rule of a WebSocket server that serves no page of its own but is opened by the pages of
+/// known sites (the Foxglove live server of `haptic2d run --foxglove`): a program (no `Origin`, no
+/// fetch metadata) is allowed; a browser page is allowed only when its `Origin` is one of
+/// `allowed` (exact, e.g. `https://app.foxglove.dev`; case-insensitive) or a loopback page
+/// ([`origin_is_loopback`]); every other page, and a browser request without `Origin`, is refused
+/// with the reason.
+pub fn check_page_origin(headers: &HeaderMap, allowed: &[&str]) -> Result<(), String> {
+    let origin = match classify(headers) {
+        Client::NonBrowser => return Ok(()),
+        Client::BrowserWithoutOrigin => {
+            return Err("a browser request without an Origin header is refused".into())
+        }
+        Client::SameOrigin { .. } | Client::Foreign { .. } => headers
+            .get(ORIGIN)
+            .and_then(|o| o.to_str().ok())
+            .unwrap_or("<not ASCII>"),
+    };
+    if allowed.iter().any(|a| a.eq_ignore_ascii_case(origin)) || origin_is_loopback(origin) {
+        return Ok(());
+    }
+    Err(format!(
+        "the page at origin `{}` is refused: only {} and pages on loopback may connect",
+        origin.chars().take(100).collect::<String>(),
+        allowed.join(", ")
+    ))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -313,5 +357,47 @@ mod tests {
         }
         assert!(token_eq("", ""));
         assert!(!token_eq("", "x"));
+    }
+
+    #[test]
+    fn page_origins_allowed_are_the_listed_sites_and_loopback_pages_only() {
+        let app = ["https://app.foxglove.dev"];
+        let check =
+            |pairs: &[(&'static str, &'static str)]| check_page_origin(&headers(pairs), &app);
+        assert!(check(&[("host", "127.0.0.1:8765")]).is_ok(), "a program");
+        for ok in [
+            "https://app.foxglove.dev",
+            "HTTPS://APP.FOXGLOVE.DEV",
+            "http://127.0.0.1:3000",
+            "http://127.8.9.10",
+            "http://[::1]:8080",
+            "http://localhost:8080",
+            "http://studio.localhost",
+        ] {
+            assert!(
+                check(&[("origin", ok), ("host", "127.0.0.1:8765")]).is_ok(),
+                "{ok}"
+            );
+        }
+        for bad in [
+            "https://evil.example",
+            "https://app.foxglove.dev.evil.example",
+            "http://app.foxglove.dev",
+            "https://app.foxglove.dev/x",
+            "http://192.168.1.5:8765",
+            "http://localhost.evil.example",
+            "null",
+            "file://",
+        ] {
+            let e = check(&[("origin", bad), ("host", "127.0.0.1:8765")]).unwrap_err();
+            assert!(e.contains("refused"), "{bad}: {e}");
+        }
+        // A page on this server's own (non-loopback) address is not a loopback page either.
+        assert!(check(&[
+            ("origin", "http://10.0.0.5:8765"),
+            ("host", "10.0.0.5:8765")
+        ])
+        .is_err());
+        assert!(check(&[("host", "127.0.0.1:8765"), ("sec-fetch-mode", "websocket")]).is_err());
     }
 }

@@ -6,17 +6,23 @@
 //! - [`schemas`]: topics and JSON Schemas of the other channels (Foxglove `SceneUpdate` included);
 //! - [`writer`]: [`McapSink`], an MCAP file being written;
 //! - [`logger`]: [`McapLogger`], the logger thread draining the ring into a sink;
+//! - [`limits`]: the caps every log reader checks first (1 GiB a file, 1 MiB a CSV line);
+//! - [`frame`]: the bounded MCAP record reader (every length checked before it is used);
 //! - [`reader`]: reading logs back (info, tick rows, encoder angles for a replay);
 //! - [`replay`]: [`McapReplay`], `--device replay:FILE.mcap`;
+//! - [`tick_csv`]: CSV tick logs read back (`log info`, `log convert`);
 //! - [`world_csv`]: the world channels as CSV tables (`log convert FILE.mcap OUT.csv`).
 
 pub mod columns;
 pub mod encode;
+pub mod frame;
+pub mod limits;
 pub mod logger;
 pub mod reader;
 pub mod record;
 pub mod replay;
 pub mod schemas;
+pub mod tick_csv;
 pub mod world_csv;
 pub mod writer;
 

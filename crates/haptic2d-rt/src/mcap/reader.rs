@@ -1,11 +1,13 @@
 //! Reading haptic2d MCAP logs back: what a file holds ([`LogInfo`], for `haptic2d log info`), its
 //! tick rows ([`read_ticks`], for `log convert` and the tests) and its encoder angles
 //! ([`read_encoders`], for `--device replay:FILE.mcap`). One linear pass over the records (chunks
-//! unpacked), so a file whose summary is missing still reads up to its last complete record.
+//! unpacked, [`frame::walk`]: every length checked before it is used), so a file whose summary is
+//! missing still reads up to its last complete record, and a malformed one is an error.
 
 use crate::mcap::columns::{row_from_json, TickRow, LOOP_COLUMN_COUNT};
+use crate::mcap::frame::{self, End, Rec, MAGIC};
+use crate::mcap::limits::read_log_file;
 use crate::mcap::schemas::TOPIC_TICK;
-use ::mcap::records::Record;
 use std::collections::{BTreeMap, HashMap};
 use std::path::Path;
 
@@ -64,78 +66,105 @@ impl LogInfo {
     }
 }
 
-/// Reads the whole file `path` (errors name it).
+/// Reads the whole MCAP file `path` (errors name it): at most
+/// [`MAX_LOG_BYTES`](crate::mcap::limits::MAX_LOG_BYTES) (1 GiB; a larger file is refused before it
+/// is read), and only if it starts with the MCAP magic bytes (checked on the first 8 bytes, so
+/// `/dev/zero` or a CSV given as an MCAP log is refused at once).
 pub fn read_file(path: &Path) -> Result<Vec<u8>, String> {
-    std::fs::read(path).map_err(|e| format!("cannot read the MCAP file {}: {e}", path.display()))
+    read_log_file(path, "MCAP file", Some(MAGIC))
 }
 
 /// Calls `on_message(topic, log_time, data)` for every message, and returns the file's
-/// description. `label` names the file in errors. A file that is not MCAP at all is an error; a
-/// truncated one is read up to the damage ([`LogInfo::complete`] false).
+/// description. `label` names the file in errors. Every record length and every length inside a
+/// record is checked against the bytes that follow before anything is read or allocated
+/// ([`frame::walk`]). A file that is not MCAP, or whose records are malformed (a length past the
+/// end of the file above the log cap, a string past its record, an unknown record inside a chunk, a
+/// compressed chunk), is an error naming the byte offset and the messages read before it; a log
+/// cut while it was written (it ends inside a record, or before its footer) is read up to the cut
+/// ([`LogInfo::complete`] false, [`LogInfo::damage`] says where).
 pub fn scan(
     bytes: &[u8],
     label: &str,
     mut on_message: impl FnMut(&str, u64, &[u8]) -> Result<(), String>,
 ) -> Result<LogInfo, String> {
-    if !bytes.starts_with(::mcap::MAGIC) {
+    if !bytes.starts_with(MAGIC) {
         return Err(format!(
             "{label} is not an MCAP file (it does not start with the MCAP magic bytes)\n    fix: give a file written by `haptic2d run --log FILE.mcap` or another MCAP writer"
         ));
     }
-    let reader = ::mcap::read::ChunkFlattener::new_with_options(
-        bytes,
-        ::mcap::read::Options::IgnoreEndMagic.into(),
-    )
-    .map_err(|e| format!("{label}: {e}"))?;
     let mut info = LogInfo::default();
     let mut schemas: HashMap<u16, (String, String, Vec<u8>)> = HashMap::new();
     let mut channel_index: HashMap<u16, usize> = HashMap::new();
-    for rec in reader {
-        let rec = match rec {
-            Ok(r) => r,
-            Err(e) => {
-                info.damage = Some(e.to_string());
-                break;
-            }
-        };
+    // Errors of the callback are the caller's (e.g. a tick that is not JSON): passed on as they are.
+    let mut own_error: Option<String> = None;
+    let end = frame::walk(bytes, &mut |_at, rec| {
         match rec {
-            Record::Schema { header, data } => {
-                schemas.insert(header.id, (header.name, header.encoding, data.into_owned()));
+            Rec::Schema {
+                id,
+                name,
+                encoding,
+                data,
+            } => {
+                schemas
+                    .entry(id)
+                    .or_insert_with(|| (name.to_string(), encoding.to_string(), data.to_vec()));
             }
-            Record::Channel(c) => {
-                let (schema, schema_encoding, schema_data) =
-                    schemas.get(&c.schema_id).cloned().unwrap_or_default();
-                channel_index.entry(c.id).or_insert_with(|| {
+            Rec::Channel {
+                id,
+                schema_id,
+                topic,
+                message_encoding,
+            } => {
+                if let std::collections::hash_map::Entry::Vacant(slot) = channel_index.entry(id) {
+                    let (schema, schema_encoding, schema_data) =
+                        schemas.get(&schema_id).cloned().unwrap_or_default();
                     info.channels.push(ChannelInfo {
-                        topic: c.topic,
+                        topic: topic.to_string(),
                         schema,
                         schema_encoding,
-                        message_encoding: c.message_encoding,
+                        message_encoding: message_encoding.to_string(),
                         schema_data,
                         count: 0,
                     });
-                    info.channels.len() - 1
-                });
+                    slot.insert(info.channels.len() - 1);
+                }
             }
-            Record::Message { header, data } => {
-                let Some(&k) = channel_index.get(&header.channel_id) else {
+            Rec::Message {
+                channel_id,
+                log_time: t,
+                data,
+                ..
+            } => {
+                let Some(&k) = channel_index.get(&channel_id) else {
                     return Err(format!(
-                        "{label}: a message on channel {} comes before that channel's record",
-                        header.channel_id
+                        "a message on channel {channel_id} comes before that channel's record"
                     ));
                 };
                 info.channels[k].count += 1;
                 info.messages += 1;
-                let t = header.log_time;
                 info.time_range_ns = Some(match info.time_range_ns {
                     None => (t, t),
                     Some((a, b)) => (a.min(t), b.max(t)),
                 });
-                on_message(&info.channels[k].topic, t, &data)?;
+                if let Err(e) = on_message(&info.channels[k].topic, t, data) {
+                    own_error = Some(e.clone());
+                    return Err(e);
+                }
             }
-            Record::Metadata(m) => info.metadata.push((m.name, m.metadata)),
-            Record::Footer(_) => info.complete = true,
-            _ => {}
+            Rec::Metadata { name, map } => info.metadata.push((name.to_string(), map)),
+            Rec::Footer => info.complete = true,
+        }
+        Ok(())
+    });
+    match end {
+        Ok(End::Footer | End::Unfinished) => {}
+        Ok(End::Cut(where_)) => info.damage = Some(where_),
+        Err(e) if own_error.as_ref() == Some(&e) => return Err(e),
+        Err(e) => {
+            return Err(format!(
+                "{label} is a damaged MCAP file: {e} ({} messages read before it)\n    fix: give a log written by `haptic2d run --log FILE.mcap` or `haptic2d simulate --out FILE.mcap`; an MCAP from elsewhere must be uncompressed",
+                info.messages
+            ))
         }
     }
     Ok(info)
@@ -171,8 +200,12 @@ pub fn read_ticks(bytes: &[u8], label: &str) -> Result<(Vec<TickRow>, LogInfo), 
 /// replay. Errors name the file and say what is missing.
 pub fn read_encoders(path: &Path) -> Result<Vec<[f64; 4]>, String> {
     let bytes = read_file(path)?;
-    let label = path.display().to_string();
-    let (rows, _) = read_ticks(&bytes, &label)?;
+    encoders_of(&bytes, &path.display().to_string())
+}
+
+/// [`read_encoders`] of a log already in memory (`label` names it in errors).
+pub fn encoders_of(bytes: &[u8], label: &str) -> Result<Vec<[f64; 4]>, String> {
+    let (rows, _) = read_ticks(bytes, label)?;
     if rows.is_empty() {
         return Err(format!(
             "{label} has no {TOPIC_TICK} messages: it needs a log of `haptic2d run --log FILE.mcap` to replay"
