@@ -51,7 +51,7 @@ def pack_state(seq, echo_seq, status, device_ns, echo_host_ns, position, velocit
                       device_ns, echo_host_ns, *position, *velocity, *force)
 
 
-# --- the pantograph (DEVICES §2): motor 1 at (0, 0), motor 2 at (d, 0) -----------------------
+# --- the pantograph (docs/DEVICES.md §2): motor 1 at (0, 0), motor 2 at (d, 0) -----------------------
 class Pantograph:
     def __init__(self, d, l1, l2):
         self.d, self.l1, self.l2 = d, l1, l2

@@ -1,9 +1,9 @@
-//! Byte vectors of the Haply protocol (DEVICES §1), written out by hand from the spec.
+//! Byte vectors of the Haply protocol (docs/DEVICES.md §1), written out by hand from the spec.
 
 use haptic2d_devices::haply::codec::*;
 
 fn gen2_setup() -> BoardSetup {
-    // Gen 2 (DEVICES §2): motor 1 CCW on port 2 (241°), motor 2 CW on port 1 (−61°), 10752 counts.
+    // Gen 2 (docs/DEVICES.md §2): motor 1 CCW on port 2 (241°), motor 2 CW on port 1 (−61°), 10752 counts.
     let mut s = BoardSetup::empty(1);
     s.motor_mask = 0b0011;
     s.enc_mask = 0b0011;

@@ -1,4 +1,4 @@
-//! The Haply board protocol (DEVICES §1) as a pure codec: bytes in, typed frames out, buffers owned
+//! The Haply board protocol (docs/DEVICES.md §1) as a pure codec: bytes in, typed frames out, buffers owned
 //! by the caller; no clock, no port, no allocation.
 //!
 //! ```text
@@ -392,7 +392,7 @@ pub enum HostFrame {
 /// board's current setup (a write's length depends on it). Returns `Ok(None)` while the frame is
 /// incomplete, else the frame and its length.
 ///
-/// Direction bytes follow the firmware's quirk (DEVICES §1): the `k`-th direction byte on the wire
+/// Direction bytes follow the firmware's quirk (docs/DEVICES.md §1): the `k`-th direction byte on the wire
 /// is assigned to port `k + 1`, whatever the mask says, so a mask that does not start at port 1
 /// shifts the directions onto the wrong ports (ports past the bytes sent get clockwise). Hosts that
 /// use masks starting at port 1 with no gaps, as our driver does, are unaffected.

@@ -1,4 +1,4 @@
-//! A stand-in Haply board: the firmware's behaviour (DEVICES §1) over any byte stream, moving a
+//! A stand-in Haply board: the firmware's behaviour (docs/DEVICES.md §1) over any byte stream, moving a
 //! simulated linkage ([`Plant`]) under the motor torques and a simulated hand.
 //!
 //! What it reproduces:

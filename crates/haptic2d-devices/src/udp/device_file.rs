@@ -13,7 +13,7 @@
 //! torque_limit = 0.123          # N·m on each joint, enforced by the host
 //! max_missed_deadlines = 10     # watchdog: consecutive missed deadlines (0 = off)
 //! max_stall_periods = 5         # the loop's own delay between two ticks that trips (periods)
-//! [linkage]                     # the 2-DOF pantograph (DEVICES §2), device frame
+//! [linkage]                     # the 2-DOF pantograph (docs/DEVICES.md §2), device frame
 //! d = 0.038                     # m
 //! l1 = 0.07                     # m
 //! l2 = 0.09                     # m
