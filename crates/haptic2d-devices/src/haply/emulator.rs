@@ -436,6 +436,19 @@ pub fn serve<S: Read + Write>(
                 break;
             }
         }
+        // Real time: the linkage moves while no write arrives too (the motors hold the last
+        // torque, the hand keeps acting), in steps of at least 1 ms.
+        if config.clock == EmulatorClock::RealTime && !fw.next_is_write() {
+            let now = Instant::now();
+            let dt = now.duration_since(last_step).as_secs_f64();
+            if dt >= 1e-3 {
+                last_step = now;
+                if let Err(e) = plant.step(&fw.joint_torques(), &config.hand, b_h, dt.min(0.1)) {
+                    reason = format!("the simulated linkage failed: {e}");
+                    break 'outer;
+                }
+            }
+        }
         loop {
             // The firmware services the port at most every 50 µs.
             let ready = last_service + service;
