@@ -36,7 +36,7 @@ fn device_file(dir: &Path, name: &str, edit: impl Fn(String) -> String) -> PathB
 fn shipped_file(dir: &Path, file: &str, name: &str, edit: impl Fn(String) -> String) -> PathBuf {
     let p = dir.join(name);
     let text = shipped_text(file)
-        .replace("timeout_periods = 3 ", "timeout_periods = 100 ")
+        .replace("timeout_periods = 20 ", "timeout_periods = 100 ")
         .replace("max_missed_deadlines = 10 ", "max_missed_deadlines = 0 ")
         .replace("max_stall_periods = 5 ", "max_stall_periods = 1000 ");
     std::fs::write(&p, edit(text)).unwrap();

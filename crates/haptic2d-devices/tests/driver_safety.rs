@@ -481,3 +481,75 @@ fn a_handle_moving_during_the_setup_is_refused_before_any_torque() {
     let board = MockBoard::of(&file, BoardKind::M3, |_, _| {});
     HaplyDevice::open(board, &file, Duration::from_millis(1), "haply:mock").unwrap();
 }
+
+/// A silent stream: writes accepted, reads return nothing after `read_sleep`.
+struct Silent {
+    read_sleep: Duration,
+}
+impl Read for Silent {
+    fn read(&mut self, _buf: &mut [u8]) -> std::io::Result<usize> {
+        std::thread::sleep(self.read_sleep);
+        Err(std::io::ErrorKind::TimedOut.into())
+    }
+}
+impl Write for Silent {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        Ok(buf.len())
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+/// Issue 34 finding 10: the lost-device message said nothing about who was late. A host that kept
+/// waiting (short reads) blames the device; a host that was not running for most of the wait (here a
+/// read that takes 30 ms, as a descheduled process) says so and points at the machine.
+#[test]
+fn a_timeout_says_whether_the_host_or_the_device_was_late() {
+    let setup = device_file("haply-2diy-gen3.toml").board_setup();
+    let mut t = Transport::from_stream(
+        Silent {
+            read_sleep: Duration::from_micros(200),
+        },
+        setup,
+        Duration::from_millis(10),
+    )
+    .unwrap();
+    t.send_write(&[0.0, 0.0]).unwrap();
+    let e = t.read_reply().unwrap_err().to_string();
+    assert!(e.contains("the device was late"), "{e}");
+    let mut t = Transport::from_stream(
+        Silent {
+            read_sleep: Duration::from_millis(30),
+        },
+        setup,
+        Duration::from_millis(10),
+    )
+    .unwrap();
+    t.send_write(&[0.0, 0.0]).unwrap();
+    let e = t.read_reply().unwrap_err().to_string();
+    assert!(
+        e.contains("the host itself was not running") && e.contains("timeout_periods"),
+        "{e}"
+    );
+}
+
+/// A board on a pseudo-terminal is an emulator: its lost-device message does not send the user to a
+/// USB cable.
+#[test]
+fn a_lost_emulator_on_a_pseudo_terminal_is_not_blamed_on_a_usb_cable() {
+    let mut file = device_file("haply-2diy-gen3.toml");
+    file.timeout_periods = 20.0;
+    let start = file.rest_pose().unwrap();
+    let mut emu = start_emulator(&file, HandModel::grip(start), 0.001);
+    let mut dev = open_driver(&emu, &file, 0.001);
+    dev.read_encoders().unwrap();
+    dev.write_torques(&[0.0; 4]).unwrap();
+    emu.kill();
+    let msg = dev.read_encoders().unwrap_err().to_string();
+    assert!(
+        msg.contains("emulator on a pseudo-terminal (no USB cable)")
+            && !msg.contains("check the USB cable"),
+        "{msg}"
+    );
+}
