@@ -149,6 +149,8 @@ fn pulse<S: Read + Write>(
     let mut problems = Vec::new();
     let mut pulses = Vec::new();
     let mut q_rest = [0.0; 4];
+    // Twin: (motor, closure-error change (m), limit (m)) of the pulses that broke the closure.
+    let mut drifts: Vec<(usize, f64, f64)> = Vec::new();
     for (j, m) in file.motors.iter().enumerate() {
         let q0 = hold(dev, [0.0; 4], Duration::from_millis(150))?;
         if j == 0 {
@@ -171,16 +173,38 @@ fn pulse<S: Read + Write>(
             ));
         }
         if let HaplyKind::Twin(p) = &file.kind {
-            if let Err(e) = TwinKinematics::new(p).fk(&q1, 0.0) {
-                problems.push(format!(
-                    "after pulsing motor[{j}] (port {}) the two linkages no longer close ({e}): a motor or encoder direction is reversed; check motor[{j}].direction and encoder_direction first",
+            // The readings of a rigid handle keep |P_2 − P_1| = r_c while it moves; a reversed
+            // joint makes them drift apart. Threshold: 3 counts of a proximal link at its elbow.
+            let mut kin = TwinKinematics::new(p);
+            kin.closure_tol = f64::INFINITY;
+            let closure = |q: &[f64; 4]| kin.fk(q, 0.0).map(|f| f.closure_error);
+            let limit = 3.0 * count * p.l1;
+            match (closure(&q0), closure(&q1)) {
+                (Ok(c0), Ok(c1)) => {
+                    if (c1 - c0).abs() > limit {
+                        drifts.push((j, c1 - c0, limit));
+                    }
+                }
+                (_, Err(e)) | (Err(e), _) => problems.push(format!(
+                    "after pulsing motor[{j}] (port {}) the twin kinematics fail ({e}): a motor or encoder direction is reversed; check motor[{j}].direction and encoder_direction first",
                     m.port
-                ));
+                )),
             }
         }
         pulses.push(Pulse { dq });
     }
     hold(dev, [0.0; 4], Duration::from_millis(50))?;
+    if let Some(&(worst, _, limit)) = drifts.iter().max_by(|a, b| a.1.abs().total_cmp(&b.1.abs())) {
+        let list: Vec<String> = drifts
+            .iter()
+            .map(|(j, d, _)| format!("motor[{j}] {:+.2} mm", d * 1e3))
+            .collect();
+        problems.push(format!(
+            "the readings no longer describe one rigid handle while the motors push (closure error change per pulse, above 3 counts = {:.2} mm: {}): a direction is reversed — a joint whose motor and encoder are both reversed still shows a growing angle; the largest change is under motor[{worst}]'s pulse: check it first (flip both motor[{worst}].direction and motor[{worst}].encoder_direction if its angle grew, else its encoder_direction) and run the check again",
+            limit * 1e3,
+            list.join(", ")
+        ));
+    }
     if !problems.is_empty() {
         return Ok(problems);
     }

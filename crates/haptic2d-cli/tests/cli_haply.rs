@@ -230,6 +230,32 @@ fn device_check_tells_a_reversed_motor_and_encoder_from_a_correct_joint() {
     assert_eq!(out.matches("angle +").count(), 2, "{out}");
 }
 
+/// The twin's pulse check: a correct board passes; with q11's motor and encoder both reversed every
+/// angle still grows, and the closure of the readings under the pulses gives it away.
+#[test]
+fn device_check_on_the_twin_finds_a_joint_with_motor_and_encoder_reversed() {
+    let _turn = turn();
+    let dir = tempfile::tempdir().unwrap();
+    let good = shipped_file(dir.path(), "haply-twin.toml", "twin.toml", |t| t);
+    let (emu, pty) = emulate(&["--device-file", good.to_str().unwrap()]);
+    let (code, out) = device_check(&pty, &good);
+    stop(emu);
+    assert_eq!(code, Some(0), "{out}");
+    let board = shipped_file(dir.path(), "haply-twin.toml", "board.toml", |t| {
+        t.replacen("direction = \"ccw\"", "direction = \"cw\"", 1)
+    });
+    let (emu, pty) = emulate(&["--device-file", board.to_str().unwrap()]);
+    let (code, out) = device_check(&pty, &good);
+    stop(emu);
+    assert_eq!(code, Some(2), "{out}");
+    assert_eq!(out.matches("angle +").count(), 4, "{out}");
+    assert!(
+        out.contains("no longer describe one rigid handle")
+            && out.contains("under motor[0]'s pulse"),
+        "{out}"
+    );
+}
+
 /// Issue 34 finding 4 / item 7: the twin on an M0 ended with "check the USB cable" although the
 /// board answered. It is refused at open, naming the port count, before any torque.
 #[test]
