@@ -10,12 +10,11 @@ use std::time::Duration;
 use haptic2d::device::HandModel;
 use haptic2d::haptic::ControllerKind;
 use haptic2d::world::World;
-use haptic2d_devices::haply::serial::{open_port, Pty};
+use haptic2d_devices::haply::serial::{open_port, BoardPort, Pty};
 use haptic2d_devices::haply::{
     emulator, serve, EmulatorClock, EmulatorConfig, EmulatorReport, HaplyDevice, HaplyDeviceFile,
     HaplyKind, HaplySystem,
 };
-use serialport::TTYPort;
 
 /// A shipped device file, with a generous reply timeout (100 periods): these tests check physics
 /// and protocol on a machine shared with compilers, not timing (the lost-device tests set theirs).
@@ -100,7 +99,7 @@ pub fn start_emulator_damped(file: &HaplyDeviceFile, hand: HandModel, dt: f64, b
 }
 
 /// Opens the driver on the emulator's port at period `dt` (s).
-pub fn open_driver(emu: &Emu, file: &HaplyDeviceFile, dt: f64) -> HaplyDevice<TTYPort> {
+pub fn open_driver(emu: &Emu, file: &HaplyDeviceFile, dt: f64) -> HaplyDevice<BoardPort> {
     let port = open_port(&emu.path).unwrap();
     HaplyDevice::open(
         port,
@@ -146,7 +145,7 @@ pub fn coupling() -> ControllerKind {
 /// the contact count.
 pub fn run(
     system: &mut HaplySystem,
-    dev: &mut HaplyDevice<TTYPort>,
+    dev: &mut HaplyDevice<BoardPort>,
     ticks: usize,
 ) -> Vec<(f64, f64, u32)> {
     use haptic2d_rt::DeviceIo;
