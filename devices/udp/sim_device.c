@@ -220,7 +220,7 @@ static void pack_state(uint8_t *b, uint32_t seq, uint32_t echo_seq, uint32_t sta
     for (int i = 0; i < 3; i++) { stf(b + 32 + 4 * i, pos[i]); stf(b + 44 + 4 * i, vel[i]); }
 }
 
-/* ---- the pantograph (DEVICES §2): motor 1 at (0, 0), motor 2 at (d, 0) ------------------ */
+/* ---- the pantograph (docs/DEVICES.md §2): motor 1 at (0, 0), motor 2 at (d, 0) ------------------ */
 static const double D = 0.038, L1 = 0.07, L2 = 0.09;
 
 static void ik(double x, double y, double q[2]) {

@@ -158,7 +158,7 @@ class Session:
         return b + mac(self.key, b)
 
 
-# --- the pantograph (DEVICES §2): motor 1 at (0, 0), motor 2 at (d, 0) -----------------------
+# --- the pantograph (docs/DEVICES.md §2): motor 1 at (0, 0), motor 2 at (d, 0) -----------------------
 class Pantograph:
     def __init__(self, d, l1, l2):
         self.d, self.l1, self.l2 = d, l1, l2

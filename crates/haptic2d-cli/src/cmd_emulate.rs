@@ -12,7 +12,9 @@
 use crate::hand_arg::HandSpec;
 use crate::haply_arg::{exit, fail, load_file};
 use haptic2d_devices::haply::serial::Pty;
-use haptic2d_devices::haply::{emulator, serve, EmulatorClock, EmulatorConfig, HaplyKind};
+use haptic2d_devices::haply::{
+    emulator, serve, BoardKind, EmulatorClock, EmulatorConfig, HaplyKind,
+};
 use haptic2d_rt::signal::install_ctrlc_stop;
 use std::io::Write;
 use std::path::PathBuf;
@@ -37,10 +39,19 @@ pub struct EmulateArgs {
     /// inverse3: follow | free | push:FX,FY,FZ[,HOLD].
     #[arg(long, allow_hyphen_values = true)]
     pub hand: Option<String>,
-    /// Start point of the handle X,Y (m, the device file's frame). Default the workspace centre.
+    /// Where the handle is when the host sets the board up, X,Y (m, the device file's frame).
+    /// Default the device file's rest pose (the offsets' pose), where a user holds it when `run`
+    /// starts: the stock firmware reports the offsets there, wherever the handle really is.
     /// inverse3: X,Y,Z of the cursor (m, device frame), default 0,0,0.
     #[arg(long, allow_hyphen_values = true)]
     pub start: Option<String>,
+    /// haply: the board, m3 (4 ports) or m0 (2 ports: a setup naming ports 3–4 gets short replies).
+    #[arg(long, default_value = "m3")]
+    pub board: String,
+    /// haply: where the handle was when the board was powered, X,Y (m). It does not change what the
+    /// board reports (the encoders are set at every setup); default the start point.
+    #[arg(long, allow_hyphen_values = true)]
+    pub power_up: Option<String>,
     /// Service time of the board (µs), at least 50.
     #[arg(long, default_value_t = 50.0)]
     pub service_us: f64,
@@ -89,25 +100,24 @@ fn run_inner(a: &EmulateArgs) -> Result<u8, (u8, String)> {
         return Err(bad("--hand-damping must be ≥ 0 N·s/m".into()));
     }
     let file = load_file(a.device_file.as_deref()).map_err(bad)?;
-    let mut start = file.workspace_center();
-    if let Some(s) = &a.start {
-        let v: Vec<f64> = s
-            .split(',')
-            .map(|p| p.trim().parse::<f64>())
-            .collect::<Result<_, _>>()
-            .map_err(|_| bad(format!("--start `{s}`: expected X,Y in metres")))?;
-        if v.len() != 2 || !v.iter().all(|x| x.is_finite()) {
-            return Err(bad(format!("--start `{s}`: expected X,Y in metres")));
-        }
-        start[0] = v[0];
-        start[1] = v[1];
-    }
+    let board = BoardKind::from_name(&a.board)
+        .ok_or_else(|| bad(format!("--board `{}`: expected m0 or m3", a.board)))?;
+    let rest = file
+        .rest_pose()
+        .map_err(|e| bad(format!("{}: {e}", file.source)))?;
+    let start = point_arg("--start", a.start.as_deref(), rest).map_err(bad)?;
+    let power_up = match &a.power_up {
+        Some(_) => Some(point_arg("--power-up", a.power_up.as_deref(), rest).map_err(bad)?),
+        None => None,
+    };
     let hand = HandSpec::parse(a.hand.as_deref().unwrap_or("follow")).map_err(bad)?;
     let config = EmulatorConfig {
         hand: hand.model(start),
         service_time: Duration::from_secs_f64(a.service_us * 1e-6),
         clock: EmulatorClock::RealTime,
         hand_damping: a.hand_damping,
+        board,
+        power_up,
     };
     let plant = emulator::plant_for(&file, Some(start), &config).map_err(bad)?;
     let pty = Pty::new().map_err(|e| (exit::ERROR, e))?;
@@ -119,10 +129,12 @@ fn run_inner(a: &EmulateArgs) -> Result<u8, (u8, String)> {
         HaplyKind::Twin(_) => "twin pantograph",
     };
     eprintln!(
-        "emulating {} ({kind}, board id {}) from {}; hand {}; Ctrl-C stops",
+        "emulating {} ({kind}, board id {}, {board:?} with the stock firmware: encoders set at every setup, no watchdog) from {}; handle at ({:.4}, {:.4}) m when set up; hand {}; Ctrl-C stops",
         file.name,
         file.id,
         file.source,
+        start[0],
+        start[1],
         a.hand.as_deref().unwrap_or("follow")
     );
     if let Some(d) = a.duration {
@@ -139,8 +151,13 @@ fn run_inner(a: &EmulateArgs) -> Result<u8, (u8, String)> {
     let report = serve(master, &file, plant, &config, &stop);
     drop(keep);
     eprintln!(
-        "emulator stopped ({}): {} frames, {} replies, {} bytes discarded",
-        report.reason, report.frames, report.replies, report.discarded
+        "emulator stopped ({}): {} frames, {} setups, {} replies, {} bytes discarded; motors still hold {:?} N·m",
+        report.reason,
+        report.frames,
+        report.setups,
+        report.replies,
+        report.discarded,
+        &report.held_torques[..file.joints()]
     );
     Ok(exit::CLEAN)
 }
@@ -153,6 +170,22 @@ fn run_inverse3(_a: &EmulateArgs) -> Result<u8, (u8, String)> {
         exit::BAD_INPUT,
         format!("emulate inverse3: {}", crate::inverse3_arg::NOT_BUILT),
     ))
+}
+
+/// `X,Y` (m) of option `opt`, or `default` when absent; θ kept from `default`.
+fn point_arg(opt: &str, arg: Option<&str>, default: [f64; 3]) -> Result<[f64; 3], String> {
+    let Some(s) = arg else {
+        return Ok(default);
+    };
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|p| p.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("{opt} `{s}`: expected X,Y in metres"))?;
+    if v.len() != 2 || !v.iter().all(|x| x.is_finite()) {
+        return Err(format!("{opt} `{s}`: expected X,Y in metres"));
+    }
+    Ok([v[0], v[1], default[2]])
 }
 
 /// `haptic2d emulate inverse3`.

@@ -110,10 +110,19 @@ pub fn real_device(port: &str, device_file: Option<&Path>) -> Result<RealDevice,
         max_missed_run: file.max_missed_deadlines,
         max_stall_periods: file.max_stall_periods,
         match_controller: Some(Box::new(move |k| matcher.controller_for(k))),
-        // Open and hand-shake before the first deadline.
+        // Open and hand-shake before the first deadline, with the handle at the rest pose
+        // (docs/DEVICES.md §7); the firmware's line and, for a board without a watchdog, the
+        // warning are printed once here, before the loop.
         open: Box::new(move |period| {
             let port = open_port(&path)?;
+            eprintln!(
+                "{open_name}: hold the handle still at its rest pose while the board is set up"
+            );
             let dev = HaplyDevice::open(port, &file, period, &open_name)?;
+            eprintln!("{open_name}: {}", dev.firmware_summary());
+            if let Some(w) = dev.start_warning() {
+                eprintln!("warning: {w}");
+            }
             Ok(Box::new(dev) as Box<dyn DeviceIo + Send>)
         }),
     })

@@ -36,7 +36,7 @@ fn device_file(dir: &Path, name: &str, edit: impl Fn(String) -> String) -> PathB
 fn shipped_file(dir: &Path, file: &str, name: &str, edit: impl Fn(String) -> String) -> PathBuf {
     let p = dir.join(name);
     let text = shipped_text(file)
-        .replace("timeout_periods = 3 ", "timeout_periods = 100 ")
+        .replace("timeout_periods = 20 ", "timeout_periods = 100 ")
         .replace("max_missed_deadlines = 10 ", "max_missed_deadlines = 0 ")
         .replace("max_stall_periods = 5 ", "max_stall_periods = 1000 ");
     std::fs::write(&p, edit(text)).unwrap();
@@ -105,6 +105,13 @@ fn run_against_the_emulator_for_3_s_logs_and_exits_clean() {
         out.contains(&format!("device haply:{pty}")) && out.contains("on time:"),
         "{out}"
     );
+    // The stock firmware has no watchdog: said once, at start (issue 34 finding 3).
+    assert_eq!(
+        out.matches("warning: this board's firmware has no watchdog")
+            .count(),
+        1,
+        "{out}"
+    );
     let rows = std::fs::read_to_string(&log).unwrap().lines().count() - 1;
     assert!(rows > 500, "only {rows} rows logged:\n{out}");
 }
@@ -143,28 +150,44 @@ fn emulator_killed_mid_run_exits_4_naming_the_device() {
     assert!(!out.contains("non-finite device input"), "{out}");
 }
 
-#[test]
-fn device_check_finds_a_flipped_motor_direction() {
-    let _turn = turn();
-    let dir = tempfile::tempdir().unwrap();
-    let good = device_file(dir.path(), "gen3.toml", |t| t);
-    let (emu, pty) = emulate(&["--device-file", good.to_str().unwrap()]);
-    let dev = format!("haply:{pty}");
+/// `device check FILE --pulse` against the emulator at `pty`: the exit code and the output.
+fn device_check(pty: &str, file: &Path) -> (Option<i32>, String) {
     let o = Command::new(BIN)
         .args([
             "device",
             "check",
             "--device",
-            &dev,
+            &format!("haply:{pty}"),
             "--pulse",
             "--device-file",
         ])
-        .arg(&good)
+        .arg(file)
         .output()
         .unwrap();
-    let out = text(&o);
-    assert!(o.status.success(), "{out}");
-    assert!(out.contains("end point (") && out.contains("ok:"), "{out}");
+    (o.status.code(), text(&o))
+}
+
+/// Issue 34 finding 1: against a board that sets its encoders at setup, `device check` said "far
+/// outside the workspace" (exit 2) on every correctly wired board. Held at the rest pose (the
+/// emulator's default start), a correct board now passes, and the check says which firmware it is.
+#[test]
+fn device_check_passes_on_a_correct_board_held_at_rest_and_finds_a_flipped_motor() {
+    let _turn = turn();
+    let dir = tempfile::tempdir().unwrap();
+    let good = device_file(dir.path(), "gen3.toml", |t| t);
+    let (emu, pty) = emulate(&["--device-file", good.to_str().unwrap()]);
+    let (code, out) = device_check(&pty, &good);
+    assert_eq!(code, Some(0), "{out}");
+    assert!(
+        out.contains("rest pose: end point (0.0190 m, 0.0357 m)") && out.contains("ok:"),
+        "{out}"
+    );
+    assert!(
+        out.contains("stock firmware") && out.contains("no watchdog"),
+        "{out}"
+    );
+    // The emulated hand lets the handle settle back at the rest pose before the next check.
+    std::thread::sleep(Duration::from_millis(300));
     // The host's file says motor 1 turns CW (its encoder still CCW): the emulated board, wired
     // CCW, pushes that link backwards.
     let flipped = device_file(dir.path(), "flipped.toml", |t| {
@@ -174,23 +197,81 @@ fn device_check_finds_a_flipped_motor_direction() {
             1,
         )
     });
-    let o = Command::new(BIN)
-        .args([
-            "device",
-            "check",
-            "--device",
-            &dev,
-            "--pulse",
-            "--device-file",
-        ])
-        .arg(&flipped)
-        .output()
-        .unwrap();
+    let (code, out) = device_check(&pty, &flipped);
+    stop(emu);
+    assert_eq!(code, Some(2), "{out}");
+    assert!(
+        out.contains("fix: motor[0] turns its link clockwise")
+            && out.contains("flip motor[0].direction"),
+        "{out}"
+    );
+}
+
+/// Issue 34 finding 8: a joint whose motor AND encoder are both reversed read "+" like a correct
+/// one. The other joint's motion under the pulse (the five-bar's coupling) now tells them apart.
+#[test]
+fn device_check_tells_a_reversed_motor_and_encoder_from_a_correct_joint() {
+    let _turn = turn();
+    let dir = tempfile::tempdir().unwrap();
+    let good = device_file(dir.path(), "gen3.toml", |t| t);
+    // The emulated board is wired with motor 1 and its encoder both reversed against the file.
+    let board = device_file(dir.path(), "board.toml", |t| {
+        t.replacen("direction = \"ccw\"", "direction = \"cw\"", 1)
+    });
+    let (emu, pty) = emulate(&["--device-file", board.to_str().unwrap()]);
+    let (code, out) = device_check(&pty, &good);
+    stop(emu);
+    assert_eq!(code, Some(2), "{out}");
+    assert!(
+        out.contains("motor[0]'s motor AND encoder are both reversed"),
+        "{out}"
+    );
+    // Both joints' angles still grow under a positive torque, as on a correct board.
+    assert_eq!(out.matches("angle +").count(), 2, "{out}");
+}
+
+/// The twin's pulse check: a correct board passes; with q11's motor and encoder both reversed every
+/// angle still grows, and the closure of the readings under the pulses gives it away.
+#[test]
+fn device_check_on_the_twin_finds_a_joint_with_motor_and_encoder_reversed() {
+    let _turn = turn();
+    let dir = tempfile::tempdir().unwrap();
+    let good = shipped_file(dir.path(), "haply-twin.toml", "twin.toml", |t| t);
+    let (emu, pty) = emulate(&["--device-file", good.to_str().unwrap()]);
+    let (code, out) = device_check(&pty, &good);
+    stop(emu);
+    assert_eq!(code, Some(0), "{out}");
+    let board = shipped_file(dir.path(), "haply-twin.toml", "board.toml", |t| {
+        t.replacen("direction = \"ccw\"", "direction = \"cw\"", 1)
+    });
+    let (emu, pty) = emulate(&["--device-file", board.to_str().unwrap()]);
+    let (code, out) = device_check(&pty, &good);
+    stop(emu);
+    assert_eq!(code, Some(2), "{out}");
+    assert_eq!(out.matches("angle +").count(), 4, "{out}");
+    assert!(
+        out.contains("no longer describe one rigid handle")
+            && out.contains("under motor[0]'s pulse"),
+        "{out}"
+    );
+}
+
+/// Issue 34 finding 4 / item 7: the twin on an M0 ended with "check the USB cable" although the
+/// board answered. It is refused at open, naming the port count, before any torque.
+#[test]
+fn twin_on_an_m0_board_is_refused_naming_the_port_count() {
+    let _turn = turn();
+    let dir = tempfile::tempdir().unwrap();
+    let file = shipped_file(dir.path(), "haply-twin.toml", "twin.toml", |t| t);
+    let (emu, pty) = emulate(&["--device-file", file.to_str().unwrap(), "--board", "m0"]);
+    let o = haply_run(&pty, &file, "1").output().unwrap();
     stop(emu);
     let out = text(&o);
-    assert_eq!(o.status.code(), Some(2), "{out}");
+    assert_eq!(o.status.code(), Some(4), "{out}");
     assert!(
-        out.contains("motor[0]") && out.contains("direction"),
+        out.contains("M0 board has 2 ports")
+            && out.contains("ports 1–4")
+            && !out.contains("USB cable"),
         "{out}"
     );
 }
@@ -255,8 +336,10 @@ fn haply_run_is_the_normal_loop_torques_start_at_zero_ramp_in_and_stay_clamped()
     let (emu, pty) = emulate(&[
         "--device-file",
         file.to_str().unwrap(),
+        // The user holds the handle at the rest pose while the board is set up (docs/DEVICES.md
+        // §7), then pushes: hold 0.8 s, then 0.5 N along x.
         "--hand",
-        "constant:0.5,0,0",
+        "script:0.8,0.5,0,0,100",
     ]);
     let log = dir.path().join("ramp.csv");
     let o = haply_run(&pty, &file, "1.5")
@@ -321,7 +404,8 @@ fn a_silent_emulated_device_exits_4_with_the_reason() {
     );
     assert!(
         out.contains(&format!("haply:{pty}"))
-            && out.contains("check the USB cable")
+            && out.contains("emulator on a pseudo-terminal (no USB cable)")
+            && out.contains("the device was late")
             && out.contains("torques were set to zero")
             && !out.contains("stalled"),
         "{out}"
@@ -341,7 +425,7 @@ fn twin_runs_through_the_normal_loop_against_the_emulator() {
         "--device-file",
         file.to_str().unwrap(),
         "--hand",
-        "constant:0.3,0,0",
+        "script:0.8,0.3,0,0,100",
     ]);
     let log = dir.path().join("twin.csv");
     let o = haply_run(&pty, &file, "1.5")

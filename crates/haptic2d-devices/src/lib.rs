@@ -2,11 +2,11 @@
 //! emulators that speak the same protocols so that every test runs without hardware.
 //!
 //! - [`haply`]: Haply boards (the 2DIY pantograph, and the twin pantograph built from two 2DIY
-//!   linkages on one board's 4 ports), DEVICES §1–§3.
+//!   linkages on one board's 4 ports), docs/DEVICES.md §1–§3.
 //! - [`udp`]: the open UDP device protocol for custom hardware and other programs
 //!   (docs/DEVICE-PROTOCOL.md).
 //! - `inverse3` (feature `inverse3`): Haply's Inverse3 through its Inverse Service and the `haply`
-//!   client crate, in planar mode, and an emulator of the service (DEVICES §4).
+//!   client crate, in planar mode, and an emulator of the service (docs/DEVICES.md §4).
 #![warn(missing_docs)]
 
 pub mod device_toml;

@@ -120,3 +120,90 @@ fn device_files_are_read_with_the_scene_file_cap() {
     let e = haptic2d_devices::udp::UdpDeviceFile::from_path(zero).unwrap_err();
     assert!(e.contains("larger than the documented cap"), "{e}");
 }
+
+/// Issue 34 finding 7: the shipped twin gave both linkages the same offsets; at the pose they
+/// describe the end points coincide and the closure error is r_c = 0.020 m. Its offsets now are the
+/// inverse kinematics of its homing pose: the closure error there is ~0.
+#[test]
+fn shipped_twin_offsets_close_at_its_homing_pose() {
+    use haptic2d::device::TwinKinematics;
+    let twin = shipped("haply-twin.toml");
+    let HaplyKind::Twin(p) = &twin.kind else {
+        panic!("not a twin")
+    };
+    let q: Vec<f64> = twin
+        .motors
+        .iter()
+        .map(|m| m.offset_deg.to_radians())
+        .collect();
+    let fk = TwinKinematics::new(p)
+        .fk(&[q[0], q[1], q[2], q[3]], 0.0)
+        .unwrap_or_else(|e| panic!("the shipped offsets do not close: {e}"));
+    assert!(fk.closure_error.abs() < 1e-6, "{}", fk.closure_error);
+    let rest = twin.rest_pose().unwrap();
+    assert!(
+        (rest[0] - 0.0).abs() < 1e-6 && (rest[1] - 0.10).abs() < 1e-6 && rest[2].abs() < 1e-6,
+        "{rest:?}"
+    );
+}
+
+#[test]
+fn twin_offsets_that_do_not_close_are_refused_naming_the_fix() {
+    let text = std::fs::read_to_string(format!(
+        "{}/../../devices/haply-twin.toml",
+        env!("CARGO_MANIFEST_DIR")
+    ))
+    .unwrap();
+    // Main's file: both linkages at the 2DIY gen 3 offsets.
+    let same = text
+        .replace("139.075826", "168.0")
+        .replace("125.070550", "168.0")
+        .replace("40.924174", "12.0")
+        .replace("28.489432", "12.0")
+        .replace("[rest]\npose = [0.0, 0.10, 0.0]", "");
+    let e = err(&same);
+    assert!(
+        e.contains("motor.offset_deg") && e.contains("closure") && e.contains("inverse kinematics"),
+        "{e}"
+    );
+    // A rest pose that the offsets do not describe names rest.pose and gives the offsets for it.
+    let moved = text.replace("pose = [0.0, 0.10, 0.0]", "pose = [0.005, 0.10, 0.0]");
+    let e = err(&moved);
+    assert!(
+        e.contains("rest.pose") && e.contains("q11 q12 q21 q22"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_2diy_rest_pose_that_the_offsets_do_not_describe_is_refused() {
+    let e = err(&GOOD.replace(
+        "half_width = 0.03",
+        "half_width = 0.03\n[rest]\npose = [0.019, 0.10]",
+    ));
+    assert!(
+        e.contains("rest.pose") && e.contains("(0.0190, 0.0357) m"),
+        "{e}"
+    );
+    HaplyDeviceFile::from_toml(
+        &GOOD.replace(
+            "half_width = 0.03",
+            "half_width = 0.03\n[rest]\npose = [0.019, 0.0357]",
+        ),
+        "t",
+    )
+    .unwrap();
+}
+
+#[test]
+fn watchdog_ms_defaults_to_20_and_is_checked() {
+    assert_eq!(
+        HaplyDeviceFile::from_toml(GOOD, "t").unwrap().watchdog_ms,
+        20
+    );
+    let e = err(&GOOD.replace("id = 1", "id = 1\nwatchdog_ms = 0"));
+    assert!(
+        e.contains("board.watchdog_ms") && e.contains("1–1000"),
+        "{e}"
+    );
+}

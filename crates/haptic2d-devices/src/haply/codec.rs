@@ -1,4 +1,4 @@
-//! The Haply board protocol (DEVICES §1) as a pure codec: bytes in, typed frames out, buffers owned
+//! The Haply board protocol (docs/DEVICES.md §1) as a pure codec: bytes in, typed frames out, buffers owned
 //! by the caller; no clock, no port, no allocation.
 //!
 //! ```text
@@ -31,6 +31,18 @@ pub const CMD_RESET: u8 = 0x00;
 pub const CMD_SETUP: u8 = 0x01;
 /// Command byte of a write.
 pub const CMD_WRITE: u8 = 0x02;
+/// Command byte of haptic2d firmware's identify query (docs/DEVICES.md §6): a lone byte, no id. The
+/// stock firmware discards it.
+pub const CMD_IDENTIFY: u8 = 0x03;
+/// Command byte of haptic2d firmware's watchdog setting: `[0x04][watchdog_ms u16 LE]`. Sent only to
+/// a board that answered identify.
+pub const CMD_SET_WATCHDOG: u8 = 0x04;
+/// Length of haptic2d firmware's identify frame (bytes).
+pub const IDENTIFY_LEN: usize = 10;
+/// The identify frame's magic bytes after its first byte `0x03`.
+pub const IDENTIFY_MAGIC: [u8; 4] = *b"H2DF";
+/// The watchdog times haptic2d firmware accepts (ms).
+pub const WATCHDOG_MS_RANGE: std::ops::RangeInclusive<u16> = 1..=1000;
 /// Largest setup frame (bytes): 3 + 4 + 1 + 4 + 1 + 12 + 1 + 4 + 8·4.
 pub const SETUP_MAX_LEN: usize = 62;
 /// Largest write frame (bytes): 2 + 4 + 4·4.
@@ -202,6 +214,8 @@ pub enum CodecError {
     UnknownCommand(u8),
     /// A setup cannot be encoded (what is wrong).
     Invalid(&'static str),
+    /// Bytes that are not haptic2d firmware's identify frame (what is wrong).
+    NotIdentify(&'static str),
 }
 
 impl fmt::Display for CodecError {
@@ -220,6 +234,7 @@ impl fmt::Display for CodecError {
             }
             CodecError::UnknownCommand(b) => write!(f, "unknown command byte 0x{b:02x}"),
             CodecError::Invalid(s) => write!(f, "invalid setup: {s}"),
+            CodecError::NotIdentify(s) => write!(f, "not an identify frame: {s}"),
         }
     }
 }
@@ -367,6 +382,95 @@ pub fn encode_reply(
     Ok(len)
 }
 
+/// What haptic2d's own board firmware says about itself (its identify frame, docs/DEVICES.md §6).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FirmwareIdentity {
+    /// Firmware version.
+    pub version: u8,
+    /// Motor/encoder ports of the board (2 on an M0, 4 on an M3).
+    pub ports: u8,
+    /// Capability bits: [`CAP_WATCHDOG`], [`CAP_RESET_ZEROES`], [`CAP_BOARD_CLAMP`].
+    pub caps: u8,
+    /// The watchdog time now in force (ms).
+    pub watchdog_ms: u16,
+}
+
+/// Capability bit: the board zeroes its motors when no write arrives within the watchdog time.
+pub const CAP_WATCHDOG: u8 = 1 << 0;
+/// Capability bit: reset zeroes the motor output.
+pub const CAP_RESET_ZEROES: u8 = 1 << 1;
+/// Capability bit: the board clamps every torque itself.
+pub const CAP_BOARD_CLAMP: u8 = 1 << 2;
+
+impl FirmwareIdentity {
+    /// True when the board has a watchdog.
+    pub fn has_watchdog(&self) -> bool {
+        self.caps & CAP_WATCHDOG != 0
+    }
+    /// True when reset zeroes the motor output.
+    pub fn reset_zeroes_motors(&self) -> bool {
+        self.caps & CAP_RESET_ZEROES != 0
+    }
+    /// True when the board clamps the torques itself.
+    pub fn clamps_torque(&self) -> bool {
+        self.caps & CAP_BOARD_CLAMP != 0
+    }
+}
+
+/// Encodes the identify query `[0x03]` into `out`; returns the length (1).
+pub fn encode_identify(out: &mut [u8]) -> Result<usize, CodecError> {
+    need(out, 1)?;
+    out[0] = CMD_IDENTIFY;
+    Ok(1)
+}
+
+/// Encodes the watchdog setting `[0x04][watchdog_ms u16 LE]`; returns the length (3). Errors when
+/// `watchdog_ms` is outside 1–1000.
+pub fn encode_set_watchdog(watchdog_ms: u16, out: &mut [u8]) -> Result<usize, CodecError> {
+    if !WATCHDOG_MS_RANGE.contains(&watchdog_ms) {
+        return Err(CodecError::Invalid("the watchdog time must be 1–1000 ms"));
+    }
+    need(out, 3)?;
+    out[0] = CMD_SET_WATCHDOG;
+    out[1..3].copy_from_slice(&watchdog_ms.to_le_bytes());
+    Ok(3)
+}
+
+/// Encodes an identify frame (the board side, for tests and emulators); returns the length (10).
+pub fn encode_identity(id: &FirmwareIdentity, out: &mut [u8]) -> Result<usize, CodecError> {
+    need(out, IDENTIFY_LEN)?;
+    out[0] = CMD_IDENTIFY;
+    out[1..5].copy_from_slice(&IDENTIFY_MAGIC);
+    out[5] = id.version;
+    out[6] = id.ports;
+    out[7] = id.caps;
+    out[8..10].copy_from_slice(&id.watchdog_ms.to_le_bytes());
+    Ok(IDENTIFY_LEN)
+}
+
+/// Decodes an identify frame from `bytes` (exactly the frame; extra bytes are ignored). Errors:
+/// [`CodecError::Short`], [`CodecError::NotIdentify`].
+pub fn decode_identity(bytes: &[u8]) -> Result<FirmwareIdentity, CodecError> {
+    if bytes.first().is_some_and(|&b| b != CMD_IDENTIFY) {
+        return Err(CodecError::NotIdentify("the first byte is not 0x03"));
+    }
+    if bytes.len() < IDENTIFY_LEN {
+        return Err(CodecError::Short {
+            expected: IDENTIFY_LEN,
+            got: bytes.len(),
+        });
+    }
+    if bytes[1..5] != IDENTIFY_MAGIC {
+        return Err(CodecError::NotIdentify("the magic bytes are not \"H2DF\""));
+    }
+    Ok(FirmwareIdentity {
+        version: bytes[5],
+        ports: bytes[6],
+        caps: bytes[7],
+        watchdog_ms: u16::from_le_bytes([bytes[8], bytes[9]]),
+    })
+}
+
 /// A host frame as the board reads it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum HostFrame {
@@ -392,7 +496,7 @@ pub enum HostFrame {
 /// board's current setup (a write's length depends on it). Returns `Ok(None)` while the frame is
 /// incomplete, else the frame and its length.
 ///
-/// Direction bytes follow the firmware's quirk (DEVICES §1): the `k`-th direction byte on the wire
+/// Direction bytes follow the firmware's quirk (docs/DEVICES.md §1): the `k`-th direction byte on the wire
 /// is assigned to port `k + 1`, whatever the mask says, so a mask that does not start at port 1
 /// shifts the directions onto the wrong ports (ports past the bytes sent get clockwise). Hosts that
 /// use masks starting at port 1 with no gaps, as our driver does, are unaffected.
@@ -498,5 +602,78 @@ impl Reader<'_> {
         let s = self.b.get(self.at..self.at + 4)?;
         self.at += 4;
         Some(f32::from_le_bytes([s[0], s[1], s[2], s[3]]))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn identify_query_is_one_byte_0x03_without_an_id() {
+        let mut out = [0u8; 4];
+        assert_eq!(encode_identify(&mut out), Ok(1));
+        assert_eq!(out[0], 0x03);
+    }
+
+    #[test]
+    fn set_watchdog_is_0x04_and_the_time_little_endian_within_1_to_1000_ms() {
+        let mut out = [0u8; 3];
+        assert_eq!(encode_set_watchdog(20, &mut out), Ok(3));
+        assert_eq!(out, [0x04, 20, 0]);
+        assert_eq!(encode_set_watchdog(1000, &mut out), Ok(3));
+        assert_eq!(out, [0x04, 0xe8, 0x03]);
+        assert!(matches!(
+            encode_set_watchdog(0, &mut out),
+            Err(CodecError::Invalid(_))
+        ));
+        assert!(matches!(
+            encode_set_watchdog(1001, &mut out),
+            Err(CodecError::Invalid(_))
+        ));
+    }
+
+    #[test]
+    fn identify_frame_bytes_by_hand_decode_to_the_identity() {
+        // [0x03]['H','2','D','F'][version 2][ports 4][caps 0b101][watchdog 300 ms = 0x012c LE]
+        let bytes = [0x03, b'H', b'2', b'D', b'F', 2, 4, 0b101, 0x2c, 0x01];
+        let id = decode_identity(&bytes).unwrap();
+        assert_eq!(
+            id,
+            FirmwareIdentity {
+                version: 2,
+                ports: 4,
+                caps: 0b101,
+                watchdog_ms: 300
+            }
+        );
+        assert!(id.has_watchdog() && !id.reset_zeroes_motors() && id.clamps_torque());
+        let mut out = [0u8; IDENTIFY_LEN];
+        assert_eq!(encode_identity(&id, &mut out), Ok(IDENTIFY_LEN));
+        assert_eq!(out, bytes);
+    }
+
+    #[test]
+    fn identify_frame_with_a_wrong_magic_a_wrong_first_byte_or_short_is_refused() {
+        let good = [0x03, b'H', b'2', b'D', b'F', 1, 4, 7, 20, 0];
+        let mut bad = good;
+        bad[2] = b'X';
+        assert!(matches!(
+            decode_identity(&bad),
+            Err(CodecError::NotIdentify(_))
+        ));
+        bad = good;
+        bad[0] = 0x01;
+        assert!(matches!(
+            decode_identity(&bad),
+            Err(CodecError::NotIdentify(_))
+        ));
+        assert_eq!(
+            decode_identity(&good[..9]),
+            Err(CodecError::Short {
+                expected: 10,
+                got: 9
+            })
+        );
     }
 }

@@ -9,9 +9,10 @@
 //! id = 1                        # board id, 0–255
 //! usb_ids = ["2341:804d"]       # vendor:product (hex) for --device haply:auto
 //! torque_limit = 0.123          # N·m, ≤ the firmware's 0.123
-//! timeout_periods = 3           # a reply later than this many periods = device lost
+//! timeout_periods = 20          # a reply later than this many periods = device lost
 //! max_missed_deadlines = 10     # watchdog: consecutive missed deadlines (0 = off)
 //! max_stall_periods = 5         # the loop's own delay between two ticks that trips (periods)
+//! watchdog_ms = 20              # haptic2d firmware only: motors zeroed without a write for this long
 //! [linkage]                     # 2diy only (the twin's geometry is its [device] table)
 //! d = 0.038                     # m
 //! l1 = 0.07                     # m
@@ -27,7 +28,7 @@
 //! ```
 
 use haptic2d::device::pantograph2::Pantograph2;
-use haptic2d::device::DeviceParams;
+use haptic2d::device::{DeviceParams, TwinKinematics};
 use haptic2d::geom::Vec2;
 use haptic2d::haptic::ControllerKind;
 use haptic2d::scene::{device_params_from_toml, SceneError, SceneErrors};
@@ -79,7 +80,10 @@ pub struct HaplyDeviceFile {
     pub usb_ids: Vec<(u16, u16)>,
     /// Torque limit the driver enforces on every motor (N·m), ≤ 0.123.
     pub torque_limit: f64,
-    /// A reply later than this many periods means the device is lost. Default 3.
+    /// A reply later than this many periods means the device is lost. Default 20: at 1 kHz, 3
+    /// periods tripped within 0.2–2 s against the emulator on a 2-core machine at load average 11
+    /// with nothing wrong (issue 34); the stock board holds the last torque meanwhile either way,
+    /// haptic2d's firmware zeroes it after its own `watchdog_ms`.
     pub timeout_periods: f64,
     /// The watchdog trips after this many consecutive missed deadlines; `None` (0 in the file)
     /// turns the check off. Default 10.
@@ -88,6 +92,9 @@ pub struct HaplyDeviceFile {
     /// the board, which `timeout_periods` bounds) that trips the stall check (periods, ≥ 1).
     /// Default 5, the shared safety layer's.
     pub max_stall_periods: f64,
+    /// The watchdog time set on a board running haptic2d's firmware (ms, 1–1000; the stock
+    /// firmware has none). Default 20.
+    pub watchdog_ms: u16,
     /// Motors in joint order.
     pub motors: Vec<MotorSpec>,
     /// 2DIY or twin.
@@ -109,6 +116,14 @@ struct RawFile {
     device: Option<toml::Table>,
     #[serde(default)]
     motor: Vec<RawMotor>,
+    #[serde(default)]
+    rest: Option<RawRest>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawRest {
+    pose: Vec<f64>,
 }
 
 #[derive(Deserialize)]
@@ -120,12 +135,14 @@ struct RawBoard {
     usb_ids: Vec<String>,
     #[serde(default = "firmware_limit")]
     torque_limit: f64,
-    #[serde(default = "three")]
+    #[serde(default = "twenty_periods")]
     timeout_periods: f64,
     #[serde(default = "ten")]
     max_missed_deadlines: i64,
     #[serde(default = "five")]
     max_stall_periods: f64,
+    #[serde(default = "twenty")]
+    watchdog_ms: i64,
 }
 
 #[derive(Deserialize)]
@@ -157,11 +174,14 @@ struct RawMotor {
 fn one() -> i64 {
     1
 }
-fn three() -> f64 {
-    3.0
+fn twenty_periods() -> f64 {
+    20.0
 }
 fn five() -> f64 {
     5.0
+}
+fn twenty() -> i64 {
+    20
 }
 fn ten() -> i64 {
     10
@@ -244,7 +264,7 @@ impl HaplyDeviceFile {
             errs.push(SceneError::new(
                 "board.timeout_periods",
                 format!("{} periods is too short", b.timeout_periods),
-                "give a number of control periods ≥ 1 (default 3)",
+                "give a number of control periods ≥ 1 (default 20)",
             ));
         }
         if !(0..=100_000).contains(&b.max_missed_deadlines) {
@@ -259,6 +279,13 @@ impl HaplyDeviceFile {
                 "board.max_stall_periods",
                 format!("{} periods is not a stall limit", b.max_stall_periods),
                 "give a number of control periods ≥ 1 (default 5)",
+            ));
+        }
+        if !(1..=1000).contains(&b.watchdog_ms) {
+            errs.push(SceneError::new(
+                "board.watchdog_ms",
+                format!("{} ms is outside 1–1000 ms", b.watchdog_ms),
+                "give the time after which haptic2d's board firmware zeroes the motors without a write (default 20 ms)",
             ));
         }
         let n_expected = match raw.kind.as_str() {
@@ -395,6 +422,9 @@ impl HaplyDeviceFile {
             },
             _ => None,
         };
+        if let (Some(k), true) = (&kind, errs.is_empty()) {
+            check_rest_pose(k, &motors, raw.rest.as_ref(), &mut errs);
+        }
         match kind {
             Some(kind) if errs.is_empty() => Ok(Self {
                 name: raw.name.unwrap_or_else(|| raw.kind.clone()),
@@ -407,6 +437,7 @@ impl HaplyDeviceFile {
                     .ok()
                     .filter(|n| *n > 0),
                 max_stall_periods: b.max_stall_periods,
+                watchdog_ms: b.watchdog_ms.clamp(1, 1000) as u16,
                 motors,
                 kind,
             }),
@@ -484,11 +515,146 @@ impl HaplyDeviceFile {
         }
     }
 
+    /// The joint angles of the rest (calibration) pose (rad, joint order): the offsets. Right after
+    /// a setup the board reports exactly these, within one count, wherever the handle is
+    /// (docs/DEVICES.md §1.3.3).
+    pub fn rest_joint_angles(&self) -> [f64; PORTS] {
+        let mut q = [0.0; PORTS];
+        for (qj, m) in q.iter_mut().zip(&self.motors) {
+            *qj = m.offset_deg.to_radians();
+        }
+        q
+    }
+
+    /// The rest (calibration) pose: the forward kinematics of the offsets (2DIY: end point `(x, y,
+    /// 0)`, m, board frame; twin: handle pose `(x, y, θ)`, m, m, rad, MODELS §10 frame). The user
+    /// holds the handle here when a host starts (docs/DEVICES.md §7). Errors when the offsets do
+    /// not assemble (the twin: a closure error of `closure_tol` or more).
+    pub fn rest_pose(&self) -> Result<[f64; 3], String> {
+        let q = self.rest_joint_angles();
+        match &self.kind {
+            HaplyKind::TwoDiy { linkage, .. } => linkage
+                .fk([q[0], q[1]])
+                .map(|e| [e.x, e.y, 0.0])
+                .map_err(|e| format!("the offsets do not assemble into the linkage: {e}")),
+            HaplyKind::Twin(p) => TwinKinematics::new(p)
+                .fk(&q, 0.0)
+                .map(|f| f.pose)
+                .map_err(|e| format!("the offsets are not a pose of the twin: {e}")),
+        }
+    }
+
     /// A start pose inside the workspace: the centre (m, board frame; θ = 0 for the twin).
     pub fn workspace_center(&self) -> [f64; 3] {
         match &self.kind {
             HaplyKind::TwoDiy { center, .. } => [center[0], center[1], 0.0],
             HaplyKind::Twin(p) => [p.workspace_center_x, p.workspace_center_y, 0.0],
+        }
+    }
+}
+
+/// The rest (homing) pose against the offsets (docs/DEVICES.md §1.3.3, §3): the twin's offsets must
+/// close (closure error below `closure_tol`); a `[rest] pose` given must be the offsets' pose
+/// (within 1 mm and 0.01 rad). Errors give the offsets that would match.
+fn check_rest_pose(
+    kind: &HaplyKind,
+    motors: &[MotorSpec],
+    rest: Option<&RawRest>,
+    errs: &mut Vec<SceneError>,
+) {
+    let mut q = [0.0; PORTS];
+    for (qj, m) in q.iter_mut().zip(motors) {
+        *qj = m.offset_deg.to_radians();
+    }
+    let deg = |q: &[f64]| {
+        q.iter()
+            .map(|v| format!("{:.6}", v.to_degrees()))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    match kind {
+        HaplyKind::TwoDiy { linkage, .. } => {
+            let Some(r) = rest else { return };
+            if r.pose.len() != 2 || !r.pose.iter().all(|v| v.is_finite()) {
+                errs.push(SceneError::new(
+                    "rest.pose",
+                    "must be [x, y] in metres for a 2diy",
+                    "give the end point of the rest pose, board frame",
+                ));
+                return;
+            }
+            let want = Vec2::new(r.pose[0], r.pose[1]);
+            match linkage.fk([q[0], q[1]]) {
+                Ok(e) if (e - want).length() <= 1e-3 => {}
+                got => {
+                    let fix = match linkage.ik(want) {
+                        Ok(qi) => format!(
+                            "offsets ({}) in joint order put the rest pose there",
+                            deg(&qi)
+                        ),
+                        Err(_) => "the pose is out of reach: give a reachable one".into(),
+                    };
+                    errs.push(SceneError::new(
+                        "rest.pose",
+                        format!(
+                            "the offsets put the end point at {}, not at ({:.4}, {:.4}) m",
+                            got.map(|e| format!("({:.4}, {:.4}) m", e.x, e.y))
+                                .unwrap_or_else(|e| e.to_string()),
+                            want.x,
+                            want.y
+                        ),
+                        fix,
+                    ));
+                }
+            }
+        }
+        HaplyKind::Twin(p) => {
+            let kin = TwinKinematics::new(p);
+            let want = match rest {
+                Some(r) if r.pose.len() == 3 && r.pose.iter().all(|v| v.is_finite()) => {
+                    Some([r.pose[0], r.pose[1], r.pose[2]])
+                }
+                Some(_) => {
+                    errs.push(SceneError::new(
+                        "rest.pose",
+                        "must be [x, y, theta] (m, m, rad) for a twin",
+                        "give the handle's homing pose, MODELS §10 frame",
+                    ));
+                    return;
+                }
+                None => None,
+            };
+            let fix = |w: Option<[f64; 3]>| {
+                match w.map(|w| kin.ik(&w)) {
+                Some(Ok(qi)) => format!(
+                    "set the four offsets to the homing pose's inverse kinematics ({}, q11 q12 q21 q22)",
+                    deg(&qi)
+                ),
+                _ => "set the four offsets to the inverse kinematics of one handle pose and give it as [rest] pose = [x, y, theta] (docs/DEVICES.md §3)".into(),
+            }
+            };
+            match kin.fk(&q, want.map_or(0.0, |w| w[2])) {
+                Err(e) => errs.push(SceneError::new(
+                    "motor.offset_deg",
+                    format!("the offsets are not a pose of the twin: {e}"),
+                    fix(want),
+                )),
+                Ok(f) => {
+                    if let Some(w) = want {
+                        let d = ((f.pose[0] - w[0]).powi(2) + (f.pose[1] - w[1]).powi(2)).sqrt();
+                        if d > 1e-3 || (f.pose[2] - w[2]).abs() > 1e-2 {
+                            errs.push(SceneError::new(
+                                "rest.pose",
+                                format!(
+                                    "the offsets put the handle at ({:.4} m, {:.4} m, {:.4} rad), not at the rest pose",
+                                    f.pose[0], f.pose[1], f.pose[2]
+                                ),
+                                fix(want),
+                            ));
+                        }
+                    }
+                }
+            }
         }
     }
 }

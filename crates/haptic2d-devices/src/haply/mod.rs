@@ -10,10 +10,10 @@ pub mod serial;
 pub mod system;
 pub mod transport;
 
-pub use codec::{BoardSetup, CodecError, Reply, Rotation};
+pub use codec::{BoardSetup, CodecError, FirmwareIdentity, Reply, Rotation};
 pub use device_file::{HaplyDeviceFile, HaplyKind, MotorSpec};
-pub use driver::HaplyDevice;
-pub use emulator::{serve, EmulatorClock, EmulatorConfig, EmulatorReport, Firmware};
+pub use driver::{check_rest, HaplyDevice, NO_WATCHDOG_WARNING};
+pub use emulator::{serve, BoardKind, EmulatorClock, EmulatorConfig, EmulatorReport, Firmware};
 pub use plant::{Plant, Plant2};
 pub use system::{HaplySystem, HaplyTick};
 pub use transport::{HaplyError, Transport};

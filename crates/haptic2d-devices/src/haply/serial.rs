@@ -10,8 +10,71 @@ use serialport::{SerialPort, TTYPort};
 /// deadline decides (µs granularity is not needed: replies arrive within a period).
 pub const STREAM_TIMEOUT: Duration = Duration::from_micros(500);
 
+/// A board's serial port whose reads do not allocate: `serialport`'s read builds a boxed
+/// `io::Error` for every read timeout, which the driver's exchange would hit under load (caught by
+/// `tests/haply_no_alloc.rs`). Reads wait with `ppoll` for at most [`STREAM_TIMEOUT`] and return
+/// `Ok(0)` when nothing came; errors are OS errors (no allocation). Writes go through `serialport`.
+#[derive(Debug)]
+pub struct BoardPort {
+    tty: TTYPort,
+}
+
+impl BoardPort {
+    /// The underlying port.
+    pub fn tty(&self) -> &TTYPort {
+        &self.tty
+    }
+}
+
+impl std::io::Read for BoardPort {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        use std::os::unix::io::AsRawFd;
+        if buf.is_empty() {
+            return Ok(0);
+        }
+        let fd = self.tty.as_raw_fd();
+        let mut pfd = libc::pollfd {
+            fd,
+            events: libc::POLLIN,
+            revents: 0,
+        };
+        let ts = libc::timespec {
+            tv_sec: 0,
+            tv_nsec: STREAM_TIMEOUT.as_nanos() as libc::c_long,
+        };
+        // SAFETY: `pfd` and `ts` are valid for the call; one descriptor, no signal mask.
+        let r = unsafe { libc::ppoll(&mut pfd, 1, &ts, std::ptr::null()) };
+        if r < 0 {
+            return Err(std::io::Error::last_os_error());
+        }
+        if r == 0 {
+            return Ok(0);
+        }
+        if pfd.revents & (libc::POLLHUP | libc::POLLERR | libc::POLLNVAL) != 0
+            && pfd.revents & libc::POLLIN == 0
+        {
+            return Err(std::io::Error::from_raw_os_error(libc::EIO));
+        }
+        // SAFETY: `buf` is valid for `buf.len()` bytes; `fd` is open (owned by `self.tty`).
+        let n = unsafe { libc::read(fd, buf.as_mut_ptr().cast(), buf.len()) };
+        if n < 0 {
+            return Err(std::io::Error::last_os_error());
+        }
+        Ok(n as usize)
+    }
+}
+
+impl std::io::Write for BoardPort {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.tty.write(buf)
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.tty.flush()
+    }
+}
+
 /// Opens the serial port at `path` for a board (the baud rate is ignored by USB CDC ACM), raw mode.
-pub fn open_port(path: &str) -> Result<TTYPort, String> {
+pub fn open_port(path: &str) -> Result<BoardPort, String> {
     let builder = serialport::new(path, 115_200).timeout(STREAM_TIMEOUT);
     let mut port = TTYPort::open(&builder).map_err(|e| {
         format!(
@@ -20,7 +83,7 @@ pub fn open_port(path: &str) -> Result<TTYPort, String> {
     })?;
     make_raw(&port).map_err(|e| format!("{path}: {e}"))?;
     let _ = port.set_exclusive(false);
-    Ok(port)
+    Ok(BoardPort { tty: port })
 }
 
 /// Puts a tty in raw mode (no echo, no line editing, no CR/LF translation): the protocol is binary.

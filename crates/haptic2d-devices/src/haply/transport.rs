@@ -1,14 +1,15 @@
 //! The Haply transport: frames over any `Read + Write` stream (a serial port, a pseudo-terminal, an
-//! in-memory mock), with read timeouts, detection of a stream out of step, **one**
-//! resynchronisation (reset + setup) and then a clear stop.
+//! in-memory mock), with read timeouts and detection of a stream out of step. It **never
+//! resynchronises**: the stock firmware sets its encoders at every setup (docs/DEVICES.md §1.3.3),
+//! so a re-setup mid-run would re-zero them wherever the handle is and silently shift the
+//! calibration. A stream out of step is an error; the driver zeroes the torques and ends the run.
 //!
 //! ```text
-//! handshake:  reset → setup → write(0…) → reply          (before the first deadline)
-//! per tick:   send_write(τ) … read_reply() → angles       (deadline: sent + timeout)
-//! out of step (first byte ≠ id, short reply, garbage):
-//!             drain input → reset → setup → write(0…) → reply   (once; torques zero until then)
-//!             a second time → HaplyError::OutOfStep (stop)
-//! nothing at all within the timeout → HaplyError::Lost
+//! open:       drain → identify [0x03] (≤ 100 ms; silence = stock firmware)
+//!             → [0x04][watchdog_ms] (haptic2d firmware only) → reset → setup → write(0…) → reply
+//! per tick:   send_write(τ) … read_reply() → angles        (deadline: sent + timeout)
+//! out of step (first byte ≠ id, short reply, garbage)  → HaplyError::OutOfStep
+//! nothing at all within the timeout                   → HaplyError::Lost (who was late, if known)
 //! ```
 //!
 //! The stream's own read timeout should be short (the serial opener uses ≤ 1 ms): the transport
@@ -19,8 +20,9 @@ use std::io::{ErrorKind, Read, Write};
 use std::time::{Duration, Instant};
 
 use super::codec::{
-    decode_reply, encode_reset, encode_setup, encode_write, BoardSetup, CodecError, Reply, PORTS,
-    REPLY_MAX_LEN, SETUP_MAX_LEN, WRITE_MAX_LEN,
+    decode_identity, decode_reply, encode_identify, encode_reset, encode_set_watchdog,
+    encode_setup, encode_write, BoardSetup, CodecError, FirmwareIdentity, Reply, IDENTIFY_LEN,
+    PORTS, REPLY_MAX_LEN, SETUP_MAX_LEN, WRITE_MAX_LEN,
 };
 
 /// A transport failure; mapped to `DeviceError::Lost`/`Io` at the `DeviceIo` boundary.
@@ -28,7 +30,7 @@ use super::codec::{
 pub enum HaplyError {
     /// No reply (or not all of it) within the timeout, or the port closed.
     Lost(String),
-    /// The stream stayed out of step after the one resynchronisation allowed.
+    /// The stream is out of step: a byte was lost or added on the line.
     OutOfStep(CodecError),
     /// A read or write failed.
     Io(String),
@@ -42,7 +44,7 @@ impl fmt::Display for HaplyError {
             HaplyError::Lost(s) => write!(f, "{s}"),
             HaplyError::OutOfStep(e) => write!(
                 f,
-                "the byte stream is out of step ({e}) and one resynchronisation (reset + setup) did not fix it"
+                "the byte stream is out of step ({e}): a byte was lost or added on the line"
             ),
             HaplyError::Io(s) => write!(f, "{s}"),
             HaplyError::Config(s) => write!(f, "{s}"),
@@ -61,14 +63,30 @@ pub struct Transport<S> {
     tx: [u8; SETUP_MAX_LEN],
     rx: [u8; REPLY_MAX_LEN],
     sent_at: Option<Instant>,
-    resyncs_left: u32,
-    resyncs: u32,
+}
+
+/// How the host spent a wait that timed out: to tell a late device from a late host.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WaitTiming {
+    /// From the write to the first read attempt (s): the host's own delay before it waited.
+    pub start_delay: f64,
+    /// The longest gap between two read attempts while waiting (s): the host not running.
+    pub max_gap: f64,
+    /// The whole wait, write to giving up (s).
+    pub total: f64,
+}
+
+impl WaitTiming {
+    /// True when the host itself was not running for at least half of the timeout `timeout` (s):
+    /// then the late reply may be the host's fault (a loaded machine), not the device's.
+    pub fn host_late(&self, timeout: f64) -> bool {
+        self.start_delay.max(self.max_gap) >= 0.5 * timeout
+    }
 }
 
 impl<S: Read + Write> Transport<S> {
     /// A transport to the board configured by `setup` over `stream`, waiting at most `timeout` for
-    /// each reply (from the moment its write was sent). Nothing is sent yet: call
-    /// [`handshake`](Self::handshake).
+    /// each reply (from the moment its write was sent). Nothing is sent yet.
     pub fn from_stream(
         stream: S,
         setup: BoardSetup,
@@ -87,8 +105,6 @@ impl<S: Read + Write> Transport<S> {
             tx: [0; SETUP_MAX_LEN],
             rx: [0; REPLY_MAX_LEN],
             sent_at: None,
-            resyncs_left: 1,
-            resyncs: 0,
         })
     }
 
@@ -99,14 +115,14 @@ impl<S: Read + Write> Transport<S> {
         }
     }
 
+    /// The reply timeout.
+    pub fn timeout(&self) -> Duration {
+        self.timeout
+    }
+
     /// The board set-up.
     pub fn setup(&self) -> &BoardSetup {
         &self.setup
-    }
-
-    /// Resynchronisations done so far (0 or 1).
-    pub fn resyncs(&self) -> u32 {
-        self.resyncs
     }
 
     /// The stream (e.g. to inspect a mock).
@@ -119,18 +135,65 @@ impl<S: Read + Write> Transport<S> {
         self.sent_at.is_some()
     }
 
-    /// Reset + setup + a zero-torque write, and its reply: the board is configured and answering.
-    pub fn handshake(&mut self) -> Result<Reply, HaplyError> {
-        self.send_reset_setup()?;
-        self.send_write(&[0.0; PORTS][..self.setup.n_motors()])?;
-        self.wait_reply()
+    /// Sends haptic2d firmware's identify query and waits up to `wait` for its 10-byte answer.
+    /// `Ok(None)`: nothing came back, a stock firmware (which discards the byte). Bytes that are not
+    /// an identify frame are an error.
+    pub fn identify(&mut self, wait: Duration) -> Result<Option<FirmwareIdentity>, HaplyError> {
+        let n = encode_identify(&mut self.tx).map_err(cfg)?;
+        write_all(&mut self.stream, &self.tx[..n])?;
+        self.read_identity(wait)
     }
 
-    fn send_reset_setup(&mut self) -> Result<(), HaplyError> {
+    /// Sets haptic2d firmware's watchdog to `ms` (1–1000) and returns the identify frame the board
+    /// answers with. Only for a board that answered [`identify`](Self::identify): a stock board
+    /// would read the two argument bytes as commands.
+    pub fn set_watchdog(
+        &mut self,
+        ms: u16,
+        wait: Duration,
+    ) -> Result<FirmwareIdentity, HaplyError> {
+        let n = encode_set_watchdog(ms, &mut self.tx).map_err(cfg)?;
+        write_all(&mut self.stream, &self.tx[..n])?;
+        match self.read_identity(wait)? {
+            Some(id) => Ok(id),
+            None => Err(HaplyError::Lost(format!(
+                "no answer to the watchdog setting within {:.0} ms",
+                wait.as_secs_f64() * 1e3
+            ))),
+        }
+    }
+
+    fn read_identity(&mut self, wait: Duration) -> Result<Option<FirmwareIdentity>, HaplyError> {
+        let deadline = Instant::now() + wait;
+        let mut got = 0;
+        while got < IDENTIFY_LEN && Instant::now() < deadline {
+            match self.stream.read(&mut self.rx[got..IDENTIFY_LEN]) {
+                Ok(n) => got += n,
+                Err(e) if transient(&e) => {}
+                Err(e) => {
+                    return Err(HaplyError::Lost(format!(
+                        "the port failed while waiting for the identify answer ({e})"
+                    )))
+                }
+            }
+        }
+        if got == 0 {
+            return Ok(None);
+        }
+        decode_identity(&self.rx[..got])
+            .map(Some)
+            .map_err(HaplyError::OutOfStep)
+    }
+
+    /// Reset + setup + a zero-torque write, and its reply: the board is configured and answering.
+    /// Call it once, with the handle at the rest pose (docs/DEVICES.md §7).
+    pub fn handshake(&mut self) -> Result<Reply, HaplyError> {
         let n = encode_reset(self.setup.id, &mut self.tx).map_err(cfg)?;
         write_all(&mut self.stream, &self.tx[..n])?;
         let n = encode_setup(&self.setup, &mut self.tx).map_err(cfg)?;
-        write_all(&mut self.stream, &self.tx[..n])
+        write_all(&mut self.stream, &self.tx[..n])?;
+        self.send_write(&[0.0; PORTS][..self.setup.n_motors()])?;
+        self.read_reply()
     }
 
     /// Sends a write with `torques` (N·m, one per used motor port in ascending port order; clamp
@@ -157,40 +220,24 @@ impl<S: Read + Write> Transport<S> {
         Ok(())
     }
 
-    /// Reads the reply to the last write, waiting until `timeout` after it was sent. A stream out of
-    /// step is resynchronised once (the reply then comes from the zero-torque write of the
-    /// resynchronisation); the second time it is an error.
-    pub fn read_reply(&mut self) -> Result<Reply, HaplyError> {
-        match self.wait_reply() {
-            Err(HaplyError::OutOfStep(e)) => {
-                if self.resyncs_left == 0 {
-                    return Err(HaplyError::OutOfStep(e));
-                }
-                self.resyncs_left -= 1;
-                self.resyncs += 1;
-                self.drain();
-                self.send_reset_setup()?;
-                self.send_write(&[0.0; PORTS][..self.setup.n_motors()])?;
-                self.wait_reply()
-            }
-            other => other,
-        }
-    }
-
     /// Write then read: one exchange.
     pub fn exchange(&mut self, torques: &[f32]) -> Result<Reply, HaplyError> {
         self.send_write(torques)?;
         self.read_reply()
     }
 
-    /// One attempt at reading a full reply before the deadline; no resynchronisation.
-    fn wait_reply(&mut self) -> Result<Reply, HaplyError> {
+    /// Reads the reply to the last write, waiting until `timeout` after it was sent. A reply that
+    /// is out of step is an error ([`HaplyError::OutOfStep`]); nothing is re-sent.
+    pub fn read_reply(&mut self) -> Result<Reply, HaplyError> {
         let Some(sent) = self.sent_at.take() else {
             return Err(HaplyError::Config("read_reply without a write".into()));
         };
         let len = self.setup.reply_len();
         let deadline = sent + self.timeout;
         let mut got = 0;
+        let mut last = Instant::now();
+        let start_delay = last.duration_since(sent);
+        let mut max_gap = Duration::ZERO;
         while got < len {
             // The first byte tells at once whether the stream is in step.
             if got >= 1 && self.rx[0] != self.setup.id {
@@ -198,20 +245,24 @@ impl<S: Read + Write> Transport<S> {
             }
             match self.stream.read(&mut self.rx[got..len]) {
                 Ok(n) => got += n,
-                Err(e) if matches!(e.kind(), ErrorKind::TimedOut | ErrorKind::WouldBlock) => {}
-                Err(e) if e.kind() == ErrorKind::Interrupted => {}
+                Err(e) if transient(&e) => {}
                 Err(e) => {
                     return Err(HaplyError::Lost(format!(
                         "the port failed while waiting for a reply ({e}): unplugged or closed"
                     )))
                 }
             }
-            if got < len && Instant::now() >= deadline {
+            let now = Instant::now();
+            max_gap = max_gap.max(now.duration_since(last));
+            last = now;
+            if got < len && now >= deadline {
                 if got == 0 {
-                    return Err(HaplyError::Lost(format!(
-                        "no reply within {:.1} ms",
-                        self.timeout.as_secs_f64() * 1e3
-                    )));
+                    let timing = WaitTiming {
+                        start_delay: start_delay.as_secs_f64(),
+                        max_gap: max_gap.as_secs_f64(),
+                        total: now.duration_since(sent).as_secs_f64(),
+                    };
+                    return Err(HaplyError::Lost(no_reply_message(self.timeout, &timing)));
                 }
                 break;
             }
@@ -225,19 +276,48 @@ impl<S: Read + Write> Transport<S> {
         .map_err(HaplyError::OutOfStep)
     }
 
-    /// Discards whatever is waiting on the input (up to one timeout).
-    fn drain(&mut self) {
-        let until = Instant::now() + self.timeout.min(Duration::from_millis(5));
+    /// Discards whatever is waiting on the input: until `quiet` passes without a byte, at most
+    /// `max`. For the start, before identify (a previous host may have left a reply behind).
+    pub fn drain(&mut self, quiet: Duration, max: Duration) {
+        let start = Instant::now();
+        let mut last_byte = start;
         let mut buf = [0u8; 64];
-        while Instant::now() < until {
+        while start.elapsed() < max && last_byte.elapsed() < quiet {
             match self.stream.read(&mut buf) {
-                Ok(0) => break,
-                Ok(_) => {}
-                Err(e) if e.kind() == ErrorKind::Interrupted => {}
+                Ok(0) => {}
+                Ok(_) => last_byte = Instant::now(),
+                Err(e) if transient(&e) => {}
                 Err(_) => break,
             }
         }
     }
+}
+
+/// The message of a reply that did not come: who was late, when the timing tells.
+fn no_reply_message(timeout: Duration, t: &WaitTiming) -> String {
+    let ms = |s: f64| s * 1e3;
+    let to = timeout.as_secs_f64();
+    if t.host_late(to) {
+        format!(
+            "no reply within {:.1} ms of the write, but the host itself was not running for {:.1} ms of that wait (it began waiting {:.1} ms after the write): the host was late, not necessarily the device — a loaded machine; run with real-time priority or raise board.timeout_periods",
+            ms(to),
+            ms(t.start_delay.max(t.max_gap)),
+            ms(t.start_delay)
+        )
+    } else {
+        format!(
+            "no reply within {:.1} ms of the write (the host waited {:.1} ms and was running throughout): the device was late",
+            ms(to),
+            ms(t.total)
+        )
+    }
+}
+
+fn transient(e: &std::io::Error) -> bool {
+    matches!(
+        e.kind(),
+        ErrorKind::TimedOut | ErrorKind::WouldBlock | ErrorKind::Interrupted
+    )
 }
 
 fn cfg(e: CodecError) -> HaplyError {

@@ -1,5 +1,5 @@
 //! Haply's Inverse3 (3-DOF spatial) through Haply's Inverse Service and its official Rust client,
-//! the `haply` crate (DEVICES §4), in planar mode: two device axes carry the world plane, the third
+//! the `haply` crate (docs/DEVICES.md §4), in planar mode: two device axes carry the world plane, the third
 //! is held by a stiff, damped virtual plane rendered on the device.
 //!
 //! - [`device_file`] — `devices/inverse3.toml`;

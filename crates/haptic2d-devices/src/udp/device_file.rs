@@ -15,7 +15,7 @@
 //! max_stall_periods = 5         # the loop's own delay between two ticks that trips (periods)
 //! key_file = "udp.key"          # protocol version 2: the shared key (hex or raw, mode 600),
 //!                               # relative to this file; without it version 1, loopback only
-//! [linkage]                     # the 2-DOF pantograph (DEVICES §2), device frame
+//! [linkage]                     # the 2-DOF pantograph (docs/DEVICES.md §2), device frame
 //! d = 0.038                     # m
 //! l1 = 0.07                     # m
 //! l2 = 0.09                     # m
@@ -268,7 +268,7 @@ impl UdpDeviceFile {
                 errs.push(SceneError::new(
                     "linkage",
                     e,
-                    "give the pantograph's d, l1, l2 in metres (DEVICES §2)",
+                    "give the pantograph's d, l1, l2 in metres (docs/DEVICES.md §2)",
                 ));
                 None
             }

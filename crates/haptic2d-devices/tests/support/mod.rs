@@ -10,12 +10,11 @@ use std::time::Duration;
 use haptic2d::device::HandModel;
 use haptic2d::haptic::ControllerKind;
 use haptic2d::world::World;
-use haptic2d_devices::haply::serial::{open_port, Pty};
+use haptic2d_devices::haply::serial::{open_port, BoardPort, Pty};
 use haptic2d_devices::haply::{
     emulator, serve, EmulatorClock, EmulatorConfig, EmulatorReport, HaplyDevice, HaplyDeviceFile,
-    HaplySystem,
+    HaplyKind, HaplySystem,
 };
-use serialport::TTYPort;
 
 /// A shipped device file, with a generous reply timeout (100 periods): these tests check physics
 /// and protocol on a machine shared with compilers, not timing (the lost-device tests set theirs).
@@ -23,6 +22,26 @@ pub fn device_file(name: &str) -> HaplyDeviceFile {
     let path = format!("{}/../../devices/{name}", env!("CARGO_MANIFEST_DIR"));
     let mut f = HaplyDeviceFile::from_path(std::path::Path::new(&path)).unwrap();
     f.timeout_periods = 100.0;
+    f
+}
+
+/// [`device_file`] with the rest (homing) pose moved to the workspace centre: the offsets become the
+/// centre's inverse kinematics (a homing jig at the centre). The stock firmware reports the offsets
+/// at setup (docs/DEVICES.md §1.3.3), so an emulator whose handle starts at the centre agrees with
+/// this file; the closed-loop physics tests start there.
+pub fn device_file_homed_at_center(name: &str) -> HaplyDeviceFile {
+    let mut f = device_file(name);
+    let c = f.workspace_center();
+    let q = match &f.kind {
+        HaplyKind::TwoDiy { linkage, .. } => {
+            let q = linkage.ik(haptic2d::geom::Vec2::new(c[0], c[1])).unwrap();
+            [q[0], q[1], 0.0, 0.0]
+        }
+        HaplyKind::Twin(p) => haptic2d::device::TwinKinematics::new(p).ik(&c).unwrap(),
+    };
+    for (m, qj) in f.motors.iter_mut().zip(q) {
+        m.offset_deg = qj.to_degrees();
+    }
     f
 }
 
@@ -80,7 +99,7 @@ pub fn start_emulator_damped(file: &HaplyDeviceFile, hand: HandModel, dt: f64, b
 }
 
 /// Opens the driver on the emulator's port at period `dt` (s).
-pub fn open_driver(emu: &Emu, file: &HaplyDeviceFile, dt: f64) -> HaplyDevice<TTYPort> {
+pub fn open_driver(emu: &Emu, file: &HaplyDeviceFile, dt: f64) -> HaplyDevice<BoardPort> {
     let port = open_port(&emu.path).unwrap();
     HaplyDevice::open(
         port,
@@ -126,7 +145,7 @@ pub fn coupling() -> ControllerKind {
 /// the contact count.
 pub fn run(
     system: &mut HaplySystem,
-    dev: &mut HaplyDevice<TTYPort>,
+    dev: &mut HaplyDevice<BoardPort>,
     ticks: usize,
 ) -> Vec<(f64, f64, u32)> {
     use haptic2d_rt::DeviceIo;

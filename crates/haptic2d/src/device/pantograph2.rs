@@ -1,4 +1,4 @@
-//! The 2-DOF five-bar of a Haply 2DIY (DEVICES §2), in the board's own frame: motor 1 at `(0, 0)`,
+//! The 2-DOF five-bar of a Haply 2DIY (docs/DEVICES.md §2), in the board's own frame: motor 1 at `(0, 0)`,
 //! motor 2 at `(d, 0)`, `d ≥ 0` (0 on gen 2, 0.038 m on gen 3). It reuses [`FiveBar`] (motor axes at
 //! `∓d/2`) shifted by `d/2` in x, and adds the 2×2 Jacobian and `τ = Jᵀ f`.
 //!
@@ -187,7 +187,7 @@ mod tests {
 
     #[test]
     fn published_rest_angles_assemble() {
-        // DEVICES §2: gen 2 offsets (241°, −61°) and gen 3 (168°, 12°) are valid assemblies.
+        // docs/DEVICES.md §2: gen 2 offsets (241°, −61°) and gen 3 (168°, 12°) are valid assemblies.
         let g2 = Pantograph2::new(0.0, 0.07, 0.09).unwrap();
         let e = g2.fk([241f64.to_radians(), (-61f64).to_radians()]).unwrap();
         assert!(e.x.abs() < 1e-9 && e.y > 0.0, "{e:?}");

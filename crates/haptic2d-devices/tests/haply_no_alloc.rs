@@ -1,0 +1,32 @@
+//! The Haply driver's exchange (read the reply, write the torques) allocates nothing once open
+//! (issue 34 keeps it so: the identify, rest check and loss latch happen at open or on the error
+//! path). The shared counting allocator counts per thread: the emulator's thread allocates freely.
+
+mod support;
+use support::*;
+
+use haptic2d::device::HandModel;
+use haptic2d_rt::DeviceIo;
+
+#[path = "../../haptic2d/tests/support/counting_alloc.rs"]
+mod counting_alloc;
+use counting_alloc::allocations;
+
+#[test]
+fn the_haply_exchange_allocates_nothing_once_open() {
+    let file = device_file("haply-2diy-gen3.toml");
+    let start = file.rest_pose().unwrap();
+    let emu = start_emulator(&file, HandModel::grip(start), 0.001);
+    let mut dev = open_driver(&emu, &file, 0.001);
+    for _ in 0..20 {
+        dev.read_encoders().unwrap();
+        dev.write_torques(&[0.01, -0.01, 0.0, 0.0]).unwrap();
+    }
+    let before = allocations();
+    for _ in 0..500 {
+        dev.read_encoders().unwrap();
+        dev.write_torques(&[0.01, -0.01, 0.0, 0.0]).unwrap();
+    }
+    let allocs = allocations() - before;
+    assert_eq!(allocs, 0, "allocations on the exchange");
+}
