@@ -245,8 +245,9 @@ fn devices_lists_ports_without_failing() {
 
 /// Column `name` of a CSV log, as numbers.
 /// Task L item 1: the Haply board runs in the one loop of `run` — its CSV log has the same columns
-/// as the simulated device's, the torques start at exactly zero and ramp in (a constant hand push
-/// on the emulated handle makes them grow), and every torque stays within the device file's limit.
+/// as the simulated device's, the torques start at exactly zero and ramp in (a hand push on the
+/// emulated handle after the ramp makes them grow), and every torque stays within the device file's
+/// limit.
 #[test]
 fn haply_run_is_the_normal_loop_torques_start_at_zero_ramp_in_and_stay_clamped() {
     let _turn = turn();
@@ -255,8 +256,11 @@ fn haply_run_is_the_normal_loop_torques_start_at_zero_ramp_in_and_stay_clamped()
     let (emu, pty) = emulate(&[
         "--device-file",
         file.to_str().unwrap(),
+        // Held for 0.6 s (the ramp), then a 0.5 N push: a push from t = 0 runs the free handle
+        // 10 mm past the workspace edge within 75 ms, while the torques (the wall's too) are still
+        // ramping in, a safety stop since the 2-DOF path has the workspace bound (issue 34).
         "--hand",
-        "constant:0.5,0,0",
+        "script:0.6,0.5,0,0,5",
     ]);
     let log = dir.path().join("ramp.csv");
     let o = haply_run(&pty, &file, "1.5")

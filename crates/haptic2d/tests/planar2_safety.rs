@@ -214,8 +214,8 @@ fn planar2_an_implausible_joint_angle_trips_with_its_reason() {
     assert!(trip.to_string().contains("plausible"), "{trip}");
 }
 
-/// … and so does a joint that jumps faster than any hand moves it (0.5 rad in one 1 ms tick:
-/// 500 rad/s against the 100 rad/s bound).
+/// … and so does a joint that jumps faster than any hand moves it (1.5 rad in one 1 ms tick:
+/// 1500 rad/s against the 1000 rad/s bound).
 #[test]
 fn planar2_an_implausible_joint_speed_trips_with_its_reason() {
     let mut sys = system(0.0);
@@ -223,11 +223,11 @@ fn planar2_an_implausible_joint_speed_trips_with_its_reason() {
     for _ in 0..10 {
         assert!(!sys.tick(&q).tripped);
     }
-    let out = sys.tick(&[q[0] + 0.5, q[1]]);
+    let out = sys.tick(&[q[0] + 1.5, q[1]]);
     assert!(out.tripped && out.torques == [0.0; 2]);
     let trip = sys.safety_trip().unwrap();
     assert!(
-        matches!(trip.reason, SafetyReason::JointSpeed { index: 0, value, limit } if (value - 500.0).abs() < 1e-6 && limit == 100.0),
+        matches!(trip.reason, SafetyReason::JointSpeed { index: 0, value, limit } if (value - 1500.0).abs() < 1e-6 && limit == 1000.0),
         "{trip}"
     );
 }

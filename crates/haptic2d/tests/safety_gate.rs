@@ -278,14 +278,15 @@ fn an_implausible_joint_angle_trips_with_its_reason() {
     assert!(trip.to_string().contains("encoder"), "{trip}");
 }
 
-/// … and a joint that moves 0.3 rad between two readings 1 ms apart (300 rad/s against the
-/// 100 rad/s bound) trips with JointSpeed; the same jump over a 10 ms late tick (30 rad/s) does not.
+/// … and a joint that moves 1.5 rad between two readings 1 ms apart (1500 rad/s against the
+/// 1000 rad/s bound) trips with JointSpeed; the same jump over a 10 ms late tick (150 rad/s) does
+/// not.
 #[test]
 fn an_implausible_joint_speed_trips_with_its_reason() {
     let mut sys = system(no_ramp());
     let q = q_at(&sys, centre(&sys));
     sys.tick(&q);
-    let jumped = [q[0] + 0.03, q[1], q[2], q[3]];
+    let jumped = [q[0] + 1.5, q[1], q[2], q[3]];
     let out = sys.tick_elapsed(&jumped, 0.010);
     assert!(
         !matches!(
@@ -298,11 +299,11 @@ fn an_implausible_joint_speed_trips_with_its_reason() {
     );
     let mut sys = system(no_ramp());
     sys.tick(&q);
-    let out = sys.tick(&[q[0] + 0.3, q[1], q[2], q[3]]);
+    let out = sys.tick(&[q[0] + 1.5, q[1], q[2], q[3]]);
     assert!(out.tripped && out.torques == [0.0; 4]);
     let trip = sys.safety_trip().unwrap();
     assert!(
-        matches!(trip.reason, SafetyReason::JointSpeed { index: 0, value, limit } if (value - 300.0).abs() < 1e-6 && limit == 100.0),
+        matches!(trip.reason, SafetyReason::JointSpeed { index: 0, value, limit } if (value - 1500.0).abs() < 1e-6 && limit == 1000.0),
         "{trip}"
     );
 }

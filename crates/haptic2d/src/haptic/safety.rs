@@ -173,7 +173,7 @@ impl fmt::Display for SafetyReason {
                 window,
             } => write!(
                 f,
-                "limit cycle: in the last {:.0} ms a motor sat at its torque limit in {:.0} % of the ticks and motor {motor}'s saturated torque reversed {reversals} times (an oscillation at the actuators' limit, not a push): the stability gate trusted a device inertia nobody measured; measure it (`haptic2d device identify`), re-check `haptic2d stability`, or use gentler controller gains",
+                "limit cycle: in the last {:.0} ms a motor sat at its torque limit in {:.0} % of the ticks and motor {motor}'s saturated torque reversed {reversals} times (an oscillation at the actuators' limit, not a push): the stability gate trusted a device inertia nobody measured (the device is likely lighter than its model); measure its effective inertia (`haptic2d device identify`, issue 34 build item 6, is not built yet), re-check with `haptic2d stability`, or use gentler controller gains",
                 window * 1e3,
                 saturated * 100.0
             ),
@@ -248,8 +248,12 @@ pub struct SafetyConfig {
     /// its assembly pose, whatever the encoder offsets).
     pub max_joint_angle: f64,
     /// Plausibility bound on every joint speed `|q_i,k − q_i,k−1| / Δt` (rad/s) between two
-    /// readings: faster trips ([`SafetyReason::JointSpeed`]). Default 100 rad/s: 7 m/s at the end of
-    /// a 2DIY's 70 mm proximal link, seven times a fast flick of the hand (1 m/s, 14 rad/s).
+    /// readings: faster trips ([`SafetyReason::JointSpeed`]). Default 1000 rad/s, a jump of more
+    /// than 1 rad in one 1 ms tick (70 m/s at the end of a 2DIY's 70 mm link; a fast flick of the
+    /// hand is 1 m/s, 14 rad/s): far enough above any hand that the timing of a loaded machine (the
+    /// host measures 1 ms while the board's clock advanced several) cannot reach it — 158 rad/s was
+    /// seen against the emulator at a load average of 10 — and still a garbage reading or a
+    /// re-zeroed encoder.
     pub max_joint_speed: f64,
     /// Window of the limit-cycle check (s; 0 = off). Default 0.2 s. See
     /// [`LimitCycleMonitor`](super::limit_cycle::LimitCycleMonitor) for the derivation.
@@ -270,7 +274,7 @@ impl Default for SafetyConfig {
             max_stall_periods: 5.0,
             min_stall_time: 0.02,
             max_joint_angle: 4.0 * std::f64::consts::PI,
-            max_joint_speed: 100.0,
+            max_joint_speed: 1000.0,
             limit_cycle_window: 0.2,
             limit_cycle_saturation: 0.5,
             limit_cycle_reversals: 8,
