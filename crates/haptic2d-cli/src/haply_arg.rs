@@ -85,12 +85,15 @@ pub fn real_device(port: &str, device_file: Option<&Path>) -> Result<RealDevice,
     let name = format!("haply:{path}");
     let (model, kind) = match &file.kind {
         HaplyKind::TwoDiy {
-            linkage, center, ..
+            linkage,
+            center,
+            half_width,
         } => (
             DeviceModel::FiveBar {
                 linkage: *linkage,
                 tau_max: file.torque_limit,
                 center: *center,
+                workspace: haptic2d::haptic::WorkspaceSquare::around(*center, *half_width),
             },
             "2-DOF 2DIY",
         ),

@@ -97,6 +97,8 @@ pub fn real_device(url: Option<&str>, device_file: Option<&Path>) -> Result<Real
             linkage: virtual_linkage(),
             tau_max: virtual_torque_limit(file.force_limit),
             center: virtual_center(),
+            // The plane's square, moved with the plane point to the virtual linkage's centre.
+            workspace: haptic2d::haptic::WorkspaceSquare::around(virtual_center(), file.half_width),
         },
         summary,
         wait_periods: file.timeout_periods,

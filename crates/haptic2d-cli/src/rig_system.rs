@@ -61,6 +61,28 @@ impl RigSystem {
         }
     }
 
+    /// A running tick on joint angles `q` (rad) taken `elapsed` s after the previous one, of which
+    /// the loop waited `device_wait` s for the device (so that a stall says whether the host or the
+    /// device was late). Never allocates.
+    #[inline]
+    pub fn tick_timed(&mut self, q: &V4, elapsed: f64, device_wait: f64) -> TickOutput {
+        match self {
+            RigSystem::Twin(s) => s.tick_timed(q, elapsed, device_wait),
+            RigSystem::TwoDof(s) => widen(s.tick_timed(&[q[0], q[1]], elapsed, device_wait)),
+        }
+    }
+
+    /// The system's stall check alone (for a device paced by the ticks, whose signals are
+    /// differentiated over one period): trips when `elapsed` (s) exceeds the stall limit. Returns
+    /// true when it tripped. Never allocates.
+    #[inline]
+    pub fn check_stall(&mut self, elapsed: f64, device_wait: f64) -> bool {
+        match self {
+            RigSystem::Twin(s) => s.check_stall(elapsed, device_wait),
+            RigSystem::TwoDof(s) => s.check_stall(elapsed, device_wait),
+        }
+    }
+
     /// The world.
     pub fn world(&self) -> &World {
         match self {

@@ -112,6 +112,7 @@ pub fn real_device(
             linkage: file.linkage,
             tau_max: file.torque_limit,
             center: reach_center(&file.linkage),
+            workspace: haptic2d::haptic::WorkspaceSquare::five_bar(&file.linkage),
         },
         summary,
         wait_periods: file.timeout_periods,

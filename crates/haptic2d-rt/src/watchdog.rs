@@ -213,7 +213,7 @@ impl fmt::Display for Fault {
             ),
             FaultKind::Stall { periods, limit } => write!(
                 f,
-                "the loop stalled: this tick came {periods:.1} periods after the previous one (limit {limit}); the device held its torques unsupervised (machine overloaded, or the device blocked)"
+                "the loop stalled: this tick came {periods:.1} periods after the previous one on the host's own account (limit {limit:.1}; the wait for the device is not counted): the host was late and the device held its torques unsupervised; the machine is overloaded or the loop thread was stopped (give it real-time priority, close other programs, lower --rate, or raise max_stall_periods in the device file)"
             ),
             FaultKind::MissedDeadlines { run, limit } => write!(
                 f,

@@ -289,7 +289,14 @@ fn safety_singularity_margin_trips() {
         },
         ..HapticConfig::default()
     };
-    let mut l = closed_loop(&config, box_world(0.01, None), HandModel::Free, true);
+    // Likewise the joint-speed plausibility check (issue 34): the handle is teleported there in one
+    // tick, faster than any hand moves it.
+    let safety = SafetyConfig {
+        max_joint_speed: f64::INFINITY,
+        ..SafetyConfig::default()
+    };
+    let sys = HapticSystem::with_safety(box_world(0.01, None), &config, safety).unwrap();
+    let mut l = DeviceInTheLoop::new(sys, HandModel::Free, 10, true).unwrap();
     l.hand = HandModel::grip(l.plant.pose());
     l.step().unwrap();
     // Encoders of a handle pose far outside the workspace, next to the reach boundary.

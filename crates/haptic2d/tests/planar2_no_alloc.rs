@@ -5,7 +5,7 @@
 use haptic2d::device::pantograph2::Pantograph2;
 use haptic2d::geom::Vec2;
 use haptic2d::haptic::planar2::{Planar2Config, Planar2System};
-use haptic2d::haptic::ControllerKind;
+use haptic2d::haptic::{ControllerKind, WorkspaceSquare};
 use haptic2d::scene::builtin;
 #[path = "support/counting_alloc.rs"]
 mod counting_alloc;
@@ -18,6 +18,14 @@ fn handle_at(k: usize) -> Vec2 {
 }
 
 fn run(controller: ControllerKind, grasp: [f64; 2]) -> (u64, Planar2System) {
+    run_bounded(controller, grasp, None)
+}
+
+fn run_bounded(
+    controller: ControllerKind,
+    grasp: [f64; 2],
+    workspace: Option<WorkspaceSquare>,
+) -> (u64, Planar2System) {
     let world = builtin("box-in-walls", Some(1000.0))
         .unwrap()
         .unwrap()
@@ -26,6 +34,7 @@ fn run(controller: ControllerKind, grasp: [f64; 2]) -> (u64, Planar2System) {
     let mut c = Planar2Config::new(linkage, 0.123);
     c.controller = controller;
     c.grasp = grasp;
+    c.workspace = workspace;
     let mut sys = Planar2System::new(world, c).unwrap();
     let mut total = 0;
     let mut contacts_seen = false;
@@ -77,5 +86,28 @@ fn planar2_off_centre_grasp_lets_contact_turn_the_box() {
         b.pose.angle.abs() < 1e-6,
         "centred grasp turned the box: {}",
         b.pose.angle
+    );
+}
+
+/// Issue 34 build item 5: with the device file's workspace square the 2-DOF tick applies the wall
+/// (the path runs 5 mm past the −x edge of a ±25 mm square) and still allocates nothing.
+#[test]
+fn planar2_tick_with_the_workspace_wall_does_not_allocate() {
+    let square = WorkspaceSquare::around([0.019, 0.10], 0.025);
+    let (a, sys) = run_bounded(
+        ControllerKind::from_name("coupling").unwrap(),
+        [0.0; 2],
+        Some(square),
+    );
+    assert_eq!(a, 0);
+    // The path's far point, 5 mm past the −x edge, is inside the wall (pushed back toward +x).
+    let far = handle_at(1000);
+    let (wall, trip) = sys
+        .workspace()
+        .expect("bounded")
+        .wrench(&[far.x, far.y, 0.0], &[0.0; 3]);
+    assert!(
+        (wall[0] - 2000.0 * 0.005).abs() < 1e-9 && trip.is_none(),
+        "{wall:?}"
     );
 }

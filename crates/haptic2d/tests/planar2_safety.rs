@@ -6,7 +6,7 @@
 use haptic2d::device::pantograph2::Pantograph2;
 use haptic2d::geom::Vec2;
 use haptic2d::haptic::planar2::{Planar2Config, Planar2System};
-use haptic2d::haptic::{ControllerKind, SafetyReason};
+use haptic2d::haptic::{ControllerKind, SafetyReason, WorkspaceSquare};
 use haptic2d::scene::builtin;
 
 const T: f64 = 1e-3;
@@ -23,6 +23,8 @@ fn system(ramp_time: f64) -> Planar2System {
     let mut c = Planar2Config::new(linkage(), 0.123);
     c.controller = ControllerKind::from_name("coupling").unwrap();
     c.safety.ramp_time = ramp_time;
+    // The periods rule alone (the 20 ms floor has its own test in safety_gate.rs).
+    c.safety.min_stall_time = 0.0;
     Planar2System::new(world, c).unwrap()
 }
 
@@ -74,7 +76,7 @@ fn planar2_a_stall_latches_zero_torques_in_the_same_tick_with_its_reason() {
     assert_eq!(out.torques, [0.0; 2]);
     let trip = sys.safety_trip().unwrap();
     assert!(
-        matches!(trip.reason, SafetyReason::Stall { elapsed, limit } if elapsed == 6.0 * T && (limit - 5.0 * T).abs() < 1e-15),
+        matches!(trip.reason, SafetyReason::Stall { elapsed, limit, .. } if elapsed == 6.0 * T && (limit - 5.0 * T).abs() < 1e-15),
         "{trip}"
     );
     assert!(trip.to_string().contains("stalled"), "{trip}");
@@ -110,4 +112,122 @@ fn planar2_pause_and_rearm_realign_and_ramp_in_from_zero() {
     assert_eq!(sys.ramp(), 0.0);
     assert_eq!(sys.tick(&q_at(0.02)).torques, [0.0; 2]);
     assert!(!sys.tick(&q_at(0.025)).tripped);
+}
+
+/// Issue 34 finding 5: the 2-DOF path had no workspace bound. With the device file's square set
+/// (`Planar2Config::workspace`), the handle 2 mm past the +x edge feels the twin's wall (the same
+/// `WorkspaceBound`): the first tick's command is the wall alone, −K·2 mm = −4 N.
+#[test]
+fn planar2_past_the_edge_the_handle_feels_the_same_wall_as_the_twin() {
+    let world = builtin("box-in-walls", Some(1000.0))
+        .unwrap()
+        .unwrap()
+        .world;
+    let mut c = Planar2Config::new(linkage(), 0.123);
+    c.controller = ControllerKind::from_name("coupling").unwrap();
+    c.safety.ramp_time = 0.0;
+    c.workspace = Some(WorkspaceSquare::around([0.019, 0.10], 0.03));
+    let mut sys = Planar2System::new(world, c).unwrap();
+    assert_eq!(sys.workspace().unwrap().stiffness, 2000.0);
+    let out = sys.tick(&q_at(0.032));
+    assert!(!out.tripped, "{:?}", sys.safety_trip());
+    let f = out.record.f_cm;
+    assert!((f[0] + 4.0).abs() < 1e-9 && f[1].abs() < 1e-9, "{f:?}");
+    assert!(peak(&out.torques) > 1e-3, "{:?}", out.torques);
+}
+
+/// … and past the trip distance (10 mm) the latch trips in the tick that reads it.
+#[test]
+fn planar2_beyond_the_trip_distance_the_latch_trips() {
+    let world = builtin("box-in-walls", Some(1000.0))
+        .unwrap()
+        .unwrap()
+        .world;
+    let mut c = Planar2Config::new(linkage(), 0.123);
+    c.workspace = Some(WorkspaceSquare::around([0.019, 0.10], 0.03));
+    let mut sys = Planar2System::new(world, c).unwrap();
+    let mut dx = 0.0;
+    for _ in 0..400 {
+        let out = sys.tick(&q_at(dx));
+        if out.tripped {
+            assert_eq!(out.torques, [0.0; 2]);
+            break;
+        }
+        dx += 0.0002;
+    }
+    let trip = sys.safety_trip().expect("tripped");
+    println!("{trip}");
+    assert!(dx - 0.03 > 0.01 && dx - 0.03 < 0.0103, "{dx}");
+    assert!(
+        matches!(trip.reason, SafetyReason::Workspace { axis: 0, edge, .. } if (edge - 0.049).abs() < 1e-12),
+        "{trip}"
+    );
+    // Without a square (Planar2Config::new's default) the same walk does not trip there.
+    let world = builtin("box-in-walls", Some(1000.0))
+        .unwrap()
+        .unwrap()
+        .world;
+    let mut sys = Planar2System::new(world, Planar2Config::new(linkage(), 0.123)).unwrap();
+    assert!(sys.workspace().is_none());
+    let mut dx = 0.0;
+    while dx < 0.043 {
+        sys.tick(&q_at(dx));
+        dx += 0.0002;
+    }
+    assert!(sys.safety_trip().is_none(), "{:?}", sys.safety_trip());
+}
+
+/// The square of a five-bar whose device file has none (a UDP pantograph): for the 2DIY gen 3
+/// geometry, (0.019, 0.088) ± 0.032 m, with the default wall.
+#[test]
+fn a_five_bar_without_a_square_gets_one_around_its_reach_centre() {
+    let s = WorkspaceSquare::five_bar(&linkage());
+    assert!((s.centre[0] - 0.019).abs() < 1e-12);
+    // r = (0.07 + 0.09 + 0.02)/2 = 0.09, y = √(0.09² − 0.019²).
+    assert!((s.centre[1] - (0.0081f64 - 0.000361).sqrt()).abs() < 1e-12);
+    assert!((s.half_width - 0.032).abs() < 1e-12);
+    assert_eq!(s.trip_distance, 0.01);
+    assert!(s.validate().is_ok());
+    let bad = WorkspaceSquare {
+        half_width: 0.0,
+        ..s
+    };
+    assert!(bad.validate().unwrap_err().contains("half_width"));
+}
+
+/// Issue 34 build item 5: a joint angle no linkage can reach (1e30 rad, a garbage word) trips in
+/// the tick that reads it, with a reason that names the joint and the bound.
+#[test]
+fn planar2_an_implausible_joint_angle_trips_with_its_reason() {
+    let mut sys = system(0.0);
+    sys.tick(&q_at(0.0));
+    let q = q_at(0.0);
+    let out = sys.tick(&[q[0], 1e30]);
+    assert!(out.tripped);
+    assert_eq!(out.torques, [0.0; 2]);
+    let trip = sys.safety_trip().unwrap();
+    println!("{trip}");
+    assert!(
+        matches!(trip.reason, SafetyReason::JointAngle { index: 1, value, .. } if value == 1e30),
+        "{trip}"
+    );
+    assert!(trip.to_string().contains("plausible"), "{trip}");
+}
+
+/// … and so does a joint that jumps faster than any hand moves it (1.5 rad in one 1 ms tick:
+/// 1500 rad/s against the 1000 rad/s bound).
+#[test]
+fn planar2_an_implausible_joint_speed_trips_with_its_reason() {
+    let mut sys = system(0.0);
+    let q = q_at(0.0);
+    for _ in 0..10 {
+        assert!(!sys.tick(&q).tripped);
+    }
+    let out = sys.tick(&[q[0] + 1.5, q[1]]);
+    assert!(out.tripped && out.torques == [0.0; 2]);
+    let trip = sys.safety_trip().unwrap();
+    assert!(
+        matches!(trip.reason, SafetyReason::JointSpeed { index: 0, value, limit } if (value - 1500.0).abs() < 1e-6 && limit == 1000.0),
+        "{trip}"
+    );
 }

@@ -199,3 +199,49 @@ fn a_pushing_hand_is_held_at_the_edge() {
     );
     assert!((last - edge - 1.5 / 2000.0).abs() < 2e-4, "{}", last - edge);
 }
+
+/// Issue 34 build item 5, the twin's half of "a push that overpowers the wall trips at the
+/// documented distance": a hand pushing 30 N toward +x (more than the wall's 20 N at 10 mm) after a
+/// 0.6 s grip runs the plant past the edge; the latch trips in the tick whose reading is more than
+/// `workspace_trip_distance` (10 mm) past it, by less than that tick's travel, and zeroes the torques.
+#[test]
+fn a_push_that_overpowers_the_wall_trips_at_the_trip_distance() {
+    let p = DeviceParams::default();
+    let world = builtin("box-in-walls", Some(RATE)).unwrap().unwrap().world;
+    let config = HapticConfig {
+        device: p,
+        controller: ControllerKind::Coupling(CouplingGains::default()),
+        ..HapticConfig::default()
+    };
+    let sys = HapticSystem::new(world, &config).unwrap();
+    let mut l = DeviceInTheLoop::new(sys, HandModel::Free, 4, false).unwrap();
+    l.hand = HandModel::grip(l.plant.pose());
+    let edge = p.workspace_center_x + p.workspace_half_width;
+    let mut prev = l.plant_pose()[0];
+    for k in 0..(3.0 * RATE) as usize {
+        if k == 600 {
+            l.hand = HandModel::Constant {
+                wrench: [30.0, 0.0, 0.0],
+            };
+        }
+        let read = l.plant_pose()[0];
+        let out = l.step().expect("the plant stays in reach");
+        if out.tripped {
+            assert_eq!(out.torques, [0.0; 4]);
+            let trip = l.system.safety_trip().unwrap();
+            println!("{trip}");
+            assert!(
+                matches!(trip.reason, SafetyReason::Workspace { axis: 0, .. }),
+                "{trip}"
+            );
+            assert!(read - edge > p.workspace_trip_distance, "{read}");
+            assert!(
+                read - edge <= p.workspace_trip_distance + (read - prev).abs() + 1e-9,
+                "{read} (previous {prev})"
+            );
+            return;
+        }
+        prev = read;
+    }
+    panic!("never tripped");
+}

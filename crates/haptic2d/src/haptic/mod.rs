@@ -9,8 +9,10 @@
 
 pub mod config;
 pub mod experiment;
+pub mod limit_cycle;
 pub mod mapping;
 pub mod planar2;
+pub mod plausibility;
 pub mod record;
 pub mod safety;
 pub mod system;
@@ -18,8 +20,10 @@ pub mod workspace;
 
 pub use config::{ControllerKind, HapticConfig};
 pub use experiment::DeviceInTheLoop;
+pub use limit_cycle::LimitCycleMonitor;
 pub use mapping::DeviceMap;
+pub use plausibility::JointPlausibility;
 pub use record::{TickRecord, TICK_COLUMNS};
 pub use safety::{Safety, SafetyConfig, SafetyReason, SafetyTrip};
 pub use system::{HapticSystem, TickOutput};
-pub use workspace::WorkspaceBound;
+pub use workspace::{WorkspaceBound, WorkspaceSquare};

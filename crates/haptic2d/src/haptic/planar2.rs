@@ -12,6 +12,7 @@
 //! 1–2. q (rad) → E, J, margin (five-bar)           ⇒ handle point, filtered velocity
 //! 3–6. world.begin_step                              ⇒ slave pose, contact wrench
 //! 7.   controller on (x, y) of the grasp point      ⇒ f_cm (device), f_cs (slave)
+//! 8b.  workspace bound (wall, trip) at the handle    ⇒ f_cm += wall
 //! 9.   τ = Jᵀ f_cm, direction-preserving saturation, start-up ramp, safety gate
 //! 10.  f_cs at the grasp point, world.finish_step
 //! 11.  record
@@ -41,8 +42,11 @@ use crate::geom::{cross, Vec2};
 use crate::world::World;
 
 use super::config::ControllerKind;
+use super::limit_cycle::LimitCycleMonitor;
+use super::plausibility::JointPlausibility;
 use super::record::{TickRecord, FLAG_NEAR_SINGULAR, FLAG_SAFETY, FLAG_SATURATED};
 use super::safety::{Safety, SafetyConfig, SafetyReason, SafetyTrip};
+use super::workspace::{WorkspaceBound, WorkspaceSquare};
 
 /// Natural frequency of the twist target's torsion spring on the slave (Hz), critically damped.
 pub const TWIST_TARGET_HZ: f64 = 5.0;
@@ -71,6 +75,11 @@ pub struct Planar2Config {
     pub min_singularity_margin: f64,
     /// Keep the scene's loads on the slave body. Default false (the hand drives it).
     pub keep_slave_loads: bool,
+    /// The workspace square of the device file (device frame) with its wall and trip, the same
+    /// bound as the twin pantograph's ([`WorkspaceBound`]). `None` (the default of [`Self::new`]):
+    /// no bound; `haptic2d run` always sets one (the 2DIY's and the Inverse3's `[workspace]`, or
+    /// [`WorkspaceSquare::five_bar`] for a device file without one).
+    pub workspace: Option<WorkspaceSquare>,
 }
 
 impl Planar2Config {
@@ -87,6 +96,7 @@ impl Planar2Config {
             safety: SafetyConfig::default(),
             min_singularity_margin: 0.1,
             keep_slave_loads: false,
+            workspace: None,
         }
     }
 }
@@ -118,6 +128,9 @@ pub struct Planar2System {
     slave: usize,
     filter: VelocityFilter,
     safety: Safety,
+    workspace: Option<WorkspaceBound>,
+    plausibility: JointPlausibility,
+    limit_cycle: LimitCycleMonitor,
     /// World point of the grasp at start (m): the first handle position maps here.
     world_origin: Vec2,
     device_origin: Option<Vec2>,
@@ -153,6 +166,9 @@ impl Planar2System {
             return Err("velocity_cutoff_hz must be > 0 Hz (default 50)".into());
         }
         config.safety.validate()?;
+        if let Some(w) = &config.workspace {
+            w.validate()?;
+        }
         let slave = match &config.slave {
             Some(name) => world
                 .body_index(name)
@@ -194,6 +210,9 @@ impl Planar2System {
                 config.tau_max[0].min(config.tau_max[1]),
                 config.safety.torque_trip_margin,
             ),
+            workspace: config.workspace.map(|w| WorkspaceBound::of_square(&w, dt)),
+            plausibility: JointPlausibility::new(&config.safety),
+            limit_cycle: LimitCycleMonitor::new(&config.safety, dt),
             ramp_len: (config.safety.ramp_time / dt).round() as u64,
             ramp_ticks: 0,
             started: false,
@@ -232,27 +251,27 @@ impl Planar2System {
     }
 
     /// One sample from the motor angles `q` (rad) to the motor torques (N·m), `elapsed` seconds
-    /// after the previous tick (the loop's own interval, measured by the caller). A tick more than
-    /// `safety.max_stall_periods` periods late trips the latch with [`SafetyReason::Stall`] in this
+    /// after the previous tick (the loop's own interval, measured by the caller). A tick later than the
+    /// stall limit ([`SafetyConfig::stall_limit`]) trips the latch with [`SafetyReason::Stall`] in this
     /// same tick (the device held its last torques unsupervised for that long); a NaN interval
     /// counts as a stall. The filter and the world use the fixed period `T`.
     pub fn tick_elapsed(&mut self, q: &[f64; 2], elapsed: f64) -> Planar2Output {
-        let (k, t, dt) = (self.world.tick(), self.world.time(), self.dt);
+        self.tick_timed(q, elapsed, f64::NAN)
+    }
+
+    /// [`Self::tick_elapsed`] with the part of `elapsed` the loop spent waiting for the device's
+    /// reply, `device_wait` (s; NaN = unknown), so that a stall says whether the host or the device
+    /// was late. Never allocates.
+    pub fn tick_timed(&mut self, q: &[f64; 2], elapsed: f64, device_wait: f64) -> Planar2Output {
+        let (k, t) = (self.world.tick(), self.world.time());
         let mut flags = 0u32;
 
-        // 0. Stall, as in HapticSystem::tick_elapsed (the shared safety layer's limit).
-        let stall_limit = self.config.safety.max_stall_periods * dt;
-        if self.started && (elapsed.is_nan() || elapsed > stall_limit) {
-            self.safety.trip(
-                k,
-                t,
-                SafetyReason::Stall {
-                    elapsed,
-                    limit: stall_limit,
-                },
-            );
-        }
+        // 0. Stall and joint plausibility: the shared safety layer, as in HapticSystem.
+        self.check_stall(elapsed, device_wait);
         self.started = true;
+        if let Some(reason) = self.plausibility.check(q, elapsed) {
+            self.safety.trip(k, t, reason);
+        }
 
         // 1–2. Handle point, Jacobian, margin; filtered velocity; device → world translation.
         let st = match self.config.linkage.state(*q) {
@@ -314,6 +333,16 @@ impl Planar2System {
             f_cs[2] = 0.0;
         }
 
+        // 8b. Workspace bound of the device file at the handle point (device frame; the device →
+        //     world map is a translation, so velocity and force are the same in both).
+        if let (Some(s), Some(w)) = (st, self.workspace.as_ref()) {
+            let x = [s.e.x, s.e.y, 0.0];
+            if let Some(reason) = w.apply(&x, &v_m, &mut f_cm) {
+                self.safety.trip(k, t, reason);
+            }
+            f_cm[2] = 0.0;
+        }
+
         // 9. τ = Jᵀ f_cm, direction-preserving saturation, start-up ramp, safety gate.
         let mut tau4 = [0.0; 4];
         if let (Some(s), false) = (st, self.safety.is_latched()) {
@@ -326,6 +355,11 @@ impl Planar2System {
             }
             if scale < 1.0 {
                 flags |= FLAG_SATURATED;
+            }
+            let (t0, t1) = (tau[0] * scale, tau[1] * scale);
+            let tau_max = [self.config.tau_max[0], self.config.tau_max[1], 0.0, 0.0];
+            if let Some(reason) = self.limit_cycle.observe(&[t0, t1, 0.0, 0.0], &tau_max) {
+                self.safety.trip(k, t, reason);
             }
             let ramp = self.ramp();
             tau4[0] = tau[0] * scale * ramp;
@@ -400,6 +434,10 @@ impl Planar2System {
     /// allocates.
     pub fn tick_paused(&mut self, q: &[f64; 2]) -> Planar2Output {
         let (k, t) = (self.world.tick(), self.world.time());
+        if let Some(reason) = self.plausibility.check_angles(q) {
+            self.safety.trip(k, t, reason);
+        }
+        self.limit_cycle.reset();
         let mut x_m = [f64::NAN; 3];
         let mut margin = f64::NAN;
         match self.config.linkage.state(*q) {
@@ -456,7 +494,25 @@ impl Planar2System {
     /// zero, as at start-up.
     pub fn reset_safety(&mut self) {
         self.safety.reset();
+        self.plausibility.reset();
+        self.limit_cycle.reset();
         self.realign();
+    }
+
+    /// The stall check of [`Self::tick_elapsed`] on its own (see
+    /// [`HapticSystem::check_stall`](super::HapticSystem::check_stall)): trips when `elapsed` (s;
+    /// `device_wait` s of it waiting for the device, NaN = unknown) exceeds the stall limit `max(max_stall_periods·T, min_stall_time)`.
+    /// Returns true when it tripped. Never allocates.
+    pub fn check_stall(&mut self, elapsed: f64, device_wait: f64) -> bool {
+        let (k, t) = (self.world.tick(), self.world.time());
+        let limit = self.config.safety.stall_limit(self.dt);
+        self.safety
+            .check_stall(k, t, self.started, elapsed, device_wait, limit)
+    }
+
+    /// The workspace bound the tick applies, if any.
+    pub fn workspace(&self) -> Option<&WorkspaceBound> {
+        self.workspace.as_ref()
     }
 
     /// Switches the teleoperation controller to `kind` from its reset state; the gains are checked

@@ -10,7 +10,9 @@ use crate::geom::Vec2;
 use crate::world::World;
 
 use super::config::{ControllerKind, HapticConfig};
+use super::limit_cycle::LimitCycleMonitor;
 use super::mapping::DeviceMap;
+use super::plausibility::JointPlausibility;
 use super::record::{
     TickRecord, FLAG_NEAR_SINGULAR, FLAG_PASSIVITY_ACTIVE, FLAG_SAFETY, FLAG_SATURATED,
 };
@@ -89,6 +91,8 @@ pub struct HapticSystem {
     slave: usize,
     map: DeviceMap,
     workspace: WorkspaceBound,
+    plausibility: JointPlausibility,
+    limit_cycle: LimitCycleMonitor,
     safety: Safety,
     safety_config: SafetyConfig,
     preload: f64,
@@ -193,6 +197,8 @@ impl HapticSystem {
             slave,
             map,
             workspace: WorkspaceBound::new(&config.device, dt),
+            plausibility: JointPlausibility::new(&safety),
+            limit_cycle: LimitCycleMonitor::new(&safety, dt),
             safety: Safety::new(
                 config.device.min_singularity_margin,
                 tau_max,
@@ -224,7 +230,8 @@ impl HapticSystem {
     /// `elapsed` is what the real-time loop measured; a device paced by the ticks themselves (a
     /// simulated plant that advances one period per tick, a replay) passes `T` (or calls
     /// [`Self::tick`]). A late tick differentiates and integrates the device signals over the measured
-    /// interval; one more than `max_stall_periods` periods late trips the latch, because the device
+    /// interval; one later than the stall limit (`max_stall_periods` periods, at least `min_stall_time`,
+    /// [`SafetyConfig::stall_limit`]) trips the latch, because the device
     /// held its last torques unsupervised for that long. The world still steps by `T`: its
     /// integrator is passive for that step (§6).
     ///
@@ -232,23 +239,23 @@ impl HapticSystem {
     /// integration of step 10 has then already run, which only moves the write by the integration
     /// time (about a microsecond) and keeps the tick one call.
     pub fn tick_elapsed(&mut self, q: &V4, elapsed: f64) -> TickOutput {
+        self.tick_timed(q, elapsed, f64::NAN)
+    }
+
+    /// [`Self::tick_elapsed`] with the part of `elapsed` the loop spent waiting for the device's
+    /// reply, `device_wait` (s; NaN = unknown), so that a stall says whether the host or the device
+    /// was late. Never allocates, locks, prints or does I/O.
+    pub fn tick_timed(&mut self, q: &V4, elapsed: f64, device_wait: f64) -> TickOutput {
         let (k, t, dt) = (self.world.tick(), self.world.time(), self.dt);
         let mut flags = 0u32;
 
         // 0. Stall: the device held the previous torques for `elapsed` seconds, unsupervised.
-        let stall_limit = self.safety_config.max_stall_periods * dt;
-        // (A NaN interval counts as a stall: a broken clock must not pass.)
-        if self.started && (elapsed.is_nan() || elapsed > stall_limit) {
-            self.safety.trip(
-                k,
-                t,
-                SafetyReason::Stall {
-                    elapsed,
-                    limit: stall_limit,
-                },
-            );
-        }
+        //    Plausibility: a joint reading no hand can produce is a fault of the encoder or driver.
+        self.check_stall(elapsed, device_wait);
         self.started = true;
+        if let Some(reason) = self.plausibility.check(q, elapsed) {
+            self.safety.trip(k, t, reason);
+        }
 
         // 1–2. Device pose by forward kinematics (θ unwrapped, closure monitor), filtered twist, and
         //      the hand-wrench estimate from the torques of the previous interval (§10.3, §10.6,
@@ -335,16 +342,7 @@ impl HapticSystem {
         //     square, and a trip beyond it.
         let mut f_dev = f_port;
         if let Some(e) = est {
-            let (wall, excursion) = self.workspace.wrench(&e.pose, &e.velocity);
-            f_dev[0] += wall[0];
-            f_dev[1] += wall[1];
-            if let Some(x) = excursion {
-                let reason = SafetyReason::Workspace {
-                    axis: x.axis,
-                    position: x.position,
-                    edge: x.edge,
-                    trip: self.workspace.trip_distance,
-                };
+            if let Some(reason) = self.workspace.apply(&e.pose, &e.velocity, &mut f_dev) {
                 self.safety.trip(k, t, reason);
             }
         }
@@ -363,6 +361,10 @@ impl HapticSystem {
                     wrench_scale = cmd.wrench_scale;
                     if cmd.saturated {
                         flags |= FLAG_SATURATED;
+                    }
+                    let tau_max = [self.safety.tau_max; 4];
+                    if let Some(reason) = self.limit_cycle.observe(&cmd.tau, &tau_max) {
+                        self.safety.trip(k, t, reason);
                     }
                     if cmd.near_singular {
                         flags |= FLAG_NEAR_SINGULAR;
@@ -469,6 +471,10 @@ impl HapticSystem {
     /// device, the frozen slave and zero commands. Never allocates, locks, prints or does I/O.
     pub fn tick_paused(&mut self, q: &V4) -> TickOutput {
         let (k, t) = (self.world.tick(), self.world.time());
+        if let Some(reason) = self.plausibility.check_angles(q) {
+            self.safety.trip(k, t, reason);
+        }
+        self.limit_cycle.reset();
         let mut closure_fault = false;
         let est = match self.device.estimate(q, &self.tau_prev) {
             Ok(e) => Some(e),
@@ -592,6 +598,20 @@ impl HapticSystem {
         self.device.reset(theta);
         self.aligned = false;
         self.started = false;
+        self.plausibility.reset();
+        self.limit_cycle.reset();
+    }
+
+    /// The stall check of [`Self::tick_elapsed`] on its own, for a device paced by the ticks (the
+    /// simulated plant) whose signals are differentiated over one period but whose loop can still
+    /// stall: trips ([`SafetyReason::Stall`]) when `elapsed` (s since the previous tick; of which
+    /// `device_wait` s waiting for the device, NaN = unknown) exceeds the stall limit `max(max_stall_periods·T, min_stall_time)`; the
+    /// next tick's torques are then zero. Returns true when it tripped. Never allocates.
+    pub fn check_stall(&mut self, elapsed: f64, device_wait: f64) -> bool {
+        let (k, t) = (self.world.tick(), self.world.time());
+        let limit = self.safety_config.stall_limit(self.dt);
+        self.safety
+            .check_stall(k, t, self.started, elapsed, device_wait, limit)
     }
     /// The safety settings (ramp, stall limit, torque trip margin).
     pub fn safety_config(&self) -> &SafetyConfig {

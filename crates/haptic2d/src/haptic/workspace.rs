@@ -1,5 +1,8 @@
-//! The workspace bound of the device file (DESIGN §7): a stiff passive wall just past the edge of the
-//! workspace square, and a trip beyond it.
+//! The workspace bound of the device file (DESIGN §7), written once for every device: a stiff
+//! passive wall just past the edge of the workspace square, and a trip beyond it. The twin pantograph
+//! ([`HapticSystem`](super::HapticSystem)) and every 2-DOF device ([`Planar2System`](super::planar2::Planar2System):
+//! a 2DIY, a UDP device, the Inverse3's planar mode) apply the same [`WorkspaceBound::apply`] to the
+//! handle point in the device frame.
 //!
 //! Per axis `x`, `y` with edges `c ± h` (centre `c`, half-width `h`): outside the square the
 //! penetration is `p = |x − edge|` and the outward unit `n = ±1`, and the handle gets
@@ -15,7 +18,85 @@
 //! θ is unbounded (the twin pantograph rotates without limit).
 
 use crate::device::linalg::V3;
+use crate::device::pantograph2::Pantograph2;
 use crate::device::DeviceParams;
+
+use super::safety::SafetyReason;
+
+/// The workspace square of a device file and its wall, before the period is known (SI units).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WorkspaceSquare {
+    /// Centre `(x, y)` (m, device frame).
+    pub centre: [f64; 2],
+    /// Half-width (m), > 0.
+    pub half_width: f64,
+    /// Wall stiffness `K` (N/m), ≥ 0 (0 = no wall, the trip still applies).
+    pub wall_stiffness: f64,
+    /// Wall damping `B` (N·s/m), ≥ 0.
+    pub wall_damping: f64,
+    /// Trip distance past the edge (m), > 0.
+    pub trip_distance: f64,
+}
+
+impl WorkspaceSquare {
+    /// The square and wall of the twin-pantograph parameters `p` (`workspace_*` fields).
+    pub fn of_device(p: &DeviceParams) -> Self {
+        Self {
+            centre: [p.workspace_center_x, p.workspace_center_y],
+            half_width: p.workspace_half_width,
+            wall_stiffness: p.workspace_wall_stiffness,
+            wall_damping: p.workspace_wall_damping,
+            trip_distance: p.workspace_trip_distance,
+        }
+    }
+
+    /// The square of `centre` ± `half_width` (m) with the default wall of the device file
+    /// (`K` = 2000 N/m, `B` = 5 N·s/m, trip 10 mm past the edge: the [`DeviceParams`] defaults).
+    pub fn around(centre: [f64; 2], half_width: f64) -> Self {
+        let d = DeviceParams::default();
+        Self {
+            centre,
+            half_width,
+            wall_stiffness: d.workspace_wall_stiffness,
+            wall_damping: d.workspace_wall_damping,
+            trip_distance: d.workspace_trip_distance,
+        }
+    }
+
+    /// The square of a five-bar whose device file names none (a UDP pantograph): centred on the
+    /// symmetry axis `x = d/2` at the middle of each motor's reach, `r = (l1 + l2 + |l1 − l2|)/2`,
+    /// `y = √(r² − (d/2)²)`, with half-width `(l1 + l2)/5` (the 2DIY's published ±30 mm square for its
+    /// 160 mm reach, rounded): for the 2DIY gen 3 geometry (0.019, 0.088) ± 0.032 m.
+    pub fn five_bar(l: &Pantograph2) -> Self {
+        let r = 0.5 * (l.l1 + l.l2 + (l.l1 - l.l2).abs());
+        let x = 0.5 * l.d;
+        Self::around([x, (r * r - x * x).max(0.0).sqrt()], (l.l1 + l.l2) / 5.0)
+    }
+
+    /// Checks every field; the error names it.
+    pub fn validate(&self) -> Result<(), String> {
+        if !self.centre.iter().all(|c| c.is_finite()) {
+            return Err(format!(
+                "workspace centre {:?} m must be finite",
+                self.centre
+            ));
+        }
+        for (name, v, strict) in [
+            ("half_width", self.half_width, true),
+            ("wall_stiffness", self.wall_stiffness, false),
+            ("wall_damping", self.wall_damping, false),
+            ("trip_distance", self.trip_distance, true),
+        ] {
+            if !(v.is_finite() && (v > 0.0 || (!strict && v == 0.0))) {
+                return Err(format!(
+                    "workspace {name} must be a finite number {} 0 (got {v})",
+                    if strict { ">" } else { ">=" }
+                ));
+            }
+        }
+        Ok(())
+    }
+}
 
 /// The bound, in handle coordinates.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -46,14 +127,17 @@ pub struct WorkspaceExcursion {
 impl WorkspaceBound {
     /// The bound of device `p` at period `dt` (s).
     pub fn new(p: &DeviceParams, dt: f64) -> Self {
+        Self::of_square(&WorkspaceSquare::of_device(p), dt)
+    }
+
+    /// The bound of square `s` at period `dt` (s).
+    pub fn of_square(s: &WorkspaceSquare, dt: f64) -> Self {
         Self {
-            centre: [p.workspace_center_x, p.workspace_center_y],
-            half_width: p.workspace_half_width,
-            stiffness: p
-                .workspace_wall_stiffness
-                .min(2.0 * p.workspace_wall_damping / dt),
-            damping: p.workspace_wall_damping,
-            trip_distance: p.workspace_trip_distance,
+            centre: s.centre,
+            half_width: s.half_width,
+            stiffness: s.wall_stiffness.min(2.0 * s.wall_damping / dt),
+            damping: s.wall_damping,
+            trip_distance: s.trip_distance,
         }
     }
 
@@ -85,5 +169,21 @@ impl WorkspaceBound {
             }
         }
         (f, out)
+    }
+
+    /// The bound applied to a device command: adds the wall wrench at handle pose `x` (m, device
+    /// frame) and twist `v` to the command `f` (N, device frame), and returns the trip reason when
+    /// the handle is past the trip distance. The one place both systems' ticks call. Never allocates.
+    #[inline]
+    pub fn apply(&self, x: &V3, v: &V3, f: &mut V3) -> Option<SafetyReason> {
+        let (wall, excursion) = self.wrench(x, v);
+        f[0] += wall[0];
+        f[1] += wall[1];
+        excursion.map(|e| SafetyReason::Workspace {
+            axis: e.axis,
+            position: e.position,
+            edge: e.edge,
+            trip: self.trip_distance,
+        })
     }
 }
