@@ -1,7 +1,7 @@
 //! Stage 3 of the contact step: a Continuous record whose vertex has come nearer to another line of
 //! its edge polygon is handed over to that edge (the depth invariant of [`ContactSet::step`]).
 
-use super::invariant::face_on_face_ok;
+use super::invariant::overlap_ok;
 use super::sync::new_entry;
 use super::ContactSet;
 use super::PastPoses;
@@ -41,9 +41,7 @@ impl ContactSet {
             }
             let cb = &colliders[e.key.edge_collider as usize];
             let (j, max_d) = nearest_line(cb, e.point);
-            if e.d[0] >= max_d - self.delta_c
-                || face_on_face_ok(e.key, colliders, self.delta_c, self.cos_parallel)
-            {
+            if e.d[0] >= max_d - self.delta_c || overlap_ok(e.key, colliders, self.delta_c) {
                 continue;
             }
             let key = VeCandidate {
