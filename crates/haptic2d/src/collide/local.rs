@@ -1078,8 +1078,10 @@ impl Ctx {
                     inside = Some(p);
                 }
             }
-            if max_d == f64::NEG_INFINITY {
-                // Every edge of B is a seam: its neighbours' surfaces hold the vertex.
+            if max_d == f64::NEG_INFINITY || (max_all > max_d && max_all > 0.0) {
+                // Every edge of B is a seam, or the vertex is outside B across a seam: the
+                // neighbouring pieces' surfaces hold it.
+                slack.decided(max_all.abs());
                 continue;
             }
             // Nearest line first: its edge must hold the vertex (always so inside B, see above);
@@ -1182,8 +1184,9 @@ fn most_aligned_edge(c: &Collider, v: usize, p: Vec2) -> usize {
 
 /// The nearest edge line of `b` to the world point `p`: `(j*, d_{j*})` with `d_{j*} = max_j d_j`
 /// over `b`'s edge lines that are not seams (m, positive outside; `(0, −∞)` if every edge is a
-/// seam). For `p` inside `b`, `−d_{j*}` is its depth (distance to the body's surface through
-/// `b`'s surface edges).
+/// seam), or the seam line `p` is farthest outside of if it is outside `b` across a seam (then
+/// `j*` is a seam, never a contact edge). For `p` inside `b`, `−d_{j*}` is its depth (distance
+/// to the body's surface through `b`'s surface edges).
 ///
 /// The invariant of every VE record `(V, e)` (issue 10): `d_e ≥ d_{j*} − δ_c`, so its stored
 /// energy `½·K_c·d_e²` never exceeds that of the vertex's real depth by more than the corner
@@ -1191,16 +1194,23 @@ fn most_aligned_edge(c: &Collider, v: usize, p: Vec2) -> usize {
 #[inline]
 pub fn nearest_line(b: &Collider, p: Vec2) -> (usize, f64) {
     let mut best = (0usize, f64::NEG_INFINITY);
+    let mut seam = (0usize, 0.0f64);
     for e in 0..b.len() {
-        if b.is_seam(e) {
-            continue;
-        }
         let d = b.edge_distance(e, p);
-        if d > best.1 {
+        if b.is_seam(e) {
+            if d > seam.1 {
+                seam = (e, d);
+            }
+        } else if d > best.1 {
             best = (e, d);
         }
     }
-    best
+    // Outside `b` across a seam: the point is that far from `b` (in the next piece).
+    if seam.1 > 0.0 && seam.1 > best.1 {
+        seam
+    } else {
+        best
+    }
 }
 
 /// Penetration depth of two convex polygons by separating axes (m): the smallest overlap of their

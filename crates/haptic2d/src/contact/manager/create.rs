@@ -100,7 +100,7 @@ impl ContactSet {
                         let e = &mut self.entries[t];
                         start_record(e, p, tick, &mut self.events, false);
                         e.law = self.laws.acquire(normal, friction, e.s_g);
-                        found_inside(e, self.delta_c, &mut self.laws);
+                        found_inside(e, colliders, self.delta_c, &mut self.laws);
                         self.new_count[e.body_a] += 1;
                     }
                     None => {
@@ -108,7 +108,7 @@ impl ContactSet {
                         let mut e = new_entry(tick, key, colliders, bodies, past);
                         start_record(&mut e, p, tick, &mut self.events, false);
                         e.law = self.laws.acquire(normal, friction, e.s_g);
-                        found_inside(&mut e, self.delta_c, &mut self.laws);
+                        found_inside(&mut e, colliders, self.delta_c, &mut self.laws);
                         self.new_count[e.body_a] += 1;
                         self.pending.push(e);
                     }
@@ -196,17 +196,25 @@ impl ContactSet {
     }
 }
 
-/// A record found with its vertex already behind its edge's line by more than `δ_c` at the last
-/// sample (issue 35) did not come in through that edge: it came through a seam of a multi-piece
-/// body (a vertex that slid under a wall slab inside the floor slab and rose into the wall slab
-/// 27 mm from its face: +7.4 J from nothing in `corner-seam-tunnel.toml`), or its pair's corners
-/// crossed. Its spring would store `½·K·δ²` that nothing paid for, so the law's surface starts
-/// at the vertex (the surface offset of `laws/normal/impact_offset.rs`, `σ = δ`): it stores
-/// nothing at creation, resists any further penetration, and follows the vertex back out. The
-/// overlap stays (reported by [`World::max_overlap`](crate::world::World::max_overlap)), and
-/// no energy appears. Records at `t = 0` (no history) keep their depth, as before.
-fn found_inside(e: &mut VeContact, delta_c: f64, laws: &mut crate::contact::law_pool::LawPool) {
-    if e.hist >= 2 && e.d[0] < 0.0 && e.d[1] < -delta_c {
+/// A record on a piece with seams, found with its vertex already behind its edge's line by more
+/// than `δ_c` at the last sample (issue 35), did not come in through that edge but through a seam
+/// (a vertex that slid under a wall slab inside the floor slab and rose into the wall slab 27 mm
+/// from its face: +7.4 J from nothing in `corner-seam-tunnel.toml`). Its spring would store
+/// `½·K·δ²` that nothing paid for, so the law's surface starts at the vertex (the surface offset
+/// of `laws/normal/impact_offset.rs`, `σ = δ`): it stores nothing at creation, resists any
+/// further penetration, and follows the vertex back out. The overlap stays (reported by
+/// [`World::max_overlap`](crate::world::World::max_overlap)), and no energy appears. Records at
+/// `t = 0` (no history) keep their depth, as before. Only pieces with seams: elsewhere a record
+/// released and created again deep (a recollision, a vertex past an edge's end) would lose its
+/// depth each time and let a body sink (random scenes fell 100 mm into the floor).
+fn found_inside(
+    e: &mut VeContact,
+    colliders: &[Collider],
+    delta_c: f64,
+    laws: &mut crate::contact::law_pool::LawPool,
+) {
+    let seams = colliders[e.key.edge_collider as usize].seams != 0;
+    if seams && e.hist >= 2 && e.d[0] < 0.0 && e.d[1] < -delta_c {
         laws.impact_resolved(e.law, e.d, 0);
     }
 }
