@@ -591,7 +591,13 @@ impl World {
     /// report can be less where corners or edges cross; this is the truth. Costs a SAT test per
     /// proximate pair whose boxes overlap: for reports, not the haptic loop.
     pub fn max_overlap(&self) -> crate::collide::Overlap {
-        crate::collide::max_overlap(&self.colliders, &self.pairs)
+        // Pairs the local stage certified apart have none (`max_overlap_of_states`); before the
+        // first step it has no states yet.
+        if self.local.pair_states().len() == self.pairs.len() && self.tick > 0 {
+            crate::collide::max_overlap_of_states(&self.colliders, self.local.pair_states())
+        } else {
+            crate::collide::max_overlap(&self.colliders, &self.pairs)
+        }
     }
 
     /// Samples at which the swept test put a body back, and global updates run early, so far.

@@ -37,7 +37,7 @@ pub use local::{
     corner_facing_edge, nearest_line, sat_axis, sat_depth, LocalStage, PairState, DEFAULT_DELTA_C,
     DEFAULT_EPS_S, NEAR_PARALLEL_ANGLE,
 };
-pub use overlap::{max_overlap, Overlap};
+pub use overlap::{max_overlap, max_overlap_of_states, Overlap};
 pub use seam::{mark_seams, seam_mask, SEAM_ANGLE, SEAM_DISTANCE, SEAM_MAX_EDGES};
 pub use toi::{
     allowed_depth, radius as polygon_radius, speed_limit, swept_put_back,
