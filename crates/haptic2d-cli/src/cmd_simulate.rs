@@ -7,7 +7,7 @@
 
 use crate::exit::{Failure, Status};
 use crate::scene_arg;
-use crate::world_mcap::WorldOut;
+use crate::world_mcap::{OverlapSummary, WorldOut};
 use haptic2d::scene::{divergence, MAX_SAMPLES};
 use haptic2d_rt::signal::install_stop_signals;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -90,6 +90,9 @@ pub fn run(a: &SimulateArgs) -> Result<Status, Failure> {
     let mut max_excess = f64::NEG_INFINITY;
     let mut max_contacts = 0;
     let mut max_depth = 0.0f64;
+    // The true largest overlap of two bodies (separating-axis depth, issue 35), from t = 0.
+    let mut overlap = OverlapSummary::default();
+    overlap.sample(&world);
     let mut done = 0u64;
     let mut status = Status::Clean;
     for k in 1..=ticks {
@@ -103,7 +106,7 @@ pub fn run(a: &SimulateArgs) -> Result<Status, Failure> {
         if let Some(d) = divergence(&world) {
             // The rows so far are kept (flushed below); this one is not written.
             if let Some(c) = csv.take() {
-                c.finish()
+                c.finish(&overlap)
                     .map_err(|e| Failure::error(format!("cannot write CSV: {e}")))?;
                 crate::pipe::restore_after_output();
             }
@@ -122,6 +125,7 @@ pub fn run(a: &SimulateArgs) -> Result<Status, Failure> {
             .contact_records()
             .map(|c| -c.d[0])
             .fold(max_depth, f64::max);
+        overlap.sample(&world);
         if k % 256 == 0 {
             if !shown && start.elapsed() > Duration::from_secs(1) {
                 bar.set_draw_target(ProgressDrawTarget::stderr());
@@ -138,7 +142,7 @@ pub fn run(a: &SimulateArgs) -> Result<Status, Failure> {
     }
     bar.finish_and_clear();
     if let Some(c) = csv {
-        c.finish()
+        c.finish(&overlap)
             .map_err(|e| Failure::error(format!("cannot write CSV: {e}")))?;
         // The file is whole: a SIGPIPE that stopped the run ends the process now (status 141).
         crate::pipe::restore_after_output();
@@ -169,6 +173,19 @@ pub fn run(a: &SimulateArgs) -> Result<Status, Failure> {
         "deepest contact penetration: {:.3} mm at the end, {:.3} mm over the run",
         depth_now * 1e3,
         max_depth * 1e3
+    );
+    let pair = if overlap.max_m > 0.0 {
+        format!(
+            " (\"{}\" and \"{}\" at t = {:.3} s)",
+            overlap.bodies.0, overlap.bodies.1, overlap.at_s
+        )
+    } else {
+        String::new()
+    };
+    println!(
+        "largest overlap of two bodies (separating-axis depth): {:.3} mm at the end, {:.3} mm over the run{pair}",
+        overlap.end_m * 1e3,
+        overlap.max_m * 1e3
     );
     if let Some(p) = a.out {
         println!("wrote {}", p.display());

@@ -17,7 +17,8 @@ impl<W: Write> WorldCsv<W> {
         let dynamic: Vec<usize> = (0..world.bodies.len())
             .filter(|&i| world.bodies[i].is_dynamic())
             .collect();
-        let mut header = String::from("t,energy.kinetic,energy.stored,work.applied,contacts");
+        let mut header =
+            String::from("t,energy.kinetic,energy.stored,work.applied,contacts,overlap");
         for &i in &dynamic {
             let n = &world.bodies[i].name;
             for c in ["x", "y", "theta", "vx", "vy", "omega"] {
@@ -40,12 +41,13 @@ impl<W: Write> WorldCsv<W> {
         let e = world.ledger();
         let _ = write!(
             l,
-            "{},{},{},{},{}",
+            "{},{},{},{},{},{}",
             world.time(),
             e.kinetic,
             e.stored,
             e.applied_work,
-            world.contacts().contact_count()
+            world.contacts().contact_count(),
+            world.max_overlap().depth
         );
         for &i in &self.dynamic {
             let b = &world.bodies[i];

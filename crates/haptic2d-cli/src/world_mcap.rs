@@ -4,7 +4,7 @@
 
 use crate::csv_out::WorldCsv;
 use haptic2d::world::World;
-use haptic2d_rt::mcap::{McapSetup, McapSink, WorldSample};
+use haptic2d_rt::mcap::{McapSetup, McapSink, Metadata, WorldSample};
 use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::BufWriter;
@@ -73,11 +73,57 @@ impl WorldOut {
         }
     }
 
-    /// Finishes the file (flush; an MCAP log gets its summary and index).
-    pub fn finish(self) -> std::io::Result<()> {
+    /// Finishes the file (flush; an MCAP log gets its summary and index, and the metadata
+    /// record `haptic2d.overlap` with the run's largest overlap of two bodies, `overlap`).
+    pub fn finish(self, overlap: &OverlapSummary) -> std::io::Result<()> {
         match self {
             Self::Csv(c) => c.finish(),
-            Self::Mcap { sink, .. } => sink.finish(&[]).map(|_| ()).map_err(other),
+            Self::Mcap { sink, .. } => sink
+                .finish(&[overlap.metadata()])
+                .map(|_| ())
+                .map_err(other),
+        }
+    }
+}
+
+/// The largest overlap of two bodies over a run (separating-axis depth, issue 35): what the
+/// summary prints and the MCAP log's `haptic2d.overlap` metadata record holds.
+#[derive(Clone, Debug, Default)]
+pub struct OverlapSummary {
+    /// Largest separating-axis depth over the run (m).
+    pub max_m: f64,
+    /// Time of it (s).
+    pub at_s: f64,
+    /// The two bodies' names then (empty if no overlap).
+    pub bodies: (String, String),
+    /// The overlap at the end of the run (m).
+    pub end_m: f64,
+}
+
+impl OverlapSummary {
+    /// Takes the world's overlap now into the summary.
+    pub fn sample(&mut self, world: &World) {
+        let o = world.max_overlap();
+        self.end_m = o.depth;
+        if o.depth > self.max_m {
+            let name = |c: u32| world.bodies[world.colliders[c as usize].body].name.clone();
+            self.max_m = o.depth;
+            self.at_s = world.time();
+            self.bodies = (name(o.pair.0), name(o.pair.1));
+        }
+    }
+
+    /// The metadata record `haptic2d.overlap`: `max_m`, `at_s`, `body_a`, `body_b`, `end_m`.
+    pub fn metadata(&self) -> Metadata {
+        let mut m = BTreeMap::new();
+        m.insert("max_m".to_string(), self.max_m.to_string());
+        m.insert("at_s".to_string(), self.at_s.to_string());
+        m.insert("body_a".to_string(), self.bodies.0.clone());
+        m.insert("body_b".to_string(), self.bodies.1.clone());
+        m.insert("end_m".to_string(), self.end_m.to_string());
+        Metadata {
+            name: "haptic2d.overlap".into(),
+            metadata: m,
         }
     }
 }

@@ -44,7 +44,7 @@ fn simulate_writes_the_documented_columns() {
     let mut lines = csv.lines();
     assert_eq!(
         lines.next().unwrap(),
-        "t,energy.kinetic,energy.stored,work.applied,contacts,box.x,box.y,box.theta,box.vx,box.vy,box.omega"
+        "t,energy.kinetic,energy.stored,work.applied,contacts,overlap,box.x,box.y,box.theta,box.vx,box.vy,box.omega"
     );
     // 1 s at 500 Hz, every 10th sample, plus the initial row.
     assert_eq!(lines.count(), 51);

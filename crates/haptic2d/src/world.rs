@@ -7,8 +7,8 @@
 
 use crate::body::Body;
 use crate::collide::{
-    allowed_depth, body_thickness, speed_limit, swept_put_back, BroadPhase, Collider, LocalStage,
-    SweepScratch, SweptShape, DEFAULT_DELTA_PROX,
+    allowed_depth, body_thickness, mark_seams, speed_limit, swept_put_back, BroadPhase, Collider,
+    LocalStage, SweepScratch, SweptShape, DEFAULT_DELTA_PROX,
 };
 use crate::contact::{ContactParams, ContactSet, PastPoses, VeContact, Wrench2};
 use crate::geom::{Pose, Rot, Vec2};
@@ -169,6 +169,8 @@ impl World {
                 colliders.push(Collider::new(i, bodies[i].is_dynamic(), p, &bodies[i].pose));
             }
         }
+        // Internal edges of multi-piece bodies are never contact normals (`collide/seam.rs`).
+        mark_seams(&mut colliders);
         let n = bodies.len();
         let colliders_len = colliders.len().max(4);
         let mut radius = vec![0.0f64; n];
@@ -587,6 +589,20 @@ impl World {
         self.skipped_global_updates
     }
 
+    /// The largest overlap of two bodies now: the separating-axis depth of the proximate pair
+    /// that overlaps most (`collide/overlap.rs`; seams left out). What the contact records
+    /// report can be less where corners or edges cross; this is the truth. Costs a SAT test per
+    /// proximate pair whose boxes overlap: for reports, not the haptic loop.
+    pub fn max_overlap(&self) -> crate::collide::Overlap {
+        // Pairs the local stage certified apart have none (`max_overlap_of_states`); before the
+        // first step it has no states yet.
+        if self.local.pair_states().len() == self.pairs.len() && self.tick > 0 {
+            crate::collide::max_overlap_of_states(&self.colliders, self.local.pair_states())
+        } else {
+            crate::collide::max_overlap(&self.colliders, &self.pairs)
+        }
+    }
+
     /// Samples at which the swept test put a body back, and global updates run early, so far.
     pub fn continuous_stats(&self) -> (u64, u64) {
         (self.swept_hits, self.early_global_updates)
@@ -620,6 +636,7 @@ impl World {
                 start: self.prev[i],
                 end: self.bodies[i].pose,
                 radius: self.radius[i],
+                seams: self.colliders[c].seams,
             };
             // Swept boxes apart: the start AABBs (this sample's colliders), each grown by its
             // body's motion, do not overlap, so the pair cannot touch during the sample.

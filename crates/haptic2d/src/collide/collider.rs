@@ -17,6 +17,10 @@ pub struct Collider {
     world: Vec<Vec2>,
     /// World bounding box (m), not inflated.
     pub aabb: Aabb,
+    /// Seam mask: bit `e` set when edge `e` is an internal edge of a body of several pieces,
+    /// covered by another piece (`seam.rs`), and so never a contact normal. 0 for a lone piece;
+    /// set by [`mark_seams`](super::mark_seams) (the world does it when it is built).
+    pub seams: u128,
 }
 
 impl Collider {
@@ -29,6 +33,7 @@ impl Collider {
             local,
             world: vec![Vec2::ZERO; 2 * n],
             aabb: Aabb::EMPTY,
+            seams: 0,
         };
         c.update(pose);
         c
@@ -72,6 +77,12 @@ impl Collider {
     pub fn world_tangent(&self, e: usize) -> Vec2 {
         let n = self.world_normals()[e];
         Vec2::new(-n.y, n.x)
+    }
+
+    /// Whether edge `e` is a seam (an internal edge of a multi-piece body, `seam.rs`).
+    #[inline(always)]
+    pub fn is_seam(&self, e: usize) -> bool {
+        e < 128 && (self.seams >> e) & 1 == 1
     }
 
     /// Number of vertices (= edges).

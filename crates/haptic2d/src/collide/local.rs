@@ -872,7 +872,11 @@ impl Ctx {
         let p = pv.c.world_vertices()[v];
         let s = pe.c.edge_coordinate(e, p);
         let l = pe.c.local.lengths()[e];
-        if s < -self.eps_s || s > l + self.eps_s || pe.c.edge_distance(e, p) > self.delta_c {
+        if pe.c.is_seam(e)
+            || s < -self.eps_s
+            || s > l + self.eps_s
+            || pe.c.edge_distance(e, p) > self.delta_c
+        {
             return false;
         }
         out.push(VeCandidate {
@@ -1041,6 +1045,8 @@ impl Ctx {
             // can be decided by round-off. Counting costs one compare per edge; the corner rule
             // itself runs only then.
             let mut near_lines = 0u32;
+            // The nearest line of all, seams included: whether the vertex is inside B.
+            let mut max_all = f64::NEG_INFINITY;
             for (e, (&e0, &n)) in b_starts.iter().zip(b_normals).enumerate() {
                 // = `b.c.edge_distance(e, p)`
                 let d = n.dot(p - e0);
@@ -1048,6 +1054,12 @@ impl Ctx {
                     // Farther than δ_c from B's half-plane, so from B.
                     slack.decided(d - self.delta_c);
                     continue 'vertex;
+                }
+                max_all = max_all.max(d);
+                if b.c.seams != 0 && b.c.is_seam(e) {
+                    // A seam is no surface of B's body: never the vertex's contact normal.
+                    slack.decided((self.delta_c - d).min((d + self.delta_c).abs()));
+                    continue;
                 }
                 if d > max_d {
                     second = max_d;
@@ -1060,11 +1072,17 @@ impl Ctx {
                 slack.decided((self.delta_c - d).min((d + self.delta_c).abs()));
             }
             slack.decided(0.5 * (max_d - second));
-            if max_d < 0.0 {
-                slack.inside = slack.inside.max(-max_d);
+            if max_all < 0.0 {
+                slack.inside = slack.inside.max(-max_all);
                 if inside.is_none() {
                     inside = Some(p);
                 }
+            }
+            if max_d == f64::NEG_INFINITY || (max_all > max_d && max_all > 0.0) {
+                // Every edge of B is a seam, or the vertex is outside B across a seam: the
+                // neighbouring pieces' surfaces hold it.
+                slack.decided(max_all.abs());
+                continue;
             }
             // Nearest line first: its edge must hold the vertex (always so inside B, see above);
             // otherwise the vertex is in a corner region outside B and gets no candidate.
@@ -1099,6 +1117,9 @@ impl Ctx {
     fn corner_edge(&self, a: &Collider, v: usize, b: &Collider, e: usize, max_d: f64) -> usize {
         let p = a.world_vertices()[v];
         for e2 in [b.local.prev(e), b.local.next(e)] {
+            if b.is_seam(e2) {
+                continue;
+            }
             let d = b.edge_distance(e2, p);
             let s = b.edge_coordinate(e2, p);
             let in_range = s >= -self.eps_s && s <= b.local.lengths()[e2] + self.eps_s;
@@ -1162,31 +1183,60 @@ fn most_aligned_edge(c: &Collider, v: usize, p: Vec2) -> usize {
 }
 
 /// The nearest edge line of `b` to the world point `p`: `(j*, d_{j*})` with `d_{j*} = max_j d_j`
-/// over all of `b`'s edge lines (m, positive outside). For `p` inside `b`, `−d_{j*}` is its depth
-/// (distance to the boundary) and edge `j*` holds `p` in its range (see `vertices_against`).
+/// over `b`'s edge lines that are not seams (m, positive outside; `(0, −∞)` if every edge is a
+/// seam), or the seam line `p` is farthest outside of if it is outside `b` across a seam (then
+/// `j*` is a seam, never a contact edge). For `p` inside `b`, `−d_{j*}` is its depth (distance
+/// to the body's surface through `b`'s surface edges).
 ///
 /// The invariant of every VE record `(V, e)` (issue 10): `d_e ≥ d_{j*} − δ_c`, so its stored
 /// energy `½·K_c·d_e²` never exceeds that of the vertex's real depth by more than the corner
-/// tolerance allows.
+/// tolerance allows, or (issue 35) `−d_e ≤ sat_depth + δ_c`, the pair's overlap.
 #[inline]
 pub fn nearest_line(b: &Collider, p: Vec2) -> (usize, f64) {
     let mut best = (0usize, f64::NEG_INFINITY);
+    let mut seam = (0usize, 0.0f64);
     for e in 0..b.len() {
         let d = b.edge_distance(e, p);
-        if d > best.1 {
+        if b.is_seam(e) {
+            if d > seam.1 {
+                seam = (e, d);
+            }
+        } else if d > best.1 {
             best = (e, d);
         }
     }
-    best
+    // Outside `b` across a seam: the point is that far from `b` (in the next piece).
+    if seam.1 > 0.0 && seam.1 > best.1 {
+        seam
+    } else {
+        best
+    }
 }
 
 /// Penetration depth of two convex polygons by separating axes (m): the smallest overlap of their
-/// projections over every edge normal of both, `0` if some axis separates them. No vertex of one
+/// projections over the edge normals of both, `0` if some axis separates them. No vertex of one
 /// can be deeper in the other than this (translating by the minimum separating vector clears
-/// every vertex). Costs `O((n_a + n_b)²)`: for checks, not the hot path.
+/// every vertex). Costs `O((n_a + n_b)²)`: for checks and reports, not the hot path.
+///
+/// **Seams** (`seam.rs`): a piece of a multi-piece body is cleared through the body's surface,
+/// never through a seam into the next piece. So a seam's normal is no axis, and neither is an
+/// axis whose separating motion (of `a` relative to `b`) has a component through a seam of `b`
+/// (or, reversed, of `a`): moving along it could clear the piece through the joint. Along an
+/// admissible axis `u` every vertex leaves the piece through a surface edge `f` (`n_f·u > 0`)
+/// after at least its depth `−d_f`, so the bound above still holds with depth measured to the
+/// nearest surface line ([`nearest_line`]). A piece with no admissible axis gets the least
+/// overlap over its surface normals.
 pub fn sat_depth(a: &Collider, b: &Collider) -> f64 {
-    let mut depth = f64::INFINITY;
-    for (p, q) in [(a, b), (b, a)] {
+    sat_axis(a, b).0
+}
+
+/// [`sat_depth`] with its axis: `(depth, u)`, `u` the unit direction in which `a` moves
+/// (relative to `b`) to separate by `depth`; `u = 0` when the pair is apart.
+pub fn sat_axis(a: &Collider, b: &Collider) -> (f64, Vec2) {
+    let seams = a.seams != 0 || b.seams != 0;
+    let mut best = (f64::INFINITY, Vec2::ZERO);
+    let mut fallback = (f64::INFINITY, Vec2::ZERO);
+    for (p, q, sign) in [(a, b, -1.0), (b, a, 1.0)] {
         for e in 0..p.len() {
             // Overlap along n_e: how far q's deepest vertex is behind p's edge line e.
             let min_d = q
@@ -1194,14 +1244,40 @@ pub fn sat_depth(a: &Collider, b: &Collider) -> f64 {
                 .iter()
                 .map(|&v| p.edge_distance(e, v))
                 .fold(f64::INFINITY, f64::min);
-            depth = depth.min((-min_d).max(0.0));
+            if min_d >= 0.0 {
+                return (0.0, Vec2::ZERO);
+            }
+            if seams && p.is_seam(e) {
+                continue;
+            }
+            let u = p.world_normals()[e] * sign;
+            if -min_d < fallback.0 {
+                fallback = (-min_d, u);
+            }
+            let through = seams && (through_seam(b, u) || through_seam(a, -u));
+            if !through && -min_d < best.0 {
+                best = (-min_d, u);
+            }
         }
     }
-    if depth.is_finite() {
-        depth
+    if best.0.is_finite() {
+        best
+    } else if fallback.0.is_finite() {
+        fallback
     } else {
-        0.0
+        (0.0, Vec2::ZERO)
     }
+}
+
+/// Whether moving a body relative to `c` along `u` has a component out through a seam of `c`
+/// (`n_s·u > 0` for a seam `s`, beyond round-off).
+#[inline]
+pub(crate) fn through_seam(c: &Collider, u: Vec2) -> bool {
+    c.seams != 0
+        && c.world_normals()
+            .iter()
+            .enumerate()
+            .any(|(e, n)| c.is_seam(e) && n.dot(u) > 1e-12)
 }
 
 #[cfg(test)]

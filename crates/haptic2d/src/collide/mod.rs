@@ -6,6 +6,7 @@
 //! - [`BroadPhase`] (`broad.rs`): inflated AABBs, sort-and-sweep, GJK → proximity set (§9.1);
 //! - [`FeatureTracker`] (`tracker.rs`): Lin–Canny closest features per pair (§9.3);
 //! - [`LocalStage`] (`local.rs`): one tracker per proximate pair, VE candidates (§9.4–9.5);
+//! - [`mark_seams`] (`seam.rs`): the internal edges of multi-piece bodies, never contact normals;
 //! - [`swept_put_back`] (`toi.rs`): the swept test (time of impact) for bodies too fast for one
 //!   sample, and the speed limits the world guarantees ([`speed_limit`], [`allowed_depth`]).
 //!
@@ -20,7 +21,9 @@ mod broad;
 mod collider;
 mod gjk;
 mod local;
+mod overlap;
 mod reuse;
+mod seam;
 mod toi;
 mod tracker;
 
@@ -31,9 +34,11 @@ pub use gjk::{
     GJK_MAX_ITERATIONS,
 };
 pub use local::{
-    corner_facing_edge, nearest_line, sat_depth, LocalStage, PairState, DEFAULT_DELTA_C,
+    corner_facing_edge, nearest_line, sat_axis, sat_depth, LocalStage, PairState, DEFAULT_DELTA_C,
     DEFAULT_EPS_S, NEAR_PARALLEL_ANGLE,
 };
+pub use overlap::{max_overlap, max_overlap_of_states, Overlap};
+pub use seam::{mark_seams, seam_mask, SEAM_ANGLE, SEAM_DISTANCE, SEAM_MAX_EDGES};
 pub use toi::{
     allowed_depth, radius as polygon_radius, speed_limit, swept_put_back,
     thickness as body_thickness, SweepScratch, SweptShape, TOI_MAX_SAMPLES,

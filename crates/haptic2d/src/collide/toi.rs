@@ -97,6 +97,9 @@ pub struct SweptShape<'a> {
     pub end: Pose,
     /// Largest vertex distance from the centre of mass (m), see [`radius`].
     pub radius: f64,
+    /// The shape's seam mask ([`Collider::seams`](super::Collider::seams)): seams are no
+    /// separating axes of the depth (`seam.rs`).
+    pub seams: u128,
 }
 
 impl SweptShape<'_> {
@@ -133,6 +136,7 @@ pub struct SweepScratch {
     vb: Vec<Vec2>,
     na: Vec<Vec2>,
     nb: Vec<Vec2>,
+    seams: [u128; 2],
 }
 
 impl SweepScratch {
@@ -143,6 +147,7 @@ impl SweepScratch {
             vb: Vec::with_capacity(n),
             na: Vec::with_capacity(n),
             nb: Vec::with_capacity(n),
+            seams: [0; 2],
         }
     }
 
@@ -157,24 +162,50 @@ impl SweepScratch {
         }
         fill(a, lam, &mut self.va, &mut self.na);
         fill(b, lam, &mut self.vb, &mut self.nb);
+        self.seams = [a.seams, b.seams];
     }
 
-    /// Separating-axis depth of the placed pair (m, 0 if apart).
+    /// Separating-axis depth of the placed pair (m, 0 if apart), with the seam rules of
+    /// [`sat_depth`](super::sat_depth).
     fn depth(&self) -> f64 {
-        let mut depth = f64::INFINITY;
-        for (v, n, w) in [
-            (&self.va, &self.na, &self.vb),
-            (&self.vb, &self.nb, &self.va),
+        let [sa, sb] = self.seams;
+        let seam = |s: u128, e: usize| e < 128 && (s >> e) & 1 == 1;
+        let through = |n: &[Vec2], s: u128, u: Vec2| {
+            s != 0
+                && n.iter()
+                    .enumerate()
+                    .any(|(e, m)| seam(s, e) && m.dot(u) > 1e-12)
+        };
+        let (mut depth, mut fallback) = (f64::INFINITY, f64::INFINITY);
+        for (v, n, w, s, sign) in [
+            (&self.va, &self.na, &self.vb, sa, -1.0),
+            (&self.vb, &self.nb, &self.va, sb, 1.0),
         ] {
             for e in 0..v.len() {
                 let min_d = w
                     .iter()
                     .map(|&q| n[e].dot(q - v[e]))
                     .fold(f64::INFINITY, f64::min);
-                depth = depth.min((-min_d).max(0.0));
+                if min_d >= 0.0 {
+                    return 0.0;
+                }
+                if seam(s, e) {
+                    continue;
+                }
+                fallback = fallback.min(-min_d);
+                let u = n[e] * sign;
+                if (sa | sb) == 0 || !(through(&self.nb, sb, u) || through(&self.na, sa, -u)) {
+                    depth = depth.min(-min_d);
+                }
             }
         }
-        depth
+        if depth.is_finite() {
+            depth
+        } else if fallback.is_finite() {
+            fallback
+        } else {
+            0.0
+        }
     }
 }
 

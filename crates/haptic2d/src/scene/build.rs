@@ -12,10 +12,12 @@ use super::file::{BodySection, SceneFile};
 use super::laws::{friction_from, normal_from};
 use super::{SceneError, SceneErrors};
 use crate::body::Body;
+use crate::collide::{body_thickness, speed_limit};
 use crate::contact::ContactParams;
 use crate::device::DeviceParams;
 use crate::geom::{ConvexPolygon, MassProperties, Pose, Rot, Vec2};
 use crate::integrate::{min_mass, IntegrationMode};
+use crate::laws::normal::NormalModel;
 use crate::load::{Load, Profile};
 use crate::world::{World, WorldParams};
 
@@ -675,6 +677,21 @@ pub(super) fn build(
         }
     }
 
+    // Where the no-tunnelling promise needs the contact springs (issue 35): with impacts off,
+    // nothing but the normal law stops a body that reaches a part, so it is stopped before a
+    // corner passes the middle of the thinnest part only below `(w/2)·√(K/m)`.
+    if !params.contact.impacts {
+        warnings.extend(spring_stop_warnings(
+            &bodies,
+            &shapes,
+            &normal,
+            speed_limit(params.delta_prox, params.delta_c) / dt,
+        ));
+    }
+    if normal.name() == "pulse" {
+        warnings.push(PULSE_NOT_PASSIVE_2D.to_string());
+    }
+
     // [[load]]
     let mut loads = Vec::new();
     for (li, l) in file.loads.iter().enumerate() {
@@ -803,4 +820,66 @@ pub(super) fn build(
         device,
         allow_initial_overlap: w.allow_initial_overlap.unwrap_or(false),
     })
+}
+
+/// The `check` warning of a scene with the braking-pulse law (docs/MODELS.md §5.7): measured on
+/// `pulse-energy.toml` (impacts off, two polygons in a box, 2 s at 1 kHz).
+pub const PULSE_NOT_PASSIVE_2D: &str = "normal.model = \"pulse\" is not passive in 2-D: its pulse is sized from the pair's \
+     reduced mass (no rotational inertia) and pushes for n_p samples after entry whatever the body does (a spinning \
+     polygon, a corner that leaves early, other contacts), so it can return more energy than the entry had; measured \
+     +1.545 J on pulse-energy.toml (2 s, impacts off). Passive only in the 1-D Fig. 4 case (a face flat against a \
+     wall); prefer \"paper\", \"minsky\" or \"hysteretic\" for general scenes (docs/MODELS.md §5.7)";
+
+/// With impacts off, the speed (m/s) below which the normal law alone stops a body of mass `m`
+/// before one corner passes the middle of a part of thickness `w` (m): a corner spring `K`
+/// (N/m) absorbs `½·m·v²` within `w/2` iff `v ≤ (w/2)·√(K/m)` (damping and other corners only
+/// help). Beyond it, the nearest line of the corner is the far face and the body can pass.
+pub fn spring_stop_speed(mass: f64, k: f64, w: f64) -> f64 {
+    0.5 * w * (k / mass).sqrt()
+}
+
+/// One warning per dynamic body whose [`spring_stop_speed`] against the thinnest part of any
+/// other body is below `limit` (m/s, the proximity guarantee), i.e. where `check` cannot promise
+/// "no tunnelling below `limit`" with impacts off.
+fn spring_stop_warnings(
+    bodies: &[Body],
+    shapes: &[Vec<ConvexPolygon>],
+    normal: &NormalModel,
+    limit: f64,
+) -> Vec<String> {
+    let (k, _) = normal.stiffness_damping();
+    let thick: Vec<f64> = shapes
+        .iter()
+        .map(|ps| ps.iter().map(body_thickness).fold(f64::INFINITY, f64::min))
+        .collect();
+    let mut out = Vec::new();
+    for (i, b) in bodies.iter().enumerate() {
+        if !b.is_dynamic() || k.is_nan() || k <= 0.0 {
+            continue;
+        }
+        let Some((j, w)) = thick
+            .iter()
+            .enumerate()
+            .filter(|&(j, _)| j != i)
+            .min_by(|a, b| a.1.total_cmp(b.1))
+            .map(|(j, &w)| (j, w))
+        else {
+            continue;
+        };
+        let v = spring_stop_speed(b.mass, k, w);
+        if v.is_finite() && v < limit {
+            out.push(format!(
+                "contact.impacts = false: only the contact springs stop body \"{}\" ({:.3} kg), so the \
+                 no-tunnelling promise holds below {v:.2} m/s, not {limit:.1} m/s: faster, one corner \
+                 (K = {k} N/m) is not stopped within half the thinnest part it can hit (\"{}\", {:.1} mm) \
+                 and can pass through it, (w/2)·√(K/m); fix: contact.impacts = true, a stiffer normal \
+                 law or thicker parts",
+                b.name,
+                b.mass,
+                bodies[j].name,
+                w * 1e3
+            ));
+        }
+    }
+    out
 }

@@ -14,7 +14,7 @@ mod laws;
 pub mod overlap;
 
 pub use bounds::{divergence, Divergence, MAX_BODIES, MAX_FILE_BYTES, MAX_RATE_HZ, MAX_SAMPLES};
-pub use build::Scene;
+pub use build::{spring_stop_speed, Scene, PULSE_NOT_PASSIVE_2D};
 pub use builtin::{builtin, builtin_names, pile_toml, BUILTIN};
 pub use device::{device_params_from_toml, DEVICE_TEMPLATE};
 pub use error::{SceneError, SceneErrors};

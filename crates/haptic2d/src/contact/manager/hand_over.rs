@@ -1,7 +1,7 @@
 //! Stage 3 of the contact step: a Continuous record whose vertex has come nearer to another line of
 //! its edge polygon is handed over to that edge (the depth invariant of [`ContactSet::step`]).
 
-use super::invariant::face_on_face_ok;
+use super::invariant::overlap_ok;
 use super::sync::new_entry;
 use super::ContactSet;
 use super::PastPoses;
@@ -41,9 +41,7 @@ impl ContactSet {
             }
             let cb = &colliders[e.key.edge_collider as usize];
             let (j, max_d) = nearest_line(cb, e.point);
-            if e.d[0] >= max_d - self.delta_c
-                || face_on_face_ok(e.key, colliders, self.delta_c, self.cos_parallel)
-            {
+            if e.d[0] >= max_d - self.delta_c || overlap_ok(e.key, colliders, self.delta_c) {
                 continue;
             }
             let key = VeCandidate {
@@ -51,8 +49,11 @@ impl ContactSet {
                 ..e.key
             };
             let s_j = cb.edge_coordinate(j, e.point);
-            let holds =
-                max_d <= p.delta_off && s_j >= -p.eps_s && s_j <= cb.local.lengths()[j] + p.eps_s;
+            // Never onto a seam (the vertex is then outside B, in the next piece).
+            let holds = !cb.is_seam(j)
+                && max_d <= p.delta_off
+                && s_j >= -p.eps_s
+                && s_j <= cb.local.lengths()[j] + p.eps_s;
             let e = &mut self.entries[idx];
             e.state = None;
             self.laws.release(e.law);

@@ -286,13 +286,12 @@ impl ContactSet {
     /// ```
     ///
     /// which also bounds `−d_e` by the pair's separating-axis depth `+ δ_c` (no vertex is deeper
-    /// in B than the pair's penetration depth). One exception, face on face: where `V` sits at a
-    /// corner of B on its side line (coincident corners of an aligned stack) and `e` *faces* an
-    /// edge of A at `V` (antiparallel within [`NEAR_PARALLEL_ANGLE`], the corner-on-corner rule),
-    /// the faces overlap by the pair's separating-axis depth while `V` is on B's boundary: the
-    /// record is then valid up to that depth, `−d_e ≤ depth_SAT + δ_c` (a landing 10-box stack
-    /// compresses its faces by 2.02 mm with `V` at `±1e-19 m` from the side line). A far edge
-    /// never faces A (its normal points away from A). Candidates satisfy it where they are made (the
+    /// in B than the pair's penetration depth; `j` over B's surface lines, seams left out,
+    /// `collide/seam.rs`). Or the overlap bound (issue 35): `−d_e ≤ depth_SAT + δ_c` for any
+    /// edge. It covers faces on faces (a landing 10-box stack compresses its faces by 2.02 mm
+    /// with `V` at `±1e-19 m` from the side line) and crossing corners, where a record on the
+    /// edge its vertex crossed keeps pushing within the pair's overlap instead of being handed
+    /// to a shallower line; a far edge breaks it. Candidates satisfy it where they are made (the
     /// local stage's nearest-line rule); `create` checks it for the edge it picks (the crossed-edge
     /// rule may pick another one); `hand_over` moves a record whose vertex has come nearer to
     /// another line of B by more than `δ_c` to that edge (or releases it if the vertex is outside

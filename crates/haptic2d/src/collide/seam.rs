@@ -1,0 +1,156 @@
+//! Seams: the internal edges of a body made of several convex pieces (issue 35).
+//!
+//! A wall built from pieces (a floor slab and a wall slab meeting at a joint) has edges that lie
+//! inside the body: the wall slab's bottom edge is covered by the floor slab's top edge. Such an
+//! edge is no surface of the body, so it is never a contact normal: a vertex 35 mm inside the
+//! wall slab and 0.1 mm above the floor slab is nearest to the wall slab's *bottom* line, and
+//! measured against it would be pushed along the joint (down, into the floor) instead of out of
+//! the wall, and slide through the wall at the joint (`corner-seam-tunnel.toml`: a 3.6 kg polygon
+//! at 4 m/s ended 8.65 m below the container). Box2D's chain shapes solve the same problem with
+//! ghost vertices (only the chain's outer side is a surface).
+//!
+//! An edge `e` of piece `P` is a **seam** when the edges of the body's other pieces that lie on
+//! its line with the opposite normal (antiparallel within [`SEAM_ANGLE`], the line within
+//! [`SEAM_DISTANCE`]) cover all of it, up to `SEAM_DISTANCE` at either end. A partly covered
+//! edge (the floor slab's top edge, covered only under the walls) stays a surface: its exposed
+//! part is one. The vertex scan (`local.rs`), [`nearest_line`](super::nearest_line),
+//! [`sat_depth`](super::sat_depth), the swept test's depth and the crossed-edge rule skip seams.
+
+use super::Collider;
+use crate::geom::ConvexPolygon;
+
+/// Largest angle (rad, from antiparallel) between two edges that join at a seam.
+pub const SEAM_ANGLE: f64 = 1e-6;
+/// Largest distance (m) between the lines of two edges that join at a seam, and the gap left
+/// uncovered at either end of a seam.
+pub const SEAM_DISTANCE: f64 = 1e-7;
+
+/// Edges beyond this index are never marked as seams (the scene files allow 128 vertices).
+pub const SEAM_MAX_EDGES: usize = 128;
+
+/// The seam mask of `piece` among `others` (the other pieces of the same body, all in the body
+/// frame): bit `e` set when edge `e` is a seam (module docs).
+pub fn seam_mask<'a>(
+    piece: &ConvexPolygon,
+    others: impl Iterator<Item = &'a ConvexPolygon> + Clone,
+) -> u128 {
+    let cos = SEAM_ANGLE.cos();
+    let (v, n, t, len) = (
+        piece.vertices(),
+        piece.normals(),
+        piece.tangents(),
+        piece.lengths(),
+    );
+    let mut mask = 0u128;
+    let mut cover: Vec<(f64, f64)> = Vec::new();
+    for e in 0..piece.len().min(SEAM_MAX_EDGES) {
+        cover.clear();
+        for q in others.clone() {
+            for f in 0..q.len() {
+                let (f0, f1) = (q.vertices()[f], q.vertices()[q.next(f)]);
+                let on_line = n[e].dot(f0 - v[e]).abs() <= SEAM_DISTANCE
+                    && n[e].dot(f1 - v[e]).abs() <= SEAM_DISTANCE;
+                if n[e].dot(q.normals()[f]) > -cos || !on_line {
+                    continue;
+                }
+                let (s0, s1) = (t[e].dot(f0 - v[e]), t[e].dot(f1 - v[e]));
+                cover.push((s0.min(s1), s0.max(s1)));
+            }
+        }
+        cover.sort_by(|a, b| a.0.total_cmp(&b.0));
+        // Covered from 0 up to `reach`.
+        let mut reach = 0.0f64;
+        for &(lo, hi) in &cover {
+            if lo > reach + SEAM_DISTANCE {
+                break;
+            }
+            reach = reach.max(hi);
+        }
+        if !cover.is_empty() && reach >= len[e] - SEAM_DISTANCE && cover[0].0 <= SEAM_DISTANCE {
+            mask |= 1u128 << e;
+        }
+    }
+    mask
+}
+
+/// Marks the seams of every collider (`Collider::seams`) from the other pieces of its body.
+pub fn mark_seams(colliders: &mut [Collider]) {
+    let masks: Vec<u128> = (0..colliders.len())
+        .map(|i| {
+            let body = colliders[i].body;
+            let others = colliders
+                .iter()
+                .enumerate()
+                .filter(move |&(j, c)| j != i && c.body == body)
+                .map(|(_, c)| &c.local);
+            seam_mask(&colliders[i].local, others)
+        })
+        .collect();
+    for (c, m) in colliders.iter_mut().zip(masks) {
+        c.seams = m;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::{Pose, Vec2};
+
+    fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> ConvexPolygon {
+        ConvexPolygon::new(vec![
+            Vec2::new(x0, y0),
+            Vec2::new(x1, y0),
+            Vec2::new(x1, y1),
+            Vec2::new(x0, y1),
+        ])
+        .unwrap()
+    }
+
+    /// The container of `corner-seam-tunnel.toml`: each wall slab's edge on the floor (or
+    /// ceiling) slab is a seam; the floor's top edge, covered only at its ends, is a surface.
+    #[test]
+    fn container_joints_are_seams_and_exposed_faces_are_not() {
+        let pieces = [
+            rect(-0.1, -0.1, 0.5, 0.0),
+            rect(-0.1, 0.0, 0.0, 0.4),
+            rect(0.4, 0.0, 0.5, 0.4),
+            rect(-0.1, 0.4, 0.5, 0.5),
+        ];
+        let mut cols: Vec<Collider> = pieces
+            .iter()
+            .map(|p| Collider::new(0, false, p.clone(), &Pose::new(0.0, 0.0, 0.0)))
+            .collect();
+        mark_seams(&mut cols);
+        // Edges run from vertex i to i + 1: bottom, right, top, left.
+        assert_eq!(cols[0].seams, 0, "the floor's top edge is partly exposed");
+        assert_eq!(
+            cols[3].seams, 0,
+            "the ceiling's bottom edge is partly exposed"
+        );
+        assert_eq!(cols[1].seams, 0b0101, "left wall: bottom and top are seams");
+        assert_eq!(
+            cols[2].seams, 0b0101,
+            "right wall: bottom and top are seams"
+        );
+        assert!(cols[2].is_seam(0) && !cols[2].is_seam(3));
+    }
+
+    /// Pieces of different bodies, or touching only along part of an edge, make no seam.
+    #[test]
+    fn other_bodies_and_partial_cover_make_no_seam() {
+        let mut cols = vec![
+            Collider::new(0, false, rect(0.0, 0.0, 1.0, 1.0), &Pose::default()),
+            Collider::new(1, false, rect(0.0, 1.0, 1.0, 2.0), &Pose::default()),
+            Collider::new(2, false, rect(0.0, 0.0, 1.0, 1.0), &Pose::default()),
+            Collider::new(2, false, rect(0.0, 1.0, 0.5, 2.0), &Pose::default()),
+        ];
+        mark_seams(&mut cols);
+        assert_eq!(cols[0].seams, 0);
+        assert_eq!(cols[1].seams, 0);
+        assert_eq!(cols[2].seams, 0, "top edge only half covered");
+        assert_eq!(
+            cols[3].seams, 0b0001,
+            "bottom edge fully on the lower piece"
+        );
+    }
+}
