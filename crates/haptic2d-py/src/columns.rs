@@ -1,7 +1,8 @@
 //! The column set of `haptic2d simulate`'s CSV (docs/CSV.md), assembled from the core's public API so
 //! `World.run` returns the same names and the same numbers as the CLI's file.
 //!
-//! Columns: `t, energy.kinetic, energy.stored, work.applied, contacts`, then per dynamic body `NAME`
+//! Columns: `t, energy.kinetic, energy.stored, work.applied, contacts, overlap` (the largest
+//! separating-axis overlap of two bodies, m), then per dynamic body `NAME`
 //! (in body order) `NAME.x, NAME.y, NAME.theta, NAME.vx, NAME.vy, NAME.omega`.
 
 use haptic2d::world::World;
@@ -18,12 +19,13 @@ pub struct WorldColumns {
 }
 
 /// Number of global columns before the per-body ones (`contacts` included).
-pub const GLOBAL: [&str; 5] = [
+pub const GLOBAL: [&str; 6] = [
     "t",
     "energy.kinetic",
     "energy.stored",
     "work.applied",
     "contacts",
+    "overlap",
 ];
 
 impl WorldColumns {
@@ -58,9 +60,10 @@ impl WorldColumns {
         v[2].push(e.stored);
         v[3].push(e.applied_work);
         self.contacts.push(world.contacts().contact_count() as i64);
+        v[4].push(world.max_overlap().depth);
         for (j, &i) in self.dynamic.iter().enumerate() {
             let b = &world.bodies[i];
-            let c = 4 + 6 * j;
+            let c = 5 + 6 * j;
             v[c].push(b.pose.pos.x);
             v[c + 1].push(b.pose.pos.y);
             v[c + 2].push(b.pose.angle);

@@ -41,10 +41,20 @@ impl HaplySystem {
         grasp: [f64; 2],
     ) -> Result<Self, String> {
         match &file.kind {
-            HaplyKind::TwoDiy { linkage, .. } => {
+            HaplyKind::TwoDiy {
+                linkage,
+                center,
+                half_width,
+            } => {
                 let mut c = Planar2Config::new(*linkage, file.torque_limit);
                 c.controller = controller;
                 c.grasp = grasp;
+                // The device file's workspace square: the passive wall near its edge and the trip
+                // beyond it, as on every device (the same square `haptic2d run` gives the 2DIY).
+                c.workspace = Some(haptic2d::haptic::WorkspaceSquare::around(
+                    *center,
+                    *half_width,
+                ));
                 Ok(HaplySystem::TwoDof(Planar2System::new(world, c)?))
             }
             HaplyKind::Twin(p) => {

@@ -83,7 +83,7 @@ class World:
     def run(self, duration: float, every: int = 1) -> Dict[str, np.ndarray]:
         """Runs ``duration`` s (rounded to whole samples) with the scene's loads and returns the
         columns of ``haptic2d simulate``'s CSV (docs/CSV.md): ``t, energy.kinetic, energy.stored,
-        work.applied, contacts`` and per dynamic body ``NAME.x, NAME.y, NAME.theta, NAME.vx,
+        work.applied, contacts, overlap`` and per dynamic body ``NAME.x, NAME.y, NAME.theta, NAME.vx,
         NAME.vy, NAME.omega`` (m, rad, m/s, rad/s, J). The first row is the state before the run,
         then every ``every``-th sample. The loop runs in Rust with the GIL released. Raises
         ``FloatingPointError`` if a body's state becomes non-finite.
