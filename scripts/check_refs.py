@@ -44,16 +44,21 @@ def slug(heading):
 
 
 def headings(path):
-    """(slugs, section numbers) of a Markdown file."""
+    """(slugs, section numbers) of a Markdown file. A numbered list item `3. …` at the start of a line
+    under a numbered heading `1.3` is section `1.3.3` (DEVICES.md numbers its facts so)."""
     slugs, numbers = set(), set()
     counts = {}
     in_code = False
+    current = None
     for line in path.read_text(encoding="utf-8").split("\n"):
         if line.startswith("```"):
             in_code = not in_code
             continue
         if in_code:
             continue
+        item = re.match(r"^([0-9]+)\. ", line)
+        if item and current:
+            numbers.add(f"{current}.{item.group(1)}")
         m = re.match(r"^(#{1,6})\s+(.*?)\s*#*\s*$", line)
         if not m:
             continue
@@ -62,10 +67,11 @@ def headings(path):
         n = counts.get(base, 0)
         counts[base] = n + 1
         slugs.add(base if n == 0 else f"{base}-{n}")
-        # "7.3 The LCP solver", "0. Conventions", "Appendix F. Frictional impacts", "F. …"
-        num = re.match(r"^(?:Part\s+)?(?:Appendix\s+)?([0-9]+(?:\.[0-9]+)*|[A-Z])[.\s:]", text)
-        if num:
-            numbers.add(num.group(1).rstrip("."))
+        # "7.3 The LCP solver", "0. Conventions", "Appendix F. Frictional impacts", "F. …", "9.5a …"
+        num = re.match(r"^(?:Part\s+)?(?:Appendix\s+)?([0-9]+(?:\.[0-9]+)*[a-z]?|[A-Z])[.\s:]", text)
+        current = num.group(1).rstrip(".") if num else None
+        if current:
+            numbers.add(current)
     return slugs, numbers
 
 
@@ -108,28 +114,34 @@ def main():
         "MODELS": ROOT / "docs/MODELS.md",
     }
     # A book's own sections are cited with the book: "Stronge §4.3", "Impact Mechanics, §4.3",
-    # "*Numerical Recipes* §11.5" (EXTERNAL); `§N` is a placeholder in prose about the references.
-    ref = re.compile(r"(?:(DESIGN|DEVICES|MODELS|paper|Paper|PAPER|STYLE|EXTERNAL)\s+)?§\s?([0-9]+(?:\.[0-9]+)*|[A-F]\b)")
-    external = re.compile(r"(Stronge|Impact Mechanics\*?,?( 2000,)?|Numerical Recipes\*?|Brogliato|Glocker)\s*$")
+    # "*Numerical Recipes* §11.5"; `§N` is a placeholder in prose about the references.
+    ref = re.compile(r"§\s?([0-9]+(?:\.[0-9]+)*[a-z]?|[A-F]\b)")
+    external = re.compile(r"(Stronge|Impact Mechanics\*?,?( 2000,)?|Numerical Recipes\*?|Brogliato|Glocker|paper|Paper|PAPER|STYLE(\.md)?)\s*$")
+    # Which document a reference means: the nearest name before it on the line ("DESIGN §1",
+    # "docs/DEVICES.md §1.3", "[DEVICES.md](DEVICES.md) §6"), else the file's own kind (a bare § in
+    # DEVICES.md is DEVICES.md's own), else MODELS.
+    names = re.compile(r"(DESIGN|ARCHITECTURE(?:\.md)?|DEVICES(?:\.md)?|MODELS(?:\.md)?)(?:\]\([^)]*\))?\s*$")
+    kinds = {"DESIGN": "DESIGN", "ARCHITECTURE": "DESIGN", "DEVICES": "DEVICES", "MODELS": "MODELS"}
     sources = tracked((".rs", ".md", ".toml", ".py", ".pyi", ".js", ".html", ".c", ".h", ".sh"))
     count = 0
     for f in sources:
         text = f.read_text(encoding="utf-8", errors="replace")
+        own = {"DEVICES.md": "DEVICES"}.get(f.name, "MODELS")
         for i, line in enumerate(text.split("\n"), 1):
             for m in ref.finditer(line):
-                kind, num = m.group(1) or "", m.group(2)
-                if kind.lower() in ("paper", "style", "external") or external.search(line[: m.start()]):
+                num = m.group(1)
+                before = line[: m.start()]
+                if external.search(before):
                     continue
-                doc = docs[kind or "MODELS"]
+                named = names.search(before)
+                kind = kinds[named.group(1).split(".")[0]] if named else own
+                doc = docs[kind]
                 count += 1
                 if not doc.exists():
                     problems.append(f"{f.relative_to(ROOT)}:{i}: `{kind} §{num}` points at {doc.relative_to(ROOT)}, which does not exist")
                     continue
-                numbers = heads(doc)[1]
-                # A reference resolves to its own section or, failing that, to the nearest enclosing one
-                # that exists (§6.7.2 → 6.7 when 6.7 has no numbered subsections).
-                if num not in numbers:
-                    problems.append(f"{f.relative_to(ROOT)}:{i}: `{(kind + ' ') if kind else ''}§{num}`: no section {num} in {doc.relative_to(ROOT)}")
+                if num not in heads(doc)[1]:
+                    problems.append(f"{f.relative_to(ROOT)}:{i}: `{kind} §{num}`: no section {num} in {doc.relative_to(ROOT)}")
     if verbose:
         print(f"check_refs: {len(md_files)} Markdown files, {count} section references")
     for p in problems:

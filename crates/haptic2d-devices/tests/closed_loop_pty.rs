@@ -8,9 +8,10 @@
 //! is at its half-length 0.02 m, so the handle, mapped to the world, should settle at
 //! `0.02 − F/K_r`.
 //!
-//! The board's firmware reports the offsets at setup wherever the handle is (docs/DEVICES.md
-//! §1.3.3): the 2DIY test homes at the workspace centre (its offsets are the centre's inverse
-//! kinematics, as with a homing jig there), the twin's shipped homing pose is the centre already.
+//! The board's firmware reports the offsets at setup wherever the handle is
+//! (docs/DEVICES.md §1.3.3): the 2DIY test homes at the workspace centre (its offsets are the
+//! centre's inverse kinematics, as with a homing jig there), the twin's shipped homing pose is the
+//! centre already.
 
 mod support;
 use support::*;
