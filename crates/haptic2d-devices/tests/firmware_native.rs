@@ -11,8 +11,7 @@ use std::process::{Child, Command, Stdio};
 use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
-use haptic2d_devices::haply::serial::open_port;
-use serialport::TTYPort;
+use haptic2d_devices::haply::serial::{open_port, BoardPort};
 
 /// How late past its time the native watchdog may act on a loaded machine (µs).
 const SCHEDULING_MARGIN_US: u64 = 30_000;
@@ -109,7 +108,7 @@ impl Firmware {
         Self { child, pty, log }
     }
 
-    fn port(&self) -> TTYPort {
+    fn port(&self) -> BoardPort {
         open_port(&self.pty).unwrap()
     }
 
@@ -238,7 +237,7 @@ impl MotorLog {
 }
 
 /// Reads exactly `n` bytes, or what came within `limit`.
-fn read_n(port: &mut TTYPort, n: usize, limit: Duration) -> Vec<u8> {
+fn read_n(port: &mut BoardPort, n: usize, limit: Duration) -> Vec<u8> {
     let mut out = vec![0u8; n];
     let mut got = 0;
     let t0 = Instant::now();
@@ -255,11 +254,11 @@ fn read_n(port: &mut TTYPort, n: usize, limit: Duration) -> Vec<u8> {
 }
 
 /// Bytes arriving within `limit` (for "no reply" checks).
-fn read_any(port: &mut TTYPort, limit: Duration) -> Vec<u8> {
+fn read_any(port: &mut BoardPort, limit: Duration) -> Vec<u8> {
     read_n(port, 256, limit)
 }
 
-fn send(port: &mut TTYPort, bytes: &[u8]) {
+fn send(port: &mut BoardPort, bytes: &[u8]) {
     port.write_all(bytes).unwrap();
     port.flush().unwrap();
 }
@@ -337,7 +336,7 @@ fn identify_answers_h2df_version_1_its_ports_its_capabilities_and_the_20_ms_defa
 fn set_watchdog_takes_1_to_1000_ms_keeps_the_old_value_otherwise_and_answers_the_identity() {
     let fw = Firmware::start(Board::M3, "set-watchdog");
     let mut port = fw.port();
-    let set = |port: &mut TTYPort, ms: u16| {
+    let set = |port: &mut BoardPort, ms: u16| {
         let mut f = vec![0x04];
         f.extend_from_slice(&ms.to_le_bytes());
         send(port, &f);
@@ -478,7 +477,7 @@ fn a_new_setup_zeroes_the_motors() {
 
 /// Writes at about 1 kHz for `for_ms`, then stops; returns the log once the motors are zero
 /// (panics if they are not within `limit`) with the time from the last write to zero (µs).
-fn stop_writing_and_time_the_zero(fw: &Firmware, port: &mut TTYPort, for_ms: u64) -> u64 {
+fn stop_writing_and_time_the_zero(fw: &Firmware, port: &mut BoardPort, for_ms: u64) -> u64 {
     let t0 = Instant::now();
     while t0.elapsed() < Duration::from_millis(for_ms) {
         send(port, &write_frame(&[0.1, -0.1]));
@@ -605,7 +604,7 @@ fn encoder_motion_is_counted_from_the_setup_count_in_the_direction_the_setup_nam
     setup[7] = 0; // enc_dir of port 2: clockwise
     assert_eq!(&setup[3..8], &[1, 1, 0b11, 1, 0]);
     send(&mut port, &setup);
-    let angles = |port: &mut TTYPort| {
+    let angles = |port: &mut BoardPort| {
         send(port, &write_frame(&[0.0, 0.0]));
         let r = read_n(port, 9, WAIT);
         assert_eq!(r.len(), 9, "reply {r:?}");
