@@ -2,7 +2,7 @@
 //! the simulated twin pantograph, released 0.02 m from the left wall and pushed into it by a constant
 //! 2 N, 500 Hz, 10 s, one case per wall (SEH, ZOH, braking pulse, hysteretic). Each claim is carried
 //! by a named configuration on the spec's device, with its reason and `haptic2d stability`'s verdict
-//! ([`carrier`]): the hysteretic wall by the default, the pulse wall by the former default, SEH and
+//! (`carrier`): the hysteretic wall by the default, the pulse wall by the former default, SEH and
 //! ZOH by the §11.1 table (unstable released there, refused on a real device). Comparison runs: every
 //! other configuration on every wall, the §11.1 table on a device damped at twice Colgate's bound and
 //! the virtual coupling. A sweep of the device damping under the §11.1 table

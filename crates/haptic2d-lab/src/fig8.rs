@@ -3,7 +3,7 @@
 //! simulated twin pantograph at 1 kHz with mapping scale 2; the hand grips the handle for 1 s, then
 //! lets go and `F_pk (1 − cos 2πt)/2` with `F_pk = 2.1 N` (world) pushes the handle along x; y and θ
 //! are free. The claims are carried by the default controller (`C6 = −1`, `C5 = 2`, damping
-//! injection; [`carrier`] gives the reason the report prints beside `haptic2d stability`'s verdict);
+//! injection; `carrier` gives the reason the report prints beside `haptic2d stability`'s verdict);
 //! comparison runs: the virtual coupling (§11.2), the §11.1 table (unstable with the hand released,
 //! §11.4), and the default at the paper's setting (500 Hz, mapping scale 1), a named variant.
 //!
