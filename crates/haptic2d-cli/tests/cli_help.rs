@@ -59,3 +59,29 @@ fn an_unknown_option_before_help_is_refused() {
     let o = haptic2d(&["run", "--headles", "--help"]);
     assert!(!o.status.success(), "{}", text(&o));
 }
+
+/// Every other help screen fits in the same width (the top level carries the exit codes).
+#[test]
+fn every_other_help_fits_in_100_columns() {
+    let screens: [&[&str]; 8] = [
+        &[],
+        &["check"],
+        &["sweep"],
+        &["scenes"],
+        &["devices"],
+        &["device", "check"],
+        &["log", "info"],
+        &["log", "convert"],
+    ];
+    for words in screens {
+        let mut args = words.to_vec();
+        args.push("--help");
+        let o = haptic2d(&args);
+        let help = text(&o);
+        assert!(o.status.success(), "{args:?}:\n{help}");
+        for line in help.lines() {
+            let n = line.chars().count();
+            assert!(n <= MAX_COLUMNS, "{args:?}: line of {n} columns: {line}");
+        }
+    }
+}
