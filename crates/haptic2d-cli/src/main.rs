@@ -198,12 +198,12 @@ const EMULATE_EXAMPLES: &[Example] = &[
         "haptic2d emulate haply --board m0 --hand constant:1,0,0 --duration 30",
     ),
     (
-        "An Inverse3 service on a free loopback port",
-        "haptic2d emulate inverse3 --bind 127.0.0.1:0",
+        "The twin-pantograph Haply rig (four motors on an M3 board)",
+        "haptic2d emulate haply --device-file devices/haply-twin.toml",
     ),
     (
-        "An Inverse3 with a VerseGrip turning at 0.5 rad/s",
-        "haptic2d emulate inverse3 --grip-rate 0.5",
+        "An Inverse3 service on a free loopback port (a build with --features inverse3)",
+        "haptic2d emulate inverse3 --bind 127.0.0.1:0",
     ),
 ];
 
@@ -222,7 +222,7 @@ const LOG_EXAMPLES: &[Example] = &[
     ),
     (
         "A CSV tick log to MCAP",
-        "haptic2d log convert run.csv run.mcap",
+        "haptic2d log convert ticks.csv ticks.mcap",
     ),
 ];
 
