@@ -55,8 +55,8 @@ Exit codes:
   5    energy excess above the §13.1 bound (simulate --strict; always a warning otherwise)
   6    the simulation diverged (simulate)
   130  interrupted by SIGINT or SIGTERM (run, simulate; summary printed, logs end on a whole row)
-  141  (shell status) ended by SIGPIPE: the reader of the output closed it, e.g. `| head -1` (run: after
-       zeroing the torques and finishing its log; simulate --out: after finishing the file)";
+  141  (shell status) ended by SIGPIPE: the reader of the output closed it, e.g. `| head -1`
+       (run: after zeroing the torques and ending its log; simulate --out: after ending the file)";
 
 /// A command that could not run: the status to exit with and the message to print.
 #[derive(Clone, Debug, PartialEq, Eq)]

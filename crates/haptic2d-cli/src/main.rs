@@ -42,6 +42,7 @@ use std::process::ExitCode;
     version,
     about = "Haptic rendering of planar rigid-body motion: a passive planar world, contact and friction models, and a simulated twin-pantograph haptic device.",
     long_about = None,
+    max_term_width = 100,
     after_help = exit::EXIT_CODES_HELP
 )]
 struct Cli {
@@ -53,8 +54,10 @@ struct Cli {
 enum Command {
     /// Run the haptic loop: device, controller and world at the control rate (default: box-in-walls,
     /// simulated device, four-channel controller, 1000 Hz); prints a timing summary at exit.
+    #[command(after_help = examples_help(RUN_EXAMPLES))]
     Run(cmd_run::RunArgs),
     /// Simulate a scene's world alone (no device), headless and as fast as possible, writing a CSV.
+    #[command(after_help = examples_help(SIMULATE_EXAMPLES))]
     Simulate {
         /// A scene file path, or a built-in scene name (see `haptic2d scenes`).
         scene: String,
@@ -79,6 +82,7 @@ enum Command {
     Scenes,
     /// A stand-in device on a pseudo-terminal, speaking the real protocol: `emulate haply` (first
     /// stdout line `pty: PATH`; then `run --device haply:PATH`).
+    #[command(after_help = examples_help(EMULATE_EXAMPLES))]
     Emulate(cmd_emulate::EmulateArgs),
     /// List the serial ports with their USB ids (Haply boards marked).
     Devices,
@@ -98,6 +102,7 @@ enum Command {
     },
     /// Reproduce the paper's figures (Fig. 4 walls, Figs. 5–6 walls with the device, Fig. 7 peg in
     /// hole, Figs. 8–11 peg with the device) as CSV data, SVG/PNG plots, metrics.json and REPORT.md.
+    #[command(after_help = examples_help(REPRODUCE_EXAMPLES))]
     Reproduce {
         /// Which figure: all, fig4, fig5, fig7 or fig8.
         #[arg(default_value = "all")]
@@ -115,10 +120,11 @@ enum Command {
     },
     /// The loop's stability per axis with the hand held and released: right-most poles, sampled-data
     /// growth rate and a verdict, plus a plot of the poles against the hand's impedance.
+    #[command(after_help = examples_help(STABILITY_EXAMPLES))]
     Stability(cmd_stability::StabilityArgs),
     /// Logs: `log info FILE` (channels, counts, duration, timing summary), `log convert IN OUT`
     /// (tick logs between CSV and MCAP, by extension).
-    #[command(subcommand)]
+    #[command(subcommand, after_help = examples_help(LOG_EXAMPLES))]
     Log(cmd_log::LogCmd),
     /// Parameter sweeps; `walls`: stiffness × damping of every wall law, classified by energy gain.
     Sweep {
@@ -134,6 +140,130 @@ enum Command {
         #[arg(long, default_value = "reproduction/sweep-walls")]
         out: PathBuf,
     },
+}
+
+/// An example of a subcommand's `--help`: what it does, and the command line (words split at
+/// spaces, no quoting; `cli_tests::every_example_parses` parses each one).
+type Example = (&'static str, &'static str);
+
+const RUN_EXAMPLES: &[Example] = &[
+    (
+        "Headless for 10 s, every tick logged to MCAP",
+        "haptic2d run --headless --duration 10 --log run.mcap",
+    ),
+    (
+        "A Haply 2DIY on a serial port, with its device file",
+        "haptic2d run --device haply:/dev/ttyACM0 --device-file devices/haply-2diy-gen3.toml",
+    ),
+    (
+        "Peg in hole with the paper's controller, display on http://127.0.0.1:8080/",
+        "haptic2d run peg-in-hole --controller-file controllers/paper-4ch.toml",
+    ),
+    (
+        "A scripted hand push on the simulated device, 5 s, CSV log",
+        "haptic2d run --headless --duration 5 --hand script:0.6,-2,0,0,1 --log run.csv",
+    ),
+    (
+        "Live view in Foxglove (ws://127.0.0.1:8765), normal scheduling",
+        "haptic2d run --foxglove --no-rt",
+    ),
+];
+
+const SIMULATE_EXAMPLES: &[Example] = &[
+    (
+        "100 boxes for 5 s, every sample to CSV",
+        "haptic2d simulate pile:100 --duration 5 --out pile.csv",
+    ),
+    (
+        "The peg scene to MCAP (open in Foxglove)",
+        "haptic2d simulate peg-in-hole --duration 3 --out peg.mcap",
+    ),
+    (
+        "A scene file at 2 kHz, every 10th sample kept",
+        "haptic2d simulate scenes/box-in-walls.toml --rate 2000 --every 10 --out box.csv",
+    ),
+    (
+        "Exit with status 5 on an energy excess",
+        "haptic2d simulate box-in-walls --strict",
+    ),
+];
+
+const EMULATE_EXAMPLES: &[Example] = &[
+    (
+        "A Haply 2DIY gen3 on a pseudo-terminal (then `run --device haply:PATH`)",
+        "haptic2d emulate haply --device-file devices/haply-2diy-gen3.toml",
+    ),
+    (
+        "A 2-port M0 board, a hand pushing 1 N along x, for 30 s",
+        "haptic2d emulate haply --board m0 --hand constant:1,0,0 --duration 30",
+    ),
+    (
+        "The twin-pantograph Haply rig (four motors on an M3 board)",
+        "haptic2d emulate haply --device-file devices/haply-twin.toml",
+    ),
+    (
+        "An Inverse3 service on a free loopback port (a build with --features inverse3)",
+        "haptic2d emulate inverse3 --bind 127.0.0.1:0",
+    ),
+];
+
+const LOG_EXAMPLES: &[Example] = &[
+    (
+        "Channels, counts, duration and timing of a run's log",
+        "haptic2d log info run.mcap",
+    ),
+    (
+        "Rows and columns of a CSV tick log",
+        "haptic2d log info run.csv",
+    ),
+    (
+        "An MCAP tick log to CSV",
+        "haptic2d log convert run.mcap run.csv",
+    ),
+    (
+        "A CSV tick log to MCAP",
+        "haptic2d log convert ticks.csv ticks.mcap",
+    ),
+];
+
+const REPRODUCE_EXAMPLES: &[Example] = &[
+    (
+        "Every figure; exit with an error if a claim is not reproduced",
+        "haptic2d reproduce all --strict",
+    ),
+    (
+        "Fig. 4 (walls) into a folder of its own",
+        "haptic2d reproduce fig4 --out repro-fig4",
+    ),
+    (
+        "Figs. 8–11 with the paper's controller",
+        "haptic2d reproduce fig8 --controller-file controllers/paper-4ch.toml",
+    ),
+];
+
+const STABILITY_EXAMPLES: &[Example] = &[
+    (
+        "The paper's controller on the default scene",
+        "haptic2d stability --controller-file controllers/paper-4ch.toml",
+    ),
+    (
+        "A Haply 2DIY's axes with the coupling controller",
+        "haptic2d stability --controller coupling --device-file devices/haply-2diy-gen3.toml",
+    ),
+    (
+        "Figs. 8–11's mapping (scale 2) at 2 kHz, no extra delay",
+        "haptic2d stability peg-in-hole --scale 2 --rate 2000 --delay 0 --out stability-peg",
+    ),
+];
+
+/// The `Examples:` block after a subcommand's help: each example's description as a `#` comment,
+/// then its command line.
+fn examples_help(examples: &[Example]) -> String {
+    let mut s = String::from("Examples:");
+    for (what, line) in examples {
+        s.push_str(&format!("\n  # {what}\n  {line}"));
+    }
+    s
 }
 
 fn main() -> ExitCode {
@@ -197,5 +327,44 @@ fn main() -> ExitCode {
             eprintln!("error: {}", f.message.trim_end());
             f.status.into()
         }
+    }
+}
+
+#[cfg(test)]
+mod cli_tests {
+    use super::*;
+
+    /// Every example in a `--help` is accepted by the parser, as the subcommand it documents.
+    #[test]
+    fn every_example_parses() {
+        let lists: [(&str, &[Example]); 6] = [
+            ("run", RUN_EXAMPLES),
+            ("simulate", SIMULATE_EXAMPLES),
+            ("emulate", EMULATE_EXAMPLES),
+            ("log", LOG_EXAMPLES),
+            ("reproduce", REPRODUCE_EXAMPLES),
+            ("stability", STABILITY_EXAMPLES),
+        ];
+        for (cmd, examples) in lists {
+            assert!(
+                (3..=5).contains(&examples.len()),
+                "{cmd}: {} examples",
+                examples.len()
+            );
+            for (_, line) in examples {
+                let words: Vec<&str> = line.split_whitespace().collect();
+                assert_eq!(&words[..2], ["haptic2d", cmd], "{line}");
+                if let Err(e) = Cli::try_parse_from(&words) {
+                    panic!("{line}: {e}");
+                }
+            }
+        }
+    }
+
+    /// A wrong option in an example would be caught (the check above can fail).
+    #[test]
+    fn a_misspelt_example_is_refused() {
+        assert!(Cli::try_parse_from(["haptic2d", "run", "--headles"]).is_err());
+        assert!(Cli::try_parse_from(["haptic2d", "log", "info"]).is_err());
     }
 }

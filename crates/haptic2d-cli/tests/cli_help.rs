@@ -1,0 +1,87 @@
+//! Issue 39, item 7: every main command's `--help` ends with working examples and fits in 100
+//! columns. (`cli_tests::every_example_parses` in main.rs parses each example with the real
+//! parser; here each example printed in the help is run with `--help` appended, which clap refuses
+//! when an option before it is unknown or its value does not parse.)
+
+mod common;
+
+use common::{haptic2d, text};
+
+/// The longest help line allowed (characters).
+const MAX_COLUMNS: usize = 100;
+
+#[test]
+fn every_command_help_has_examples_that_parse() {
+    for cmd in [
+        "run",
+        "simulate",
+        "emulate",
+        "log",
+        "reproduce",
+        "stability",
+    ] {
+        let o = haptic2d(&[cmd, "--help"]);
+        let help = text(&o);
+        assert!(o.status.success(), "{cmd} --help:\n{help}");
+        for line in help.lines() {
+            let n = line.chars().count();
+            assert!(
+                n <= MAX_COLUMNS,
+                "{cmd} --help: line of {n} columns: {line}"
+            );
+        }
+        let (_, examples) = help
+            .split_once("\nExamples:\n")
+            .unwrap_or_else(|| panic!("{cmd} --help has no Examples: block:\n{help}"));
+        let lines: Vec<&str> = examples
+            .lines()
+            .map(str::trim)
+            .filter(|l| l.starts_with("haptic2d "))
+            .collect();
+        assert!(
+            (3..=5).contains(&lines.len()),
+            "{cmd}: {} examples in:\n{examples}",
+            lines.len()
+        );
+        for line in lines {
+            let mut args: Vec<&str> = line.split_whitespace().skip(1).collect();
+            assert_eq!(args[0], cmd, "{line}");
+            args.push("--help");
+            let o = haptic2d(&args);
+            assert!(o.status.success(), "{line} --help:\n{}", text(&o));
+        }
+    }
+}
+
+/// The check above can fail: an unknown option before `--help` is refused.
+#[test]
+fn an_unknown_option_before_help_is_refused() {
+    let o = haptic2d(&["run", "--headles", "--help"]);
+    assert!(!o.status.success(), "{}", text(&o));
+}
+
+/// Every other help screen fits in the same width (the top level carries the exit codes).
+#[test]
+fn every_other_help_fits_in_100_columns() {
+    let screens: [&[&str]; 8] = [
+        &[],
+        &["check"],
+        &["sweep"],
+        &["scenes"],
+        &["devices"],
+        &["device", "check"],
+        &["log", "info"],
+        &["log", "convert"],
+    ];
+    for words in screens {
+        let mut args = words.to_vec();
+        args.push("--help");
+        let o = haptic2d(&args);
+        let help = text(&o);
+        assert!(o.status.success(), "{args:?}:\n{help}");
+        for line in help.lines() {
+            let n = line.chars().count();
+            assert!(n <= MAX_COLUMNS, "{args:?}: line of {n} columns: {line}");
+        }
+    }
+}
