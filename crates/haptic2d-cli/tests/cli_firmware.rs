@@ -165,7 +165,7 @@ fn kill_9_of_run_against_our_firmware_zeroes_the_motors_within_the_watchdog_time
 
     let file = patient_device_file(
         "haply-2diy-gen3.toml",
-        ("3", "1000"),
+        ("20", "1000"),
         "firmware",
         "gen3.toml",
     );

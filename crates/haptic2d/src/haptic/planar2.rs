@@ -335,7 +335,7 @@ impl Planar2System {
 
         // 8b. Workspace bound of the device file at the handle point (device frame; the device →
         //     world map is a translation, so velocity and force are the same in both).
-        if let (Some(s), Some(w)) = (st, self.workspace.as_ref()) {
+        if let (Some(s), Some(w)) = (st, self.workspace.as_mut()) {
             let x = [s.e.x, s.e.y, 0.0];
             if let Some(reason) = w.apply(&x, &v_m, &mut f_cm) {
                 self.safety.trip(k, t, reason);

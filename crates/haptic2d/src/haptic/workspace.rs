@@ -111,6 +111,12 @@ pub struct WorkspaceBound {
     pub damping: f64,
     /// Trip distance past the edge (m).
     pub trip_distance: f64,
+    /// Whether the handle has been inside the square yet. A device starts where its user holds it:
+    /// a Haply board at its rest (calibration) pose, which can lie outside the square (a gen 3
+    /// 2DIY's is 34 mm below it), and the user then brings the handle in. Until the handle is first
+    /// inside, the bound neither pushes nor trips (the start-up ramp and the other trips hold as
+    /// always); from then on it does both.
+    pub armed: bool,
 }
 
 /// A handle past the trip distance.
@@ -138,6 +144,7 @@ impl WorkspaceBound {
             stiffness: s.wall_stiffness.min(2.0 * s.wall_damping / dt),
             damping: s.wall_damping,
             trip_distance: s.trip_distance,
+            armed: false,
         }
     }
 
@@ -174,8 +181,17 @@ impl WorkspaceBound {
     /// The bound applied to a device command: adds the wall wrench at handle pose `x` (m, device
     /// frame) and twist `v` to the command `f` (N, device frame), and returns the trip reason when
     /// the handle is past the trip distance. The one place both systems' ticks call. Never allocates.
+    ///
+    /// The bound arms the first time the handle is inside the square ([`Self::armed`]).
     #[inline]
-    pub fn apply(&self, x: &V3, v: &V3, f: &mut V3) -> Option<SafetyReason> {
+    pub fn apply(&mut self, x: &V3, v: &V3, f: &mut V3) -> Option<SafetyReason> {
+        if !self.armed {
+            let inside = (0..2).all(|a| (x[a] - self.centre[a]).abs() <= self.half_width);
+            if !inside {
+                return None;
+            }
+            self.armed = true;
+        }
         let (wall, excursion) = self.wrench(x, v);
         f[0] += wall[0];
         f[1] += wall[1];
@@ -185,5 +201,39 @@ impl WorkspaceBound {
             edge: e.edge,
             trip: self.trip_distance,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A Haply board starts at its rest pose, which can lie outside the square (a gen 3 2DIY's is
+    /// 34 mm below it): the bound must neither push nor trip there, and must do both once the user
+    /// has brought the handle inside (found when the rest-pose start-up met the 2-DOF bound).
+    #[test]
+    fn a_handle_starting_outside_the_square_arms_the_bound_when_it_first_enters() {
+        let square = WorkspaceSquare::around([0.019, 0.100], 0.03);
+        let mut b = WorkspaceBound::of_square(&square, 1e-3);
+        let v = [0.0; 3];
+        let rest = [0.019, 0.0357, 0.0]; // 34.3 mm below the edge: past the 10 mm trip distance
+        let mut f = [0.0; 3];
+        assert_eq!(b.apply(&rest, &v, &mut f), None);
+        assert_eq!(
+            f, [0.0; 3],
+            "no wall force before the handle has been inside"
+        );
+        assert!(!b.armed);
+        // Brought in: armed, no force inside.
+        assert_eq!(b.apply(&[0.019, 0.100, 0.0], &v, &mut f), None);
+        assert!(b.armed);
+        assert_eq!(f, [0.0; 3]);
+        // Now 5 mm past the lower edge: the wall pushes back (+y); 34 mm past: the trip.
+        assert_eq!(b.apply(&[0.019, 0.065, 0.0], &v, &mut f), None);
+        assert!(f[1] > 0.0, "{f:?}");
+        assert!(matches!(
+            b.apply(&rest, &v, &mut [0.0; 3]),
+            Some(SafetyReason::Workspace { axis: 1, .. })
+        ));
     }
 }
