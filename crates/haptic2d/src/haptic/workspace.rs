@@ -111,11 +111,12 @@ pub struct WorkspaceBound {
     pub damping: f64,
     /// Trip distance past the edge (m).
     pub trip_distance: f64,
-    /// Whether the handle has been inside the square yet. A device starts where its user holds it:
-    /// a Haply board at its rest (calibration) pose, which can lie outside the square (a gen 3
-    /// 2DIY's is 34 mm below it), and the user then brings the handle in. Until the handle is first
-    /// inside, the bound neither pushes nor trips (the start-up ramp and the other trips hold as
-    /// always); from then on it does both.
+    /// Whether the bound acts. A 2-DOF device starts where its user holds it: a Haply 2DIY at its
+    /// rest (calibration) pose, which can lie outside the square (a gen 3 2DIY's is 34 mm below
+    /// it), and the user then brings the handle in. Its bound ([`Self::of_square`]) starts unarmed
+    /// and arms when the handle is first inside; until then it neither pushes nor trips (the
+    /// start-up ramp and the other trips hold as always). The twin's ([`Self::new`]) is armed from
+    /// the start.
     pub armed: bool,
 }
 
@@ -131,12 +132,17 @@ pub struct WorkspaceExcursion {
 }
 
 impl WorkspaceBound {
-    /// The bound of device `p` at period `dt` (s).
+    /// The bound of the twin-pantograph device `p` at period `dt` (s), armed from the first tick: the
+    /// twin starts at its homing pose, the centre of its square (simulated or on Haply boards), so a
+    /// twin handle outside its square is a fault and trips at once.
     pub fn new(p: &DeviceParams, dt: f64) -> Self {
-        Self::of_square(&WorkspaceSquare::of_device(p), dt)
+        let mut b = Self::of_square(&WorkspaceSquare::of_device(p), dt);
+        b.armed = true;
+        b
     }
 
-    /// The bound of square `s` at period `dt` (s).
+    /// The bound of square `s` at period `dt` (s), not yet armed: it arms when the handle is first
+    /// inside the square ([`Self::armed`]; a 2-DOF device, e.g. a 2DIY starting at its rest pose).
     pub fn of_square(s: &WorkspaceSquare, dt: f64) -> Self {
         Self {
             centre: s.centre,
