@@ -4,6 +4,7 @@
 //! The format is documented in `docs/SCENES.md`; built-in scenes live in `scenes/` and are embedded in
 //! the binary.
 
+mod body_table;
 pub mod bounds;
 mod build;
 mod builtin;
@@ -11,7 +12,9 @@ mod device;
 mod error;
 mod file;
 mod laws;
+mod load_table;
 pub mod overlap;
+mod world_table;
 
 pub use bounds::{divergence, Divergence, MAX_BODIES, MAX_FILE_BYTES, MAX_RATE_HZ, MAX_SAMPLES};
 pub use build::{spring_stop_speed, Scene, PULSE_NOT_PASSIVE_2D};
