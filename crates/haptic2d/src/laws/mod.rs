@@ -5,4 +5,5 @@
 
 pub mod friction;
 pub mod normal;
+pub mod params;
 mod stiffness;

@@ -12,6 +12,14 @@
 
 use super::{FrictionInput, FrictionLaw, FrictionMode};
 
+crate::law_params! { FingerPad, "friction model 'nahvi'";
+    k_p0 (self.k_p0) [] "N/m" Positive "pad stiffness at zero load",
+    k_p1 (self.k_p1) [] "1/m" NonNegative "load stiffening",
+    b_pad (self.b_pad) [] "N·s/m" NonNegative "pad damping",
+    mu_s (self.mu_s) [] "" Positive "static friction coefficient (≥ mu_k)",
+    mu_k (self.mu_k) [] "" Positive "kinetic friction coefficient",
+}
+
 /// Nahvi finger-pad friction (§3). Parameters are public; the state (`s_a`, mode) is private.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FingerPad {
@@ -73,54 +81,19 @@ impl FingerPad {
     }
     /// Checks the parameters; the error names the offending one.
     pub fn validate(&self) -> Result<(), String> {
-        if !(self.k_p0.is_finite() && self.k_p0 > 0.0) {
+        crate::laws::params::validate(self)?;
+        if self.mu_s < self.mu_k {
             return Err(format!(
-                "k_p0 must be a positive stiffness in N/m, got {}",
-                self.k_p0
-            ));
-        }
-        if !(self.k_p1.is_finite() && self.k_p1 >= 0.0) {
-            return Err(format!(
-                "k_p1 must be a non-negative load stiffening in 1/m, got {}",
-                self.k_p1
-            ));
-        }
-        if !(self.b_pad.is_finite() && self.b_pad >= 0.0) {
-            return Err(format!(
-                "b_pad must be a non-negative damping in N·s/m, got {}",
-                self.b_pad
-            ));
-        }
-        if !(self.mu_k.is_finite() && self.mu_k > 0.0) {
-            return Err(format!("mu_k must be positive, got {}", self.mu_k));
-        }
-        if !(self.mu_s.is_finite() && self.mu_s >= self.mu_k) {
-            return Err(format!(
-                "mu_s must be at least mu_k (static ≥ kinetic), got mu_s = {} < mu_k = {}",
+                "friction model 'nahvi': mu_s must be at least mu_k (static ≥ kinetic), got mu_s = {} < mu_k = {}",
                 self.mu_s, self.mu_k
             ));
         }
         Ok(())
     }
-    /// The parameter keys accepted by [`FingerPad::set_param`].
-    pub const KEYS: &'static [&'static str] = &["k_p0", "k_p1", "b_pad", "mu_s", "mu_k"];
-    /// Sets one parameter by its scene-file key (see [`FingerPad::KEYS`]); the error lists the valid keys.
-    /// Ranges are checked by [`FingerPad::validate`].
+    /// Sets one parameter by its key ([`Self::SPECS`]); the error lists the valid keys. Ranges are
+    /// checked by `validate`.
     pub fn set_param(&mut self, key: &str, value: f64) -> Result<(), String> {
-        match key {
-            "k_p0" => self.k_p0 = value,
-            "k_p1" => self.k_p1 = value,
-            "b_pad" => self.b_pad = value,
-            "mu_s" => self.mu_s = value,
-            "mu_k" => self.mu_k = value,
-            _ => {
-                return Err(format!(
-                    "unknown parameter '{key}' for friction model 'nahvi'; valid keys: {}",
-                    Self::KEYS.join(", ")
-                ))
-            }
-        }
-        Ok(())
+        crate::laws::params::set(self, key, value)
     }
 }
 

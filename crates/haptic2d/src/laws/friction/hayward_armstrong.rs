@@ -14,6 +14,14 @@
 
 use super::{FrictionInput, FrictionLaw, FrictionMode};
 
+crate::law_params! { @impl HaywardArmstrong, |s: &HaywardArmstrong| if s.is_dahl() { "friction model 'dahl'" } else { "friction model 'hayward-armstrong'" };
+    k (self.k) [] "N/m" Positive "bristle stiffness",
+    mu_k (self.mu_k) [] "" Positive "kinetic friction coefficient",
+    r_stick (self.r_stick) [] "" OpenUnit "stick fraction of the breakaway strain",
+    sigma1 (self.sigma1) [] "N·s/m" NonNegative "bristle damping",
+    sigma2 (self.sigma2) [] "N·s/m" NonNegative "viscous friction"
+}
+
 /// Which adhesion map the model uses.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum AdhesionMap {
@@ -119,59 +127,13 @@ impl HaywardArmstrong {
     }
     /// Checks the parameters; the error names the offending one.
     pub fn validate(&self) -> Result<(), String> {
-        if !(self.k.is_finite() && self.k > 0.0) {
-            return Err(format!(
-                "k must be a positive stiffness in N/m, got {}",
-                self.k
-            ));
-        }
-        if !(self.mu_k.is_finite() && self.mu_k > 0.0) {
-            return Err(format!("mu_k must be positive, got {}", self.mu_k));
-        }
-        if !(self.r_stick.is_finite() && self.r_stick > 0.0 && self.r_stick < 1.0) {
-            return Err(format!(
-                "r_stick must lie strictly between 0 and 1, got {}",
-                self.r_stick
-            ));
-        }
-        if !(self.sigma1.is_finite() && self.sigma1 >= 0.0) {
-            return Err(format!(
-                "sigma1 must be a non-negative damping in N·s/m, got {}",
-                self.sigma1
-            ));
-        }
-        if !(self.sigma2.is_finite() && self.sigma2 >= 0.0) {
-            return Err(format!(
-                "sigma2 must be a non-negative damping in N·s/m, got {}",
-                self.sigma2
-            ));
-        }
+        crate::laws::params::validate(self)?;
         Ok(())
     }
-    /// The parameter keys accepted by [`HaywardArmstrong::set_param`].
-    pub const KEYS: &'static [&'static str] = &["k", "mu_k", "r_stick", "sigma1", "sigma2"];
-    /// Sets one parameter by its scene-file key (see [`HaywardArmstrong::KEYS`]); the error lists the
-    /// valid keys. Ranges are checked by [`HaywardArmstrong::validate`].
+    /// Sets one parameter by its key ([`Self::SPECS`]); the error lists the valid keys. Ranges are
+    /// checked by `validate`.
     pub fn set_param(&mut self, key: &str, value: f64) -> Result<(), String> {
-        match key {
-            "k" => self.k = value,
-            "mu_k" => self.mu_k = value,
-            "r_stick" => self.r_stick = value,
-            "sigma1" => self.sigma1 = value,
-            "sigma2" => self.sigma2 = value,
-            _ => {
-                return Err(format!(
-                    "unknown parameter '{key}' for friction model '{}'; valid keys: {}",
-                    if self.is_dahl() {
-                        "dahl"
-                    } else {
-                        "hayward-armstrong"
-                    },
-                    Self::KEYS.join(", ")
-                ))
-            }
-        }
-        Ok(())
+        crate::laws::params::set(self, key, value)
     }
 }
 

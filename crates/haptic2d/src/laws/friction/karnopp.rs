@@ -7,6 +7,12 @@
 
 use super::{FrictionInput, FrictionLaw, FrictionMode};
 
+crate::law_params! { Karnopp, "friction model 'classical'";
+    v_th (self.v_th) [] "m/s" Positive "stick velocity band",
+    mu_s (self.mu_s) [] "" Positive "static friction coefficient (≥ mu_k)",
+    mu_k (self.mu_k) [] "" Positive "kinetic friction coefficient",
+}
+
 /// Karnopp's classical stick/slip model (§4.1). Stateless apart from the logged mode.
 ///
 /// Needs [`FrictionInput::f_ext_t`]: this contact's share `(t·F_A^nonfric)/n_t` of the non-friction
@@ -44,40 +50,19 @@ impl Karnopp {
     }
     /// Checks the parameters; the error names the offending one.
     pub fn validate(&self) -> Result<(), String> {
-        if !(self.v_th.is_finite() && self.v_th > 0.0) {
+        crate::laws::params::validate(self)?;
+        if self.mu_s < self.mu_k {
             return Err(format!(
-                "v_th must be a positive velocity band in m/s, got {}",
-                self.v_th
-            ));
-        }
-        if !(self.mu_k.is_finite() && self.mu_k > 0.0) {
-            return Err(format!("mu_k must be positive, got {}", self.mu_k));
-        }
-        if !(self.mu_s.is_finite() && self.mu_s >= self.mu_k) {
-            return Err(format!(
-                "mu_s must be at least mu_k (static ≥ kinetic), got mu_s = {} < mu_k = {}",
+                "friction model 'classical': mu_s must be at least mu_k (static ≥ kinetic), got mu_s = {} < mu_k = {}",
                 self.mu_s, self.mu_k
             ));
         }
         Ok(())
     }
-    /// The parameter keys accepted by [`Karnopp::set_param`].
-    pub const KEYS: &'static [&'static str] = &["v_th", "mu_s", "mu_k"];
-    /// Sets one parameter by its scene-file key (see [`Karnopp::KEYS`]); the error lists the valid keys.
-    /// Ranges are checked by [`Karnopp::validate`].
+    /// Sets one parameter by its key ([`Self::SPECS`]); the error lists the valid keys. Ranges are
+    /// checked by `validate`.
     pub fn set_param(&mut self, key: &str, value: f64) -> Result<(), String> {
-        match key {
-            "v_th" => self.v_th = value,
-            "mu_s" => self.mu_s = value,
-            "mu_k" => self.mu_k = value,
-            _ => {
-                return Err(format!(
-                    "unknown parameter '{key}' for friction model 'classical'; valid keys: {}",
-                    Self::KEYS.join(", ")
-                ))
-            }
-        }
-        Ok(())
+        crate::laws::params::set(self, key, value)
     }
 }
 

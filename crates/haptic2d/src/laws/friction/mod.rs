@@ -7,6 +7,7 @@ mod karnopp;
 mod reset_integrator;
 mod salcudean_vlaar;
 
+use crate::laws::params::{ParamSpec, Params, TableRow};
 pub use finger_pad::FingerPad;
 pub use hayward_armstrong::{AdhesionMap, HaywardArmstrong};
 pub use karnopp::Karnopp;
@@ -156,15 +157,15 @@ impl FrictionModel {
         })
     }
 
-    /// The parameter keys that [`FrictionModel::set_param`] accepts for this model.
-    pub fn param_keys(&self) -> &'static [&'static str] {
+    /// This model's parameters, declared once ([`crate::laws::params`]).
+    pub fn specs(&self) -> &'static [ParamSpec] {
         match self {
             FrictionModel::None => &[],
-            FrictionModel::ResetIntegrator(_) => ResetIntegrator::KEYS,
-            FrictionModel::HaywardArmstrong(_) => HaywardArmstrong::KEYS,
-            FrictionModel::FingerPad(_) => FingerPad::KEYS,
-            FrictionModel::Karnopp(_) => Karnopp::KEYS,
-            FrictionModel::SalcudeanVlaar(_) => SalcudeanVlaar::KEYS,
+            FrictionModel::ResetIntegrator(_) => ResetIntegrator::SPECS,
+            FrictionModel::HaywardArmstrong(_) => HaywardArmstrong::SPECS,
+            FrictionModel::FingerPad(_) => FingerPad::SPECS,
+            FrictionModel::Karnopp(_) => Karnopp::SPECS,
+            FrictionModel::SalcudeanVlaar(_) => SalcudeanVlaar::SPECS,
         }
     }
 
@@ -208,15 +209,14 @@ impl FrictionModel {
 
     /// Checks the parameters; the error names the model and the offending parameter.
     pub fn validate(&self) -> Result<(), String> {
-        let r = match self {
+        match self {
             FrictionModel::None => Ok(()),
             FrictionModel::ResetIntegrator(m) => m.validate(),
             FrictionModel::HaywardArmstrong(m) => m.validate(),
             FrictionModel::FingerPad(m) => m.validate(),
             FrictionModel::Karnopp(m) => m.validate(),
             FrictionModel::SalcudeanVlaar(m) => m.validate(),
-        };
-        r.map_err(|e| format!("friction model '{}': {e}", self.name()))
+        }
     }
 
     /// Whether the model reads [`FrictionInput::f_ext_t`] (only the classical model, §4.1); the world
@@ -266,4 +266,69 @@ impl FrictionLaw for FrictionModel {
     fn mode(&self) -> FrictionMode {
         dispatch!(self, m => m.mode(), none => FrictionMode::Slip)
     }
+}
+
+/// A stand-in for the frictionless row of the MODELS table: no parameters.
+struct Frictionless;
+
+impl Params for Frictionless {
+    fn law_name(&self) -> &'static str {
+        "friction model 'none'"
+    }
+    fn specs(&self) -> &'static [ParamSpec] {
+        &[]
+    }
+    fn get(&self, _key: &str) -> f64 {
+        f64::NAN
+    }
+    fn put(&mut self, _key: &str, _value: f64) {}
+}
+
+/// The rows of the friction-model table of docs/MODELS.md Part I, with their per-contact defaults.
+pub(crate) fn table_rows() -> Vec<TableRow> {
+    let row = |names, summary, law: Box<dyn Params>, extra_keys| TableRow {
+        names,
+        summary,
+        law,
+        extra_keys,
+    };
+    vec![
+        row(&["none"], "frictionless", Box::new(Frictionless), ""),
+        row(
+            &["reset-integrator"],
+            "Haessig–Friedland reset integrator (the paper's choice), §1",
+            Box::new(ResetIntegrator::per_contact()),
+            "`load_scaling` (`\"limit\"`, default, or `\"stiffness\"`: then `p0` is used)",
+        ),
+        row(
+            &["hayward-armstrong"],
+            "driftless Dahl (elasto-plastic), §2",
+            Box::new(HaywardArmstrong::per_contact()),
+            "",
+        ),
+        row(
+            &["dahl"],
+            "plain Dahl (α ≡ 1) for comparison, §2",
+            Box::new(HaywardArmstrong::per_contact().dahl()),
+            "",
+        ),
+        row(
+            &["nahvi"],
+            "finger-pad model, §3",
+            Box::new(FingerPad::per_contact()),
+            "",
+        ),
+        row(
+            &["classical"],
+            "Karnopp velocity threshold, §4.1",
+            Box::new(Karnopp::per_contact()),
+            "",
+        ),
+        row(
+            &["salcudean-vlaar"],
+            "modified Karnopp with PD stick, §4.2",
+            Box::new(SalcudeanVlaar::per_contact()),
+            "",
+        ),
+    ]
 }

@@ -2,6 +2,14 @@
 
 use super::{FrictionInput, FrictionLaw, FrictionMode};
 
+crate::law_params! { ResetIntegrator, "friction model 'reset-integrator'";
+    kr (self.kr) [] "N/m" Positive "stick stiffness Kr",
+    mu_s (self.mu_s) [] "" Positive "static friction coefficient (≥ mu_k)",
+    mu_k (self.mu_k) [] "" Positive "kinetic friction coefficient",
+    beta (self.beta) [] "N·s/m" NonNegative "stick damping β",
+    p0 (self.p0_fixed) [] "m" Positive "fixed strain limit (with load_scaling = \"stiffness\")",
+}
+
 /// How Coulomb proportionality to the normal load enters (§1, "Load dependence").
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum LoadScaling {
@@ -122,59 +130,20 @@ impl ResetIntegrator {
         let bits = |m: &Self| [m.kr, m.mu_s, m.mu_k, m.beta, m.p0_fixed].map(f64::to_bits);
         bits(self) == bits(other) && self.scaling == other.scaling
     }
-    /// The parameter keys accepted by [`ResetIntegrator::set_param`] (`p0` is the fixed strain limit of
-    /// [`LoadScaling::Stiffness`]).
-    pub const KEYS: &'static [&'static str] = &["kr", "mu_s", "mu_k", "beta", "p0"];
-    /// Sets one parameter by its scene-file key (see [`ResetIntegrator::KEYS`]); the error lists the valid
-    /// keys. Ranges are checked by [`ResetIntegrator::validate`].
+    /// Sets one parameter by its key ([`Self::SPECS`]); the error lists the valid keys. Ranges are
+    /// checked by `validate`.
     pub fn set_param(&mut self, key: &str, value: f64) -> Result<(), String> {
-        match key {
-            "kr" => {
-                self.kr = value;
-                self.k_used = value;
-            }
-            "mu_s" => self.mu_s = value,
-            "mu_k" => self.mu_k = value,
-            "beta" => self.beta = value,
-            "p0" => self.p0_fixed = value,
-            _ => {
-                return Err(format!(
-                "unknown parameter '{key}' for friction model 'reset-integrator'; valid keys: {}",
-                Self::KEYS.join(", ")
-            ))
-            }
-        }
+        crate::laws::params::set(self, key, value)?;
+        self.k_used = self.kr;
         Ok(())
     }
     /// Checks the parameters; the error names the offending one.
     pub fn validate(&self) -> Result<(), String> {
-        if !(self.kr > 0.0 && self.kr.is_finite()) {
+        crate::laws::params::validate(self)?;
+        if self.mu_s < self.mu_k {
             return Err(format!(
-                "kr must be a positive stiffness in N/m, got {}",
-                self.kr
-            ));
-        }
-        if !(self.mu_k > 0.0 && self.mu_k.is_finite()) {
-            return Err(format!("mu_k must be positive, got {}", self.mu_k));
-        }
-        if !(self.mu_s >= self.mu_k && self.mu_s.is_finite()) {
-            return Err(format!(
-                "mu_s must be at least mu_k (static ≥ kinetic), got mu_s = {} < mu_k = {}",
+                "friction model 'reset-integrator': mu_s must be at least mu_k (static ≥ kinetic), got mu_s = {} < mu_k = {}",
                 self.mu_s, self.mu_k
-            ));
-        }
-        if !(self.beta >= 0.0 && self.beta.is_finite()) {
-            return Err(format!(
-                "beta must be a non-negative damping in N·s/m, got {}",
-                self.beta
-            ));
-        }
-        if self.scaling == LoadScaling::Stiffness
-            && !(self.p0_fixed.is_finite() && self.p0_fixed > 0.0)
-        {
-            return Err(format!(
-                "p0 must be a positive strain limit in m, got {}",
-                self.p0_fixed
             ));
         }
         Ok(())

@@ -7,6 +7,15 @@
 
 use super::{FrictionInput, FrictionLaw, FrictionMode};
 
+crate::law_params! { SalcudeanVlaar, "friction model 'salcudean-vlaar'";
+    k_p (self.k_p) [] "N/m" Positive "stick PD stiffness",
+    k_d (self.k_d) [] "N·s/m" NonNegative "stick PD damping",
+    b_v (self.b_v) [] "N·s/m" NonNegative "viscous friction",
+    v_th (self.v_th) [] "m/s" Positive "stick velocity threshold",
+    mu_s (self.mu_s) [] "" Positive "static friction coefficient (≥ mu_k)",
+    mu_k (self.mu_k) [] "" Positive "kinetic friction coefficient",
+}
+
 /// Salcudean–Vlaar friction (§4.2). Parameters are public; the state (`s_a`, mode) is private.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SalcudeanVlaar {
@@ -59,61 +68,19 @@ impl SalcudeanVlaar {
     }
     /// Checks the parameters; the error names the offending one.
     pub fn validate(&self) -> Result<(), String> {
-        if !(self.k_p.is_finite() && self.k_p > 0.0) {
+        crate::laws::params::validate(self)?;
+        if self.mu_s < self.mu_k {
             return Err(format!(
-                "k_p must be a positive stiffness in N/m, got {}",
-                self.k_p
-            ));
-        }
-        if !(self.k_d.is_finite() && self.k_d >= 0.0) {
-            return Err(format!(
-                "k_d must be a non-negative damping in N·s/m, got {}",
-                self.k_d
-            ));
-        }
-        if !(self.b_v.is_finite() && self.b_v >= 0.0) {
-            return Err(format!(
-                "b_v must be a non-negative damping in N·s/m, got {}",
-                self.b_v
-            ));
-        }
-        if !(self.v_th.is_finite() && self.v_th > 0.0) {
-            return Err(format!(
-                "v_th must be a positive velocity threshold in m/s, got {}",
-                self.v_th
-            ));
-        }
-        if !(self.mu_k.is_finite() && self.mu_k > 0.0) {
-            return Err(format!("mu_k must be positive, got {}", self.mu_k));
-        }
-        if !(self.mu_s.is_finite() && self.mu_s >= self.mu_k) {
-            return Err(format!(
-                "mu_s must be at least mu_k (static ≥ kinetic), got mu_s = {} < mu_k = {}",
+                "friction model 'salcudean-vlaar': mu_s must be at least mu_k (static ≥ kinetic), got mu_s = {} < mu_k = {}",
                 self.mu_s, self.mu_k
             ));
         }
         Ok(())
     }
-    /// The parameter keys accepted by [`SalcudeanVlaar::set_param`].
-    pub const KEYS: &'static [&'static str] = &["k_p", "k_d", "b_v", "v_th", "mu_s", "mu_k"];
-    /// Sets one parameter by its scene-file key (see [`SalcudeanVlaar::KEYS`]); the error lists the valid
-    /// keys. Ranges are checked by [`SalcudeanVlaar::validate`].
+    /// Sets one parameter by its key ([`Self::SPECS`]); the error lists the valid keys. Ranges are
+    /// checked by `validate`.
     pub fn set_param(&mut self, key: &str, value: f64) -> Result<(), String> {
-        match key {
-            "k_p" => self.k_p = value,
-            "k_d" => self.k_d = value,
-            "b_v" => self.b_v = value,
-            "v_th" => self.v_th = value,
-            "mu_s" => self.mu_s = value,
-            "mu_k" => self.mu_k = value,
-            _ => {
-                return Err(format!(
-                "unknown parameter '{key}' for friction model 'salcudean-vlaar'; valid keys: {}",
-                Self::KEYS.join(", ")
-            ))
-            }
-        }
-        Ok(())
+        crate::laws::params::set(self, key, value)
     }
 }
 

@@ -1,6 +1,11 @@
 //! Colgate & Schenkel (1997) wall and passivity condition (§5.4).
 
-use super::{check_nonneg, NormalInput, NormalLaw};
+use super::{NormalInput, NormalLaw};
+
+crate::law_params! { ColgateLaw, "colgate";
+    k (self.k) [] "N/m" NonNegative "wall stiffness",
+    b (self.b) [] "N·s/m" Finite "virtual damping (may be negative: the condition uses |B|)",
+}
 
 /// Signed Colgate passivity margin `b − (K·T/2 + |B|)` (N·s/m): the sampled wall
 /// `F = K·δ_k + B·(δ_k − δ_{k−1})/T` on a device with physical damping `b` (N·s/m) at period `t` (s)
@@ -26,9 +31,6 @@ pub struct ColgateLaw {
 }
 
 impl ColgateLaw {
-    /// Valid parameter names for [`ColgateLaw::set_param`].
-    pub const PARAMS: &'static str = "k, b";
-
     /// A wall of stiffness `k` (N/m) and virtual damping `b` (N·s/m).
     pub fn new(k: f64, b: f64) -> Self {
         Self { k, b, stored: 0.0 }
@@ -43,23 +45,11 @@ impl ColgateLaw {
     }
     /// Checks the parameters; the error names the bad one. `B` may be negative (the condition uses `|B|`).
     pub fn validate(&self) -> Result<(), String> {
-        check_nonneg("colgate", "k", self.k)?;
-        if !self.b.is_finite() {
-            return Err(format!(
-                "colgate: parameter `b` must be finite, got {}",
-                self.b
-            ));
-        }
-        Ok(())
+        crate::laws::params::validate(self)
     }
-    /// Sets a parameter by name: `k` (N/m), `b` (N·s/m).
+    /// Sets a parameter by its key or an alias ([`Self::SPECS`]); ranges are checked by `validate`.
     pub fn set_param(&mut self, key: &str, value: f64) -> Result<(), String> {
-        match key {
-            "k" => self.k = value,
-            "b" => self.b = value,
-            _ => return Err(super::unknown_key("colgate", key, Self::PARAMS)),
-        }
-        Ok(())
+        crate::laws::params::set(self, key, value)
     }
 }
 

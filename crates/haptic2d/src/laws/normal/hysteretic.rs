@@ -1,10 +1,28 @@
 //! Goldfarb–Wang hysteretic wall: a spring in parallel with elasto-slide (Maxwell-slip) elements
 //! (§5.8, [REC]).
 
-use super::{check_nonneg, NormalInput, NormalLaw};
+use super::{NormalInput, NormalLaw};
+
+crate::law_params! { HystereticLaw, "hysteretic";
+    k0 (self.k0) [] "N/m" NonNegative "spring in parallel with the elements",
+    k1 (self.elements[0].k) [] "N/m" NonNegative "element 1 spring",
+    k2 (self.elements[1].k) [] "N/m" NonNegative "element 2 spring",
+    k3 (self.elements[2].k) [] "N/m" NonNegative "element 3 spring",
+    k4 (self.elements[3].k) [] "N/m" NonNegative "element 4 spring",
+    f1 (self.elements[0].f) [] "N" NonNegative "element 1 block friction",
+    f2 (self.elements[1].f) [] "N" NonNegative "element 2 block friction",
+    f3 (self.elements[2].f) [] "N" NonNegative "element 3 block friction",
+    f4 (self.elements[3].f) [] "N" NonNegative "element 4 block friction",
+    m1 (self.elements[0].m) [] "kg" NonNegative "element 1 block mass (0 = massless)",
+    m2 (self.elements[1].m) [] "kg" NonNegative "element 2 block mass (0 = massless)",
+    m3 (self.elements[2].m) [] "kg" NonNegative "element 3 block mass (0 = massless)",
+    m4 (self.elements[3].m) [] "kg" NonNegative "element 4 block mass (0 = massless)",
+}
 
 /// Most elasto-slide elements one wall can carry (fixed, so the law stays `Copy` and allocation-free).
 pub const MAX_ELEMENTS: usize = 4;
+// The parameter declarations below name elements 1–4 one by one.
+const _: () = assert!(MAX_ELEMENTS == 4);
 
 /// Karnopp stick threshold for blocks with mass (m/s).
 pub const BLOCK_STICK_SPEED: f64 = 1e-4;
@@ -91,9 +109,6 @@ pub struct HystereticLaw {
 }
 
 impl HystereticLaw {
-    /// Valid parameter names for [`HystereticLaw::set_param`] (`i` = 1..=4).
-    pub const PARAMS: &'static str = "k0, k<i>, f<i>, m<i> (element i = 1..4)";
-
     /// A wall with spring `k0` (N/m) and the massless elements `(k_i N/m, f_i N)` (at most
     /// [`MAX_ELEMENTS`]; extra ones are an error).
     pub fn new(k0: f64, elements: &[(f64, f64)]) -> Result<Self, String> {
@@ -156,36 +171,12 @@ impl HystereticLaw {
     }
     /// Checks the parameters; the error names the bad one.
     pub fn validate(&self) -> Result<(), String> {
-        check_nonneg("hysteretic", "k0", self.k0)?;
-        for (i, e) in self.elements.iter().enumerate() {
-            check_nonneg("hysteretic", &format!("k{}", i + 1), e.k)?;
-            check_nonneg("hysteretic", &format!("f{}", i + 1), e.f)?;
-            check_nonneg("hysteretic", &format!("m{}", i + 1), e.m)?;
-        }
-        Ok(())
+        crate::laws::params::validate(self)
     }
-    /// Sets a parameter by name: `k0` (N/m), or for element `i` in 1..=4: `k<i>` (N/m), `f<i>` (N),
-    /// `m<i>` (kg).
+    /// Sets a parameter by its key ([`Self::SPECS`]): `k0` (N/m), or for element `i` in 1..=4:
+    /// `k<i>` (N/m), `f<i>` (N), `m<i>` (kg). Ranges are checked by `validate`.
     pub fn set_param(&mut self, key: &str, value: f64) -> Result<(), String> {
-        if key == "k0" {
-            self.k0 = value;
-            return Ok(());
-        }
-        let err = || super::unknown_key("hysteretic", key, Self::PARAMS);
-        let mut chars = key.chars();
-        let field = chars.next().ok_or_else(err)?;
-        let index: usize = chars.as_str().parse().map_err(|_| err())?;
-        if !(1..=MAX_ELEMENTS).contains(&index) {
-            return Err(err());
-        }
-        let e = &mut self.elements[index - 1];
-        match field {
-            'k' => e.k = value,
-            'f' => e.f = value,
-            'm' => e.m = value,
-            _ => return Err(err()),
-        }
-        Ok(())
+        crate::laws::params::set(self, key, value)
     }
 }
 

@@ -1,6 +1,12 @@
 //! Massie PI wall (PHANToM rendering, §5.6, [REC] form).
 
-use super::{check_nonneg, NormalInput, NormalLaw};
+use super::{NormalInput, NormalLaw};
+
+crate::law_params! { MassiePiLaw, "pi";
+    k (self.k) [] "N/m" NonNegative "proportional stiffness",
+    k_i (self.k_i) [] "N/(m·s)" NonNegative "integral gain",
+    i_max (self.i_max) [] "m·s" NonNegativeOrInfinite "anti-windup bound",
+}
 
 /// While `δ_k > 0`: `I_k = I_{k−1} + T·δ_k`, `F_w,k = max(0, K·δ_k + K_I·I_k)`; at `δ_k = 0` the
 /// integral resets. Optional anti-windup clamps `0 ≤ I_k ≤ I_max`.
@@ -22,9 +28,6 @@ pub struct MassiePiLaw {
 }
 
 impl MassiePiLaw {
-    /// Valid parameter names for [`MassiePiLaw::set_param`].
-    pub const PARAMS: &'static str = "k, k_i, i_max";
-
     /// A PI wall with gains `k` (N/m), `k_i` (N/(m·s)) and anti-windup bound `i_max` (m·s).
     pub fn new(k: f64, k_i: f64, i_max: f64) -> Self {
         Self {
@@ -49,25 +52,11 @@ impl MassiePiLaw {
     }
     /// Checks the parameters; the error names the bad one.
     pub fn validate(&self) -> Result<(), String> {
-        check_nonneg("pi", "k", self.k)?;
-        check_nonneg("pi", "k_i", self.k_i)?;
-        if self.i_max.is_nan() || self.i_max < 0.0 {
-            return Err(format!(
-                "pi: parameter `i_max` must be ≥ 0 (or infinite), got {}",
-                self.i_max
-            ));
-        }
-        Ok(())
+        crate::laws::params::validate(self)
     }
-    /// Sets a parameter by name: `k` (N/m), `k_i` (N/(m·s)), `i_max` (m·s).
+    /// Sets a parameter by its key or an alias ([`Self::SPECS`]); ranges are checked by `validate`.
     pub fn set_param(&mut self, key: &str, value: f64) -> Result<(), String> {
-        match key {
-            "k" => self.k = value,
-            "k_i" => self.k_i = value,
-            "i_max" => self.i_max = value,
-            _ => return Err(super::unknown_key("pi", key, Self::PARAMS)),
-        }
-        Ok(())
+        crate::laws::params::set(self, key, value)
     }
 }
 

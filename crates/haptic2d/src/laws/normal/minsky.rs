@@ -1,6 +1,11 @@
 //! Minsky et al. (1990): stabilise the wall by adding damping (§5.3, [REC] form).
 
-use super::{check_nonneg, NormalInput, NormalLaw};
+use super::{NormalInput, NormalLaw};
+
+crate::law_params! { MinskyLaw, "minsky";
+    k (self.k) [] "N/m" NonNegative "wall stiffness",
+    b_m (self.b_m) ["b"] "N·s/m" NonNegative "wall damping",
+}
 
 /// `F_w,k = max(0, K·δ_k + B_M·v_in,k)` while `δ_k > 0`, else 0.
 ///
@@ -16,9 +21,6 @@ pub struct MinskyLaw {
 }
 
 impl MinskyLaw {
-    /// Valid parameter names for [`MinskyLaw::set_param`].
-    pub const PARAMS: &'static str = "k, b_m";
-
     /// A wall of stiffness `k` (N/m) and damping `b_m` (N·s/m).
     pub fn new(k: f64, b_m: f64) -> Self {
         Self {
@@ -37,17 +39,11 @@ impl MinskyLaw {
     }
     /// Checks the parameters; the error names the bad one.
     pub fn validate(&self) -> Result<(), String> {
-        check_nonneg("minsky", "k", self.k)?;
-        check_nonneg("minsky", "b_m", self.b_m)
+        crate::laws::params::validate(self)
     }
-    /// Sets a parameter by name: `k` (N/m), `b_m` (N·s/m).
+    /// Sets a parameter by its key or an alias ([`Self::SPECS`]); ranges are checked by `validate`.
     pub fn set_param(&mut self, key: &str, value: f64) -> Result<(), String> {
-        match key {
-            "k" => self.k = value,
-            "b_m" | "b" => self.b_m = value,
-            _ => return Err(super::unknown_key("minsky", key, Self::PARAMS)),
-        }
-        Ok(())
+        crate::laws::params::set(self, key, value)
     }
 }
 

@@ -23,6 +23,7 @@ mod pulse;
 mod seh;
 mod zoh;
 
+use crate::laws::params::{ParamSpec, Params, TableRow};
 pub use colgate::{colgate_margin, ColgateLaw};
 pub use hysteretic::{HystereticLaw, SlideElement, BLOCK_STICK_SPEED, MAX_ELEMENTS};
 pub use impact_offset::ContactNormal;
@@ -74,22 +75,6 @@ pub trait NormalLaw {
     fn force(&mut self, input: &NormalInput) -> f64;
     /// Energy stored in the law's springs after the last `force` call (J), for the energy ledger.
     fn stored_energy(&self) -> f64;
-}
-
-/// Checks that a parameter is finite and non-negative; the error names the law and the parameter.
-pub(crate) fn check_nonneg(law: &str, key: &str, value: f64) -> Result<(), String> {
-    if value.is_finite() && value >= 0.0 {
-        Ok(())
-    } else {
-        Err(format!(
-            "{law}: parameter `{key}` must be finite and ≥ 0, got {value}"
-        ))
-    }
-}
-
-/// Error for an unknown parameter name, listing the valid ones.
-pub(crate) fn unknown_key(law: &str, key: &str, valid: &str) -> String {
-    format!("{law}: unknown parameter `{key}`; valid parameters: {valid}")
 }
 
 /// The selectable normal laws. Every variant carries its parameters and its per-contact state, so a
@@ -221,19 +206,39 @@ impl NormalModel {
         }
     }
 
-    /// The valid parameter names of this model, for messages and help text.
-    pub fn param_names(&self) -> &'static str {
+    /// This model's parameters, declared once ([`crate::laws::params`]).
+    pub fn specs(&self) -> &'static [ParamSpec] {
         match self {
-            NormalModel::Paper(_) => PaperLaw::PARAMS,
-            NormalModel::Zoh(_) => ZohLaw::PARAMS,
-            NormalModel::Minsky(_) => MinskyLaw::PARAMS,
-            NormalModel::Colgate(_) => ColgateLaw::PARAMS,
-            NormalModel::Seh(_) => SehLaw::PARAMS,
-            NormalModel::MassiePi(_) => MassiePiLaw::PARAMS,
-            NormalModel::BrakingPulse(_) => BrakingPulseLaw::PARAMS,
-            NormalModel::Hysteretic(_) => HystereticLaw::PARAMS,
+            NormalModel::Paper(_) => PaperLaw::SPECS,
+            NormalModel::Zoh(_) => ZohLaw::SPECS,
+            NormalModel::Minsky(_) => MinskyLaw::SPECS,
+            NormalModel::Colgate(_) => ColgateLaw::SPECS,
+            NormalModel::Seh(_) => SehLaw::SPECS,
+            NormalModel::MassiePi(_) => MassiePiLaw::SPECS,
+            NormalModel::BrakingPulse(_) => BrakingPulseLaw::SPECS,
+            NormalModel::Hysteretic(_) => HystereticLaw::SPECS,
         }
     }
+}
+
+/// The rows of the normal-law table of docs/MODELS.md Part I, with their per-contact defaults.
+pub(crate) fn table_rows() -> Vec<TableRow> {
+    let row = |names, summary, law: Box<dyn Params>| TableRow {
+        names,
+        summary,
+        law,
+        extra_keys: "",
+    };
+    vec![
+        row(&["paper"], "the paper's law, §5.9: `F_n = max(0, −Kc·d̃ − Bc·C0)`, `d̃` the SEH estimate", Box::new(PaperLaw::per_contact())),
+        row(&["zoh"], "pure stiffness, zero-order hold (active), §5.2", Box::new(ZohLaw::per_contact())),
+        row(&["minsky"], "stiffness + damping, §5.3", Box::new(MinskyLaw::per_contact())),
+        row(&["colgate"], "`K·δ + B·Δδ/T`, §5.4 (passive with plant damping `b > KT/2 + \\|B\\|`; that `b` is the body's `damping`)", Box::new(ColgateLaw::per_contact())),
+        row(&["seh", "seh-pc"], "Ellis sample–estimate–hold, optionally with the predictor–corrector (`seh-pc` sets `corrector = 1`), §5.5", Box::new(SehLaw::per_contact())),
+        row(&["pi"], "Massie PI wall, §5.6", Box::new(MassiePiLaw::per_contact())),
+        row(&["pulse"], "Salcudean–Vlaar braking pulse, §5.7", Box::new(BrakingPulseLaw::per_contact())),
+        row(&["hysteretic"], "Goldfarb–Wang elasto-slide wall, §5.8", Box::new(HystereticLaw::per_contact())),
+    ]
 }
 
 impl Default for NormalModel {

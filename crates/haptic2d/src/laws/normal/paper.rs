@@ -1,6 +1,11 @@
 //! The paper's continuous-contact law (§5.9): an SEH spring plus damping.
 
-use super::{check_nonneg, NormalInput, NormalLaw};
+use super::{NormalInput, NormalLaw};
+
+crate::law_params! { PaperLaw, "paper";
+    kc (self.kc) ["k"] "N/m" NonNegative "contact stiffness Kc",
+    bc (self.bc) ["b"] "N·s/m" NonNegative "contact damping Bc",
+}
 
 /// `F_n,k = max(0, −Kc·d̃_k − Bc·C0,k)` with `d̃_k = 2d_k − 1.5d_{k−1} + 0.5d_{k−2}` (paper eq. 1).
 ///
@@ -20,9 +25,6 @@ pub struct PaperLaw {
 }
 
 impl PaperLaw {
-    /// Valid parameter names for [`PaperLaw::set_param`].
-    pub const PARAMS: &'static str = "kc, bc";
-
     /// A law with stiffness `kc` (N/m) and damping `bc` (N·s/m).
     pub fn new(kc: f64, bc: f64) -> Self {
         Self {
@@ -57,17 +59,11 @@ impl PaperLaw {
     }
     /// Checks the parameters; the error names the bad one.
     pub fn validate(&self) -> Result<(), String> {
-        check_nonneg("paper", "kc", self.kc)?;
-        check_nonneg("paper", "bc", self.bc)
+        crate::laws::params::validate(self)
     }
-    /// Sets a parameter by name: `kc` (N/m), `bc` (N·s/m).
+    /// Sets a parameter by its key or an alias ([`Self::SPECS`]); ranges are checked by `validate`.
     pub fn set_param(&mut self, key: &str, value: f64) -> Result<(), String> {
-        match key {
-            "kc" | "k" => self.kc = value,
-            "bc" | "b" => self.bc = value,
-            _ => return Err(super::unknown_key("paper", key, Self::PARAMS)),
-        }
-        Ok(())
+        crate::laws::params::set(self, key, value)
     }
 }
 

@@ -1,6 +1,12 @@
 //! Salcudean–Vlaar braking pulse on wall entry (§5.7, [REC] sizing).
 
-use super::{check_nonneg, NormalInput, NormalLaw};
+use super::{NormalInput, NormalLaw};
+
+crate::law_params! { BrakingPulseLaw, "pulse";
+    k (self.k) [] "N/m" NonNegative "wall stiffness",
+    e_b (self.e_b) [] "" NonNegative "pulse restitution",
+    n_p (self.n_p) [] "samples" Count "pulse length",
+}
 
 /// Spring `K·δ_k` plus, for the first `N_p` samples inside, a braking pulse
 /// `F_b = (1 + e_b)·m_eff·v_c / (N_p·T)` sized to reverse the latched entry speed `v_c` to `e_b·v_c`.
@@ -27,9 +33,6 @@ pub struct BrakingPulseLaw {
 }
 
 impl BrakingPulseLaw {
-    /// Valid parameter names for [`BrakingPulseLaw::set_param`].
-    pub const PARAMS: &'static str = "k, e_b, n_p";
-
     /// A wall of stiffness `k` (N/m) with pulse restitution `e_b` and length `n_p` samples.
     pub fn new(k: f64, e_b: f64, n_p: u32) -> Self {
         Self {
@@ -53,30 +56,11 @@ impl BrakingPulseLaw {
     }
     /// Checks the parameters; the error names the bad one.
     pub fn validate(&self) -> Result<(), String> {
-        check_nonneg("pulse", "k", self.k)?;
-        check_nonneg("pulse", "e_b", self.e_b)?;
-        if self.n_p == 0 {
-            return Err("pulse: parameter `n_p` must be ≥ 1 sample, got 0".to_string());
-        }
-        Ok(())
+        crate::laws::params::validate(self)
     }
-    /// Sets a parameter by name: `k` (N/m), `e_b` (-), `n_p` (samples, a positive integer).
+    /// Sets a parameter by its key or an alias ([`Self::SPECS`]); ranges are checked by `validate`.
     pub fn set_param(&mut self, key: &str, value: f64) -> Result<(), String> {
-        match key {
-            "k" => self.k = value,
-            "e_b" => self.e_b = value,
-            "n_p" => {
-                let whole = value >= 1.0 && value.fract() == 0.0 && value <= u32::MAX as f64;
-                if !whole {
-                    return Err(format!(
-                        "pulse: parameter `n_p` must be a positive whole number of samples, got {value}"
-                    ));
-                }
-                self.n_p = value as u32;
-            }
-            _ => return Err(super::unknown_key("pulse", key, Self::PARAMS)),
-        }
-        Ok(())
+        crate::laws::params::set(self, key, value)
     }
 }
 

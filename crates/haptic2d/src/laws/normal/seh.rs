@@ -1,6 +1,11 @@
 //! Ellis et al. (1997) sample–estimate–hold wall, with the optional predictor–corrector (§5.5).
 
-use super::{check_nonneg, NormalInput, NormalLaw};
+use super::{NormalInput, NormalLaw};
+
+crate::law_params! { SehLaw, "seh";
+    k (self.k) [] "N/m" NonNegative "wall stiffness",
+    corrector (self.corrector) [] "" Switch "predictor–corrector off (0) or on (1)",
+}
 
 /// SEH wall: hold `F_w,k = max(0, K·δ̃_k)` with the extrapolated penetration
 /// `δ̃_k = 2δ_k − 1.5δ_{k−1} + 0.5δ_{k−2}` over the coming interval (applied while `δ_k > 0`).
@@ -25,9 +30,6 @@ pub struct SehLaw {
 }
 
 impl SehLaw {
-    /// Valid parameter names for [`SehLaw::set_param`].
-    pub const PARAMS: &'static str = "k, corrector (0 or 1)";
-
     /// A wall of stiffness `k` (N/m), with or without the corrector.
     pub fn new(k: f64, corrector: bool) -> Self {
         Self {
@@ -52,26 +54,11 @@ impl SehLaw {
     }
     /// Checks the parameters; the error names the bad one.
     pub fn validate(&self) -> Result<(), String> {
-        check_nonneg("seh", "k", self.k)
+        crate::laws::params::validate(self)
     }
-    /// Sets a parameter by name: `k` (N/m), `corrector` (0 = off, 1 = on).
+    /// Sets a parameter by its key or an alias ([`Self::SPECS`]); ranges are checked by `validate`.
     pub fn set_param(&mut self, key: &str, value: f64) -> Result<(), String> {
-        match key {
-            "k" => self.k = value,
-            "corrector" => {
-                if value == 0.0 {
-                    self.corrector = false;
-                } else if value == 1.0 {
-                    self.corrector = true;
-                } else {
-                    return Err(format!(
-                        "seh: parameter `corrector` must be 0 or 1, got {value}"
-                    ));
-                }
-            }
-            _ => return Err(super::unknown_key("seh", key, Self::PARAMS)),
-        }
-        Ok(())
+        crate::laws::params::set(self, key, value)
     }
 }
 

@@ -1,6 +1,10 @@
 //! ZOH pure stiffness, the "active" wall (§5.2).
 
-use super::{check_nonneg, NormalInput, NormalLaw};
+use super::{NormalInput, NormalLaw};
+
+crate::law_params! { ZohLaw, "zoh";
+    k (self.k) [] "N/m" NonNegative "wall stiffness",
+}
 
 /// `F_w,k = K·δ_k`, held over the sample.
 ///
@@ -16,9 +20,6 @@ pub struct ZohLaw {
 }
 
 impl ZohLaw {
-    /// Valid parameter names for [`ZohLaw::set_param`].
-    pub const PARAMS: &'static str = "k";
-
     /// A wall of stiffness `k` (N/m).
     pub fn new(k: f64) -> Self {
         Self { k, stored: 0.0 }
@@ -33,15 +34,11 @@ impl ZohLaw {
     }
     /// Checks the parameters; the error names the bad one.
     pub fn validate(&self) -> Result<(), String> {
-        check_nonneg("zoh", "k", self.k)
+        crate::laws::params::validate(self)
     }
-    /// Sets a parameter by name (`k`, N/m).
+    /// Sets a parameter by its key or an alias ([`Self::SPECS`]); ranges are checked by `validate`.
     pub fn set_param(&mut self, key: &str, value: f64) -> Result<(), String> {
-        match key {
-            "k" => self.k = value,
-            _ => return Err(super::unknown_key("zoh", key, Self::PARAMS)),
-        }
-        Ok(())
+        crate::laws::params::set(self, key, value)
     }
 }
 
