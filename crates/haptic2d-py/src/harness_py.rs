@@ -206,3 +206,39 @@ pub fn model_names() -> (Vec<&'static str>, Vec<&'static str>) {
         FrictionModel::NAMES.to_vec(),
     )
 }
+
+/// The declared parameters of the wall law or friction model `model` (`laws/params.rs`): one
+/// dict per parameter with `key`, `aliases`, `unit`, `rule`, `meaning` and `default` (the
+/// per-contact default when `per_contact`, the 1-D one otherwise).
+#[pyfunction]
+#[pyo3(signature = (model, per_contact = false))]
+pub fn law_params<'py>(
+    py: Python<'py>,
+    model: &str,
+    per_contact: bool,
+) -> PyResult<Vec<Bound<'py, PyDict>>> {
+    let normal = NormalModel::from_name(model, per_contact);
+    let friction = FrictionModel::from_name(model, per_contact);
+    let law: &dyn haptic2d::laws::params::Params = match (&normal, &friction) {
+        (Ok(n), _) => n.params(),
+        (_, Ok(f)) => f.params(),
+        (Err(e), Err(_)) => {
+            return Err(value_error(format!(
+                "{e}; friction models: {}",
+                FrictionModel::NAMES.join(", ")
+            )))
+        }
+    };
+    let mut out = Vec::new();
+    for s in law.specs() {
+        let d = PyDict::new(py);
+        d.set_item("key", s.key)?;
+        d.set_item("aliases", s.aliases.to_vec())?;
+        d.set_item("unit", s.unit)?;
+        d.set_item("rule", s.rule.describe())?;
+        d.set_item("meaning", s.meaning)?;
+        d.set_item("default", law.get(s.key))?;
+        out.push(d);
+    }
+    Ok(out)
+}

@@ -20,6 +20,7 @@ fn _haptic2d(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(harness_py::wall_run, m)?)?;
     m.add_function(wrap_pyfunction!(harness_py::peg_run, m)?)?;
     m.add_function(wrap_pyfunction!(harness_py::model_names, m)?)?;
+    m.add_function(wrap_pyfunction!(harness_py::law_params, m)?)?;
     m.add_function(wrap_pyfunction!(lab::sweep_task, m)?)?;
     m.add_function(wrap_pyfunction!(lab::sweep_models, m)?)?;
     m.add_function(wrap_pyfunction!(lab::reproduce, m)?)?;

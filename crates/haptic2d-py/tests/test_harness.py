@@ -101,3 +101,21 @@ def test_friction_parameters_change_the_result():
     b = harness.peg("reset-integrator", duration=2.2, mu_s=0.9, mu_k=0.8)
     assert not np.array_equal(a.x, b.x)
     assert b.metrics["max_abs_x"] <= a.metrics["max_abs_x"]
+
+
+def test_law_params_lists_the_declared_keys_and_their_defaults():
+    paper = {p["key"]: p for p in harness.law_params("paper")}
+    assert set(paper) == {"kc", "bc"}
+    assert paper["kc"]["unit"] == "N/m" and paper["kc"]["aliases"] == ["k"]
+    # The per-contact default is half the 1-D one (a face rests on two contacts, §5).
+    per = {p["key"]: p["default"] for p in harness.law_params("paper", per_contact=True)}
+    assert per["kc"] == 0.5 * paper["kc"]["default"]
+    keys = [p["key"] for p in harness.law_params("reset-integrator")]
+    assert keys == ["kr", "mu_s", "mu_k", "beta", "p0"]
+    assert harness.law_params("none") == []
+    # Every declared key is accepted by the harness it belongs to.
+    for law in harness.WALL_LAWS:
+        for p in harness.law_params(law):
+            assert p["rule"] and p["meaning"]
+    with pytest.raises(ValueError, match="unknown normal law"):
+        harness.law_params("no-such-law")

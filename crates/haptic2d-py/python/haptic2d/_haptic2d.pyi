@@ -11,6 +11,7 @@ __all__ = [
     "wall_run",
     "peg_run",
     "model_names",
+    "law_params",
     "sweep_task",
     "sweep_models",
     "reproduce",
@@ -120,6 +121,7 @@ def peg_run(
     per_contact: bool,
 ) -> Dict[str, Any]: ...
 def model_names() -> Tuple[List[str], List[str]]: ...
+def law_params(model: str, per_contact: bool = False) -> List[Dict[str, Any]]: ...
 def sweep_task(
     model: str, ks: List[float], bs: List[float], rate_hz: float, duration: float
 ) -> Dict[str, Any]: ...

@@ -10,7 +10,7 @@ scene-file name (case-insensitive, so ``K=2000`` sets ``k``). Defaults are the s
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Dict, Optional, Tuple, Union
+from typing import Any, Dict, List, Optional, Tuple, Union
 
 import numpy as np
 
@@ -23,6 +23,19 @@ WALL_LAWS: Tuple[str, ...] = tuple(_haptic2d.model_names()[0])
 FRICTION_MODELS: Tuple[str, ...] = tuple(_haptic2d.model_names()[1])
 #: Integration modes of the wall harness.
 INTEGRATIONS = ("exact-zoh", "semi-implicit", "explicit-euler")
+
+
+def law_params(model: str, per_contact: bool = False) -> List[Dict[str, Any]]:
+    """The parameters of the wall law or friction model ``model``, as the Rust core declares them.
+
+    One dict per parameter: ``key`` (the keyword :func:`wall`/:func:`peg` and scene files take),
+    ``aliases``, ``unit`` (SI; empty for a pure number), ``rule`` (the accepted values, in words),
+    ``meaning`` and ``default`` (the 1-D default, or the halved per-contact one with
+    ``per_contact=True``). The same declarations generate docs/MODELS.md Part I.
+    """
+    if not isinstance(model, str):
+        raise TypeError(f"model must be a string, got {type(model).__name__}")
+    return _haptic2d.law_params(model, bool(per_contact))
 
 
 @dataclass
@@ -193,4 +206,13 @@ def peg(
     return PegRun(**d)
 
 
-__all__ = ["wall", "peg", "WallRun", "PegRun", "WALL_LAWS", "FRICTION_MODELS", "INTEGRATIONS"]
+__all__ = [
+    "wall",
+    "peg",
+    "law_params",
+    "WallRun",
+    "PegRun",
+    "WALL_LAWS",
+    "FRICTION_MODELS",
+    "INTEGRATIONS",
+]

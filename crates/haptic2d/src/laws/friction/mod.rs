@@ -157,6 +157,18 @@ impl FrictionModel {
         })
     }
 
+    /// The model behind this variant as its parameter declarations: [`Params::get`] reads a value.
+    pub fn params(&self) -> &dyn Params {
+        match self {
+            FrictionModel::None => &Frictionless,
+            FrictionModel::ResetIntegrator(m) => m,
+            FrictionModel::HaywardArmstrong(m) => m,
+            FrictionModel::FingerPad(m) => m,
+            FrictionModel::Karnopp(m) => m,
+            FrictionModel::SalcudeanVlaar(m) => m,
+        }
+    }
+
     /// This model's parameters, declared once ([`crate::laws::params`]).
     pub fn specs(&self) -> &'static [ParamSpec] {
         match self {

@@ -206,6 +206,20 @@ impl NormalModel {
         }
     }
 
+    /// The law behind this model as its parameter declarations: [`Params::get`] reads a value.
+    pub fn params(&self) -> &dyn Params {
+        match self {
+            NormalModel::Paper(l) => l,
+            NormalModel::Zoh(l) => l,
+            NormalModel::Minsky(l) => l,
+            NormalModel::Colgate(l) => l,
+            NormalModel::Seh(l) => l,
+            NormalModel::MassiePi(l) => l,
+            NormalModel::BrakingPulse(l) => l,
+            NormalModel::Hysteretic(l) => l,
+        }
+    }
+
     /// This model's parameters, declared once ([`crate::laws::params`]).
     pub fn specs(&self) -> &'static [ParamSpec] {
         match self {
