@@ -169,15 +169,6 @@ impl HystereticLaw {
         }
         b
     }
-    /// Checks the parameters; the error names the bad one.
-    pub fn validate(&self) -> Result<(), String> {
-        crate::laws::params::validate(self)
-    }
-    /// Sets a parameter by its key ([`Self::SPECS`]): `k0` (N/m), or for element `i` in 1..=4:
-    /// `k<i>` (N/m), `f<i>` (N), `m<i>` (kg). Ranges are checked by `validate`.
-    pub fn set_param(&mut self, key: &str, value: f64) -> Result<(), String> {
-        crate::laws::params::set(self, key, value)
-    }
 }
 
 impl NormalLaw for HystereticLaw {

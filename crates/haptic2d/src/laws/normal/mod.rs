@@ -177,32 +177,29 @@ impl NormalModel {
         })
     }
 
-    /// Checks the parameters; the error names the law and the bad parameter.
+    /// Checks every parameter against its declared rule; the error names the law, the parameter,
+    /// the rule and the unit.
     pub fn validate(&self) -> Result<(), String> {
-        match self {
-            NormalModel::Paper(l) => l.validate(),
-            NormalModel::Zoh(l) => l.validate(),
-            NormalModel::Minsky(l) => l.validate(),
-            NormalModel::Colgate(l) => l.validate(),
-            NormalModel::Seh(l) => l.validate(),
-            NormalModel::MassiePi(l) => l.validate(),
-            NormalModel::BrakingPulse(l) => l.validate(),
-            NormalModel::Hysteretic(l) => l.validate(),
-        }
+        crate::laws::params::validate(self.params())
     }
 
-    /// Sets one parameter by name (units as documented on each law); the error lists the valid keys.
+    /// Sets one parameter by its key or an alias ([`Self::specs`]); the error lists the valid keys.
     /// Call [`NormalModel::validate`] after setting all of them.
     pub fn set_param(&mut self, key: &str, value: f64) -> Result<(), String> {
+        crate::laws::params::set(self.params_mut(), key, value)
+    }
+
+    /// The law behind this model as its parameter declarations, to set a value.
+    fn params_mut(&mut self) -> &mut dyn Params {
         match self {
-            NormalModel::Paper(l) => l.set_param(key, value),
-            NormalModel::Zoh(l) => l.set_param(key, value),
-            NormalModel::Minsky(l) => l.set_param(key, value),
-            NormalModel::Colgate(l) => l.set_param(key, value),
-            NormalModel::Seh(l) => l.set_param(key, value),
-            NormalModel::MassiePi(l) => l.set_param(key, value),
-            NormalModel::BrakingPulse(l) => l.set_param(key, value),
-            NormalModel::Hysteretic(l) => l.set_param(key, value),
+            NormalModel::Paper(l) => l,
+            NormalModel::Zoh(l) => l,
+            NormalModel::Minsky(l) => l,
+            NormalModel::Colgate(l) => l,
+            NormalModel::Seh(l) => l,
+            NormalModel::MassiePi(l) => l,
+            NormalModel::BrakingPulse(l) => l,
+            NormalModel::Hysteretic(l) => l,
         }
     }
 

@@ -57,14 +57,6 @@ impl PaperLaw {
     pub(crate) fn same_params(&self, other: &Self) -> bool {
         self.kc.to_bits() == other.kc.to_bits() && self.bc.to_bits() == other.bc.to_bits()
     }
-    /// Checks the parameters; the error names the bad one.
-    pub fn validate(&self) -> Result<(), String> {
-        crate::laws::params::validate(self)
-    }
-    /// Sets a parameter by its key or an alias ([`Self::SPECS`]); ranges are checked by `validate`.
-    pub fn set_param(&mut self, key: &str, value: f64) -> Result<(), String> {
-        crate::laws::params::set(self, key, value)
-    }
 }
 
 impl NormalLaw for PaperLaw {

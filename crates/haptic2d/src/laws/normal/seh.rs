@@ -52,14 +52,6 @@ impl SehLaw {
         self.corrector = corrector;
         self
     }
-    /// Checks the parameters; the error names the bad one.
-    pub fn validate(&self) -> Result<(), String> {
-        crate::laws::params::validate(self)
-    }
-    /// Sets a parameter by its key or an alias ([`Self::SPECS`]); ranges are checked by `validate`.
-    pub fn set_param(&mut self, key: &str, value: f64) -> Result<(), String> {
-        crate::laws::params::set(self, key, value)
-    }
 }
 
 impl NormalLaw for SehLaw {

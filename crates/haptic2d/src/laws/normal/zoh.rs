@@ -32,14 +32,6 @@ impl ZohLaw {
     pub fn per_contact() -> Self {
         Self::new(1000.0)
     }
-    /// Checks the parameters; the error names the bad one.
-    pub fn validate(&self) -> Result<(), String> {
-        crate::laws::params::validate(self)
-    }
-    /// Sets a parameter by its key or an alias ([`Self::SPECS`]); ranges are checked by `validate`.
-    pub fn set_param(&mut self, key: &str, value: f64) -> Result<(), String> {
-        crate::laws::params::set(self, key, value)
-    }
 }
 
 impl NormalLaw for ZohLaw {
