@@ -79,22 +79,6 @@ impl FingerPad {
     pub fn deflection(&self) -> f64 {
         self.u
     }
-    /// Checks the parameters; the error names the offending one.
-    pub fn validate(&self) -> Result<(), String> {
-        crate::laws::params::validate(self)?;
-        if self.mu_s < self.mu_k {
-            return Err(format!(
-                "friction model 'nahvi': mu_s must be at least mu_k (static ≥ kinetic), got mu_s = {} < mu_k = {}",
-                self.mu_s, self.mu_k
-            ));
-        }
-        Ok(())
-    }
-    /// Sets one parameter by its key ([`Self::SPECS`]); the error lists the valid keys. Ranges are
-    /// checked by `validate`.
-    pub fn set_param(&mut self, key: &str, value: f64) -> Result<(), String> {
-        crate::laws::params::set(self, key, value)
-    }
 }
 
 impl FrictionLaw for FingerPad {

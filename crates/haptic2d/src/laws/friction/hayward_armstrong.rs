@@ -125,16 +125,6 @@ impl HaywardArmstrong {
             }
         }
     }
-    /// Checks the parameters; the error names the offending one.
-    pub fn validate(&self) -> Result<(), String> {
-        crate::laws::params::validate(self)?;
-        Ok(())
-    }
-    /// Sets one parameter by its key ([`Self::SPECS`]); the error lists the valid keys. Ranges are
-    /// checked by `validate`.
-    pub fn set_param(&mut self, key: &str, value: f64) -> Result<(), String> {
-        crate::laws::params::set(self, key, value)
-    }
 }
 
 impl FrictionLaw for HaywardArmstrong {

@@ -157,6 +157,19 @@ impl FrictionModel {
         })
     }
 
+    /// The model behind this variant as its parameter declarations, to set a value (`None` for
+    /// the frictionless model, which has none).
+    fn params_mut(&mut self) -> Option<&mut dyn Params> {
+        Some(match self {
+            FrictionModel::None => return None,
+            FrictionModel::ResetIntegrator(m) => m,
+            FrictionModel::HaywardArmstrong(m) => m,
+            FrictionModel::FingerPad(m) => m,
+            FrictionModel::Karnopp(m) => m,
+            FrictionModel::SalcudeanVlaar(m) => m,
+        })
+    }
+
     /// The model behind this variant as its parameter declarations: [`Params::get`] reads a value.
     pub fn params(&self) -> &dyn Params {
         match self {
@@ -181,11 +194,9 @@ impl FrictionModel {
         }
     }
 
-    /// Sets one parameter by its scene-file key. Keys per model: reset-integrator `kr, mu_s, mu_k, beta,
-    /// p0`; hayward-armstrong/dahl `k, mu_k, r_stick, sigma1, sigma2`; nahvi `k_p0, k_p1, b_pad, mu_s,
-    /// mu_k`; classical `v_th, mu_s, mu_k`; salcudean-vlaar `k_p, k_d, b_v, v_th, mu_s, mu_k`. The error
-    /// names the model and lists its valid keys; a non-finite value is refused. Ranges are checked by
-    /// [`FrictionModel::validate`].
+    /// Sets one parameter by its scene-file key ([`Self::specs`]; docs/MODELS.md Part I lists them
+    /// per model). The error names the model and lists its valid keys; a non-finite value is
+    /// refused. Ranges are checked by [`FrictionModel::validate`].
     pub fn set_param(&mut self, key: &str, value: f64) -> Result<(), String> {
         if !value.is_finite() {
             return Err(format!(
@@ -193,15 +204,15 @@ impl FrictionModel {
                 self.name()
             ));
         }
-        match self {
-            FrictionModel::None => Err(format!(
+        if let FrictionModel::ResetIntegrator(m) = self {
+            // Its set_param also moves the stiffness in use with `kr`.
+            return m.set_param(key, value);
+        }
+        match self.params_mut() {
+            Some(p) => crate::laws::params::set(p, key, value),
+            None => Err(format!(
                 "friction model 'none' has no parameters (got '{key}')"
             )),
-            FrictionModel::ResetIntegrator(m) => m.set_param(key, value),
-            FrictionModel::HaywardArmstrong(m) => m.set_param(key, value),
-            FrictionModel::FingerPad(m) => m.set_param(key, value),
-            FrictionModel::Karnopp(m) => m.set_param(key, value),
-            FrictionModel::SalcudeanVlaar(m) => m.set_param(key, value),
         }
     }
 
@@ -221,14 +232,18 @@ impl FrictionModel {
 
     /// Checks the parameters; the error names the model and the offending parameter.
     pub fn validate(&self) -> Result<(), String> {
-        match self {
-            FrictionModel::None => Ok(()),
-            FrictionModel::ResetIntegrator(m) => m.validate(),
-            FrictionModel::HaywardArmstrong(m) => m.validate(),
-            FrictionModel::FingerPad(m) => m.validate(),
-            FrictionModel::Karnopp(m) => m.validate(),
-            FrictionModel::SalcudeanVlaar(m) => m.validate(),
+        let p = self.params();
+        crate::laws::params::validate(p)?;
+        if p.specs().iter().any(|s| s.key == "mu_s") {
+            let (mu_s, mu_k) = (p.get("mu_s"), p.get("mu_k"));
+            if mu_s < mu_k {
+                return Err(format!(
+                    "{}: mu_s must be at least mu_k (static ≥ kinetic), got mu_s = {mu_s} < mu_k = {mu_k}",
+                    p.law_name()
+                ));
+            }
         }
+        Ok(())
     }
 
     /// Whether the model reads [`FrictionInput::f_ext_t`] (only the classical model, §4.1); the world

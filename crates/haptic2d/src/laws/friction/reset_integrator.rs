@@ -137,17 +137,6 @@ impl ResetIntegrator {
         self.k_used = self.kr;
         Ok(())
     }
-    /// Checks the parameters; the error names the offending one.
-    pub fn validate(&self) -> Result<(), String> {
-        crate::laws::params::validate(self)?;
-        if self.mu_s < self.mu_k {
-            return Err(format!(
-                "friction model 'reset-integrator': mu_s must be at least mu_k (static ≥ kinetic), got mu_s = {} < mu_k = {}",
-                self.mu_s, self.mu_k
-            ));
-        }
-        Ok(())
-    }
 }
 
 impl FrictionLaw for ResetIntegrator {
