@@ -3,21 +3,20 @@
 
 use crate::control::coupling::VirtualCoupling;
 use crate::control::four_channel::{FourChannel, TeleopSignals};
-use crate::control::passivity::{explicit_damping_limit, PlanarPassivity};
-use crate::device::linalg::{M3, V3, V4};
-use crate::device::{DeviceEstimate, DeviceFault, TwinPantograph};
-use crate::geom::Vec2;
+use crate::control::passivity::PlanarPassivity;
+use crate::device::linalg::{V3, V4};
+use crate::device::{DeviceFault, TwinPantograph};
 use crate::world::World;
 
 use super::config::{ControllerKind, HapticConfig};
 use super::limit_cycle::LimitCycleMonitor;
 use super::mapping::DeviceMap;
 use super::plausibility::JointPlausibility;
-use super::record::{
-    TickRecord, FLAG_NEAR_SINGULAR, FLAG_PASSIVITY_ACTIVE, FLAG_SAFETY, FLAG_SATURATED,
-};
+use super::record::{TickRecord, FLAG_SAFETY};
 use super::safety::{Safety, SafetyConfig, SafetyReason, SafetyTrip};
 use super::workspace::WorkspaceBound;
+
+mod steps;
 
 /// The running controller (one of the §11 architectures).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -246,209 +245,31 @@ impl HapticSystem {
     /// reply, `device_wait` (s; NaN = unknown), so that a stall says whether the host or the device
     /// was late. Never allocates, locks, prints or does I/O.
     pub fn tick_timed(&mut self, q: &V4, elapsed: f64, device_wait: f64) -> TickOutput {
-        let (k, t, dt) = (self.world.tick(), self.world.time(), self.dt);
+        let t = self.world.time();
         let mut flags = 0u32;
-
-        // 0. Stall: the device held the previous torques for `elapsed` seconds, unsupervised.
-        //    Plausibility: a joint reading no hand can produce is a fault of the encoder or driver.
-        self.check_stall(elapsed, device_wait);
-        self.started = true;
-        if let Some(reason) = self.plausibility.check(q, elapsed) {
-            self.safety.trip(k, t, reason);
-        }
-
-        // 1–2. Device pose by forward kinematics (θ unwrapped, closure monitor), filtered twist, and
-        //      the hand-wrench estimate from the torques of the previous interval (§10.3, §10.6,
-        //      §10.7), both over the measured interval.
-        let mut closure_fault = false;
-        let est: Option<DeviceEstimate> =
-            match self.device.estimate_elapsed(q, &self.tau_prev, elapsed) {
-                Ok(e) => Some(e),
-                Err(fault) => {
-                    closure_fault = matches!(fault, DeviceFault::ClosureViolation { .. });
-                    self.safety.trip(k, t, SafetyReason::Device(fault));
-                    None
-                }
-            };
-
-        // 1b. Start-up alignment, at the first valid reading (and after a re-arm or a pause): anchor
-        //     the mapping so that the measured handle pose maps onto the slave's current pose. The
-        //     coupling then starts with zero pose error wherever the handle was, and the slave is not
-        //     moved (moving it could put it inside a wall). The torque ramp restarts here.
-        if let (Some(e), false) = (est, self.aligned) {
-            let body = &self.world.bodies[self.slave];
-            self.map.device_origin = e.pose;
-            self.map.world_origin = [body.pose.pos.x, body.pose.pos.y, body.pose.angle];
-            self.aligned = true;
-            self.ramp_ticks = 0;
-        }
-
-        // 3–6. World: proximity every N_g samples, local contacts and god-objects, contact states and
-        //      simultaneous impacts (velocities jump now), then normal and friction forces.
-        self.world.begin_step();
-        let body = &self.world.bodies[self.slave];
-        let x_s = [body.pose.pos.x, body.pose.pos.y, body.pose.angle];
-        let v_s = [body.vel.x, body.vel.y, body.omega];
-        let cw = self.world.contact_wrench(self.slave);
-        let f_e = [-cw.force.x, -cw.force.y, -cw.torque];
-
-        // 7. Teleoperation: device command f_cm and slave drive f_cs (§11), in world coordinates.
-        //    The master-mass feed-forward (off by default) gets the device's mass matrix at the
-        //    measured pose, in world coordinates: with the twist map v_w = S·v_d and the wrench map
-        //    f_d = S·f_w (S = diag(s, s, 1)), f_d = M_d·a_d gives f_w = S⁻¹·M_d·S⁻¹·a_w.
-        let m_dev = self.device.mass_matrix();
-        let (mut f_cm, mut f_cs) = ([0.0; 3], [0.0; 3]);
-        let (mut x_m, mut v_m, mut w_h) = ([0.0; 3], [0.0; 3], [0.0; 3]);
-        if let Some(e) = est {
-            (x_m, v_m, w_h) = (e.pose, e.velocity, e.hand_wrench);
-        }
-        if let (Some(e), false) = (est, self.safety.is_latched()) {
-            let sc = [self.map.scale, self.map.scale, 1.0];
-            let master_mass: M3 =
-                std::array::from_fn(|i| std::array::from_fn(|j| m_dev[i][j] / (sc[i] * sc[j])));
-            let signals = TeleopSignals {
-                x_m: self.map.pose_to_world(&e.pose),
-                v_m: self.map.twist_to_world(&e.velocity),
-                f_h: self.map.wrench_to_world(&e.hand_wrench),
-                x_s,
-                v_s,
-                f_e,
-                master_mass,
-            };
-            (f_cm, f_cs) = self.controller.step(&signals);
-        }
-
-        // 8. Passivity observer/controller on the device port (§12), in handle coordinates, with α
-        //    per axis capped at the explicit-damping limit 2·M_ii/T of the device's inertia on that
-        //    axis. It stops (α = 0, nothing booked but the zero applied) while latched.
-        let mut f_port = self.map.wrench_to_device(&f_cm);
-        let (mut po_energy, mut alpha) = (0.0, [0.0; 3]);
-        if let Some(pc) = self.passivity.as_mut() {
-            match (est, self.safety.is_latched()) {
-                (Some(e), false) => {
-                    let cap = std::array::from_fn(|i| explicit_damping_limit(m_dev[i][i], dt));
-                    f_port = pc.update_limited(e.pose, e.velocity, f_port, dt, cap);
-                    alpha = [pc.x.alpha(), pc.y.alpha(), pc.theta.alpha()];
-                    if alpha.iter().any(|a| *a > 0.0) {
-                        flags |= FLAG_PASSIVITY_ACTIVE;
-                    }
-                }
-                _ => pc.idle(),
-            }
-            po_energy = pc.e_obs();
-        }
-
-        // 8b. Workspace bound (device file): a passive wall just past the edge of the workspace
-        //     square, and a trip beyond it.
-        let mut f_dev = f_port;
-        if let Some(e) = est {
-            if let Some(reason) = self.workspace.apply(&e.pose, &e.velocity, &mut f_dev) {
-                self.safety.trip(k, t, reason);
-            }
-        }
-        f_cm = self.map.wrench_to_world(&f_dev);
-
-        // 9. Redundancy resolution to four motor torques, saturation (§10.5), the start-up ramp, and
-        //    the final gate: a fault, a non-finite value, a singular pose or a request above τ_max
-        //    by more than the margin zeroes the torques in this same tick; a request just above τ_max
-        //    is clamped to it.
-        let mut tau = [0.0; 4];
-        let mut wrench_scale = 0.0;
-        if !self.safety.is_latched() {
-            match self.device.torques_for_wrench(&f_dev, self.preload) {
-                Ok(cmd) => {
-                    tau = cmd.tau;
-                    wrench_scale = cmd.wrench_scale;
-                    if cmd.saturated {
-                        flags |= FLAG_SATURATED;
-                    }
-                    let tau_max = [self.safety.tau_max; 4];
-                    if let Some(reason) = self.limit_cycle.observe(&cmd.tau, &tau_max) {
-                        self.safety.trip(k, t, reason);
-                    }
-                    if cmd.near_singular {
-                        flags |= FLAG_NEAR_SINGULAR;
-                        self.safety.trip(
-                            k,
-                            t,
-                            SafetyReason::Singularity {
-                                margin: cmd.margin,
-                                limit: self.safety.min_margin,
-                            },
-                        );
-                    }
-                }
-                Err(fault) => self.safety.trip(k, t, SafetyReason::Torques(fault)),
-            }
-        }
-        let ramp = self.ramp_factor();
-        tau.iter_mut().for_each(|v| *v *= ramp);
-        if let Some((i, v)) = self.injected.take() {
-            tau[i] = v;
-        }
-        let peak_before = tau.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        let gated = self.safety.gate(k, t, &mut tau);
-        let peak_after = tau.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        if gated {
-            flags |= FLAG_SAFETY;
+        self.supervise_input(q, elapsed, device_wait); // 0
+        let (est, closure_fault) = self.sense(q, elapsed); // 1–2
+        self.align(est); // 1b
+        let slave = self.contact_stage(); // 3–6
+        let (f_cm, mut f_cs) = self.teleoperate(est, &slave); // 7
+        let port = self.port_passivity(est, &f_cm, &mut flags); // 8
+        let f_dev = self.workspace_wall(est, port.f_port); // 8b
+        let motor = self.motor_torques(&f_dev, &mut flags); // 9
+        if motor.gated {
             f_cs = [0.0; 3];
-        } else if self.aligned {
-            self.ramp_ticks = self.ramp_ticks.saturating_add(1);
         }
-
-        // 9b. The passivity observer books the wrench the port actually produced: the controller's
-        //     output scaled by the saturation, the ramp and the final clamp (zero when gated).
-        if let Some(pc) = self.passivity.as_mut() {
-            let applied = if gated || peak_before == 0.0 {
-                0.0
-            } else {
-                wrench_scale * ramp * (peak_after / peak_before)
-            };
-            pc.book_applied([
-                applied * f_port[0],
-                applied * f_port[1],
-                applied * f_port[2],
-            ]);
-        }
-
-        // 10. Slave drive held over the sample, then passive integration of every body to k+1 (§6).
-        self.world
-            .set_drive(self.slave, Vec2::new(f_cs[0], f_cs[1]), f_cs[2]);
-        self.world.finish_step();
-        self.tau_prev = tau;
-
-        // 11. Log: signals, energies and the contact count into the tick record.
-        let ledger = self.world.ledger();
-        let margin = if est.is_some() {
-            self.device.margin()
-        } else {
-            0.0
-        };
-        self.record = TickRecord {
-            t,
-            x_m,
-            v_m,
-            w_h,
-            x_s,
-            v_s,
-            f_cm,
-            f_cs,
-            f_e,
-            tau,
-            contacts: self.world.contacts().contact_count() as u32,
-            kinetic: ledger.kinetic,
-            stored: ledger.stored,
-            applied_work: ledger.applied_work,
-            po_energy,
-            alpha,
-            margin: self.device.margin(),
-            closure_error: est.map_or(f64::NAN, |e| e.closure_error),
-            flags,
-        };
+        self.book_port(&port.f_port, motor.applied); // 9b
+        self.integrate(&f_cs, motor.tau); // 10
+        let f_cm = self.map.wrench_to_world(&f_dev);
+        self.record_tick(t, est, &slave, (f_cm, f_cs), &port, motor.tau, flags); // 11
         TickOutput {
-            torques: tau,
+            torques: motor.tau,
             tripped: self.safety.is_latched(),
-            margin,
+            margin: if est.is_some() {
+                self.device.margin()
+            } else {
+                0.0
+            },
             closure_fault,
             record: self.record,
         }
