@@ -9,6 +9,8 @@
 //! - [`fig8`]: Figs. 8–11, the peg in a tight hole with the device in the loop.
 //! - [`experiments`]: the device-in-the-loop runs of Figs. 5–6 and 8–11 (library code the figures call).
 //! - [`harness`]: the 1-D reduced harnesses of Figs. 4 and 7 (§5.1, §13).
+//! - [`network`]: the loop split at a network: an impairment layer and a device–world run across it
+//!   with and without time-domain passivity (issue 41).
 //! - [`sweep`]: stiffness × damping sweeps of the wall laws on the 1-D Fig. 4 harness (Z-width chart).
 //!
 //! Adding a figure: implement [`Figure`] in a new file and add it to [`figure::registry`].
@@ -25,6 +27,7 @@ pub mod fig7;
 pub mod fig8;
 pub mod figure;
 pub mod harness;
+pub mod network;
 pub mod plot;
 pub mod schema;
 pub mod stability;

@@ -4,3 +4,4 @@ pub mod coupling;
 pub mod file;
 pub mod four_channel;
 pub mod passivity;
+pub mod tdpa;

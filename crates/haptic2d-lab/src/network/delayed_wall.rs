@@ -1,0 +1,257 @@
+//! A device and a world on two sides of a network: the hand pushes the device's handle, the handle
+//! drives a virtual body through a coupling on the world side, the body hits a stiff wall, and the
+//! coupling force comes back to the handle. One axis (x), 1 kHz, simulated time.
+//!
+//! The device side sends the handle's position and velocity (and, with TDPA, its port's
+//! energy-in); the world side runs the coupling `F_c = K_c·(x_m − x_s) + B_c·(v_m − v_s)` on the
+//! delayed handle state, drives the body with it and sends the reaction `−F_c` back (with its
+//! port's energy-in). With `tdpa`, each side runs a [`TdpaPort`] on its force output; without, the
+//! ports only observe. The result books the network's energy balance (`created = out − in`, J),
+//! the largest force on the handle, and the transparency in contact.
+
+use super::link::{Impairment, Link};
+use haptic2d::control::tdpa::{NetworkEnergy, TdpaPort};
+
+/// One run's settings. SI units.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DelayedWall {
+    /// Sample time (s).
+    pub dt: f64,
+    /// Run length (s).
+    pub duration: f64,
+    /// The link in each direction (delay in samples; the round trip is twice it).
+    pub link: Impairment,
+    /// Time-domain passivity on both ports.
+    pub tdpa: bool,
+    /// Handle mass (kg) and viscous friction (N·s/m).
+    pub m_device: f64,
+    /// Handle viscous friction (N·s/m).
+    pub b_device: f64,
+    /// Hand: a spring (N/m) and damper (N·s/m) from the hand's target to the handle.
+    pub k_hand: f64,
+    /// Hand damping (N·s/m).
+    pub b_hand: f64,
+    /// The hand's target moves from 0 at `v_hand` (m/s) up to `x_hand_end` (m), then stays.
+    pub v_hand: f64,
+    /// Where the hand's target stops (m).
+    pub x_hand_end: f64,
+    /// The hand lets go at this time (s; infinite: never).
+    pub release_at: f64,
+    /// Virtual body mass (kg).
+    pub m_body: f64,
+    /// Coupling stiffness (N/m) and damping (N·s/m).
+    pub k_coupling: f64,
+    /// Coupling damping (N·s/m).
+    pub b_coupling: f64,
+    /// Wall position (m), stiffness (N/m).
+    pub x_wall: f64,
+    /// Wall stiffness (N/m).
+    pub k_wall: f64,
+}
+
+impl DelayedWall {
+    /// The default experiment: 1 kHz, 4 s, a 0.2 kg handle pushed by a hand (300 N/m, 3 N·s/m) at
+    /// 0.05 m/s towards a 5 000 N/m wall 40 mm away until its target is 20 mm past the wall; the
+    /// hand lets go at 2.5 s; coupling 600 N/m, 4 N·s/m; body 0.3 kg.
+    pub fn new(link: Impairment, tdpa: bool) -> Self {
+        Self {
+            dt: 1e-3,
+            duration: 4.0,
+            link,
+            tdpa,
+            m_device: 0.2,
+            b_device: 0.2,
+            k_hand: 300.0,
+            b_hand: 3.0,
+            v_hand: 0.05,
+            x_hand_end: 0.06,
+            release_at: 2.5,
+            m_body: 0.3,
+            k_coupling: 600.0,
+            b_coupling: 4.0,
+            x_wall: 0.04,
+            k_wall: 5000.0,
+        }
+    }
+}
+
+/// What a run measured.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DelayedWallResult {
+    /// The network's energy balance over the run.
+    pub network: NetworkEnergy,
+    /// Energy the passivity controllers dissipated (J).
+    pub dissipated: f64,
+    /// Largest force on the handle (N).
+    pub max_handle_force: f64,
+    /// Largest speed of the handle (m/s).
+    pub max_handle_speed: f64,
+    /// While the hand pushes into the wall (the last second before the release): mean
+    /// `|F_handle − F_wall|` (N), the force the hand feels against the wall's.
+    pub force_error: f64,
+    /// Mean wall force over the same window (N).
+    pub wall_force: f64,
+    /// `|x_m − x_s|` at the release (m): the handle–body separation, the coupling's deflection
+    /// `F/K_c` plus any position drift the passivity controllers caused.
+    pub separation: f64,
+    /// Messages lost in both directions.
+    pub lost: u64,
+}
+
+/// The device side's message: handle position (m), velocity (m/s), its port's energy-in (J).
+#[derive(Clone, Copy, Debug)]
+struct ToWorld {
+    x: f64,
+    v: f64,
+    e_in: f64,
+}
+
+/// The world side's message: force for the handle (N), its port's energy-in (J).
+#[derive(Clone, Copy, Debug)]
+struct ToDevice {
+    f: f64,
+    e_in: f64,
+}
+
+/// Runs `cfg`.
+pub fn run_delayed_wall(cfg: &DelayedWall) -> DelayedWallResult {
+    let dt = cfg.dt;
+    let n = (cfg.duration / dt).round() as u64;
+    let mut up: Link<ToWorld> = Link::new(cfg.link);
+    let back_imp = Impairment {
+        seed: cfg.link.seed.wrapping_add(1),
+        ..cfg.link
+    };
+    let mut down: Link<ToDevice> = Link::new(back_imp);
+    let (mut master, mut slave) = (TdpaPort::new(), TdpaPort::new());
+    let (mut x_m, mut v_m, mut x_s, mut v_s) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    let (mut max_f, mut max_v) = (0.0f64, 0.0f64);
+    let (mut err_sum, mut wall_sum, mut window) = (0.0, 0.0, 0u64);
+    let mut separation = f64::NAN;
+    let alpha_m = 2.0 * cfg.m_device / dt;
+    let alpha_s = 2.0 * cfg.m_body / dt;
+    for k in 0..n {
+        let t = k as f64 * dt;
+        // Device side: read the newest force, apply the master port's controller.
+        let (f_req, far_s) = down.receive(k).map_or((0.0, 0.0), |m| (m.f, m.e_in));
+        let f_m = if cfg.tdpa {
+            master.step(f_req, v_m, far_s, dt, alpha_m)
+        } else {
+            master.observe(f_req, v_m, dt);
+            f_req
+        };
+        up.send(
+            k,
+            ToWorld {
+                x: x_m,
+                v: v_m,
+                e_in: master.energy_in(),
+            },
+        );
+        // World side: the coupling on the newest handle state, the slave port's controller.
+        let (xm_r, vm_r, far_m) = up
+            .receive(k)
+            .map_or((0.0, 0.0, 0.0), |m| (m.x, m.v, m.e_in));
+        let f_c = cfg.k_coupling * (xm_r - x_s) + cfg.b_coupling * (vm_r - v_s);
+        let f_s = if cfg.tdpa {
+            slave.step(f_c, v_s, far_m, dt, alpha_s)
+        } else {
+            slave.observe(f_c, v_s, dt);
+            f_c
+        };
+        down.send(
+            k,
+            ToDevice {
+                f: -f_s,
+                e_in: slave.energy_in(),
+            },
+        );
+        // The wall on the body, the hand on the handle.
+        let f_wall = if x_s > cfg.x_wall {
+            -cfg.k_wall * (x_s - cfg.x_wall)
+        } else {
+            0.0
+        };
+        let held = t < cfg.release_at;
+        let target = (cfg.v_hand * t).min(cfg.x_hand_end);
+        let f_hand = if held {
+            cfg.k_hand * (target - x_m) - cfg.b_hand * v_m
+        } else {
+            0.0
+        };
+        // Semi-implicit Euler on both bodies (passive for these masses and gains, §6).
+        v_m += dt * (f_hand + f_m - cfg.b_device * v_m) / cfg.m_device;
+        x_m += dt * v_m;
+        v_s += dt * (f_s + f_wall) / cfg.m_body;
+        x_s += dt * v_s;
+        max_f = max_f.max(f_m.abs());
+        max_v = max_v.max(v_m.abs());
+        if held && t >= cfg.release_at - 1.0 && x_s > cfg.x_wall {
+            err_sum += (f_m.abs() - f_wall.abs()).abs();
+            wall_sum += f_wall.abs();
+            window += 1;
+        }
+        if separation.is_nan() && !held {
+            separation = (x_m - x_s).abs();
+        }
+        if !(x_m.is_finite() && x_s.is_finite()) {
+            break;
+        }
+    }
+    let w = window.max(1) as f64;
+    DelayedWallResult {
+        network: NetworkEnergy::of(&master, &slave),
+        dissipated: master.dissipated() + slave.dissipated(),
+        max_handle_force: max_f,
+        max_handle_speed: max_v,
+        force_error: err_sum / w,
+        wall_force: wall_sum / w,
+        separation,
+        lost: up.lost + down.lost,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn run(round_trip_ms: u32, loss: f64, tdpa: bool) -> DelayedWallResult {
+        let link = Impairment::delay_loss(round_trip_ms / 2, loss, 11);
+        run_delayed_wall(&DelayedWall::new(link, tdpa))
+    }
+
+    #[test]
+    fn without_delay_the_coupling_creates_no_energy() {
+        let r = run(0, 0.0, false);
+        assert!(r.network.created <= 1e-3, "{r:?}");
+    }
+
+    #[test]
+    fn tdpa_keeps_the_network_passive_at_every_delay_and_loss() {
+        for rt in [0, 10, 50, 200] {
+            for loss in [0.0, 0.05, 0.1] {
+                let r = run(rt, loss, true);
+                assert!(
+                    r.network.created <= 1e-3,
+                    "round trip {rt} ms, loss {loss}: created {} J ({r:?})",
+                    r.network.created
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn without_tdpa_a_50_ms_round_trip_with_5_percent_loss_creates_energy() {
+        let r = run(50, 0.05, false);
+        assert!(r.network.created > 0.01, "{r:?}");
+    }
+
+    #[test]
+    fn with_tdpa_the_wall_is_still_felt_at_a_50_ms_round_trip() {
+        // Transparency: pushing into the wall, the handle force follows the wall force.
+        let r = run(50, 0.0, true);
+        assert!(r.wall_force > 3.0, "{r:?}");
+        assert!(r.force_error < 0.1 * r.wall_force, "{r:?}");
+        assert!(r.max_handle_force < 10.0, "{r:?}");
+    }
+}
