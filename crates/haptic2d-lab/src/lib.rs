@@ -28,6 +28,7 @@ pub mod harness;
 pub mod plot;
 pub mod schema;
 pub mod stability;
+pub mod study;
 pub mod sweep;
 pub mod world2d;
 
