@@ -191,6 +191,18 @@ pub fn results_tsv(res: &[ConditionResult]) -> String {
     s
 }
 
+/// Three significant figures (at least the integer part).
+fn short(x: f64) -> String {
+    let digits = if x.abs() >= 100.0 {
+        0
+    } else if x.abs() >= 10.0 {
+        1
+    } else {
+        3
+    };
+    format!("{x:.digits$}")
+}
+
 /// Draws the psychometric curves (one panel per condition: proportion correct per level, the fit,
 /// 75 %) and, when there are staircases, their tracks; writes `<stem>.svg` and `.png`.
 pub fn plot(res: &[ConditionResult], stem: &Path, title: &str) -> Result<Vec<PathBuf>, String> {
@@ -210,8 +222,12 @@ pub fn plot(res: &[ConditionResult], stem: &Path, title: &str) -> Result<Vec<Pat
             .collect();
         panels.push(Panel {
             title: format!(
-                "{}: JND {:.4} [{:.4}, {:.4}], Weber {:.3}",
-                r.condition, r.jnd, r.jnd_ci.0, r.jnd_ci.1, r.weber
+                "{}: JND {} [{}, {}], Weber {:.3}",
+                r.condition,
+                short(r.jnd),
+                short(r.jnd_ci.0),
+                short(r.jnd_ci.1),
+                r.weber
             ),
             x_label: format!("delta of {} (comparison − reference)", r.vary),
             y_label: "proportion correct".into(),
