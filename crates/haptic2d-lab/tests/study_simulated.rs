@@ -253,3 +253,18 @@ fn study_file_errors_name_the_field_and_the_fix() {
         .to_string();
     assert!(e.contains("line ") && e.contains("colour"), "{e}");
 }
+
+/// Every study shipped in studies/ is valid.
+#[test]
+fn every_shipped_study_file_is_valid() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../studies");
+    let mut n = 0;
+    for e in std::fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.extension().is_some_and(|x| x == "toml") {
+            Study::load(&p).unwrap_or_else(|e| panic!("{e}"));
+            n += 1;
+        }
+    }
+    assert!(n >= 2, "{n} study files");
+}

@@ -241,7 +241,7 @@ pub fn plot(res: &[ConditionResult], stem: &Path, title: &str) -> Result<Vec<Pat
                 ),
             ],
             h_lines: vec![0.5, 0.75],
-            y_range: Some((0.4, 1.02)),
+            y_range: Some((0.0, 1.02)),
             ..Panel::default()
         });
     }

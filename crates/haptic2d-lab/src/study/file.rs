@@ -509,13 +509,17 @@ fn validate(
         conditions,
         method,
         blocks,
-        observer: observer?,
+        observer: observer.unwrap_or_default(),
     };
-    if errs.is_empty() {
-        // Every stimulus a condition can present must build a valid scene with the probe in it.
+    // Every stimulus a condition can present must build a valid scene with the probe in it (checked
+    // even when other fields have problems, so all are reported at once).
+    {
         let largest = study.method.largest_delta();
         for c in &study.conditions {
             for (which, delta) in [(&c.reference, None), (&c.comparison, Some(largest))] {
+                if delta.is_some_and(|d| !(d.is_finite() && d > 0.0)) {
+                    continue; // the method's own error is reported
+                }
                 let vary = delta.map(|d| (&c.vary, d));
                 match stimulus::world(&study, which, vary) {
                     Ok(w) => {
@@ -538,7 +542,10 @@ fn validate(
                                     s.message
                                 );
                             }
-                            errs.push(s);
+                            // The same stimulus as reference and comparison: report it once.
+                            if !errs.iter().any(|e| e.field == s.field) {
+                                errs.push(s);
+                            }
                         }
                     }
                 }
