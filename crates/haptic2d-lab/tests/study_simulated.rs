@@ -268,3 +268,40 @@ fn every_shipped_study_file_is_valid() {
     }
     assert!(n >= 2, "{n} study files");
 }
+
+/// The method of constant stimuli presents the practice trials first (at the largest delta), then
+/// every delta exactly `repeats` times, in an order and with interval orders that depend on the seed.
+#[test]
+fn constant_stimuli_schedule_presents_every_delta_exactly_repeats_times() {
+    use haptic2d_lab::study::schedule::Schedule;
+    let (study, _) = load(&shipped());
+    let order = |seed: u64| {
+        let mut s = Schedule::new(&study, seed);
+        let mut v = Vec::new();
+        while let Some(t) = s.next_trial() {
+            s.record(&t, true);
+            v.push(t);
+        }
+        v
+    };
+    let a = order(1);
+    assert_eq!(a.len(), 284);
+    assert!(a[..4].iter().all(|t| t.practice && t.delta == 480.0));
+    for d in [30.0, 60.0, 100.0, 150.0, 220.0, 320.0, 480.0] {
+        let n = a[4..]
+            .iter()
+            .filter(|t| !t.practice && t.delta == d)
+            .count();
+        assert_eq!(n, 40, "delta {d}");
+    }
+    let first = a.iter().filter(|t| t.comparison_interval == 1).count();
+    assert!(
+        (110..=174).contains(&first),
+        "{first} of 284 comparisons first"
+    );
+    let b = order(2);
+    assert_ne!(
+        a.iter().map(|t| t.delta).collect::<Vec<_>>(),
+        b.iter().map(|t| t.delta).collect::<Vec<_>>()
+    );
+}

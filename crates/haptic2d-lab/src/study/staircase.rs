@@ -110,6 +110,20 @@ mod tests {
         assert!(s.done(), "stops at max_reversals");
     }
 
+    #[test]
+    fn three_down_needs_three_correct_answers_and_clamps_at_min_delta() {
+        let mut s = Staircase::new(&spec(3), 4.0);
+        s.update(true);
+        s.update(true);
+        assert_eq!(s.delta, 4.0);
+        s.update(true);
+        assert_eq!(s.delta, 2.0);
+        for _ in 0..6 {
+            s.update(true);
+        }
+        assert_eq!(s.delta, 1.0, "clamped at min_delta");
+    }
+
     /// Levitt's targets: 2-down converges on 70.7 %, 3-down on 79.4 % correct.
     #[test]
     fn the_rules_target_levitts_proportions() {
