@@ -3,7 +3,6 @@
 //! psychometric functions and draws them; `study check FILE` validates a study file.
 
 use crate::exit::{Failure, Status};
-use haptic2d::scene::MAX_FILE_BYTES;
 use haptic2d_lab::study::analyse::{analyse_dir, AnalyseOptions};
 use haptic2d_lab::study::fit::Shape;
 use haptic2d_lab::study::method::Method;
@@ -127,9 +126,7 @@ fn study_run(
         )));
     }
     let study = load(file)?;
-    if std::fs::metadata(file).map(|m| m.len()).unwrap_or(0) > MAX_FILE_BYTES {
-        return Err(Failure::from(format!("{} is too large", file.display())));
-    }
+    // The text stored beside the data (Study::load has checked its size and content).
     let text = std::fs::read_to_string(file)
         .map_err(|e| Failure::from(format!("cannot read {}: {e}", file.display())))?;
     let seed = session_seed(study.seed, participant, session);

@@ -3,7 +3,7 @@
 //! through the real world step and answers 2AFC trials (a **model**, never data), sessions written as
 //! per-trial TSV that resume without losing or repeating a trial, and the psychometric analysis.
 //!
-//! - [`file`]: the study file (TOML) and its validation → [`Study`].
+//! - [`file`](mod@file): the study file (TOML) and its validation → [`Study`].
 //! - [`stimulus`]: a named parameter set applied to the scene → a [`World`](haptic2d::world::World).
 //! - [`method`], [`staircase`], [`schedule`]: what is presented when.
 //! - [`observer`]: the [`Observer`] trait and the [`SimulatedObserver`] model.
