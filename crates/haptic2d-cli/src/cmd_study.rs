@@ -125,10 +125,7 @@ fn study_run(
             "--observer {observer}: only `simulated` is built (the simulated observer, a model)\n    fix: --observer simulated; answers from the browser page or device buttons are not built yet"
         )));
     }
-    let study = load(file)?;
-    // The text stored beside the data (Study::load has checked its size and content).
-    let text = std::fs::read_to_string(file)
-        .map_err(|e| Failure::from(format!("cannot read {}: {e}", file.display())))?;
+    let (study, text) = Study::read(file).map_err(Failure::from)?;
     let seed = session_seed(study.seed, participant, session);
     let mut obs = SimulatedObserver::new(study.observer, seed);
     eprintln!(

@@ -214,6 +214,12 @@ pub struct Study {
 impl Study {
     /// Reads and validates a study file; a relative `scene` path is resolved beside it.
     pub fn load(path: &Path) -> Result<Study, String> {
+        Self::read(path).map(|(s, _)| s)
+    }
+
+    /// As [`load`](Self::load), also returning the file's text (the text validated is the text to
+    /// store beside the data: the file is read once).
+    pub fn read(path: &Path) -> Result<(Study, String), String> {
         let meta = std::fs::metadata(path)
             .map_err(|e| format!("cannot read study file {}: {e}", path.display()))?;
         if meta.len() > MAX_FILE_BYTES {
@@ -225,8 +231,9 @@ impl Study {
         }
         let text = std::fs::read_to_string(path)
             .map_err(|e| format!("cannot read study file {}: {e}", path.display()))?;
-        Study::from_toml(&text, &path.display().to_string(), path.parent())
-            .map_err(|e| e.to_string().trim_end().to_string())
+        let study = Study::from_toml(&text, &path.display().to_string(), path.parent())
+            .map_err(|e| e.to_string().trim_end().to_string())?;
+        Ok((study, text))
     }
 
     /// Parses and validates study text; `dir` resolves a relative scene path.
