@@ -90,6 +90,14 @@ fn study_interrupted_by_sigint_resumes_with_no_trial_lost_or_repeated() {
         "{out}"
     );
     assert!(b.join("analysis.tsv").is_file() && b.join("psychometric.svg").is_file());
+    // The per-level counts add up to the analysed (non-practice) trials.
+    let levels = std::fs::read_to_string(b.join("analysis-levels.tsv")).unwrap();
+    let n: u32 = levels
+        .lines()
+        .skip(1)
+        .map(|l| l.split('\t').nth(2).unwrap().parse::<u32>().unwrap())
+        .sum();
+    assert_eq!(n, 7 * 150, "{levels}");
     let table = std::fs::read_to_string(b.join("analysis.tsv")).unwrap();
     assert!(
         table

@@ -191,6 +191,18 @@ pub fn results_tsv(res: &[ConditionResult]) -> String {
     s
 }
 
+/// The trials per stimulus level as a TSV table (`condition delta n_trials n_correct`: the
+/// `[x, k, n]` data other fitting tools such as psignifit take).
+pub fn levels_tsv(res: &[ConditionResult]) -> String {
+    let mut s = String::from("condition\tdelta\tn_trials\tn_correct\n");
+    for r in res {
+        for p in &r.points {
+            s.push_str(&format!("{}\t{}\t{}\t{}\n", r.condition, p.x, p.n, p.k));
+        }
+    }
+    s
+}
+
 /// Three significant figures (at least the integer part).
 fn short(x: f64) -> String {
     let digits = if x.abs() >= 100.0 {
@@ -267,8 +279,8 @@ pub fn plot(res: &[ConditionResult], stem: &Path, title: &str) -> Result<Vec<Pat
     write_panels(stem, title, &panels, 2, (640, 440))
 }
 
-/// Analyses every session at or below `dir` and writes `analysis.tsv` and `psychometric.svg/.png`
-/// in `dir`. Returns the results and the written paths.
+/// Analyses every session at or below `dir` and writes `analysis.tsv`, `analysis-levels.tsv` and
+/// `psychometric.svg/.png` in `dir`. Returns the results and the written paths.
 pub fn analyse_dir(
     dir: &Path,
     opts: &AnalyseOptions,
@@ -283,7 +295,9 @@ pub fn analyse_dir(
     let res = analyse_rows(&rows, opts)?;
     let tsv = dir.join("analysis.tsv");
     std::fs::write(&tsv, results_tsv(&res)).map_err(|e| format!("{}: {e}", tsv.display()))?;
-    let mut paths = vec![tsv];
+    let levels = dir.join("analysis-levels.tsv");
+    std::fs::write(&levels, levels_tsv(&res)).map_err(|e| format!("{}: {e}", levels.display()))?;
+    let mut paths = vec![tsv, levels];
     paths.extend(plot(
         &res,
         &dir.join("psychometric"),
