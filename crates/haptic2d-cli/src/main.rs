@@ -10,6 +10,7 @@ mod cmd_run;
 mod cmd_scenes;
 mod cmd_simulate;
 mod cmd_stability;
+mod cmd_study;
 mod cmd_sweep;
 mod controller_file;
 mod csv_out;
@@ -126,6 +127,10 @@ enum Command {
     /// (tick logs between CSV and MCAP, by extension).
     #[command(subcommand, after_help = examples_help(LOG_EXAMPLES))]
     Log(cmd_log::LogCmd),
+    /// Perceptual studies (docs/STUDIES.md): `study run FILE --observer simulated`, `study analyse
+    /// DIR`, `study check FILE`.
+    #[command(subcommand)]
+    Study(cmd_study::StudyCmd),
     /// Parameter sweeps; `walls`: stiffness × damping of every wall law, classified by energy gain.
     Sweep {
         /// What to sweep: walls.
@@ -312,6 +317,7 @@ fn main() -> ExitCode {
         } => cmd_reproduce::run(&figure, &out, strict, controller_file.as_deref())
             .map(|()| Status::Clean),
         Command::Log(cmd) => cmd_log::run(&cmd),
+        Command::Study(cmd) => cmd_study::run(&cmd),
         Command::Sweep {
             target,
             rate,

@@ -31,6 +31,7 @@ pub mod network;
 pub mod plot;
 pub mod schema;
 pub mod stability;
+pub mod study;
 pub mod sweep;
 pub mod world2d;
 

@@ -1,0 +1,223 @@
+//! `haptic2d study`: perceptual studies (docs/STUDIES.md). `study run FILE --observer simulated`
+//! runs (or resumes) a session headless on the simulated observer; `study analyse DIR` fits the
+//! psychometric functions and draws them; `study check FILE` validates a study file.
+
+use crate::exit::{Failure, Status};
+use haptic2d_lab::study::analyse::{analyse_dir, AnalyseOptions};
+use haptic2d_lab::study::fit::Shape;
+use haptic2d_lab::study::method::Method;
+use haptic2d_lab::study::{run as run_session, session_seed, SimulatedObserver, Study};
+use std::path::{Path, PathBuf};
+
+/// `haptic2d study` subcommands.
+#[derive(clap::Subcommand, Debug)]
+pub enum StudyCmd {
+    /// Run (or resume) one session of a study: writes OUT/sub-ID/ses-N/ with trials.tsv, the study
+    /// file and session.json. An existing session resumes after its last recorded trial.
+    Run {
+        /// The study file (TOML, docs/STUDIES.md), e.g. studies/stiffness-walls.toml.
+        file: PathBuf,
+        /// Who answers: `simulated` (the simulated observer, a model, parameters in the file's
+        /// [observer]). The browser page and device buttons are not built yet.
+        #[arg(long, default_value = "simulated")]
+        observer: String,
+        /// Output folder (one sub-ID/ses-N directory per participant and session inside).
+        #[arg(long, default_value = "study-data")]
+        out: PathBuf,
+        /// Pseudonymous participant ID (letters, digits, '-'; never a name).
+        #[arg(long, default_value = "sim01")]
+        participant: String,
+        /// Session number.
+        #[arg(long, default_value_t = 1)]
+        session: u32,
+        /// Stop after this many new trials (the session resumes on the next run).
+        #[arg(long)]
+        stop_after: Option<u32>,
+    },
+    /// Fit psychometric functions per condition (maximum likelihood, guess rate 0.5, fitted lapse
+    /// rate, parametric-bootstrap 95 % intervals), report JNDs and Weber fractions, and write
+    /// analysis.tsv and psychometric.svg/.png into DIR.
+    Analyse {
+        /// A session directory (OUT/sub-ID/ses-N) or the --out folder of `study run` (its sessions
+        /// are pooled per condition).
+        dir: PathBuf,
+        /// Psychometric function: weibull or normal (cumulative normal).
+        #[arg(long, default_value = "weibull")]
+        shape: String,
+        /// Bootstrap repetitions.
+        #[arg(long, default_value_t = 500)]
+        bootstrap: u32,
+        /// Seed of the bootstrap.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+    },
+    /// Validate a study file and explain every problem found.
+    Check {
+        /// The study file.
+        file: PathBuf,
+    },
+}
+
+/// Runs a `study` subcommand.
+pub fn run(cmd: &StudyCmd) -> Result<Status, Failure> {
+    match cmd {
+        StudyCmd::Run {
+            file,
+            observer,
+            out,
+            participant,
+            session,
+            stop_after,
+        } => study_run(file, observer, out, participant, *session, *stop_after),
+        StudyCmd::Analyse {
+            dir,
+            shape,
+            bootstrap,
+            seed,
+        } => analyse(dir, shape, *bootstrap, *seed),
+        StudyCmd::Check { file } => {
+            let study = load(file)?;
+            println!(
+                "{}: ok: study `{}`, scene {}, {} condition(s), {} block(s), {}",
+                file.display(),
+                study.name,
+                study.scene_source,
+                study.conditions.len(),
+                study.blocks.len(),
+                describe_method(&study.method)
+            );
+            Ok(Status::Clean)
+        }
+    }
+}
+
+fn describe_method(m: &Method) -> String {
+    match m {
+        Method::Constant { deltas, repeats } => format!(
+            "constant stimuli: {} deltas × {repeats} repeats per condition",
+            deltas.len()
+        ),
+        Method::Staircase(s) => format!(
+            "{} interleaved 1-up/{}-down staircase(s) per condition (target {:.1} % correct), stop at {} trials or {} reversals",
+            s.starts.len(),
+            s.down,
+            100.0 * s.target(),
+            s.max_trials,
+            s.max_reversals
+        ),
+    }
+}
+
+fn load(file: &Path) -> Result<Study, Failure> {
+    Study::load(file).map_err(Failure::from)
+}
+
+fn study_run(
+    file: &Path,
+    observer: &str,
+    out: &Path,
+    participant: &str,
+    session: u32,
+    stop_after: Option<u32>,
+) -> Result<Status, Failure> {
+    if observer != "simulated" {
+        return Err(Failure::from(format!(
+            "--observer {observer}: only `simulated` is built (the simulated observer, a model)\n    fix: --observer simulated; answers from the browser page or device buttons are not built yet"
+        )));
+    }
+    let (study, text) = Study::read(file).map_err(Failure::from)?;
+    let seed = session_seed(study.seed, participant, session);
+    let mut obs = SimulatedObserver::new(study.observer, seed);
+    eprintln!(
+        "study `{}`: participant {participant}, session {session}, {}; answered by the simulated observer (a model, not data: W = {}, λ = {})",
+        study.name,
+        describe_method(&study.method),
+        study.observer.weber_fraction,
+        study.observer.lapse_rate
+    );
+    let mut last_pct = u32::MAX;
+    let mut progress = |done: u32, planned: u32| {
+        let pct = (100 * done) / planned.max(1);
+        if pct / 10 != last_pct / 10 || done == planned {
+            last_pct = pct;
+            eprintln!("  trial {done} of at most {planned} ({pct} %)");
+        }
+    };
+    let s = run_session(
+        &study,
+        &text,
+        out,
+        participant,
+        session,
+        &mut obs,
+        &mut progress,
+        stop_after,
+    )
+    .map_err(Failure::error)?;
+    println!(
+        "{}: {} trial(s) run{}; {}",
+        s.dir.display(),
+        s.ran,
+        if s.resumed > 0 {
+            format!(" after {} resumed from trials.tsv", s.resumed)
+        } else {
+            String::new()
+        },
+        if s.complete {
+            format!(
+                "session complete\nnext: haptic2d study analyse {}",
+                s.dir.display()
+            )
+        } else {
+            "session not complete: run the same command again to resume".into()
+        }
+    );
+    Ok(Status::Clean)
+}
+
+fn analyse(dir: &Path, shape: &str, bootstrap: u32, seed: u64) -> Result<Status, Failure> {
+    let shape = Shape::from_name(shape).map_err(|e| Failure::from(format!("--shape: {e}")))?;
+    if !(10..=100_000).contains(&bootstrap) {
+        return Err(Failure::from(format!(
+            "--bootstrap {bootstrap}: give 10 to 100000 repetitions"
+        )));
+    }
+    let opts = AnalyseOptions {
+        shape,
+        bootstrap,
+        seed,
+        ..Default::default()
+    };
+    let (res, paths) = analyse_dir(dir, &opts).map_err(Failure::from)?;
+    for r in &res {
+        println!(
+            "{} ({}, reference {}): {} trials, {} fit (α = {:.4}, β = {:.3}, lapse {:.3})",
+            r.condition,
+            r.vary,
+            r.reference_value,
+            r.trials,
+            r.fit.shape.name(),
+            r.fit.alpha,
+            r.fit.beta,
+            r.fit.lapse
+        );
+        println!(
+            "  JND (75 % correct) {:.4} [{:.4}, {:.4}] (95 % parametric bootstrap, {bootstrap} reps)",
+            r.jnd, r.jnd_ci.0, r.jnd_ci.1
+        );
+        println!(
+            "  Weber fraction {:.4} [{:.4}, {:.4}]",
+            r.weber, r.weber_ci.0, r.weber_ci.1
+        );
+        if let Some(e) = r.staircase_estimate {
+            println!("  staircase estimate (mean delta at reversals after the second) {e:.4}");
+        }
+        println!(
+            "  PSE: not defined by this design (the comparison is always the stiffer stimulus)"
+        );
+    }
+    for p in paths {
+        println!("wrote {}", p.display());
+    }
+    Ok(Status::Clean)
+}

@@ -1,0 +1,563 @@
+//! The TOML schema of a study file (serde types, unknown fields are errors) and its validation into a
+//! [`Study`]: every problem is reported with the field it concerns and the fix, as scene files are.
+//!
+//! The format is documented in `docs/STUDIES.md`; `studies/stiffness-walls.toml` is a worked example.
+
+use super::method::Method;
+use super::observer::ObserverParams;
+use super::stimulus::{self, Param};
+use haptic2d::scene::{SceneError, SceneErrors, BUILTIN, MAX_FILE_BYTES};
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// A whole study file.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StudyFile {
+    /// Study name (used in reports).
+    pub name: Option<String>,
+    /// One-line description.
+    pub description: Option<String>,
+    /// A built-in scene name (`haptic2d scenes`) or a scene file path relative to the study file.
+    pub scene: String,
+    /// Control rate (Hz) overriding the scene's `world.rate`.
+    pub rate: Option<f64>,
+    /// The body the participant's handle holds (the simulated hand presses it).
+    pub probe: String,
+    /// Unit direction (world frame) from the probe toward the wall it explores.
+    pub toward: [f64; 2],
+    /// Seed of every random choice (trial order, interval order); recorded with the data.
+    pub seed: u64,
+    /// The task.
+    pub task: TaskSection,
+    /// Named stimuli: parameter sets of the wall (`normal`) and friction (`friction`) laws.
+    #[serde(default)]
+    pub stimuli: BTreeMap<String, StimulusSection>,
+    /// Conditions: a reference stimulus, the comparison and the parameter the method varies.
+    #[serde(rename = "condition", default)]
+    pub conditions: Vec<ConditionSection>,
+    /// The psychophysical method.
+    pub method: MethodSection,
+    /// Blocks (default: one block with every condition, no practice).
+    #[serde(rename = "block", default)]
+    pub blocks: Vec<BlockSection>,
+    /// Parameters of the simulated observer (a model, not data).
+    #[serde(default)]
+    pub observer: ObserverSection,
+}
+
+/// `[task]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TaskSection {
+    /// `"2afc"` or `"2ifc"`: two intervals, one reference and one comparison; "which was stiffer?".
+    pub kind: String,
+}
+
+/// `[stimuli.NAME]`: a parameter set; each table is a scene file's `[normal]`/`[friction]` table.
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StimulusSection {
+    /// Wall law and its parameters, e.g. `{ model = "paper", kc = 1000.0, bc = 5.0 }` (default: the scene's).
+    pub normal: Option<toml::Table>,
+    /// Friction model and its parameters (default: the scene's).
+    pub friction: Option<toml::Table>,
+}
+
+/// `[[condition]]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ConditionSection {
+    /// Condition name (a label in the data).
+    pub name: String,
+    /// The reference stimulus (a key of `[stimuli]`).
+    pub reference: String,
+    /// The comparison's base stimulus (default: the reference).
+    pub comparison: Option<String>,
+    /// The comparison parameter the method varies, `normal.KEY` or `friction.KEY`: the comparison
+    /// presents the base stimulus with that parameter raised by the method's delta.
+    pub vary: String,
+}
+
+/// `[method]`.
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MethodSection {
+    /// `"constant"` (method of constant stimuli) or `"staircase"` (transformed up/down).
+    pub kind: String,
+    /// Constant stimuli: the deltas (comparison − base, in the unit of `vary`), all > 0.
+    pub deltas: Option<Vec<f64>>,
+    /// Constant stimuli: presentations of each delta per condition.
+    pub repeats: Option<u32>,
+    /// Staircase: `"1-up-2-down"` (→ 70.7 % correct) or `"1-up-3-down"` (→ 79.4 %).
+    pub rule: Option<String>,
+    /// Staircase: the starting delta of each interleaved staircase of a condition.
+    pub starts: Option<Vec<f64>>,
+    /// Staircase: multiplicative step (down = delta / f, up = delta · f), > 1.
+    pub step_factor: Option<f64>,
+    /// Staircase: the step factor until the second reversal (default `step_factor`).
+    pub initial_step_factor: Option<f64>,
+    /// Staircase: stop after this many trials.
+    pub max_trials: Option<u32>,
+    /// Staircase: stop after this many reversals.
+    pub max_reversals: Option<u32>,
+    /// Staircase: smallest delta (default: the smallest start / 64).
+    pub min_delta: Option<f64>,
+    /// Staircase: largest delta (default: 4 × the largest start).
+    pub max_delta: Option<f64>,
+}
+
+/// `[[block]]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BlockSection {
+    /// The conditions run (interleaved at random) in this block.
+    pub conditions: Vec<String>,
+    /// Practice trials at the start of the block (easiest delta; not analysed).
+    pub practice: Option<u32>,
+}
+
+/// `[observer]`: the simulated observer's model parameters.
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObserverSection {
+    /// Weber fraction `W`: the relative stiffness increment the model discriminates at 75 % correct.
+    pub weber_fraction: Option<f64>,
+    /// Lapse rate `λ`: the probability the model answers at random.
+    pub lapse_rate: Option<f64>,
+    /// The two press forces `[F1, F2]` (N) of the exploration, `0 < F1 < F2`.
+    pub press_forces: Option<[f64; 2]>,
+    /// Duration of each press (s).
+    pub press_time: Option<f64>,
+    /// Median decision time added to the exploration time (s).
+    pub decision_time: Option<f64>,
+}
+
+/// The task of a study.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Task {
+    /// Two intervals (reference and comparison in random order), "which was stiffer?".
+    TwoAfc,
+}
+
+impl Task {
+    /// The guess rate `γ` of the task (0.5 for two alternatives).
+    pub fn guess_rate(self) -> f64 {
+        match self {
+            Task::TwoAfc => 0.5,
+        }
+    }
+}
+
+/// A validated condition.
+#[derive(Clone, Debug)]
+pub struct Condition {
+    /// Condition name.
+    pub name: String,
+    /// Reference stimulus name.
+    pub reference: String,
+    /// Comparison base stimulus name.
+    pub comparison: String,
+    /// The varied parameter.
+    pub vary: Param,
+    /// The value of `vary` in the reference stimulus (unit of the parameter).
+    pub reference_value: f64,
+    /// The value of `vary` in the comparison base stimulus.
+    pub base_value: f64,
+}
+
+/// A validated block.
+#[derive(Clone, Debug)]
+pub struct Block {
+    /// Indices into [`Study::conditions`].
+    pub conditions: Vec<usize>,
+    /// Practice trials at its start.
+    pub practice: u32,
+}
+
+/// A validated study, ready to run.
+#[derive(Clone, Debug)]
+pub struct Study {
+    /// Study name.
+    pub name: String,
+    /// Description.
+    pub description: String,
+    /// Where the study came from (file path).
+    pub source: String,
+    /// The scene's TOML text and its source (built-in name or path).
+    pub scene_text: String,
+    /// The scene's source, for messages.
+    pub scene_source: String,
+    /// Control rate override (Hz).
+    pub rate: Option<f64>,
+    /// Probe body name.
+    pub probe: String,
+    /// Unit direction toward the wall.
+    pub toward: [f64; 2],
+    /// Recorded seed.
+    pub seed: u64,
+    /// Task.
+    pub task: Task,
+    /// Named stimuli.
+    pub stimuli: BTreeMap<String, StimulusSection>,
+    /// Conditions.
+    pub conditions: Vec<Condition>,
+    /// Method.
+    pub method: Method,
+    /// Blocks.
+    pub blocks: Vec<Block>,
+    /// The simulated observer's parameters.
+    pub observer: ObserverParams,
+}
+
+impl Study {
+    /// Reads and validates a study file; a relative `scene` path is resolved beside it.
+    pub fn load(path: &Path) -> Result<Study, String> {
+        Self::read(path).map(|(s, _)| s)
+    }
+
+    /// As [`load`](Self::load), also returning the file's text (the text validated is the text to
+    /// store beside the data: the file is read once).
+    pub fn read(path: &Path) -> Result<(Study, String), String> {
+        let meta = std::fs::metadata(path)
+            .map_err(|e| format!("cannot read study file {}: {e}", path.display()))?;
+        if meta.len() > MAX_FILE_BYTES {
+            return Err(format!(
+                "study file {} is {} bytes, more than {MAX_FILE_BYTES}",
+                path.display(),
+                meta.len()
+            ));
+        }
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| format!("cannot read study file {}: {e}", path.display()))?;
+        let study = Study::from_toml(&text, &path.display().to_string(), path.parent())
+            .map_err(|e| e.to_string().trim_end().to_string())?;
+        Ok((study, text))
+    }
+
+    /// Parses and validates study text; `dir` resolves a relative scene path.
+    pub fn from_toml(text: &str, source: &str, dir: Option<&Path>) -> Result<Study, SceneErrors> {
+        let fail = |errors| SceneErrors {
+            source: source.to_string(),
+            errors,
+        };
+        let file: StudyFile = toml::from_str(text).map_err(|e| {
+            fail(vec![SceneError::from_toml(
+                text,
+                &e,
+                "check the TOML syntax and field names against docs/STUDIES.md",
+            )])
+        })?;
+        let mut errs = Vec::new();
+        let study = validate(file, source, dir, &mut errs);
+        match study {
+            Some(s) if errs.is_empty() => Ok(s),
+            _ => Err(fail(errs)),
+        }
+    }
+
+    /// The index of the condition called `name`.
+    pub fn condition_index(&self, name: &str) -> Option<usize> {
+        self.conditions.iter().position(|c| c.name == name)
+    }
+}
+
+fn err(errs: &mut Vec<SceneError>, field: &str, msg: impl Into<String>, fix: impl Into<String>) {
+    errs.push(SceneError::new(field, msg, fix));
+}
+
+fn scene_text(scene: &str, dir: Option<&Path>) -> Result<(String, String), String> {
+    if let Some((_, _, text)) = BUILTIN.iter().find(|b| b.0 == scene) {
+        return Ok((text.to_string(), format!("built-in:{scene}")));
+    }
+    let p = match dir {
+        Some(d) if Path::new(scene).is_relative() => d.join(scene),
+        _ => Path::new(scene).to_path_buf(),
+    };
+    match std::fs::metadata(&p) {
+        Ok(m) if m.len() > MAX_FILE_BYTES => Err(format!(
+            "{} is larger than {MAX_FILE_BYTES} bytes",
+            p.display()
+        )),
+        Ok(_) => std::fs::read_to_string(&p)
+            .map(|t| (t, p.display().to_string()))
+            .map_err(|e| format!("cannot read {}: {e}", p.display())),
+        Err(e) => Err(format!(
+            "`{scene}` is no built-in scene and no readable file ({}: {e})",
+            p.display()
+        )),
+    }
+}
+
+fn validate(
+    f: StudyFile,
+    source: &str,
+    dir: Option<&Path>,
+    errs: &mut Vec<SceneError>,
+) -> Option<Study> {
+    let task = match f.task.kind.as_str() {
+        "2afc" | "2ifc" => Task::TwoAfc,
+        other => {
+            err(
+                errs,
+                "task.kind",
+                format!("unknown task `{other}`"),
+                "write kind = \"2afc\" (or \"2ifc\"); 3AFC, same–different and magnitude estimation are not built yet",
+            );
+            Task::TwoAfc
+        }
+    };
+    let (scene_text, scene_source) = match scene_text(&f.scene, dir) {
+        Ok(t) => t,
+        Err(e) => {
+            err(errs, "scene", e, "give a built-in scene name (`haptic2d scenes`) or a scene file path relative to the study file");
+            return None;
+        }
+    };
+    if let Some(r) = f.rate {
+        if !(r.is_finite() && r > 0.0) {
+            err(
+                errs,
+                "rate",
+                format!("must be a positive rate in Hz, got {r}"),
+                "e.g. rate = 500.0, or remove it to use the scene's",
+            );
+        }
+    }
+    let n = (f.toward[0].powi(2) + f.toward[1].powi(2)).sqrt();
+    let toward = if n.is_finite() && n > 1e-9 {
+        [f.toward[0] / n, f.toward[1] / n]
+    } else {
+        err(
+            errs,
+            "toward",
+            "must be a non-zero direction",
+            "e.g. toward = [-1.0, 0.0] for a wall on the probe's left",
+        );
+        [1.0, 0.0]
+    };
+    if f.stimuli.is_empty() {
+        err(
+            errs,
+            "stimuli",
+            "no stimulus defined",
+            "add e.g. [stimuli.spring] normal = { model = \"paper\", kc = 1000.0 }",
+        );
+    }
+    let observer = ObserverParams::from_section(&f.observer, errs);
+    let method = Method::from_section(&f.method, errs);
+    // Conditions.
+    let mut conditions = Vec::new();
+    if f.conditions.is_empty() {
+        err(
+            errs,
+            "condition",
+            "no condition defined",
+            "add a [[condition]] with name, reference and vary",
+        );
+    }
+    for (i, c) in f.conditions.iter().enumerate() {
+        let field = format!("condition[{i}]");
+        if f.conditions[..i].iter().any(|o| o.name == c.name) {
+            err(
+                errs,
+                &format!("{field}.name"),
+                format!("`{}` is used twice", c.name),
+                "give every condition its own name",
+            );
+        }
+        if c.name.is_empty() || c.name.contains(['\t', '\n']) {
+            err(
+                errs,
+                &format!("{field}.name"),
+                "must be non-empty, without tabs or newlines",
+                "e.g. name = \"spring-1000\"",
+            );
+        }
+        let comparison = c.comparison.clone().unwrap_or_else(|| c.reference.clone());
+        let mut ok = true;
+        for (key, s) in [("reference", &c.reference), ("comparison", &comparison)] {
+            if !f.stimuli.contains_key(s) {
+                ok = false;
+                err(
+                    errs,
+                    &format!("{field}.{key}"),
+                    format!("no stimulus called `{s}`"),
+                    format!(
+                        "use one of: {}",
+                        f.stimuli.keys().cloned().collect::<Vec<_>>().join(", ")
+                    ),
+                );
+            }
+        }
+        let vary = match Param::parse(&c.vary) {
+            Ok(p) => p,
+            Err(e) => {
+                err(
+                    errs,
+                    &format!("{field}.vary"),
+                    e,
+                    "write vary = \"normal.KEY\" or \"friction.KEY\", e.g. \"normal.kc\"",
+                );
+                continue;
+            }
+        };
+        if !ok {
+            continue;
+        }
+        let value = |name: &str, errs: &mut Vec<SceneError>| -> Option<f64> {
+            match stimulus::param_value(&f.stimuli[name], &vary) {
+                Ok(v) => Some(v),
+                Err(e) => {
+                    err(
+                        errs,
+                        &format!("stimuli.{name}.{vary}"),
+                        e,
+                        format!("set {vary} in stimulus `{name}` (the method varies it)"),
+                    );
+                    None
+                }
+            }
+        };
+        let (Some(reference_value), Some(base_value)) =
+            (value(&c.reference, errs), value(&comparison, errs))
+        else {
+            continue;
+        };
+        conditions.push(Condition {
+            name: c.name.clone(),
+            reference: c.reference.clone(),
+            comparison,
+            vary,
+            reference_value,
+            base_value,
+        });
+    }
+    // Blocks.
+    let mut blocks = Vec::new();
+    if f.blocks.is_empty() {
+        blocks.push(Block {
+            conditions: (0..conditions.len()).collect(),
+            practice: 0,
+        });
+    }
+    let mut used = vec![false; f.conditions.len()];
+    for (i, b) in f.blocks.iter().enumerate() {
+        let field = format!("block[{i}]");
+        let mut idx = Vec::new();
+        if b.conditions.is_empty() {
+            err(
+                errs,
+                &format!("{field}.conditions"),
+                "lists no condition",
+                "list the condition names this block runs",
+            );
+        }
+        for name in &b.conditions {
+            match f.conditions.iter().position(|c| &c.name == name) {
+                Some(k) if used[k] => err(
+                    errs,
+                    &format!("{field}.conditions"),
+                    format!("condition `{name}` is already in an earlier block"),
+                    "put each condition in one block",
+                ),
+                Some(k) => {
+                    used[k] = true;
+                    idx.push(k);
+                }
+                None => err(
+                    errs,
+                    &format!("{field}.conditions"),
+                    format!("no condition called `{name}`"),
+                    "use the names of the [[condition]] tables",
+                ),
+            }
+        }
+        let practice = b.practice.unwrap_or(0);
+        if practice > 1000 {
+            err(
+                errs,
+                &format!("{field}.practice"),
+                format!("{practice} practice trials"),
+                "use at most 1000",
+            );
+        }
+        blocks.push(Block {
+            conditions: idx,
+            practice,
+        });
+    }
+    if !f.blocks.is_empty() {
+        for (k, u) in used.iter().enumerate() {
+            if !u {
+                err(
+                    errs,
+                    "block",
+                    format!("condition `{}` is in no block", f.conditions[k].name),
+                    "add it to a block's conditions, or remove it",
+                );
+            }
+        }
+    }
+    let method = method?;
+    let study = Study {
+        name: f.name.clone().unwrap_or_else(|| "study".into()),
+        description: f.description.clone().unwrap_or_default(),
+        source: source.to_string(),
+        scene_text,
+        scene_source,
+        rate: f.rate,
+        probe: f.probe.clone(),
+        toward,
+        seed: f.seed,
+        task,
+        stimuli: f.stimuli.clone(),
+        conditions,
+        method,
+        blocks,
+        observer: observer.unwrap_or_default(),
+    };
+    // Every stimulus a condition can present must build a valid scene with the probe in it (checked
+    // even when other fields have problems, so all are reported at once).
+    {
+        let largest = study.method.largest_delta();
+        for c in &study.conditions {
+            for (which, delta) in [(&c.reference, None), (&c.comparison, Some(largest))] {
+                if delta.is_some_and(|d| !(d.is_finite() && d > 0.0)) {
+                    continue; // the method's own error is reported
+                }
+                let vary = delta.map(|d| (&c.vary, d));
+                match stimulus::world(&study, which, vary) {
+                    Ok(w) => {
+                        if w.body_index(&study.probe).is_none() {
+                            err(
+                                errs,
+                                "probe",
+                                format!("the scene has no body called `{}`", study.probe),
+                                "name a dynamic body of the scene",
+                            );
+                            return None;
+                        }
+                    }
+                    Err(e) => {
+                        for mut s in e {
+                            s.field = format!("stimuli.{which}.{}", s.field);
+                            if delta.is_some() {
+                                s.message = format!(
+                                    "{} (comparison at the largest delta {largest})",
+                                    s.message
+                                );
+                            }
+                            // The same stimulus as reference and comparison: report it once.
+                            if !errs.iter().any(|e| e.field == s.field) {
+                                errs.push(s);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+    Some(study)
+}

@@ -1,0 +1,33 @@
+//! Perceptual studies (issue 40, first slice): study files, the trial schedule (method of constant
+//! stimuli, interleaved transformed up/down staircases), a simulated observer that explores the wall
+//! through the real world step and answers 2AFC trials (a **model**, never data), sessions written as
+//! per-trial TSV that resume without losing or repeating a trial, and the psychometric analysis.
+//!
+//! - [`file`](mod@file): the study file (TOML) and its validation → [`Study`].
+//! - [`stimulus`]: a named parameter set applied to the scene → a [`World`](haptic2d::world::World).
+//! - [`method`], [`staircase`], [`schedule`]: what is presented when.
+//! - [`observer`]: the [`Observer`] trait and the [`SimulatedObserver`] model.
+//! - [`trials`], [`session`]: the data on disk, running and resuming a session.
+//! - [`fit`], [`analyse`]: psychometric fits, bootstrap intervals, reports and plots.
+//! - [`numeric`], [`rng`]: the normal CDF, Nelder–Mead and a seeded generator.
+//!
+//! Not built yet: answers from the browser page or device buttons, trials on a real device, MCAP per
+//! trial, QUEST, 3AFC/same–different/magnitude estimation, PsychoPy (see `docs/STUDIES.md`).
+
+pub mod analyse;
+pub mod file;
+pub mod fit;
+pub mod method;
+pub mod numeric;
+pub mod observer;
+pub mod rng;
+pub mod schedule;
+pub mod session;
+pub mod staircase;
+pub mod stimulus;
+pub mod trials;
+
+pub use analyse::{analyse_dir, AnalyseOptions, ConditionResult};
+pub use file::Study;
+pub use observer::{Observer, ObserverParams, SimulatedObserver};
+pub use session::{run, session_dir, session_seed, RunSummary};

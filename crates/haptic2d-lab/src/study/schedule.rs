@@ -1,0 +1,177 @@
+//! The trial schedule of one session: blocks in order, practice trials at the start of each block,
+//! then the block's conditions interleaved at random (constant stimuli: every delta × repeats,
+//! shuffled; staircases: a random unfinished staircase each trial), and the interval order of each
+//! trial. Every choice comes from one generator seeded by the session seed, so the schedule is a
+//! function of the seed and the answers: replaying a session's recorded answers reproduces it
+//! trial for trial (that is how a session resumes).
+
+use super::file::Study;
+use super::method::Method;
+use super::rng::Rng;
+use super::staircase::Staircase;
+
+/// One scheduled trial.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TrialSpec {
+    /// Trial number in the session, from 1.
+    pub trial: u32,
+    /// Block number, from 1.
+    pub block: u32,
+    /// A practice trial (not analysed, does not move a staircase).
+    pub practice: bool,
+    /// Condition index.
+    pub condition: usize,
+    /// Staircase index (`None` for constant stimuli and practice).
+    pub track: Option<usize>,
+    /// Comparison − base value of the varied parameter.
+    pub delta: f64,
+    /// The interval (1 or 2) presenting the comparison.
+    pub comparison_interval: u8,
+}
+
+/// One staircase of the session.
+#[derive(Clone, Debug)]
+pub struct Track {
+    /// Its condition.
+    pub condition: usize,
+    /// Its state.
+    pub stair: Staircase,
+}
+
+/// The schedule's state.
+#[derive(Clone, Debug)]
+pub struct Schedule {
+    study: Study,
+    rng: Rng,
+    block: usize,
+    started: bool,
+    practice_left: u32,
+    queue: Vec<(usize, f64)>,
+    /// The staircases (all conditions; empty for constant stimuli).
+    pub tracks: Vec<Track>,
+    trial: u32,
+}
+
+impl Schedule {
+    /// A schedule for `study` from `seed`.
+    pub fn new(study: &Study, seed: u64) -> Self {
+        let mut tracks = Vec::new();
+        if let Method::Staircase(s) = &study.method {
+            for (c, _) in study.conditions.iter().enumerate() {
+                for &start in &s.starts {
+                    tracks.push(Track {
+                        condition: c,
+                        stair: Staircase::new(s, start),
+                    });
+                }
+            }
+        }
+        Self {
+            study: study.clone(),
+            rng: Rng::new(seed),
+            block: 0,
+            started: false,
+            practice_left: 0,
+            queue: Vec::new(),
+            tracks,
+            trial: 0,
+        }
+    }
+
+    fn start_block(&mut self) {
+        let b = &self.study.blocks[self.block];
+        self.practice_left = b.practice;
+        self.queue.clear();
+        if let Method::Constant { deltas, repeats } = &self.study.method {
+            for &c in &b.conditions {
+                for &d in deltas {
+                    for _ in 0..*repeats {
+                        self.queue.push((c, d));
+                    }
+                }
+            }
+            self.rng.shuffle(&mut self.queue);
+            self.queue.reverse(); // popped from the end: the shuffled order front to back
+        }
+        self.started = true;
+    }
+
+    fn open_tracks(&self) -> Vec<usize> {
+        let conds = &self.study.blocks[self.block].conditions;
+        (0..self.tracks.len())
+            .filter(|&t| conds.contains(&self.tracks[t].condition) && !self.tracks[t].stair.done())
+            .collect()
+    }
+
+    fn block_left(&self) -> bool {
+        match self.study.method {
+            Method::Constant { .. } => !self.queue.is_empty(),
+            Method::Staircase(_) => !self.open_tracks().is_empty(),
+        }
+    }
+
+    /// The next trial, or `None` when the session is over. Call [`record`](Self::record) with its
+    /// answer before asking for the next.
+    pub fn next_trial(&mut self) -> Option<TrialSpec> {
+        loop {
+            if self.block >= self.study.blocks.len() {
+                return None;
+            }
+            if !self.started {
+                self.start_block();
+            }
+            if self.block_left() {
+                break;
+            }
+            self.block += 1;
+            self.started = false;
+        }
+        self.trial += 1;
+        let conds = self.study.blocks[self.block].conditions.clone();
+        let (condition, track, delta, practice) = if self.practice_left > 0 {
+            self.practice_left -= 1;
+            let c = conds[self.rng.below(conds.len())];
+            (c, None, self.study.method.practice_delta(), true)
+        } else if let Some((c, d)) = self.queue.pop() {
+            (c, None, d, false)
+        } else {
+            let open = self.open_tracks();
+            let t = open[self.rng.below(open.len())];
+            (
+                self.tracks[t].condition,
+                Some(t),
+                self.tracks[t].stair.delta,
+                false,
+            )
+        };
+        let comparison_interval = 1 + self.rng.below(2) as u8;
+        Some(TrialSpec {
+            trial: self.trial,
+            block: self.block as u32 + 1,
+            practice,
+            condition,
+            track,
+            delta,
+            comparison_interval,
+        })
+    }
+
+    /// Records the answer to `spec` (moves its staircase).
+    pub fn record(&mut self, spec: &TrialSpec, correct: bool) {
+        if let Some(t) = spec.track {
+            self.tracks[t].stair.update(correct);
+        }
+    }
+
+    /// Trials the session will run at most (exact for constant stimuli; the trial limits for
+    /// staircases), for progress reports.
+    pub fn planned(&self) -> u32 {
+        let practice: u32 = self.study.blocks.iter().map(|b| b.practice).sum();
+        let n = self.study.conditions.len() as u32;
+        practice
+            + match &self.study.method {
+                Method::Constant { deltas, repeats } => n * deltas.len() as u32 * repeats,
+                Method::Staircase(s) => n * s.starts.len() as u32 * s.max_trials,
+            }
+    }
+}

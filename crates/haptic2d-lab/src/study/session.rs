@@ -1,0 +1,203 @@
+//! Running one session: the directory `OUT/sub-<ID>/ses-<N>/` holds `trials.tsv` (one row per
+//! answered trial, written and synced as each trial ends), `study.toml` (the study file, verbatim)
+//! and `session.json` (pseudonymous participant ID, session, seeds, software version, observer).
+//!
+//! A session whose directory already exists resumes: its rows are read (a line cut short by a crash
+//! is dropped), the schedule is replayed from the recorded answers (each replayed trial must match
+//! its row, or the study or seed changed and the run stops), and the remaining trials follow. No
+//! trial is lost or repeated.
+
+use super::file::Study;
+use super::observer::Observer;
+use super::rng::{hash_text, mix};
+use super::schedule::{Schedule, TrialSpec};
+use super::trials::{self, TrialRow, HEADER};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// The software version written beside the data.
+pub const VERSION: &str = concat!("haptic2d ", env!("CARGO_PKG_VERSION"));
+
+/// Checks a participant ID: 1–32 letters, digits or `-` (a pseudonymous code, never a name).
+pub fn check_participant(id: &str) -> Result<(), String> {
+    if !id.is_empty() && id.len() <= 32 && id.chars().all(|c| c.is_ascii_alphanumeric() || c == '-')
+    {
+        Ok(())
+    } else {
+        Err(format!(
+            "participant ID `{id}` is not 1–32 letters, digits or '-'\n    fix: use a pseudonymous code such as P07 (never a name)"
+        ))
+    }
+}
+
+/// The directory of a session.
+pub fn session_dir(out: &Path, participant: &str, session: u32) -> PathBuf {
+    out.join(format!("sub-{participant}"))
+        .join(format!("ses-{session}"))
+}
+
+/// The seed of a session: the study's recorded seed mixed with the participant ID and session, so
+/// every participant and session gets its own (reproducible) order.
+pub fn session_seed(study_seed: u64, participant: &str, session: u32) -> u64 {
+    mix(mix(study_seed, hash_text(participant)), u64::from(session))
+}
+
+/// What a run did.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RunSummary {
+    /// The session directory.
+    pub dir: PathBuf,
+    /// Trials found in the directory and replayed.
+    pub resumed: u32,
+    /// Trials run now.
+    pub ran: u32,
+    /// The session is complete.
+    pub complete: bool,
+}
+
+/// Row of `spec` answered `response` at `rt` s.
+fn row(study: &Study, sched: &Schedule, spec: &TrialSpec, response: u8, rt: f64) -> TrialRow {
+    let c = &study.conditions[spec.condition];
+    let stair = spec.track.map(|t| &sched.tracks[t].stair);
+    TrialRow {
+        trial: spec.trial,
+        block: spec.block,
+        practice: spec.practice,
+        condition: c.name.clone(),
+        track: spec.track,
+        vary: c.vary.to_string(),
+        reference_value: c.reference_value,
+        comparison_value: c.base_value + spec.delta,
+        delta: spec.delta,
+        comparison_interval: spec.comparison_interval,
+        response,
+        correct: response == spec.comparison_interval,
+        rt,
+        reversals: stair.map(|s| s.reversals),
+        run: stair.map(|s| s.run),
+    }
+}
+
+/// Runs (or resumes) session `session` of `participant` in `out`, answering with `observer`;
+/// `study_text` is the study file's text (stored verbatim). `progress(done, planned)` is called
+/// after every trial. `stop_after` ends the run after that many new trials (an interruption, for
+/// tests and pilots).
+#[allow(clippy::too_many_arguments)]
+pub fn run(
+    study: &Study,
+    study_text: &str,
+    out: &Path,
+    participant: &str,
+    session: u32,
+    observer: &mut dyn Observer,
+    progress: &mut dyn FnMut(u32, u32),
+    stop_after: Option<u32>,
+) -> Result<RunSummary, String> {
+    check_participant(participant)?;
+    let dir = session_dir(out, participant, session);
+    let tsv = dir.join("trials.tsv");
+    let copy = dir.join("study.toml");
+    let seed = session_seed(study.seed, participant, session);
+    let mut sched = Schedule::new(study, seed);
+    let io = |p: &Path, e: std::io::Error| format!("{}: {e}", p.display());
+    let mut resumed = 0;
+    if tsv.exists() {
+        let stored = std::fs::read_to_string(&copy).map_err(|e| io(&copy, e))?;
+        if stored != study_text {
+            return Err(format!(
+                "{} holds a session of a different study file (its study.toml differs)\n    fix: give another --out, --participant or --session, or the study file this session was started with",
+                dir.display()
+            ));
+        }
+        let text = std::fs::read_to_string(&tsv).map_err(|e| io(&tsv, e))?;
+        let (rows, complete) =
+            trials::read(&text).map_err(|e| format!("{}: {e}", tsv.display()))?;
+        for r in &rows {
+            let spec = sched.next_trial().ok_or_else(|| {
+                format!(
+                    "{}: row {} is beyond the end of the schedule",
+                    tsv.display(),
+                    r.trial
+                )
+            })?;
+            let expect = row(study, &sched, &spec, r.response, r.rt);
+            let same = spec.trial == r.trial
+                && spec.practice == r.practice
+                && expect.condition == r.condition
+                && spec.delta == r.delta
+                && spec.comparison_interval == r.comparison_interval;
+            if !same {
+                return Err(format!(
+                    "{}: trial {} does not match the study's schedule (recorded {} delta {} interval {}, scheduled {} delta {} interval {}): the study file or its seed changed\n    fix: resume with the study file the session was started with",
+                    tsv.display(), r.trial, r.condition, r.delta, r.comparison_interval, expect.condition, spec.delta, spec.comparison_interval
+                ));
+            }
+            sched.record(&spec, r.correct);
+            resumed += 1;
+        }
+        if complete < text.len() || text.is_empty() {
+            // Drop the cut line (or write the header of an empty file).
+            let f = std::fs::OpenOptions::new()
+                .write(true)
+                .open(&tsv)
+                .map_err(|e| io(&tsv, e))?;
+            f.set_len(complete as u64).map_err(|e| io(&tsv, e))?;
+            if complete == 0 {
+                std::fs::write(&tsv, format!("{HEADER}\n")).map_err(|e| io(&tsv, e))?;
+            }
+        }
+    } else {
+        std::fs::create_dir_all(&dir).map_err(|e| io(&dir, e))?;
+        std::fs::write(&copy, study_text).map_err(|e| io(&copy, e))?;
+        let meta = serde_json::json!({
+            "study": study.name,
+            "study_file": study.source,
+            "scene": study.scene_source,
+            "participant": participant,
+            "session": session,
+            "seed": study.seed,
+            "session_seed": seed,
+            "software": VERSION,
+            "observer": observer.describe(),
+            "task": "2afc: which interval was stiffer?",
+            "trials": "trials.tsv (docs/STUDIES.md)",
+        });
+        let mj = dir.join("session.json");
+        std::fs::write(
+            &mj,
+            serde_json::to_string_pretty(&meta).unwrap_or_default() + "\n",
+        )
+        .map_err(|e| io(&mj, e))?;
+        std::fs::write(&tsv, format!("{HEADER}\n")).map_err(|e| io(&tsv, e))?;
+    }
+    let mut file = std::fs::OpenOptions::new()
+        .append(true)
+        .open(&tsv)
+        .map_err(|e| io(&tsv, e))?;
+    let planned = sched.planned();
+    let mut ran = 0;
+    let mut complete = false;
+    loop {
+        if stop_after.is_some_and(|n| ran >= n) {
+            break;
+        }
+        let Some(spec) = sched.next_trial() else {
+            complete = true;
+            break;
+        };
+        let a = observer.answer(study, &spec)?;
+        sched.record(&spec, a.response == spec.comparison_interval);
+        let r = row(study, &sched, &spec, a.response, a.rt);
+        file.write_all(r.to_line().as_bytes())
+            .map_err(|e| io(&tsv, e))?;
+        file.sync_data().map_err(|e| io(&tsv, e))?;
+        ran += 1;
+        progress(spec.trial, planned);
+    }
+    Ok(RunSummary {
+        dir,
+        resumed,
+        ran,
+        complete,
+    })
+}
