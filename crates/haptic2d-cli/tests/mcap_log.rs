@@ -43,10 +43,12 @@ fn ticks_of(path: &Path) -> Vec<TickRow> {
     read_ticks(&bytes, "test").unwrap().0
 }
 
-/// The CSV row of a tick row's record columns, as the CSV logger writes them.
+/// The CSV row of a tick row as the CSV run logger writes it: the record columns, then the
+/// encoders (`encoders.q1..q4`, columns 3..7 of the table).
 fn record_text(row: &TickRow) -> Vec<String> {
     row[LOOP_COLUMN_COUNT..]
         .iter()
+        .chain(&row[3..LOOP_COLUMN_COUNT])
         .map(|v| v.expect("record column").to_string())
         .collect()
 }
@@ -132,9 +134,10 @@ fn mcap_log_of_a_2s_run_has_every_tick_and_matches_the_csv_log_of_the_same_run()
     let (header, csv) = csv_rows(&csv);
     let names: Vec<&str> = TICK_TABLE[LOOP_COLUMN_COUNT..]
         .iter()
+        .chain(&TICK_TABLE[3..LOOP_COLUMN_COUNT])
         .map(|c| c.name)
         .collect();
-    assert_eq!(header, names);
+    assert_eq!(header, names, "record columns, then encoders.q1..q4");
     let n = csv.len().min(rows.len());
     // (A loaded machine skips deadlines, so the two runs may differ in length.)
     assert!(n > 100, "{n} shared ticks");
@@ -275,6 +278,42 @@ fn replay_of_an_mcap_recording_reproduces_its_device_motion() {
     for (k, (x, y)) in a.iter().zip(&b).enumerate() {
         for col in 3..11 {
             assert_eq!(x[col], y[col], "tick {k}, {}", TICK_TABLE[col].name);
+        }
+    }
+}
+
+/// Issue 39 item 5: `run --log x.csv` records the encoders (`encoders.q1..q4`), so the CSV log of
+/// a run replays (`--device replay:x.csv`): one replayed tick per logged row, the same encoder
+/// angles in and so the same device pose out (forward kinematics), ending "the replay ended".
+#[test]
+fn replay_of_a_run_csv_log_reproduces_its_device_motion() {
+    let dir = tempfile::tempdir().unwrap();
+    let (rec, rep) = (dir.path().join("rec.csv"), dir.path().join("rep.csv"));
+    run_logged(&rec, &["--duration", "0.5", "--hand", "sine:0.3,2"]);
+    let (h, a) = csv_rows(&rec);
+    let enc: Vec<usize> = ["encoders.q1", "encoders.q2", "encoders.q3", "encoders.q4"]
+        .iter()
+        .map(|n| {
+            h.iter()
+                .position(|c| c == n)
+                .unwrap_or_else(|| panic!("no {n} in {h:?}"))
+        })
+        .collect();
+    // The hand moved the device: the encoders are not constant.
+    assert_ne!(a[0][enc[0]], a[a.len() - 1][enc[0]], "the recording moves");
+    let out = run_logged(&rep, &["--device", &format!("replay:{}", rec.display())]);
+    assert!(out.contains("the replay ended"), "{out}");
+    assert!(!out.contains("safety stop"), "{out}");
+    let (h2, b) = csv_rows(&rep);
+    assert_eq!(h, h2);
+    assert_eq!(a.len(), b.len(), "one replayed tick per recorded row");
+    let pose: Vec<usize> = ["device.x", "device.y", "device.theta"]
+        .iter()
+        .map(|n| h.iter().position(|c| c == n).unwrap())
+        .collect();
+    for (k, (x, y)) in a.iter().zip(&b).enumerate() {
+        for &c in enc.iter().chain(&pose) {
+            assert_eq!(x[c], y[c], "row {k}, {}", h[c]);
         }
     }
 }
