@@ -62,7 +62,7 @@ pub const TICK_TABLE: [Column; TICK_TABLE_LEN] = [
     u(
         "deadline_ns",
         "ns",
-        "the tick's deadline, CLOCK_MONOTONIC (= the message's log_time)",
+        "the tick's deadline, CLOCK_MONOTONIC (the message's log_time is this plus the Unix offset of the haptic2d.clock metadata)",
     ),
     u(
         "lateness_ns",

@@ -214,3 +214,66 @@ pub fn encode_scene_update<B: Write>(
     )?;
     Ok(())
 }
+
+/// Writes one `FrameTransform` (JSON object) of frame `child` in `world` at the planar pose
+/// `[x, y, θ]` (m, m, rad): translation `(x, y, 0)`, rotation θ about z.
+fn write_transform<B: Write>(
+    b: &mut B,
+    sec: u64,
+    nsec: u64,
+    child: &str,
+    pose: [f64; 3],
+) -> std::io::Result<()> {
+    let half = 0.5 * pose[2];
+    write!(
+        b,
+        "{{\"timestamp\":{{\"sec\":{sec},\"nsec\":{nsec}}},\"parent_frame_id\":\"world\",\"child_frame_id\":{child},\"translation\":{{\"x\":"
+    )?;
+    write_json_f64(b, pose[0])?;
+    b.write_all(b",\"y\":")?;
+    write_json_f64(b, pose[1])?;
+    b.write_all(b",\"z\":0},\"rotation\":{\"x\":0,\"y\":0,\"z\":")?;
+    write_json_f64(b, half.sin())?;
+    b.write_all(b",\"w\":")?;
+    write_json_f64(b, half.cos())?;
+    b.write_all(b"}}")
+}
+
+/// Writes a Foxglove `FrameTransforms` (JSON, `/haptic2d/tf`): the frame `body/NAME` of every body
+/// kept in the sample, and — for a haptic tick (`tick` given) — `device` at the handle pose and
+/// `slave` at the slave pose, all children of `world`. Poses are planar: `(x, y, 0)` and a rotation
+/// by θ about z (quaternion `(0, 0, sin θ/2, cos θ/2)`). `names`: the bodies' names as JSON
+/// strings; a non-finite pose is written as the string `"NaN"`/`"inf"` like every float.
+pub fn encode_frame_transforms<B: Write>(
+    b: &mut B,
+    names: &[String],
+    s: &WorldSample,
+    tick: Option<&haptic2d::haptic::TickRecord>,
+    log_time: u64,
+) -> std::io::Result<()> {
+    let (sec, nsec) = (log_time / 1_000_000_000, log_time % 1_000_000_000);
+    b.write_all(b"{\"transforms\":[")?;
+    let mut first = true;
+    for (i, body) in s.bodies().iter().enumerate() {
+        if !first {
+            b.write_all(b",")?;
+        }
+        first = false;
+        // `names` are JSON strings (quoted, escaped): the frame id is `"body/` + their inside.
+        let child = match names.get(i) {
+            Some(n) if n.len() >= 2 => format!("\"body/{}", &n[1..]),
+            _ => format!("\"body/body{i}\""),
+        };
+        write_transform(b, sec, nsec, &child, body.pose)?;
+    }
+    if let Some(r) = tick {
+        for (child, pose) in [("\"device\"", r.x_m), ("\"slave\"", r.x_s)] {
+            if !first {
+                b.write_all(b",")?;
+            }
+            first = false;
+            write_transform(b, sec, nsec, child, pose)?;
+        }
+    }
+    b.write_all(b"]}")
+}
