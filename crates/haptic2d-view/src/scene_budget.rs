@@ -113,6 +113,12 @@ fn percentile(sorted: &[f64], p: f64) -> f64 {
 /// [`COST_PERCENTILE`] allows have, the trial stops ([`TrialEnd::OverBudget`]). Allocates (the
 /// clones) and takes up to [`MAX_TRIAL_WALL_S`]: call it off the real-time thread.
 pub fn trial(world: &World, budget_s: f64, margin: f64) -> Trial {
+    trial_within(world, budget_s, margin, MAX_TRIAL_WALL_S)
+}
+
+/// [`trial`] with a wall-clock limit of `max_wall_s` (s) instead of [`MAX_TRIAL_WALL_S`] (for
+/// measurements that must see the whole trial of a heavy scene).
+pub fn trial_within(world: &World, budget_s: f64, margin: f64, max_wall_s: f64) -> Trial {
     let dt = world.params.dt;
     let planned = ((TRIAL_S / dt).ceil() as usize).max(MIN_TRIAL_STEPS);
     // More than `allowed` steps over the budget put the percentile over it.
@@ -122,7 +128,7 @@ pub fn trial(world: &World, budget_s: f64, margin: f64) -> Trial {
     let mut over = 0usize;
     let mut end = TrialEnd::Complete;
     let start = Instant::now();
-    let limit = Duration::from_secs_f64(MAX_TRIAL_WALL_S);
+    let limit = Duration::from_secs_f64(max_wall_s.max(0.0));
     for _ in 0..planned {
         let t0 = Instant::now();
         a.step();
