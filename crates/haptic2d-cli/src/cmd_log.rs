@@ -96,8 +96,17 @@ pub struct Staged {
 }
 
 impl Staged {
-    /// Stages `dest`; the caller creates and writes [`Staged::path`].
+    /// Stages `dest`; the caller creates and writes [`Staged::path`]. An existing `dest` that is
+    /// not a regular file (`/dev/stdout`, a named pipe) is written directly: renaming over it would
+    /// replace the device or pipe.
     pub fn new(dest: &Path) -> Self {
+        if std::fs::metadata(dest).is_ok_and(|m| !m.is_file()) {
+            return Self {
+                tmp: dest.to_path_buf(),
+                dest: dest.to_path_buf(),
+                committed: true,
+            };
+        }
         let name = dest
             .file_name()
             .map(|n| n.to_string_lossy().into_owned())
@@ -116,6 +125,9 @@ impl Staged {
 
     /// Renames the complete temporary file to the output's name (atomic on one file system).
     pub fn commit(mut self) -> Result<(), Failure> {
+        if self.tmp == self.dest {
+            return Ok(()); // written directly (not a regular file)
+        }
         std::fs::rename(&self.tmp, &self.dest).map_err(|e| {
             Failure::error(format!(
                 "cannot rename {} to {}: {e}",

@@ -271,3 +271,47 @@ fn log_convert_renames_its_complete_output_into_place() {
     let info = haptic2d_rt::mcap::reader::read_info(&bytes, "out.mcap").unwrap();
     assert!(info.complete && info.messages >= 1000, "{info:?}");
 }
+
+/// An output that is not a regular file (a named pipe, `/dev/stdout`) is written in place, never
+/// replaced by a rename: `log convert in.mcap FIFO` streams the CSV into the pipe.
+#[test]
+fn log_convert_into_a_named_pipe_writes_the_pipe_and_keeps_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = big_tick_csv(dir.path(), 100);
+    let mcap = dir.path().join("x.mcap");
+    let o = common::haptic2d(&[
+        "log",
+        "convert",
+        csv.to_str().unwrap(),
+        mcap.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", common::text(&o));
+    let fifo = dir.path().join("pipe");
+    let c = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
+    // SAFETY: mkfifo(3) with a valid NUL-terminated path.
+    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+    let reader = {
+        let fifo = fifo.clone();
+        std::thread::spawn(move || std::fs::read_to_string(fifo).unwrap())
+    };
+    let o = common::haptic2d(&[
+        "log",
+        "convert",
+        mcap.to_str().unwrap(),
+        fifo.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", common::text(&o));
+    // (Checked before joining the reader: had the pipe been renamed over, the reader would wait
+    // for a writer forever.)
+    use std::os::unix::fs::FileTypeExt;
+    assert!(
+        std::fs::metadata(&fifo).unwrap().file_type().is_fifo(),
+        "the named pipe was replaced"
+    );
+    let text = reader.join().unwrap();
+    assert_eq!(
+        text.lines().count(),
+        101,
+        "header + 100 rows through the pipe"
+    );
+}
