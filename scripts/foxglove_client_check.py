@@ -12,7 +12,8 @@ advertised with the `jsonschema` package. It:
 3. subscribes to every channel, then decodes the binary message-data frames
    (`0x01`, subscription id u32 LE, timestamp u64 LE ns, payload) as JSON and validates the first
    20 of each channel against its channel's schema; checks every channel delivers, per-channel timestamps never go
-   back, and the tick index grows;
+   back and are Unix-epoch ns (within a minute of this machine's clock), `/haptic2d/tf` places
+   `body/NAME`, `device` and `slave` in `world`, and the tick index grows;
 4. sends a malformed text message and a binary frame: the server answers with `status` and keeps
    streaming;
 5. unsubscribes from `/haptic2d/tick` (then an unsupported operation as a marker: its status reply
@@ -133,7 +134,7 @@ def session(ws: Any) -> None:
         validators[c["id"]] = jsonschema.validators.validator_for(schema)(schema)
     topics = sorted(c["topic"] for c in channels.values())
     want = ["/haptic2d/bodies", "/haptic2d/contacts", "/haptic2d/energy", "/haptic2d/scene_update",
-            "/haptic2d/tick"]
+            "/haptic2d/tf", "/haptic2d/tick"]
     if topics != want:
         fail(f"advertised topics {topics}, want {want}")
     print(f"advertise: {len(channels)} channels, every schema a valid JSON Schema")
@@ -179,6 +180,15 @@ def session(ws: Any) -> None:
             if errors:
                 fail(f"{ch['topic']} message does not match its advertised schema: {errors[0].message}")
             topic = ch["topic"]
+            # Log times are Unix-epoch ns (docs/LOGS.md, "Clock"): within a minute of this clock.
+            if abs(t - time.time_ns()) > 60e9:
+                fail(f"{topic}: timestamp {t} ns is not the Unix time now ({time.time_ns()} ns)")
+            if topic == "/haptic2d/tf":
+                frames = {x["child_frame_id"] for x in payload["transforms"]}
+                if not {"device", "slave"} <= frames or not any(f.startswith("body/") for f in frames):
+                    fail(f"/haptic2d/tf frames {sorted(frames)}: want body/NAME, device and slave")
+                if any(x["parent_frame_id"] != "world" for x in payload["transforms"]):
+                    fail("/haptic2d/tf: a transform whose parent is not `world`")
             if topic in last_time and t < last_time[topic]:
                 fail(f"{topic}: timestamp went back from {last_time[topic]} to {t} ns")
             last_time[topic] = t

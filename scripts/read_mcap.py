@@ -5,7 +5,8 @@
 
 Checks: every channel has a JSON Schema that parses and JSON messages; /haptic2d/tick has one
 message per tick (N, or the `ticks` of the run's timing summary in the metadata record
-`haptic2d.timing`), sequence = tick index, log_time = the tick's deadline; with --csv (a CSV tick
+`haptic2d.timing`), sequence = tick index, log_time = the tick's deadline + the Unix offset of the
+metadata record `haptic2d.clock`; /haptic2d/tf places body/NAME, device and slave in world; with --csv (a CSV tick
 log of the same deterministic run, `haptic2d run --log RUN.csv`), the first and last ticks the two
 logs share match column by column. Prints a summary; exits 1 on the first failed check.
 """
@@ -64,6 +65,14 @@ def main():
             if s.get("type") != "object":
                 fail(f"schema {schema.name} is not an object schema")
         metadata = {m.name: dict(m.metadata) for m in reader.iter_metadata()}
+        # log_time = deadline + offset (Unix-epoch ns; docs/LOGS.md "Clock"), from haptic2d.clock.
+        clock = metadata.get("haptic2d.clock", {})
+        offset = 0
+        if clock.get("source") == "monotonic_deadline":
+            offset = int(clock["monotonic_to_unix_offset_ns"])
+            if clock.get("log_time") != "unix_epoch_ns" or offset < 1_577_836_800 * 10**9:
+                fail(f"haptic2d.clock {clock}: log_time is not Unix-epoch ns")
+        tf_frames = set()
         counts = {}
         ticks = []
         for schema, channel, message in reader.iter_messages(log_time_order=False):
@@ -74,9 +83,15 @@ def main():
             if channel.topic == "/haptic2d/tick":
                 if body["index"] % 2**32 != message.sequence:
                     fail(f"tick {body['index']}: sequence {message.sequence}")
-                if body["deadline_ns"] != message.log_time:
-                    fail(f"tick {body['index']}: log_time {message.log_time} != deadline {body['deadline_ns']}")
+                if body["deadline_ns"] + offset != message.log_time:
+                    fail(f"tick {body['index']}: log_time {message.log_time} != deadline {body['deadline_ns']} + offset {offset}")
                 ticks.append(flat(body))
+            if channel.topic == "/haptic2d/tf":
+                for x in body["transforms"]:
+                    q = x["rotation"]
+                    if x["parent_frame_id"] != "world" or abs(q["z"] ** 2 + q["w"] ** 2 - 1) > 1e-9:
+                        fail(f"/haptic2d/tf: {x}")
+                    tf_frames.add(x["child_frame_id"])
 
     stats = summary.statistics
     if stats is not None and stats.message_count != sum(counts.values()):
@@ -91,6 +106,10 @@ def main():
     for k, t in enumerate(ticks):
         if t["index"] != k:
             fail(f"tick message {k} has index {t['index']}: a tick is missing or out of order")
+    if "/haptic2d/tf" in counts:
+        if not {"device", "slave"} <= tf_frames or not any(f.startswith("body/") for f in tf_frames):
+            fail(f"/haptic2d/tf frames {sorted(tf_frames)}: want body/NAME, device and slave")
+        print(f"/haptic2d/tf: frames {', '.join(sorted(tf_frames))} in world")
     print(f"{args.mcap_file}: {len(ticks)} ticks = the run's tick count; channels: "
           + ", ".join(f"{t} {n}" for t, n in sorted(counts.items())))
 

@@ -4,6 +4,14 @@
 //! every tick column it has (the loop columns too) in `OUT`, and writes each world channel the log
 //! has (bodies, contacts, energy) as its own CSV next to it: `OUT.bodies.csv`, `OUT.contacts.csv`,
 //! `OUT.energy.csv` (`OUT` without its `.csv`; layout in [`haptic2d_rt::mcap::world_csv`]).
+//!
+//! **Signals** (issue 38 item 3): every output is written under a temporary name in its own
+//! directory (`.NAME.partial-PID`) and renamed to its name only once it is complete (an MCAP with
+//! its summary and footer), so a conversion killed by any signal never leaves a half file under
+//! the output's name — an older file of that name stays as it was. SIGINT, SIGTERM and SIGPIPE stop
+//! the conversion, remove the temporary files and end it (exit 130; SIGPIPE: the process ends of
+//! it, shell status 141). A signal that cannot be caught (SIGKILL) or a second SIGINT/SIGTERM
+//! leaves the temporary file behind, never a damaged output.
 
 use crate::exit::{Failure, Status};
 use crate::run_log::is_mcap;
@@ -15,9 +23,12 @@ use haptic2d_rt::mcap::schemas::TOPIC_TICK;
 use haptic2d_rt::mcap::tick_csv::read_tick_csv;
 use haptic2d_rt::mcap::world_csv::{read_world_tables, WorldTable};
 use haptic2d_rt::mcap::{McapSetup, McapSink};
+use haptic2d_rt::signal::install_stop_signals;
 use std::collections::BTreeMap;
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 
 /// `haptic2d log` subcommands.
 #[derive(clap::Subcommand, Debug)]
@@ -41,9 +52,104 @@ pub enum LogCmd {
 pub fn run(cmd: &LogCmd) -> Result<Status, Failure> {
     match cmd {
         LogCmd::Info { file } => info(file),
-        LogCmd::Convert { input, output } => convert(input, output),
+        LogCmd::Convert { input, output } => {
+            let stop = install_stop_signals().map_err(Failure::error)?;
+            let r = convert(input, output, &Stop(stop));
+            // Every output is renamed or removed: a SIGPIPE ends the process now (status 141);
+            // otherwise SIGPIPE gets its default action back for the report line.
+            crate::pipe::restore_after_output();
+            if let Ok(lines) = &r {
+                for l in lines {
+                    println!("{l}");
+                }
+            }
+            r.map(|_| Status::Clean)
+        }
     }
 }
+
+/// The stop signals of a conversion: SIGINT/SIGTERM (the flag) or SIGPIPE ([`crate::pipe`]).
+struct Stop(Arc<AtomicBool>);
+
+impl Stop {
+    /// `Err` (exit 130) once a stop signal arrived; the staged outputs are then removed as they drop.
+    fn check(&self, outl: &str) -> Result<(), Failure> {
+        if self.0.load(Ordering::Relaxed) || crate::pipe::sigpipe_seen() {
+            return Err(Failure {
+                status: Status::Interrupted,
+                message: format!(
+                    "log convert interrupted by a signal: {outl} was not written (nothing of it is left)"
+                ),
+            });
+        }
+        Ok(())
+    }
+}
+
+/// An output written under a temporary name next to its final one (`.NAME.partial-PID`) and renamed
+/// to it by [`Staged::commit`]; dropped uncommitted (an error, a signal), it removes the temporary
+/// file.
+pub struct Staged {
+    tmp: PathBuf,
+    dest: PathBuf,
+    committed: bool,
+}
+
+impl Staged {
+    /// Stages `dest`; the caller creates and writes [`Staged::path`]. An existing `dest` that is
+    /// not a regular file (`/dev/stdout`, a named pipe) is written directly: renaming over it would
+    /// replace the device or pipe.
+    pub fn new(dest: &Path) -> Self {
+        if std::fs::metadata(dest).is_ok_and(|m| !m.is_file()) {
+            return Self {
+                tmp: dest.to_path_buf(),
+                dest: dest.to_path_buf(),
+                committed: true,
+            };
+        }
+        let name = dest
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        Self {
+            tmp: dest.with_file_name(format!(".{name}.partial-{}", std::process::id())),
+            dest: dest.to_path_buf(),
+            committed: false,
+        }
+    }
+
+    /// The temporary file to write.
+    pub fn path(&self) -> &Path {
+        &self.tmp
+    }
+
+    /// Renames the complete temporary file to the output's name (atomic on one file system).
+    pub fn commit(mut self) -> Result<(), Failure> {
+        if self.tmp == self.dest {
+            return Ok(()); // written directly (not a regular file)
+        }
+        std::fs::rename(&self.tmp, &self.dest).map_err(|e| {
+            Failure::error(format!(
+                "cannot rename {} to {}: {e}",
+                self.tmp.display(),
+                self.dest.display()
+            ))
+        })?;
+        self.committed = true;
+        Ok(())
+    }
+}
+
+impl Drop for Staged {
+    fn drop(&mut self) {
+        if !self.committed {
+            let _ = std::fs::remove_file(&self.tmp);
+        }
+    }
+}
+
+/// Rows between two checks of the stop signals.
+const CHECK_EVERY: usize = 4096;
 
 fn secs(ns: u64) -> f64 {
     ns as f64 * 1e-9
@@ -136,12 +242,15 @@ fn read_csv(path: &Path) -> Result<(Vec<usize>, Vec<Vec<Val>>), Failure> {
     Ok(read_tick_csv(path)?)
 }
 
-fn convert(input: &Path, output: &Path) -> Result<Status, Failure> {
+/// Converts `input` to `output`; returns the report lines (printed once every output is in place).
+fn convert(input: &Path, output: &Path, stop: &Stop) -> Result<Vec<String>, Failure> {
     let (inl, outl) = (input.display().to_string(), output.display().to_string());
     match (is_mcap(input), is_mcap(output)) {
         (false, true) => {
             let (cols, rows) = read_csv(input)?;
-            let file = std::fs::File::create(output)
+            stop.check(&outl)?;
+            let staged = Staged::new(output);
+            let file = std::fs::File::create(staged.path())
                 .map_err(|e| Failure::error(format!("cannot create {outl}: {e}")))?;
             let mut scene = BTreeMap::new();
             scene.insert("converted_from".to_string(), inl.clone());
@@ -149,6 +258,9 @@ fn convert(input: &Path, output: &Path) -> Result<Status, Failure> {
                 .map_err(|e| Failure::error(format!("cannot write {outl}: {e}")))?;
             let (ki, kd, kt) = (column_index("index"), column_index("deadline_ns"), column_index("t"));
             for (i, r) in rows.iter().enumerate() {
+                if i % CHECK_EVERY == 0 {
+                    stop.check(&outl)?;
+                }
                 let mut row: TickRow = [None; TICK_TABLE_LEN];
                 for (&k, v) in cols.iter().zip(r) {
                     row[k] = Some(*v);
@@ -170,12 +282,15 @@ fn convert(input: &Path, output: &Path) -> Result<Status, Failure> {
             let stats = sink
                 .finish(&[])
                 .map_err(|e| Failure::error(format!("cannot finish {outl}: {e}")))?;
-            println!("{inl} → {outl}: {} ticks, {} columns", stats.count(TOPIC_TICK), cols.len());
+            stop.check(&outl)?;
+            staged.commit()?;
+            Ok(vec![format!("{inl} → {outl}: {} ticks, {} columns", stats.count(TOPIC_TICK), cols.len())])
         }
         (true, false) => {
             let bytes = read_file(input)?;
             let (rows, info) = read_ticks(&bytes, &inl)?;
             let (tables, _) = read_world_tables(&bytes, &inl)?;
+            stop.check(&outl)?;
             if let Some(cut) = &info.damage {
                 eprintln!("warning: {inl} was cut short ({cut}): converting the records before the cut");
             }
@@ -184,12 +299,16 @@ fn convert(input: &Path, output: &Path) -> Result<Status, Failure> {
                     return Err(format!("{inl} has no {TOPIC_TICK}, bodies, contacts or energy messages: nothing to convert to CSV").into());
                 }
                 // A world recording (`simulate --out FILE.mcap`): the world channels only.
-                let written = write_world_tables(output, &tables)?;
-                println!("{inl} → {}: no {TOPIC_TICK} messages (a world recording), so no tick CSV", written.join(", "));
-                return Ok(Status::Clean);
+                let (written, staged) = write_world_tables(output, &tables, stop)?;
+                stop.check(&outl)?;
+                for s in staged {
+                    s.commit()?;
+                }
+                return Ok(vec![format!("{inl} → {}: no {TOPIC_TICK} messages (a world recording), so no tick CSV", written.join(", "))]);
             }
             let present: Vec<usize> = (0..TICK_TABLE_LEN).filter(|&k| rows[0][k].is_some()).collect();
-            let mut w = csv::Writer::from_path(output)
+            let staged = Staged::new(output);
+            let mut w = csv::Writer::from_path(staged.path())
                 .map_err(|e| Failure::error(format!("cannot create {outl}: {e}")))?;
             let wr = |e: csv::Error| Failure::error(format!("cannot write {outl}: {e}"));
             // Loop columns last: the tick columns first keep the CSV logger's layout.
@@ -201,6 +320,9 @@ fn convert(input: &Path, output: &Path) -> Result<Status, Failure> {
                 .collect();
             w.write_record(order.iter().map(|&k| TICK_TABLE[k].name)).map_err(wr)?;
             for (i, r) in rows.iter().enumerate() {
+                if i % CHECK_EVERY == 0 {
+                    stop.check(&outl)?;
+                }
                 let mut fields = Vec::with_capacity(order.len());
                 for &k in &order {
                     let v = r[k].ok_or_else(|| {
@@ -214,10 +336,16 @@ fn convert(input: &Path, output: &Path) -> Result<Status, Failure> {
                 w.write_record(&fields).map_err(wr)?;
             }
             w.flush().map_err(|e| Failure::error(format!("cannot write {outl}: {e}")))?;
-            let written = write_world_tables(output, &tables)?;
+            drop(w);
+            let (written, world_staged) = write_world_tables(output, &tables, stop)?;
+            stop.check(&outl)?;
+            for s in world_staged {
+                s.commit()?;
+            }
+            staged.commit()?;
             let world: u64 = tables.iter().map(|t| t.messages).sum();
             let skipped = info.messages.saturating_sub(rows.len() as u64 + world);
-            println!(
+            Ok(vec![format!(
                 "{inl} → {outl}: {} ticks, {} columns{}{}",
                 rows.len(),
                 order.len(),
@@ -231,16 +359,13 @@ fn convert(input: &Path, output: &Path) -> Result<Status, Failure> {
                 } else {
                     String::new()
                 }
-            );
+            )])
         }
-        _ => {
-            return Err(format!(
+        _ => Err(format!(
                 "log convert {inl} {outl}: converts between CSV and MCAP (one of the two must end in .mcap, the other not)"
             )
-            .into())
-        }
+            .into()),
     }
-    Ok(Status::Clean)
 }
 
 /// The CSV of world channel `suffix` next to the tick CSV `output`: `OUT.csv` → `OUT.bodies.csv`
@@ -254,22 +379,33 @@ pub fn world_csv_path(output: &Path, suffix: &str) -> PathBuf {
     output.with_file_name(format!("{stem}{suffix}"))
 }
 
-/// Writes every world table with messages next to `output`; returns the paths written.
-fn write_world_tables(output: &Path, tables: &[WorldTable]) -> Result<Vec<String>, Failure> {
+/// Writes every world table with messages next to `output`, each staged under a temporary name;
+/// returns the paths to be written and the staged files (the caller commits them).
+fn write_world_tables(
+    output: &Path,
+    tables: &[WorldTable],
+    stop: &Stop,
+) -> Result<(Vec<String>, Vec<Staged>), Failure> {
     let mut written = Vec::new();
+    let mut staged = Vec::new();
     for t in tables.iter().filter(|t| t.messages > 0) {
         let path = world_csv_path(output, t.channel.suffix);
         let label = path.display().to_string();
+        let s = Staged::new(&path);
         let wr = |e: csv::Error| Failure::error(format!("cannot write {label}: {e}"));
-        let mut w = csv::Writer::from_path(&path)
+        let mut w = csv::Writer::from_path(s.path())
             .map_err(|e| Failure::error(format!("cannot create {label}: {e}")))?;
+        staged.push(s);
         w.write_record(t.channel.header()).map_err(wr)?;
-        for r in &t.rows {
+        for (i, r) in t.rows.iter().enumerate() {
+            if i % CHECK_EVERY == 0 {
+                stop.check(&label)?;
+            }
             w.write_record(r).map_err(wr)?;
         }
         w.flush()
             .map_err(|e| Failure::error(format!("cannot write {label}: {e}")))?;
         written.push(label);
     }
-    Ok(written)
+    Ok((written, staged))
 }

@@ -22,11 +22,15 @@
 //! Protocol subset: the server sends `serverInfo` and `advertise` (channels with their JSON
 //! Schemas) on connect, accepts `subscribe` / `unsubscribe`, answers anything else with a `status`
 //! warning, and sends message data as binary frames `[0x01][subscription id u32 LE][log time u64
-//! LE][JSON payload]`.
+//! LE][JSON payload]`. The log time is Unix-epoch ns, as in a recording: the tick's
+//! `CLOCK_MONOTONIC` deadline plus the offset read when the server started
+//! ([`haptic2d_rt::mcap::clock`]).
 
+use haptic2d_rt::mcap::clock::monotonic_to_unix_offset_ns;
 use haptic2d_rt::mcap::columns::tick_json_schema;
 use haptic2d_rt::mcap::encode::{
-    encode_bodies, encode_contacts, encode_energy, encode_scene_update, encode_tick,
+    encode_bodies, encode_contacts, encode_energy, encode_frame_transforms, encode_scene_update,
+    encode_tick,
 };
 use haptic2d_rt::mcap::schemas::*;
 use haptic2d_rt::mcap::{LoggedTick, McapSetup};
@@ -91,12 +95,13 @@ impl std::fmt::Display for FoxgloveStats {
 }
 
 /// Channel ids advertised (1-based, in this order).
-const CHANNELS: [(&str, &str); 5] = [
+const CHANNELS: [(&str, &str); 6] = [
     (TOPIC_TICK, SCHEMA_TICK),
     (TOPIC_BODIES, SCHEMA_BODIES),
     (TOPIC_CONTACTS, SCHEMA_CONTACTS),
     (TOPIC_ENERGY, SCHEMA_ENERGY),
     (TOPIC_SCENE_UPDATE, SCHEMA_SCENE_UPDATE),
+    (TOPIC_TF, SCHEMA_TF),
 ];
 
 /// The running server; dropping it (or [`shutdown`](Self::shutdown)) stops it.
@@ -255,6 +260,8 @@ struct Server {
     buf: Vec<u8>,
     refused: Arc<AtomicU64>,
     stats: FoxgloveStats,
+    /// `CLOCK_REALTIME − CLOCK_MONOTONIC` (ns), read at the start: deadline → Unix-epoch log time.
+    unix_offset_ns: u64,
 }
 
 impl Server {
@@ -266,6 +273,7 @@ impl Server {
             CONTACTS_SCHEMA,
             ENERGY_SCHEMA,
             SCENE_UPDATE_SCHEMA,
+            TF_SCHEMA,
         ];
         let channels: Vec<Value> = CHANNELS
             .iter()
@@ -292,6 +300,7 @@ impl Server {
             stats: FoxgloveStats::default(),
             advertise: json!({"op": "advertise", "channels": channels}).to_string(),
             buf: Vec::with_capacity(64 * 1024),
+            unix_offset_ns: monotonic_to_unix_offset_ns(),
         }
     }
 
@@ -453,7 +462,7 @@ impl Server {
         if self.clients.iter().all(|c| c.subs.is_empty()) {
             return;
         }
-        let t = snap.deadline_ns;
+        let t = snap.deadline_ns.saturating_add(self.unix_offset_ns);
         for ch in 1..=CHANNELS.len() as u32 {
             if !self
                 .clients
@@ -476,6 +485,14 @@ impl Server {
                     &self.setup.bodies,
                     &self.names,
                     &snap.world,
+                    t,
+                )
+                .is_ok(),
+                6 if world => encode_frame_transforms(
+                    &mut self.buf,
+                    &self.names,
+                    &snap.world,
+                    Some(&snap.rec),
                     t,
                 )
                 .is_ok(),

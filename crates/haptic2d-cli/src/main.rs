@@ -278,7 +278,9 @@ fn main() -> ExitCode {
     // cleanup); `simulate --out` finishes its file first; printing commands just end quietly.
     match &cli.command {
         Command::Run(_) | Command::Emulate(_) => {}
-        Command::Simulate { out: Some(_), .. } => pipe::stop_on_sigpipe(),
+        Command::Simulate { out: Some(_), .. } | Command::Log(cmd_log::LogCmd::Convert { .. }) => {
+            pipe::stop_on_sigpipe()
+        }
         _ => pipe::quiet_on_closed_pipe(),
     }
     let result = match cli.command {

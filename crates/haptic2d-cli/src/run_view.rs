@@ -10,9 +10,10 @@
 //!
 //! Security (docs/DISPLAY.md): the server accepts commands only from the page it served (or a
 //! program, with the token where one is required); the token is required off loopback and, with
-//! `--require-token`, on loopback too. Before the loop starts, every built-in scene is timed at the
-//! loop's rate ([`haptic2d_view::scene_budget`]); a switch to one whose world step does not fit the
-//! period is refused by the server with the reason (greyed out on the page), and again here.
+//! `--require-token`, on loopback too. Before the loop starts, every built-in scene is run for a
+//! short timed trial at the loop's rate ([`haptic2d_view::scene_budget`]); a switch to one whose
+//! measured step does not fit the period is refused by the server with the reason (greyed out on
+//! the page), and again here.
 
 use crate::run_rig::Rig;
 use haptic2d::contact::ImpactFriction;
@@ -23,7 +24,7 @@ use haptic2d::scene::{builtin, BUILTIN};
 use haptic2d::world::World;
 use haptic2d_rt::clock::now_ns;
 use haptic2d_rt::TickInfo;
-use haptic2d_view::scene_budget::{estimate_step_s, verdict};
+use haptic2d_view::scene_budget::assess;
 use haptic2d_view::{
     Command, Frame, FrameInputs, LiveTiming, SceneCost, SceneInfo, ViewHandle, ViewHub,
     ViewOptions, ViewServer, DEFAULT_FRAME_RATE_HZ, DEFAULT_STEP_FRACTION,
@@ -61,7 +62,7 @@ pub struct LiveView {
 /// Starts the display server on `bind` for the rig's current scene `scene` at `rate` (Hz); with
 /// `require_token`, commands need the token on a loopback bind too. Returns the server handle (keep
 /// it on the main thread; dropping it stops the server) and the loop's end. Call it before the
-/// loop starts: it times a few steps of every built-in scene (a few tenths of a second).
+/// loop starts: it runs a timed trial of every built-in scene (at most 0.6 s each).
 pub fn start(
     bind: SocketAddr,
     rig: &Rig,
@@ -76,12 +77,7 @@ pub fn start(
     for (name, _, _) in BUILTIN {
         if let Some(Ok(s)) = builtin(name, Some(rate)) {
             bodies = bodies.max(s.world.bodies.len());
-            costs.push(verdict(
-                name,
-                estimate_step_s(&s.world),
-                rate,
-                DEFAULT_STEP_FRACTION,
-            ));
+            costs.push(assess(name, &s.world, rate, DEFAULT_STEP_FRACTION));
         }
     }
     let too_heavy = costs

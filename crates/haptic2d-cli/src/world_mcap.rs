@@ -58,15 +58,15 @@ impl WorldOut {
         })
     }
 
-    /// Writes the current state of `world` (log_time = round(t · 10⁹) ns).
+    /// Writes the current state of `world` (log_time = the Unix time the file was started +
+    /// round(t · 10⁹) ns).
     pub fn row(&mut self, world: &World) -> std::io::Result<()> {
         match self {
             Self::Csv(c) => c.row(world),
             Self::Mcap { sink, sample, seq } => {
                 sample.capture(world);
-                let t = world.time().max(0.0);
-                sink.write_world(*seq, (t * 1e9).round() as u64, sample)
-                    .map_err(other)?;
+                let log_time = sink.sim_log_time(world.time());
+                sink.write_world(*seq, log_time, sample).map_err(other)?;
                 *seq += 1;
                 Ok(())
             }

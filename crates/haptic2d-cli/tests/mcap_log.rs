@@ -43,10 +43,12 @@ fn ticks_of(path: &Path) -> Vec<TickRow> {
     read_ticks(&bytes, "test").unwrap().0
 }
 
-/// The CSV row of a tick row's record columns, as the CSV logger writes them.
+/// The CSV row of a tick row as the CSV run logger writes it: the record columns, then the
+/// encoders (`encoders.q1..q4`, columns 3..7 of the table).
 fn record_text(row: &TickRow) -> Vec<String> {
     row[LOOP_COLUMN_COUNT..]
         .iter()
+        .chain(&row[3..LOOP_COLUMN_COUNT])
         .map(|v| v.expect("record column").to_string())
         .collect()
 }
@@ -132,9 +134,10 @@ fn mcap_log_of_a_2s_run_has_every_tick_and_matches_the_csv_log_of_the_same_run()
     let (header, csv) = csv_rows(&csv);
     let names: Vec<&str> = TICK_TABLE[LOOP_COLUMN_COUNT..]
         .iter()
+        .chain(&TICK_TABLE[3..LOOP_COLUMN_COUNT])
         .map(|c| c.name)
         .collect();
-    assert_eq!(header, names);
+    assert_eq!(header, names, "record columns, then encoders.q1..q4");
     let n = csv.len().min(rows.len());
     // (A loaded machine skips deadlines, so the two runs may differ in length.)
     assert!(n > 100, "{n} shared ticks");
@@ -275,6 +278,42 @@ fn replay_of_an_mcap_recording_reproduces_its_device_motion() {
     for (k, (x, y)) in a.iter().zip(&b).enumerate() {
         for col in 3..11 {
             assert_eq!(x[col], y[col], "tick {k}, {}", TICK_TABLE[col].name);
+        }
+    }
+}
+
+/// Issue 39 item 5: `run --log x.csv` records the encoders (`encoders.q1..q4`), so the CSV log of
+/// a run replays (`--device replay:x.csv`): one replayed tick per logged row, the same encoder
+/// angles in and so the same device pose out (forward kinematics), ending "the replay ended".
+#[test]
+fn replay_of_a_run_csv_log_reproduces_its_device_motion() {
+    let dir = tempfile::tempdir().unwrap();
+    let (rec, rep) = (dir.path().join("rec.csv"), dir.path().join("rep.csv"));
+    run_logged(&rec, &["--duration", "0.5", "--hand", "sine:0.3,2"]);
+    let (h, a) = csv_rows(&rec);
+    let enc: Vec<usize> = ["encoders.q1", "encoders.q2", "encoders.q3", "encoders.q4"]
+        .iter()
+        .map(|n| {
+            h.iter()
+                .position(|c| c == n)
+                .unwrap_or_else(|| panic!("no {n} in {h:?}"))
+        })
+        .collect();
+    // The hand moved the device: the encoders are not constant.
+    assert_ne!(a[0][enc[0]], a[a.len() - 1][enc[0]], "the recording moves");
+    let out = run_logged(&rep, &["--device", &format!("replay:{}", rec.display())]);
+    assert!(out.contains("the replay ended"), "{out}");
+    assert!(!out.contains("safety stop"), "{out}");
+    let (h2, b) = csv_rows(&rep);
+    assert_eq!(h, h2);
+    assert_eq!(a.len(), b.len(), "one replayed tick per recorded row");
+    let pose: Vec<usize> = ["device.x", "device.y", "device.theta"]
+        .iter()
+        .map(|n| h.iter().position(|c| c == n).unwrap())
+        .collect();
+    for (k, (x, y)) in a.iter().zip(&b).enumerate() {
+        for &c in enc.iter().chain(&pose) {
+            assert_eq!(x[c], y[c], "row {k}, {}", h[c]);
         }
     }
 }
@@ -612,4 +651,251 @@ fn sigpipe_during_simulate_out_mcap_leaves_a_readable_mcap_then_ends_of_sigpipe(
 #[test]
 fn sigterm_during_simulate_out_mcap_leaves_a_readable_mcap_and_exits_130() {
     assert_eq!(simulate_mcap_then(libc::SIGTERM).0, Some(130));
+}
+
+/// Every message of `topic` with its `log_time` (ns).
+fn timed_messages_of(path: &Path, topic: &str) -> Vec<(u64, serde_json::Value)> {
+    let bytes = read_file(path).unwrap();
+    let mut out = Vec::new();
+    haptic2d_rt::mcap::reader::scan(&bytes, "test", |tp, t, data| {
+        if tp == topic {
+            out.push((t, serde_json::from_slice(data).unwrap()));
+        }
+        Ok(())
+    })
+    .unwrap();
+    out
+}
+
+fn unix_now_ns() -> u64 {
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .unwrap()
+        .as_nanos() as u64
+}
+
+/// Issue 39 item 8: `log_time` is Unix-epoch ns (so recordings line up with other robot logs):
+/// each tick's monotonic deadline plus the one offset the log records in `haptic2d.clock`; a
+/// `simulate` recording's is its start time plus the simulated time.
+#[test]
+fn mcap_log_time_is_unix_epoch_ns_the_deadline_plus_the_recorded_offset() {
+    let dir = tempfile::tempdir().unwrap();
+    let m = dir.path().join("clock.mcap");
+    let before = unix_now_ns();
+    run_logged(&m, &["--duration", "0.3"]);
+    let after = unix_now_ns();
+    let bytes = read_file(&m).unwrap();
+    let info = read_info(&bytes, "clock.mcap").unwrap();
+    let clock = info.metadata("haptic2d.clock").expect("haptic2d.clock");
+    assert_eq!(clock["log_time"], "unix_epoch_ns");
+    assert_eq!(clock["source"], "monotonic_deadline");
+    let offset: u64 = clock["monotonic_to_unix_offset_ns"].parse().unwrap();
+    let ticks = timed_messages_of(&m, TOPIC_TICK);
+    assert!(ticks.len() > 50);
+    for (t, msg) in &ticks {
+        assert_eq!(*t, msg["deadline_ns"].as_u64().unwrap() + offset, "{msg}");
+        assert!(
+            (before..=after).contains(t),
+            "log_time {t} outside the run ({before}..{after})"
+        );
+    }
+    // simulate: the start's Unix time + round(t · 1e9).
+    let s = dir.path().join("sim.mcap");
+    let before = unix_now_ns();
+    let o = haptic2d(&[
+        "simulate",
+        "box-in-walls",
+        "--duration",
+        "0.05",
+        "--out",
+        s.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let bytes = read_file(&s).unwrap();
+    let info = read_info(&bytes, "sim.mcap").unwrap();
+    let clock = info.metadata("haptic2d.clock").expect("haptic2d.clock");
+    assert_eq!(
+        (clock["log_time"].as_str(), clock["source"].as_str()),
+        ("unix_epoch_ns", "sim_time")
+    );
+    let start: u64 = clock["sim_start_unix_ns"].parse().unwrap();
+    assert!(start >= before && start <= unix_now_ns());
+    for (t, msg) in timed_messages_of(&s, TOPIC_ENERGY) {
+        let sim = (msg["t"].as_f64().unwrap() * 1e9).round() as u64;
+        assert_eq!(t, start + sim, "{msg}");
+    }
+}
+
+/// Issue 39 item 8: `/haptic2d/tf` (`foxglove.FrameTransforms`) places every body (`body/NAME`),
+/// the device handle (`device`) and the slave (`slave`) in `world` at the poses the bodies and
+/// tick messages of the same tick carry: translation (x, y, 0), rotation θ about z.
+#[test]
+fn frame_transforms_place_the_bodies_and_the_device_where_the_messages_say() {
+    let dir = tempfile::tempdir().unwrap();
+    let m = dir.path().join("tf.mcap");
+    run_logged(&m, &["--duration", "0.3", "--hand", "sine:0.3,2"]);
+    let bytes = read_file(&m).unwrap();
+    let info = read_info(&bytes, "tf.mcap").unwrap();
+    let ch = info
+        .channels
+        .iter()
+        .find(|c| c.topic == TOPIC_TF)
+        .expect("tf channel");
+    assert_eq!(ch.schema, "foxglove.FrameTransforms");
+    assert_eq!(info.count(TOPIC_TF), info.count(TOPIC_SCENE_UPDATE));
+    let bodies: std::collections::HashMap<u64, serde_json::Value> =
+        timed_messages_of(&m, TOPIC_BODIES).into_iter().collect();
+    let ticks: std::collections::HashMap<u64, serde_json::Value> =
+        timed_messages_of(&m, TOPIC_TICK).into_iter().collect();
+    let tfs = timed_messages_of(&m, TOPIC_TF);
+    assert!(tfs.len() > 5);
+    let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * (1.0 + b.abs());
+    for (t, tf) in &tfs {
+        let mut want: Vec<(String, f64, f64, f64)> = bodies[t]["bodies"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|b| {
+                let f = |k: &str| b[k].as_f64().unwrap();
+                (
+                    format!("body/{}", b["name"].as_str().unwrap()),
+                    f("x"),
+                    f("y"),
+                    f("theta"),
+                )
+            })
+            .collect();
+        let d = &ticks[t];
+        for (frame, obj) in [("device", "device"), ("slave", "slave")] {
+            let f = |k: &str| d[obj][k].as_f64().unwrap();
+            want.push((frame.to_string(), f("x"), f("y"), f("theta")));
+        }
+        let got = tf["transforms"].as_array().unwrap();
+        assert_eq!(got.len(), want.len(), "{tf}");
+        for (g, (frame, x, y, th)) in got.iter().zip(&want) {
+            assert_eq!(g["parent_frame_id"], "world");
+            assert_eq!(g["child_frame_id"], frame.as_str());
+            assert_eq!(g["timestamp"]["sec"].as_u64().unwrap(), t / 1_000_000_000);
+            assert_eq!(g["timestamp"]["nsec"].as_u64().unwrap(), t % 1_000_000_000);
+            let tr = &g["translation"];
+            let q = &g["rotation"];
+            assert!(close(tr["x"].as_f64().unwrap(), *x) && close(tr["y"].as_f64().unwrap(), *y));
+            assert_eq!(tr["z"], 0);
+            assert!(close(q["z"].as_f64().unwrap(), (0.5 * th).sin()), "{g}");
+            assert!(close(q["w"].as_f64().unwrap(), (0.5 * th).cos()), "{g}");
+        }
+    }
+}
+
+/// The value at a Foxglove message path's field part (`a.b`, `arr[0].c`) in `msg`.
+fn at_path<'a>(msg: &'a serde_json::Value, path: &str) -> Option<&'a serde_json::Value> {
+    let mut v = msg;
+    for part in path.split('.') {
+        let (name, index) = match part.split_once('[') {
+            Some((n, i)) => (n, Some(i.trim_end_matches(']').parse::<usize>().ok()?)),
+            None => (part, None),
+        };
+        v = v.get(name)?;
+        if let Some(i) = index {
+            v = v.get(i)?;
+        }
+    }
+    Some(v)
+}
+
+/// Issue 39 item 8: the shipped layout (`foxglove/haptic2d-layout.json`, named in docs/LOGS.md)
+/// names topics a recording has, plot paths that resolve to numbers in its messages, and frames
+/// that `/haptic2d/tf` publishes — so opening a recording with it shows data, not empty panels.
+#[test]
+fn the_shipped_foxglove_layout_names_topics_fields_and_frames_a_recording_has() {
+    let layout_path =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../foxglove/haptic2d-layout.json");
+    let layout: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&layout_path).unwrap()).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let m = dir.path().join("layout.mcap");
+    // peg-in-hole: the peg touches its channel from the first tick, so the contact plot has data.
+    run_logged(&m, &["peg-in-hole", "--duration", "0.5"]);
+    let bytes = read_file(&m).unwrap();
+    let info = read_info(&bytes, "layout.mcap").unwrap();
+    let panels = layout["configById"].as_object().unwrap();
+    let mut plots = 0;
+    let mut three_d = 0;
+    for (id, cfg) in panels {
+        if id.starts_with("Plot!") {
+            for p in cfg["paths"].as_array().unwrap() {
+                let value = p["value"].as_str().unwrap();
+                let (topic, field) = value[1..]
+                    .split_once('.')
+                    .map(|(t, f)| (format!("/{t}"), f))
+                    .unwrap();
+                assert!(info.count(&topic) > 0, "{id}: no messages on {topic}");
+                let msgs = messages_of(&m, &topic);
+                let numbers = msgs
+                    .iter()
+                    .filter_map(|msg| at_path(msg, field))
+                    .filter(|v| v.is_number() || v.is_string())
+                    .count();
+                assert!(
+                    numbers > 0,
+                    "{id}: `{value}` resolves in no {topic} message"
+                );
+                plots += 1;
+            }
+        } else if id.starts_with("3D!") {
+            three_d += 1;
+            for topic in cfg["topics"].as_object().unwrap().keys() {
+                assert!(info.count(topic) > 0, "{id}: no messages on {topic}");
+            }
+            let tf = messages_of(&m, TOPIC_TF);
+            let frames: std::collections::BTreeSet<String> = tf
+                .iter()
+                .flat_map(|t| t["transforms"].as_array().unwrap().clone())
+                .flat_map(|x| {
+                    [
+                        x["parent_frame_id"].as_str().unwrap().to_string(),
+                        x["child_frame_id"].as_str().unwrap().to_string(),
+                    ]
+                })
+                .collect();
+            assert!(
+                frames.contains(cfg["followTf"].as_str().unwrap()),
+                "{frames:?}"
+            );
+            for key in cfg["transforms"].as_object().unwrap().keys() {
+                let f = key.strip_prefix("frame:").unwrap();
+                assert!(
+                    frames.contains(f),
+                    "{id}: frame {f} not published: {frames:?}"
+                );
+            }
+            // The scene updates draw in the frame the panel follows.
+            let su = messages_of(&m, TOPIC_SCENE_UPDATE);
+            assert!(su[0]["entities"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .all(|e| e["frame_id"] == cfg["followTf"]));
+        }
+    }
+    assert!(
+        plots >= 5 && three_d == 1,
+        "{plots} plot paths, {three_d} 3D panels"
+    );
+    // Every panel of the layout tree is configured, and every configured panel is in the tree.
+    fn leaves(v: &serde_json::Value, out: &mut Vec<String>) {
+        match v {
+            serde_json::Value::String(s) => out.push(s.clone()),
+            v => {
+                leaves(&v["first"], out);
+                leaves(&v["second"], out);
+            }
+        }
+    }
+    let mut tree = Vec::new();
+    leaves(&layout["layout"], &mut tree);
+    tree.sort();
+    let mut ids: Vec<String> = panels.keys().cloned().collect();
+    ids.sort();
+    assert_eq!(tree, ids);
 }

@@ -62,7 +62,7 @@ pub const TICK_TABLE: [Column; TICK_TABLE_LEN] = [
     u(
         "deadline_ns",
         "ns",
-        "the tick's deadline, CLOCK_MONOTONIC (= the message's log_time)",
+        "the tick's deadline, CLOCK_MONOTONIC (the message's log_time is this plus the Unix offset of the haptic2d.clock metadata)",
     ),
     u(
         "lateness_ns",
@@ -206,6 +206,19 @@ pub fn csv_header() -> Vec<String> {
         .iter()
         .map(|c| c.name.to_string())
         .collect()
+}
+
+/// The encoder columns of [`TICK_TABLE`] (`encoders.q1..q4`, rad), in order.
+pub const ENCODER_COLUMNS: [&str; 4] = ["encoders.q1", "encoders.q2", "encoders.q3", "encoders.q4"];
+
+/// The CSV header of `haptic2d run --log FILE.csv`: the [`TickRecord`] columns ([`csv_header`]),
+/// then [`ENCODER_COLUMNS`] — the order `log convert RUN.mcap RUN.csv` writes them in (record
+/// columns first, then the loop columns present), so a run's CSV converts to MCAP and back to the
+/// same text.
+pub fn run_csv_header() -> Vec<String> {
+    let mut h = csv_header();
+    h.extend(ENCODER_COLUMNS.iter().map(|s| s.to_string()));
+    h
 }
 
 /// The index of the column named `name` in [`TICK_TABLE`].
@@ -408,6 +421,20 @@ mod tests {
     #[test]
     fn record_columns_of_the_table_are_tick_columns() {
         assert_eq!(csv_header(), TICK_COLUMNS.to_vec());
+    }
+
+    #[test]
+    fn run_csv_header_is_the_record_columns_then_the_encoders() {
+        let h = run_csv_header();
+        assert_eq!(&h[..TICK_COLUMNS.len()], &csv_header()[..]);
+        assert_eq!(
+            &h[TICK_COLUMNS.len()..],
+            &["encoders.q1", "encoders.q2", "encoders.q3", "encoders.q4"]
+        );
+        // Every column maps back to the tick table (log convert CSV → MCAP), the encoders to
+        // the loop columns 3..7 in order.
+        let idx: Vec<usize> = h.iter().map(|n| column_index(n).unwrap()).collect();
+        assert_eq!(&idx[TICK_COLUMNS.len()..], &[3, 4, 5, 6]);
     }
 
     #[test]

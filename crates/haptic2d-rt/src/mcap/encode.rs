@@ -214,3 +214,127 @@ pub fn encode_scene_update<B: Write>(
     )?;
     Ok(())
 }
+
+/// Writes one `FrameTransform` (JSON object) of frame `child` in `world` at the planar pose
+/// `[x, y, θ]` (m, m, rad): translation `(x, y, 0)`, rotation θ about z.
+fn write_transform<B: Write>(
+    b: &mut B,
+    sec: u64,
+    nsec: u64,
+    child: &str,
+    pose: [f64; 3],
+) -> std::io::Result<()> {
+    let half = 0.5 * pose[2];
+    write!(
+        b,
+        "{{\"timestamp\":{{\"sec\":{sec},\"nsec\":{nsec}}},\"parent_frame_id\":\"world\",\"child_frame_id\":{child},\"translation\":{{\"x\":"
+    )?;
+    write_json_f64(b, pose[0])?;
+    b.write_all(b",\"y\":")?;
+    write_json_f64(b, pose[1])?;
+    b.write_all(b",\"z\":0},\"rotation\":{\"x\":0,\"y\":0,\"z\":")?;
+    write_json_f64(b, half.sin())?;
+    b.write_all(b",\"w\":")?;
+    write_json_f64(b, half.cos())?;
+    b.write_all(b"}}")
+}
+
+/// Writes a Foxglove `FrameTransforms` (JSON, `/haptic2d/tf`): the frame `body/NAME` of every body
+/// kept in the sample, and — for a haptic tick (`tick` given) — `device` at the handle pose and
+/// `slave` at the slave pose, all children of `world`. Poses are planar: `(x, y, 0)` and a rotation
+/// by θ about z (quaternion `(0, 0, sin θ/2, cos θ/2)`). `names`: the bodies' names as JSON
+/// strings. A frame whose pose is not finite (a device that sent NaN) is left out of the message:
+/// Foxglove's schema wants numbers there, and a frame has no place to be drawn.
+pub fn encode_frame_transforms<B: Write>(
+    b: &mut B,
+    names: &[String],
+    s: &WorldSample,
+    tick: Option<&haptic2d::haptic::TickRecord>,
+    log_time: u64,
+) -> std::io::Result<()> {
+    let (sec, nsec) = (log_time / 1_000_000_000, log_time % 1_000_000_000);
+    b.write_all(b"{\"transforms\":[")?;
+    let mut first = true;
+    let finite = |p: &[f64; 3]| p.iter().all(|v| v.is_finite());
+    for (i, body) in s.bodies().iter().enumerate() {
+        if !finite(&body.pose) {
+            continue;
+        }
+        if !first {
+            b.write_all(b",")?;
+        }
+        first = false;
+        // `names` are JSON strings (quoted, escaped): the frame id is `"body/` + their inside.
+        let child = match names.get(i) {
+            Some(n) if n.len() >= 2 => format!("\"body/{}", &n[1..]),
+            _ => format!("\"body/body{i}\""),
+        };
+        write_transform(b, sec, nsec, &child, body.pose)?;
+    }
+    if let Some(r) = tick {
+        for (child, pose) in [("\"device\"", r.x_m), ("\"slave\"", r.x_s)] {
+            if !finite(&pose) {
+                continue;
+            }
+            if !first {
+                b.write_all(b",")?;
+            }
+            first = false;
+            write_transform(b, sec, nsec, child, pose)?;
+        }
+    }
+    b.write_all(b"]}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mcap::schemas::TF_SCHEMA;
+    use haptic2d::haptic::TickRecord;
+
+    #[test]
+    fn frame_transforms_rotate_about_z_and_leave_out_a_non_finite_pose() {
+        let mut s = WorldSample {
+            body_count: 2,
+            ..WorldSample::default()
+        };
+        s.bodies[0].pose = [0.1, -0.2, std::f64::consts::FRAC_PI_2];
+        s.bodies[1].pose = [f64::NAN, 0.0, 0.0];
+        let rec = TickRecord {
+            x_m: [0.3, 0.4, 0.0],
+            x_s: [0.0, f64::INFINITY, 0.0],
+            ..TickRecord::default()
+        };
+        let names = vec!["\"box\"".to_string(), "\"bad\"".to_string()];
+        let mut b = Vec::new();
+        encode_frame_transforms(&mut b, &names, &s, Some(&rec), 1_700_000_000_123_456_789).unwrap();
+        let v: serde_json::Value = serde_json::from_slice(&b).unwrap();
+        let t = v["transforms"].as_array().unwrap();
+        // body/bad and slave have non-finite poses: left out.
+        let frames: Vec<&str> = t
+            .iter()
+            .map(|x| x["child_frame_id"].as_str().unwrap())
+            .collect();
+        assert_eq!(frames, ["body/box", "device"]);
+        let q = &t[0]["rotation"];
+        let h = std::f64::consts::FRAC_1_SQRT_2; // 90° about z: (0, 0, sin 45°, cos 45°)
+        assert!((q["z"].as_f64().unwrap() - h).abs() < 1e-15);
+        assert!((q["w"].as_f64().unwrap() - h).abs() < 1e-15);
+        assert_eq!(t[0]["timestamp"]["sec"], 1_700_000_000);
+        assert_eq!(t[0]["timestamp"]["nsec"], 123_456_789);
+        assert_eq!(t[1]["translation"]["x"], 0.3);
+        // Every field Foxglove's schema requires is there, numbers where it wants numbers.
+        let schema: serde_json::Value = serde_json::from_str(TF_SCHEMA).unwrap();
+        let item = &schema["properties"]["transforms"]["items"];
+        for x in t {
+            for k in item["required"].as_array().unwrap() {
+                assert!(x.get(k.as_str().unwrap()).is_some(), "{k} missing in {x}");
+            }
+            for (obj, keys) in [("translation", "xyz"), ("rotation", "xyzw")] {
+                for k in keys.chars() {
+                    assert!(x[obj][k.to_string()].is_number(), "{x}");
+                }
+            }
+        }
+    }
+}

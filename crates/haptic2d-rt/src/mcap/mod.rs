@@ -1,5 +1,6 @@
 //! MCAP logs of the haptic loop and the world (issue 14; channels and schemas: docs/LOGS.md).
 //!
+//! - [`clock`]: `log_time` in Unix-epoch ns (the offset from `CLOCK_MONOTONIC`);
 //! - [`columns`]: the one table of tick columns with units (CSV header, JSON Schema, JSON rows);
 //! - [`record`]: [`LoggedTick`], the fixed-size record the loop pushes into the telemetry ring;
 //! - [`encode`]: the JSON encoders of the messages (shared with the Foxglove live server);
@@ -13,6 +14,7 @@
 //! - [`tick_csv`]: CSV tick logs read back (`log info`, `log convert`);
 //! - [`world_csv`]: the world channels as CSV tables (`log convert FILE.mcap OUT.csv`).
 
+pub mod clock;
 pub mod columns;
 pub mod encode;
 pub mod frame;

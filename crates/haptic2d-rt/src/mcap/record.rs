@@ -4,7 +4,7 @@
 //! allocation; [`LoggedTick::capture`] is allocation-free.
 
 use crate::logger::CsvRecord;
-use crate::mcap::columns::csv_header;
+use crate::mcap::columns::run_csv_header;
 use crate::runner::TickInfo;
 use haptic2d::contact::ContactState;
 use haptic2d::haptic::TickRecord;
@@ -166,14 +166,20 @@ impl LoggedTick {
     }
 }
 
-/// A CSV tick log of `LoggedTick`s is the same as one of `TickRecord`s: the [`TickRecord`]
-/// columns only (the CSV format is unchanged; the loop columns are in MCAP logs).
+/// The CSV tick log of `haptic2d run --log FILE.csv`: the [`TickRecord`] columns, then the
+/// encoder angles `encoders.q1..q4` (rad) read that tick ([`run_csv_header`]), so that
+/// `--device replay:FILE.csv` plays a run's CSV log back (issue 39) and `log convert` maps every
+/// column to the tick table.
 impl CsvRecord for LoggedTick {
     fn header() -> Vec<String> {
-        csv_header()
+        run_csv_header()
     }
 
     fn write_row<W: std::io::Write>(&self, out: &mut csv::Writer<W>) -> csv::Result<()> {
-        self.rec.write_row(out)
+        self.rec.write_row(out)?;
+        for v in self.q {
+            out.write_field(v.to_string())?;
+        }
+        Ok(())
     }
 }

@@ -4,18 +4,24 @@
 //! `write_to_known_channel` with a JSON body encoded into one reused buffer; `finish` writes the
 //! summary and index and its statistics are folded into the [`McapStats`] returned.
 //!
-//! Timestamps: a tick's `log_time` (and `publish_time`) is its deadline (`CLOCK_MONOTONIC` ns) and
-//! its `sequence` the tick index (mod 2³²; the full index is in the message). A world sample of
-//! `haptic2d simulate` has `log_time = round(t · 10⁹)` and `sequence` = the sample number.
+//! Timestamps ([`clock`](super::clock)): a tick's `log_time` (and `publish_time`) is its deadline
+//! (`CLOCK_MONOTONIC` ns) moved to the Unix epoch by the offset read when the log started, and its
+//! `sequence` the tick index (mod 2³²; the full index is in the message). A world sample of
+//! `haptic2d simulate` has `log_time` = the Unix time the simulation started + `round(t · 10⁹)`,
+//! and `sequence` = the sample number. A tick log converted from CSV keeps the recorded deadline
+//! (or `t`). The metadata record `haptic2d.clock` says which.
 
+use crate::mcap::clock::{clock_metadata, monotonic_to_unix_offset_ns, unix_now_ns, LogClock};
 use crate::mcap::columns::{tick_json_schema, tick_row, TickRow};
 use crate::mcap::encode::{
-    encode_bodies, encode_contacts, encode_energy, encode_scene_update, encode_tick_row,
+    encode_bodies, encode_contacts, encode_energy, encode_frame_transforms, encode_scene_update,
+    encode_tick_row,
 };
 use crate::mcap::record::{LoggedTick, WorldSample};
 use crate::mcap::schemas::*;
 use ::mcap::records::{MessageHeader, Metadata};
 use ::mcap::{WriteOptions, Writer};
+use haptic2d::haptic::TickRecord;
 use haptic2d::world::World;
 use std::collections::BTreeMap;
 use std::io::{Seek, Write};
@@ -52,6 +58,8 @@ pub struct McapSetup {
     /// Register the world channels (bodies, contacts, energy, `SceneUpdate`); false for a tick log
     /// converted from CSV, which has no world samples.
     pub world: bool,
+    /// What the `log_time`s count (written as the metadata record `haptic2d.clock`).
+    pub clock: LogClock,
 }
 
 impl McapSetup {
@@ -72,12 +80,22 @@ impl McapSetup {
                     .collect(),
             })
             .collect();
+        let clock = if ticks {
+            LogClock::UnixFromMonotonic {
+                offset_ns: monotonic_to_unix_offset_ns(),
+            }
+        } else {
+            LogClock::UnixFromSimTime {
+                start_ns: unix_now_ns(),
+            }
+        };
         Self {
             scene,
             bodies,
             scene_update_hz: DEFAULT_SCENE_UPDATE_HZ,
             ticks,
             world: true,
+            clock,
         }
     }
 
@@ -89,6 +107,7 @@ impl McapSetup {
             scene_update_hz: 0.0,
             ticks: true,
             world: false,
+            clock: LogClock::Converted,
         }
     }
 }
@@ -120,6 +139,7 @@ struct Channels {
     energy: Option<u16>,
     scene: u16,
     scene_update: Option<u16>,
+    tf: Option<u16>,
 }
 
 /// An MCAP file being written (not thread-bound: the [`McapLogger`](super::McapLogger) thread and
@@ -184,10 +204,16 @@ impl<W: Write + Seek> McapSink<W> {
         } else {
             None
         };
+        let tf = if setup.world && setup.scene_update_hz > 0.0 {
+            Some(add(&mut w, SCHEMA_TF, TF_SCHEMA, TOPIC_TF)?)
+        } else {
+            None
+        };
         w.write_metadata(&Metadata {
             name: "haptic2d.scene".into(),
             metadata: setup.scene.clone(),
         })?;
+        w.write_metadata(&clock_metadata(setup.clock))?;
         let names_json = setup
             .bodies
             .iter()
@@ -207,6 +233,7 @@ impl<W: Write + Seek> McapSink<W> {
                 energy,
                 scene,
                 scene_update,
+                tf,
             },
             setup,
             names_json,
@@ -241,14 +268,27 @@ impl<W: Write + Seek> McapSink<W> {
     /// Writes one haptic tick: `/haptic2d/tick`, and — when the tick carries a world sample — the
     /// bodies, contacts, energy and (decimated) `SceneUpdate`.
     pub fn write_tick(&mut self, t: &LoggedTick) -> ::mcap::McapResult<()> {
-        let log_time = t.deadline_ns;
+        let log_time = match self.setup.clock {
+            LogClock::UnixFromMonotonic { offset_ns } => t.deadline_ns.saturating_add(offset_ns),
+            _ => t.deadline_ns,
+        };
         self.scene_once(log_time)?;
         let row = tick_row(t.index, t.deadline_ns, t.lateness_ns, &t.q, &t.rec);
         self.write_tick_row(t.index, log_time, &row)?;
         if t.world.body_count > 0 {
-            self.write_world(t.index, log_time, &t.world)?;
+            self.write_world_of(t.index, log_time, &t.world, Some(&t.rec))?;
         }
         Ok(())
+    }
+
+    /// The `log_time` (ns) of a world sample at simulated time `t_s` (s): the Unix time the log
+    /// started + `round(t · 10⁹)` ([`LogClock::UnixFromSimTime`]), else `round(t · 10⁹)`.
+    pub fn sim_log_time(&self, t_s: f64) -> u64 {
+        let t = (t_s.max(0.0) * 1e9).round() as u64;
+        match self.setup.clock {
+            LogClock::UnixFromSimTime { start_ns } => start_ns.saturating_add(t),
+            _ => t,
+        }
     }
 
     /// Writes one `/haptic2d/tick` message from a row (present cells only) at `log_time` (ns);
@@ -275,6 +315,18 @@ impl<W: Write + Seek> McapSink<W> {
         seq: u64,
         log_time: u64,
         s: &WorldSample,
+    ) -> ::mcap::McapResult<()> {
+        self.write_world_of(seq, log_time, s, None)
+    }
+
+    /// [`write_world`](Self::write_world); `tick`: the haptic tick's record, whose device and slave
+    /// poses join the bodies' in the `FrameTransforms`.
+    fn write_world_of(
+        &mut self,
+        seq: u64,
+        log_time: u64,
+        s: &WorldSample,
+        tick: Option<&TickRecord>,
     ) -> ::mcap::McapResult<()> {
         self.scene_once(log_time)?;
         let (Some(bodies), Some(contacts), Some(energy)) =
@@ -304,6 +356,12 @@ impl<W: Write + Seek> McapSink<W> {
                 )
                 .map_err(io_err)?;
                 self.emit(id, seq, log_time)?;
+                if let Some(tf) = self.ch.tf {
+                    self.buf.clear();
+                    encode_frame_transforms(&mut self.buf, &self.names_json, s, tick, log_time)
+                        .map_err(io_err)?;
+                    self.emit(tf, seq, log_time)?;
+                }
             }
         }
         Ok(())
