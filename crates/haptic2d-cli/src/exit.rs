@@ -54,7 +54,8 @@ Exit codes:
   4    the device was lost (run)
   5    energy excess above the §13.1 bound (simulate --strict; always a warning otherwise)
   6    the simulation diverged (simulate)
-  130  interrupted by SIGINT or SIGTERM (run, simulate; summary printed, logs end on a whole row)
+  130  interrupted by SIGINT or SIGTERM (run, simulate: summary printed, logs end on a whole row;
+       log convert: no output left behind)
   141  (shell status) ended by SIGPIPE: the reader of the output closed it, e.g. `| head -1`
        (run: after zeroing the torques and ending its log; simulate --out: after ending the file)";
 
