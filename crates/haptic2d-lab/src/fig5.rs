@@ -19,6 +19,7 @@
 
 use crate::csv::write_columns;
 use crate::experiments::fig5::{run_case, Fig5Case, Fig5Expectation, Fig5Params, FIG5_CASES};
+use crate::experiments::{with_capstan_friction, Protocol};
 use crate::fig5_sweep;
 use crate::figure::{Figure, FigureContext, FigureReport};
 use crate::plot::{write_panels, Panel, Series, Stroke};
@@ -29,7 +30,7 @@ use std::fmt::Write as _;
 /// The runs: `(name, parameters)`: the default controller on the spec's device, the §11.1 table on
 /// the same device, the §11.1 table on a device damped at twice Colgate's bound, the virtual
 /// coupling, and the former default (master-side local force feedback only). Which run carries which wall's claim: [`carrier`].
-fn controllers(ctx: Option<&FigureContext>) -> Vec<(String, Fig5Params)> {
+fn controllers(ctx: Option<&FigureContext>) -> Result<Vec<(String, Fig5Params)>, String> {
     let mut v = vec![
         ("four-channel".to_string(), Fig5Params::default()),
         (
@@ -54,12 +55,39 @@ fn controllers(ctx: Option<&FigureContext>) -> Vec<(String, Fig5Params)> {
             },
         ),
     ];
-    // `reproduce --controller-file`: that controller carries the claims.
-    if let Some((label, kind)) = ctx.and_then(|c| c.controller.as_ref()) {
-        v[0].0 = label.clone();
-        v[0].1.haptic.controller = *kind;
+    // Issue 36 item 4: every carrier (the default, the §11.1 table, the former default) also with
+    // the push injected into the hand-force estimate instead of acting on the handle; item 3: the
+    // default on the device of `devices/twin-pantograph-capstan-friction.toml`, without and with
+    // its friction compensation. All comparison runs.
+    for i in [0, 1, 4] {
+        let (name, p) = v[i].clone();
+        v.push((
+            format!("{name}-estimate-injection"),
+            Fig5Params {
+                protocol: Protocol::EstimateInjection,
+                ..p
+            },
+        ));
     }
-    v
+    for (suffix, compensated) in [
+        ("capstan-friction", false),
+        ("capstan-friction-compensated", true),
+    ] {
+        let mut p = v[0].1.clone();
+        p.haptic.device = with_capstan_friction(&p.haptic.device, compensated)?;
+        v.push((format!("four-channel-{suffix}"), p));
+    }
+    // `reproduce --controller-file`: that controller carries the claims (and runs the default's
+    // variants).
+    if let Some((label, kind)) = ctx.and_then(|c| c.controller.as_ref()) {
+        for (name, p) in v.iter_mut() {
+            if name.starts_with("four-channel") && !name.starts_with("four-channel-spec") {
+                *name = name.replacen("four-channel", label, 1);
+                p.haptic.controller = *kind;
+            }
+        }
+    }
+    Ok(v)
 }
 
 /// Why the default carries the Fig. 6 claims (pulse, hysteretic walls).
@@ -147,6 +175,10 @@ pub fn check(c: &Fig5Case) -> Check {
             ),
         ),
     };
+    let detail = match &c.stopped {
+        Some(why) => format!("safety stop: {why}; {detail}"),
+        None => detail,
+    };
     Check::new(id, m.pass, detail)
 }
 
@@ -161,10 +193,11 @@ impl Figure for Fig5 {
         "Figs. 5–6: a box pushed into undamped walls with the device in the loop"
     }
     fn jobs(&self) -> u64 {
-        ((controllers(None).len() + fig5_sweep::MARGINS.len()) * FIG5_CASES.len()) as u64
+        ((controllers(None).map_or(0, |c| c.len()) + fig5_sweep::MARGINS.len()) * FIG5_CASES.len())
+            as u64
     }
     fn run(&self, ctx: &FigureContext) -> Result<FigureReport, String> {
-        let ctrl = controllers(Some(ctx));
+        let ctrl = controllers(Some(ctx))?;
         let jobs: Vec<(usize, usize)> = (0..ctrl.len())
             .flat_map(|i| (0..FIG5_CASES.len()).map(move |j| (i, j)))
             .collect();

@@ -15,6 +15,7 @@
 
 use crate::csv::write_columns;
 use crate::experiments::fig8::{run_case, Fig8Case, Fig8Params, FIG8_CASES};
+use crate::experiments::{with_capstan_friction, Protocol};
 use crate::figure::{Figure, FigureContext, FigureReport};
 use crate::plot::{write_panels, Panel, Series, Stroke};
 use crate::schema::{CaseMetrics, Check, Dimension, Fig7Measured, FigureMetrics, Measured};
@@ -24,7 +25,7 @@ use std::fmt::Write as _;
 /// The controllers compared: `(name, parameters, comparison)`. The four-channel controller with its
 /// released-stable default gains carries the claims; the virtual coupling and the §11.1 table are
 /// comparison runs.
-fn controllers(ctx: Option<&FigureContext>) -> Vec<(String, Fig8Params)> {
+fn controllers(ctx: Option<&FigureContext>) -> Result<Vec<(String, Fig8Params)>, String> {
     let mut v = vec![
         ("four-channel".to_string(), Fig8Params::default()),
         ("coupling".to_string(), Fig8Params::coupling()),
@@ -43,14 +44,36 @@ fn controllers(ctx: Option<&FigureContext>) -> Vec<(String, Fig8Params)> {
             },
         ),
     ];
-    // `reproduce --controller-file`: that controller carries the claims (and runs the variant).
-    if let Some((label, kind)) = ctx.and_then(|c| c.controller.as_ref()) {
-        v[0].0 = label.clone();
-        v[0].1.haptic.controller = *kind;
-        v[3].0 = format!("{label}-500hz-scale1");
-        v[3].1.haptic.controller = *kind;
+    // Issue 36 item 3, named comparison runs: the carrier on the device of
+    // `devices/twin-pantograph-capstan-friction.toml` (realistic joint Coulomb friction), without
+    // and with its friction compensation. Item 4: the carrier with the push injected into the
+    // hand-force estimate instead of acting on the handle.
+    let base = v[0].1.clone();
+    for (suffix, compensated) in [
+        ("capstan-friction", false),
+        ("capstan-friction-compensated", true),
+    ] {
+        let mut p = base.clone();
+        p.haptic.device = with_capstan_friction(&p.haptic.device, compensated)?;
+        v.push((format!("four-channel-{suffix}"), p));
     }
-    v
+    v.push((
+        "four-channel-estimate-injection".to_string(),
+        Fig8Params {
+            protocol: Protocol::EstimateInjection,
+            ..base
+        },
+    ));
+    // `reproduce --controller-file`: that controller carries the claims (and runs the variants).
+    if let Some((label, kind)) = ctx.and_then(|c| c.controller.as_ref()) {
+        for (name, p) in v.iter_mut() {
+            if name.starts_with("four-channel") && !name.starts_with("four-channel-spec") {
+                *name = name.replacen("four-channel", label, 1);
+                p.haptic.controller = *kind;
+            }
+        }
+    }
+    Ok(v)
 }
 
 /// Why the default carries the Figs. 8–11 claims.
@@ -135,10 +158,10 @@ impl Figure for Fig8 {
         "Figs. 8–11: a peg pushed in a tight hole with the device in the loop"
     }
     fn jobs(&self) -> u64 {
-        (controllers(None).len() * FIG8_CASES.len()) as u64
+        (controllers(None).map_or(0, |c| c.len()) * FIG8_CASES.len()) as u64
     }
     fn run(&self, ctx: &FigureContext) -> Result<FigureReport, String> {
-        let ctrl = controllers(Some(ctx));
+        let ctrl = controllers(Some(ctx))?;
         let jobs: Vec<(usize, usize)> = (0..ctrl.len())
             .flat_map(|i| (0..FIG8_CASES.len()).map(move |j| (i, j)))
             .collect();
