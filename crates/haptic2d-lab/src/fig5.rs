@@ -4,8 +4,10 @@
 //! by a named configuration on the spec's device, with its reason and `haptic2d stability`'s verdict
 //! (`carrier`): the hysteretic wall by the default, the pulse wall by the former default, SEH and
 //! ZOH by the §11.1 table (unstable released there, refused on a real device). Comparison runs: every
-//! other configuration on every wall, the §11.1 table on a device damped at twice Colgate's bound and
-//! the virtual coupling. A sweep of the device damping under the §11.1 table
+//! other configuration on every wall, the §11.1 table on a device damped at twice Colgate's bound,
+//! the virtual coupling, every carrier with the push injected into the hand-force estimate (issue 36
+//! item 4), and the default on the capstan-friction device without and with friction compensation
+//! (item 3). A sweep of the device damping under the §11.1 table
 //! ([`crate::fig5_sweep`]) shows where that table's claims hold.
 //!
 //! Pass criteria (the paper's claim; numbers from the spec's W6/W7 with W7's 0.06 m/s taken relative to
@@ -338,7 +340,14 @@ fn report(m: &FigureMetrics, sweep: &str) -> String {
          C6 = −1, D_m = 2 N·s/m) and the paper's §11.1 table (`four-channel-spec`). Comparison runs: \
          the other configurations on every wall, the §11.1 table on a device damped at twice \
          Colgate's bound (`four-channel-spec-damped-device`, `f_v = 1.44e-2 N·m·s/rad`) and the \
-         virtual coupling (§11.2). Pass: SEH/ZOH \
+         virtual coupling (§11.2); each carrier with the push injected into the hand-force estimate \
+         instead of acting on the handle (`*-estimate-injection`: the second reading of \
+         \"the hand is replaced by a constant force\"; with C6 = −1 the device is commanded against \
+         the injected push and the box never reaches the wall, and the §11.1 table neither keeps \
+         bouncing nor settles); the default on a device with realistic joint Coulomb friction \
+         (`four-channel-capstan-friction`, 0.015 N·m per joint, \
+         `devices/twin-pantograph-capstan-friction.toml`) and with that file's friction compensation \
+         (`four-channel-capstan-friction-compensated`); MODELS.md §11.4. Pass: SEH/ZOH \
          keep bouncing (≥ 2 separations in the last 2 s, never settles); pulse stable at the first \
          impact (first contact ratio ≤ 0.4 — none if the box never leaves the wall —, entries after \
          the 2nd impact < 0.15·v1, none in the last 2 s; W7); hysteretic stable soon (first 3 ratios < \

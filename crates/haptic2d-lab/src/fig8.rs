@@ -5,7 +5,10 @@
 //! are free. The claims are carried by the default controller (`C6 = −1`, `C5 = 2`, damping
 //! injection; `carrier` gives the reason the report prints beside `haptic2d stability`'s verdict);
 //! comparison runs: the virtual coupling (§11.2), the §11.1 table (unstable with the hand released,
-//! §11.4), and the default at the paper's setting (500 Hz, mapping scale 1), a named variant.
+//! §11.4), the default at the paper's setting (500 Hz, mapping scale 1), a named variant, the
+//! paper-rate study's soft coupling there, the default on the capstan-friction device without and
+//! with friction compensation, and the default with the push injected into the hand-force estimate
+//! (issue 36 items 2–4).
 //!
 //! Pass criteria (§13.2 thresholds on the cycles after the release): the run ends without a safety
 //! stop; every `advance_k > 5e-3 m` (F7-3); classical `min creep_k ≥ 5e-4 m` (F7-1, drift), the others
@@ -43,6 +46,20 @@ fn controllers(ctx: Option<&FigureContext>) -> Result<Vec<(String, Fig8Params)>,
                 ..Fig8Params::default()
             },
         ),
+        // The paper-rate study's best stable design (issue 36 item 2, MODELS.md §11.4): a soft
+        // virtual coupling (`controllers/coupling-paper-rate.toml`), at 500 Hz and scale 1.
+        (
+            "coupling-160-500hz-scale1".to_string(),
+            Fig8Params {
+                rate: 500.0,
+                scale: 1.0,
+                haptic: haptic2d::haptic::HapticConfig {
+                    controller: haptic2d::haptic::ControllerKind::Coupling(PAPER_RATE_COUPLING),
+                    ..haptic2d::haptic::HapticConfig::default()
+                },
+                ..Fig8Params::default()
+            },
+        ),
     ];
     // Issue 36 item 3, named comparison runs: the carrier on the device of
     // `devices/twin-pantograph-capstan-friction.toml` (realistic joint Coulomb friction), without
@@ -75,6 +92,14 @@ fn controllers(ctx: Option<&FigureContext>) -> Result<Vec<(String, Fig8Params)>,
     }
     Ok(v)
 }
+
+/// The gains of `controllers/coupling-paper-rate.toml`: `K_vc` = 160 N/m, `B_vc` = 7.8125 N·s/m (θ
+/// 0.125 N·m/rad, 0.005 N·m·s/rad).
+pub const PAPER_RATE_COUPLING: haptic2d::control::coupling::CouplingGains =
+    haptic2d::control::coupling::CouplingGains {
+        k: [160.0, 160.0, 0.125],
+        b: [7.8125, 7.8125, 0.005],
+    };
 
 /// Why the default carries the Figs. 8–11 claims.
 const DEFAULT_REASON: &str = "the default controller, stable held and released with margin on the peg (`haptic2d stability peg-in-hole`): its slave-side local force feedback C5 makes the hand's push reach the peg without reflecting the contact force to a released handle";
@@ -279,9 +304,16 @@ fn report(m: &FigureMetrics) -> String {
          pantograph at 1 kHz, mapping scale 2; the hand holds the handle for 1 s, then lets go and \
          `2.1 N (1 − cos 2πt)/2` (world) pushes the handle along x, y and θ free. The claims are carried \
          by the default controller (C6 = −1, C5 = 2, D_m = 1 N·s/m); comparison runs: the virtual \
-         coupling (§11.2), the paper's §11.1 table, and the default at the paper's own setting, \
+         coupling (§11.2), the paper's §11.1 table, the default at the paper's own setting, \
          500 Hz and mapping scale 1 (`four-channel-500hz-scale1`: the device's world-side inertia \
-         four times that at scale 2; the claims do not hold there, MODELS.md §11.4). Pass: no safety stop; \
+         four times that at scale 2; the claims do not hold there), the paper-rate study's best stable \
+         design there (`coupling-160-500hz-scale1`, `controllers/coupling-paper-rate.toml`: 4 of 5, \
+         but walls felt at 7 % of their stiffness), the default on a device with realistic joint \
+         Coulomb friction (`four-channel-capstan-friction`, 0.015 N·m per joint from \
+         `devices/twin-pantograph-capstan-friction.toml`) and with that file's friction compensation \
+         (`four-channel-capstan-friction-compensated`), and the default with the push injected into \
+         the hand-force estimate instead of acting on the handle (`four-channel-estimate-injection`, \
+         the second reading of the paper's protocol); MODELS.md §11.4 discusses each. Pass: no safety stop; \
          classical `min creep_k ≥ 5e-4 m` (F7-1, drift), the others `max creep_k ≤ 2e-4 m` (F7-2, \
          stick); every `advance_k > 5e-3 m` (F7-3, slip). `creep_k = x(k + 0.2) − x(k − 0.1)`, \
          `advance_k = x(k + 0.9) − x(k − 0.1)`, k counted in seconds after the release.\n\n\
