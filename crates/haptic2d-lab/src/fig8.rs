@@ -74,6 +74,16 @@ fn controllers(ctx: Option<&FigureContext>) -> Result<Vec<(String, Fig8Params)>,
         p.haptic.device = with_capstan_friction(&p.haptic.device, compensated)?;
         v.push((format!("four-channel-{suffix}"), p));
     }
+    // The same compensation with a deadband of 0.01 rad/s: below the 0.04 rad/s spike one encoder
+    // count makes through the velocity filter, so a real device could dither at rest with it (the
+    // reason the file keeps 0.05); it compensates the breakaway the stick models need each cycle.
+    let mut fine = base.clone();
+    fine.haptic.device = with_capstan_friction(&fine.haptic.device, true)?;
+    fine.haptic.device.friction_deadband = FINE_DEADBAND;
+    v.push((
+        "four-channel-capstan-friction-compensated-deadband-0.01".to_string(),
+        fine,
+    ));
     v.push((
         "four-channel-estimate-injection".to_string(),
         Fig8Params {
@@ -100,6 +110,9 @@ pub const PAPER_RATE_COUPLING: haptic2d::control::coupling::CouplingGains =
         k: [160.0, 160.0, 0.125],
         b: [7.8125, 7.8125, 0.005],
     };
+
+/// The deadband of the fine-deadband friction comparison run (rad/s of joint rate).
+pub const FINE_DEADBAND: f64 = 0.01;
 
 /// Why the default carries the Figs. 8–11 claims.
 const DEFAULT_REASON: &str = "the default controller, stable held and released with margin on the peg (`haptic2d stability peg-in-hole`): its slave-side local force feedback C5 makes the hand's push reach the peg without reflecting the contact force to a released handle";
@@ -311,7 +324,9 @@ fn report(m: &FigureMetrics) -> String {
          but walls felt at 7 % of their stiffness), the default on a device with realistic joint \
          Coulomb friction (`four-channel-capstan-friction`, 0.015 N·m per joint from \
          `devices/twin-pantograph-capstan-friction.toml`) and with that file's friction compensation \
-         (`four-channel-capstan-friction-compensated`), and the default with the push injected into \
+         (`four-channel-capstan-friction-compensated`, deadband 0.05 rad/s; and \
+         `…-deadband-0.01`, a deadband below one encoder count's velocity spike), and the default \
+         with the push injected into \
          the hand-force estimate instead of acting on the handle (`four-channel-estimate-injection`, \
          the second reading of the paper's protocol); MODELS.md §11.4 discusses each. Pass: no safety stop; \
          classical `min creep_k ≥ 5e-4 m` (F7-1, drift), the others `max creep_k ≤ 2e-4 m` (F7-2, \

@@ -119,9 +119,9 @@ fn reproduce_all_writes_every_output_and_the_cases_pass() {
     // Fig. 5: 5 configurations + 3 carriers under the estimate-injection protocol + the default on
     // the capstan-friction device without and with compensation, × 4 walls. Fig. 8: the default,
     // the coupling, the §11.1 table, the paper-rate variant, the paper-rate study's soft coupling,
-    // the two friction runs and the estimate-injection protocol, × 5 friction models.
+    // the three friction runs and the estimate-injection protocol, × 5 friction models.
     assert_eq!(m5.cases.len(), 40);
-    assert_eq!(m8.cases.len(), 40);
+    assert_eq!(m8.cases.len(), 45);
     let names = |m: &FigureMetrics, pass: bool, comparison: bool| {
         let mut v: Vec<String> = m
             .cases
@@ -182,7 +182,7 @@ fn reproduce_all_writes_every_output_and_the_cases_pass() {
     // Comparison runs that pass: the coupling everywhere; the soft coupling at 500 Hz / scale 1 all
     // but the classical model (its peg creeps backwards); with the capstan's joint friction
     // (0.015 N·m) the default keeps only the classical drift, and its compensation (0.8, deadband
-    // 0.05 rad/s) brings back Salcudean–Vlaar; the push injected into the hand-force estimate moves
+    // 0.05 rad/s) brings back Salcudean–Vlaar, and with a 0.01 rad/s deadband every model; the push injected into the hand-force estimate moves
     // the peg for no model (the default's C6 = −1 drives the released handle against it).
     assert_eq!(
         names(&m8, true, true),
@@ -196,12 +196,17 @@ fn reproduce_all_writes_every_output_and_the_cases_pass() {
             "coupling/nahvi",
             "coupling/reset-integrator",
             "coupling/salcudean-vlaar",
+            "four-channel-capstan-friction-compensated-deadband-0.01/classical",
+            "four-channel-capstan-friction-compensated-deadband-0.01/dahl",
+            "four-channel-capstan-friction-compensated-deadband-0.01/nahvi",
+            "four-channel-capstan-friction-compensated-deadband-0.01/reset-integrator",
+            "four-channel-capstan-friction-compensated-deadband-0.01/salcudean-vlaar",
             "four-channel-capstan-friction-compensated/classical",
             "four-channel-capstan-friction-compensated/salcudean-vlaar",
             "four-channel-capstan-friction/classical",
         ]
     );
-    assert_eq!(m8.comparisons(), 35);
+    assert_eq!(m8.comparisons(), 40);
     // Both protocols for every claim: each carrier also with the push in the hand-force estimate.
     for (m, runs) in [
         (
