@@ -258,68 +258,82 @@ pub fn claims(kind: &ControllerKind) -> Result<Vec<ClaimOutcome>, String> {
         controller: *kind,
         ..HapticConfig::default()
     };
-    let mut out = Vec::new();
-    let p5 = fig5::Fig5Params {
+    let mut out = fig5_claims(&fig5::Fig5Params {
         haptic: haptic.clone(),
         ..fig5::Fig5Params::default()
-    };
-    for (name, normal, e) in fig5::FIG5_CASES {
-        match fig5::run_case(&p5, name, normal, e) {
-            Ok(c) => out.push(ClaimOutcome {
-                claim: format!("fig5/{name}"),
-                pass: c.metrics.pass,
-                detail: crate::fig5::check(&c).detail,
-            }),
-            Err(e) => out.push(ClaimOutcome {
-                claim: format!("fig5/{name}"),
-                pass: false,
-                detail: e,
-            }),
-        }
-    }
-    let p8 = fig8::Fig8Params {
+    });
+    out.extend(fig8_claims(&fig8::Fig8Params {
         haptic,
         ..fig8::Fig8Params::default()
-    };
-    for (name, model, drift) in fig8::FIG8_CASES {
-        match fig8::run_case(&p8, name, model, drift) {
-            Ok(c) => {
-                let min_adv = c
-                    .metrics
-                    .advance
-                    .iter()
-                    .copied()
-                    .fold(f64::INFINITY, f64::min);
-                let creep = if drift {
-                    c.metrics
-                        .creep
+    }));
+    Ok(out)
+}
+
+/// The 4 walls of Figs. 5–6 with the settings `p5` (a run that fails counts as not passing).
+pub fn fig5_claims(p5: &fig5::Fig5Params) -> Vec<ClaimOutcome> {
+    fig5::FIG5_CASES
+        .iter()
+        .map(
+            |(name, normal, e)| match fig5::run_case(p5, name, normal, *e) {
+                Ok(c) => ClaimOutcome {
+                    claim: format!("fig5/{name}"),
+                    pass: c.metrics.pass,
+                    detail: crate::fig5::check(&c).detail,
+                },
+                Err(e) => ClaimOutcome {
+                    claim: format!("fig5/{name}"),
+                    pass: false,
+                    detail: e,
+                },
+            },
+        )
+        .collect()
+}
+
+/// The 5 friction models of Figs. 8–11 with the settings `p8` (rate, mapping scale, protocol,
+/// device and controller); a run that fails or stops counts as not passing.
+pub fn fig8_claims(p8: &fig8::Fig8Params) -> Vec<ClaimOutcome> {
+    fig8::FIG8_CASES
+        .iter()
+        .map(
+            |(name, model, drift)| match fig8::run_case(p8, name, model, *drift) {
+                Ok(c) => {
+                    let min_adv = c
+                        .metrics
+                        .advance
                         .iter()
                         .copied()
-                        .fold(f64::INFINITY, f64::min)
-                } else {
-                    c.metrics.creep.iter().map(|x| x.abs()).fold(0.0, f64::max)
-                };
-                out.push(ClaimOutcome {
+                        .fold(f64::INFINITY, f64::min);
+                    let creep = if *drift {
+                        c.metrics
+                            .creep
+                            .iter()
+                            .copied()
+                            .fold(f64::INFINITY, f64::min)
+                    } else {
+                        c.metrics.creep.iter().map(|x| x.abs()).fold(0.0, f64::max)
+                    };
+                    ClaimOutcome {
+                        claim: format!("fig8/{name}"),
+                        pass: c.metrics.pass && c.stopped.is_none(),
+                        detail: format!(
+                            "min advance {:.2} mm, {} creep {:.3} mm{}",
+                            min_adv * 1e3,
+                            if *drift { "min" } else { "max |.|" },
+                            creep * 1e3,
+                            c.stopped
+                                .map_or(String::new(), |s| format!(", stopped: {s}"))
+                        ),
+                    }
+                }
+                Err(e) => ClaimOutcome {
                     claim: format!("fig8/{name}"),
-                    pass: c.metrics.pass && c.stopped.is_none(),
-                    detail: format!(
-                        "min advance {:.2} mm, {} creep {:.3} mm{}",
-                        min_adv * 1e3,
-                        if drift { "min" } else { "max |.|" },
-                        creep * 1e3,
-                        c.stopped
-                            .map_or(String::new(), |s| format!(", stopped: {s}"))
-                    ),
-                })
-            }
-            Err(e) => out.push(ClaimOutcome {
-                claim: format!("fig8/{name}"),
-                pass: false,
-                detail: e,
-            }),
-        }
-    }
-    Ok(out)
+                    pass: false,
+                    detail: e,
+                },
+            },
+        )
+        .collect()
 }
 
 /// `haptic2d stability`'s verdict for `config` around `world` at `rate` (Hz), for the simulated

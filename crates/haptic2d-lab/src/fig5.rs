@@ -4,8 +4,10 @@
 //! by a named configuration on the spec's device, with its reason and `haptic2d stability`'s verdict
 //! (`carrier`): the hysteretic wall by the default, the pulse wall by the former default, SEH and
 //! ZOH by the §11.1 table (unstable released there, refused on a real device). Comparison runs: every
-//! other configuration on every wall, the §11.1 table on a device damped at twice Colgate's bound and
-//! the virtual coupling. A sweep of the device damping under the §11.1 table
+//! other configuration on every wall, the §11.1 table on a device damped at twice Colgate's bound,
+//! the virtual coupling, every carrier with the push injected into the hand-force estimate (issue 36
+//! item 4), and the default on the capstan-friction device without and with friction compensation
+//! (item 3). A sweep of the device damping under the §11.1 table
 //! ([`crate::fig5_sweep`]) shows where that table's claims hold.
 //!
 //! Pass criteria (the paper's claim; numbers from the spec's W6/W7 with W7's 0.06 m/s taken relative to
@@ -19,6 +21,7 @@
 
 use crate::csv::write_columns;
 use crate::experiments::fig5::{run_case, Fig5Case, Fig5Expectation, Fig5Params, FIG5_CASES};
+use crate::experiments::{with_capstan_friction, Protocol};
 use crate::fig5_sweep;
 use crate::figure::{Figure, FigureContext, FigureReport};
 use crate::plot::{write_panels, Panel, Series, Stroke};
@@ -29,7 +32,7 @@ use std::fmt::Write as _;
 /// The runs: `(name, parameters)`: the default controller on the spec's device, the §11.1 table on
 /// the same device, the §11.1 table on a device damped at twice Colgate's bound, the virtual
 /// coupling, and the former default (master-side local force feedback only). Which run carries which wall's claim: [`carrier`].
-fn controllers(ctx: Option<&FigureContext>) -> Vec<(String, Fig5Params)> {
+fn controllers(ctx: Option<&FigureContext>) -> Result<Vec<(String, Fig5Params)>, String> {
     let mut v = vec![
         ("four-channel".to_string(), Fig5Params::default()),
         (
@@ -54,12 +57,39 @@ fn controllers(ctx: Option<&FigureContext>) -> Vec<(String, Fig5Params)> {
             },
         ),
     ];
-    // `reproduce --controller-file`: that controller carries the claims.
-    if let Some((label, kind)) = ctx.and_then(|c| c.controller.as_ref()) {
-        v[0].0 = label.clone();
-        v[0].1.haptic.controller = *kind;
+    // Issue 36 item 4: every carrier (the default, the §11.1 table, the former default) also with
+    // the push injected into the hand-force estimate instead of acting on the handle; item 3: the
+    // default on the device of `devices/twin-pantograph-capstan-friction.toml`, without and with
+    // its friction compensation. All comparison runs.
+    for i in [0, 1, 4] {
+        let (name, p) = v[i].clone();
+        v.push((
+            format!("{name}-estimate-injection"),
+            Fig5Params {
+                protocol: Protocol::EstimateInjection,
+                ..p
+            },
+        ));
     }
-    v
+    for (suffix, compensated) in [
+        ("capstan-friction", false),
+        ("capstan-friction-compensated", true),
+    ] {
+        let mut p = v[0].1.clone();
+        p.haptic.device = with_capstan_friction(&p.haptic.device, compensated)?;
+        v.push((format!("four-channel-{suffix}"), p));
+    }
+    // `reproduce --controller-file`: that controller carries the claims (and runs the default's
+    // variants).
+    if let Some((label, kind)) = ctx.and_then(|c| c.controller.as_ref()) {
+        for (name, p) in v.iter_mut() {
+            if name.starts_with("four-channel") && !name.starts_with("four-channel-spec") {
+                *name = name.replacen("four-channel", label, 1);
+                p.haptic.controller = *kind;
+            }
+        }
+    }
+    Ok(v)
 }
 
 /// Why the default carries the Fig. 6 claims (pulse, hysteretic walls).
@@ -147,6 +177,10 @@ pub fn check(c: &Fig5Case) -> Check {
             ),
         ),
     };
+    let detail = match &c.stopped {
+        Some(why) => format!("safety stop: {why}; {detail}"),
+        None => detail,
+    };
     Check::new(id, m.pass, detail)
 }
 
@@ -161,10 +195,11 @@ impl Figure for Fig5 {
         "Figs. 5–6: a box pushed into undamped walls with the device in the loop"
     }
     fn jobs(&self) -> u64 {
-        ((controllers(None).len() + fig5_sweep::MARGINS.len()) * FIG5_CASES.len()) as u64
+        ((controllers(None).map_or(0, |c| c.len()) + fig5_sweep::MARGINS.len()) * FIG5_CASES.len())
+            as u64
     }
     fn run(&self, ctx: &FigureContext) -> Result<FigureReport, String> {
-        let ctrl = controllers(Some(ctx));
+        let ctrl = controllers(Some(ctx))?;
         let jobs: Vec<(usize, usize)> = (0..ctrl.len())
             .flat_map(|i| (0..FIG5_CASES.len()).map(move |j| (i, j)))
             .collect();
@@ -305,7 +340,14 @@ fn report(m: &FigureMetrics, sweep: &str) -> String {
          C6 = −1, D_m = 2 N·s/m) and the paper's §11.1 table (`four-channel-spec`). Comparison runs: \
          the other configurations on every wall, the §11.1 table on a device damped at twice \
          Colgate's bound (`four-channel-spec-damped-device`, `f_v = 1.44e-2 N·m·s/rad`) and the \
-         virtual coupling (§11.2). Pass: SEH/ZOH \
+         virtual coupling (§11.2); each carrier with the push injected into the hand-force estimate \
+         instead of acting on the handle (`*-estimate-injection`: the second reading of \
+         \"the hand is replaced by a constant force\"; with C6 = −1 the device is commanded against \
+         the injected push and the box never reaches the wall, and the §11.1 table neither keeps \
+         bouncing nor settles); the default on a device with realistic joint Coulomb friction \
+         (`four-channel-capstan-friction`, 0.015 N·m per joint, \
+         `devices/twin-pantograph-capstan-friction.toml`) and with that file's friction compensation \
+         (`four-channel-capstan-friction-compensated`); MODELS.md §11.4. Pass: SEH/ZOH \
          keep bouncing (≥ 2 separations in the last 2 s, never settles); pulse stable at the first \
          impact (first contact ratio ≤ 0.4 — none if the box never leaves the wall —, entries after \
          the 2nd impact < 0.15·v1, none in the last 2 s; W7); hysteretic stable soon (first 3 ratios < \

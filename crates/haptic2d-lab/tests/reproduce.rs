@@ -116,8 +116,12 @@ fn reproduce_all_writes_every_output_and_the_cases_pass() {
     check_schema(&v8, "fig8", &["peak_force_n", "creep_m", "advance_m"]);
     let m5: FigureMetrics = serde_json::from_value(v5).expect("typed fig5");
     let m8: FigureMetrics = serde_json::from_value(v8).expect("typed fig8");
-    assert_eq!(m5.cases.len(), 20);
-    assert_eq!(m8.cases.len(), 20);
+    // Fig. 5: 5 configurations + 3 carriers under the estimate-injection protocol + the default on
+    // the capstan-friction device without and with compensation, × 4 walls. Fig. 8: the default,
+    // the coupling, the §11.1 table, the paper-rate variant, the paper-rate study's soft coupling,
+    // the three friction runs and the estimate-injection protocol, × 5 friction models.
+    assert_eq!(m5.cases.len(), 40);
+    assert_eq!(m8.cases.len(), 45);
     let names = |m: &FigureMetrics, pass: bool, comparison: bool| {
         let mut v: Vec<String> = m
             .cases
@@ -139,7 +143,7 @@ fn reproduce_all_writes_every_output_and_the_cases_pass() {
     );
     assert_eq!(
         (m5.passed(), m5.claim_count(), m5.comparisons()),
-        (4, 4, 16)
+        (4, 4, 36)
     );
     // The default does not keep bouncing, nor settle the pulse wall at the first impact.
     for n in ["four-channel/seh", "four-channel/zoh", "four-channel/pulse"] {
@@ -175,23 +179,67 @@ fn reproduce_all_writes_every_output_and_the_cases_pass() {
         assert!(c.model.starts_with("four-channel/"), "{}", c.model);
         assert!(c.pass, "{}: {:?}", c.model, c.checks);
     }
+    // Comparison runs that pass: the coupling everywhere; the soft coupling at 500 Hz / scale 1 all
+    // but the classical model (its peg creeps backwards); with the capstan's joint friction
+    // (0.015 N·m) the default keeps only the classical drift, and its compensation (0.8, deadband
+    // 0.05 rad/s) brings back Salcudean–Vlaar, and with a 0.01 rad/s deadband every model; the push injected into the hand-force estimate moves
+    // the peg for no model (the default's C6 = −1 drives the released handle against it).
     assert_eq!(
         names(&m8, true, true),
         [
+            "coupling-160-500hz-scale1/dahl",
+            "coupling-160-500hz-scale1/nahvi",
+            "coupling-160-500hz-scale1/reset-integrator",
+            "coupling-160-500hz-scale1/salcudean-vlaar",
             "coupling/classical",
             "coupling/dahl",
             "coupling/nahvi",
             "coupling/reset-integrator",
-            "coupling/salcudean-vlaar"
+            "coupling/salcudean-vlaar",
+            "four-channel-capstan-friction-compensated-deadband-0.01/classical",
+            "four-channel-capstan-friction-compensated-deadband-0.01/dahl",
+            "four-channel-capstan-friction-compensated-deadband-0.01/nahvi",
+            "four-channel-capstan-friction-compensated-deadband-0.01/reset-integrator",
+            "four-channel-capstan-friction-compensated-deadband-0.01/salcudean-vlaar",
+            "four-channel-capstan-friction-compensated/classical",
+            "four-channel-capstan-friction-compensated/salcudean-vlaar",
+            "four-channel-capstan-friction/classical",
         ]
     );
-    assert_eq!(m8.comparisons(), 15);
+    assert_eq!(m8.comparisons(), 40);
+    // Both protocols for every claim: each carrier also with the push in the hand-force estimate.
+    for (m, runs) in [
+        (
+            &m5,
+            vec![
+                "four-channel-estimate-injection/hysteretic",
+                "four-channel-spec-estimate-injection/seh",
+                "four-channel-spec-estimate-injection/zoh",
+                "former-default-estimate-injection/pulse",
+            ],
+        ),
+        (
+            &m8,
+            vec![
+                "four-channel-estimate-injection/classical",
+                "four-channel-estimate-injection/reset-integrator",
+                "four-channel-estimate-injection/dahl",
+                "four-channel-estimate-injection/nahvi",
+                "four-channel-estimate-injection/salcudean-vlaar",
+            ],
+        ),
+    ] {
+        for r in runs {
+            let c = m.cases.iter().find(|c| c.model == r).expect(r);
+            assert!(c.comparison && !c.pass, "{r}: {:?}", c.checks);
+        }
+    }
     assert!(report.contains("Which configuration reproduces each claim"));
     for f in ["fig5/sweep.csv", "fig5/sweep.png", "fig5/sweep.svg"] {
         assert!(out.join(f).is_file(), "{f}");
     }
     assert!(report.contains("![sweep](fig5/sweep.png)"));
-    assert!(report.contains("4 / 4 (+16 comparison runs)"), "{report}");
+    assert!(report.contains("4 / 4 (+36 comparison runs)"), "{report}");
     assert!(s.all_pass());
 }
 

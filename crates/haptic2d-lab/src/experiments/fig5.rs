@@ -97,6 +97,10 @@ pub struct Fig5Params {
     /// The haptic system's safety settings (start-up ramp, stall limit, torque trip margin).
     /// Default: [`SafetyConfig::default`] (the torques ramp in over 0.5 s from the first tick).
     pub safety: SafetyConfig,
+    /// Where the constant push acts after the release: on the handle (default) or in the
+    /// hand-force estimate (the handle is then released along x, y and θ still guided when
+    /// [`Fig5Params::guide_y_theta`]).
+    pub protocol: super::Protocol,
 }
 
 impl Fig5Params {
@@ -206,6 +210,7 @@ impl Default for Fig5Params {
             pulse_device_mass: false,
             colgate_margin: None,
             safety: SafetyConfig::default(),
+            protocol: super::Protocol::HandleForce,
         }
     }
 }
@@ -260,6 +265,9 @@ pub struct Fig5Case {
     pub gap: Vec<f64>,
     /// Metrics.
     pub metrics: Fig5Metrics,
+    /// The safety stop that ended the run early, if any (then `metrics.pass` is false and the
+    /// metrics cover the run up to the stop).
+    pub stopped: Option<String>,
 }
 
 /// The box's gap to the left wall (its minimum vertex x) at pose `(x, y, θ)`, for a w × h box.
@@ -354,7 +362,19 @@ pub fn run_case(
     // After the release: a constant push along −x. With the guide, a spring of 1 N/m stretched by
     // 2 m gives F·(1 ± 1 %) over the few centimetres of travel, with no damping along x, while y and θ
     // keep the grip's spring–damper.
-    let released = if p.guide_y_theta {
+    let inject = p.protocol == super::Protocol::EstimateInjection;
+    let released = if inject {
+        // The hand lets go along x; the push enters the hand-force estimate (set at the release).
+        if p.guide_y_theta {
+            HandModel::SpringDamper {
+                target: start,
+                stiffness: [0.0, stiffness[1], stiffness[2]],
+                damping: [0.0, damping[1], damping[2]],
+            }
+        } else {
+            HandModel::Free
+        }
+    } else if p.guide_y_theta {
         let len = 2.0;
         HandModel::SpringDamper {
             target: [start[0] - len, start[1], start[2]],
@@ -371,23 +391,29 @@ pub fn run_case(
     let n = (p.duration / dt).round() as usize;
     let n_hold = (p.t_hold / dt).round() as usize;
     let (mut records, mut gap) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    let mut stopped = None;
     for k in 0..n {
         if k == n_hold {
             l.hand = released;
+            if inject {
+                let scale = l.system.map().scale;
+                l.system
+                    .set_hand_estimate_injection([-scale * p.push, 0.0, 0.0]);
+            }
         }
         let out = l
             .step()
             .map_err(|e| format!("fig5 {name}: simulated device failed: {e}"))?;
-        if out.tripped {
-            return Err(format!(
-                "fig5 {name}: {}",
-                l.system
-                    .safety_trip()
-                    .map_or(String::new(), |t| t.to_string())
-            ));
-        }
         gap.push(box_gap(&out.record.x_s, [0.02, 0.01]));
         records.push(out.record);
+        if out.tripped {
+            stopped = Some(
+                l.system
+                    .safety_trip()
+                    .map_or("safety stop".to_string(), |t| t.to_string()),
+            );
+            break;
+        }
     }
     let samples: Vec<BounceSample> = records
         .iter()
@@ -421,36 +447,38 @@ pub fn run_case(
         .copied()
         .fold(0.0, f64::max);
     let ratios = &bounce.contact_ratios;
-    let pass = match expectation {
-        // Bounces persist to the end of the run: still separating in the last 2 s, never settled.
-        Fig5Expectation::KeepsBouncing => late_separations >= 2 && bounce.settle_time.is_none(),
-        // W7: the first impact removes most of the energy, later impacts are slow, none at the end.
-        Fig5Expectation::SettlesAtFirstImpact => {
-            let after_second = bounce
-                .entry_speeds
-                .iter()
-                .skip(2)
-                .copied()
-                .fold(0.0, f64::max);
-            // A box that never leaves the wall after its first impact has no completed contact and
-            // so no ratio: that is the ideal outcome and counts as ratio 0.
-            first_entry_speed > 0.0
-                && ratios.first().is_none_or(|r| *r <= 0.4)
-                && after_second < 0.15 * first_entry_speed
-                && late_separations == 0
-        }
-        // W6: the first three contacts lose energy, and the block stops leaving the wall soon.
-        Fig5Expectation::SettlesSoon => {
-            first_entry_speed > 0.0
-                && ratios.iter().take(3).all(|r| *r < 0.85)
-                && bounce.separations() <= 6
-        }
-    };
+    let pass = stopped.is_none()
+        && match expectation {
+            // Bounces persist to the end of the run: still separating in the last 2 s, never settled.
+            Fig5Expectation::KeepsBouncing => late_separations >= 2 && bounce.settle_time.is_none(),
+            // W7: the first impact removes most of the energy, later impacts are slow, none at the end.
+            Fig5Expectation::SettlesAtFirstImpact => {
+                let after_second = bounce
+                    .entry_speeds
+                    .iter()
+                    .skip(2)
+                    .copied()
+                    .fold(0.0, f64::max);
+                // A box that never leaves the wall after its first impact has no completed contact and
+                // so no ratio: that is the ideal outcome and counts as ratio 0.
+                first_entry_speed > 0.0
+                    && ratios.first().is_none_or(|r| *r <= 0.4)
+                    && after_second < 0.15 * first_entry_speed
+                    && late_separations == 0
+            }
+            // W6: the first three contacts lose energy, and the block stops leaving the wall soon.
+            Fig5Expectation::SettlesSoon => {
+                first_entry_speed > 0.0
+                    && ratios.iter().take(3).all(|r| *r < 0.85)
+                    && bounce.separations() <= 6
+            }
+        };
     Ok(Fig5Case {
         name,
         expectation,
         records,
         gap,
+        stopped,
         metrics: Fig5Metrics {
             bounce,
             late_separations,

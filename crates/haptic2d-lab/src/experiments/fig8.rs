@@ -84,6 +84,9 @@ pub struct Fig8Params {
     /// 1 N/m spring whose anchor is moved every tick). Default false: the paper's user releases the
     /// handle.
     pub guide_y_theta: bool,
+    /// Where the sinusoid acts after the release: on the handle (default) or in the hand-force
+    /// estimate (the handle is then released with nothing pushing it).
+    pub protocol: super::Protocol,
 }
 
 impl Default for Fig8Params {
@@ -101,6 +104,7 @@ impl Default for Fig8Params {
             haptic: HapticConfig::default(),
             push_in: false,
             guide_y_theta: false,
+            protocol: super::Protocol::HandleForce,
         }
     }
 }
@@ -281,6 +285,11 @@ pub fn run_case(
             let x = l.plant.pose();
             let f = sine.wrench(&x, &[0.0; 3], t)[0];
             f_world = f / s;
+            let inject = p.protocol == super::Protocol::EstimateInjection;
+            if inject {
+                l.system.set_hand_estimate_injection([f, 0.0, 0.0]);
+            }
+            let f = if inject { 0.0 } else { f };
             l.hand = if p.guide_y_theta {
                 // The x push as a 1 N/m spring stretched by f metres from the current pose: f to within
                 // 1 N/m × the travel in one tick; y and θ keep the grip.
@@ -289,6 +298,8 @@ pub fn run_case(
                     stiffness: [1.0, stiffness[1], stiffness[2]],
                     damping: [0.0, damping[1], damping[2]],
                 }
+            } else if inject {
+                HandModel::Free
             } else {
                 sine
             };

@@ -9,3 +9,65 @@
 
 pub mod fig5;
 pub mod fig8;
+
+/// How "the hand is replaced by a constant force" (Figs. 5–6; the sinusoidal force of Figs. 8–11)
+/// is read (issue 36 item 4). The paper's force information is observer-based, so the force could
+/// have acted on the handle or been fed to the controller as the hand's force.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Protocol {
+    /// The force acts on the handle, as a hand pushing it would; the observer estimates it (the
+    /// default, the reading used so far).
+    #[default]
+    HandleForce,
+    /// The hand lets go (nothing pushes the handle along the push) and the force is added to the
+    /// hand-force estimate the controller receives
+    /// ([`HapticSystem::set_hand_estimate_injection`](haptic2d::haptic::system::HapticSystem::set_hand_estimate_injection)).
+    EstimateInjection,
+}
+
+impl Protocol {
+    /// Both protocols.
+    pub const ALL: [Protocol; 2] = [Protocol::HandleForce, Protocol::EstimateInjection];
+
+    /// The protocol's name in reports: `handle-force` or `estimate-injection`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Protocol::HandleForce => "handle-force",
+            Protocol::EstimateInjection => "estimate-injection",
+        }
+    }
+}
+
+/// The device file of the friction comparison runs (issue 36 item 3): the spec device with
+/// realistic joint Coulomb friction and its friction compensation.
+pub const CAPSTAN_FRICTION_FILE: &str = "devices/twin-pantograph-capstan-friction.toml";
+
+const CAPSTAN_FRICTION_TOML: &str =
+    include_str!("../../../../devices/twin-pantograph-capstan-friction.toml");
+
+/// The device of [`CAPSTAN_FRICTION_FILE`] (its joint Coulomb friction `f_c`, the compensation
+/// fraction and deadband), every other field the spec's default.
+pub fn capstan_friction_device() -> Result<haptic2d::device::DeviceParams, String> {
+    haptic2d::scene::device_params_from_toml(CAPSTAN_FRICTION_TOML, CAPSTAN_FRICTION_FILE, None)
+        .map_err(|e| e.to_string())
+}
+
+/// `device` with the joint friction of [`CAPSTAN_FRICTION_FILE`]; its compensation as in the file
+/// when `compensated`, off otherwise.
+pub fn with_capstan_friction(
+    device: &haptic2d::device::DeviceParams,
+    compensated: bool,
+) -> Result<haptic2d::device::DeviceParams, String> {
+    let f = capstan_friction_device()?;
+    Ok(haptic2d::device::DeviceParams {
+        f_c: f.f_c,
+        f_v: f.f_v,
+        friction_compensation: if compensated {
+            f.friction_compensation
+        } else {
+            0.0
+        },
+        friction_deadband: f.friction_deadband,
+        ..*device
+    })
+}

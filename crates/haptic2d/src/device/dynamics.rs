@@ -98,6 +98,21 @@ impl LumpedDynamics {
         qd.map(|v| self.f_c * sgn(v) + self.f_v * v)
     }
 
+    /// The friction compensation's feed-forward at estimated joint rates `qd` (rad/s), §10.5: the
+    /// model's friction `f_c·sgn(q̇_i) + f_v·q̇_i` (N·m) in the direction of motion, with the Coulomb
+    /// part dropped on a joint whose `|q̇_i|` is below `deadband` (rad/s). The caller scales it by
+    /// the compensated fraction and saturates it with the rest of the torques.
+    pub fn friction_feedforward(&self, qd: &V4, deadband: f64) -> V4 {
+        qd.map(|v| {
+            let coulomb = if v.abs() < deadband {
+                0.0
+            } else {
+                self.f_c * sgn(v)
+            };
+            coulomb + self.f_v * v
+        })
+    }
+
     /// Every dynamic term at pose `x` and twist `xd`. `c` uses the analytic `J̇_a` (§10.6 allows a
     /// numerical one; the analytic form makes the simulated plant exactly energy-consistent).
     pub fn terms(&self, x: &V3, xd: &V3) -> Result<DynamicsTerms, DeviceFault> {
@@ -133,5 +148,28 @@ impl LumpedDynamics {
         let j = jacobian_at(&self.kin, &self.kin.configuration(x)?)?;
         let m = self.mass_matrix(&j, x[2]);
         Ok(0.5 * dot3(xd, &m3_mul_v(&m, xd)))
+    }
+}
+
+#[cfg(test)]
+mod friction_tests {
+    use super::*;
+    use crate::device::DeviceParams;
+
+    #[test]
+    fn friction_feedforward_drops_the_coulomb_part_inside_the_deadband_only() {
+        let m = LumpedDynamics::new(&DeviceParams {
+            f_c: 0.015,
+            f_v: 1e-3,
+            ..DeviceParams::default()
+        });
+        let qd = [0.01, -0.01, 0.2, -0.2];
+        let ff = m.friction_feedforward(&qd, 0.05);
+        let expect = [1e-5, -1e-5, 0.015 + 2e-4, -0.015 - 2e-4];
+        for i in 0..4 {
+            assert!((ff[i] - expect[i]).abs() < 1e-15, "{ff:?}");
+        }
+        // With no deadband it is the model's friction itself.
+        assert_eq!(m.friction_feedforward(&qd, 0.0), m.joint_friction(&qd));
     }
 }

@@ -60,9 +60,15 @@ pub struct DeviceParams {
     /// Singularity-margin threshold (dimensionless `|sin|`): below it commanded forces are clamped to
     /// zero and a flag is raised (§10.4). Default 0.1.
     pub min_singularity_margin: f64,
-    /// Friction-compensation fraction applied by the low-level controller, `0..=1` (§11.2). Default 0
-    /// (the spec's option uses 0.5).
+    /// Friction-compensation fraction applied by the low-level controller, `0..=1` (§11.2): that
+    /// fraction of the model's joint friction `τ̂_f(q̇)` is fed forward in the direction of motion
+    /// (§10.5). Default 0 (the spec's option uses 0.5).
     pub friction_compensation: f64,
+    /// Deadband of the friction compensation's Coulomb part (rad/s of joint rate): a joint whose
+    /// estimated rate `|q̇_i|` is below it gets no Coulomb feed-forward (its viscous part is kept),
+    /// so encoder noise at rest does not dither the motors. Default 0.05 (about 5 mm/s at the
+    /// handle with `l1` = 0.1 m, several times the velocity estimate's quantisation noise).
+    pub friction_deadband: f64,
     /// Stiffness of the workspace bound (N/m): past the edge of the workspace square the handle feels
     /// a wall `F = −K·(penetration) − B·v` (never pulling inward). Default 2000; 0 = no wall (the trip
     /// still applies).
@@ -103,6 +109,7 @@ impl Default for DeviceParams {
             closure_tol: 1e-3,
             min_singularity_margin: 0.1,
             friction_compensation: 0.0,
+            friction_deadband: 0.05,
             workspace_wall_stiffness: 2000.0,
             workspace_wall_damping: 5.0,
             workspace_trip_distance: 0.01,
@@ -114,7 +121,7 @@ impl DeviceParams {
     /// Every field, in declaration order, with its unit as written in scene and device files
     /// (`"-"` for a dimensionless number). Used by file loaders for messages and by the template
     /// `devices/twin-pantograph.toml`.
-    pub const FIELDS: [(&'static str, &'static str); 27] = [
+    pub const FIELDS: [(&'static str, &'static str); 28] = [
         ("s", "m"),
         ("l1", "m"),
         ("l2", "m"),
@@ -139,6 +146,7 @@ impl DeviceParams {
         ("closure_tol", "m"),
         ("min_singularity_margin", "-"),
         ("friction_compensation", "-"),
+        ("friction_deadband", "rad/s"),
         ("workspace_wall_stiffness", "N/m"),
         ("workspace_wall_damping", "N·s/m"),
         ("workspace_trip_distance", "m"),
@@ -230,6 +238,7 @@ impl DeviceParams {
                 self.friction_compensation
             ));
         }
+        non_negative("friction_deadband", self.friction_deadband)?;
         non_negative("workspace_wall_stiffness", self.workspace_wall_stiffness)?;
         non_negative("workspace_wall_damping", self.workspace_wall_damping)?;
         positive("workspace_trip_distance", self.workspace_trip_distance)?;

@@ -140,8 +140,9 @@ impl TwinPantograph {
 
     /// Step 9: the four motor torques (N·m) producing handle wrench `w` (N, N, N·m) at the last measured
     /// pose: minimum-norm redundancy resolution, plus internal preload `preload·ν` (N·m, clamped to
-    /// `±0.1·τ_max`), plus friction compensation (`params.friction_compensation·τ̂_f`, default off),
-    /// then direction-preserving saturation. Below the singularity-margin threshold the torques are
+    /// `±0.1·τ_max`), plus friction compensation (`params.friction_compensation·τ̂_f` at the
+    /// estimated joint rates, Coulomb part outside `params.friction_deadband`; default off), then
+    /// direction-preserving saturation (so the compensation is clamped with every other torque). Below the singularity-margin threshold the torques are
     /// zero and `near_singular` is set.
     pub fn torques_for_wrench(&self, w: &V3, preload: f64) -> Result<TorqueCommand, DeviceFault> {
         if self.pose.is_none() {
@@ -162,7 +163,9 @@ impl TwinPantograph {
         let mut tau_w = min_norm_torques(&self.jac, w)?;
         if self.params.friction_compensation > 0.0 {
             let qd = j_mul_v(&self.jac, &self.velocity);
-            let tf = self.model.joint_friction(&qd);
+            let tf = self
+                .model
+                .friction_feedforward(&qd, self.params.friction_deadband);
             for i in 0..4 {
                 tau_w[i] += self.params.friction_compensation * tf[i];
             }
@@ -195,5 +198,73 @@ impl TwinPantograph {
             Some(p) => self.model.mass_matrix(&self.jac, p[2]),
             None => [[0.0; 3]; 3],
         }
+    }
+}
+
+#[cfg(test)]
+mod friction_compensation_tests {
+    use super::*;
+
+    /// A device with joint friction `f_c` (no viscous part), compensation `fraction` and `deadband`,
+    /// read twice 1 ms apart with the handle moved 0.1 mm along +x and 0.05 mm along +y between the
+    /// readings (raw 0.1 and 0.05 m/s, through the 50 Hz velocity filter).
+    fn moving(f_c: f64, fraction: f64, deadband: f64) -> TwinPantograph {
+        let p = DeviceParams {
+            f_c,
+            f_v: 0.0,
+            friction_compensation: fraction,
+            friction_deadband: deadband,
+            ..DeviceParams::default()
+        };
+        let mut d = TwinPantograph::new(p, 1e-3, ObserverKind::Static).unwrap();
+        let kin = TwinKinematics::new(&p);
+        let x0 = [0.0, 0.14, 0.0];
+        let x1 = [1e-4, 0.14 + 5e-5, 0.0];
+        d.estimate(&kin.ik(&x0).unwrap(), &[0.0; 4]).unwrap();
+        d.estimate(&kin.ik(&x1).unwrap(), &[0.0; 4]).unwrap();
+        d
+    }
+
+    #[test]
+    fn friction_compensation_feeds_the_coulomb_torque_forward_in_the_direction_of_motion() {
+        let d = moving(0.015, 0.8, 0.05);
+        let qd = j_mul_v(&d.jac, &d.velocity);
+        assert!(
+            qd.iter().all(|v| v.abs() > 0.05),
+            "every joint moves: {qd:?}"
+        );
+        let cmd = d.torques_for_wrench(&[0.0; 3], 0.0).unwrap();
+        for (i, (t, v)) in cmd.tau.iter().zip(&qd).enumerate() {
+            // No wrench asked: the torque is the compensation alone, 0.8·f_c along q̇_i.
+            assert!(
+                (t - 0.8 * 0.015 * v.signum()).abs() < 1e-12,
+                "joint {i}: τ = {t}, q̇ = {v}"
+            );
+        }
+        // Inside the deadband (every joint's rate below 10 rad/s) nothing is fed forward.
+        let still = moving(0.015, 0.8, 10.0);
+        let cmd = still.torques_for_wrench(&[0.0; 3], 0.0).unwrap();
+        assert_eq!(cmd.tau, [0.0; 4]);
+        // Off by default.
+        let off = moving(0.015, 0.0, 0.05);
+        assert_eq!(
+            off.torques_for_wrench(&[0.0; 3], 0.0).unwrap().tau,
+            [0.0; 4]
+        );
+    }
+
+    #[test]
+    fn friction_compensation_is_clamped_with_the_other_torques() {
+        // A compensation of 0.45 N·m per joint on top of a 20 N push: more than τ_max = 0.5 N·m
+        // on some joint, so the saturation scales the command and no torque exceeds τ_max.
+        let d = moving(0.45, 1.0, 0.05);
+        let cmd = d.torques_for_wrench(&[20.0, 0.0, 0.0], 0.0).unwrap();
+        assert!(cmd.saturated, "{cmd:?}");
+        let tau_max = DeviceParams::default().tau_max;
+        assert!(
+            cmd.tau.iter().all(|t| t.abs() <= tau_max + 1e-12),
+            "{:?}",
+            cmd.tau
+        );
     }
 }

@@ -98,6 +98,9 @@ pub struct HapticSystem {
     dt: f64,
     tau_prev: V4,
     injected: Option<(usize, f64)>,
+    /// A wrench added to the hand-wrench estimate before the controller (handle frame: N, N, N·m);
+    /// zero except in experiments ([`HapticSystem::set_hand_estimate_injection`]).
+    hand_injection: V3,
     /// False until the first valid reading after construction, a re-arm or a pause.
     aligned: bool,
     /// Ticks since the alignment (the ramp's clock).
@@ -208,6 +211,7 @@ impl HapticSystem {
             dt,
             tau_prev: [0.0; 4],
             injected: None,
+            hand_injection: [0.0; 3],
             aligned: false,
             ramp_ticks: 0,
             ramp_len: (safety.ramp_time / dt).round() as u64,
@@ -371,6 +375,16 @@ impl HapticSystem {
     pub fn inject_torque_fault(&mut self, index: usize, value: f64) {
         if index < 4 {
             self.injected = Some((index, value));
+        }
+    }
+
+    /// Experiments only (issue 36, "the hand is replaced by a constant force" read as a force in the
+    /// hand-force estimate): from the next tick on, `w` (handle frame: N, N, N·m) is added to the
+    /// observer's hand-wrench estimate that the controller receives (`f_h` of §11.1). The recorded
+    /// `w_h` stays the observer's own estimate. Non-finite values are ignored; zero turns it off.
+    pub fn set_hand_estimate_injection(&mut self, w: V3) {
+        if w.iter().all(|v| v.is_finite()) {
+            self.hand_injection = w;
         }
     }
 

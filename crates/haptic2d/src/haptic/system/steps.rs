@@ -119,7 +119,9 @@ impl HapticSystem {
         let signals = TeleopSignals {
             x_m: self.map.pose_to_world(&e.pose),
             v_m: self.map.twist_to_world(&e.velocity),
-            f_h: self.map.wrench_to_world(&e.hand_wrench),
+            f_h: self.map.wrench_to_world(&std::array::from_fn(|i| {
+                e.hand_wrench[i] + self.hand_injection[i]
+            })),
             x_s: slave.x_s,
             v_s: slave.v_s,
             f_e: slave.f_e,
