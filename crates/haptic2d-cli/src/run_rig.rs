@@ -38,6 +38,7 @@ use haptic2d::haptic::{
     ControllerKind, HapticConfig, HapticSystem, SafetyConfig, TickOutput, WorkspaceSquare,
 };
 use haptic2d::world::World;
+use haptic2d_devices::device_safety::DeviceSafety;
 use haptic2d_rt::clock::now_ns;
 use haptic2d_rt::io::DEFAULT_REPLAY_COLUMNS;
 use haptic2d_rt::{
@@ -144,6 +145,9 @@ pub enum DeviceModel {
         /// The workspace square of the device file (m, the linkage's frame) with its wall and
         /// trip: the bound the 2-DOF tick applies, as the twin's from its parameters.
         workspace: WorkspaceSquare,
+        /// The dynamics `haptic2d device identify` measured (the device file's `[identified]`),
+        /// used by the stability gate in place of the built-in estimates; `None`: not measured.
+        identified: Option<haptic2d_devices::haply::identified::Identified>,
     },
 }
 
@@ -166,6 +170,8 @@ pub struct RealDevice {
     /// The loop's own delay between two ticks that trips the stall check (periods, ≥ 1; the shared
     /// safety layer's default is 5).
     pub max_stall_periods: f64,
+    /// The device file's `[safety]` table: plausibility bounds and the stall floor.
+    pub safety: DeviceSafety,
     /// Matches the controller to the device (e.g. the Haply twin's θ gains to its crank); `None`
     /// keeps the controller as chosen.
     pub match_controller: Option<MatchController>,
@@ -185,6 +191,7 @@ impl std::fmt::Debug for RealDevice {
             .field("wait_periods", &self.wait_periods)
             .field("max_missed_run", &self.max_missed_run)
             .field("max_stall_periods", &self.max_stall_periods)
+            .field("safety", &self.safety)
             .finish_non_exhaustive()
     }
 }
@@ -196,6 +203,7 @@ struct RealLimits {
     wait_periods: f64,
     max_missed_run: Option<u32>,
     max_stall_periods: f64,
+    safety: DeviceSafety,
 }
 
 /// The stall limit of the simulated device (s): at least 40 ms, twice the shared 20 ms floor of a
@@ -327,6 +335,7 @@ impl Rig {
             wait_periods: real.wait_periods,
             max_missed_run: real.max_missed_run,
             max_stall_periods: real.max_stall_periods,
+            safety: real.safety,
         };
         let period = Duration::from_secs_f64(world.params.dt);
         let system = Self::real_system(world, &config, &limits).map_err(|e| {
@@ -360,10 +369,11 @@ impl Rig {
         config: &HapticConfig,
         limits: &RealLimits,
     ) -> Result<RigSystem, String> {
-        let safety = SafetyConfig {
+        // The device file's plausibility bounds and stall floor (its `[safety]` table).
+        let safety = limits.safety.apply(SafetyConfig {
             max_stall_periods: limits.max_stall_periods + limits.wait_periods,
             ..SafetyConfig::default()
-        };
+        });
         Ok(match &limits.model {
             DeviceModel::Twin(_) => {
                 RigSystem::Twin(HapticSystem::with_safety(world, config, safety)?)
@@ -408,15 +418,17 @@ impl Rig {
                 _ => self.config.device.min_singularity_margin,
             },
             max_missed_run: if real { missed } else { None },
-            // The device file's periods, at least the shared safety layer's `min_stall_time`.
-            max_stall_periods: real.then_some(
-                self.real
-                    .as_ref()
-                    .map_or(SafetyConfig::default().max_stall_periods, |l| {
-                        l.max_stall_periods
-                    })
-                    .max(SafetyConfig::default().min_stall_time / self.system.world().params.dt),
-            ),
+            // The device file's periods, at least its stall floor (`[safety] stall_floor`).
+            max_stall_periods: real.then_some({
+                let (periods, floor) = self.real.as_ref().map_or(
+                    (
+                        SafetyConfig::default().max_stall_periods,
+                        SafetyConfig::default().min_stall_time,
+                    ),
+                    |l| (l.max_stall_periods, l.safety.stall_floor),
+                );
+                periods.max(floor / self.system.world().params.dt)
+            }),
         }
     }
 
@@ -783,11 +795,13 @@ mod tests {
                 tau_max: 0.123,
                 center: [0.019, 0.10],
                 workspace: WorkspaceSquare::around([0.019, 0.10], 0.03),
+                identified: None,
             },
             summary: "a fake 2DIY".into(),
             wait_periods,
             max_missed_run: None,
             max_stall_periods: 5.0,
+            safety: DeviceSafety::default(),
             match_controller: None,
             open: Box::new(move |_| {
                 Ok(Box::new(FakeBoard {

@@ -182,7 +182,7 @@ fn identify_response_signs_reveal_reversed_directions() {
     assert_eq!(signs(&good, &good), (true, true, true));
     let mut motor_only = good.clone();
     motor_only.motors[0].direction = flip(motor_only.motors[0].direction);
-    assert_eq!(signs(&good, &motor_only).0, false);
+    assert!(!signs(&good, &motor_only).0);
     let mut both = good.clone();
     both.motors[0].direction = flip(both.motors[0].direction);
     both.motors[0].encoder_direction = flip(both.motors[0].encoder_direction);

@@ -39,8 +39,13 @@
 //!
 //! `p = M'·q̇(t₀)` (a handle not quite still) and `c` (the start sample's quantisation) are unknowns
 //! per pulse and row; `∫τ` is exact (the board holds each torque until the next write), `∫(q − q₀)`
-//! and `∫∫τ` are trapezoids over the sample times. Linear least squares over every sample of both
-//! pulses (Householder QR on unit-norm columns), 16 unknowns.
+//! and `∫∫τ` are trapezoids over the sample times. Linear least squares over every sample of every
+//! pulse (Householder QR on unit-norm columns), `8 + 4·pulses` unknowns.
+//!
+//! **A third pulse** ([`heavy_direction`]): near a 2DIY's folded rest pose `M` is nearly singular
+//! (eigenvalues ~8× apart), the joint pulses hardly move the heavy direction and its inertia is
+//! poorly seen (one joint came out 12 % off). A third doublet along the first estimate's heavy
+//! eigenvector, sized to move the end point a few mm, fixes that; the final fit uses all three.
 //!
 //! **Directions.** The response `A' = M'⁻¹ = D_e·M⁻¹·D_m`: `sign A'_jj = e_j·m_j` (the sign of joint
 //! `j`'s acceleration under its own torque) and `sign A'_kj = e_k·m_j·sign (M⁻¹)_kj`, where
@@ -186,7 +191,7 @@ pub fn joint_directions(plan: &PulsePlan) -> [[f64; 2]; 2] {
 /// The third pulse, along the heavy eigen-direction of a first estimate's symmetric inertia: a
 /// five-bar near its folded rest pose moves ~8× less in that direction under the joint pulses, so
 /// its inertia there is poorly seen. Its amplitude (N·m) is the one the first estimate predicts to
-/// move the end point a third of [`PulsePlan::max_excursion`] by the end of the doublet's first half
+/// move the end point a sixth of [`PulsePlan::max_excursion`] by the end of the doublet's first half
 /// (`|J·M⁻¹·u|·T²/π`, `j` the Jacobian at the rest pose, `Ė = J·q̇`), at least the plan's amplitude
 /// and at most `cap` (N·m). `None` when the estimate is not positive definite.
 pub fn heavy_direction(
@@ -210,7 +215,7 @@ pub fn heavy_direction(
         [heavy - m[1][1], m[0][1]]
     };
     let n = (v[0] * v[0] + v[1] * v[1]).sqrt();
-    if !(n > 0.0) {
+    if !(n.is_finite() && n > 0.0) {
         return None;
     }
     let u = [v[0] / n, v[1] / n];
@@ -225,10 +230,10 @@ pub fn heavy_direction(
         j[1][0] * dq[0] + j[1][1] * dq[1],
     ];
     let per_newton_metre = (de[0] * de[0] + de[1] * de[1]).sqrt();
-    if !(per_newton_metre > 0.0) {
+    if !(per_newton_metre.is_finite() && per_newton_metre > 0.0) {
         return None;
     }
-    let a = (plan.max_excursion / 3.0 / per_newton_metre)
+    let a = (plan.max_excursion / 6.0 / per_newton_metre)
         .max(plan.amplitude)
         .min(cap);
     Some([a * u[0], a * u[1]])
