@@ -86,6 +86,10 @@ fn identify(
     heavy: bool,
 ) -> (haptic2d_devices::haply::identify::Identification, [f64; 3]) {
     let (mut emu, numbers) = emulator_with(truth, scale, b_h);
+    // The plant steps one period per write, so a slow reply changes nothing but the wait.
+    let mut host = host.clone();
+    host.timeout_periods = 1000.0;
+    let host = &host;
     let mut dev = open_driver(&emu, host, 0.001);
     let HaplyKind::TwoDiy { linkage, .. } = &host.kind else {
         panic!()
