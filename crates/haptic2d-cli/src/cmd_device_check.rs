@@ -50,11 +50,17 @@ pub struct CheckArgs {
 pub enum DeviceCommand {
     /// Read the angles and the pose; with --pulse confirm the motor directions.
     Check(CheckArgs),
+    /// Measure a 2DIY's inertia and damping from small torque pulses (hand released) and write
+    /// them to the device file's [identified] table for the stability gate.
+    Identify(crate::cmd_device_identify::IdentifyArgs),
 }
 
 /// Runs `device SUBCOMMAND`.
 pub fn run(c: &DeviceCommand) -> ExitCode {
-    let DeviceCommand::Check(a) = c;
+    let a = match c {
+        DeviceCommand::Check(a) => a,
+        DeviceCommand::Identify(a) => return crate::cmd_device_identify::run(a),
+    };
     match check(a) {
         Ok(code) => ExitCode::from(code),
         Err((code, msg)) => fail(code, &msg),
@@ -135,8 +141,9 @@ fn pose_report(file: &HaplyDeviceFile, q: &[f64; 4]) -> Vec<String> {
 }
 
 /// One pulse's outcome: the joint angle changes (rad) from before to the end of the pulse.
-struct Pulse {
-    dq: [f64; 4],
+pub(crate) struct Pulse {
+    /// Joint angle changes (rad).
+    pub(crate) dq: [f64; 4],
 }
 
 /// Pulses each motor in turn with `+tau` for 150 ms, then rests 150 ms, and diagnoses the
@@ -231,7 +238,7 @@ fn pulse<S: Read + Write>(
 }
 
 /// The direction diagnosis of a five-bar from its two pulses (module documentation).
-fn diagnose_2dof(
+pub(crate) fn diagnose_2dof(
     linkage: &Pantograph2,
     q_rest: &[f64; 4],
     pulses: &[Pulse],

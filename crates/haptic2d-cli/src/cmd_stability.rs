@@ -11,6 +11,7 @@ use crate::scene_arg;
 use haptic2d::device::pantograph2::Pantograph2;
 use haptic2d::geom::Vec2;
 use haptic2d::haptic::{ControllerKind, HapticConfig};
+use haptic2d_devices::haply::identified::Identified;
 use haptic2d_devices::haply::{HaplyDeviceFile, HaplyKind, Plant2};
 use haptic2d_lab::stability::planar2::{
     analyse_planar2, check_released_stability_planar2, FiveBarDynamics,
@@ -148,10 +149,13 @@ pub fn check_real_device(
     match model {
         DeviceModel::Twin(_) => haptic2d_lab::stability::check_released_stability(config, world),
         DeviceModel::FiveBar {
-            linkage, center, ..
+            linkage,
+            center,
+            identified,
+            ..
         } => check_released_stability_planar2(
             linkage,
-            &five_bar_dynamics(linkage, *center)?,
+            &five_bar_dynamics(linkage, *center, identified.as_ref())?.0,
             Vec2::new(center[0], center[1]),
             &config.controller,
             world,
@@ -159,15 +163,34 @@ pub fn check_real_device(
     }
 }
 
-/// The lumped dynamics of a 2DIY five-bar: the numbers of the emulator's simulated linkage
-/// (`haptic2d_devices::haply::Plant2`; estimates, not measurements of a kit).
-fn five_bar_dynamics(linkage: &Pantograph2, center: [f64; 2]) -> Result<FiveBarDynamics, String> {
+/// The lumped dynamics of a 2DIY five-bar and where they come from: the device file's
+/// `[identified]` table (`haptic2d device identify`) when present, else the numbers of the
+/// emulator's simulated linkage (`haptic2d_devices::haply::Plant2`; estimates, not measurements of
+/// a kit).
+fn five_bar_dynamics(
+    linkage: &Pantograph2,
+    center: [f64; 2],
+    identified: Option<&Identified>,
+) -> Result<(FiveBarDynamics, String), String> {
+    if let Some(i) = identified {
+        return Ok((
+            FiveBarDynamics {
+                i_j: i.joint_inertia,
+                m_e: i.end_mass,
+                b: i.joint_damping(),
+            },
+            format!("identified {} ([identified] of the device file)", i.date),
+        ));
+    }
     let p = Plant2::new(*linkage, Vec2::new(center[0], center[1]))?;
-    Ok(FiveBarDynamics {
-        i_j: p.i_j,
-        m_e: p.m_e,
-        b: p.b,
-    })
+    Ok((
+        FiveBarDynamics {
+            i_j: p.i_j,
+            m_e: p.m_e,
+            b: p.b,
+        },
+        "built-in estimates, not measured (run `haptic2d device identify`)".into(),
+    ))
 }
 
 /// `haptic2d stability --device-file HAPLY.toml` for a 2DIY: the x and y axes.
@@ -180,9 +203,14 @@ fn run_planar2(
     center: [f64; 2],
 ) -> Result<(), String> {
     let scene = scene_arg::load(&a.scene, Some(a.rate))?;
+    let (dynamics, origin) = five_bar_dynamics(linkage, center, file.identified.as_ref())?;
+    println!(
+        "device dynamics: I_j {:.3e} kg·m², m_e {:.4} kg, b {:.2e} N·m·s/rad — {origin}",
+        dynamics.i_j, dynamics.m_e, dynamics.b
+    );
     let axes = analyse_planar2(
         linkage,
-        &five_bar_dynamics(linkage, center)?,
+        &dynamics,
         Vec2::new(center[0], center[1]),
         controller,
         &scene.world,

@@ -94,13 +94,25 @@ pub fn real_device(port: &str, device_file: Option<&Path>) -> Result<RealDevice,
                 tau_max: file.torque_limit,
                 center: *center,
                 workspace: haptic2d::haptic::WorkspaceSquare::around(*center, *half_width),
+                identified: file.identified.clone(),
             },
             "2-DOF 2DIY",
         ),
         HaplyKind::Twin(p) => (DeviceModel::Twin(*p), "twin pantograph"),
     };
+    let dynamics = match (&file.kind, &file.identified) {
+        (HaplyKind::Twin(_), _) => String::new(),
+        (_, Some(i)) => format!(
+            ", stability gate on the identified dynamics of {} (I_j {:.3e} kg·m², m_e {:.4} kg, b {:.2e} N·m·s/rad)",
+            i.date,
+            i.joint_inertia,
+            i.end_mass,
+            i.joint_damping()
+        ),
+        (_, None) => ", stability gate on the built-in estimates of the dynamics (not measured: `haptic2d device identify`)".to_string(),
+    };
     let summary = format!(
-        "{}, {kind}, torque limit {} N·m",
+        "{}, {kind}, torque limit {} N·m{dynamics}",
         file.source, file.torque_limit
     );
     let open_name = name.clone();
@@ -112,6 +124,7 @@ pub fn real_device(port: &str, device_file: Option<&Path>) -> Result<RealDevice,
         wait_periods: file.timeout_periods,
         max_missed_run: file.max_missed_deadlines,
         max_stall_periods: file.max_stall_periods,
+        safety: file.safety,
         match_controller: Some(Box::new(move |k| matcher.controller_for(k))),
         // Open and hand-shake before the first deadline, with the handle at the rest pose
         // (docs/DEVICES.md §7); the firmware's line and, for a board without a watchdog, the

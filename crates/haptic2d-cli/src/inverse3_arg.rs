@@ -99,11 +99,13 @@ pub fn real_device(url: Option<&str>, device_file: Option<&Path>) -> Result<Real
             center: virtual_center(),
             // The plane's square, moved with the plane point to the virtual linkage's centre.
             workspace: haptic2d::haptic::WorkspaceSquare::around(virtual_center(), file.half_width),
+            identified: None,
         },
         summary,
         wait_periods: file.timeout_periods,
         max_missed_run: file.max_missed_deadlines,
         max_stall_periods: file.max_stall_periods,
+        safety: file.safety,
         match_controller: None,
         // Connect and wait for the first state before the first deadline.
         open: Box::new(move |period| {

@@ -2,6 +2,7 @@
 
 mod cmd_check;
 mod cmd_device_check;
+mod cmd_device_identify;
 mod cmd_devices;
 mod cmd_emulate;
 mod cmd_log;
@@ -87,7 +88,7 @@ enum Command {
     Emulate(cmd_emulate::EmulateArgs),
     /// List the serial ports with their USB ids (Haply boards marked).
     Devices,
-    /// Device tools: `device check --device haply:PATH [--pulse]`.
+    /// Device tools: `device check --device haply:PATH [--pulse]`, `device identify`.
     Device {
         #[command(subcommand)]
         command: cmd_device_check::DeviceCommand,

@@ -38,6 +38,7 @@ use haptic2d::haptic::{
     ControllerKind, HapticConfig, HapticSystem, SafetyConfig, TickOutput, WorkspaceSquare,
 };
 use haptic2d::world::World;
+use haptic2d_devices::device_safety::DeviceSafety;
 use haptic2d_rt::clock::now_ns;
 use haptic2d_rt::io::DEFAULT_REPLAY_COLUMNS;
 use haptic2d_rt::{
@@ -144,6 +145,9 @@ pub enum DeviceModel {
         /// The workspace square of the device file (m, the linkage's frame) with its wall and
         /// trip: the bound the 2-DOF tick applies, as the twin's from its parameters.
         workspace: WorkspaceSquare,
+        /// The dynamics `haptic2d device identify` measured (the device file's `[identified]`),
+        /// used by the stability gate in place of the built-in estimates; `None`: not measured.
+        identified: Option<haptic2d_devices::haply::identified::Identified>,
     },
 }
 
@@ -166,6 +170,8 @@ pub struct RealDevice {
     /// The loop's own delay between two ticks that trips the stall check (periods, ≥ 1; the shared
     /// safety layer's default is 5).
     pub max_stall_periods: f64,
+    /// The device file's `[safety]` table: plausibility bounds and the stall floor.
+    pub safety: DeviceSafety,
     /// Matches the controller to the device (e.g. the Haply twin's θ gains to its crank); `None`
     /// keeps the controller as chosen.
     pub match_controller: Option<MatchController>,
@@ -185,6 +191,7 @@ impl std::fmt::Debug for RealDevice {
             .field("wait_periods", &self.wait_periods)
             .field("max_missed_run", &self.max_missed_run)
             .field("max_stall_periods", &self.max_stall_periods)
+            .field("safety", &self.safety)
             .finish_non_exhaustive()
     }
 }
@@ -196,6 +203,7 @@ struct RealLimits {
     wait_periods: f64,
     max_missed_run: Option<u32>,
     max_stall_periods: f64,
+    safety: DeviceSafety,
 }
 
 /// The stall limit of the simulated device (s): at least 40 ms, twice the shared 20 ms floor of a
@@ -327,6 +335,7 @@ impl Rig {
             wait_periods: real.wait_periods,
             max_missed_run: real.max_missed_run,
             max_stall_periods: real.max_stall_periods,
+            safety: real.safety,
         };
         let period = Duration::from_secs_f64(world.params.dt);
         let system = Self::real_system(world, &config, &limits).map_err(|e| {
@@ -360,10 +369,11 @@ impl Rig {
         config: &HapticConfig,
         limits: &RealLimits,
     ) -> Result<RigSystem, String> {
-        let safety = SafetyConfig {
+        // The device file's plausibility bounds and stall floor (its `[safety]` table).
+        let safety = limits.safety.apply(SafetyConfig {
             max_stall_periods: limits.max_stall_periods + limits.wait_periods,
             ..SafetyConfig::default()
-        };
+        });
         Ok(match &limits.model {
             DeviceModel::Twin(_) => {
                 RigSystem::Twin(HapticSystem::with_safety(world, config, safety)?)
@@ -408,15 +418,17 @@ impl Rig {
                 _ => self.config.device.min_singularity_margin,
             },
             max_missed_run: if real { missed } else { None },
-            // The device file's periods, at least the shared safety layer's `min_stall_time`.
-            max_stall_periods: real.then_some(
-                self.real
-                    .as_ref()
-                    .map_or(SafetyConfig::default().max_stall_periods, |l| {
-                        l.max_stall_periods
-                    })
-                    .max(SafetyConfig::default().min_stall_time / self.system.world().params.dt),
-            ),
+            // The device file's periods, at least its stall floor (`[safety] stall_floor`).
+            max_stall_periods: real.then_some({
+                let (periods, floor) = self.real.as_ref().map_or(
+                    (
+                        SafetyConfig::default().max_stall_periods,
+                        SafetyConfig::default().min_stall_time,
+                    ),
+                    |l| (l.max_stall_periods, l.safety.stall_floor),
+                );
+                periods.max(floor / self.system.world().params.dt)
+            }),
         }
     }
 
@@ -783,11 +795,13 @@ mod tests {
                 tau_max: 0.123,
                 center: [0.019, 0.10],
                 workspace: WorkspaceSquare::around([0.019, 0.10], 0.03),
+                identified: None,
             },
             summary: "a fake 2DIY".into(),
             wait_periods,
             max_missed_run: None,
             max_stall_periods: 5.0,
+            safety: DeviceSafety::default(),
             match_controller: None,
             open: Box::new(move |_| {
                 Ok(Box::new(FakeBoard {
@@ -807,6 +821,141 @@ mod tests {
             real,
         )
         .unwrap()
+    }
+
+    /// A 2-DOF device whose joint 0 turns `step` rad per read from its workspace centre.
+    struct MovingBoard {
+        q: [f64; 2],
+        step: f64,
+    }
+
+    impl DeviceIo for MovingBoard {
+        fn read_encoders(&mut self) -> Result<[f64; 4], DeviceError> {
+            self.q[0] += self.step;
+            Ok([self.q[0], self.q[1], 0.0, 0.0])
+        }
+        fn write_torques(&mut self, _tau: &[f64; 4]) -> Result<(), DeviceError> {
+            Ok(())
+        }
+        fn zero_torques(&mut self) {}
+        fn name(&self) -> &str {
+            "moving-board"
+        }
+    }
+
+    /// `shipped` (a file of devices/) with its `[safety]` lines edited by `edit`, in `dir`.
+    fn safety_file(
+        dir: &std::path::Path,
+        shipped: &str,
+        edit: impl Fn(String) -> String,
+    ) -> std::path::PathBuf {
+        let text = std::fs::read_to_string(format!(
+            "{}/../../devices/{shipped}",
+            env!("CARGO_MANIFEST_DIR")
+        ))
+        .unwrap();
+        let p = dir.join(shipped);
+        std::fs::write(&p, edit(text)).unwrap();
+        p
+    }
+
+    /// Ticks the real device `real` (its I/O replaced by a board turning joint 0 at 10 rad/s, far
+    /// below the default bound of 1000 rad/s) for 20 ms; returns the trip, if any.
+    fn run_at_10_rad_per_s(real: RealDevice) -> Option<haptic2d::haptic::SafetyTrip> {
+        let mut real = real;
+        let DeviceModel::FiveBar {
+            linkage, center, ..
+        } = &real.model
+        else {
+            panic!("a 2-DOF device")
+        };
+        let q = linkage
+            .ik(haptic2d::geom::Vec2::new(center[0], center[1]))
+            .unwrap();
+        real.open = Box::new(move |_| Ok(Box::new(MovingBoard { q, step: 0.01 }) as _));
+        let scene = builtin("box-in-walls", Some(1000.0)).unwrap().unwrap();
+        let mut rig = Rig::with_real(
+            scene.world,
+            "box-in-walls",
+            HapticConfig::default(),
+            DeviceChoice::Haply("fake".into()),
+            real,
+        )
+        .unwrap();
+        for k in 0..20 {
+            let q = rig.read().unwrap();
+            rig.tick_system(&q, &info(k), false);
+        }
+        rig.system.safety_trip()
+    }
+
+    /// Issue 38 item 6, issue 34: the device file's `[safety] max_velocity` reaches the system of
+    /// every device kind. 10 rad/s passes the default bound and trips a file's 5 rad/s, which the
+    /// trip names; the file's `stall_floor` sets the watchdog's floor.
+    fn a_file_velocity_bound_is_honoured(
+        load: impl Fn(&std::path::Path) -> RealDevice,
+        shipped: &str,
+    ) {
+        let dir = tempfile::tempdir().unwrap();
+        let plain = safety_file(dir.path(), shipped, |t| t);
+        assert_eq!(run_at_10_rad_per_s(load(&plain)), None, "{shipped}");
+        let tight = safety_file(dir.path(), shipped, |t| {
+            t.replace("max_velocity = 1000.0", "max_velocity = 5.0")
+                .replace("stall_floor = 0.02 ", "stall_floor = 0.1 ")
+        });
+        let real = load(&tight);
+        assert_eq!(real.safety.stall_floor, 0.1);
+        let trip = run_at_10_rad_per_s(real).expect("a trip");
+        match trip.reason {
+            haptic2d::haptic::SafetyReason::JointSpeed { index, limit, .. } => {
+                assert_eq!((index, limit), (0, 5.0), "{trip}")
+            }
+            r => panic!("{shipped}: wrong reason {r:?}"),
+        }
+        // The stall floor (0.1 s = 100 periods at 1 kHz) is the watchdog's too.
+        let mut real = load(&tight);
+        real.open = Box::new(|_| {
+            Ok(Box::new(MovingBoard {
+                q: [0.0; 2],
+                step: 0.0,
+            }) as _)
+        });
+        let scene = builtin("box-in-walls", Some(1000.0)).unwrap().unwrap();
+        let rig = Rig::with_real(
+            scene.world,
+            "box-in-walls",
+            HapticConfig::default(),
+            DeviceChoice::Haply("fake".into()),
+            real,
+        )
+        .unwrap();
+        let stall = rig.watchdog_config().max_stall_periods.unwrap();
+        assert!((stall - 100.0).abs() < 1e-9, "{stall}");
+    }
+
+    #[test]
+    fn a_haply_file_velocity_bound_and_stall_floor_are_honoured() {
+        a_file_velocity_bound_is_honoured(
+            |p| crate::haply_arg::real_device("/dev/null", Some(p)).unwrap(),
+            "haply-2diy-gen3.toml",
+        );
+    }
+
+    #[test]
+    fn a_udp_file_velocity_bound_and_stall_floor_are_honoured() {
+        a_file_velocity_bound_is_honoured(
+            |p| crate::udp_arg::real_device("127.0.0.1:5005", Some(p), false).unwrap(),
+            "udp-pantograph.toml",
+        );
+    }
+
+    #[test]
+    #[cfg(feature = "inverse3")]
+    fn an_inverse3_file_velocity_bound_and_stall_floor_are_honoured() {
+        a_file_velocity_bound_is_honoured(
+            |p| crate::inverse3_arg::real_device(None, Some(p)).unwrap(),
+            "inverse3.toml",
+        );
     }
 
     /// One tick of the loop's order (read, system, watchdog) at `info`; the torques as guarded.

@@ -113,11 +113,13 @@ pub fn real_device(
             tau_max: file.torque_limit,
             center: reach_center(&file.linkage),
             workspace: haptic2d::haptic::WorkspaceSquare::five_bar(&file.linkage),
+            identified: None,
         },
         summary,
         wait_periods: file.timeout_periods,
         max_missed_run: file.max_missed_deadlines,
         max_stall_periods: file.max_stall_periods,
+        safety: file.safety,
         match_controller: None,
         // Open (the first state received) before the first deadline.
         open: Box::new(move |period| {

@@ -9,6 +9,7 @@
 //!   client crate, in planar mode, and an emulator of the service (docs/DEVICES.md §4).
 #![warn(missing_docs)]
 
+pub mod device_safety;
 pub mod device_toml;
 pub mod file_read;
 pub mod haply;

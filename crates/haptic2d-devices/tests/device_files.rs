@@ -207,3 +207,159 @@ fn watchdog_ms_defaults_to_20_and_is_checked() {
         "{e}"
     );
 }
+
+fn shipped_text(name: &str) -> String {
+    std::fs::read_to_string(format!(
+        "{}/../../devices/{name}",
+        env!("CARGO_MANIFEST_DIR")
+    ))
+    .unwrap()
+}
+
+/// Issue 38 item 6: every shipped device file carries the `[safety]` table with the shared
+/// defaults (4π rad, 1000 rad/s, 20 ms), so the shipped behaviour is unchanged.
+#[test]
+fn shipped_safety_tables_are_the_shared_defaults() {
+    use haptic2d_devices::device_safety::DeviceSafety;
+    let d = DeviceSafety::default();
+    assert_eq!(d.max_angle, 4.0 * std::f64::consts::PI);
+    assert_eq!((d.max_velocity, d.stall_floor), (1000.0, 0.02));
+    for f in [
+        "haply-2diy-gen2.toml",
+        "haply-2diy-gen3.toml",
+        "haply-twin.toml",
+    ] {
+        assert_eq!(shipped(f).safety, d, "{f}");
+    }
+    let udp = haptic2d_devices::udp::UdpDeviceFile::from_toml(
+        &shipped_text("udp-pantograph.toml"),
+        "udp",
+    )
+    .unwrap();
+    assert_eq!(udp.safety, d);
+    #[cfg(feature = "inverse3")]
+    {
+        let i3 = haptic2d_devices::inverse3::Inverse3DeviceFile::from_toml(
+            &shipped_text("inverse3.toml"),
+            "inverse3",
+        )
+        .unwrap();
+        assert_eq!(i3.safety, d);
+    }
+}
+
+/// NaN, negative, zero and absurd bounds are refused, naming `safety.FIELD`, in every kind of file.
+#[test]
+fn bad_safety_values_name_the_field_in_every_device_file() {
+    let cases = [
+        (
+            "max_velocity = 1000.0",
+            "max_velocity = nan",
+            "safety.max_velocity",
+        ),
+        (
+            "max_velocity = 1000.0",
+            "max_velocity = -5.0",
+            "safety.max_velocity",
+        ),
+        (
+            "max_velocity = 1000.0",
+            "max_velocity = 1e9",
+            "safety.max_velocity",
+        ),
+        (
+            "max_angle = 12.566370614359172",
+            "max_angle = 0.0",
+            "safety.max_angle",
+        ),
+        (
+            "max_angle = 12.566370614359172",
+            "max_angle = inf",
+            "safety.max_angle",
+        ),
+        (
+            "stall_floor = 0.02",
+            "stall_floor = -0.01",
+            "safety.stall_floor",
+        ),
+        (
+            "stall_floor = 0.02",
+            "stall_floor = 60.0",
+            "safety.stall_floor",
+        ),
+    ];
+    for (from, to, field) in cases {
+        let haply = shipped_text("haply-2diy-gen3.toml").replace(from, to);
+        let e = HaplyDeviceFile::from_toml(&haply, "t")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(field) && e.contains("fix"), "{to}: {e}");
+        let udp = shipped_text("udp-pantograph.toml").replace(from, to);
+        let e = haptic2d_devices::udp::UdpDeviceFile::from_toml(&udp, "t")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(field), "udp {to}: {e}");
+        #[cfg(feature = "inverse3")]
+        {
+            let i3 = shipped_text("inverse3.toml").replace(from, to);
+            let e = haptic2d_devices::inverse3::Inverse3DeviceFile::from_toml(&i3, "t")
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains(field), "inverse3 {to}: {e}");
+        }
+    }
+    // A stall floor of 0 is allowed (the periods alone), as in the shared settings.
+    let haply =
+        shipped_text("haply-2diy-gen3.toml").replace("stall_floor = 0.02", "stall_floor = 0");
+    assert_eq!(
+        HaplyDeviceFile::from_toml(&haply, "t")
+            .unwrap()
+            .safety
+            .stall_floor,
+        0.0
+    );
+}
+
+const IDENTIFIED: &str = r#"
+[identified]
+date = "2026-12-05T14:02:15Z"
+command = "haptic2d device identify"
+inertia = [1.5e-4, 1.6e-4]
+inertia_coupling = -1.2e-4
+damping = [1.9e-4, 1.9e-4]
+joint_inertia = 2.0e-5
+end_mass = 0.031
+"#;
+
+/// The `[identified]` table of a 2DIY is read back; implausible values and a twin are refused.
+#[test]
+fn identified_tables_are_read_and_checked() {
+    let text = shipped_text("haply-2diy-gen3.toml") + IDENTIFIED;
+    let f = HaplyDeviceFile::from_toml(&text, "t").unwrap();
+    let i = f.identified.unwrap();
+    assert_eq!(i.inertia, [1.5e-4, 1.6e-4]);
+    assert!((i.joint_damping() - 1.9e-4).abs() < 1e-12);
+    for (from, to, field) in [
+        (
+            "inertia = [1.5e-4",
+            "inertia = [-1.5e-4",
+            "identified.inertia[0]",
+        ),
+        ("end_mass = 0.031", "end_mass = nan", "identified.end_mass"),
+        (
+            "damping = [1.9e-4",
+            "damping = [50.0",
+            "identified.damping[0]",
+        ),
+        (
+            "inertia_coupling = -1.2e-4",
+            "inertia_coupling = -3e-4",
+            "identified.inertia_coupling",
+        ),
+    ] {
+        let e = err(&text.replace(from, to));
+        assert!(e.contains(field), "{to}: {e}");
+    }
+    let twin = shipped_text("haply-twin.toml") + IDENTIFIED;
+    assert!(err(&twin).contains("identified"));
+}

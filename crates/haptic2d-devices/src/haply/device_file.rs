@@ -25,6 +25,9 @@
 //! direction = "ccw"
 //! offset_deg = 168.0
 //! counts_per_turn = 4880.0
+//! [safety]                      # optional (crate::device_safety): plausibility bounds, stall floor
+//! max_velocity = 1000.0         # rad/s
+//! [identified]                  # 2diy only, optional: written by `haptic2d device identify`
 //! ```
 
 use haptic2d::device::pantograph2::Pantograph2;
@@ -35,6 +38,8 @@ use haptic2d::scene::{device_params_from_toml, SceneError, SceneErrors};
 use serde::Deserialize;
 
 use super::codec::{BoardSetup, Rotation, FIRMWARE_TORQUE_LIMIT, PORTS};
+use super::identified::{Identified, RawIdentified};
+use crate::device_safety::{DeviceSafety, RawSafety};
 
 /// Which device a file describes.
 #[derive(Clone, Debug, PartialEq)]
@@ -99,6 +104,10 @@ pub struct HaplyDeviceFile {
     pub motors: Vec<MotorSpec>,
     /// 2DIY or twin.
     pub kind: HaplyKind,
+    /// The `[safety]` table: plausibility bounds and the stall floor (defaults when absent).
+    pub safety: DeviceSafety,
+    /// The `[identified]` table of a 2DIY: the dynamics `haptic2d device identify` measured.
+    pub identified: Option<Identified>,
 }
 
 #[derive(Deserialize)]
@@ -118,6 +127,10 @@ struct RawFile {
     motor: Vec<RawMotor>,
     #[serde(default)]
     rest: Option<RawRest>,
+    #[serde(default)]
+    safety: Option<RawSafety>,
+    #[serde(default)]
+    identified: Option<RawIdentified>,
 }
 
 #[derive(Deserialize)]
@@ -425,6 +438,19 @@ impl HaplyDeviceFile {
         if let (Some(k), true) = (&kind, errs.is_empty()) {
             check_rest_pose(k, &motors, raw.rest.as_ref(), &mut errs);
         }
+        let safety = RawSafety::check(raw.safety.as_ref(), &mut errs);
+        let identified = match (&raw.identified, raw.kind.as_str()) {
+            (None, _) => None,
+            (Some(i), "2diy") => i.check(&mut errs),
+            (Some(_), _) => {
+                errs.push(SceneError::new(
+                    "identified",
+                    format!("kind `{}` has no identified model", raw.kind),
+                    "delete the [identified] table: `haptic2d device identify` measures a 2diy",
+                ));
+                None
+            }
+        };
         match kind {
             Some(kind) if errs.is_empty() => Ok(Self {
                 name: raw.name.unwrap_or_else(|| raw.kind.clone()),
@@ -440,6 +466,8 @@ impl HaplyDeviceFile {
                 watchdog_ms: b.watchdog_ms.clamp(1, 1000) as u16,
                 motors,
                 kind,
+                safety,
+                identified,
             }),
             _ => Err(fail(errs)),
         }

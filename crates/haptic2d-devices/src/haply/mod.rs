@@ -5,6 +5,8 @@ pub mod codec;
 pub mod device_file;
 pub mod driver;
 pub mod emulator;
+pub mod identified;
+pub mod identify;
 pub mod plant;
 pub mod serial;
 pub mod system;

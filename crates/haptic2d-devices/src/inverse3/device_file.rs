@@ -80,6 +80,9 @@ pub struct Inverse3DeviceFile {
     pub center: [f64; 2],
     /// Half side of the usable square (m).
     pub half_width: f64,
+    /// The `[safety]` table: plausibility bounds on the joint readings and the stall floor
+    /// (defaults when absent; `crate::device_safety`).
+    pub safety: crate::device_safety::DeviceSafety,
 }
 
 #[derive(Deserialize)]
@@ -93,6 +96,8 @@ struct RawFile {
     plane: RawPlane,
     limits: RawLimits,
     workspace: RawWorkspace,
+    #[serde(default)]
+    safety: Option<crate::device_safety::RawSafety>,
 }
 
 #[derive(Deserialize)]
@@ -291,6 +296,7 @@ impl Inverse3DeviceFile {
                 "give half the side of the usable square in metres",
             );
         }
+        let safety = crate::device_safety::RawSafety::check(raw.safety.as_ref(), &mut errs);
         match mapped {
             Some(axes) if errs.is_empty() => Ok(Self {
                 name: raw.name.unwrap_or_else(|| "Haply Inverse3".into()),
@@ -311,6 +317,7 @@ impl Inverse3DeviceFile {
                 ramp_time: l.ramp_time,
                 center: w.center,
                 half_width: w.half_width,
+                safety,
             }),
             _ => Err(fail(errs)),
         }

@@ -67,6 +67,9 @@ pub struct UdpDeviceFile {
     pub key: Option<UdpKey>,
     /// Where the key was read from (for messages).
     pub key_file: Option<PathBuf>,
+    /// The `[safety]` table: plausibility bounds on the joint readings and the stall floor
+    /// (defaults when absent; `crate::device_safety`).
+    pub safety: crate::device_safety::DeviceSafety,
 }
 
 #[derive(Deserialize)]
@@ -78,6 +81,8 @@ struct RawFile {
     #[serde(default)]
     protocol: Option<RawProtocol>,
     linkage: RawLinkage,
+    #[serde(default)]
+    safety: Option<crate::device_safety::RawSafety>,
 }
 
 #[derive(Deserialize)]
@@ -273,6 +278,7 @@ impl UdpDeviceFile {
                 None
             }
         };
+        let safety = crate::device_safety::RawSafety::check(raw.safety.as_ref(), &mut errs);
         match linkage {
             Some(linkage) if errs.is_empty() => Ok(Self {
                 name: raw.name.unwrap_or_else(|| "UDP device".into()),
@@ -289,6 +295,7 @@ impl UdpDeviceFile {
                 linkage,
                 key,
                 key_file,
+                safety,
             }),
             _ => Err(fail(errs)),
         }

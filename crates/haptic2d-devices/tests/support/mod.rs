@@ -50,7 +50,7 @@ pub struct Emu {
     pub path: String,
     pub stop: Arc<AtomicBool>,
     pub handle: Option<JoinHandle<EmulatorReport>>,
-    keep: Option<std::fs::File>,
+    pub keep: Option<std::fs::File>,
 }
 
 impl Emu {

@@ -173,7 +173,7 @@ impl fmt::Display for SafetyReason {
                 window,
             } => write!(
                 f,
-                "limit cycle: in the last {:.0} ms a motor sat at its torque limit in {:.0} % of the ticks and motor {motor}'s saturated torque reversed {reversals} times (an oscillation at the actuators' limit, not a push): the stability gate trusted a device inertia nobody measured (the device is likely lighter than its model); measure its effective inertia (`haptic2d device identify`, issue 34 build item 6, is not built yet), re-check with `haptic2d stability`, or use gentler controller gains",
+                "limit cycle: in the last {:.0} ms a motor sat at its torque limit in {:.0} % of the ticks and motor {motor}'s saturated torque reversed {reversals} times (an oscillation at the actuators' limit, not a push): the stability gate trusted a device inertia nobody measured (the device is likely lighter than its model); measure its effective inertia (`haptic2d device identify --write` on a 2DIY, docs/HARDWARE.md \"Identify your device\"), re-check with `haptic2d stability`, or use gentler controller gains",
                 window * 1e3,
                 saturated * 100.0
             ),
