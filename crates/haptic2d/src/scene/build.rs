@@ -348,7 +348,7 @@ pub(super) fn build(
             errs.push(SceneError::new(
                 "contact.impact_sweeps",
                 format!("must be in [1, 200], got {n}"),
-                "e.g. impact_sweeps = 32",
+                "e.g. impact_sweeps = 8",
             ));
         }
         cp.impact_sweeps = n.clamp(1, 200);
