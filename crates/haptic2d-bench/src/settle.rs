@@ -12,7 +12,8 @@ use crate::timing::{now, Clock};
 /// Applies `law.key=value` overrides (`normal.bc=200`, `friction.beta=40`) to the prototypes of the
 /// world's laws (every contact created afterwards gets them), and the world options
 /// `world.proximity_spread=0/1`, `world.proximity_skip=0/1`, `world.chain_tau=SECONDS` (0 = chain damper off) and
-/// `world.chain_sweeps=N`.
+/// `world.chain_sweeps=N`, and `contact.impact_sweeps=N` (the impact work budget, 1–200,
+/// docs/MODELS.md §7.7; 200 is the limit before the budget).
 pub fn apply(w: &mut World, sets: &[String]) -> Result<(), String> {
     for s in sets {
         let (k, v) = s
@@ -41,7 +42,13 @@ pub fn apply(w: &mut World, sets: &[String]) -> Result<(), String> {
                 w.params.chain_sweeps = v as u32;
                 Ok(())
             }
-            _ => Err("expected normal.KEY, friction.KEY or world.{proximity_spread, proximity_skip, chain_tau, chain_sweeps} (chain_sweeps a whole number)".into()),
+            Some(("contact", "impact_sweeps"))
+                if (1.0..=200.0).contains(&v) && v.fract() == 0.0 =>
+            {
+                w.params.contact.impact_sweeps = v as u32;
+                Ok(())
+            }
+            _ => Err("expected normal.KEY, friction.KEY, world.{proximity_spread, proximity_skip, chain_tau, chain_sweeps} or contact.impact_sweeps (sweeps a whole number, impact_sweeps 1 to 200)".into()),
         };
         r.map_err(|e| format!("--set {s}: {e}"))?;
     }

@@ -142,6 +142,27 @@ pub struct ImpactSolver {
     mu: f64,
     /// The frictional solver, used when `friction` is Coulomb and `μ > 0`.
     fric: FrictionalImpactSolver,
+    /// Sweep budget of each projected Gauss–Seidel phase of the sparse path (§7.7; default
+    /// [`PGS_MAX_SWEEPS`], the world sets its own from `ContactParams::impact_sweeps`).
+    sweep_budget: usize,
+    /// Work counters of the sparse path (§7.7), since the solver was made.
+    budget: BudgetCounters,
+}
+
+/// What the sparse path's work budget did (§7.7), counted since the solver was made.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct BudgetCounters {
+    /// Row updates of the sparse projected Gauss–Seidel (both phases): its work.
+    pub row_updates: u64,
+    /// Sparse islands solved.
+    pub islands: u64,
+    /// Sparse PGS phases (compression or correction) stopped by the sweep budget before their
+    /// `1e-9 N·s` convergence test.
+    pub phases_cut: u64,
+    /// Islands whose restitution impulses were scaled down (the passive fallback: the full
+    /// Poisson restitution would have raised the kinetic energy, as it can after a compression
+    /// the budget cut short, or by round-off after one stopped at its tolerance).
+    pub restitution_scaled: u64,
 }
 
 impl Default for ImpactSolver {
@@ -177,6 +198,8 @@ impl ImpactSolver {
             mu: 0.0,
             // Grown on first use only: the frictionless default keeps §7's memory (impact_memory.rs).
             fric: FrictionalImpactSolver::default(),
+            sweep_budget: PGS_MAX_SWEEPS,
+            budget: BudgetCounters::default(),
         };
         s.reserve(rows);
         s
@@ -206,6 +229,22 @@ impl ImpactSolver {
             // The frictional buffers for a typical set, before the first impact needs them.
             self.fric.reserve(8);
         }
+    }
+
+    /// Sweeps each projected Gauss–Seidel phase of the sparse path (`n > DENSE_MAX_ROWS`) may run
+    /// at most (§7.7; at least 1, at most [`PGS_MAX_SWEEPS`]; default [`PGS_MAX_SWEEPS`]).
+    pub fn set_sweep_budget(&mut self, sweeps: usize) {
+        self.sweep_budget = sweeps.clamp(1, PGS_MAX_SWEEPS);
+    }
+
+    /// The sparse path's sweep budget in use (§7.7).
+    pub fn sweep_budget(&self) -> usize {
+        self.sweep_budget
+    }
+
+    /// What the sparse path's work budget did since the solver was made (§7.7).
+    pub fn budget_counters(&self) -> BudgetCounters {
+        self.budget
     }
 
     /// The frictional solver (its impulses of the last frictional solve, its fallback counters).
@@ -444,32 +483,98 @@ impl ImpactSolver {
             self.inv_diag[i] = if d > 0.0 { 1.0 / d } else { 0.0 };
         }
         self.normal_velocities(rows, bodies, Buf::Pre);
-        // 1. Compression: PGS on the bodies' twists, starting from λ = 0.
+        self.budget.islands += 1;
+        // 1. Compression: PGS on the bodies' twists, starting from λ = 0. Every row update is
+        // the exact minimiser of the kinetic energy along its row under `λ_i ≥ 0`, so the
+        // kinetic energy falls at every update, wherever the budget stops it (§7.7).
         self.lambda[..n].fill(0.0);
         let compression = self.pgs_on_bodies(rows, bodies, Buf::Impulse);
-        // 2. Poisson restitution: the bodies already carry λ; add e_i·λ_i.
+        // 2. Poisson restitution: the bodies already carry λ; add p_i = e_i·λ_i. The energy
+        // terms of the passive check (§7.7) are read on the way: with `b_c = G·u_c` after the
+        // compression (held in `b_post` for now) and `b_1` after the restitution, the
+        // compression changed the kinetic energy by `½·λᵀ(b⁻ + b_c)` (≤ 0) and the restitution
+        // by `c + q`, `c = pᵀ·b_c`, `q = ½·pᵀ·A·p = ½·pᵀ(b_1 − b_c)`.
         for (i, row) in rows.iter().enumerate() {
             self.step[i] = row.restitution * self.lambda[i];
             self.impulse[i] = (1.0 + row.restitution) * self.lambda[i];
             self.correction[i] = 0.0;
         }
+        self.normal_velocities(rows, bodies, Buf::Post);
+        let (mut dke_compression, mut c) = (0.0, 0.0);
+        for i in 0..n {
+            dke_compression += 0.5 * self.lambda[i] * (self.b_pre[i] + self.b_post[i]);
+            c += self.step[i] * self.b_post[i];
+        }
         self.apply_impulses(rows, bodies, Buf::Step);
         self.normal_velocities(rows, bodies, Buf::Mid);
+        let mut q = 0.0;
+        for i in 0..n {
+            q += 0.5 * self.step[i] * (self.b_mid[i] - self.b_post[i]);
+        }
         self.b_post[..n].copy_from_slice(&self.b_mid[..n]);
-        // 3. Plastic correction: PGS again from the post-restitution twists, λ' from 0.
-        let mut correction = None;
-        let mut passes = 0;
-        if self.b_post[..n].iter().any(|&v| v < -self.eps_v) {
-            passes = 1;
-            self.step[..n].fill(0.0);
-            correction = Some(self.pgs_on_bodies(rows, bodies, Buf::Step));
-            for i in 0..n {
-                self.correction[i] = self.step[i];
-                self.impulse[i] += self.step[i];
+        // 3. Plastic correction: PGS again from the post-restitution twists, λ' from 0 (it only
+        // removes kinetic energy, for the same reason as the compression).
+        let (mut correction, mut passes) = self.sparse_correction(rows, bodies);
+        // 4. The passive check (§7.7): Poisson's restitution cannot raise the kinetic energy
+        // only if `λ ⟂ G·u_c`, which a compression cut short by the budget breaks (and one
+        // stopped by the 1e-9 N·s test leaves a residual of). If the whole impact raised it, the
+        // correction and the part of the restitution above the largest passive scale `s` are
+        // taken back and the correction runs again: the compression and the scaled restitution
+        // then leave at most the energy before, and the correction only removes energy.
+        let mut dke_correction = 0.0;
+        for i in 0..n {
+            dke_correction += 0.5 * self.correction[i] * (self.b_mid[i] + self.b_post[i]);
+        }
+        let dke_compression = dke_compression.min(0.0);
+        let q = q.max(0.0);
+        if dke_compression + c + q + dke_correction > 0.0 {
+            // The root of q·s² + c·s + dke = 0 that is ≥ 0 (dke ≤ 0); with q = 0 the energy is
+            // linear in s and c > 0 (else s = 1 would pass, the correction being ≤ 0).
+            let s = if q > 0.0 {
+                (-c + (c * c - 4.0 * q * dke_compression).max(0.0).sqrt()) / (2.0 * q)
+            } else if c > 0.0 {
+                -dke_compression / c
+            } else {
+                1.0
+            };
+            // A hair under the root, so round-off cannot put the energy above its bound.
+            let s = (s * (1.0 - 1e-9)).clamp(0.0, 1.0);
+            self.budget.restitution_scaled += 1;
+            for (i, row) in rows.iter().enumerate() {
+                self.step[i] = (s - 1.0) * row.restitution * self.lambda[i] - self.correction[i];
             }
-            self.normal_velocities(rows, bodies, Buf::Post);
+            self.apply_impulses(rows, bodies, Buf::Step);
+            for (i, row) in rows.iter().enumerate() {
+                self.impulse[i] = (1.0 + s * row.restitution) * self.lambda[i];
+                self.correction[i] = 0.0;
+            }
+            self.normal_velocities(rows, bodies, Buf::Mid);
+            self.b_post[..n].copy_from_slice(&self.b_mid[..n]);
+            (correction, passes) = self.sparse_correction(rows, bodies);
         }
         self.outcome(bodies, totals, ke_before, passes, compression, correction)
+    }
+
+    /// The sparse path's plastic correction: if some `b_post < −ε_v`, projected Gauss–Seidel from
+    /// the current twists with `λ'` from 0, added to `correction` and `impulse`; `b_post` then
+    /// holds the final normal velocities. Returns its report and the number of passes (0 or 1).
+    fn sparse_correction(
+        &mut self,
+        rows: &[ImpactRow],
+        bodies: &mut [Body],
+    ) -> (Option<LcpReport>, usize) {
+        let n = rows.len();
+        if !self.b_post[..n].iter().any(|&v| v < -self.eps_v) {
+            return (None, 0);
+        }
+        self.step[..n].fill(0.0);
+        let report = self.pgs_on_bodies(rows, bodies, Buf::Step);
+        for i in 0..n {
+            self.correction[i] = self.step[i];
+            self.impulse[i] += self.step[i];
+        }
+        self.normal_velocities(rows, bodies, Buf::Post);
+        (Some(report), 1)
     }
 
     /// Issue 16: the frictional solve; the per-row buffers report its normal impulses.
@@ -514,12 +619,12 @@ impl ImpactSolver {
 
     /// Projected Gauss–Seidel applied directly to the bodies' twists; accumulates the impulses in
     /// `lambda` (`Buf::Impulse`) or `step` (`Buf::Step`), which must start at zero. Stops when the
-    /// largest increment of a sweep is below 1e-9 N·s, or after `PGS_MAX_SWEEPS` sweeps.
+    /// largest increment of a sweep is below 1e-9 N·s, or after the sweep budget (§7.7).
     fn pgs_on_bodies(&mut self, rows: &[ImpactRow], bodies: &mut [Body], into: Buf) -> LcpReport {
         let n = rows.len();
         let mut sweeps = 0;
         let mut converged = false;
-        while sweeps < PGS_MAX_SWEEPS {
+        while sweeps < self.sweep_budget {
             sweeps += 1;
             let mut max_delta = 0.0f64;
             for (i, row) in rows.iter().enumerate() {
@@ -538,20 +643,17 @@ impl ImpactSolver {
                 *acc = new;
                 if delta != 0.0 {
                     max_delta = select_max(delta.abs(), max_delta);
-                    for (off, bi) in [(0usize, row.body_a), (3, row.body_b)] {
-                        let b = &mut bodies[bi];
-                        if b.is_dynamic() {
-                            b.vel.x += b.inv_mass * j[off] * delta;
-                            b.vel.y += b.inv_mass * j[off + 1] * delta;
-                            b.omega += b.inv_inertia * j[off + 2] * delta;
-                        }
-                    }
+                    apply_row(&j, row, bodies, delta);
                 }
             }
             if max_delta < 1e-9 {
                 converged = true;
                 break;
             }
+        }
+        self.budget.row_updates += (sweeps * n) as u64;
+        if !converged {
+            self.budget.phases_cut += 1;
         }
         LcpReport {
             n,
@@ -653,6 +755,19 @@ impl Totals {
         match self {
             Totals::Summed => bodies.iter().map(Body::kinetic_energy).sum(),
             Totals::Skipped => 0.0,
+        }
+    }
+}
+
+/// Applies the impulse `p` (N·s) of `row` (Jacobian `j`) to its dynamic bodies: `Δu = M⁻¹·G_iᵀ·p`.
+#[inline]
+fn apply_row(j: &[f64; 6], row: &ImpactRow, bodies: &mut [Body], p: f64) {
+    for (off, bi) in [(0usize, row.body_a), (3, row.body_b)] {
+        let b = &mut bodies[bi];
+        if b.is_dynamic() {
+            b.vel.x += b.inv_mass * j[off] * p;
+            b.vel.y += b.inv_mass * j[off + 1] * p;
+            b.omega += b.inv_inertia * j[off + 2] * p;
         }
     }
 }

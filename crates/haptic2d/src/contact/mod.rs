@@ -17,7 +17,7 @@ mod test_pile;
 pub use god_object::entry_point;
 pub use impact_friction::{default_impact_mu, ImpactFriction};
 pub use manager::{ContactSet, PastPoses, Wrench2};
-pub use params::ContactParams;
+pub use params::{ContactParams, DEFAULT_IMPACT_SWEEPS};
 pub use record::{
     ContactEvent, ContactState, EventKind, LawState, Loaded, LoadedContact, VeContact, NO_LAW,
 };

@@ -34,7 +34,21 @@ pub struct ContactParams {
     /// paper's §7.2 step 4 (the §5.9 law acts on the whole remaining penetration from the impact
     /// sample on; the Fig. 4 2-D reproduction uses it, as its 1-D harness does).
     pub impact_surface_offset: bool,
+    /// Work budget of an impact sample (docs/MODELS.md §7.7): the sweeps each projected
+    /// Gauss–Seidel phase (compression, plastic correction) of a large island (more than
+    /// `DENSE_MAX_ROWS` = 24 rows: the sparse path) may run, 1 to 200. A phase that runs out
+    /// stops where it is (it has only removed kinetic energy) and the island's restitution is
+    /// scaled so that the impact cannot create energy. Default [`DEFAULT_IMPACT_SWEEPS`]; 200 is
+    /// the limit of §7.3 (before issue 42's budget).
+    pub impact_sweeps: u32,
 }
+
+/// Default sweep budget of a large island's impact phases (§7.7): the two phases together get
+/// the chain damper's default of 16 sweeps, so an impact sample's solve costs about `2 × 8` row
+/// updates per contact record of the island (at most `3 × 8` where the energy check fires).
+/// Measured on a landing pile:1000 (docs/PERFORMANCE.md): worst 1 % of landing steps 6.0× the
+/// settled median at 8, 7.1× at 16, 9.4–10.2× at 32, 30–34× at 200; 4 gains nothing over 8.
+pub const DEFAULT_IMPACT_SWEEPS: u32 = 8;
 
 impl Default for ContactParams {
     fn default() -> Self {
@@ -50,6 +64,7 @@ impl Default for ContactParams {
             impact_friction: super::ImpactFriction::None,
             impact_mu: None,
             impact_surface_offset: true,
+            impact_sweeps: DEFAULT_IMPACT_SWEEPS,
         }
     }
 }

@@ -89,6 +89,8 @@ pub struct ContactSection {
     /// detection depth and the struck contacts carry the impact sample's loads (default true since
     /// issue 35, docs/MODELS.md §7.6; false = §7.2 step 4 as written).
     pub impact_surface_offset: Option<bool>,
+    /// Sweep budget of a large island's impact phases, 1 to 200 (default 8; docs/MODELS.md §7.7).
+    pub impact_sweeps: Option<u32>,
 }
 
 /// `[[body]]`.

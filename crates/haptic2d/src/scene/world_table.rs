@@ -193,5 +193,15 @@ pub(super) fn contact_params(
     if let Some(on) = c.impact_surface_offset {
         cp.impact_surface_offset = on;
     }
+    if let Some(n) = c.impact_sweeps {
+        if !(1..=200).contains(&n) {
+            errs.push(SceneError::new(
+                "contact.impact_sweeps",
+                format!("must be in [1, 200], got {n}"),
+                "e.g. impact_sweeps = 32",
+            ));
+        }
+        cp.impact_sweeps = n.clamp(1, 200);
+    }
     cp
 }

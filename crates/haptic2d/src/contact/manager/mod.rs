@@ -263,6 +263,12 @@ impl ContactSet {
         self.solver.energy_fallbacks()
     }
 
+    /// What the impact solver's work budget did so far (docs/MODELS.md §7.7): row updates of
+    /// large islands, phases the budget cut short, islands whose restitution it scaled.
+    pub fn impact_budget(&self) -> crate::contact::impact::BudgetCounters {
+        self.solver.budget_counters()
+    }
+
     /// Energy stored in all contact and friction springs after the last step (J).
     pub fn stored_energy(&self) -> f64 {
         self.stored
@@ -342,6 +348,8 @@ impl ContactSet {
             let mu = (self.params.impact_mu)
                 .unwrap_or_else(|| crate::contact::default_impact_mu(friction));
             self.solver.set_friction(self.params.impact_friction, mu);
+            self.solver
+                .set_sweep_budget(self.params.impact_sweeps as usize);
             self.resolve_impacts(tick, bodies);
         }
         lap.charge(times, Stage::ContactEvents);
