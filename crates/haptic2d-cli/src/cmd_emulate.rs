@@ -30,7 +30,11 @@ use std::time::Duration;
 
 /// `haptic2d emulate haply|inverse3`.
 #[derive(clap::Args, Debug)]
-#[command(subcommand_required = true, arg_required_else_help = true)]
+#[command(
+    subcommand_required = true,
+    arg_required_else_help = true,
+    subcommand_value_name = "haply|inverse3"
+)]
 pub struct EmulateArgs {
     /// Which emulator.
     #[command(subcommand)]
