@@ -405,3 +405,53 @@ fn a_lost_device_is_not_a_clean_run() {
     .is_none());
     assert!(verdict(None, "", "SCHED_FIFO 70").is_some());
 }
+
+/// Issue 39 item 4: a stand-in device the kernel refuses real-time priority (here: without
+/// `CAP_SYS_NICE`, dropped with util-linux's `setpriv`) says so, says how to get it, and runs
+/// anyway — the Haply emulator and the Python reference device alike.
+#[test]
+fn a_device_refused_real_time_priority_says_how_to_get_it_and_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let drop_nice = ["--bounding-set=-sys_nice", "--inh-caps=-sys_nice"];
+    let py = root()
+        .join("devices/udp/sim_device.py")
+        .display()
+        .to_string();
+    let bin = env!("CARGO_BIN_EXE_haptic2d");
+    let cases: [(&[&str], &str, &str); 2] = [
+        (
+            &[bin, "emulate", "haply", "--duration", "0.3"],
+            "pty: ",
+            "chrt -f 70",
+        ),
+        (
+            &["python3", &py, "--bind", "127.0.0.1:0", "--duration", "0.3"],
+            "listening on ",
+            "chrt -f 70 python3",
+        ),
+    ];
+    for (cmd, first, fix) in cases {
+        let o = Command::new("setpriv")
+            .args(drop_nice)
+            .args(cmd)
+            .current_dir(dir.path())
+            .output()
+            .unwrap_or_else(|e| {
+                panic!("setpriv: {e} (this test needs util-linux: apt-get install util-linux)")
+            });
+        let (out, err) = (
+            String::from_utf8_lossy(&o.stdout),
+            String::from_utf8_lossy(&o.stderr),
+        );
+        assert!(o.status.success(), "{cmd:?}: {out}\n{err}");
+        assert!(out.starts_with(first), "{cmd:?}: {out}");
+        assert!(
+            err.contains("without real-time priority") && err.contains(fix),
+            "{cmd:?}: {err}"
+        );
+        assert!(
+            err.contains("ulimit -r 70") && err.contains("lost device"),
+            "{err}"
+        );
+    }
+}
