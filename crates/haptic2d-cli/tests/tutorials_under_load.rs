@@ -26,6 +26,9 @@ use std::time::{Duration, Instant};
 const RUNS: usize = 10;
 /// `--duration` of each run (s), instead of the docs' 3.
 const DURATION: &str = "1.5";
+/// Runs of one tutorial that may be run again because the whole (virtual) machine stopped: the
+/// host's own time stalled while its hypervisor took at least 20 ms of CPU away (`/proc/stat`).
+const MAX_STOLEN: usize = 3;
 
 /// Two threads that burn a core each until dropped (normal priority, like a compiler or a game).
 struct Burners {
@@ -241,38 +244,50 @@ fn tutorial(name: &str, mut start: impl FnMut(&Path) -> (Device, Vec<String>)) {
     let t0 = Instant::now();
     let mut failures = Vec::new();
     let mut worst = String::new();
+    let mut stolen = Vec::new();
     for run in 0..RUNS {
-        let steal0 = steal_ms();
-        let (device, host) = start(dir.path());
-        let child = command(&host, dir.path())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap();
-        let ended = wait_with_limit(child, Duration::from_secs(30));
-        let (status, out) = match ended {
-            Some((s, o)) => (Some(s), o),
-            None => (None, String::new()),
-        };
-        if let Some(l) = out.lines().find(|l| l.trim_start().starts_with("compute")) {
-            worst = format!("run {run}: {}", l.trim());
+        loop {
+            let steal0 = steal_ms();
+            let (device, host) = start(dir.path());
+            let child = command(&host, dir.path())
+                .stdout(Stdio::piped())
+                .stderr(Stdio::piped())
+                .spawn()
+                .unwrap();
+            let ended = wait_with_limit(child, Duration::from_secs(30));
+            let (status, out) = match ended {
+                Some((s, o)) => (Some(s), o),
+                None => (None, String::new()),
+            };
+            if let Some(l) = out.lines().find(|l| l.trim_start().starts_with("compute")) {
+                worst = format!("run {run}: {}", l.trim());
+            }
+            let verdict = verdict(status, &out, &device.stderr());
+            drop(device);
+            let Some(f) = verdict else { break };
+            // Time the hypervisor took this virtual machine's CPUs away during the run.
+            let steal = steal_ms().zip(steal0).map(|(b, a)| b.saturating_sub(a));
+            let shown = steal.map_or("unknown".into(), |ms| format!("{ms} ms"));
+            let f = format!("run {run} (CPU steal during the run: {shown}): {f}");
+            // A stall of the host's own time while the hypervisor took at least the stall floor
+            // (20 ms) of CPU away is the whole machine stopping, which the stall check rightly
+            // trips on and no default can hold through: run again, at most MAX_STOLEN times in
+            // all, each one shown. Anything else fails the test.
+            let host_late = f.contains("the host was late") || f.contains("The host was late");
+            if host_late && steal.is_some_and(|ms| ms >= 20) && stolen.len() < MAX_STOLEN {
+                eprintln!("{name}: run again after a stall of the whole machine: {f}");
+                stolen.push(f);
+                continue;
+            }
+            failures.push(f);
+            break;
         }
-        if let Some(f) = verdict(status, &out, &device.stderr()) {
-            // For the reader of a failure: time the hypervisor took this virtual machine's CPUs
-            // away during the run (a stall nothing inside the machine can prevent).
-            let steal = steal_ms().zip(steal0).map_or("unknown".into(), |(b, a)| {
-                format!("{} ms", b.saturating_sub(a))
-            });
-            failures.push(format!(
-                "run {run} (CPU steal during the run: {steal}): {f}"
-            ));
-        }
-        drop(device);
     }
     eprintln!(
-        "{name}: {} of {RUNS} runs clean beside 2 busy threads in {:.1} s (last {worst})",
+        "{name}: {} of {RUNS} runs clean beside 2 busy threads in {:.1} s, {} run again after a stall of the whole machine (last {worst})",
         RUNS - failures.len(),
-        t0.elapsed().as_secs_f64()
+        t0.elapsed().as_secs_f64(),
+        stolen.len()
     );
     assert!(
         failures.is_empty(),
