@@ -6,6 +6,7 @@
  *   cc -O2 -o sim_device devices/udp/sim_device.c -lm
  *   ./sim_device --self-test                       # SHA-256 / HMAC test vectors, exit 0 if right
  *   ./sim_device --bind 127.0.0.1:5005 --key-file udp.key [--pose] [--duration S]
+ *                [--rt-priority 70 | --no-rt]
  *   haptic2d run --device udp:127.0.0.1:5005 --device-file my-device.toml --headless --duration 3
  *
  * With --key-file (hex or raw key bytes, mode 600; the host's protocol.key_file) it speaks
@@ -20,6 +21,12 @@
  * one state. On a microcontroller keep pack/unpack and serve(); replace plant_step() and the
  * sampling with your encoders and motor drivers. The first stdout line is
  * `listening on ADDR:PORT`.
+ *
+ * Real-time priority: on a host computer the device shares the cores with everything else, and at
+ * normal priority a loaded machine delays its answers past the host's timeout (a lost device, exit
+ * 4). It asks for SCHED_FIFO 70 (--rt-priority P; the host's loop has 80) and locked memory; when
+ * the kernel refuses it says so and how to get it, and runs anyway (--no-rt: do not ask).
+ * A microcontroller has no other program to wait for: drop realtime() there.
  */
 #include <arpa/inet.h>
 #include <math.h>
@@ -33,6 +40,8 @@
 #include <sys/time.h>
 #include <time.h>
 #include <fcntl.h>
+#include <sched.h>
+#include <sys/mman.h>
 #include <unistd.h>
 
 /* ---- SHA-256 (FIPS 180-4) and HMAC-SHA256 (RFC 2104) ----------------------------------- */
@@ -387,24 +396,56 @@ static int receive2(int fd, const uint8_t *b, long n, const struct sockaddr *pee
     return 1;
 }
 
+/* SCHED_FIFO `prio` and locked memory for this process; prints what it got on stderr, and how to
+ * get it when refused. */
+static void realtime(int prio) {
+    if (prio <= 0) {
+        fprintf(stderr, "sim_device: normal priority (--no-rt): on a loaded machine its answers come "
+                        "late and the host may stop with a lost device\n");
+        return;
+    }
+    struct sched_param sp = {0};
+    sp.sched_priority = prio;
+    if (sched_setscheduler(0, SCHED_FIFO, &sp) != 0) {
+        fprintf(stderr,
+                "warning: sim_device runs without real-time priority (SCHED_FIFO %d refused: needs "
+                "CAP_SYS_NICE or `ulimit -r %d`): on a loaded machine its answers come late and the "
+                "host may stop with a lost device (exit 4)\n    fix: run it as root, or `sudo setcap "
+                "cap_sys_nice,cap_ipc_lock+ep ./sim_device`, or raise the rtprio limit (`ulimit -r "
+                "%d`), or start it with `sudo chrt -f %d ./sim_device ...`\n",
+                prio, prio, prio, prio);
+        return;
+    }
+    int locked = mlockall(MCL_CURRENT | MCL_FUTURE) == 0;
+    fprintf(stderr, "sim_device: real-time priority SCHED_FIFO %d%s\n", prio,
+            locked ? ", memory locked" : " (memory not locked)");
+}
+
 int main(int argc, char **argv) {
     const char *bind_arg = "127.0.0.1:5005";
     const char *key_file = NULL;
     FILE *trace = NULL;
-    int pose = 0;
+    int pose = 0, rt_prio = 70;
     double duration = 0, watchdog_s = 0.1;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--bind") && i + 1 < argc) bind_arg = argv[++i];
         else if (!strcmp(argv[i], "--pose")) pose = 1;
         else if (!strcmp(argv[i], "--duration") && i + 1 < argc) duration = atof(argv[++i]);
         else if (!strcmp(argv[i], "--key-file") && i + 1 < argc) key_file = argv[++i];
+        else if (!strcmp(argv[i], "--rt-priority") && i + 1 < argc) {
+            rt_prio = atoi(argv[++i]);
+            if (rt_prio < 1 || rt_prio > 99) {
+                fprintf(stderr, "error: --rt-priority %s: expected 1-99 (default 70)\n", argv[i]);
+                return 2;
+            }
+        } else if (!strcmp(argv[i], "--no-rt")) rt_prio = 0;
         else if (!strcmp(argv[i], "--trace") && i + 1 < argc) {
             trace = fopen(argv[++i], "w");
             if (!trace) { perror(argv[i]); return 1; }
         } else if (!strcmp(argv[i], "--self-test")) return self_test();
         else {
             fprintf(stderr, "usage: %s [--bind ADDR:PORT] [--key-file KEY] [--pose] [--duration S] "
-                            "[--trace FILE] | --self-test\n", argv[0]);
+                            "[--rt-priority P | --no-rt] [--trace FILE] | --self-test\n", argv[0]);
             return 2;
         }
     }
@@ -438,6 +479,7 @@ int main(int argc, char **argv) {
         perror("error: bind");
         return 1;
     }
+    realtime(rt_prio);
     socklen_t alen = sizeof a;
     getsockname(fd, (struct sockaddr *)&a, &alen);
     char shown[64];

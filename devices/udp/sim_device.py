@@ -20,9 +20,16 @@ push. Commands are joint torques (tau = J^T f, so f = J^-T tau) or a wrench; the
 (zero-order hold) until the next command. The device answers every command with one state: joint
 angles (or the pose with --pose), joint rates, status. Its own watchdog zeroes the motors when no
 command arrives for --watchdog-ms; the first line on stdout is `listening on ADDR:PORT`.
+
+Real-time priority: on a host computer the device shares the cores with everything else, and at
+normal priority a loaded machine delays its answers past the host's timeout (a lost device, exit 4).
+It asks for SCHED_FIFO 70 (--rt-priority P; the host's loop has 80) and locked memory; when the
+kernel refuses it says so and how to get it, and runs anyway (--no-rt: do not ask).
 """
 
 import argparse
+import ctypes
+import ctypes.util
 import hashlib
 import hmac
 import ipaddress
@@ -291,6 +298,36 @@ def serve(args):
             print(f"applied {command[0]:.6f} {command[1]:.6f}", file=args.trace, flush=True)
 
 
+def realtime(prio):
+    """SCHED_FIFO `prio` and locked memory for this process; says on stderr what it got, and how to
+    get it when the kernel refuses (0: normal priority, on purpose)."""
+    if prio <= 0:
+        print("sim_device.py: normal priority (--no-rt): on a loaded machine its answers come late "
+              "and the host may stop with a lost device", file=sys.stderr, flush=True)
+        return
+    try:
+        os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(prio))
+    except (OSError, AttributeError) as e:
+        print(f"warning: sim_device.py runs without real-time priority (SCHED_FIFO {prio} refused: "
+              f"{e}): on a loaded machine its answers come late and the host may stop with a lost "
+              f"device (exit 4)\n    fix: run it as root, or raise the rtprio limit "
+              f"(`ulimit -r {prio}`; `@audio - rtprio 95` in /etc/security/limits.conf), or start "
+              f"it with `sudo chrt -f {prio} python3 {sys.argv[0]} ...`",
+              file=sys.stderr, flush=True)
+        return
+    libc = ctypes.CDLL(ctypes.util.find_library("c"), use_errno=True)
+    locked = libc.mlockall(3) == 0  # MCL_CURRENT | MCL_FUTURE
+    print(f"sim_device.py: real-time priority SCHED_FIFO {prio}"
+          f"{', memory locked' if locked else ' (memory not locked)'}", file=sys.stderr, flush=True)
+
+
+def priority(text):
+    p = int(text)
+    if not 1 <= p <= 99:
+        raise argparse.ArgumentTypeError(f"{text}: expected 1-99 (default 70)")
+    return p
+
+
 def pair(text):
     a, b = text.split(",")
     return float(a), float(b)
@@ -316,9 +353,13 @@ def main():
     p.add_argument("--duration", type=float, default=None, help="exit after (s)")
     p.add_argument("--key-file", default=None,
                    help="protocol v2: the shared key (hex or raw bytes, mode 600)")
+    p.add_argument("--rt-priority", type=priority, default=70, metavar="P",
+                   help="SCHED_FIFO priority 1-99 (default 70; the host's loop has 80)")
+    p.add_argument("--no-rt", action="store_true", help="normal priority (answers late under load)")
     p.add_argument("--trace", type=argparse.FileType("w"), default=None,
                    help="append each command the device acts on to this file (tests)")
     args = p.parse_args()
+    realtime(0 if args.no_rt else args.rt_priority)
     try:
         serve(args)
     except KeyboardInterrupt:

@@ -117,11 +117,13 @@ pub fn real_device(port: &str, device_file: Option<&Path>) -> Result<RealDevice,
     );
     let open_name = name.clone();
     let matcher = file.clone();
+    // The driver's own timeout (a pseudo-terminal's is longer: see PTY_MIN_TIMEOUT_PERIODS).
+    let wait_periods = haptic2d_devices::haply::driver::timeout_periods_for(&file, &name);
     Ok(RealDevice {
         name,
         model,
         summary,
-        wait_periods: file.timeout_periods,
+        wait_periods,
         max_missed_run: file.max_missed_deadlines,
         max_stall_periods: file.max_stall_periods,
         safety: file.safety,

@@ -82,8 +82,8 @@ enum Command {
     },
     /// List the built-in scenes.
     Scenes,
-    /// A stand-in device on a pseudo-terminal, speaking the real protocol: `emulate haply` (first
-    /// stdout line `pty: PATH`; then `run --device haply:PATH`).
+    /// A stand-in device speaking the real protocol, at real-time priority: `emulate haply` (a Haply
+    /// board on a pseudo-terminal) or `emulate inverse3` (Haply's Inverse Service on loopback).
     #[command(after_help = examples_help(EMULATE_EXAMPLES))]
     Emulate(cmd_emulate::EmulateArgs),
     /// List the serial ports with their USB ids (Haply boards marked).
@@ -200,12 +200,8 @@ const EMULATE_EXAMPLES: &[Example] = &[
         "haptic2d emulate haply --device-file devices/haply-2diy-gen3.toml",
     ),
     (
-        "A 2-port M0 board, a hand pushing 1 N along x, for 30 s",
-        "haptic2d emulate haply --board m0 --hand constant:1,0,0 --duration 30",
-    ),
-    (
-        "The twin-pantograph Haply rig (four motors on an M3 board)",
-        "haptic2d emulate haply --device-file devices/haply-twin.toml",
+        "The twin-pantograph Haply rig for 30 s, at normal priority",
+        "haptic2d emulate haply --device-file haply-twin --duration 30 --no-rt",
     ),
     (
         "An Inverse3 service on a free loopback port (a build with --features inverse3)",
@@ -346,10 +342,12 @@ mod cli_tests {
     /// Every example in a `--help` is accepted by the parser, as the subcommand it documents.
     #[test]
     fn every_example_parses() {
-        let lists: [(&str, &[Example]); 6] = [
+        let lists: [(&str, &[Example]); 8] = [
             ("run", RUN_EXAMPLES),
             ("simulate", SIMULATE_EXAMPLES),
             ("emulate", EMULATE_EXAMPLES),
+            ("emulate", cmd_emulate::HAPLY_EXAMPLES),
+            ("emulate", cmd_emulate::INVERSE3_EXAMPLES),
             ("log", LOG_EXAMPLES),
             ("reproduce", REPRODUCE_EXAMPLES),
             ("stability", STABILITY_EXAMPLES),
@@ -375,5 +373,10 @@ mod cli_tests {
     fn a_misspelt_example_is_refused() {
         assert!(Cli::try_parse_from(["haptic2d", "run", "--headles"]).is_err());
         assert!(Cli::try_parse_from(["haptic2d", "log", "info"]).is_err());
+        // Each emulator has only its own options.
+        assert!(
+            Cli::try_parse_from(["haptic2d", "emulate", "haply", "--bind", "127.0.0.1:0"]).is_err()
+        );
+        assert!(Cli::try_parse_from(["haptic2d", "emulate", "inverse3", "--board", "m0"]).is_err());
     }
 }

@@ -1,5 +1,5 @@
-//! Issue 39, item 7: every main command's `--help` ends with working examples and fits in 100
-//! columns. (`cli_tests::every_example_parses` in main.rs parses each example with the real
+//! Issue 39, item 7: every main command's `--help` (and each emulator's, `emulate haply|inverse3`)
+//! ends with working examples and fits in 100 columns. (`cli_tests::every_example_parses` in main.rs parses each example with the real
 //! parser; here each example printed in the help is run with `--help` appended, which clap refuses
 //! when an option before it is unknown or its value does not parse.)
 
@@ -12,15 +12,21 @@ const MAX_COLUMNS: usize = 100;
 
 #[test]
 fn every_command_help_has_examples_that_parse() {
-    for cmd in [
-        "run",
-        "simulate",
-        "emulate",
-        "log",
-        "reproduce",
-        "stability",
-    ] {
-        let o = haptic2d(&[cmd, "--help"]);
+    let screens: [&[&str]; 8] = [
+        &["run"],
+        &["simulate"],
+        &["emulate"],
+        &["emulate", "haply"],
+        &["emulate", "inverse3"],
+        &["log"],
+        &["reproduce"],
+        &["stability"],
+    ];
+    for words in screens {
+        let cmd = words.join(" ");
+        let mut help_args = words.to_vec();
+        help_args.push("--help");
+        let o = haptic2d(&help_args);
         let help = text(&o);
         assert!(o.status.success(), "{cmd} --help:\n{help}");
         for line in help.lines() {
@@ -45,7 +51,7 @@ fn every_command_help_has_examples_that_parse() {
         );
         for line in lines {
             let mut args: Vec<&str> = line.split_whitespace().skip(1).collect();
-            assert_eq!(args[0], cmd, "{line}");
+            assert_eq!(args[..words.len()], words[..], "{line}");
             args.push("--help");
             let o = haptic2d(&args);
             assert!(o.status.success(), "{line} --help:\n{}", text(&o));
@@ -53,11 +59,29 @@ fn every_command_help_has_examples_that_parse() {
     }
 }
 
-/// The check above can fail: an unknown option before `--help` is refused.
+/// The check above can fail: an unknown option before `--help` is refused, also one that belongs
+/// to the other emulator.
 #[test]
 fn an_unknown_option_before_help_is_refused() {
     let o = haptic2d(&["run", "--headles", "--help"]);
     assert!(!o.status.success(), "{}", text(&o));
+    let o = haptic2d(&["emulate", "haply", "--bind", "127.0.0.1:0", "--help"]);
+    assert!(!o.status.success(), "{}", text(&o));
+}
+
+/// Issue 39 item 7: `emulate` names its two emulators; an unknown one is refused (exit 2) with
+/// the subcommands listed.
+#[test]
+fn emulate_without_a_known_emulator_lists_haply_and_inverse3() {
+    for args in [&["emulate"][..], &["emulate", "foo"]] {
+        let o = haptic2d(args);
+        let t = text(&o);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {t}");
+        assert!(
+            t.contains("haply") && t.contains("inverse3"),
+            "{args:?}: {t}"
+        );
+    }
 }
 
 /// Every other help screen fits in the same width (the top level carries the exit codes).

@@ -229,6 +229,13 @@ fn a_silent_device_is_lost_within_the_timeout() {
         panic!("{err}")
     };
     assert!(m.contains("no state for") && m.contains("timeout"), "{m}");
+    // On loopback the device is a program on this machine: no network to check, its priority is
+    // (issue 39 item 4).
+    assert!(
+        m.contains("program on this machine") && m.contains("real-time priority"),
+        "{m}"
+    );
+    assert!(!m.contains("network between"), "{m}");
     // Lost within timeout_periods (3) plus a tick of the last answered command.
     assert!((98..=104).contains(&ticks), "{ticks} ticks");
     assert!(dev.read_encoders().is_err(), "stays lost");

@@ -48,10 +48,36 @@ pub struct RtRequest {
 impl Default for RtRequest {
     fn default() -> Self {
         Self {
-            fifo_priority: Some(80),
+            fifo_priority: Some(LOOP_FIFO_PRIORITY),
             lock_memory: true,
             prefault_stack_bytes: 256 * 1024,
             pin: CorePin::Last,
+        }
+    }
+}
+
+/// `SCHED_FIFO` priority of the haptic loop (`haptic2d run`): 80.
+pub const LOOP_FIFO_PRIORITY: i32 = 80;
+
+/// `SCHED_FIFO` priority of a stand-in device (`haptic2d emulate …`, the UDP reference devices):
+/// 70. A real device has a CPU of its own; its stand-in shares the host's cores, and at normal
+/// priority an ordinary loaded desktop delays its answers by tens of milliseconds, which the host
+/// rightly reads as a late device (issue 39 item 4: at load average 14 on a 2-core machine, 4 of 4
+/// runs against the Haply emulator at normal priority lost the device, 0 of 4 with it at
+/// `SCHED_FIFO` 70). Below the loop's [`LOOP_FIFO_PRIORITY`], so that the stand-in never delays
+/// the loop it serves; not pinned, so that it runs on whichever core the loop leaves free.
+pub const DEVICE_FIFO_PRIORITY: i32 = 70;
+
+impl RtRequest {
+    /// What a stand-in device asks for: `SCHED_FIFO` at `priority` (default
+    /// [`DEVICE_FIFO_PRIORITY`]), memory locked, no pinning. Threads the caller starts afterwards
+    /// inherit the scheduling policy (Linux's default `PTHREAD_INHERIT_SCHED`).
+    pub fn device(priority: i32) -> Self {
+        Self {
+            fifo_priority: Some(priority),
+            lock_memory: true,
+            prefault_stack_bytes: 64 * 1024,
+            pin: CorePin::None,
         }
     }
 }
@@ -139,6 +165,23 @@ impl RtReport {
             "note: real-time setup incomplete, running best-effort with more jitter: {}",
             parts.join("; ")
         ))
+    }
+}
+
+impl RtReport {
+    /// The line a stand-in device (`program`, e.g. `haptic2d emulate haply`) prints at start: its
+    /// real-time status, and when `SCHED_FIFO` was refused, what the refusal means for the host and
+    /// the three ways to get it (the capability, an rtprio limit, or `chrt`).
+    pub fn device_note(&self, program: &str, priority: i32) -> String {
+        match &self.scheduler {
+            StepStatus::Applied(s) => format!("{program}: real-time priority {s}"),
+            StepStatus::Skipped => format!(
+                "{program}: normal priority (--no-rt): on a loaded machine its answers come late and the host may stop with a lost device"
+            ),
+            s => format!(
+                "warning: {program} runs without real-time priority (SCHED_FIFO {priority} {s}): on a loaded machine its answers come late and the host may stop with a lost device (exit 4)\n    fix: run it as root, or `sudo setcap cap_sys_nice,cap_ipc_lock+ep BINARY`, or raise the rtprio limit (`ulimit -r {priority}`; `@audio - rtprio 95` in /etc/security/limits.conf), or start it with `sudo chrt -f {priority} …`"
+            ),
+        }
     }
 }
 
@@ -275,6 +318,37 @@ mod tests {
     #[test]
     fn out_of_range_priority_is_reported_not_panicking() {
         assert!(set_fifo_priority(1000).is_degraded());
+    }
+
+    #[test]
+    fn device_note_says_how_to_get_real_time_priority_when_refused() {
+        let refused = RtReport {
+            scheduler: StepStatus::NotPermitted("needs CAP_SYS_NICE".into()),
+            ..RtReport::skipped()
+        };
+        let n = refused.device_note("haptic2d emulate haply", 70);
+        assert!(n.starts_with("warning:"), "{n}");
+        assert!(
+            n.contains("lost device") && n.contains("chrt -f 70") && n.contains("ulimit -r 70")
+        );
+        let applied = RtReport {
+            scheduler: StepStatus::Applied("SCHED_FIFO 70".into()),
+            ..RtReport::skipped()
+        };
+        let n = applied.device_note("sim", 70);
+        assert!(!n.contains("warning") && n.contains("SCHED_FIFO 70"), "{n}");
+        assert!(RtReport::skipped()
+            .device_note("sim", 70)
+            .contains("normal priority"));
+    }
+
+    #[test]
+    fn device_request_is_below_the_loop_and_unpinned() {
+        const { assert!(DEVICE_FIFO_PRIORITY < LOOP_FIFO_PRIORITY) };
+        let r = RtRequest::device(DEVICE_FIFO_PRIORITY);
+        assert_eq!(r.fifo_priority, Some(70));
+        assert_eq!(r.pin, CorePin::None);
+        assert_eq!(RtRequest::default().fifo_priority, Some(80));
     }
 
     #[test]

@@ -213,7 +213,7 @@ impl fmt::Display for Fault {
             ),
             FaultKind::Stall { periods, limit } => write!(
                 f,
-                "the loop stalled: this tick came {periods:.1} periods after the previous one on the host's own account (limit {limit:.1}; the wait for the device is not counted): the host was late and the device held its torques unsupervised; the machine is overloaded or the loop thread was stopped (give it real-time priority, close other programs, lower --rate, or raise max_stall_periods in the device file)"
+                "the loop stalled: this tick came {periods:.1} periods after the previous one on the host's own account (limit {limit:.1}; the wait for the device is not counted): the host was late, not the device, and the device held its torques unsupervised. Without real-time priority (see the summary's `real-time:` line) the machine is overloaded: run as root or raise the rtprio limit (`ulimit -r 80`), close other programs or lower --rate. With it, something stopped the loop thread: a debugger or SIGSTOP, a higher-priority real-time task, or a virtual machine whose CPU its host took away (a SCHED_FIFO thread on this project's loaded 2-core VM woke up to 9 ms late). Raise max_stall_periods in the device file only for a device that is safe to leave holding its torque that long"
             ),
             FaultKind::MissedDeadlines { run, limit } => write!(
                 f,
@@ -339,5 +339,33 @@ impl Watchdog {
     pub fn reset(&mut self) {
         self.latched = None;
         self.missed_run = 0;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Issue 39 item 4: a stall of the loop's own time says the host was late, not the device, and
+    /// what to do with and without real-time priority.
+    #[test]
+    fn a_stall_message_says_the_host_was_late_and_what_to_do_with_and_without_real_time() {
+        let mut dog = Watchdog::new(WatchdogConfig::default()).unwrap();
+        let mut tau = [0.1; 4];
+        let input = SafetyInput {
+            elapsed_periods: 101.8,
+            ..SafetyInput::nominal(7)
+        };
+        let f = dog.guard(&input, &mut tau).unwrap_err();
+        assert_eq!(tau, [0.0; 4]);
+        let m = f.to_string();
+        assert!(
+            m.contains("101.8 periods") && m.contains("the host was late, not the device"),
+            "{m}"
+        );
+        assert!(
+            m.contains("ulimit -r 80") && m.contains("virtual machine"),
+            "{m}"
+        );
     }
 }

@@ -42,6 +42,32 @@ pub const IDENTIFY_WAIT: Duration = Duration::from_millis(100);
 /// The warning for a board without a watchdog (the stock firmware), printed once at start.
 pub const NO_WATCHDOG_WARNING: &str = "this board's firmware has no watchdog: if haptic2d dies, the motors keep the last torque; flash haptic2d's firmware, see docs/FIRMWARE.md";
 
+/// The shortest reply timeout on a pseudo-terminal (control periods; 100 ms at 1 kHz), whatever
+/// the device file says. A pseudo-terminal is an emulator (`haptic2d emulate haply`, or haptic2d's
+/// firmware built natively): it has no motor, and each reply crosses the kernel's tty worker twice
+/// (host → emulator, emulator → host), a kernel thread at normal priority that neither side's
+/// real-time priority lifts. On this project's 2-core VM under load (load average 13–15, two
+/// CPU-burning threads, both sides at `SCHED_FIFO`) replies took up to 46 ms, where the device
+/// file's 20 periods stopped 2 of 10 twin runs with a lost device (issue 39 item 4). A real board's
+/// serial port keeps the device file's timeout: there the timeout bounds how long its motors hold
+/// a stale torque.
+pub const PTY_MIN_TIMEOUT_PERIODS: f64 = 100.0;
+
+/// True when the port `name` (e.g. `haply:/dev/pts/3`) is a pseudo-terminal.
+pub fn is_pty(name: &str) -> bool {
+    name.contains("/dev/pts/")
+}
+
+/// The reply timeout (control periods) the driver uses on the port `name`: the device file's, and
+/// on a pseudo-terminal at least [`PTY_MIN_TIMEOUT_PERIODS`].
+pub fn timeout_periods_for(file: &HaplyDeviceFile, name: &str) -> f64 {
+    if is_pty(name) {
+        file.timeout_periods.max(PTY_MIN_TIMEOUT_PERIODS)
+    } else {
+        file.timeout_periods
+    }
+}
+
 /// A Haply board driven over `S` (a serial port, or a pseudo-terminal in tests).
 #[derive(Debug)]
 pub struct HaplyDevice<S: Read + Write> {
@@ -69,8 +95,8 @@ impl<S: Read + Write> HaplyDevice<S> {
         period: Duration,
         name: &str,
     ) -> Result<Self, String> {
-        let timeout = period.mul_f64(file.timeout_periods);
-        let pty = name.contains("/dev/pts/");
+        let timeout = period.mul_f64(timeout_periods_for(file, name));
+        let pty = is_pty(name);
         // The handshake may wait for a board that is still booting: allow at least 100 ms.
         let mut transport = Transport::from_stream(
             stream,
@@ -199,7 +225,7 @@ impl<S: Read + Write> HaplyDevice<S> {
         self.sent = [0.0; PORTS];
         let what = match (&e, self.pty) {
             (HaplyError::OutOfStep(_), _) => "a byte was lost or added on the line; haptic2d does not re-send the setup during a run (the firmware would re-zero its encoders wherever the handle is): check that no other program uses the port, then start again with the handle at the rest pose",
-            (_, true) => "this is an emulator on a pseudo-terminal (no USB cable): check that `haptic2d emulate haply` still runs; on a loaded machine raise board.timeout_periods",
+            (_, true) => "this is an emulator on a pseudo-terminal (no USB cable): its replies cross the kernel's tty worker twice, so its timeout is at least 100 periods; check that `haptic2d emulate haply` still runs and got real-time priority (its first line on standard error says), or raise board.timeout_periods above 100",
             (_, false) => "check the USB cable, the board's power supply and that the board still shows up in `haptic2d devices`",
         };
         let zero = if zeroed {
@@ -336,5 +362,34 @@ impl<S: Read + Write> DeviceIo for HaplyDevice<S> {
 impl<S: Read + Write> Drop for HaplyDevice<S> {
     fn drop(&mut self) {
         self.zero_torques();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn gen3() -> HaplyDeviceFile {
+        let text = include_str!("../../../../devices/haply-2diy-gen3.toml");
+        HaplyDeviceFile::from_toml(text, "haply-2diy-gen3").unwrap()
+    }
+
+    /// Issue 39 item 4: an emulator's replies cross the kernel's tty worker twice; on a pseudo-terminal
+    /// the reply timeout is at least 100 periods, on a serial port it stays the device file's.
+    #[test]
+    fn a_pseudo_terminal_waits_at_least_100_periods_a_serial_port_the_files_timeout() {
+        let f = gen3();
+        assert_eq!(
+            timeout_periods_for(&f, "haply:/dev/ttyACM0"),
+            f.timeout_periods
+        );
+        assert_eq!(
+            timeout_periods_for(&f, "haply:/dev/pts/3"),
+            PTY_MIN_TIMEOUT_PERIODS
+        );
+        let mut patient = gen3();
+        patient.timeout_periods = 500.0;
+        assert_eq!(timeout_periods_for(&patient, "haply:/dev/pts/3"), 500.0);
+        assert!(f.timeout_periods < PTY_MIN_TIMEOUT_PERIODS);
     }
 }

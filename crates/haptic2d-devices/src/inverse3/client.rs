@@ -74,6 +74,11 @@ pub fn spawn(
     let handle = std::thread::Builder::new()
         .name(thread_name)
         .spawn(move || {
+            // The device side of the host at real-time priority (below the loop's), inherited by
+            // the runtime's workers that receive the states: at normal priority a loaded machine
+            // delayed them past the timeout in 8 of 10 runs against the emulator (issue 39 item
+            // 4). Refused without privilege: then it runs at normal priority, as before.
+            let _ = haptic2d_rt::rt::set_fifo_priority(haptic2d_rt::rt::DEVICE_FIFO_PRIORITY);
             let rt = match tokio::runtime::Builder::new_multi_thread()
                 .worker_threads(2)
                 .enable_all()

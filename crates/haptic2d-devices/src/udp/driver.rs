@@ -41,6 +41,8 @@ pub struct UdpDevice {
     sent: [f32; 3],
     name: String,
     lost: bool,
+    /// The device listens on this machine (a program, e.g. a reference device), not on a network.
+    loopback: bool,
 }
 
 /// How long [`UdpDevice::open`] waits for the device's first state.
@@ -74,6 +76,7 @@ impl UdpDevice {
             sent: [0.0; 3],
             name: name.to_string(),
             lost: false,
+            loopback: addr.ip().is_loopback(),
         };
         let start = Instant::now();
         let io = |e: std::io::Error| format!("{name}: UDP error: {e}");
@@ -234,11 +237,16 @@ impl DeviceIo for UdpDevice {
             self.lost = true;
             self.valid = false;
             return Err(DeviceError::Lost(format!(
-                "UDP device {}: no state for {:.1} ms after a command (timeout {:.1} ms = protocol.timeout_periods); {}\n    check: that the device still runs and that the network between host and device is up",
+                "UDP device {}: no state for {:.1} ms after a command (timeout {:.1} ms = protocol.timeout_periods); {}\n    check: {}",
                 self.name,
                 silent_for.as_secs_f64() * 1e3,
                 self.timeout.as_secs_f64() * 1e3,
-                self.transport.counters()
+                self.transport.counters(),
+                if self.loopback {
+                    "the device is a program on this machine (loopback, no network): that it still runs, and that it has real-time priority (the reference devices say so on standard error; on a loaded machine one without it answers late)"
+                } else {
+                    "that the device still runs and that the network between host and device is up"
+                }
             )));
         }
         if let Some(s) = self.transport.latest().copied() {
