@@ -130,7 +130,7 @@ enum Command {
     Log(cmd_log::LogCmd),
     /// Perceptual studies (docs/STUDIES.md): `study run FILE --observer simulated`, `study analyse
     /// DIR`, `study check FILE`.
-    #[command(subcommand)]
+    #[command(subcommand, after_help = examples_help(STUDY_EXAMPLES))]
     Study(cmd_study::StudyCmd),
     /// Parameter sweeps; `walls`: stiffness × damping of every wall law, classified by energy gain.
     Sweep {
@@ -225,6 +225,25 @@ const LOG_EXAMPLES: &[Example] = &[
     (
         "A CSV tick log to MCAP",
         "haptic2d log convert ticks.csv ticks.mcap",
+    ),
+];
+
+const STUDY_EXAMPLES: &[Example] = &[
+    (
+        "Check a study file and explain every problem",
+        "haptic2d study check studies/stiffness-walls.toml",
+    ),
+    (
+        "Run a session on the simulated observer (a model, not data); it resumes if cut",
+        "haptic2d study run studies/stiffness-walls.toml --observer simulated --out study-data",
+    ),
+    (
+        "The same study for a second pseudonymous participant",
+        "haptic2d study run studies/stiffness-walls.toml --observer simulated --participant sim02",
+    ),
+    (
+        "Fit psychometric functions, JNDs and Weber fractions, with plots",
+        "haptic2d study analyse study-data/sub-sim01/ses-1",
     ),
 ];
 
@@ -342,7 +361,7 @@ mod cli_tests {
     /// Every example in a `--help` is accepted by the parser, as the subcommand it documents.
     #[test]
     fn every_example_parses() {
-        let lists: [(&str, &[Example]); 8] = [
+        let lists: [(&str, &[Example]); 9] = [
             ("run", RUN_EXAMPLES),
             ("simulate", SIMULATE_EXAMPLES),
             ("emulate", EMULATE_EXAMPLES),
@@ -351,6 +370,7 @@ mod cli_tests {
             ("log", LOG_EXAMPLES),
             ("reproduce", REPRODUCE_EXAMPLES),
             ("stability", STABILITY_EXAMPLES),
+            ("study", STUDY_EXAMPLES),
         ];
         for (cmd, examples) in lists {
             assert!(

@@ -12,7 +12,7 @@ const MAX_COLUMNS: usize = 100;
 
 #[test]
 fn every_command_help_has_examples_that_parse() {
-    let screens: [&[&str]; 8] = [
+    let screens: [&[&str]; 9] = [
         &["run"],
         &["simulate"],
         &["emulate"],
@@ -21,6 +21,7 @@ fn every_command_help_has_examples_that_parse() {
         &["log"],
         &["reproduce"],
         &["stability"],
+        &["study"],
     ];
     for words in screens {
         let cmd = words.join(" ");
@@ -87,7 +88,7 @@ fn emulate_without_a_known_emulator_lists_haply_and_inverse3() {
 /// Every other help screen fits in the same width (the top level carries the exit codes).
 #[test]
 fn every_other_help_fits_in_100_columns() {
-    let screens: [&[&str]; 8] = [
+    let screens: [&[&str]; 9] = [
         &[],
         &["check"],
         &["sweep"],
