@@ -93,3 +93,39 @@ fn unknown_scene_and_bad_options_fail_cleanly() {
     assert!(!o.status.success());
     assert!(!text(&o).contains("panicked"));
 }
+
+/// docs/SCENES.md quotes what `check` prints for bodies that start overlapping; the quote is the
+/// binary's own output for the scene it describes (walls and a box overlapping by 5 mm, in
+/// `my.toml`), so it cannot go stale.
+#[test]
+fn scenes_md_quotes_what_check_prints_for_overlapping_bodies() {
+    let doc = std::fs::read_to_string(common::root().join("docs/SCENES.md")).unwrap();
+    let section = doc
+        .split_once("## Bodies that start overlapping")
+        .expect("SCENES.md has the section")
+        .1;
+    let quoted = section
+        .split("```")
+        .nth(1)
+        .expect("the section quotes the output")
+        .trim_start_matches('\n')
+        .trim_end();
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("my.toml"),
+        "[[body]]\nname = \"walls\"\nkind = \"fixed\"\nbox = [1.0, 0.1]\nposition = [0.0, -0.05]\n\n\
+         [[body]]\nname = \"box\"\nbox = [0.1, 0.1]\nmass = 1.0\nposition = [0.0, 0.045]\n",
+    )
+    .unwrap();
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_haptic2d"))
+        .args(["check", "my.toml"])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        stderr.starts_with(quoted),
+        "SCENES.md quotes:\n{quoted}\ncheck prints:\n{stderr}"
+    );
+}
