@@ -232,7 +232,7 @@ impl ImpactSolver {
     }
 
     /// Sweeps each projected Gauss–Seidel phase of the sparse path (`n > DENSE_MAX_ROWS`) may run
-    /// at most (§7.7; at least 1, at most [`PGS_MAX_SWEEPS`]; default [`PGS_MAX_SWEEPS`]).
+    /// at most (§7.7; at least 1, at most `PGS_MAX_SWEEPS`; default `PGS_MAX_SWEEPS`).
     pub fn set_sweep_budget(&mut self, sweeps: usize) {
         self.sweep_budget = sweeps.clamp(1, PGS_MAX_SWEEPS);
     }
