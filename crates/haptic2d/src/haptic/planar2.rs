@@ -34,19 +34,21 @@
 //! handle wherever the user holds it). Never allocates, locks or does I/O in [`Planar2System::tick`].
 
 use crate::control::coupling::VirtualCoupling;
-use crate::control::four_channel::{FourChannel, TeleopSignals};
+use crate::control::four_channel::FourChannel;
 use crate::device::filter::VelocityFilter;
-use crate::device::pantograph2::{jt_mul, Pantograph2};
+use crate::device::pantograph2::Pantograph2;
 use crate::device::DeviceFault;
-use crate::geom::{cross, Vec2};
+use crate::geom::Vec2;
 use crate::world::World;
 
 use super::config::ControllerKind;
 use super::limit_cycle::LimitCycleMonitor;
 use super::plausibility::JointPlausibility;
-use super::record::{TickRecord, FLAG_NEAR_SINGULAR, FLAG_SAFETY, FLAG_SATURATED};
+use super::record::{TickRecord, FLAG_SAFETY};
 use super::safety::{Safety, SafetyConfig, SafetyReason, SafetyTrip};
 use super::workspace::{WorkspaceBound, WorkspaceSquare};
+
+mod steps;
 
 /// Natural frequency of the twist target's torsion spring on the slave (Hz), critically damped.
 pub const TWIST_TARGET_HZ: f64 = 5.0;
@@ -263,153 +265,22 @@ impl Planar2System {
     /// reply, `device_wait` (s; NaN = unknown), so that a stall says whether the host or the device
     /// was late. Never allocates.
     pub fn tick_timed(&mut self, q: &[f64; 2], elapsed: f64, device_wait: f64) -> Planar2Output {
-        let (k, t) = (self.world.tick(), self.world.time());
+        let t = self.world.time();
         let mut flags = 0u32;
-
-        // 0. Stall and joint plausibility: the shared safety layer, as in HapticSystem.
-        self.check_stall(elapsed, device_wait);
-        self.started = true;
-        if let Some(reason) = self.plausibility.check(q, elapsed) {
-            self.safety.trip(k, t, reason);
-        }
-
-        // 1–2. Handle point, Jacobian, margin; filtered velocity; device → world translation.
-        let st = match self.config.linkage.state(*q) {
-            Ok(s) => Some(s),
-            Err(f) => {
-                self.safety.trip(k, t, SafetyReason::Device(f));
-                None
-            }
-        };
-        let mut x_m = [f64::NAN; 3];
-        let mut v_m = [0.0; 3];
-        if let Some(s) = st {
-            let origin = *self.device_origin.get_or_insert(s.e);
-            let p = s.e - origin + self.world_origin;
-            let v = self.filter.update(&[p.x, p.y, 0.0]);
-            x_m = [p.x, p.y, 0.0];
-            v_m = [v[0], v[1], 0.0];
-            if s.margin < self.config.min_singularity_margin {
-                flags |= FLAG_NEAR_SINGULAR;
-                self.safety.trip(
-                    k,
-                    t,
-                    SafetyReason::Singularity {
-                        margin: s.margin,
-                        limit: self.config.min_singularity_margin,
-                    },
-                );
-            }
-        }
-
-        // 3–6. World contacts; slave state at the grasp point.
-        self.world.begin_step();
-        let body = &self.world.bodies[self.slave];
-        let (c, theta, omega) = (body.pose.pos, body.pose.angle, body.omega);
-        let r = rotate(theta, self.config.grasp);
-        let pg = c + r;
-        let vg = body.vel + omega * crate::geom::perp(r);
-        let cw = self.world.contact_wrench(self.slave);
-        x_m[2] = theta;
-        v_m[2] = omega;
-
-        // 7. Controller on x and y (θ channel sees no error: rotation is left to the world).
-        let (mut f_cm, mut f_cs) = ([0.0; 3], [0.0; 3]);
-        if st.is_some() && !self.safety.is_latched() {
-            let s = TeleopSignals {
-                x_m,
-                v_m,
-                f_h: [0.0; 3],
-                x_s: [pg.x, pg.y, theta],
-                v_s: [vg.x, vg.y, omega],
-                f_e: [-cw.force.x, -cw.force.y, 0.0],
-                master_mass: [[0.0; 3]; 3],
-            };
-            (f_cm, f_cs) = match &mut self.controller {
-                Controller2::FourChannel(c) => c.step(&s),
-                Controller2::Coupling(c) => c.step(&s),
-            };
-            f_cm[2] = 0.0;
-            f_cs[2] = 0.0;
-        }
-
-        // 8b. Workspace bound of the device file at the handle point (device frame; the device →
-        //     world map is a translation, so velocity and force are the same in both).
-        if let (Some(s), Some(w)) = (st, self.workspace.as_mut()) {
-            let x = [s.e.x, s.e.y, 0.0];
-            if let Some(reason) = w.apply(&x, &v_m, &mut f_cm) {
-                self.safety.trip(k, t, reason);
-            }
-            f_cm[2] = 0.0;
-        }
-
-        // 9. τ = Jᵀ f_cm, direction-preserving saturation, start-up ramp, safety gate.
-        let mut tau4 = [0.0; 4];
-        if let (Some(s), false) = (st, self.safety.is_latched()) {
-            let tau = jt_mul(&s.j, [f_cm[0], f_cm[1]]);
-            let mut scale: f64 = 1.0;
-            for (t, max) in tau.iter().zip(self.config.tau_max) {
-                if t.abs() > max {
-                    scale = scale.min(max / t.abs());
-                }
-            }
-            if scale < 1.0 {
-                flags |= FLAG_SATURATED;
-            }
-            let (t0, t1) = (tau[0] * scale, tau[1] * scale);
-            let tau_max = [self.config.tau_max[0], self.config.tau_max[1], 0.0, 0.0];
-            if let Some(reason) = self.limit_cycle.observe(&[t0, t1, 0.0, 0.0], &tau_max) {
-                self.safety.trip(k, t, reason);
-            }
-            let ramp = self.ramp();
-            tau4[0] = tau[0] * scale * ramp;
-            tau4[1] = tau[1] * scale * ramp;
-        }
-        if self.safety.gate(k, t, &mut tau4) {
-            flags |= FLAG_SAFETY;
+        self.supervise_input(q, elapsed, device_wait); // 0
+        let mut handle = self.sense(q, &mut flags); // 1–2
+        let slave = self.contact_stage(); // 3–6
+        handle.x_m[2] = slave.theta;
+        handle.v_m[2] = slave.omega;
+        let (mut f_cm, mut f_cs) = self.teleoperate(&handle, &slave); // 7
+        self.workspace_wall(&handle, &mut f_cm); // 8b
+        let (tau4, gated) = self.motor_torques(&handle, &f_cm, &mut flags); // 9
+        if gated {
             f_cs = [0.0; 3];
             f_cm = [0.0; 3];
-        } else if st.is_some() {
-            self.ramp_ticks = self.ramp_ticks.saturating_add(1);
         }
-
-        // 10. Slave drive at the grasp point (plus the twist target's torsion spring-damper, world
-        // side only), integration.
-        let f = Vec2::new(f_cs[0], f_cs[1]);
-        let twist = match self.twist_target {
-            Some(th) if !self.safety.is_latched() => {
-                let (k, b) = self.twist_gains;
-                k * (th - theta) - b * omega
-            }
-            _ => 0.0,
-        };
-        self.world.set_drive(self.slave, f, cross(r, f) + twist);
-        self.world.finish_step();
-
-        // 11. Record.
-        let body = &self.world.bodies[self.slave];
-        let ledger = self.world.ledger();
-        self.record = TickRecord {
-            t,
-            x_m,
-            v_m,
-            w_h: [0.0; 3],
-            x_s: [c.x, c.y, theta],
-            v_s: [body.vel.x, body.vel.y, body.omega],
-            f_cm,
-            f_cs,
-            f_e: [-cw.force.x, -cw.force.y, -cw.torque],
-            tau: tau4,
-            contacts: self.world.contacts().contact_count() as u32,
-            kinetic: ledger.kinetic,
-            stored: ledger.stored,
-            applied_work: ledger.applied_work,
-            po_energy: 0.0,
-            alpha: [0.0; 3],
-            margin: st.map_or(f64::NAN, |s| s.margin),
-            closure_error: 0.0,
-            flags,
-        };
+        self.integrate(&f_cs, &slave); // 10
+        self.record_tick(t, &handle, &slave, (f_cm, f_cs), tau4, flags); // 11
         Planar2Output {
             torques: [tau4[0], tau4[1]],
             tripped: self.safety.is_latched(),

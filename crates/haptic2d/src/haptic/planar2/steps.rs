@@ -1,0 +1,229 @@
+//! The named steps of one tick of the 2-DOF system ([`Planar2System::tick_timed`] calls them in
+//! order; the numbers are DESIGN §1's, as in the twin's `system/steps.rs`). None allocates, locks,
+//! prints or does I/O.
+
+use super::{Controller2, Planar2System};
+use crate::control::four_channel::TeleopSignals;
+use crate::device::linalg::V3;
+use crate::device::pantograph2::{jt_mul, Pantograph2State};
+use crate::geom::{cross, Vec2};
+use crate::haptic::record::{TickRecord, FLAG_NEAR_SINGULAR, FLAG_SAFETY, FLAG_SATURATED};
+use crate::haptic::safety::SafetyReason;
+
+/// The handle as sensed this tick: the linkage state (`None` after a fault), the handle pose and
+/// twist in world coordinates (m, rad; m/s, rad/s; the rotation entries are filled from the slave).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Handle {
+    pub st: Option<Pantograph2State>,
+    pub x_m: V3,
+    pub v_m: V3,
+}
+
+/// The slave after the contact stage: centre `c` (m), angle (rad), angular velocity (rad/s), the
+/// grasp offset `r` (m, world frame), the grasp point's position and velocity, and the contact
+/// wrench on the slave (N, N·m).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Slave2 {
+    pub c: Vec2,
+    pub theta: f64,
+    pub omega: f64,
+    pub r: Vec2,
+    pub pg: Vec2,
+    pub vg: Vec2,
+    pub f_e: V3,
+}
+
+impl Planar2System {
+    /// Step 0. Stall and joint plausibility: the shared safety layer, as in `HapticSystem`.
+    pub(super) fn supervise_input(&mut self, q: &[f64; 2], elapsed: f64, device_wait: f64) {
+        let (k, t) = (self.world.tick(), self.world.time());
+        self.check_stall(elapsed, device_wait);
+        self.started = true;
+        if let Some(reason) = self.plausibility.check(q, elapsed) {
+            self.safety.trip(k, t, reason);
+        }
+    }
+
+    /// Steps 1–2. Handle point, Jacobian and singularity margin; filtered velocity; the device →
+    /// world translation (anchored at the first valid reading). A fault or a singular pose trips.
+    pub(super) fn sense(&mut self, q: &[f64; 2], flags: &mut u32) -> Handle {
+        let (k, t) = (self.world.tick(), self.world.time());
+        let st = match self.config.linkage.state(*q) {
+            Ok(s) => Some(s),
+            Err(f) => {
+                self.safety.trip(k, t, SafetyReason::Device(f));
+                None
+            }
+        };
+        let mut h = Handle {
+            st,
+            x_m: [f64::NAN; 3],
+            v_m: [0.0; 3],
+        };
+        if let Some(s) = st {
+            let origin = *self.device_origin.get_or_insert(s.e);
+            let p = s.e - origin + self.world_origin;
+            let v = self.filter.update(&[p.x, p.y, 0.0]);
+            h.x_m = [p.x, p.y, 0.0];
+            h.v_m = [v[0], v[1], 0.0];
+            if s.margin < self.config.min_singularity_margin {
+                *flags |= FLAG_NEAR_SINGULAR;
+                self.safety.trip(
+                    k,
+                    t,
+                    SafetyReason::Singularity {
+                        margin: s.margin,
+                        limit: self.config.min_singularity_margin,
+                    },
+                );
+            }
+        }
+        h
+    }
+
+    /// Steps 3–6. World contacts; the slave's state at the grasp point.
+    pub(super) fn contact_stage(&mut self) -> Slave2 {
+        self.world.begin_step();
+        let body = &self.world.bodies[self.slave];
+        let (c, theta, omega) = (body.pose.pos, body.pose.angle, body.omega);
+        let r = super::rotate(theta, self.config.grasp);
+        let cw = self.world.contact_wrench(self.slave);
+        Slave2 {
+            c,
+            theta,
+            omega,
+            r,
+            pg: c + r,
+            vg: body.vel + omega * crate::geom::perp(r),
+            f_e: [-cw.force.x, -cw.force.y, -cw.torque],
+        }
+    }
+
+    /// Step 7. The controller on x and y (the θ channel sees no error: the rotation is left to the
+    /// world); both commands zero without a reading or while latched.
+    pub(super) fn teleoperate(&mut self, h: &Handle, s: &Slave2) -> (V3, V3) {
+        if h.st.is_none() || self.safety.is_latched() {
+            return ([0.0; 3], [0.0; 3]);
+        }
+        let signals = TeleopSignals {
+            x_m: h.x_m,
+            v_m: h.v_m,
+            f_h: [0.0; 3],
+            x_s: [s.pg.x, s.pg.y, s.theta],
+            v_s: [s.vg.x, s.vg.y, s.omega],
+            f_e: [s.f_e[0], s.f_e[1], 0.0],
+            master_mass: [[0.0; 3]; 3],
+        };
+        let (mut f_cm, mut f_cs) = match &mut self.controller {
+            Controller2::FourChannel(c) => c.step(&signals),
+            Controller2::Coupling(c) => c.step(&signals),
+        };
+        f_cm[2] = 0.0;
+        f_cs[2] = 0.0;
+        (f_cm, f_cs)
+    }
+
+    /// Step 8b. The device file's workspace bound at the handle point (device frame; the device →
+    /// world map is a translation, so velocity and force are the same in both).
+    pub(super) fn workspace_wall(&mut self, h: &Handle, f_cm: &mut V3) {
+        let (k, t) = (self.world.tick(), self.world.time());
+        if let (Some(s), Some(w)) = (h.st, self.workspace.as_mut()) {
+            let x = [s.e.x, s.e.y, 0.0];
+            if let Some(reason) = w.apply(&x, &h.v_m, f_cm) {
+                self.safety.trip(k, t, reason);
+            }
+            f_cm[2] = 0.0;
+        }
+    }
+
+    /// Step 9. `τ = Jᵀ·f_cm`, direction-preserving saturation, the limit-cycle monitor, the start-up
+    /// ramp and the safety gate. Returns the four torques (N·m; the last two always 0) and whether
+    /// the gate zeroed them.
+    pub(super) fn motor_torques(
+        &mut self,
+        h: &Handle,
+        f_cm: &V3,
+        flags: &mut u32,
+    ) -> ([f64; 4], bool) {
+        let (k, t) = (self.world.tick(), self.world.time());
+        let mut tau4 = [0.0; 4];
+        if let (Some(s), false) = (h.st, self.safety.is_latched()) {
+            let tau = jt_mul(&s.j, [f_cm[0], f_cm[1]]);
+            let mut scale: f64 = 1.0;
+            for (t, max) in tau.iter().zip(self.config.tau_max) {
+                if t.abs() > max {
+                    scale = scale.min(max / t.abs());
+                }
+            }
+            if scale < 1.0 {
+                *flags |= FLAG_SATURATED;
+            }
+            let (t0, t1) = (tau[0] * scale, tau[1] * scale);
+            let tau_max = [self.config.tau_max[0], self.config.tau_max[1], 0.0, 0.0];
+            if let Some(reason) = self.limit_cycle.observe(&[t0, t1, 0.0, 0.0], &tau_max) {
+                self.safety.trip(k, t, reason);
+            }
+            let ramp = self.ramp();
+            tau4[0] = tau[0] * scale * ramp;
+            tau4[1] = tau[1] * scale * ramp;
+        }
+        let gated = self.safety.gate(k, t, &mut tau4);
+        if gated {
+            *flags |= FLAG_SAFETY;
+        } else if h.st.is_some() {
+            self.ramp_ticks = self.ramp_ticks.saturating_add(1);
+        }
+        (tau4, gated)
+    }
+
+    /// Step 10. The slave drive at the grasp point (plus the twist target's torsion
+    /// spring-damper, world side only), then the integration of every body.
+    pub(super) fn integrate(&mut self, f_cs: &V3, s: &Slave2) {
+        let f = Vec2::new(f_cs[0], f_cs[1]);
+        let twist = match self.twist_target {
+            Some(th) if !self.safety.is_latched() => {
+                let (k, b) = self.twist_gains;
+                k * (th - s.theta) - b * s.omega
+            }
+            _ => 0.0,
+        };
+        self.world.set_drive(self.slave, f, cross(s.r, f) + twist);
+        self.world.finish_step();
+    }
+
+    /// Step 11. The tick record; `t` (s) is the tick's start time.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn record_tick(
+        &mut self,
+        t: f64,
+        h: &Handle,
+        s: &Slave2,
+        (f_cm, f_cs): (V3, V3),
+        tau4: [f64; 4],
+        flags: u32,
+    ) {
+        let body = &self.world.bodies[self.slave];
+        let ledger = self.world.ledger();
+        self.record = TickRecord {
+            t,
+            x_m: h.x_m,
+            v_m: h.v_m,
+            w_h: [0.0; 3],
+            x_s: [s.c.x, s.c.y, s.theta],
+            v_s: [body.vel.x, body.vel.y, body.omega],
+            f_cm,
+            f_cs,
+            f_e: s.f_e,
+            tau: tau4,
+            contacts: self.world.contacts().contact_count() as u32,
+            kinetic: ledger.kinetic,
+            stored: ledger.stored,
+            applied_work: ledger.applied_work,
+            po_energy: 0.0,
+            alpha: [0.0; 3],
+            margin: h.st.map_or(f64::NAN, |st| st.margin),
+            closure_error: 0.0,
+            flags,
+        };
+    }
+}
