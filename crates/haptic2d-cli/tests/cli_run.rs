@@ -3,11 +3,14 @@
 
 mod common;
 
-use common::{haptic2d, text};
+use common::{haptic2d, text, turn};
 use std::process::Command;
 
 #[test]
 fn run_headless_one_second_prints_the_summary_and_logs_every_tick() {
+    // One real-time loop at a time: two loops at SCHED_FIFO pinned to the same core starve
+    // each other, and these tests check timing and the display.
+    let _turn = turn();
     let dir = tempfile::tempdir().unwrap();
     let log = dir.path().join("run.csv");
     let o = haptic2d(&[
@@ -86,6 +89,9 @@ fn run_rejects_bad_options_clearly() {
 
 #[test]
 fn run_replays_recorded_encoders() {
+    // One real-time loop at a time: two loops at SCHED_FIFO pinned to the same core starve
+    // each other, and these tests check timing and the display.
+    let _turn = turn();
     let dir = tempfile::tempdir().unwrap();
     let log = dir.path().join("rec.csv");
     // Record 0.2 s of the simulated device, then replay its encoder angles.
@@ -238,6 +244,9 @@ fn slave_pose(f: &serde_json::Value) -> [f64; 3] {
 /// switches take effect. At the end of `--duration` it still prints its timing summary.
 #[test]
 fn run_display_serves_frames_and_applies_commands() {
+    // One real-time loop at a time: two loops at SCHED_FIFO pinned to the same core starve
+    // each other, and these tests check timing and the display.
+    let _turn = turn();
     let run = Running::start(&["--duration", "8"]);
     let mut ws = connect(&run.addr);
     let welcome = wait_for(&mut ws, "welcome", 5.0, |_| true);
@@ -331,6 +340,9 @@ fn run_display_serves_frames_and_applies_commands() {
 
 #[test]
 fn run_display_port_taken_is_a_clear_error() {
+    // One real-time loop at a time: two loops at SCHED_FIFO pinned to the same core starve
+    // each other, and these tests check timing and the display.
+    let _turn = turn();
     let taken = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
     let addr = taken.local_addr().unwrap().to_string();
     let o = haptic2d(&["run", "--bind", &addr, "--duration", "1"]);
@@ -346,6 +358,9 @@ fn run_display_port_taken_is_a_clear_error() {
 
 #[test]
 fn run_display_on_a_non_loopback_address_prints_the_token() {
+    // One real-time loop at a time: two loops at SCHED_FIFO pinned to the same core starve
+    // each other, and these tests check timing and the display.
+    let _turn = turn();
     let o = haptic2d(&["run", "--bind", "0.0.0.0:0", "--duration", "0.3"]);
     let out = text(&o);
     assert!(o.status.success(), "{out}");
@@ -357,6 +372,9 @@ fn run_display_on_a_non_loopback_address_prints_the_token() {
 
 #[test]
 fn run_device_file() {
+    // One real-time loop at a time: two loops at SCHED_FIFO pinned to the same core starve
+    // each other, and these tests check timing and the display.
+    let _turn = turn();
     let dir = tempfile::tempdir().unwrap();
     let template = concat!(
         env!("CARGO_MANIFEST_DIR"),
