@@ -255,8 +255,9 @@ impl HapticSystem {
         let (est, closure_fault) = self.sense(q, elapsed); // 1–2
         self.align(est); // 1b
         let slave = self.contact_stage(); // 3–6
-        let (f_cm, mut f_cs) = self.teleoperate(est, &slave); // 7
-        let port = self.port_passivity(est, &f_cm, &mut flags); // 8
+        let m_dev = self.device.mass_matrix(); // at the measured pose, for steps 7 and 8
+        let (f_cm, mut f_cs) = self.teleoperate(est, &slave, &m_dev); // 7
+        let port = self.port_passivity(est, &f_cm, &m_dev, &mut flags); // 8
         let f_dev = self.workspace_wall(est, port.f_port); // 8b
         let motor = self.motor_torques(&f_dev, &mut flags); // 9
         if motor.gated {

@@ -105,6 +105,7 @@ impl HapticSystem {
         &mut self,
         est: Option<DeviceEstimate>,
         slave: &SlaveState,
+        m_dev: &M3,
     ) -> (V3, V3) {
         let Some(e) = est else {
             return ([0.0; 3], [0.0; 3]);
@@ -112,7 +113,6 @@ impl HapticSystem {
         if self.safety.is_latched() {
             return ([0.0; 3], [0.0; 3]);
         }
-        let m_dev = self.device.mass_matrix();
         let sc = [self.map.scale, self.map.scale, 1.0];
         let master_mass: M3 =
             std::array::from_fn(|i| std::array::from_fn(|j| m_dev[i][j] / (sc[i] * sc[j])));
@@ -137,6 +137,7 @@ impl HapticSystem {
         &mut self,
         est: Option<DeviceEstimate>,
         f_cm: &V3,
+        m_dev: &M3,
         flags: &mut u32,
     ) -> PortOutput {
         let mut out = PortOutput {
@@ -144,7 +145,6 @@ impl HapticSystem {
             po_energy: 0.0,
             alpha: [0.0; 3],
         };
-        let m_dev = self.device.mass_matrix();
         let (dt, latched) = (self.dt, self.safety.is_latched());
         if let Some(pc) = self.passivity.as_mut() {
             match (est, latched) {
