@@ -4,7 +4,7 @@
 //!
 //! The device file is the shipped reference file with a timeout of 50 periods, the
 //! missed-deadline check off and the stall limit at 1000 periods: the tests run on machines shared with compilers and check the
-//! protocol and the exit paths, not the timing (the 3-period timeout is exercised by the driver
+//! protocol and the exit paths, not the timing (the timeout itself is exercised by the driver
 //! tests in haptic2d-devices). The tests take turns to keep the load down.
 
 use std::io::{BufRead, BufReader};
