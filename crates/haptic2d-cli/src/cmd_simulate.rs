@@ -187,6 +187,15 @@ pub fn run(a: &SimulateArgs) -> Result<Status, Failure> {
         overlap.end_m * 1e3,
         overlap.max_m * 1e3
     );
+    let budget = world.contacts().impact_budget();
+    if budget.islands > 0 {
+        // Large impact islands (MODELS §7.7): how often the sweep budget and its passive fallback
+        // acted, so a user sees when restitution in a pile was cut.
+        println!(
+            "large impact islands: {} solved ({} row updates); {} solver phases stopped by the sweep budget ([contact] impact_sweeps); {} with restitution scaled down to stay passive",
+            budget.islands, budget.row_updates, budget.phases_cut, budget.restitution_scaled
+        );
+    }
     if let Some(p) = a.out {
         println!("wrote {}", p.display());
     }

@@ -129,3 +129,38 @@ fn scenes_md_quotes_what_check_prints_for_overlapping_bodies() {
         "SCENES.md quotes:\n{quoted}\ncheck prints:\n{stderr}"
     );
 }
+
+/// Issue 35: `simulate` says when the sweep budget of large impact islands (MODELS §7.7) acted, so
+/// a user sees that restitution in a landing pile was cut; a scene without large islands says
+/// nothing about it.
+#[test]
+fn simulate_reports_the_impact_sweep_budget_when_a_large_island_hits_it() {
+    let o = haptic2d(&["simulate", "pile:100", "--duration", "0.3"]);
+    assert!(o.status.success(), "{}", text(&o));
+    let out = String::from_utf8_lossy(&o.stdout).to_string();
+    let line = out
+        .lines()
+        .find(|l| l.starts_with("large impact islands: "))
+        .unwrap_or_else(|| panic!("no budget line in\n{out}"));
+    let number = |after: &str| -> u64 {
+        let i = line
+            .find(after)
+            .unwrap_or_else(|| panic!("{after}? {line}"));
+        line[..i]
+            .rsplit(|c: char| !c.is_ascii_digit())
+            .find(|w| !w.is_empty())
+            .and_then(|w| w.parse().ok())
+            .unwrap_or_else(|| panic!("{line}"))
+    };
+    // 100 boxes landing together form islands of more than 24 rows, and 8 sweeps do not
+    // converge them.
+    assert!(number(" solved") > 0, "{line}");
+    assert!(number(" solver phases stopped") > 0, "{line}");
+    let o = haptic2d(&["simulate", "box-in-walls", "--duration", "0.5"]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(
+        !String::from_utf8_lossy(&o.stdout).contains("large impact islands"),
+        "{}",
+        text(&o)
+    );
+}
