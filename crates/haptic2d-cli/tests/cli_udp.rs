@@ -1,6 +1,6 @@
 //! `haptic2d run --device udp:ADDR:PORT` against the reference device devices/udp/sim_device.py in
 //! another process, on loopback (issue 15), directly or through a proxy in the test that drops,
-//! reorders or garbles datagrams. Skipped (with a note) where `python3` is missing.
+//! reorders or garbles datagrams. Where `python3` is missing the tests fail with the install hint.
 //!
 //! The device file is the shipped reference file with a timeout of 50 periods, the
 //! missed-deadline check off and the stall limit at 1000 periods: the tests run on machines shared with compilers and check the
