@@ -2,14 +2,13 @@
 //! performs no heap allocation, with contacts coming and going as the handle drives the box into the
 //! wall and back; and the slave follows the handle with the box starting aligned to it.
 
+use crate::counting_alloc;
+use counting_alloc::allocations;
 use haptic2d::device::pantograph2::Pantograph2;
 use haptic2d::geom::Vec2;
 use haptic2d::haptic::planar2::{Planar2Config, Planar2System};
 use haptic2d::haptic::{ControllerKind, WorkspaceSquare};
 use haptic2d::scene::builtin;
-#[path = "support/counting_alloc.rs"]
-mod counting_alloc;
-use counting_alloc::allocations;
 
 /// The handle path: from the gen 3 workspace centre 30 mm towards −x and back over 4 s (m).
 fn handle_at(k: usize) -> Vec2 {

@@ -1,7 +1,7 @@
 //! Fig. 4 through the full world pipeline (§13.1): F4-1, F4-2, F4-3, the G3 state trace, and P4 for
 //! the paper method.
 
-mod common_fig4;
+use crate::common_fig4;
 
 use common_fig4::run;
 use haptic2d::contact::{ContactState, EventKind};

@@ -13,9 +13,9 @@ use haptic2d::world::World;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-const STACK: &str = include_str!("repro/stack-5-polygons-interpenetrate.toml");
-const SEAM: &str = include_str!("repro/corner-seam-tunnel.toml");
-const PULSE: &str = include_str!("repro/pulse-energy.toml");
+const STACK: &str = include_str!("../repro/stack-5-polygons-interpenetrate.toml");
+const SEAM: &str = include_str!("../repro/corner-seam-tunnel.toml");
+const PULSE: &str = include_str!("../repro/pulse-energy.toml");
 
 /// Passivity bound on the ledger excess (J), as issue 10's acceptance.
 const EXCESS_TOL: f64 = 1e-3;

@@ -7,7 +7,7 @@
 use haptic2d::scene::Scene;
 use haptic2d::world::World;
 
-const R9: &str = include_str!("repro/r9-rod-tunnel.toml");
+const R9: &str = include_str!("../repro/r9-rod-tunnel.toml");
 /// The wall's face (m).
 const FACE: f64 = 0.3;
 

@@ -7,8 +7,8 @@ use haptic2d::collide::{nearest_line, sat_depth, DEFAULT_DELTA_C};
 use haptic2d::scene::Scene;
 use haptic2d::world::World;
 
-const R8: &str = include_str!("repro/r8-polygon-drop-energy.toml");
-const R8B: &str = include_str!("repro/r8b-two-polygons-noimpacts-nofriction.toml");
+const R8: &str = include_str!("../repro/r8-polygon-drop-energy.toml");
+const R8B: &str = include_str!("../repro/r8b-two-polygons-noimpacts-nofriction.toml");
 
 /// Passivity bound on the ledger excess (J), as the acceptance: 1 mJ.
 const EXCESS_TOL: f64 = 1e-3;
@@ -135,7 +135,7 @@ fn t0_primed_peg_in_hole_reports_its_initial_contacts_and_stored_energy() {
 /// its stored energy follows the vertex's real depth down instead of staying that of the far line.
 #[test]
 fn long_lived_record_is_handed_to_the_nearer_edge_and_stores_less() {
-    let text = include_str!("repro/hand-over-triangle.toml");
+    let text = include_str!("../repro/hand-over-triangle.toml");
     let mut w = Scene::from_toml(text, "handover", None)
         .expect("valid")
         .world;

@@ -3,14 +3,13 @@
 //! without scanning (its bodies' motion relative to each other: a common drift does not count).
 //! Checked against a local stage that tracks and scans every pair every sample.
 
+use crate::polygon_support;
 use haptic2d::collide::{nearest_line, Collider, LocalStage, DEFAULT_DELTA_C};
 use haptic2d::geom::{ConvexPolygon, Pose, Vec2};
+use polygon_support::random_polygon;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::f64::consts::TAU;
-#[path = "support/polygon.rs"]
-mod polygon_support;
-use polygon_support::random_polygon;
 
 /// A motion of size drawn log-uniformly in `[1e-9, 10^top]` (m or rad).
 fn small(rng: &mut ChaCha8Rng, top: f64) -> f64 {

@@ -2,13 +2,12 @@
 //! it only computes). A counting global allocator proves it over long windows of the box-in-walls and
 //! peg-in-hole loops, with contacts coming and going, both controllers and the passivity controller.
 
+use crate::counting_alloc;
+use counting_alloc::allocations;
 use haptic2d::control::passivity::PlanarPassivity;
 use haptic2d::device::{HandModel, SimDevice};
 use haptic2d::haptic::{ControllerKind, HapticConfig, HapticSystem, SafetyConfig};
 use haptic2d::scene::builtin;
-#[path = "support/counting_alloc.rs"]
-mod counting_alloc;
-use counting_alloc::allocations;
 
 /// Allocations inside `tick` during `measure` ticks after `warm` ticks. The plant (a test fixture, not
 /// part of the tick) steps outside the counted region.

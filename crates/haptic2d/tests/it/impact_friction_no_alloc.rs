@@ -1,8 +1,7 @@
 //! The frictional impact solver (issue 16) is on the hot path (the world step): once its buffers
 //! have grown to the largest set seen, solving does not allocate (DESIGN §1).
 
-#[path = "support/counting_alloc.rs"]
-mod counting_alloc;
+use crate::counting_alloc;
 
 use haptic2d::body::Body;
 use haptic2d::contact::impact::{ImpactRow, ImpactSolver};

@@ -4,7 +4,7 @@
 //!
 //! `tall_column_*` run in CI (a 40-box column, the same modal problem as the 40-row pile:1000);
 //! `pile_1000_comes_to_rest_within_5_s` is ignored (release build:
-//! `cargo test --release -p haptic2d --test pile_settle -- --ignored`).
+//! `cargo test --release -p haptic2d --test it pile_settle:: -- --ignored`).
 
 use haptic2d::scene::{builtin, Scene};
 use haptic2d::world::World;
@@ -162,7 +162,7 @@ fn one_box_on_the_floor_is_unchanged_by_chain_damper() {
 /// pile:1000 (25 × 40 boxes) at rest within 5 s of simulated time, every body below 1 cm/s
 /// (issue 17's target). Release build: about a minute.
 #[test]
-#[ignore = "release build, ~1 min: cargo test --release -p haptic2d --test pile_settle -- --ignored"]
+#[ignore = "release build, ~1 min: cargo test --release -p haptic2d --test it pile_settle:: -- --ignored"]
 fn pile_1000_comes_to_rest_within_5_s() {
     let mut w = builtin("pile:1000", None).unwrap().unwrap().world;
     run(&mut w, 5.0);

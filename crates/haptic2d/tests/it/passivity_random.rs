@@ -13,7 +13,7 @@
 //! ([`World::prime`]). A passive run keeps it ≤ 0 up to round-off; the bound is 1 mJ in every
 //! scene.
 //!
-//! `cargo test -p haptic2d --test passivity_random -- --nocapture` prints the one-line summary;
+//! `cargo test -p haptic2d --test it passivity_random:: -- --nocapture` prints the one-line summary;
 //! `-- --ignored` runs the long variant (2000 scenes of up to 6 bodies, 2 s each).
 
 use haptic2d::scene::Scene;

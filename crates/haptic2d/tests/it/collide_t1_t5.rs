@@ -1,17 +1,15 @@
 //! Checkable behaviour of the collision detection, spec §9.6 (T1–T5).
 
+use crate::polygon_support;
+use crate::ve_support;
 use haptic2d::collide::{
     gjk_distance, required_delta_prox, BroadPhase, Collider, Feature, FeatureTracker, GjkCache,
     LocalStage, TrackStatus, VeCandidate, DEFAULT_DELTA_C, DEFAULT_DELTA_PROX,
 };
 use haptic2d::geom::{ConvexPolygon, Pose, Vec2};
+use polygon_support::random_polygon;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-#[path = "support/polygon.rs"]
-mod polygon_support;
-#[path = "support/ve.rs"]
-mod ve_support;
-use polygon_support::random_polygon;
 use std::f64::consts::{PI, TAU};
 use ve_support::ve;
 

@@ -1,10 +1,9 @@
 //! DESIGN §1 / issue: once warmed up, `World::step` performs no heap allocation. A counting global
 //! allocator proves it for the built-in scenes.
 
-use haptic2d::scene::builtin;
-#[path = "support/counting_alloc.rs"]
-mod counting_alloc;
+use crate::counting_alloc;
 use counting_alloc::allocations;
+use haptic2d::scene::builtin;
 
 /// Allocations during `measure` samples of `scene` after `warm` samples of warm-up.
 fn step_allocations(scene: &str, warm: usize, measure: usize) -> u64 {

@@ -1,10 +1,9 @@
 //! The per-sample collision functions do not allocate once their buffers have grown (DESIGN §1).
 
+use crate::counting_alloc;
+use counting_alloc::allocations;
 use haptic2d::collide::{BroadPhase, Collider, LocalStage, DEFAULT_DELTA_C, DEFAULT_DELTA_PROX};
 use haptic2d::geom::{ConvexPolygon, Pose};
-#[path = "support/counting_alloc.rs"]
-mod counting_alloc;
-use counting_alloc::allocations;
 
 /// A box falling onto a wall between two posts, with the global stage every 10 samples: after a
 /// first pass over the motion (warm-up), a second identical pass allocates nothing.

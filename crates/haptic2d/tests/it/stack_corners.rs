@@ -6,15 +6,13 @@
 //! coincident corner in the contact manager (§8.2), through the energy ledger (passivity), the
 //! contact trace (no churn) and the record count.
 
+use crate::counting_alloc;
+use crate::ve_support;
 use haptic2d::collide::{Collider, LocalStage, VeCandidate, DEFAULT_DELTA_C};
 use haptic2d::contact::EventKind;
 use haptic2d::geom::{ConvexPolygon, Pose, Rot, Vec2};
 use haptic2d::scene::{builtin, Scene, BUILTIN};
 use haptic2d::world::World;
-#[path = "support/counting_alloc.rs"]
-mod counting_alloc;
-#[path = "support/ve.rs"]
-mod ve_support;
 use ve_support::ve;
 
 /// The built-in pile with `count` boxes in `columns` columns, rows exactly aligned (`stagger =

@@ -7,7 +7,7 @@
 use haptic2d::scene::{builtin, Scene};
 use haptic2d::world::World;
 
-const R8: &str = include_str!("repro/r8-polygon-drop-energy.toml");
+const R8: &str = include_str!("../repro/r8-polygon-drop-energy.toml");
 
 /// Passivity bound on the ledger excess (J), as the acceptance: 1 mJ.
 const EXCESS_TOL: f64 = 1e-3;
