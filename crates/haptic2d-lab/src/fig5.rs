@@ -390,7 +390,7 @@ fn report(m: &FigureMetrics, sweep: &str) -> String {
          and its momentum is dissipated in the PD and slave dampers, so SEH and ZOH cannot keep \
          bouncing — their bouncing needs the handle to stop with the box, i.e. C2 = 1, the \
          released-unstable path. Of the 700+ designs of the design study (issue 36, \
-         `haptic2d-lab/tests/design_search.rs`, MODELS.md §11.4), none that is stable with margin \
+         `haptic2d-lab/tests/it/design_search.rs`, MODELS.md §11.4), none that is stable with margin \
          keeps bouncing; the pulse wall settles at the first impact only with little slave-side force \
          feedback (C5 ≤ 1), which loses the slips of Figs. 8–11.\n\n\
          ### Device-damping sweep (§11.1 table)\n\n\

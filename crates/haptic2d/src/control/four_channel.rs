@@ -145,7 +145,7 @@ impl FourChannelGains {
     }
 
     /// The default (`four-channel`), chosen by the design study of issue 36 (MODELS.md §11.4,
-    /// `haptic2d-lab/tests/design_search.rs`): the §11.1 PD gains on x and y with **local force
+    /// `haptic2d-lab/tests/it/design_search.rs`): the §11.1 PD gains on x and y with **local force
     /// feedback at both ends** — `C6 = −1` at the master (so `C2 = 0`: the wall force is not reflected
     /// to a released handle) and `C5` = [`DEFAULT_SLAVE_FORCE_FEEDBACK`] at the slave (so `C3 = 1 + C5`:
     /// the hand's push reaches the slave amplified, against `−C5·f_e`) — plus a master damping

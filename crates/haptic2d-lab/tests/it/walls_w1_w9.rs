@@ -200,7 +200,7 @@ fn w9_integrator_ordering() {
     }
 }
 
-/// Prints the §5.10 table for the report (`cargo test --test walls_w1_w9 -- --ignored --nocapture`).
+/// Prints the §5.10 table for the report (`cargo test -p haptic2d-lab --test it walls_w1_w9:: -- --ignored --nocapture`).
 #[test]
 #[ignore]
 fn fig4_table_report() {

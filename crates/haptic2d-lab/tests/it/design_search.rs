@@ -18,7 +18,7 @@
 //! four-channel design with the most claims, transparent at the wall (MODELS.md §11.4).
 //!
 //! Run (release, a few minutes on 2 cores):
-//! `cargo test --release -p haptic2d-lab --test design_search -- --ignored --nocapture`.
+//! `cargo test --release -p haptic2d-lab --test it design_search:: -- --ignored --nocapture`.
 
 use haptic2d::control::coupling::CouplingGains;
 use haptic2d::control::four_channel::FourChannelGains;
