@@ -16,3 +16,4 @@ pub mod haply;
 #[cfg(feature = "inverse3")]
 pub mod inverse3;
 pub mod udp;
+pub mod world_link;
