@@ -6,9 +6,11 @@ mod cmd_device_identify;
 mod cmd_devices;
 mod cmd_emulate;
 mod cmd_log;
+mod cmd_remote_device;
 mod cmd_reproduce;
 mod cmd_run;
 mod cmd_scenes;
+mod cmd_serve_world;
 mod cmd_simulate;
 mod cmd_stability;
 mod cmd_study;
@@ -29,6 +31,7 @@ mod run_rig;
 mod run_view;
 mod scene_arg;
 mod udp_arg;
+mod world_link_arg;
 mod world_mcap;
 
 use clap::{Parser, Subcommand};
@@ -132,6 +135,12 @@ enum Command {
     /// DIR`, `study check FILE`.
     #[command(subcommand, after_help = examples_help(STUDY_EXAMPLES))]
     Study(cmd_study::StudyCmd),
+    /// The world side of a loop split at the network: serves SCENE to one `remote-device` over
+    /// authenticated UDP, with TDPA on its port (docs/TELEOP.md).
+    ServeWorld(cmd_serve_world::ServeWorldArgs),
+    /// The device side of a loop split at the network: the simulated twin pantograph with its
+    /// local safety, rendering a `serve-world` through TDPA (docs/TELEOP.md).
+    RemoteDevice(cmd_remote_device::RemoteDeviceArgs),
     /// Parameter sweeps; `walls`: stiffness × damping of every wall law, classified by energy gain.
     Sweep {
         /// What to sweep: walls.
@@ -293,7 +302,10 @@ fn main() -> ExitCode {
     // see EPIPE as an error they handle; `run` prints through `outln!` and ends of SIGPIPE after its
     // cleanup); `simulate --out` finishes its file first; printing commands just end quietly.
     match &cli.command {
-        Command::Run(_) | Command::Emulate(_) => {}
+        Command::Run(_)
+        | Command::Emulate(_)
+        | Command::ServeWorld(_)
+        | Command::RemoteDevice(_) => {}
         Command::Simulate { out: Some(_), .. } | Command::Log(cmd_log::LogCmd::Convert { .. }) => {
             pipe::stop_on_sigpipe()
         }
@@ -304,6 +316,8 @@ fn main() -> ExitCode {
         Command::Devices => return cmd_devices::run(),
         Command::Device { command } => return cmd_device_check::run(&command),
         Command::Run(args) => cmd_run::run(&args),
+        Command::ServeWorld(args) => cmd_serve_world::run(&args),
+        Command::RemoteDevice(args) => cmd_remote_device::run(&args),
         Command::Simulate {
             scene,
             duration,
