@@ -16,6 +16,7 @@
 //! world together (crates/haptic2d/src/haptic/), which this split does not change.
 
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::Duration;
 
 use haptic2d::control::tdpa::{planar_balance, PlanarTdpa};
@@ -28,7 +29,9 @@ use haptic2d_devices::world_link::{
     LinkEndpoint, PortMessage, KIND_TO_DEVICE, KIND_TO_WORLD, PORT_LEN,
 };
 use haptic2d_rt::clock::now_ns;
-use haptic2d_rt::{run_loop, DeviceIo, LoopConfig, SimIo, TickControl, TickInfo, TickInterval};
+use haptic2d_rt::{
+    run_loop, DeviceIo, LoopConfig, SharedTarget, SimIo, TickControl, TickInfo, TickInterval,
+};
 
 use crate::exit::{Failure, Status};
 use crate::hand_arg::HandSpec;
@@ -45,6 +48,11 @@ pub struct RemoteDeviceArgs {
     /// script:HOLD,FX,FY,TAU,PUSH[,RFX,RFY,RTAU].
     #[arg(long, default_value = "follow")]
     pub hand: String,
+    /// A scripted push by the gripping hand (`--hand follow`: a spring–damper, 300 N/m, 5 N·s/m):
+    /// from time AT (s) its target moves from the start pose by (DX, DY) (m) at SPEED (m/s), then
+    /// stays; e.g. `-0.015,0,0.05,0.6` pushes 15 mm to the left from 0.6 s.
+    #[arg(long, value_name = "DX,DY,SPEED,AT", allow_hyphen_values = true)]
+    pub push: Option<String>,
     /// Run for this long (s).
     #[arg(long, default_value_t = 10.0)]
     pub duration: f64,
@@ -77,9 +85,57 @@ enum Latch {
     DeviceIo,
 }
 
+/// A hand target moving in a straight line (the `--push` option).
+#[derive(Clone, Copy, Debug)]
+struct Push {
+    /// Displacement (m, m).
+    d: [f64; 2],
+    /// Speed (m/s).
+    speed: f64,
+    /// Start time (s).
+    at: f64,
+}
+
+impl Push {
+    fn parse(text: &str) -> Result<Self, String> {
+        let v: Vec<f64> = text
+            .split(',')
+            .map(|p| p.trim().parse::<f64>().unwrap_or(f64::NAN))
+            .collect();
+        let ok = v.len() == 4 && v.iter().all(|x| x.is_finite()) && v[2] > 0.0 && v[3] >= 0.0;
+        let len = if ok { v[0].hypot(v[1]) } else { 0.0 };
+        if !ok || len > 0.05 {
+            return Err(format!(
+                "--push {text}: expected DX,DY,SPEED,AT with |(DX, DY)| ≤ 0.05 m, SPEED > 0 m/s, AT ≥ 0 s\n    fix: e.g. --push -0.015,0,0.05,0.6"
+            ));
+        }
+        Ok(Self {
+            d: [v[0], v[1]],
+            speed: v[2],
+            at: v[3],
+        })
+    }
+
+    /// The target at time `t` (s) from the start pose `origin`.
+    fn target(&self, origin: &V3, t: f64) -> V3 {
+        let len = self.d[0].hypot(self.d[1]);
+        let f = if len > 0.0 {
+            ((t - self.at).max(0.0) * self.speed / len).min(1.0)
+        } else {
+            0.0
+        };
+        [
+            origin[0] + f * self.d[0],
+            origin[1] + f * self.d[1],
+            origin[2],
+        ]
+    }
+}
+
 /// The device side's state, owned by the loop.
 struct DeviceSide {
     io: SimIo,
+    push: Option<(Push, Arc<SharedTarget>)>,
     dev: TwinPantograph,
     safety: Safety,
     workspace: WorkspaceBound,
@@ -102,6 +158,8 @@ struct DeviceSide {
     ticks: u64,
     buf: [u8; PORT_LEN],
     max_force: f64,
+    /// Largest distance of the handle from its start pose (m).
+    max_excursion: f64,
     latch: Option<(f64, Latch)>,
 }
 
@@ -109,6 +167,9 @@ impl DeviceSide {
     fn tick(&mut self, info: &TickInfo) -> TickControl {
         let (k, dt, t) = (info.deadline_index, info.period_s, info.t_s);
         let elapsed = self.interval.update(info) as f64 * 1e-9;
+        if let Some((p, target)) = &self.push {
+            target.set(p.target(&self.origin, t));
+        }
         let q = match self.io.read_encoders() {
             Ok(q) => q,
             Err(_) => return self.stop(t, Latch::DeviceIo),
@@ -183,6 +244,8 @@ impl DeviceSide {
             self.ports.observe(&applied, &v, dt);
         }
         self.max_force = self.max_force.max(applied[0].hypot(applied[1]));
+        let d = (x[0] - self.origin[0]).hypot(x[1] - self.origin[1]);
+        self.max_excursion = self.max_excursion.max(d);
         if self.io.write_torques(&self.tau).is_err() {
             return self.stop(t, Latch::DeviceIo);
         }
@@ -284,7 +347,7 @@ pub fn run(a: &RemoteDeviceArgs) -> Result<Status, Failure> {
     let dt = 1.0 / a.rate;
     let params = DeviceParams::default();
     let origin = [params.workspace_center_x, params.workspace_center_y, 0.0];
-    let io = SimIo::new(
+    let mut io = SimIo::new(
         &params,
         origin,
         hand.model(origin),
@@ -292,6 +355,20 @@ pub fn run(a: &RemoteDeviceArgs) -> Result<Status, Failure> {
         ((dt / 0.0005).ceil() as u32).max(1),
     )
     .map_err(Failure::from)?;
+    let push = match &a.push {
+        None => None,
+        Some(v) if hand == HandSpec::Follow => {
+            let target = Arc::new(SharedTarget::new(origin));
+            io.follow(target.clone());
+            Some((Push::parse(v).map_err(Failure::from)?, target))
+        }
+        Some(_) => {
+            return Err(Failure::from(format!(
+                "--push moves the gripping hand's target: it needs --hand follow (got --hand {})",
+                a.hand
+            )))
+        }
+    };
     let mut dev =
         TwinPantograph::new(params, dt, ObserverKind::default()).map_err(Failure::from)?;
     dev.reset(origin[2]);
@@ -314,6 +391,7 @@ pub fn run(a: &RemoteDeviceArgs) -> Result<Status, Failure> {
     let timeout_periods = (a.link.link_timeout_ms * 1e-3 * a.rate).ceil() as u64;
     let mut side = DeviceSide {
         io,
+        push,
         dev,
         safety: Safety::new(
             params.min_singularity_margin,
@@ -342,6 +420,7 @@ pub fn run(a: &RemoteDeviceArgs) -> Result<Status, Failure> {
         ticks: 0,
         buf: [0; PORT_LEN],
         max_force: 0.0,
+        max_excursion: 0.0,
         latch: None,
     };
     let config = LoopConfig {
@@ -403,6 +482,10 @@ fn report(
         side.max_force
     );
     outln!("link: {}", side.stats.describe());
+    outln!(
+        "handle: largest excursion {:.1} mm from the start pose",
+        side.max_excursion * 1e3
+    );
     match side.latch {
         None if interrupted => {
             outln!("stopped: interrupted by a signal (SIGINT or SIGTERM)");

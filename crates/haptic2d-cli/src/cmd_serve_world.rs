@@ -3,7 +3,8 @@
 //! open an authenticated session, then at every period: reads the newest handle state received,
 //! drives the slave body through a virtual coupling to it, with the slave port's TDPA passivity
 //! controller (energy in from the device side received with every message), steps the world and
-//! sends the coupling's reaction back with its port's energies. It runs at normal priority (it
+//! sends the coupling's reaction back (as computed, before this port's controller) with its
+//! port's energies. It runs at normal priority (it
 //! drives no motor) and ends when the device side says goodbye or falls silent.
 
 use std::net::UdpSocket;
@@ -76,6 +77,9 @@ struct WorldSide {
     /// Periods with a live link, and the largest coupling force (N).
     live_ticks: u64,
     max_force: f64,
+    /// Periods with the slave in contact, and the sums of the wall force on it, the coupling
+    /// force and their difference in magnitude (N).
+    contact: (u64, f64, f64, f64),
     /// The device side's TDPA flag, as last received.
     peer_tdpa: Option<bool>,
     end: Option<&'static str>,
@@ -108,10 +112,10 @@ impl WorldSide {
         let silent = k.saturating_sub(self.last_k);
         let (x_s, v_s) = self.slave_state();
         let live = self.last.is_some() && silent <= self.timeout_periods;
-        let mut f_s = [0.0; 3];
+        let (mut f_s, mut f_c) = ([0.0; 3], [0.0; 3]);
         let far = self.last.map_or([0.0; 3], |m| m.energy_in);
         if let (true, Some(m)) = (live, self.last) {
-            let f_c: [f64; 3] = std::array::from_fn(|i| {
+            f_c = std::array::from_fn(|i| {
                 self.k[i] * (m.pose[i] - x_s[i]) + self.b[i] * (m.twist[i] - v_s[i])
             });
             f_s = if self.tdpa {
@@ -125,6 +129,17 @@ impl WorldSide {
         self.world
             .set_drive(self.slave, Vec2::new(f_s[0], f_s[1]), f_s[2]);
         self.world.step();
+        let wall = self.world.contact_wrench(self.slave).force;
+        let (wall, coupling) = (wall.x.hypot(wall.y), f_s[0].hypot(f_s[1]));
+        if live && wall > 0.01 {
+            let c = &mut self.contact;
+            *c = (
+                c.0 + 1,
+                c.1 + wall,
+                c.2 + coupling,
+                c.3 + (wall - coupling).abs(),
+            );
+        }
         if self.tdpa {
             self.ports.book(&f_s, &v_s, dt);
         } else {
@@ -142,7 +157,10 @@ impl WorldSide {
             echo_seq: self.last.map_or(0, |m| m.seq),
             pose: x_s,
             twist: v_s,
-            force: f_s.map(|f| -f),
+            // The coupling's reaction as computed: the handle feels the coupling's stretch even
+            // while this port's controller holds the slave back (the master port's own
+            // controller limits what comes out there).
+            force: f_c.map(|f| -f),
             energy_in: self.ports.energy_in(),
             energy_out: self.ports.energy_out(),
         };
@@ -267,6 +285,7 @@ pub fn run(a: &ServeWorldArgs) -> Result<Status, Failure> {
         buf: [0; PORT_LEN],
         live_ticks: 0,
         max_force: 0.0,
+        contact: (0, 0.0, 0.0, 0.0),
         peer_tdpa: None,
         end: None,
     };
@@ -304,6 +323,14 @@ fn report(side: &mut WorldSide, summary: &haptic2d_rt::TimingSummary) {
         side.max_force
     );
     outln!("link: {}", side.stats.describe());
+    let (n, wall, coupling, diff) = side.contact;
+    let m = n.max(1) as f64;
+    outln!(
+        "contact: {n} periods with the slave in contact; mean wall force {:.3} N, mean coupling force {:.3} N, mean |difference| {:.3} N",
+        wall / m,
+        coupling / m,
+        diff / m
+    );
     if side.peer_tdpa.is_some_and(|p| p == side.tdpa) {
     } else if let Some(p) = side.peer_tdpa {
         outln!(
