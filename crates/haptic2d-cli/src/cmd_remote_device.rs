@@ -38,6 +38,22 @@ use crate::hand_arg::HandSpec;
 use crate::outln;
 use crate::world_link_arg::{energies, LinkArgs, LinkStats, Outbox};
 
+/// Examples of `remote-device --help`.
+pub const EXAMPLES: &[crate::Example] = &[
+    (
+        "The simulated device held still, for 10 s, against a world side on this machine",
+        "haptic2d remote-device --world udp:127.0.0.1:7420 --key world.key",
+    ),
+    (
+        "The grip pushes 15 mm left from 0.6 s; 5 % loss injected on what this end sends",
+        "haptic2d remote-device --world udp:127.0.0.1:7420 --key k --push -0.015,0,0.05,0.6 --loss 0.05",
+    ),
+    (
+        "A scripted hand push (hold 1 s, 2 N left for 1 s), at normal scheduling",
+        "haptic2d remote-device --world udp:10.0.0.2:7420 --key k --hand script:1,-2,0,0,1 --no-rt",
+    ),
+];
+
 /// `remote-device`'s options.
 #[derive(clap::Args, Debug)]
 pub struct RemoteDeviceArgs {

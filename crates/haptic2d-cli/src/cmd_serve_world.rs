@@ -25,6 +25,22 @@ use crate::exit::{Failure, Status};
 use crate::outln;
 use crate::world_link_arg::{energies, LinkArgs, LinkStats, Outbox};
 
+/// Examples of `serve-world --help`.
+pub const EXAMPLES: &[crate::Example] = &[
+    (
+        "Serve box-in-walls on port 7420 to a device side holding the same key",
+        "haptic2d serve-world box-in-walls --bind 0.0.0.0:7420 --key world.key",
+    ),
+    (
+        "A free loopback port (printed); 25 ms delay, 5 % loss injected on what it sends",
+        "haptic2d serve-world box-in-walls --bind 127.0.0.1:0 --key k --delay-ms 25 --loss 0.05",
+    ),
+    (
+        "Without the passivity controller (to see the delayed link create energy)",
+        "haptic2d serve-world peg-in-hole --key world.key --no-tdpa",
+    ),
+];
+
 /// `serve-world`'s options.
 #[derive(clap::Args, Debug)]
 pub struct ServeWorldArgs {

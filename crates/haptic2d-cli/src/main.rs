@@ -137,9 +137,11 @@ enum Command {
     Study(cmd_study::StudyCmd),
     /// The world side of a loop split at the network: serves SCENE to one `remote-device` over
     /// authenticated UDP, with TDPA on its port (docs/TELEOP.md).
+    #[command(after_help = examples_help(cmd_serve_world::EXAMPLES))]
     ServeWorld(cmd_serve_world::ServeWorldArgs),
     /// The device side of a loop split at the network: the simulated twin pantograph with its
     /// local safety, rendering a `serve-world` through TDPA (docs/TELEOP.md).
+    #[command(after_help = examples_help(cmd_remote_device::EXAMPLES))]
     RemoteDevice(cmd_remote_device::RemoteDeviceArgs),
     /// Parameter sweeps; `walls`: stiffness × damping of every wall law, classified by energy gain.
     Sweep {
@@ -159,7 +161,7 @@ enum Command {
 
 /// An example of a subcommand's `--help`: what it does, and the command line (words split at
 /// spaces, no quoting; `cli_tests::every_example_parses` parses each one).
-type Example = (&'static str, &'static str);
+pub(crate) type Example = (&'static str, &'static str);
 
 const RUN_EXAMPLES: &[Example] = &[
     (
@@ -375,7 +377,9 @@ mod cli_tests {
     /// Every example in a `--help` is accepted by the parser, as the subcommand it documents.
     #[test]
     fn every_example_parses() {
-        let lists: [(&str, &[Example]); 9] = [
+        let lists: [(&str, &[Example]); 11] = [
+            ("serve-world", cmd_serve_world::EXAMPLES),
+            ("remote-device", cmd_remote_device::EXAMPLES),
             ("run", RUN_EXAMPLES),
             ("simulate", SIMULATE_EXAMPLES),
             ("emulate", EMULATE_EXAMPLES),
