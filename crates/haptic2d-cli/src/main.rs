@@ -15,6 +15,7 @@ mod cmd_simulate;
 mod cmd_stability;
 mod cmd_study;
 mod cmd_sweep;
+mod cmd_teleop;
 mod controller_file;
 mod csv_out;
 mod device_arg;
@@ -143,6 +144,9 @@ enum Command {
     /// local safety, rendering a `serve-world` through TDPA (docs/TELEOP.md).
     #[command(after_help = examples_help(cmd_remote_device::EXAMPLES))]
     RemoteDevice(cmd_remote_device::RemoteDeviceArgs),
+    /// Bilateral teleoperation of two simulated devices across a simulated link, with TDPA: the
+    /// slave's wall contact felt at the master (docs/TELEOP.md).
+    Teleop(cmd_teleop::TeleopArgs),
     /// Parameter sweeps; `walls`: stiffness × damping of every wall law, classified by energy gain.
     Sweep {
         /// What to sweep: walls.
@@ -320,6 +324,7 @@ fn main() -> ExitCode {
         Command::Run(args) => cmd_run::run(&args),
         Command::ServeWorld(args) => cmd_serve_world::run(&args),
         Command::RemoteDevice(args) => cmd_remote_device::run(&args),
+        Command::Teleop(args) => cmd_teleop::run(&args),
         Command::Simulate {
             scene,
             duration,

@@ -315,3 +315,34 @@ fn a_device_side_with_another_key_gets_no_session() {
     let w = world.finish(Duration::from_secs(10));
     assert!(!w.contains("session "), "{w}");
 }
+
+/// `haptic2d teleop` with two simulated devices: the slave's wall contact is felt at the master
+/// (static force `(15 − 5) mm / (1/300 + 1/500 + 1/2000) m/N = 1.76 N`, device friction aside),
+/// and at a 50 ms round trip with 5 % loss the link creates no energy.
+#[test]
+fn teleop_of_two_simulated_devices_reproduces_the_wall_contact_at_the_master() {
+    let o = common::haptic2d(&[
+        "teleop",
+        "--master",
+        "sim",
+        "--slave",
+        "sim",
+        "--delay-ms",
+        "25",
+        "--loss",
+        "0.05",
+    ]);
+    let t = common::text(&o);
+    assert!(o.status.success(), "{t}");
+    let wall = number(&t, "contact (last second):", "wall force on the slave ");
+    let felt = number(
+        &t,
+        "contact (last second):",
+        "force of the master on the hand ",
+    );
+    assert!((1.4..2.1).contains(&wall), "{t}");
+    assert!((felt - wall).abs() < 0.1 * wall, "{t}");
+    assert!(number(&t, "network:", "created ") <= 1e-3, "{t}");
+    let o = common::haptic2d(&["teleop", "--master", "haply:/dev/null"]);
+    assert_eq!(o.status.code(), Some(2), "{}", common::text(&o));
+}
