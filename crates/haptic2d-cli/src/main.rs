@@ -6,13 +6,16 @@ mod cmd_device_identify;
 mod cmd_devices;
 mod cmd_emulate;
 mod cmd_log;
+mod cmd_remote_device;
 mod cmd_reproduce;
 mod cmd_run;
 mod cmd_scenes;
+mod cmd_serve_world;
 mod cmd_simulate;
 mod cmd_stability;
 mod cmd_study;
 mod cmd_sweep;
+mod cmd_teleop;
 mod controller_file;
 mod csv_out;
 mod device_arg;
@@ -29,6 +32,7 @@ mod run_rig;
 mod run_view;
 mod scene_arg;
 mod udp_arg;
+mod world_link_arg;
 mod world_mcap;
 
 use clap::{Parser, Subcommand};
@@ -132,6 +136,17 @@ enum Command {
     /// DIR`, `study check FILE`.
     #[command(subcommand, after_help = examples_help(STUDY_EXAMPLES))]
     Study(cmd_study::StudyCmd),
+    /// The world side of a loop split at the network: serves SCENE to one `remote-device` over
+    /// authenticated UDP, with TDPA on its port (docs/TELEOP.md).
+    #[command(after_help = examples_help(cmd_serve_world::EXAMPLES))]
+    ServeWorld(cmd_serve_world::ServeWorldArgs),
+    /// The device side of a loop split at the network: the simulated twin pantograph with its
+    /// local safety, rendering a `serve-world` through TDPA (docs/TELEOP.md).
+    #[command(after_help = examples_help(cmd_remote_device::EXAMPLES))]
+    RemoteDevice(cmd_remote_device::RemoteDeviceArgs),
+    /// Bilateral teleoperation of two simulated devices across a simulated link, with TDPA: the
+    /// slave's wall contact felt at the master (docs/TELEOP.md).
+    Teleop(cmd_teleop::TeleopArgs),
     /// Parameter sweeps; `walls`: stiffness × damping of every wall law, classified by energy gain.
     Sweep {
         /// What to sweep: walls.
@@ -150,7 +165,7 @@ enum Command {
 
 /// An example of a subcommand's `--help`: what it does, and the command line (words split at
 /// spaces, no quoting; `cli_tests::every_example_parses` parses each one).
-type Example = (&'static str, &'static str);
+pub(crate) type Example = (&'static str, &'static str);
 
 const RUN_EXAMPLES: &[Example] = &[
     (
@@ -293,7 +308,10 @@ fn main() -> ExitCode {
     // see EPIPE as an error they handle; `run` prints through `outln!` and ends of SIGPIPE after its
     // cleanup); `simulate --out` finishes its file first; printing commands just end quietly.
     match &cli.command {
-        Command::Run(_) | Command::Emulate(_) => {}
+        Command::Run(_)
+        | Command::Emulate(_)
+        | Command::ServeWorld(_)
+        | Command::RemoteDevice(_) => {}
         Command::Simulate { out: Some(_), .. } | Command::Log(cmd_log::LogCmd::Convert { .. }) => {
             pipe::stop_on_sigpipe()
         }
@@ -304,6 +322,9 @@ fn main() -> ExitCode {
         Command::Devices => return cmd_devices::run(),
         Command::Device { command } => return cmd_device_check::run(&command),
         Command::Run(args) => cmd_run::run(&args),
+        Command::ServeWorld(args) => cmd_serve_world::run(&args),
+        Command::RemoteDevice(args) => cmd_remote_device::run(&args),
+        Command::Teleop(args) => cmd_teleop::run(&args),
         Command::Simulate {
             scene,
             duration,
@@ -361,7 +382,9 @@ mod cli_tests {
     /// Every example in a `--help` is accepted by the parser, as the subcommand it documents.
     #[test]
     fn every_example_parses() {
-        let lists: [(&str, &[Example]); 9] = [
+        let lists: [(&str, &[Example]); 11] = [
+            ("serve-world", cmd_serve_world::EXAMPLES),
+            ("remote-device", cmd_remote_device::EXAMPLES),
             ("run", RUN_EXAMPLES),
             ("simulate", SIMULATE_EXAMPLES),
             ("emulate", EMULATE_EXAMPLES),

@@ -5,6 +5,8 @@
 //!   linkages on one board's 4 ports), docs/DEVICES.md §1–§3.
 //! - [`udp`]: the open UDP device protocol for custom hardware and other programs
 //!   (docs/DEVICE-PROTOCOL.md).
+//! - [`world_link`]: the haptic loop split at the network (the device on one machine, the world on
+//!   another), in the UDP protocol's authenticated framing (docs/TELEOP.md).
 //! - `inverse3` (feature `inverse3`): Haply's Inverse3 through its Inverse Service and the `haply`
 //!   client crate, in planar mode, and an emulator of the service (docs/DEVICES.md §4).
 #![warn(missing_docs)]
@@ -16,3 +18,4 @@ pub mod haply;
 #[cfg(feature = "inverse3")]
 pub mod inverse3;
 pub mod udp;
+pub mod world_link;

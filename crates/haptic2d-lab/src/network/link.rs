@@ -58,6 +58,8 @@ pub struct Link<T: Copy> {
     pub lost: u64,
     /// Messages received out of order or twice (kept out).
     pub stale: u64,
+    /// Sequence number of the newest message [`Self::deliver`] handed out.
+    delivered: u64,
 }
 
 impl<T: Copy> Link<T> {
@@ -71,6 +73,7 @@ impl<T: Copy> Link<T> {
             newest: None,
             lost: 0,
             stale: 0,
+            delivered: 0,
         }
     }
 
@@ -124,6 +127,27 @@ impl<T: Copy> Link<T> {
     }
 }
 
+impl<T: Copy> Link<T> {
+    /// As [`Self::receive`], but returns the newest message only the first time: `Some` when a
+    /// message newer than any delivered before has arrived by sample `k`. For putting the
+    /// impairment in front of a real socket: what this returns is what goes on the wire.
+    pub fn deliver(&mut self, k: u64) -> Option<T> {
+        let m = self.receive(k)?;
+        let seq = self.newest.map_or(0, |(s, _)| s);
+        if seq > self.delivered {
+            self.delivered = seq;
+            Some(m)
+        } else {
+            None
+        }
+    }
+
+    /// True when nothing is in flight.
+    pub fn is_idle(&self) -> bool {
+        self.flight.is_empty()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -136,6 +160,19 @@ mod tests {
             assert_eq!(l.receive(k), None, "sample {k}");
         }
         assert_eq!(l.receive(3), Some(7.0));
+    }
+
+    #[test]
+    fn deliver_hands_out_each_newest_message_once_after_the_delay() {
+        let mut l = Link::new(Impairment::delay_loss(2, 0.0, 1));
+        l.send(0, 1.0);
+        l.send(1, 2.0);
+        assert_eq!(l.deliver(1), None);
+        assert_eq!(l.deliver(2), Some(1.0));
+        assert_eq!(l.deliver(2), None);
+        assert_eq!(l.deliver(3), Some(2.0));
+        assert_eq!(l.deliver(9), None);
+        assert!(l.is_idle());
     }
 
     #[test]

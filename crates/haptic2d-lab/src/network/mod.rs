@@ -1,10 +1,13 @@
 //! The haptic loop split at a network (issue 41): an in-process impairment layer ([`link`]) and a
-//! device–world experiment across it with and without time-domain passivity ([`delayed_wall`]).
+//! device–world experiment across it with and without time-domain passivity ([`delayed_wall`]), and
+//! bilateral teleoperation of two simulated devices across it ([`teleop`]).
 //! Everything is deterministic (seeded) and runs in simulated time, for tests and studies; the
-//! process split over UDP is not built yet (docs/TELEOP.md says what is).
+//! process split over UDP is `haptic2d serve-world` / `remote-device` (docs/TELEOP.md).
 
 pub mod delayed_wall;
 pub mod link;
+pub mod teleop;
 
 pub use delayed_wall::{run_delayed_wall, DelayedWall, DelayedWallResult};
 pub use link::{Impairment, Link};
+pub use teleop::{run_teleop, Teleop, TeleopResult};

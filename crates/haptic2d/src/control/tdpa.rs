@@ -73,6 +73,44 @@ impl TdpaPort {
         self.alpha
     }
 
+    /// The passivity controller alone, for a caller that may apply less than it returns (a
+    /// device whose torques saturate, a start-up ramp): the force to apply, damped as in
+    /// [`Self::step`], without booking it. Book what was really applied with [`Self::book`].
+    /// A non-finite input returns no force.
+    pub fn control(&mut self, force: f64, v: f64, far_e_in: f64, dt: f64, alpha_max: f64) -> f64 {
+        self.alpha = 0.0;
+        if !(force.is_finite() && v.is_finite() && far_e_in.is_finite() && dt > 0.0) {
+            return 0.0;
+        }
+        let p = force * v;
+        if p <= 0.0 || v == 0.0 {
+            return force;
+        }
+        // Output this sample: keep e_out + p·dt ≤ far_e_in.
+        let excess = self.e_out + p * dt - far_e_in.max(0.0);
+        if excess <= 0.0 {
+            return force;
+        }
+        self.alpha = (excess / (v * v * dt)).min(alpha_max.max(0.0));
+        force - self.alpha * v
+    }
+
+    /// Books one sample in which the network really applied `force` to a body moving at `v` for
+    /// `dt` (s), with the damping of the last [`Self::control`] call (whose dissipation `α·v²·dt`
+    /// is booked, J). Non-finite values book nothing.
+    pub fn book(&mut self, force: f64, v: f64, dt: f64) {
+        if !(force.is_finite() && v.is_finite() && dt > 0.0) {
+            return;
+        }
+        self.dissipated += self.alpha * v * v * dt;
+        let p = force * v;
+        if p > 0.0 {
+            self.e_out += p * dt;
+        } else {
+            self.e_in -= p * dt;
+        }
+    }
+
     /// One sample of length `dt` (s): the network asks to apply `force` to a body moving at `v`;
     /// `far_e_in` (J) is the last energy-in received from the other port; `alpha_max` caps the
     /// damping (use `f64::INFINITY` for no cap). Returns the force to apply, with the damping that
@@ -145,6 +183,70 @@ impl NetworkEnergy {
     }
 }
 
+/// The three ports of one side of a planar link, one per axis `(x, y, θ)`: a [`TdpaPort`] each.
+/// Deterministic, no allocation.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PlanarTdpa {
+    /// The ports of the x, y and θ axes.
+    pub axes: [TdpaPort; 3],
+}
+
+impl PlanarTdpa {
+    /// Energy in per axis (J): the values to send to the other side.
+    pub fn energy_in(&self) -> [f64; 3] {
+        self.axes.map(|p| p.energy_in())
+    }
+
+    /// Energy out per axis (J).
+    pub fn energy_out(&self) -> [f64; 3] {
+        self.axes.map(|p| p.energy_out())
+    }
+
+    /// Energy in, out and dissipated summed over the three axes (J).
+    pub fn totals(&self) -> (f64, f64, f64) {
+        self.axes.iter().fold((0.0, 0.0, 0.0), |(i, o, d), p| {
+            (i + p.energy_in(), o + p.energy_out(), d + p.dissipated())
+        })
+    }
+
+    /// [`TdpaPort::control`] on each axis: `force` (N, N, N·m), `v` (m/s, m/s, rad/s), the far
+    /// side's energy-in per axis (J), `alpha_max` per axis.
+    pub fn control(
+        &mut self,
+        force: &[f64; 3],
+        v: &[f64; 3],
+        far_e_in: &[f64; 3],
+        dt: f64,
+        alpha_max: &[f64; 3],
+    ) -> [f64; 3] {
+        std::array::from_fn(|i| self.axes[i].control(force[i], v[i], far_e_in[i], dt, alpha_max[i]))
+    }
+
+    /// [`TdpaPort::book`] on each axis.
+    pub fn book(&mut self, force: &[f64; 3], v: &[f64; 3], dt: f64) {
+        for i in 0..3 {
+            self.axes[i].book(force[i], v[i], dt);
+        }
+    }
+
+    /// [`TdpaPort::observe`] on each axis (a link without the controller).
+    pub fn observe(&mut self, force: &[f64; 3], v: &[f64; 3], dt: f64) {
+        for i in 0..3 {
+            self.axes[i].observe(force[i], v[i], dt);
+        }
+    }
+}
+
+/// The balance of a planar link from the totals `(in, out)` (J) of its two sides.
+pub fn planar_balance(a: (f64, f64), b: (f64, f64)) -> NetworkEnergy {
+    let (energy_in, energy_out) = (a.0 + b.0, a.1 + b.1);
+    NetworkEnergy {
+        energy_in,
+        energy_out,
+        created: energy_out - energy_in,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -184,6 +286,48 @@ mod tests {
         assert_eq!(f, -2.0);
         assert!((p.energy_in() - 2e-3).abs() < 1e-15);
         assert_eq!(p.energy_out(), 0.0);
+    }
+
+    #[test]
+    fn control_then_book_of_the_full_output_equals_step() {
+        let (mut a, mut b) = (TdpaPort::new(), TdpaPort::new());
+        for k in 0..50 {
+            let (f, v) = ((k as f64 * 0.3).sin() * 2.0, (k as f64 * 0.17).cos());
+            let fa = a.step(f, v, 1e-3 * k as f64, 1e-3, 100.0);
+            let fb = b.control(f, v, 1e-3 * k as f64, 1e-3, 100.0);
+            b.book(fb, v, 1e-3);
+            assert_eq!(fa, fb);
+        }
+        assert_eq!(a, b);
+    }
+
+    #[test]
+    fn booking_a_saturated_output_books_what_was_applied() {
+        // The controller allows 1 N at 1 m/s; the device applied only half of it.
+        let mut p = TdpaPort::new();
+        let f = p.control(1.0, 1.0, 1.0, 1e-3, f64::INFINITY);
+        assert_eq!(f, 1.0);
+        p.book(0.5 * f, 1.0, 1e-3);
+        assert!((p.energy_out() - 0.5e-3).abs() < 1e-15);
+    }
+
+    #[test]
+    fn planar_ports_keep_each_axis_within_its_far_input() {
+        let mut side = PlanarTdpa::default();
+        let f = side.control(
+            &[1.0, -1.0, 0.1],
+            &[1.0, -1.0, 1.0],
+            &[0.2e-3, 0.0, 1.0],
+            1e-3,
+            &[f64::INFINITY; 3],
+        );
+        side.book(&f, &[1.0, -1.0, 1.0], 1e-3);
+        let out = side.energy_out();
+        assert!((out[0] - 0.2e-3).abs() < 1e-15, "{out:?}");
+        assert!(out[1].abs() < 1e-15, "{out:?}");
+        assert!((out[2] - 0.1e-3).abs() < 1e-15, "{out:?}");
+        let bal = planar_balance((0.0, side.totals().1), (0.3e-3, 0.0));
+        assert!((bal.created - 0.0).abs() < 1e-15, "{bal:?}");
     }
 
     #[test]

@@ -1,0 +1,529 @@
+//! `haptic2d remote-device --world udp:HOST:PORT --key FILE`: the device side of the haptic loop
+//! split at a network (issue 41, docs/TELEOP.md). It runs the device (the simulated twin
+//! pantograph and its simulated hand) with its local safety, and renders the force the world side
+//! sends through the master port's TDPA passivity controller. Every period:
+//!
+//! ```text
+//! encoders → pose, twist (TwinPantograph::estimate)          stall check (Safety::check_stall)
+//! newest world message (authenticated, by sequence number)    lost link: none for --link-timeout-ms → latch
+//! force · ramp → TDPA master port (energy in from the world)  workspace bound (trip past it)
+//! → torques (redundancy, saturation) → Safety::gate → motors  book the force really applied
+//! send: handle pose and twist from the start pose, the applied force, the port's energies
+//! ```
+//!
+//! Any latch zeroes the torques in the same period, stops the loop and says why (exit 3). This is
+//! a command of its own, beside `run`, because `run`'s tick is one `HapticSystem` holding device and
+//! world together (crates/haptic2d/src/haptic/), which this split does not change.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::Duration;
+
+use haptic2d::control::tdpa::{planar_balance, PlanarTdpa};
+use haptic2d::device::linalg::V3;
+use haptic2d::device::{DeviceParams, ObserverKind, TwinPantograph};
+use haptic2d::haptic::safety::{Safety, SafetyConfig, SafetyReason};
+use haptic2d::haptic::workspace::WorkspaceBound;
+use haptic2d_devices::world_link::message::{FLAG_BYE, FLAG_LATCHED, FLAG_TDPA};
+use haptic2d_devices::world_link::{
+    LinkEndpoint, PortMessage, KIND_TO_DEVICE, KIND_TO_WORLD, PORT_LEN,
+};
+use haptic2d_rt::clock::now_ns;
+use haptic2d_rt::{
+    run_loop, DeviceIo, LoopConfig, SharedTarget, SimIo, TickControl, TickInfo, TickInterval,
+};
+
+use crate::exit::{Failure, Status};
+use crate::hand_arg::HandSpec;
+use crate::outln;
+use crate::world_link_arg::{energies, LinkArgs, LinkStats, Outbox};
+
+/// Examples of `remote-device --help`.
+pub const EXAMPLES: &[crate::Example] = &[
+    (
+        "The simulated device held still, for 10 s, against a world side on this machine",
+        "haptic2d remote-device --world udp:127.0.0.1:7420 --key world.key",
+    ),
+    (
+        "The grip pushes 15 mm left from 0.6 s; 5 % loss injected on what this end sends",
+        "haptic2d remote-device --world udp:127.0.0.1:7420 --key k --push -0.015,0,0.05,0.6 --loss 0.05",
+    ),
+    (
+        "A scripted hand push (hold 1 s, 2 N left for 1 s), at normal scheduling",
+        "haptic2d remote-device --world udp:10.0.0.2:7420 --key k --hand script:1,-2,0,0,1 --no-rt",
+    ),
+];
+
+/// `remote-device`'s options.
+#[derive(clap::Args, Debug)]
+pub struct RemoteDeviceArgs {
+    /// The world side: `udp:HOST:PORT` of a `haptic2d serve-world`.
+    #[arg(long, value_name = "udp:HOST:PORT")]
+    pub world: String,
+    /// The simulated operator (as `run --hand`): follow | free | constant:FX,FY,TAU | sine:… |
+    /// script:HOLD,FX,FY,TAU,PUSH[,RFX,RFY,RTAU].
+    #[arg(long, default_value = "follow")]
+    pub hand: String,
+    /// A scripted push by the gripping hand (`--hand follow`: a spring–damper, 300 N/m, 5 N·s/m):
+    /// from time AT (s) its target moves from the start pose by (DX, DY) (m) at SPEED (m/s), then
+    /// stays; e.g. `-0.015,0,0.05,0.6` pushes 15 mm to the left from 0.6 s.
+    #[arg(long, value_name = "DX,DY,SPEED,AT", allow_hyphen_values = true)]
+    pub push: Option<String>,
+    /// Run for this long (s).
+    #[arg(long, default_value_t = 10.0)]
+    pub duration: f64,
+    /// Loop rate (Hz); the world side must run at the same rate.
+    #[arg(long, default_value_t = 1000.0)]
+    pub rate: f64,
+    /// Normal scheduling instead of real-time priority for the device loop.
+    #[arg(long)]
+    pub no_rt: bool,
+    /// A tick later than this many periods after the previous one is a stall (the latch trips).
+    #[arg(long, default_value_t = 5.0)]
+    pub max_stall_periods: f64,
+    /// Wait at most this long (s) for the world side's WELCOME.
+    #[arg(long, default_value_t = 5.0)]
+    pub connect_timeout: f64,
+    #[command(flatten)]
+    pub link: LinkArgs,
+}
+
+/// Why the device side latched zero torques.
+#[derive(Clone, Copy, Debug)]
+enum Latch {
+    /// The core's safety latch (stall, gate, workspace, device fault, singularity).
+    Safety(SafetyReason),
+    /// No datagram from the world for `silent` s (limit `limit` s).
+    LostLink { silent: f64, limit: f64 },
+    /// The world side closed the session.
+    WorldClosed,
+    /// The simulated device failed.
+    DeviceIo,
+}
+
+/// A hand target moving in a straight line (the `--push` option).
+#[derive(Clone, Copy, Debug)]
+struct Push {
+    /// Displacement (m, m).
+    d: [f64; 2],
+    /// Speed (m/s).
+    speed: f64,
+    /// Start time (s).
+    at: f64,
+}
+
+impl Push {
+    fn parse(text: &str) -> Result<Self, String> {
+        let v: Vec<f64> = text
+            .split(',')
+            .map(|p| p.trim().parse::<f64>().unwrap_or(f64::NAN))
+            .collect();
+        let ok = v.len() == 4 && v.iter().all(|x| x.is_finite()) && v[2] > 0.0 && v[3] >= 0.0;
+        let len = if ok { v[0].hypot(v[1]) } else { 0.0 };
+        if !ok || len > 0.05 {
+            return Err(format!(
+                "--push {text}: expected DX,DY,SPEED,AT with |(DX, DY)| ≤ 0.05 m, SPEED > 0 m/s, AT ≥ 0 s\n    fix: e.g. --push -0.015,0,0.05,0.6"
+            ));
+        }
+        Ok(Self {
+            d: [v[0], v[1]],
+            speed: v[2],
+            at: v[3],
+        })
+    }
+
+    /// The target at time `t` (s) from the start pose `origin`.
+    fn target(&self, origin: &V3, t: f64) -> V3 {
+        let len = self.d[0].hypot(self.d[1]);
+        let f = if len > 0.0 {
+            ((t - self.at).max(0.0) * self.speed / len).min(1.0)
+        } else {
+            0.0
+        };
+        [
+            origin[0] + f * self.d[0],
+            origin[1] + f * self.d[1],
+            origin[2],
+        ]
+    }
+}
+
+/// The device side's state, owned by the loop.
+struct DeviceSide {
+    io: SimIo,
+    push: Option<(Push, Arc<SharedTarget>)>,
+    dev: TwinPantograph,
+    safety: Safety,
+    workspace: WorkspaceBound,
+    stall_limit: f64,
+    ramp_len: u64,
+    origin: V3,
+    tdpa: bool,
+    ports: PlanarTdpa,
+    ep: LinkEndpoint,
+    outbox: Outbox,
+    stats: LinkStats,
+    interval: TickInterval,
+    timeout_periods: u64,
+    first_timeout_periods: u64,
+    last: Option<PortMessage>,
+    last_k: u64,
+    last_arrival_ns: u64,
+    seq: u32,
+    tau: [f64; 4],
+    ticks: u64,
+    buf: [u8; PORT_LEN],
+    max_force: f64,
+    /// Largest distance of the handle from its start pose (m).
+    max_excursion: f64,
+    latch: Option<(f64, Latch)>,
+}
+
+impl DeviceSide {
+    fn tick(&mut self, info: &TickInfo) -> TickControl {
+        let (k, dt, t) = (info.deadline_index, info.period_s, info.t_s);
+        let elapsed = self.interval.update(info) as f64 * 1e-9;
+        if let Some((p, target)) = &self.push {
+            target.set(p.target(&self.origin, t));
+        }
+        let q = match self.io.read_encoders() {
+            Ok(q) => q,
+            Err(_) => return self.stop(t, Latch::DeviceIo),
+        };
+        let est = match self.dev.estimate(&q, &self.tau) {
+            Ok(e) => e,
+            Err(f) => return self.stop(t, Latch::Safety(SafetyReason::Device(f))),
+        };
+        self.safety
+            .check_stall(k, t, self.ticks > 0, elapsed, f64::NAN, self.stall_limit);
+        // The world's newest message, and the lost-link check.
+        if let Some(m) = self.ep.poll(KIND_TO_DEVICE) {
+            let now = now_ns();
+            self.stats.arrived(now, m.echo_time_ns, m.echo_age_ns);
+            (self.last, self.last_k, self.last_arrival_ns) = (Some(m), k, now);
+            if m.flags & FLAG_BYE != 0 {
+                return self.stop(t, Latch::WorldClosed);
+            }
+        }
+        let silent = k.saturating_sub(self.last_k);
+        let limit = if self.last.is_some() {
+            self.timeout_periods
+        } else {
+            self.first_timeout_periods
+        };
+        if silent > limit {
+            let lost = Latch::LostLink {
+                silent: silent as f64 * dt,
+                limit: limit as f64 * dt,
+            };
+            return self.stop(t, lost);
+        }
+        // The world's force, ramped in, through the master port's passivity controller.
+        let (x, v) = (est.pose, est.velocity);
+        let ramp = (self.ticks as f64 / self.ramp_len.max(1) as f64).min(1.0);
+        let (f_req, far) = self.last.map_or(([0.0; 3], [0.0; 3]), |m| {
+            (m.force.map(|f| f * ramp), m.energy_in)
+        });
+        let f_net = if self.tdpa {
+            let m = self.dev.mass_matrix();
+            let alpha_max = [0, 1, 2].map(|i| 2.0 * m[i][i].abs() / dt);
+            self.ports.control(&f_req, &v, &far, dt, &alpha_max)
+        } else {
+            f_req
+        };
+        // Local safety: the workspace bound, the torques, the gate.
+        let mut w = f_net;
+        if let Some(r) = self.workspace.apply(&x, &v, &mut w) {
+            self.safety.trip(k, t, r);
+        }
+        let mut scale = 0.0;
+        self.tau = [0.0; 4];
+        match self.dev.torques_for_wrench(&w, 0.0) {
+            Ok(c) if c.near_singular => self.safety.trip(
+                k,
+                t,
+                SafetyReason::Singularity {
+                    margin: c.margin,
+                    limit: self.safety.min_margin,
+                },
+            ),
+            Ok(c) => (self.tau, scale) = (c.tau, c.wrench_scale),
+            Err(f) => self.safety.trip(k, t, SafetyReason::Torques(f)),
+        }
+        if self.safety.gate(k, t, &mut self.tau) {
+            scale = 0.0;
+        }
+        let applied = f_net.map(|f| f * scale);
+        if self.tdpa {
+            self.ports.book(&applied, &v, dt);
+        } else {
+            self.ports.observe(&applied, &v, dt);
+        }
+        self.max_force = self.max_force.max(applied[0].hypot(applied[1]));
+        let d = (x[0] - self.origin[0]).hypot(x[1] - self.origin[1]);
+        self.max_excursion = self.max_excursion.max(d);
+        if self.io.write_torques(&self.tau).is_err() {
+            return self.stop(t, Latch::DeviceIo);
+        }
+        self.send(k, &x, &v, &applied, 0);
+        self.ticks += 1;
+        match self.safety.trip_info() {
+            Some(trip) => self.stop(trip.t, Latch::Safety(trip.reason)),
+            None => TickControl::Continue,
+        }
+    }
+
+    fn send(&mut self, k: u64, x: &V3, v: &V3, force: &V3, flags: u32) {
+        self.seq = self.seq.wrapping_add(1);
+        let now = now_ns();
+        let msg = PortMessage {
+            seq: self.seq,
+            flags: flags | if self.tdpa { FLAG_TDPA } else { 0 },
+            time_ns: now,
+            echo_time_ns: self.last.map_or(0, |m| m.time_ns),
+            echo_age_ns: u32::try_from(now.saturating_sub(self.last_arrival_ns))
+                .unwrap_or(u32::MAX),
+            echo_seq: self.last.map_or(0, |m| m.seq),
+            pose: std::array::from_fn(|i| x[i] - self.origin[i]),
+            twist: *v,
+            force: *force,
+            energy_in: self.ports.energy_in(),
+            energy_out: self.ports.energy_out(),
+        };
+        msg.seal(
+            self.ep.key(),
+            KIND_TO_WORLD,
+            self.ep.session(),
+            &mut self.buf,
+        );
+        self.outbox.send(&mut self.ep, k, &self.buf);
+    }
+
+    /// Latches zero torques, says so to the world, and stops the loop.
+    fn stop(&mut self, t: f64, why: Latch) -> TickControl {
+        self.tau = [0.0; 4];
+        self.io.zero_torques();
+        if self.latch.is_none() {
+            self.latch = Some((t, why));
+        }
+        TickControl::Stop
+    }
+
+    /// Tells the world side the session is over (three times, past the impairment: a lost BYE
+    /// only makes the world wait for its silence timeout).
+    fn bye(&mut self, latched: bool) {
+        let flags = FLAG_BYE
+            | if latched { FLAG_LATCHED } else { 0 }
+            | if self.tdpa { FLAG_TDPA } else { 0 };
+        for _ in 0..3 {
+            self.seq = self.seq.wrapping_add(1);
+            let msg = PortMessage {
+                seq: self.seq,
+                flags,
+                time_ns: now_ns(),
+                energy_in: self.ports.energy_in(),
+                energy_out: self.ports.energy_out(),
+                ..PortMessage::default()
+            };
+            msg.seal(
+                self.ep.key(),
+                KIND_TO_WORLD,
+                self.ep.session(),
+                &mut self.buf,
+            );
+            self.ep.send(&self.buf);
+        }
+    }
+}
+
+fn world_addr(s: &str) -> Result<&str, String> {
+    s.strip_prefix("udp:")
+        .filter(|a| a.contains(':'))
+        .ok_or_else(|| {
+            format!("--world {s}: expected udp:HOST:PORT\n    fix: e.g. --world udp:127.0.0.1:7420")
+        })
+}
+
+/// Runs `remote-device`.
+pub fn run(a: &RemoteDeviceArgs) -> Result<Status, Failure> {
+    let key = a.link.key().map_err(Failure::from)?;
+    let addr = world_addr(&a.world).map_err(Failure::from)?;
+    let hand = HandSpec::parse(&a.hand).map_err(Failure::from)?;
+    if !(a.duration.is_finite() && a.duration > 0.0) {
+        return Err(Failure::from(format!(
+            "--duration must be > 0 s (got {})",
+            a.duration
+        )));
+    }
+    let safety_config = SafetyConfig {
+        max_stall_periods: a.max_stall_periods,
+        ..SafetyConfig::default()
+    };
+    safety_config.validate().map_err(Failure::from)?;
+    let dt = 1.0 / a.rate;
+    let params = DeviceParams::default();
+    let origin = [params.workspace_center_x, params.workspace_center_y, 0.0];
+    let mut io = SimIo::new(
+        &params,
+        origin,
+        hand.model(origin),
+        dt,
+        ((dt / 0.0005).ceil() as u32).max(1),
+    )
+    .map_err(Failure::from)?;
+    let push = match &a.push {
+        None => None,
+        Some(v) if hand == HandSpec::Follow => {
+            let target = Arc::new(SharedTarget::new(origin));
+            io.follow(target.clone());
+            Some((Push::parse(v).map_err(Failure::from)?, target))
+        }
+        Some(_) => {
+            return Err(Failure::from(format!(
+                "--push moves the gripping hand's target: it needs --hand follow (got --hand {})",
+                a.hand
+            )))
+        }
+    };
+    let mut dev =
+        TwinPantograph::new(params, dt, ObserverKind::default()).map_err(Failure::from)?;
+    dev.reset(origin[2]);
+    let stop = haptic2d_rt::signal::install_stop_signals().map_err(Failure::error)?;
+    let ep = LinkEndpoint::connect(
+        addr,
+        &key,
+        Duration::from_secs_f64(a.connect_timeout.max(0.1)),
+    )
+    .map_err(Failure::error)?;
+    outln!(
+        "remote-device: session {:016x} with the world at {}, simulated twin pantograph, hand {}, {} Hz, TDPA {}, impairment: {}",
+        ep.session(),
+        ep.peer(),
+        a.hand,
+        a.rate,
+        if a.link.no_tdpa { "off" } else { "on" },
+        a.link.describe(a.rate)
+    );
+    let timeout_periods = (a.link.link_timeout_ms * 1e-3 * a.rate).ceil() as u64;
+    let mut side = DeviceSide {
+        io,
+        push,
+        dev,
+        safety: Safety::new(
+            params.min_singularity_margin,
+            params.tau_max,
+            safety_config.torque_trip_margin,
+        ),
+        workspace: WorkspaceBound::new(&params, dt),
+        stall_limit: safety_config.stall_limit(dt),
+        ramp_len: (safety_config.ramp_time / dt).round() as u64,
+        origin,
+        tdpa: !a.link.no_tdpa,
+        ports: PlanarTdpa::default(),
+        outbox: a.link.outbox(a.rate),
+        stats: LinkStats::with_capacity(((a.duration + 1.0) * a.rate) as usize),
+        ep,
+        interval: TickInterval::new(),
+        timeout_periods,
+        // The first message needs the world's start and both delays on top.
+        first_timeout_periods: timeout_periods.max((a.rate as u64).max(1))
+            + 2 * (a.link.delay_ms * 1e-3 * a.rate) as u64,
+        last: None,
+        last_k: 0,
+        last_arrival_ns: 0,
+        seq: 0,
+        tau: [0.0; 4],
+        ticks: 0,
+        buf: [0; PORT_LEN],
+        max_force: 0.0,
+        max_excursion: 0.0,
+        latch: None,
+    };
+    let config = LoopConfig {
+        rate_hz: a.rate,
+        duration: Some(Duration::from_secs_f64(a.duration)),
+        rt: !a.no_rt,
+        spin_us: (0.4e6 / a.rate).min(400.0),
+        ..LoopConfig::default()
+    };
+    let summary = std::thread::scope(|s| {
+        std::thread::Builder::new()
+            .name("haptic2d-rt".into())
+            .spawn_scoped(s, || {
+                run_loop(&config, &stop as &AtomicBool, |info| side.tick(&info))
+            })
+            .map_err(|e| Failure::error(format!("cannot start the loop thread: {e}")))?
+            .join()
+            .map_err(|_| Failure::error("the loop thread panicked"))?
+            .map_err(Failure::error)
+    })?;
+    side.io.zero_torques();
+    side.bye(side.latch.is_some());
+    Ok(report(&mut side, &summary, stop.load(Ordering::Relaxed)))
+}
+
+fn report(
+    side: &mut DeviceSide,
+    summary: &haptic2d_rt::TimingSummary,
+    interrupted: bool,
+) -> Status {
+    if let Some(w) = summary.rt.as_ref().and_then(|r| r.warning()) {
+        outln!("{w}");
+    }
+    outln!("{summary}");
+    let mine = side.ports.totals();
+    outln!("master port (device): {}", energies(mine));
+    if let Some(m) = side.last {
+        let (i, o) = (
+            m.energy_in.iter().sum::<f64>(),
+            m.energy_out.iter().sum::<f64>(),
+        );
+        outln!("world port (slave, as last received): energy in {i:.6} J, out {o:.6} J");
+        let bal = planar_balance((mine.0, mine.1), (i, o));
+        outln!(
+            "network: energy created {:.6} J (out − in over both ports; ≤ 0 is passive)",
+            bal.created
+        );
+    }
+    let c = side.ep.counters;
+    outln!(
+        "link: {} received, {} stale, {} bad MAC, {} wrong session, {} malformed, {} send errors, {} dropped by the test impairment; largest force on the handle {:.3} N",
+        c.received,
+        c.stale,
+        c.bad_mac,
+        c.wrong_session,
+        c.malformed,
+        c.send_errors,
+        side.outbox.dropped(),
+        side.max_force
+    );
+    outln!("link: {}", side.stats.describe());
+    outln!(
+        "handle: largest excursion {:.1} mm from the start pose",
+        side.max_excursion * 1e3
+    );
+    match side.latch {
+        None if interrupted => {
+            outln!("stopped: interrupted by a signal (SIGINT or SIGTERM)");
+            Status::Interrupted
+        }
+        None => {
+            outln!("stopped: the duration ended; no safety stop");
+            Status::Clean
+        }
+        Some((t, why)) => {
+            let what = match why {
+                Latch::Safety(r) => format!("safety stop: {r}"),
+                Latch::LostLink { silent, limit } => format!(
+                    "safety stop: lost link: no datagram from the world for {:.0} ms (limit {:.0} ms)",
+                    silent * 1e3,
+                    limit * 1e3
+                ),
+                Latch::WorldClosed => "safety stop: the world side closed the session".into(),
+                Latch::DeviceIo => "safety stop: the simulated device failed".into(),
+            };
+            outln!("stopped: {what} at t = {t:.3} s; torques set to zero and latched");
+            Status::SafetyStop
+        }
+    }
+}

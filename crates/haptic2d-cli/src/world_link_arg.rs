@@ -1,0 +1,193 @@
+//! What `serve-world` and `remote-device` share (issue 41, docs/TELEOP.md): the key, the TDPA
+//! switch, the link timeout, the impairment in front of the socket, and the link's statistics.
+
+use std::path::PathBuf;
+
+use haptic2d_devices::udp::UdpKey;
+use haptic2d_devices::world_link::{LinkEndpoint, PORT_LEN};
+use haptic2d_lab::network::{Impairment, Link};
+
+/// Options of both ends of the world link.
+#[derive(clap::Args, Debug, Clone)]
+pub struct LinkArgs {
+    /// The shared key file (hex, `chmod 600`), as for a UDP device (docs/DEVICE-PROTOCOL.md §3);
+    /// both ends need the same one.
+    #[arg(long, value_name = "FILE")]
+    pub key: PathBuf,
+    /// Turn the time-domain passivity controller off on this end (its port only observes): to see
+    /// what the link does without it. Never on a real device.
+    #[arg(long)]
+    pub no_tdpa: bool,
+    /// No authentic datagram from the other end for this long (ms) counts as a lost link: the
+    /// device side latches zero torques and says why; the world side stops driving the slave.
+    #[arg(long, default_value_t = 100.0, value_name = "MS")]
+    pub link_timeout_ms: f64,
+    /// Test impairment of what this end sends: a one-way delay (ms), rounded to whole periods.
+    #[arg(long, default_value_t = 0.0, value_name = "MS")]
+    pub delay_ms: f64,
+    /// Test impairment: the fraction of this end's port messages dropped, in [0, 1].
+    #[arg(long, default_value_t = 0.0)]
+    pub loss: f64,
+    /// Seed of the impairment's random numbers.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+}
+
+impl LinkArgs {
+    /// Reads the key; checks the numbers. Errors name the option and the fix.
+    pub fn key(&self) -> Result<UdpKey, String> {
+        if !(self.link_timeout_ms.is_finite() && self.link_timeout_ms >= 1.0) {
+            return Err(format!(
+                "--link-timeout-ms must be at least 1 ms (got {})",
+                self.link_timeout_ms
+            ));
+        }
+        if !(self.delay_ms.is_finite() && (0.0..=10_000.0).contains(&self.delay_ms)) {
+            return Err(format!(
+                "--delay-ms must be within 0..=10000 ms (got {})",
+                self.delay_ms
+            ));
+        }
+        if !(0.0..=1.0).contains(&self.loss) {
+            return Err(format!(
+                "--loss must be a fraction in [0, 1] (got {})",
+                self.loss
+            ));
+        }
+        UdpKey::from_file(&self.key)
+    }
+
+    /// The impairment in periods of `rate_hz`, `None` when there is none.
+    pub fn outbox(&self, rate_hz: f64) -> Outbox {
+        let delay = (self.delay_ms * 1e-3 * rate_hz).round() as u32;
+        let link = (delay > 0 || self.loss > 0.0)
+            .then(|| Link::new(Impairment::delay_loss(delay, self.loss, self.seed)));
+        Outbox { link }
+    }
+
+    /// The impairment, in words.
+    pub fn describe(&self, rate_hz: f64) -> String {
+        let delay = (self.delay_ms * 1e-3 * rate_hz).round();
+        if delay == 0.0 && self.loss == 0.0 {
+            return "none".into();
+        }
+        format!(
+            "delay {} ms, loss {:.1} %, seed {}",
+            delay * 1e3 / rate_hz,
+            self.loss * 100.0,
+            self.seed
+        )
+    }
+}
+
+/// What an end sends goes through the test impairment (the lab's seeded [`Link`], in periods of
+/// the loop) before the socket. Allocation-free once its queue has grown to the delay.
+pub struct Outbox {
+    link: Option<Link<[u8; PORT_LEN]>>,
+}
+
+impl Outbox {
+    /// Sends `datagram` at deadline `k` (through the impairment, if any).
+    #[inline]
+    pub fn send(&mut self, ep: &mut LinkEndpoint, k: u64, datagram: &[u8; PORT_LEN]) {
+        match &mut self.link {
+            None => ep.send(datagram),
+            Some(l) => {
+                l.send(k, *datagram);
+                if let Some(d) = l.deliver(k) {
+                    ep.send(&d);
+                }
+            }
+        }
+    }
+
+    /// Port messages the impairment dropped.
+    pub fn dropped(&self) -> u64 {
+        self.link.as_ref().map_or(0, |l| l.lost)
+    }
+}
+
+/// The link as one end sees it: round trips (from the echoed timestamps) and arrival intervals,
+/// kept in preallocated buffers (the hot path does not allocate; beyond the capacity, samples are
+/// counted but not kept).
+pub struct LinkStats {
+    round_trip_ns: Vec<u64>,
+    interval_ns: Vec<u64>,
+    last_arrival_ns: Option<u64>,
+    /// Samples not kept for lack of room.
+    pub overflow: u64,
+}
+
+impl LinkStats {
+    /// Room for `n` samples of each.
+    pub fn with_capacity(n: usize) -> Self {
+        Self {
+            round_trip_ns: Vec::with_capacity(n),
+            interval_ns: Vec::with_capacity(n),
+            last_arrival_ns: None,
+            overflow: 0,
+        }
+    }
+
+    /// A new message arrived at `now_ns` (this end's clock) echoing this end's `echo_time_ns`
+    /// after `echo_age_ns` at the other end.
+    #[inline]
+    pub fn arrived(&mut self, now_ns: u64, echo_time_ns: u64, echo_age_ns: u32) {
+        if echo_time_ns != 0 {
+            let rt = now_ns
+                .saturating_sub(echo_time_ns)
+                .saturating_sub(echo_age_ns as u64);
+            push(&mut self.round_trip_ns, rt, &mut self.overflow);
+        }
+        if let Some(p) = self.last_arrival_ns {
+            push(
+                &mut self.interval_ns,
+                now_ns.saturating_sub(p),
+                &mut self.overflow,
+            );
+        }
+        self.last_arrival_ns = Some(now_ns);
+    }
+
+    /// "round trip p50 … ms, p99 …, max …; arrival interval p50 …, p99 …, max … ms".
+    pub fn describe(&mut self) -> String {
+        let mut s = String::new();
+        for (name, v) in [
+            ("round trip", &mut self.round_trip_ns),
+            ("arrival interval", &mut self.interval_ns),
+        ] {
+            if v.is_empty() {
+                s.push_str(&format!("{name}: no samples; "));
+                continue;
+            }
+            v.sort_unstable();
+            let q = |p: f64| v[((v.len() - 1) as f64 * p).round() as usize] as f64 * 1e-6;
+            s.push_str(&format!(
+                "{name} p50 {:.3} ms, p99 {:.3} ms, p99.9 {:.3} ms, max {:.3} ms ({} samples); ",
+                q(0.5),
+                q(0.99),
+                q(0.999),
+                q(1.0),
+                v.len()
+            ));
+        }
+        s.trim_end_matches("; ").to_string()
+    }
+}
+
+#[inline]
+fn push(v: &mut Vec<u64>, x: u64, overflow: &mut u64) {
+    if v.len() < v.capacity() {
+        v.push(x);
+    } else {
+        *overflow += 1;
+    }
+}
+
+/// "in 0.0123 J, out 0.0100 J, dissipated 0.0010 J".
+pub fn energies(totals: (f64, f64, f64)) -> String {
+    format!(
+        "energy in {:.6} J, out {:.6} J, dissipated by TDPA {:.6} J",
+        totals.0, totals.1, totals.2
+    )
+}

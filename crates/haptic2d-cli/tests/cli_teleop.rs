@@ -1,0 +1,407 @@
+//! The haptic loop split at the network (issue 41, docs/TELEOP.md): `haptic2d serve-world` and
+//! `haptic2d remote-device` as two processes over loopback, authenticated with a shared key.
+//!
+//! The acceptance test: 50 ms round trip (25 ms injected on each side) and 5 % loss on each side,
+//! the simulated hand pushes the handle so that the world's box goes into a stiff wall; with
+//! TDPA the network creates no energy (≤ 1 mJ, summed over both processes' port ledgers) and no
+//! safety stop trips; without TDPA the same run creates energy (the test proves TDPA is needed).
+//!
+//! Timing on a shared machine: the world side runs at normal priority (it drives no motor), so it
+//! never competes with a real-time device loop pinned to a core; the stall limit is 100 periods and
+//! the link timeout 300 ms (the tests check the link and the energy, not the machine's timing);
+//! the tests take turns.
+
+use std::io::{BufRead, BufReader, Read};
+use std::path::PathBuf;
+use std::process::{Child, Command, Stdio};
+use std::sync::mpsc;
+use std::time::Duration;
+
+mod common;
+use common::{turn, wait_with_limit};
+
+const BIN: &str = env!("CARGO_BIN_EXE_haptic2d");
+
+/// A fresh key file (mode 600) in a temp dir of its own.
+fn key_file(tag: &str, byte: u8) -> PathBuf {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = std::env::temp_dir().join(format!("haptic2d-teleop-{}-{tag}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join("key");
+    std::fs::write(&p, format!("{byte:02x}").repeat(32)).unwrap();
+    std::fs::set_permissions(&p, std::fs::Permissions::from_mode(0o600)).unwrap();
+    p
+}
+
+/// The wall scene of the acceptance test (docs/TELEOP.md): box-in-walls with the box 3 mm from
+/// the left wall and a stiffer contact (5 000 N/m per corner, 10 000 N/m on a face), so that the
+/// wall is reached well inside the device's workspace.
+const NEAR_WALL: &str = r#"name = "box-near-wall"
+description = "a 0.5 kg box 3 mm from a stiff wall (the world link's acceptance test)"
+[world]
+rate = 1000
+proximity_every = 10
+integration = "semi-implicit"
+[contact]
+impacts = true
+restitution = 0.5
+v_c = 0.02
+[normal]
+model = "paper"
+kc = 5000.0
+bc = 5.0
+[friction]
+model = "none"
+[[body]]
+name = "walls"
+kind = "fixed"
+pieces = [
+  [[-0.1, -0.2], [0.0, -0.2], [0.0, 0.2], [-0.1, 0.2]],
+  [[0.3, -0.2], [0.4, -0.2], [0.4, 0.2], [0.3, 0.2]],
+  [[0.0, -0.2], [0.3, -0.2], [0.3, -0.1], [0.0, -0.1]],
+  [[0.0, 0.1], [0.3, 0.1], [0.3, 0.2], [0.0, 0.2]],
+]
+[[body]]
+name = "box"
+mass = 0.5
+box = [0.04, 0.02]
+position = [0.023, 0.0]
+"#;
+
+/// A running `serve-world`, its address, and its output so far (the rest is read on a thread).
+struct World {
+    child: Child,
+    addr: String,
+    lines: mpsc::Receiver<String>,
+}
+
+impl Drop for World {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+impl World {
+    fn start(key: &PathBuf, extra: &[&str]) -> World {
+        let scene = key.with_file_name("near-wall.toml");
+        std::fs::write(&scene, NEAR_WALL).unwrap();
+        let mut child = Command::new(BIN)
+            .arg("serve-world")
+            .arg(&scene)
+            .args(["--bind", "127.0.0.1:0", "--key"])
+            .arg(key)
+            .args(extra)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let (tx, lines) = mpsc::channel();
+        let out = child.stdout.take().unwrap();
+        std::thread::spawn(move || {
+            for l in BufReader::new(out).lines().map_while(Result::ok) {
+                let _ = tx.send(l);
+            }
+        });
+        let mut err = child.stderr.take().unwrap();
+        std::thread::spawn(move || {
+            let mut s = String::new();
+            let _ = err.read_to_string(&mut s);
+            if !s.is_empty() {
+                eprintln!("serve-world stderr: {s}");
+            }
+        });
+        let mut addr = None;
+        while addr.is_none() {
+            let l = lines
+                .recv_timeout(Duration::from_secs(30))
+                .expect("serve-world prints its address");
+            addr = l
+                .strip_prefix("serve-world: listening on ")
+                .map(str::to_string);
+        }
+        World {
+            child,
+            addr: addr.unwrap(),
+            lines,
+        }
+    }
+
+    /// Waits for the world side to end (at most `limit`) and returns the rest of its output.
+    fn finish(mut self, limit: Duration) -> String {
+        let t0 = std::time::Instant::now();
+        while self.child.try_wait().unwrap().is_none() && t0.elapsed() < limit {
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        let _ = self.child.kill();
+        let mut s = String::new();
+        while let Ok(l) = self.lines.recv_timeout(Duration::from_secs(2)) {
+            s.push_str(&l);
+            s.push('\n');
+        }
+        s
+    }
+}
+
+fn device(world: &World, key: &PathBuf, extra: &[&str]) -> (i32, String) {
+    let child = Command::new(BIN)
+        .args([
+            "remote-device",
+            "--world",
+            &format!("udp:{}", world.addr),
+            "--key",
+        ])
+        .arg(key)
+        .args(extra)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let (status, text) =
+        wait_with_limit(child, Duration::from_secs(60)).expect("remote-device ends in time");
+    (status.code().unwrap_or(-1), text)
+}
+
+/// The number after `prefix` in the line starting with `line_start`.
+fn number(text: &str, line_start: &str, prefix: &str) -> f64 {
+    let line = text
+        .lines()
+        .find(|l| l.starts_with(line_start))
+        .unwrap_or_else(|| panic!("no line `{line_start}` in:\n{text}"));
+    let rest = &line[line
+        .find(prefix)
+        .unwrap_or_else(|| panic!("{prefix} in {line}"))
+        + prefix.len()..];
+    rest.split_whitespace()
+        .next()
+        .unwrap()
+        .trim_end_matches(',')
+        .parse()
+        .unwrap()
+}
+
+/// (energy in, energy out) of a port's ledger line (J).
+fn port(text: &str, line_start: &str) -> (f64, f64) {
+    (
+        number(text, line_start, "energy in "),
+        number(text, line_start, ", out "),
+    )
+}
+
+struct Pushed {
+    status: i32,
+    device: String,
+    world: String,
+    created: f64,
+}
+
+/// The acceptance run: 25 ms each way, 5 % loss each way; the gripping hand (300 N/m, 5 N·s/m)
+/// holds still for 0.6 s (the ramp), then its target moves 15 mm to the left at 50 mm/s: the box,
+/// 3 mm from the wall, is pushed into it, with about 2.3 N at rest (hand and coupling springs in
+/// series against the wall); 3 s in all.
+fn pushed_into_the_wall(tdpa: bool, tag: &str) -> Pushed {
+    let key = key_file(tag, 0x5a);
+    let mut common = vec![
+        "--delay-ms",
+        "25",
+        "--loss",
+        "0.05",
+        "--link-timeout-ms",
+        "300",
+    ];
+    if !tdpa {
+        common.push("--no-tdpa");
+    }
+    let mut w_args = common.clone();
+    w_args.extend(["--seed", "2"]);
+    let world = World::start(&key, &w_args);
+    let mut d_args = common;
+    d_args.extend([
+        "--seed",
+        "3",
+        "--duration",
+        "3",
+        "--push",
+        "-0.015,0,0.05,0.6",
+        "--max-stall-periods",
+        "100",
+    ]);
+    let (status, device) = device(&world, &key, &d_args);
+    let world = world.finish(Duration::from_secs(10));
+    let (mi, mo) = port(&device, "master port (device):");
+    let (si, so) = port(&world, "world port (slave):");
+    Pushed {
+        status,
+        created: (mo + so) - (mi + si),
+        device,
+        world,
+    }
+}
+
+#[test]
+fn with_tdpa_a_50_ms_round_trip_with_5_percent_loss_creates_no_energy_pushing_into_a_wall() {
+    let _t = turn();
+    let r = pushed_into_the_wall(true, "tdpa");
+    let all = format!("{}\n{}", r.device, r.world);
+    assert_eq!(r.status, 0, "{all}");
+    assert!(r.device.contains("no safety stop"), "{all}");
+    assert!(r.created <= 1e-3, "created {} J\n{all}", r.created);
+    // The run did what it claims: the delay and the loss were there, the wall was felt.
+    let rtt = number(&r.device, "link: round trip", "p50 ");
+    assert!(
+        (49.0..80.0).contains(&rtt),
+        "round trip p50 {rtt} ms\n{all}"
+    );
+    let dropped = number(&r.device, "link: ", "send errors, ");
+    assert!(dropped > 20.0, "{all}");
+    let f = number(&r.device, "link: ", "largest force on the handle ");
+    assert!(f > 2.0, "the wall was not felt: {f} N\n{all}");
+    // Transparency: in contact, the coupling force on the slave follows the wall's (issue 41
+    // item 5 reports it; 10 % of the wall force here).
+    let wall = number(&r.world, "contact: ", "mean wall force ");
+    let diff = number(&r.world, "contact: ", "mean |difference| ");
+    assert!(
+        wall > 1.5 && diff < 0.1 * wall,
+        "wall {wall} N, error {diff} N\n{all}"
+    );
+    assert!(
+        r.world.contains("the device side closed the session"),
+        "{all}"
+    );
+}
+
+#[test]
+fn without_tdpa_the_same_run_creates_energy() {
+    let _t = turn();
+    let r = pushed_into_the_wall(false, "none");
+    let all = format!("{}\n{}", r.device, r.world);
+    assert!(
+        r.created > 0.02,
+        "created {} J: the delayed link should create energy without TDPA\n{all}",
+        r.created
+    );
+}
+
+#[test]
+fn a_silent_world_latches_zero_torques_and_says_lost_link() {
+    let _t = turn();
+    let key = key_file("silent", 0x33);
+    // The world side stops after 1 s without a goodbye; the device side must notice.
+    let world = World::start(&key, &["--duration", "1"]);
+    let (status, text) = device(
+        &world,
+        &key,
+        &["--duration", "10", "--no-rt", "--max-stall-periods", "100"],
+    );
+    assert_eq!(status, 3, "{text}");
+    assert!(
+        text.contains("lost link: no datagram from the world"),
+        "{text}"
+    );
+    assert!(text.contains("torques set to zero and latched"), "{text}");
+}
+
+#[test]
+fn a_device_side_with_another_key_gets_no_session() {
+    let _t = turn();
+    let world = World::start(&key_file("k1", 0x11), &["--accept-timeout", "3"]);
+    let (status, text) = device(
+        &world,
+        &key_file("k2", 0x22),
+        &["--duration", "1", "--connect-timeout", "0.5"],
+    );
+    assert_eq!(status, 1, "{text}");
+    assert!(text.contains("no WELCOME"), "{text}");
+    let w = world.finish(Duration::from_secs(10));
+    assert!(!w.contains("session "), "{w}");
+}
+
+/// `haptic2d teleop` with two simulated devices: the slave's wall contact is felt at the master
+/// (static force `(15 − 5) mm / (1/300 + 1/500 + 1/2000) m/N = 1.76 N`, device friction aside),
+/// and at a 50 ms round trip with 5 % loss the link creates no energy.
+#[test]
+fn teleop_of_two_simulated_devices_reproduces_the_wall_contact_at_the_master() {
+    let o = common::haptic2d(&[
+        "teleop",
+        "--master",
+        "sim",
+        "--slave",
+        "sim",
+        "--delay-ms",
+        "25",
+        "--loss",
+        "0.05",
+    ]);
+    let t = common::text(&o);
+    assert!(o.status.success(), "{t}");
+    let wall = number(&t, "contact (last second):", "wall force on the slave ");
+    let felt = number(
+        &t,
+        "contact (last second):",
+        "force of the master on the hand ",
+    );
+    assert!((1.4..2.1).contains(&wall), "{t}");
+    assert!((felt - wall).abs() < 0.1 * wall, "{t}");
+    assert!(number(&t, "network:", "created ") <= 1e-3, "{t}");
+    let o = common::haptic2d(&["teleop", "--master", "haply:/dev/null"]);
+    assert_eq!(o.status.code(), Some(2), "{}", common::text(&o));
+}
+
+/// The acceptance run through Linux netem instead of the built-in impairment (issue 41 item 3):
+/// both processes in a network namespace of their own whose loopback delays every datagram by
+/// 25 ms and drops 5 % (so 50 ms round trip, 5 % loss each way). Skipped, saying why, where a
+/// namespace or netem is unavailable (no `unshare`, no privileges, or a kernel without the netem
+/// qdisc: the VM this was written on lacks it, so this path has not run there).
+#[test]
+fn netem_in_a_namespace_at_50_ms_and_5_percent_with_tdpa_creates_no_energy_or_skips_saying_why() {
+    let _t = turn();
+    let netem = "ip link set lo up && tc qdisc add dev lo root netem delay 25ms loss 5%";
+    match Command::new("unshare")
+        .args(["-n", "sh", "-c", netem])
+        .output()
+    {
+        Err(e) => {
+            eprintln!("skipped: cannot run unshare: {e}");
+            return;
+        }
+        Ok(o) if !o.status.success() => {
+            eprintln!(
+                "skipped: no netem in a network namespace here: {}",
+                String::from_utf8_lossy(&o.stderr).trim()
+            );
+            return;
+        }
+        Ok(_) => {}
+    }
+    let key = key_file("netem", 0x6b);
+    let scene = key.with_file_name("near-wall.toml");
+    std::fs::write(&scene, NEAR_WALL).unwrap();
+    let wout = key.with_file_name("world.txt");
+    let script = format!(
+        "{netem} && ({BIN} serve-world {s} --bind 127.0.0.1:7420 --key {k} --link-timeout-ms 300 > {w} 2>&1 &) \
+         && sleep 0.5 && {BIN} remote-device --world udp:127.0.0.1:7420 --key {k} --duration 3 \
+         --push -0.015,0,0.05,0.6 --link-timeout-ms 300 --max-stall-periods 100; echo \"device exit $?\"; sleep 1",
+        s = scene.display(),
+        k = key.display(),
+        w = wout.display()
+    );
+    let child = Command::new("unshare")
+        .args(["-n", "sh", "-c", &script])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let (_, device) = wait_with_limit(child, Duration::from_secs(60)).expect("ends in time");
+    let world = std::fs::read_to_string(&wout).unwrap_or_default();
+    let all = format!("{device}\n{world}");
+    assert!(device.contains("device exit 0"), "{all}");
+    assert!(device.contains("no safety stop"), "{all}");
+    let (mi, mo) = port(&device, "master port (device):");
+    let (si, so) = port(&world, "world port (slave):");
+    assert!((mo + so) - (mi + si) <= 1e-3, "{all}");
+    let rtt = number(&device, "link: round trip", "p50 ");
+    assert!(
+        (49.0..80.0).contains(&rtt),
+        "round trip p50 {rtt} ms\n{all}"
+    );
+}

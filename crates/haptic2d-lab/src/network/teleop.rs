@@ -1,0 +1,330 @@
+//! Bilateral teleoperation of two simulated twin-pantograph devices across a link (issue 41 item
+//! 4, first part): a hand pushes the master's handle; the slave follows it through a virtual
+//! coupling and touches a wall; the coupling's reaction comes back to the master, so the hand
+//! feels the slave's contact. Simulated time, deterministic, 1 kHz.
+//!
+//! ```text
+//! master (hand: a grip whose target moves)                   slave (environment: a wall)
+//! encoders → x_m, v_m (TwinPantograph)                       encoders → x_s, v_s
+//! newest F from the slave → master TDPA port → torques       newest (x_m, v_m) → F_c = K·Δx + B·Δv
+//! send (x_m − x_m0, v_m, E_in,m)  ──── Link (delay, loss) ──►  slave TDPA port → torques
+//!                                 ◄─── Link ───  send (−F_c, E_in,s)
+//! ```
+//!
+//! Both devices are the lumped twin-pantograph plant of MODELS §10.6 (`SimDevice`), with their
+//! joint friction; the wall is a spring–damper `F = K_w·p − B_w·ṗ` (pushing only) on the slave's
+//! true pose, held over each period. The torques go through each device's redundancy resolution
+//! and saturation; each port books the force its device really applied.
+
+use super::link::{Impairment, Link};
+use haptic2d::control::tdpa::{planar_balance, NetworkEnergy, PlanarTdpa};
+use haptic2d::device::linalg::V3;
+use haptic2d::device::{DeviceParams, HandModel, ObserverKind, SimDevice, TwinPantograph};
+
+/// One run's settings. SI units; positions relative to each device's start pose (the workspace
+/// centre).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Teleop {
+    /// Sample time (s).
+    pub dt: f64,
+    /// Run length (s).
+    pub duration: f64,
+    /// The link in each direction (delay in samples).
+    pub link: Impairment,
+    /// Time-domain passivity on both ports.
+    pub tdpa: bool,
+    /// Coupling stiffness (N/m, N/m, N·m/rad).
+    pub k: V3,
+    /// Coupling damping (N·s/m, N·s/m, N·m·s/rad).
+    pub b: V3,
+    /// The hand's target moves by this (m, m) from the start pose …
+    pub push: [f64; 2],
+    /// … at this speed (m/s) …
+    pub push_speed: f64,
+    /// … from this time (s).
+    pub push_at: f64,
+    /// The wall's surface, at this x from the slave's start (m); the wall fills `x < wall_x`.
+    pub wall_x: f64,
+    /// Wall stiffness (N/m) and damping (N·s/m).
+    pub k_wall: f64,
+    /// Wall damping (N·s/m).
+    pub b_wall: f64,
+}
+
+impl Teleop {
+    /// The default run: 3 s; coupling (500, 500, 1) N/m, (5, 5, 0.01) N·s/m; the grip's target moves
+    /// 15 mm left at 50 mm/s from 0.6 s; a 2 000 N/m, 2 N·s/m wall 5 mm left of the slave's start.
+    pub fn new(link: Impairment, tdpa: bool) -> Self {
+        Self {
+            dt: 1e-3,
+            duration: 3.0,
+            link,
+            tdpa,
+            k: [500.0, 500.0, 1.0],
+            b: [5.0, 5.0, 0.01],
+            push: [-0.015, 0.0],
+            push_speed: 0.05,
+            push_at: 0.6,
+            wall_x: -0.005,
+            k_wall: 2000.0,
+            b_wall: 2.0,
+        }
+    }
+}
+
+/// What a run measured.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TeleopResult {
+    /// The link's energy balance (both ports).
+    pub network: NetworkEnergy,
+    /// Energy the passivity controllers dissipated (J).
+    pub dissipated: f64,
+    /// Over the last second: mean wall force on the slave (N, x) …
+    pub wall_force: f64,
+    /// … mean force the master applied to the hand's handle (N, x, the contact felt) …
+    pub master_force: f64,
+    /// … and mean `| |F_master| − |F_wall| |` (N).
+    pub force_error: f64,
+    /// Largest master force (N).
+    pub max_master_force: f64,
+    /// Deepest slave penetration into the wall (m).
+    pub max_penetration: f64,
+    /// `|x_m − x_s|` at the end (m): coupling deflection plus drift.
+    pub separation: f64,
+    /// Samples run (fewer than asked if a device fault stopped it).
+    pub samples: u64,
+    /// Why it stopped early, if it did.
+    pub fault: Option<&'static str>,
+}
+
+/// Master → slave: pose, twist, energy in.
+#[derive(Clone, Copy, Debug)]
+struct Up {
+    x: V3,
+    v: V3,
+    e_in: V3,
+}
+
+/// Slave → master: force for the master, energy in.
+#[derive(Clone, Copy, Debug)]
+struct Down {
+    f: V3,
+    e_in: V3,
+}
+
+/// One device: plant, estimator, port, last torques.
+struct Side {
+    plant: SimDevice,
+    dev: TwinPantograph,
+    port: PlanarTdpa,
+    tau: [f64; 4],
+}
+
+impl Side {
+    fn new(p: &DeviceParams, x0: V3, dt: f64) -> Result<Self, String> {
+        let mut dev = TwinPantograph::new(*p, dt, ObserverKind::default())?;
+        dev.reset(x0[2]);
+        Ok(Self {
+            plant: SimDevice::new(p, x0)?,
+            dev,
+            port: PlanarTdpa::default(),
+            tau: [0.0; 4],
+        })
+    }
+
+    /// Reads the encoders: (pose, twist).
+    fn sense(&mut self) -> Result<(V3, V3), &'static str> {
+        let q = self.plant.encoders().map_err(|_| "encoders")?;
+        let e = self.dev.estimate(&q, &self.tau).map_err(|_| "kinematics")?;
+        Ok((e.pose, e.velocity))
+    }
+
+    /// The port's controller on `f_req` against `far` (J), torques, booking: returns the force
+    /// applied (N, N, N·m).
+    fn drive(
+        &mut self,
+        f_req: &V3,
+        v: &V3,
+        far: &V3,
+        tdpa: bool,
+        dt: f64,
+    ) -> Result<V3, &'static str> {
+        let f = if tdpa {
+            let m = self.dev.mass_matrix();
+            let amax = [0, 1, 2].map(|i| 2.0 * m[i][i].abs() / dt);
+            self.port.control(f_req, v, far, dt, &amax)
+        } else {
+            *f_req
+        };
+        let c = self
+            .dev
+            .torques_for_wrench(&f, 0.0)
+            .map_err(|_| "torques")?;
+        self.tau = if c.near_singular { [0.0; 4] } else { c.tau };
+        let scale = if c.near_singular { 0.0 } else { c.wrench_scale };
+        let applied = f.map(|x| x * scale);
+        if tdpa {
+            self.port.book(&applied, v, dt);
+        } else {
+            self.port.observe(&applied, v, dt);
+        }
+        Ok(applied)
+    }
+}
+
+/// Runs `cfg`. Errors only for a device that cannot be built.
+pub fn run_teleop(cfg: &Teleop) -> Result<TeleopResult, String> {
+    let p = DeviceParams::default();
+    let o = [p.workspace_center_x, p.workspace_center_y, 0.0];
+    let dt = cfg.dt;
+    let (mut m, mut s) = (Side::new(&p, o, dt)?, Side::new(&p, o, dt)?);
+    let mut up: Link<Up> = Link::new(cfg.link);
+    let mut down: Link<Down> = Link::new(Impairment {
+        seed: cfg.link.seed.wrapping_add(1),
+        ..cfg.link
+    });
+    let n = (cfg.duration / dt).round() as u64;
+    let len = cfg.push[0].hypot(cfg.push[1]);
+    let (mut wall_sum, mut mf_sum, mut err_sum, mut window) = (0.0, 0.0, 0.0, 0u64);
+    let (mut max_f, mut max_pen, mut separation) = (0.0f64, 0.0f64, 0.0);
+    let mut fault = None;
+    let mut k = 0;
+    while k < n {
+        let t = k as f64 * dt;
+        let ((xm, vm), (xs, vs)) = match (m.sense(), s.sense()) {
+            (Ok(a), Ok(b)) => (a, b),
+            (Err(e), _) | (_, Err(e)) => {
+                fault = Some(e);
+                break;
+            }
+        };
+        // Master: the newest force from the slave through its port.
+        let (f_req, far_s) = down
+            .receive(k)
+            .map_or(([0.0; 3], [0.0; 3]), |d| (d.f, d.e_in));
+        let Ok(f_m) = m.drive(&f_req, &vm, &far_s, cfg.tdpa, dt) else {
+            fault = Some("master torques");
+            break;
+        };
+        let rel = |x: &V3| -> V3 { std::array::from_fn(|i| x[i] - o[i]) };
+        up.send(
+            k,
+            Up {
+                x: rel(&xm),
+                v: vm,
+                e_in: m.port.energy_in(),
+            },
+        );
+        // Slave: the coupling to the newest master state, through its port.
+        let (f_c, far_m) = up.receive(k).map_or(([0.0; 3], [0.0; 3]), |u| {
+            let xs_r = rel(&xs);
+            let f: V3 = std::array::from_fn(|i| {
+                cfg.k[i] * (u.x[i] - xs_r[i]) + cfg.b[i] * (u.v[i] - vs[i])
+            });
+            (f, u.e_in)
+        });
+        if s.drive(&f_c, &vs, &far_m, cfg.tdpa, dt).is_err() {
+            fault = Some("slave torques");
+            break;
+        }
+        down.send(
+            k,
+            Down {
+                f: f_c.map(|f| -f),
+                e_in: s.port.energy_in(),
+            },
+        );
+        // The environments: the hand on the master, the wall on the slave (true poses).
+        let frac = if len > 0.0 {
+            ((t - cfg.push_at).max(0.0) * cfg.push_speed / len).min(1.0)
+        } else {
+            0.0
+        };
+        let target = [o[0] + frac * cfg.push[0], o[1] + frac * cfg.push[1], o[2]];
+        let sx = s.plant.pose()[0] - o[0];
+        let pen = cfg.wall_x - sx;
+        let f_wall = if pen > 0.0 {
+            (cfg.k_wall * pen - cfg.b_wall * s.plant.velocity()[0]).max(0.0)
+        } else {
+            0.0
+        };
+        max_pen = max_pen.max(pen);
+        max_f = max_f.max(f_m[0].hypot(f_m[1]));
+        if t >= cfg.duration - 1.0 {
+            wall_sum += f_wall;
+            mf_sum += f_m[0];
+            err_sum += (f_m[0].abs() - f_wall).abs();
+            window += 1;
+        }
+        separation = (xm[0] - xs[0]).hypot(xm[1] - xs[1]);
+        let wall = HandModel::Constant {
+            wrench: [f_wall, 0.0, 0.0],
+        };
+        if m.plant.step(&m.tau, &HandModel::grip(target), dt).is_err()
+            || s.plant.step(&s.tau, &wall, dt).is_err()
+        {
+            fault = Some("plant");
+            break;
+        }
+        k += 1;
+    }
+    let w = window.max(1) as f64;
+    let (mt, st) = (m.port.totals(), s.port.totals());
+    Ok(TeleopResult {
+        network: planar_balance((mt.0, mt.1), (st.0, st.1)),
+        dissipated: mt.2 + st.2,
+        wall_force: wall_sum / w,
+        master_force: mf_sum / w,
+        force_error: err_sum / w,
+        max_master_force: max_f,
+        max_penetration: max_pen,
+        separation,
+        samples: k,
+        fault,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn run(round_trip_ms: u32, loss: f64, tdpa: bool) -> TeleopResult {
+        let link = Impairment::delay_loss(round_trip_ms / 2, loss, 5);
+        run_teleop(&Teleop::new(link, tdpa)).unwrap()
+    }
+
+    /// In steady contact the master pushes back on the hand with the wall's force: hand spring
+    /// (300 N/m) against the coupling (500 N/m) in series with the wall (2 000 N/m), the target
+    /// 15 mm from the start and the wall 5 mm: the static force is
+    /// `(15 − 5) mm / (1/300 + 1/500 + 1/2000) m/N = 1.76 N` (device friction aside).
+    #[test]
+    fn the_slave_wall_contact_is_felt_at_the_master() {
+        let r = run(0, 0.0, true);
+        assert_eq!(r.fault, None, "{r:?}");
+        assert!((1.4..2.1).contains(&r.wall_force), "{r:?}");
+        assert!(
+            r.master_force > 0.0,
+            "the master pushes the hand back (+x): {r:?}"
+        );
+        assert!(r.force_error < 0.1 * r.wall_force, "{r:?}");
+    }
+
+    #[test]
+    fn with_tdpa_teleoperation_at_a_50_ms_round_trip_with_loss_creates_no_energy() {
+        for (rt, loss) in [(10, 0.05), (50, 0.05), (200, 0.1)] {
+            let r = run(rt, loss, true);
+            assert_eq!(r.fault, None, "{r:?}");
+            assert!(r.network.created <= 1e-3, "{rt} ms, {loss}: {r:?}");
+            assert!(
+                r.wall_force > 1.0,
+                "{rt} ms: the wall was not reached: {r:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn without_tdpa_teleoperation_at_a_50_ms_round_trip_creates_energy() {
+        let r = run(50, 0.05, false);
+        assert!(r.network.created > 0.01, "{r:?}");
+    }
+}
