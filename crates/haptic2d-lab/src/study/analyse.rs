@@ -3,11 +3,14 @@
 //! of the JND, the Weber fraction (JND / reference value), the staircases' reversal estimate, and
 //! the plots (psychometric curves and staircase tracks).
 //!
-//! The PSE is not reported: in this 2AFC design the comparison is always the stiffer stimulus, so
-//! the point of subjective equality is the reference by construction. A PSE needs a design with
-//! comparisons on both sides of a reference of another law (not built yet).
+//! A **PSE condition** (its comparison is another stimulus than its reference: a spring against a
+//! pulse wall) has no correct answer (`correct` is `-`): there the analysis fits
+//! `P(comparison named stiffer) = λ/2 + (1 − λ)·Φ((ln x − ln PSE)/σ)` against the comparison's value
+//! `x` (a log axis: Weber's law) and reports the PSE (the comparison value that feels as stiff as the
+//! reference), its ratio to the reference's nominal value, and the JND `PSE·(exp(σ·z₀.₇₅) − 1)`
+//! (from 50 % to 75 %), each with a parametric-bootstrap 95 % interval. A PSE outside the tested comparisons is reported as such, without an interval.
 
-use super::fit::{bootstrap_thresholds, fit, quantile, Point, PsyFit, Shape};
+use super::fit::{bootstrap, bootstrap_thresholds, fit, fit_pse, quantile, Point, PsyFit, Shape};
 use super::rng::mix;
 use super::trials::{self, TrialRow};
 use crate::plot::{write_panels, Panel, Series, Stroke};
@@ -65,6 +68,24 @@ pub struct ConditionResult {
     pub staircase_estimate: Option<f64>,
     /// Staircase tracks: per track, `(trial, delta)`.
     pub tracks: BTreeMap<usize, Vec<(f64, f64)>>,
+    /// The point of subjective equality of a PSE condition.
+    pub pse: Option<Pse>,
+}
+
+/// The PSE of a PSE condition (unit of the varied parameter).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Pse {
+    /// The comparison value judged stiffer half the time (without lapses).
+    pub value: f64,
+    /// Its bootstrap 95 % interval (`NaN`s when outside the tested range).
+    pub ci: (f64, f64),
+    /// `value / reference_value` (the reference's nominal value of the varied parameter).
+    pub ratio: f64,
+    /// Its 95 % interval.
+    pub ratio_ci: (f64, f64),
+    /// `Some("above")` / `Some("below")` when the PSE lies beyond the tested comparisons: the
+    /// comparison was (almost) never / always named stiffer.
+    pub outside: Option<&'static str>,
 }
 
 /// Every `trials.tsv` at or below `dir` (a session directory or a study's output directory).
@@ -115,18 +136,25 @@ pub fn analyse_rows(
             .filter(|r| &r.condition == name && !r.practice)
             .collect();
         let Some(first) = rs.first() else { continue };
+        let is_pse = rs.iter().any(|r| r.correct.is_none());
         let mut levels: BTreeMap<u64, Point> = BTreeMap::new();
         for r in &rs {
-            let p = levels.entry(r.delta.to_bits()).or_insert(Point {
-                x: r.delta,
-                n: 0,
-                k: 0,
-            });
+            let x = if is_pse { r.comparison_value } else { r.delta };
+            let p = levels.entry(x.to_bits()).or_insert(Point { x, n: 0, k: 0 });
             p.n += 1;
-            p.k += u32::from(r.correct);
+            p.k += u32::from(if is_pse {
+                r.comparison_chosen()
+            } else {
+                r.correct == Some(true)
+            });
         }
         let mut points: Vec<Point> = levels.into_values().collect();
         points.sort_by(|a, b| a.x.total_cmp(&b.x));
+        let rv = first.reference_value;
+        if is_pse {
+            out.push(analyse_pse(name, first, points, opts, ci as u64)?);
+            continue;
+        }
         let f = fit(&points, opts.shape, 0.5, opts.max_lapse)
             .map_err(|e| format!("condition `{name}`: {e}"))?;
         let boot = bootstrap_thresholds(
@@ -137,7 +165,6 @@ pub fn analyse_rows(
             opts.max_lapse,
         );
         let jnd_ci = (quantile(&boot, 0.025), quantile(&boot, 0.975));
-        let rv = first.reference_value;
         // Staircases.
         let mut tracks: BTreeMap<usize, Vec<(f64, f64)>> = BTreeMap::new();
         let mut reversal_deltas = Vec::new();
@@ -169,6 +196,7 @@ pub fn analyse_rows(
             fit: f,
             staircase_estimate,
             tracks,
+            pse: None,
         });
     }
     if out.is_empty() {
@@ -177,24 +205,113 @@ pub fn analyse_rows(
     Ok(out)
 }
 
+/// The PSE analysis of one condition (see the module documentation).
+fn analyse_pse(
+    name: &str,
+    first: &TrialRow,
+    points: Vec<Point>,
+    opts: &AnalyseOptions,
+    ci: u64,
+) -> Result<ConditionResult, String> {
+    // Fitted on the log of the comparison's value: a Weber-law observer's judgement is a cumulative
+    // normal of the log stimulus ratio, so the fit is not skewed where a linear axis would be.
+    if let Some(p) = points.iter().find(|p| p.x.is_nan() || p.x <= 0.0) {
+        return Err(format!(
+            "condition `{name}`: comparison value {} is not positive: the PSE is fitted on a log axis",
+            p.x
+        ));
+    }
+    let logs: Vec<Point> = points.iter().map(|p| Point { x: p.x.ln(), ..*p }).collect();
+    let f = fit_pse(&logs, opts.max_lapse).map_err(|e| format!("condition `{name}`: {e}"))?;
+    let rv = first.reference_value;
+    let lo = points.first().map_or(f64::NAN, |p| p.x);
+    let hi = points.last().map_or(f64::NAN, |p| p.x);
+    let prop = |p: &Point| f64::from(p.k) / f64::from(p.n);
+    let pse = |f: &PsyFit| f.alpha.exp();
+    let jnd = |f: &PsyFit| (f.alpha + f.spread()).exp() - f.alpha.exp();
+    let outside = if points.iter().all(|p| prop(p) < 0.5) || pse(&f) > hi {
+        Some("above")
+    } else if points.iter().all(|p| prop(p) > 0.5) || pse(&f) < lo {
+        Some("below")
+    } else {
+        None
+    };
+    let boot = bootstrap(
+        &f,
+        &logs,
+        opts.bootstrap,
+        mix(opts.seed, ci),
+        opts.max_lapse,
+    );
+    let sorted = |g: &dyn Fn(&PsyFit) -> f64| {
+        let mut v: Vec<f64> = boot.iter().map(g).filter(|x| x.is_finite()).collect();
+        v.sort_by(f64::total_cmp);
+        (quantile(&v, 0.025), quantile(&v, 0.975))
+    };
+    let nan = (f64::NAN, f64::NAN);
+    let (pse_ci, jnd_ci) = if outside.is_some() {
+        (nan, nan)
+    } else {
+        (sorted(&pse), sorted(&jnd))
+    };
+    let weber = jnd(&f) / pse(&f);
+    let weber_ci = if outside.is_some() {
+        nan
+    } else {
+        sorted(&|b| jnd(b) / pse(b))
+    };
+    let jnd = jnd(&f);
+    Ok(ConditionResult {
+        condition: name.to_string(),
+        vary: first.vary.clone(),
+        reference_value: rv,
+        trials: points.iter().map(|p| p.n).sum(),
+        points,
+        jnd,
+        jnd_ci,
+        weber,
+        weber_ci,
+        staircase_estimate: None,
+        tracks: BTreeMap::new(),
+        pse: Some(Pse {
+            value: pse(&f),
+            ci: pse_ci,
+            ratio: pse(&f) / rv,
+            ratio_ci: (pse_ci.0 / rv, pse_ci.1 / rv),
+            outside,
+        }),
+        fit: f,
+    })
+}
+
 /// The results as a TSV table (header + one row per condition).
 pub fn results_tsv(res: &[ConditionResult]) -> String {
-    let mut s = String::from("condition\tvary\treference_value\ttrials\tshape\talpha\tbeta\tlapse\tjnd\tjnd_ci_lo\tjnd_ci_hi\tweber\tweber_ci_lo\tweber_ci_hi\tstaircase_estimate\tpse\n");
+    let mut s = String::from("condition\tvary\treference_value\ttrials\tshape\talpha\tbeta\tlapse\tjnd\tjnd_ci_lo\tjnd_ci_hi\tweber\tweber_ci_lo\tweber_ci_hi\tstaircase_estimate\tpse\tpse_ci_lo\tpse_ci_hi\tpse_ratio\tpse_outside\n");
     for r in res {
         s.push_str(&format!(
-            "{}\t{}\t{}\t{}\t{}\t{:.6}\t{:.6}\t{:.6}\t{:.6}\t{:.6}\t{:.6}\t{:.6}\t{:.6}\t{:.6}\t{}\t-\n",
+            "{}\t{}\t{}\t{}\t{}\t{:.6}\t{:.6}\t{:.6}\t{:.6}\t{:.6}\t{:.6}\t{:.6}\t{:.6}\t{:.6}\t{}\t{}\n",
             r.condition, r.vary, r.reference_value, r.trials, r.fit.shape.name(), r.fit.alpha, r.fit.beta, r.fit.lapse,
             r.jnd, r.jnd_ci.0, r.jnd_ci.1, r.weber, r.weber_ci.0, r.weber_ci.1,
             r.staircase_estimate.map_or("-".into(), |v| format!("{v:.6}")),
+            r.pse.as_ref().map_or("-\t-\t-\t-\t-".into(), |p| format!(
+                "{:.6}\t{:.6}\t{:.6}\t{:.6}\t{}",
+                p.value,
+                p.ci.0,
+                p.ci.1,
+                p.ratio,
+                p.outside.unwrap_or("-")
+            )),
         ));
     }
     s
 }
 
-/// The trials per stimulus level as a TSV table (`condition delta n_trials n_correct`: the
-/// `[x, k, n]` data other fitting tools such as psignifit take).
+/// The trials per stimulus level as a TSV table (`condition level n_trials n_yes`: the `[x, k, n]`
+/// data other fitting tools such as psignifit take). `level` is the delta and `n_yes` the correct
+/// answers in a discrimination; in a PSE condition `level` is the comparison's value and `n_yes`
+/// the answers naming the comparison stiffer.
 pub fn levels_tsv(res: &[ConditionResult]) -> String {
-    let mut s = String::from("condition\tdelta\tn_trials\tn_correct\n");
+    let mut s = String::from("condition\tlevel\tn_trials\tn_yes\n");
     for r in res {
         for p in &r.points {
             s.push_str(&format!("{}\t{}\t{}\t{}\n", r.condition, p.x, p.n, p.k));
@@ -221,10 +338,20 @@ pub fn plot(res: &[ConditionResult], stem: &Path, title: &str) -> Result<Vec<Pat
     let mut panels = Vec::new();
     for (i, r) in res.iter().enumerate() {
         let xmax = r.points.iter().map(|p| p.x).fold(0.0, f64::max) * 1.1;
+        let xmin = if r.pse.is_some() {
+            r.points.first().map_or(0.0, |p| p.x) * 0.9
+        } else {
+            0.0
+        };
         let curve: Vec<(f64, f64)> = (0..=200)
             .map(|j| {
-                let x = xmax * f64::from(j) / 200.0;
-                (x, r.fit.p(x))
+                let x = xmin + (xmax - xmin) * f64::from(j) / 200.0;
+                let y = if r.pse.is_some() {
+                    r.fit.p(x.max(1e-300).ln())
+                } else {
+                    r.fit.p(x)
+                };
+                (x, y)
             })
             .collect();
         let data: Vec<(f64, f64)> = r
@@ -232,17 +359,41 @@ pub fn plot(res: &[ConditionResult], stem: &Path, title: &str) -> Result<Vec<Pat
             .iter()
             .map(|p| (p.x, f64::from(p.k) / f64::from(p.n)))
             .collect();
-        panels.push(Panel {
-            title: format!(
-                "{}: JND {} [{}, {}], Weber {:.3}",
-                r.condition,
-                short(r.jnd),
-                short(r.jnd_ci.0),
-                short(r.jnd_ci.1),
-                r.weber
+        let (title, x_label, y_label, h_lines) = match &r.pse {
+            Some(p) => (
+                match p.outside {
+                    Some(side) => format!("{}: PSE {side} the tested range", r.condition),
+                    None => format!(
+                        "{}: PSE {} [{}, {}] ({:.2} × nominal)",
+                        r.condition,
+                        short(p.value),
+                        short(p.ci.0),
+                        short(p.ci.1),
+                        p.ratio
+                    ),
+                },
+                format!("{} of the comparison", r.vary),
+                "proportion comparison named stiffer".to_string(),
+                vec![0.5],
             ),
-            x_label: format!("delta of {} (comparison − reference)", r.vary),
-            y_label: "proportion correct".into(),
+            None => (
+                format!(
+                    "{}: JND {} [{}, {}], Weber {:.3}",
+                    r.condition,
+                    short(r.jnd),
+                    short(r.jnd_ci.0),
+                    short(r.jnd_ci.1),
+                    r.weber
+                ),
+                format!("delta of {} (comparison − reference)", r.vary),
+                "proportion correct".to_string(),
+                vec![0.5, 0.75],
+            ),
+        };
+        panels.push(Panel {
+            title,
+            x_label,
+            y_label,
             series: vec![
                 Series::new("data", data, i, Stroke::Markers),
                 Series::new(
@@ -252,7 +403,7 @@ pub fn plot(res: &[ConditionResult], stem: &Path, title: &str) -> Result<Vec<Pat
                     Stroke::Solid,
                 ),
             ],
-            h_lines: vec![0.5, 0.75],
+            h_lines,
             y_range: Some((0.0, 1.02)),
             ..Panel::default()
         });
@@ -304,4 +455,68 @@ pub fn analyse_dir(
         &format!("{} session(s): psychometric functions", sessions.len()),
     )?);
     Ok((res, paths))
+}
+
+/// The text report of one condition (what `haptic2d study analyse` prints).
+pub fn report(r: &ConditionResult, bootstrap: u32) -> String {
+    let mut s = format!(
+        "{} ({}, reference {}): {} trials, {} fit (α = {:.4}, β = {:.3}, lapse {:.3})\n",
+        r.condition,
+        r.vary,
+        r.reference_value,
+        r.trials,
+        if r.pse.is_some() {
+            "PSE: cumulative normal of ln(comparison value)"
+        } else {
+            r.fit.shape.name()
+        },
+        r.fit.alpha,
+        r.fit.beta,
+        r.fit.lapse
+    );
+    match &r.pse {
+        Some(p) => {
+            match p.outside {
+                Some(side) => s.push_str(&format!(
+                    "  PSE {side} the tested comparisons ({} to {}): the comparison was {} named stiffer; no interval\n",
+                    r.points.first().map_or(f64::NAN, |q| q.x),
+                    r.points.last().map_or(f64::NAN, |q| q.x),
+                    if side == "above" { "(almost) never" } else { "(almost) always" }
+                )),
+                None => {
+                    s.push_str(&format!(
+                        "  PSE {:.4} [{:.4}, {:.4}] (95 % parametric bootstrap, {bootstrap} reps): the comparison value that feels as stiff as the reference\n",
+                        p.value, p.ci.0, p.ci.1
+                    ));
+                    s.push_str(&format!(
+                        "  PSE / nominal {:.4} [{:.4}, {:.4}] (nominal {} = {}: the reference's value, or the comparison's base when the reference has no such parameter)\n",
+                        p.ratio, p.ci.0 / r.reference_value, p.ci.1 / r.reference_value, r.vary, r.reference_value
+                    ));
+                    s.push_str(&format!(
+                        "  JND (PSE to 75 %) {:.4} [{:.4}, {:.4}], Weber fraction at the PSE {:.4} [{:.4}, {:.4}]\n",
+                        r.jnd, r.jnd_ci.0, r.jnd_ci.1, r.weber, r.weber_ci.0, r.weber_ci.1
+                    ));
+                }
+            }
+        }
+        None => {
+            s.push_str(&format!(
+                "  JND (75 % correct) {:.4} [{:.4}, {:.4}] (95 % parametric bootstrap, {bootstrap} reps)\n",
+                r.jnd, r.jnd_ci.0, r.jnd_ci.1
+            ));
+            s.push_str(&format!(
+                "  Weber fraction {:.4} [{:.4}, {:.4}]\n",
+                r.weber, r.weber_ci.0, r.weber_ci.1
+            ));
+            if let Some(e) = r.staircase_estimate {
+                s.push_str(&format!(
+                    "  staircase estimate (mean delta at reversals after the second) {e:.4}\n"
+                ));
+            }
+            s.push_str(
+                "  PSE: not defined by this design (the comparison is always the stiffer stimulus)\n",
+            );
+        }
+    }
+    s
 }

@@ -58,6 +58,14 @@ impl Method {
         }
     }
 
+    /// The smallest delta the method can present.
+    pub fn smallest_delta(&self) -> f64 {
+        match self {
+            Method::Constant { deltas, .. } => deltas.iter().copied().fold(f64::INFINITY, f64::min),
+            Method::Staircase(s) => s.min_delta,
+        }
+    }
+
     /// The delta of practice trials: the largest constant delta, or the largest staircase start.
     pub fn practice_delta(&self) -> f64 {
         match self {
@@ -67,7 +75,12 @@ impl Method {
     }
 
     /// Validates `[method]`; problems go to `errs` with the field and the fix.
-    pub fn from_section(m: &MethodSection, errs: &mut Vec<SceneError>) -> Option<Method> {
+    /// `own_deltas`: every condition gives its own `deltas`, so `[method]` need not.
+    pub fn from_section(
+        m: &MethodSection,
+        own_deltas: bool,
+        errs: &mut Vec<SceneError>,
+    ) -> Option<Method> {
         let mut e = |field: &str, msg: String, fix: &str| {
             errs.push(SceneError::new(format!("method.{field}"), msg, fix))
         };
@@ -75,14 +88,16 @@ impl Method {
         match m.kind.as_str() {
             "constant" => {
                 let deltas = m.deltas.clone().unwrap_or_default();
-                if deltas.is_empty() {
+                if deltas.is_empty() && !own_deltas {
                     e("deltas", "the method of constant stimuli needs its deltas".into(), "e.g. deltas = [50.0, 100.0, 200.0] (comparison − reference, unit of `vary`)");
                 }
-                if let Some(d) = deltas.iter().find(|d| !positive(**d)) {
+                // The sign is checked per condition (file.rs): > 0 for a discrimination, any for
+                // a PSE condition.
+                if let Some(d) = deltas.iter().find(|d| !d.is_finite()) {
                     e(
                         "deltas",
-                        format!("{d} is not a positive number"),
-                        "every delta must be > 0: the comparison is the stiffer stimulus",
+                        format!("{d} is not a number"),
+                        "give finite deltas",
                     );
                 }
                 let repeats = m.repeats.unwrap_or(0);

@@ -15,6 +15,7 @@
 //! trial, QUEST, 3AFC/same–different/magnitude estimation, PsychoPy (see `docs/STUDIES.md`).
 
 pub mod analyse;
+pub mod explore;
 pub mod file;
 pub mod fit;
 pub mod method;

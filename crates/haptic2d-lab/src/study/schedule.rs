@@ -82,9 +82,9 @@ impl Schedule {
         let b = &self.study.blocks[self.block];
         self.practice_left = b.practice;
         self.queue.clear();
-        if let Method::Constant { deltas, repeats } = &self.study.method {
+        if let Method::Constant { repeats, .. } = &self.study.method {
             for &c in &b.conditions {
-                for &d in deltas {
+                for &d in self.study.deltas(c) {
                     for _ in 0..*repeats {
                         self.queue.push((c, d));
                     }
@@ -131,7 +131,7 @@ impl Schedule {
         let (condition, track, delta, practice) = if self.practice_left > 0 {
             self.practice_left -= 1;
             let c = conds[self.rng.below(conds.len())];
-            (c, None, self.study.method.practice_delta(), true)
+            (c, None, self.study.practice_delta(c), true)
         } else if let Some((c, d)) = self.queue.pop() {
             (c, None, d, false)
         } else {
@@ -170,7 +170,12 @@ impl Schedule {
         let n = self.study.conditions.len() as u32;
         practice
             + match &self.study.method {
-                Method::Constant { deltas, repeats } => n * deltas.len() as u32 * repeats,
+                Method::Constant { repeats, .. } => {
+                    (0..self.study.conditions.len())
+                        .map(|c| self.study.deltas(c).len() as u32)
+                        .sum::<u32>()
+                        * repeats
+                }
                 Method::Staircase(s) => n * s.starts.len() as u32 * s.max_trials,
             }
     }

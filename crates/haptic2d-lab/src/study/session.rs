@@ -71,7 +71,7 @@ fn row(study: &Study, sched: &Schedule, spec: &TrialSpec, response: u8, rt: f64)
         delta: spec.delta,
         comparison_interval: spec.comparison_interval,
         response,
-        correct: response == spec.comparison_interval,
+        correct: (!c.pse).then_some(response == spec.comparison_interval),
         rt,
         reversals: stair.map(|s| s.reversals),
         run: stair.map(|s| s.run),
@@ -132,7 +132,7 @@ pub fn run(
                     tsv.display(), r.trial, r.condition, r.delta, r.comparison_interval, expect.condition, spec.delta, spec.comparison_interval
                 ));
             }
-            sched.record(&spec, r.correct);
+            sched.record(&spec, r.comparison_chosen());
             resumed += 1;
         }
         if complete < text.len() || text.is_empty() {
