@@ -104,6 +104,15 @@ fn describe_method(study: &Study) -> String {
                 n.join("/")
             )
         }
+        Method::Quest(q) => format!(
+            "QUEST (Bayesian placement at the posterior {}, prior {} ± {} log10, Weibull β = {}, lapse {}), {} trials per condition",
+            if q.place_at_mode { "mode" } else { "mean" },
+            q.start,
+            q.prior_sd,
+            q.beta,
+            q.lapse,
+            q.max_trials
+        ),
         Method::Staircase(s) => format!(
             "{} interleaved 1-up/{}-down staircase(s) per condition (target {:.1} % correct), stop at {} trials or {} reversals",
             s.starts.len(),
@@ -161,6 +170,9 @@ fn study_run(
         stop_after,
     )
     .map_err(Failure::error)?;
+    for (c, est, (lo, hi)) in &s.quest {
+        println!("QUEST {c}: threshold {est:.4} [{lo:.4}, {hi:.4}] (posterior mean, 95 % credible interval)");
+    }
     println!(
         "{}: {} trial(s) run{}; {}",
         s.dir.display(),

@@ -10,6 +10,7 @@
 //! reference), its ratio to the reference's nominal value, and the JND `PSE·(exp(σ·z₀.₇₅) − 1)`
 //! (from 50 % to 75 %), each with a parametric-bootstrap 95 % interval. A PSE outside the tested comparisons is reported as such, without an interval.
 
+use super::file::Task;
 use super::fit::{bootstrap, bootstrap_thresholds, fit, fit_pse, quantile, Point, PsyFit, Shape};
 use super::rng::mix;
 use super::trials::{self, TrialRow};
@@ -28,6 +29,9 @@ pub struct AnalyseOptions {
     pub seed: u64,
     /// Upper bound of the fitted lapse rate.
     pub max_lapse: f64,
+    /// The task's guess rate (0.5 for 2AFC, 1/3 for 3AFC); [`analyse_dir`] reads it from the
+    /// sessions' `study.toml`.
+    pub guess: f64,
 }
 
 impl Default for AnalyseOptions {
@@ -37,6 +41,7 @@ impl Default for AnalyseOptions {
             bootstrap: 500,
             seed: 1,
             max_lapse: 0.06,
+            guess: 0.5,
         }
     }
 }
@@ -155,7 +160,7 @@ pub fn analyse_rows(
             out.push(analyse_pse(name, first, points, opts, ci as u64)?);
             continue;
         }
-        let f = fit(&points, opts.shape, 0.5, opts.max_lapse)
+        let f = fit(&points, opts.shape, opts.guess, opts.max_lapse)
             .map_err(|e| format!("condition `{name}`: {e}"))?;
         let boot = bootstrap_thresholds(
             &f,
@@ -170,11 +175,13 @@ pub fn analyse_rows(
         let mut reversal_deltas = Vec::new();
         let mut last_rev: BTreeMap<usize, u32> = BTreeMap::new();
         for r in &rs {
-            if let (Some(t), Some(rev)) = (r.track, r.reversals) {
+            if let Some(t) = r.track {
                 tracks
                     .entry(t)
                     .or_default()
                     .push((f64::from(r.trial), r.delta));
+            }
+            if let (Some(t), Some(rev)) = (r.track, r.reversals) {
                 let prev = last_rev.insert(t, rev).unwrap_or(0);
                 if rev > prev && rev > 2 {
                     reversal_deltas.push(r.delta);
@@ -387,7 +394,7 @@ pub fn plot(res: &[ConditionResult], stem: &Path, title: &str) -> Result<Vec<Pat
                 ),
                 format!("delta of {} (comparison − reference)", r.vary),
                 "proportion correct".to_string(),
-                vec![0.5, 0.75],
+                vec![r.fit.guess, r.fit.guess + (1.0 - r.fit.guess) / 2.0],
             ),
         };
         panels.push(Panel {
@@ -430,6 +437,22 @@ pub fn plot(res: &[ConditionResult], stem: &Path, title: &str) -> Result<Vec<Pat
     write_panels(stem, title, &panels, 2, (640, 440))
 }
 
+/// The task of the session whose `trials.tsv` is `tsv`, from the `study.toml` stored beside it
+/// (2AFC when there is none: sessions written before the task was recorded).
+fn session_task(tsv: &Path) -> Result<Task, String> {
+    let p = tsv.with_file_name("study.toml");
+    let Ok(text) = std::fs::read_to_string(&p) else {
+        return Ok(Task::TwoAfc);
+    };
+    let t: toml::Table = toml::from_str(&text).map_err(|e| format!("{}: {e}", p.display()))?;
+    let kind = t
+        .get("task")
+        .and_then(|t| t.get("kind"))
+        .and_then(|k| k.as_str())
+        .unwrap_or("2afc");
+    Task::from_name(kind).ok_or_else(|| format!("{}: unknown task `{kind}`", p.display()))
+}
+
 /// Analyses every session at or below `dir` and writes `analysis.tsv`, `analysis-levels.tsv` and
 /// `psychometric.svg/.png` in `dir`. Returns the results and the written paths.
 pub fn analyse_dir(
@@ -437,6 +460,21 @@ pub fn analyse_dir(
     opts: &AnalyseOptions,
 ) -> Result<(Vec<ConditionResult>, Vec<PathBuf>), String> {
     let sessions = find_sessions(dir)?;
+    let mut opts = *opts;
+    let mut task: Option<Task> = None;
+    for s in &sessions {
+        let t = session_task(s)?;
+        if task.is_some_and(|k| k != t) {
+            return Err(format!(
+                "{}: the sessions below {} are of different tasks; analyse them separately",
+                s.display(),
+                dir.display()
+            ));
+        }
+        task = Some(t);
+    }
+    opts.guess = task.unwrap_or(Task::TwoAfc).guess_rate();
+    let opts = &opts;
     let mut rows = Vec::new();
     for s in &sessions {
         let text = std::fs::read_to_string(s).map_err(|e| format!("{}: {e}", s.display()))?;
@@ -501,7 +539,8 @@ pub fn report(r: &ConditionResult, bootstrap: u32) -> String {
         }
         None => {
             s.push_str(&format!(
-                "  JND (75 % correct) {:.4} [{:.4}, {:.4}] (95 % parametric bootstrap, {bootstrap} reps)\n",
+                "  JND ({:.0} % correct) {:.4} [{:.4}, {:.4}] (95 % parametric bootstrap, {bootstrap} reps)\n",
+                100.0 * (r.fit.guess + (1.0 - r.fit.guess) / 2.0),
                 r.jnd, r.jnd_ci.0, r.jnd_ci.1
             ));
             s.push_str(&format!(

@@ -107,8 +107,18 @@ pub struct MethodSection {
     pub max_reversals: Option<u32>,
     /// Staircase: smallest delta (default: the smallest start / 64).
     pub min_delta: Option<f64>,
-    /// Staircase: largest delta (default: 4 × the largest start).
+    /// Staircase: largest delta (default: 4 × the largest start). QUEST: the grid's ends.
     pub max_delta: Option<f64>,
+    /// QUEST: the prior's centre, the expected threshold (delta).
+    pub start: Option<f64>,
+    /// QUEST: the prior's sd of log₁₀ threshold (default 0.5).
+    pub prior_sd: Option<f64>,
+    /// QUEST: the assumed Weibull slope (default 3.5).
+    pub beta: Option<f64>,
+    /// QUEST: the assumed lapse rate (default 0.01).
+    pub lapse: Option<f64>,
+    /// QUEST: `"mean"` (default) or `"mode"` of the posterior.
+    pub placement: Option<String>,
 }
 
 /// `[[block]]`.
@@ -164,13 +174,36 @@ pub struct ObserverSection {
 pub enum Task {
     /// Two intervals (reference and comparison in random order), "which was stiffer?".
     TwoAfc,
+    /// Three intervals (two references and the comparison, in random order), "which was
+    /// stiffest?".
+    ThreeAfc,
 }
 
 impl Task {
-    /// The guess rate `γ` of the task (0.5 for two alternatives).
+    /// The guess rate `γ` of the task (1 / the number of intervals).
     pub fn guess_rate(self) -> f64 {
+        1.0 / self.intervals() as f64
+    }
+    /// The number of intervals of a trial.
+    pub fn intervals(self) -> usize {
         match self {
-            Task::TwoAfc => 0.5,
+            Task::TwoAfc => 2,
+            Task::ThreeAfc => 3,
+        }
+    }
+    /// The task as written in `session.json`.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Task::TwoAfc => "2afc: which interval was stiffer?",
+            Task::ThreeAfc => "3afc: which of three intervals was stiffest?",
+        }
+    }
+    /// Parses `[task] kind` (as stored in a session's `study.toml`).
+    pub fn from_name(s: &str) -> Option<Task> {
+        match s {
+            "2afc" | "2ifc" => Some(Task::TwoAfc),
+            "3afc" | "3ifc" => Some(Task::ThreeAfc),
+            _ => None,
         }
     }
 }
@@ -364,14 +397,14 @@ fn validate(
     dir: Option<&Path>,
     errs: &mut Vec<SceneError>,
 ) -> Option<Study> {
-    let task = match f.task.kind.as_str() {
-        "2afc" | "2ifc" => Task::TwoAfc,
-        other => {
+    let task = match Task::from_name(&f.task.kind) {
+        Some(t) => t,
+        None => {
             err(
                 errs,
                 "task.kind",
-                format!("unknown task `{other}`"),
-                "write kind = \"2afc\" (or \"2ifc\"); 3AFC, same–different and magnitude estimation are not built yet",
+                format!("unknown task `{}`", f.task.kind),
+                "write kind = \"2afc\" (or \"2ifc\") or \"3afc\" (or \"3ifc\"); same–different and magnitude estimation are not built yet",
             );
             Task::TwoAfc
         }
@@ -538,11 +571,22 @@ fn validate(
                 }
             }
         }
-        if pse && f.method.kind == "staircase" {
+        if pse && !matches!(f.task.kind.as_str(), "2afc" | "2ifc") {
+            err(
+                errs,
+                "task.kind",
+                format!(
+                    "condition `{}` compares two stimuli (a PSE design), which needs two intervals",
+                    c.name
+                ),
+                "use kind = \"2afc\" for PSE conditions",
+            );
+        }
+        if pse && f.method.kind != "constant" {
             err(
                 errs,
                 &format!("{field}.comparison"),
-                format!("condition `{}` compares two stimuli (a PSE design), and staircases converge on a proportion correct", c.name),
+                format!("condition `{}` compares two stimuli (a PSE design), and adaptive methods converge on a proportion correct", c.name),
                 "use kind = \"constant\" with deltas on both sides of the expected PSE",
             );
         }

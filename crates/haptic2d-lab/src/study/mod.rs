@@ -21,6 +21,7 @@ pub mod fit;
 pub mod method;
 pub mod numeric;
 pub mod observer;
+pub mod quest;
 pub mod rng;
 pub mod schedule;
 pub mod session;

@@ -13,7 +13,8 @@
 //!    `σ = ln(1 + W)/(√2·z₀.₇₅)`: two intervals whose stiffnesses differ by the Weber fraction `W`
 //!    are then ordered correctly 75 % of the time (the JND at 75 % correct is `W·K`).
 //! 3. **Decision**: with probability `λ` (lapse rate) the model answers at random; otherwise it
-//!    names the interval of larger perceived stiffness.
+//!    names the interval of largest perceived stiffness (3AFC: each of the two reference intervals
+//!    is perceived with its own noise).
 //! 4. **Response time**: `2·2·press_time` of exploration plus a log-normal decision time of median
 //!    `decision_time` (log-sd 0.3): a placeholder, not a model of decision dynamics.
 //!
@@ -268,7 +269,7 @@ impl ObserverParams {
 /// An answer to one trial.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Answer {
-    /// The interval (1 or 2) named as stiffer.
+    /// The interval (1 to the task's number) named as stiffer (stiffest).
     pub response: u8,
     /// Response time (s), measured from the start of the first interval.
     pub rt: f64,
@@ -353,14 +354,27 @@ impl Observer for SimulatedObserver {
         let sigma = self.params.sigma();
         let p_ref = k_ref.ln() + sigma * rng.normal();
         let p_cmp = k_cmp.ln() + sigma * rng.normal();
+        let n = study.task.intervals();
+        // 3AFC: a second reference interval, perceived with its own noise (drawn after the 2AFC
+        // draws, so a 2AFC session's answers do not depend on this branch).
+        let p_ref2 = if n == 3 {
+            k_ref.ln() + sigma * rng.normal()
+        } else {
+            f64::NEG_INFINITY
+        };
         let lapse = rng.uniform() < self.params.lapse_rate;
-        let coin = 1 + rng.below(2) as u8;
+        let coin = 1 + rng.below(n) as u8;
+        let ci = spec.comparison_interval;
+        // The reference intervals in order: the ones that are not the comparison's.
+        let refs: Vec<u8> = (1..=n as u8).filter(|&i| i != ci).collect();
         let response = if lapse {
             coin
-        } else if p_cmp > p_ref {
-            spec.comparison_interval
+        } else if p_cmp > p_ref && p_cmp > p_ref2 {
+            ci
+        } else if p_ref >= p_ref2 {
+            refs[0]
         } else {
-            3 - spec.comparison_interval
+            refs[1]
         };
         let rt =
             4.0 * self.params.press_time + self.params.decision_time * (0.3 * rng.normal()).exp();

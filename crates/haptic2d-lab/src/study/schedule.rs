@@ -7,6 +7,7 @@
 
 use super::file::Study;
 use super::method::Method;
+use super::quest::Quest;
 use super::rng::Rng;
 use super::staircase::Staircase;
 
@@ -25,17 +26,64 @@ pub struct TrialSpec {
     pub track: Option<usize>,
     /// Comparison − base value of the varied parameter.
     pub delta: f64,
-    /// The interval (1 or 2) presenting the comparison.
+    /// The interval (1 to the task's number of intervals) presenting the comparison.
     pub comparison_interval: u8,
 }
 
-/// One staircase of the session.
+/// An adaptive track's state: a transformed up/down staircase or a QUEST.
+#[derive(Clone, Debug)]
+pub enum Tracker {
+    /// A staircase.
+    Stair(Staircase),
+    /// A QUEST.
+    Quest(Quest),
+}
+
+impl Tracker {
+    /// The delta of its next trial.
+    pub fn delta(&self) -> f64 {
+        match self {
+            Tracker::Stair(s) => s.delta,
+            Tracker::Quest(q) => q.delta,
+        }
+    }
+    /// Its stopping rule is met.
+    pub fn done(&self) -> bool {
+        match self {
+            Tracker::Stair(s) => s.done(),
+            Tracker::Quest(q) => q.done(),
+        }
+    }
+    /// Records an answer.
+    pub fn update(&mut self, correct: bool) {
+        match self {
+            Tracker::Stair(s) => s.update(correct),
+            Tracker::Quest(q) => q.update(correct),
+        }
+    }
+    /// The staircase, if it is one.
+    pub fn stair(&self) -> Option<&Staircase> {
+        match self {
+            Tracker::Stair(s) => Some(s),
+            Tracker::Quest(_) => None,
+        }
+    }
+    /// The QUEST, if it is one.
+    pub fn quest(&self) -> Option<&Quest> {
+        match self {
+            Tracker::Quest(q) => Some(q),
+            Tracker::Stair(_) => None,
+        }
+    }
+}
+
+/// One adaptive track of the session (a staircase or a QUEST).
 #[derive(Clone, Debug)]
 pub struct Track {
     /// Its condition.
     pub condition: usize,
     /// Its state.
-    pub stair: Staircase,
+    pub tracker: Tracker,
 }
 
 /// The schedule's state.
@@ -56,15 +104,26 @@ impl Schedule {
     /// A schedule for `study` from `seed`.
     pub fn new(study: &Study, seed: u64) -> Self {
         let mut tracks = Vec::new();
-        if let Method::Staircase(s) = &study.method {
-            for (c, _) in study.conditions.iter().enumerate() {
-                for &start in &s.starts {
+        match &study.method {
+            Method::Staircase(s) => {
+                for (c, _) in study.conditions.iter().enumerate() {
+                    for &start in &s.starts {
+                        tracks.push(Track {
+                            condition: c,
+                            tracker: Tracker::Stair(Staircase::new(s, start)),
+                        });
+                    }
+                }
+            }
+            Method::Quest(q) => {
+                for (c, _) in study.conditions.iter().enumerate() {
                     tracks.push(Track {
                         condition: c,
-                        stair: Staircase::new(s, start),
+                        tracker: Tracker::Quest(Quest::new(q, study.task.guess_rate())),
                     });
                 }
             }
+            Method::Constant { .. } => {}
         }
         Self {
             study: study.clone(),
@@ -99,14 +158,16 @@ impl Schedule {
     fn open_tracks(&self) -> Vec<usize> {
         let conds = &self.study.blocks[self.block].conditions;
         (0..self.tracks.len())
-            .filter(|&t| conds.contains(&self.tracks[t].condition) && !self.tracks[t].stair.done())
+            .filter(|&t| {
+                conds.contains(&self.tracks[t].condition) && !self.tracks[t].tracker.done()
+            })
             .collect()
     }
 
     fn block_left(&self) -> bool {
         match self.study.method {
             Method::Constant { .. } => !self.queue.is_empty(),
-            Method::Staircase(_) => !self.open_tracks().is_empty(),
+            Method::Staircase(_) | Method::Quest(_) => !self.open_tracks().is_empty(),
         }
     }
 
@@ -140,11 +201,11 @@ impl Schedule {
             (
                 self.tracks[t].condition,
                 Some(t),
-                self.tracks[t].stair.delta,
+                self.tracks[t].tracker.delta(),
                 false,
             )
         };
-        let comparison_interval = 1 + self.rng.below(2) as u8;
+        let comparison_interval = 1 + self.rng.below(self.study.task.intervals()) as u8;
         Some(TrialSpec {
             trial: self.trial,
             block: self.block as u32 + 1,
@@ -159,7 +220,7 @@ impl Schedule {
     /// Records the answer to `spec` (moves its staircase).
     pub fn record(&mut self, spec: &TrialSpec, correct: bool) {
         if let Some(t) = spec.track {
-            self.tracks[t].stair.update(correct);
+            self.tracks[t].tracker.update(correct);
         }
     }
 
@@ -177,6 +238,7 @@ impl Schedule {
                         * repeats
                 }
                 Method::Staircase(s) => n * s.starts.len() as u32 * s.max_trials,
+                Method::Quest(q) => n * q.max_trials,
             }
     }
 }

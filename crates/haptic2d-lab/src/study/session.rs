@@ -53,12 +53,14 @@ pub struct RunSummary {
     pub ran: u32,
     /// The session is complete.
     pub complete: bool,
+    /// QUEST's estimate per condition (name, threshold, 95 % credible interval), for QUEST studies.
+    pub quest: Vec<(String, f64, (f64, f64))>,
 }
 
 /// Row of `spec` answered `response` at `rt` s.
 fn row(study: &Study, sched: &Schedule, spec: &TrialSpec, response: u8, rt: f64) -> TrialRow {
     let c = &study.conditions[spec.condition];
-    let stair = spec.track.map(|t| &sched.tracks[t].stair);
+    let stair = spec.track.and_then(|t| sched.tracks[t].tracker.stair());
     TrialRow {
         trial: spec.trial,
         block: spec.block,
@@ -159,7 +161,7 @@ pub fn run(
             "session_seed": seed,
             "software": VERSION,
             "observer": observer.describe(),
-            "task": "2afc: which interval was stiffer?",
+            "task": study.task.describe(),
             "trials": "trials.tsv (docs/STUDIES.md)",
         });
         let mj = dir.join("session.json");
@@ -194,10 +196,21 @@ pub fn run(
         ran += 1;
         progress(spec.trial, planned);
     }
+    let quest = sched
+        .tracks
+        .iter()
+        .filter_map(|t| {
+            t.tracker.quest().map(|q| {
+                let (est, ci) = q.estimate();
+                (study.conditions[t.condition].name.clone(), est, ci)
+            })
+        })
+        .collect();
     Ok(RunSummary {
         dir,
         resumed,
         ran,
         complete,
+        quest,
     })
 }
