@@ -131,3 +131,49 @@ fn three_afc_recovers_the_models_two_thirds_correct_point_within_its_interval() 
         assert!(rows.iter().filter(|r| r.comparison_interval == i).count() > 40);
     }
 }
+
+/// Same–different (`studies/stiffness-walls-same-different.toml`): the model observer's percepts
+/// have noise `σ` and it says "different" beyond `sd_criterion·σ`, so in the differencing model its
+/// `d' = ln(1 + Δ/kc)/σ` reaches the 2AFC 75 % point 0.954 at `Δ = W·kc` = 150 N/m, and its
+/// criterion is 1.8. Both lie in the analysis' 95 % intervals; half the trials are same trials.
+#[test]
+fn same_different_recovers_the_models_jnd_and_criterion_within_their_intervals() {
+    let (study, text) = load("stiffness-walls-same-different.toml");
+    let dir = tempfile::tempdir().unwrap();
+    let s = run_one(&study, &text, dir.path(), "sim01");
+    assert!(s.complete);
+    let (res, _) = analyse_dir(
+        dir.path(),
+        &AnalyseOptions {
+            bootstrap: 200,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let r = &res[0];
+    let sd = r.sd.as_ref().expect("a same–different analysis");
+    let truth = study.observer.weber_fraction * study.conditions[0].reference_value;
+    eprintln!(
+        "JND {:.1} [{:.1}, {:.1}] (model {truth}), criterion {:.3} [{:.3}, {:.3}] (model {})",
+        r.jnd,
+        r.jnd_ci.0,
+        r.jnd_ci.1,
+        sd.fit.criterion,
+        sd.criterion_ci.0,
+        sd.criterion_ci.1,
+        study.observer.sd_criterion
+    );
+    assert!(r.jnd_ci.0 <= truth && truth <= r.jnd_ci.1, "{:?}", r.jnd_ci);
+    assert!(r.jnd_ci.1 / r.jnd_ci.0 < 2.5, "{:?}", r.jnd_ci);
+    let k = study.observer.sd_criterion;
+    assert!(
+        sd.criterion_ci.0 <= k && k <= sd.criterion_ci.1,
+        "{:?}",
+        sd.criterion_ci
+    );
+    assert!(
+        (100..=180).contains(&sd.same_trials),
+        "{} same trials of 280",
+        sd.same_trials
+    );
+}

@@ -13,6 +13,7 @@
 use super::file::Task;
 use super::fit::{bootstrap, bootstrap_thresholds, fit, fit_pse, quantile, Point, PsyFit, Shape};
 use super::rng::mix;
+use super::same_different::{self, SdFit};
 use super::trials::{self, TrialRow};
 use crate::plot::{write_panels, Panel, Series, Stroke};
 use std::collections::BTreeMap;
@@ -32,6 +33,8 @@ pub struct AnalyseOptions {
     /// The task's guess rate (0.5 for 2AFC, 1/3 for 3AFC); [`analyse_dir`] reads it from the
     /// sessions' `study.toml`.
     pub guess: f64,
+    /// The sessions are same–different trials (signal detection, `same_different.rs`).
+    pub same_different: bool,
 }
 
 impl Default for AnalyseOptions {
@@ -42,6 +45,7 @@ impl Default for AnalyseOptions {
             seed: 1,
             max_lapse: 0.06,
             guess: 0.5,
+            same_different: false,
         }
     }
 }
@@ -75,6 +79,21 @@ pub struct ConditionResult {
     pub tracks: BTreeMap<usize, Vec<(f64, f64)>>,
     /// The point of subjective equality of a PSE condition.
     pub pse: Option<Pse>,
+    /// The differencing model of a same–different condition.
+    pub sd: Option<SdResult>,
+}
+
+/// A same–different condition's fit (`same_different.rs`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SdResult {
+    /// The fitted model.
+    pub fit: SdFit,
+    /// The criterion's 95 % interval (units of the percept noise).
+    pub criterion_ci: (f64, f64),
+    /// The observed false-alarm rate ("different" on same trials).
+    pub false_alarms: f64,
+    /// Same trials.
+    pub same_trials: u32,
 }
 
 /// The PSE of a PSE condition (unit of the varied parameter).
@@ -141,6 +160,10 @@ pub fn analyse_rows(
             .filter(|r| &r.condition == name && !r.practice)
             .collect();
         let Some(first) = rs.first() else { continue };
+        if opts.same_different {
+            out.push(analyse_sd(name, first, &rs, opts, ci as u64)?);
+            continue;
+        }
         let is_pse = rs.iter().any(|r| r.correct.is_none());
         let mut levels: BTreeMap<u64, Point> = BTreeMap::new();
         for r in &rs {
@@ -204,12 +227,88 @@ pub fn analyse_rows(
             staircase_estimate,
             tracks,
             pse: None,
+            sd: None,
         });
     }
     if out.is_empty() {
         return Err("no analysable (non-practice) trials".into());
     }
     Ok(out)
+}
+
+/// The same–different analysis of one condition: the differencing model fitted to the "different"
+/// answers of the same trials and of each comparison level (x = ln(1 + Δ/reference)).
+fn analyse_sd(
+    name: &str,
+    first: &TrialRow,
+    rs: &[&TrialRow],
+    opts: &AnalyseOptions,
+    ci: u64,
+) -> Result<ConditionResult, String> {
+    let rv = first.reference_value;
+    let mut levels: BTreeMap<u64, Point> = BTreeMap::new();
+    for r in rs {
+        let x = if r.comparison_interval == 0 {
+            0.0
+        } else {
+            (1.0 + r.delta / rv).ln()
+        };
+        let p = levels.entry(x.to_bits()).or_insert(Point { x, n: 0, k: 0 });
+        p.n += 1;
+        p.k += u32::from(r.response == 1);
+    }
+    let mut points: Vec<Point> = levels.into_values().collect();
+    points.sort_by(|a, b| a.x.total_cmp(&b.x));
+    let f = same_different::fit(&points).map_err(|e| format!("condition `{name}`: {e}"))?;
+    let boot = same_different::bootstrap(&f, &points, opts.bootstrap, mix(opts.seed, ci));
+    let q = |g: &dyn Fn(&SdFit) -> f64| {
+        let mut v: Vec<f64> = boot.iter().map(g).filter(|x| x.is_finite()).collect();
+        v.sort_by(f64::total_cmp);
+        (quantile(&v, 0.025), quantile(&v, 0.975))
+    };
+    let jnd_ci = q(&|b| b.jnd(rv));
+    let same = points
+        .iter()
+        .find(|p| p.x == 0.0)
+        .copied()
+        .unwrap_or(Point { x: 0.0, n: 0, k: 0 });
+    // For the table and plot: the levels as deltas.
+    let shown: Vec<Point> = points
+        .iter()
+        .map(|p| Point {
+            x: rv * (p.x.exp() - 1.0),
+            ..*p
+        })
+        .collect();
+    Ok(ConditionResult {
+        condition: name.to_string(),
+        vary: first.vary.clone(),
+        reference_value: rv,
+        trials: rs.len() as u32,
+        points: shown,
+        fit: PsyFit {
+            shape: Shape::Normal,
+            alpha: f.slope,
+            beta: f.criterion,
+            guess: f64::from(same.k) / f64::from(same.n.max(1)),
+            symmetric: false,
+            lapse: 0.0,
+            nll: f64::NAN,
+        },
+        jnd: f.jnd(rv),
+        jnd_ci,
+        weber: f.jnd(rv) / rv,
+        weber_ci: (jnd_ci.0 / rv, jnd_ci.1 / rv),
+        staircase_estimate: None,
+        tracks: BTreeMap::new(),
+        pse: None,
+        sd: Some(SdResult {
+            fit: f,
+            criterion_ci: q(&|b| b.criterion),
+            false_alarms: f64::from(same.k) / f64::from(same.n.max(1)),
+            same_trials: same.n,
+        }),
+    })
 }
 
 /// The PSE analysis of one condition (see the module documentation).
@@ -280,6 +379,7 @@ fn analyse_pse(
         weber_ci,
         staircase_estimate: None,
         tracks: BTreeMap::new(),
+        sd: None,
         pse: Some(Pse {
             value: pse(&f),
             ci: pse_ci,
@@ -353,7 +453,9 @@ pub fn plot(res: &[ConditionResult], stem: &Path, title: &str) -> Result<Vec<Pat
         let curve: Vec<(f64, f64)> = (0..=200)
             .map(|j| {
                 let x = xmin + (xmax - xmin) * f64::from(j) / 200.0;
-                let y = if r.pse.is_some() {
+                let y = if let Some(sd) = &r.sd {
+                    sd.fit.p_different((1.0 + x / r.reference_value).ln())
+                } else if r.pse.is_some() {
                     r.fit.p(x.max(1e-300).ln())
                 } else {
                     r.fit.p(x)
@@ -366,36 +468,51 @@ pub fn plot(res: &[ConditionResult], stem: &Path, title: &str) -> Result<Vec<Pat
             .iter()
             .map(|p| (p.x, f64::from(p.k) / f64::from(p.n)))
             .collect();
-        let (title, x_label, y_label, h_lines) = match &r.pse {
-            Some(p) => (
-                match p.outside {
-                    Some(side) => format!("{}: PSE {side} the tested range", r.condition),
-                    None => format!(
-                        "{}: PSE {} [{}, {}] ({:.2} × nominal)",
-                        r.condition,
-                        short(p.value),
-                        short(p.ci.0),
-                        short(p.ci.1),
-                        p.ratio
-                    ),
-                },
-                format!("{} of the comparison", r.vary),
-                "proportion comparison named stiffer".to_string(),
-                vec![0.5],
-            ),
-            None => (
+        let (title, x_label, y_label, h_lines) = match (&r.pse, &r.sd) {
+            (_, Some(sd)) => (
                 format!(
-                    "{}: JND {} [{}, {}], Weber {:.3}",
+                    "{}: JND {} [{}, {}] (d' = 0.954), criterion {:.2}",
                     r.condition,
                     short(r.jnd),
                     short(r.jnd_ci.0),
                     short(r.jnd_ci.1),
-                    r.weber
+                    sd.fit.criterion
                 ),
-                format!("delta of {} (comparison − reference)", r.vary),
-                "proportion correct".to_string(),
-                vec![r.fit.guess, r.fit.guess + (1.0 - r.fit.guess) / 2.0],
+                format!("delta of {} (0: same trials)", r.vary),
+                "proportion \"different\"".to_string(),
+                vec![sd.false_alarms],
             ),
+            (pse, None) => match pse {
+                Some(p) => (
+                    match p.outside {
+                        Some(side) => format!("{}: PSE {side} the tested range", r.condition),
+                        None => format!(
+                            "{}: PSE {} [{}, {}] ({:.2} × nominal)",
+                            r.condition,
+                            short(p.value),
+                            short(p.ci.0),
+                            short(p.ci.1),
+                            p.ratio
+                        ),
+                    },
+                    format!("{} of the comparison", r.vary),
+                    "proportion comparison named stiffer".to_string(),
+                    vec![0.5],
+                ),
+                None => (
+                    format!(
+                        "{}: JND {} [{}, {}], Weber {:.3}",
+                        r.condition,
+                        short(r.jnd),
+                        short(r.jnd_ci.0),
+                        short(r.jnd_ci.1),
+                        r.weber
+                    ),
+                    format!("delta of {} (comparison − reference)", r.vary),
+                    "proportion correct".to_string(),
+                    vec![r.fit.guess, r.fit.guess + (1.0 - r.fit.guess) / 2.0],
+                ),
+            },
         };
         panels.push(Panel {
             title,
@@ -474,6 +591,7 @@ pub fn analyse_dir(
         task = Some(t);
     }
     opts.guess = task.unwrap_or(Task::TwoAfc).guess_rate();
+    opts.same_different = task == Some(Task::SameDifferent);
     let opts = &opts;
     let mut rows = Vec::new();
     for s in &sessions {
@@ -512,6 +630,14 @@ pub fn report(r: &ConditionResult, bootstrap: u32) -> String {
         r.fit.beta,
         r.fit.lapse
     );
+    if let Some(sd) = &r.sd {
+        return format!(
+            "{} ({}, reference {}): {} trials ({} same), differencing model: d' = {:.3}·ln(1 + Δ/{}), criterion {:.3} [{:.3}, {:.3}], false alarms {:.3}\n  JND (d' = 0.954, the 2AFC 75 % point) {:.4} [{:.4}, {:.4}] (95 % parametric bootstrap, {bootstrap} reps)\n  Weber fraction {:.4} [{:.4}, {:.4}]\n",
+            r.condition, r.vary, r.reference_value, r.trials, sd.same_trials, sd.fit.slope, r.reference_value,
+            sd.fit.criterion, sd.criterion_ci.0, sd.criterion_ci.1, sd.false_alarms,
+            r.jnd, r.jnd_ci.0, r.jnd_ci.1, r.weber, r.weber_ci.0, r.weber_ci.1
+        );
+    }
     match &r.pse {
         Some(p) => {
             match p.outside {

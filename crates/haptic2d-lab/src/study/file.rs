@@ -147,6 +147,8 @@ pub struct ObserverSection {
     pub decision_time: Option<f64>,
     /// `"press"` (default), `"tap"` or `"stroke"` (docs/STUDIES.md, the simulated observer).
     pub exploration: Option<String>,
+    /// Same–different: the differencing criterion in units of the percept noise (default 1.8).
+    pub sd_criterion: Option<f64>,
     /// Ramp time of each change of the press force (s), default 0 (a step).
     pub press_ramp: Option<f64>,
     /// The hand's damping on the probe's velocity (N·s/m), default 0.
@@ -177,17 +179,21 @@ pub enum Task {
     /// Three intervals (two references and the comparison, in random order), "which was
     /// stiffest?".
     ThreeAfc,
+    /// Two intervals, "same or different?": half the trials present the reference twice, half
+    /// the reference and the comparison in random order.
+    SameDifferent,
 }
 
 impl Task {
-    /// The guess rate `γ` of the task (1 / the number of intervals).
+    /// The guess rate `γ` of the task (1 / the number of intervals; same–different trials are
+    /// analysed by signal detection instead, see `analyse.rs`).
     pub fn guess_rate(self) -> f64 {
         1.0 / self.intervals() as f64
     }
     /// The number of intervals of a trial.
     pub fn intervals(self) -> usize {
         match self {
-            Task::TwoAfc => 2,
+            Task::TwoAfc | Task::SameDifferent => 2,
             Task::ThreeAfc => 3,
         }
     }
@@ -196,6 +202,7 @@ impl Task {
         match self {
             Task::TwoAfc => "2afc: which interval was stiffer?",
             Task::ThreeAfc => "3afc: which of three intervals was stiffest?",
+            Task::SameDifferent => "same-different: were the two intervals the same? (response 0 = same, 1 = different; comparison_interval 0 = a same trial)",
         }
     }
     /// Parses `[task] kind` (as stored in a session's `study.toml`).
@@ -203,6 +210,7 @@ impl Task {
         match s {
             "2afc" | "2ifc" => Some(Task::TwoAfc),
             "3afc" | "3ifc" => Some(Task::ThreeAfc),
+            "same-different" => Some(Task::SameDifferent),
             _ => None,
         }
     }
@@ -404,7 +412,7 @@ fn validate(
                 errs,
                 "task.kind",
                 format!("unknown task `{}`", f.task.kind),
-                "write kind = \"2afc\" (or \"2ifc\") or \"3afc\" (or \"3ifc\"); same–different and magnitude estimation are not built yet",
+                "write kind = \"2afc\" (or \"2ifc\"), \"3afc\" (or \"3ifc\") or \"same-different\"; magnitude estimation is not built yet",
             );
             Task::TwoAfc
         }
@@ -580,6 +588,14 @@ fn validate(
                     c.name
                 ),
                 "use kind = \"2afc\" for PSE conditions",
+            );
+        }
+        if task == Task::SameDifferent && f.method.kind != "constant" {
+            err(
+                errs,
+                "method.kind",
+                "same–different trials are analysed by signal detection, and adaptive methods converge on a proportion correct",
+                "use kind = \"constant\" with a same–different task",
             );
         }
         if pse && f.method.kind != "constant" {

@@ -23,6 +23,7 @@ pub mod numeric;
 pub mod observer;
 pub mod quest;
 pub mod rng;
+pub mod same_different;
 pub mod schedule;
 pub mod session;
 pub mod staircase;

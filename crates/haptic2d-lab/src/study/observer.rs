@@ -22,7 +22,7 @@
 //! noise, lapses and RTs come from a generator seeded by the session seed and the trial number, so a
 //! resumed session answers exactly as an uninterrupted one.
 
-use super::file::{ObserverSection, Study};
+use super::file::{ObserverSection, Study, Task};
 use super::numeric::Z75;
 use super::rng::{mix, Rng};
 use super::schedule::TrialSpec;
@@ -45,6 +45,9 @@ pub struct ObserverParams {
     pub press_time: f64,
     /// Median decision time (s).
     pub decision_time: f64,
+    /// Same–different: the differencing rule's criterion, in units of the percept noise `σ`
+    /// ("different" when the two percepts differ by more).
+    pub sd_criterion: f64,
     /// Press and stroke: each change of force is ramped linearly over this time (s); 0 = a step.
     pub press_ramp: f64,
     /// How the hand explores (press, tap or stroke).
@@ -78,6 +81,7 @@ impl Default for ObserverParams {
             press_forces: [1.0, 2.0],
             press_time: 1.0,
             decision_time: 0.6,
+            sd_criterion: 1.8,
             press_ramp: 0.0,
             exploration: Exploration::Press,
             hand_damping: 0.0,
@@ -107,6 +111,7 @@ impl ObserverParams {
             press_time: s.press_time.unwrap_or(d.press_time),
             decision_time: s.decision_time.unwrap_or(d.decision_time),
             press_ramp: s.press_ramp.unwrap_or(d.press_ramp),
+            sd_criterion: s.sd_criterion.unwrap_or(d.sd_criterion),
             exploration: d.exploration,
             hand_damping: s.hand_damping.unwrap_or(d.hand_damping),
             grip_stiffness: s.grip_stiffness.unwrap_or(d.grip_stiffness),
@@ -168,6 +173,14 @@ impl ObserverParams {
                 "press_time",
                 format!("{t}"),
                 "give a press time in (0, 30] s, e.g. 1.0",
+            );
+        }
+        let c = self.sd_criterion;
+        if !(c.is_finite() && c > 0.0 && c <= 10.0) {
+            report(
+                "sd_criterion",
+                format!("{c}"),
+                "give the same–different criterion in (0, 10] units of the percept noise, e.g. 1.8",
             );
         }
         let r = self.press_ramp;
@@ -365,6 +378,21 @@ impl Observer for SimulatedObserver {
         let lapse = rng.uniform() < self.params.lapse_rate;
         let coin = 1 + rng.below(n) as u8;
         let ci = spec.comparison_interval;
+        if study.task == Task::SameDifferent {
+            // The differencing rule: "different" (1) when the two percepts differ by more than
+            // the criterion (in units of the percept noise σ). A "same" trial (ci = 0) presents
+            // the reference twice: p_cmp is then replaced by a second reference percept.
+            let other = if ci == 0 {
+                k_ref.ln() + (p_cmp - k_cmp.ln())
+            } else {
+                p_cmp
+            };
+            let different = (other - p_ref).abs() > self.params.sd_criterion * sigma;
+            let response = if lapse { coin - 1 } else { u8::from(different) };
+            let rt = 4.0 * self.params.press_time
+                + self.params.decision_time * (0.3 * rng.normal()).exp();
+            return Ok(Answer { response, rt });
+        }
         // The reference intervals in order: the ones that are not the comparison's.
         let refs: Vec<u8> = (1..=n as u8).filter(|&i| i != ci).collect();
         let response = if lapse {

@@ -5,7 +5,7 @@
 //! function of the seed and the answers: replaying a session's recorded answers reproduces it
 //! trial for trial (that is how a session resumes).
 
-use super::file::Study;
+use super::file::{Study, Task};
 use super::method::Method;
 use super::quest::Quest;
 use super::rng::Rng;
@@ -26,7 +26,8 @@ pub struct TrialSpec {
     pub track: Option<usize>,
     /// Comparison − base value of the varied parameter.
     pub delta: f64,
-    /// The interval (1 to the task's number of intervals) presenting the comparison.
+    /// The interval (1 to the task's number of intervals) presenting the comparison; 0 for a
+    /// same–different task's "same" trial (the reference in both intervals).
     pub comparison_interval: u8,
 }
 
@@ -205,7 +206,13 @@ impl Schedule {
                 false,
             )
         };
-        let comparison_interval = 1 + self.rng.below(self.study.task.intervals()) as u8;
+        // Same–different: a "same" trial (the reference twice) is comparison interval 0.
+        let same = self.study.task == Task::SameDifferent && self.rng.below(2) == 0;
+        let comparison_interval = if same {
+            0
+        } else {
+            1 + self.rng.below(self.study.task.intervals()) as u8
+        };
         Some(TrialSpec {
             trial: self.trial,
             block: self.block as u32 + 1,
