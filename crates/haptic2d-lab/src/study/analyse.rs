@@ -521,7 +521,13 @@ pub fn plot(res: &[ConditionResult], stem: &Path, title: &str) -> Result<Vec<Pat
             series: vec![
                 Series::new("data", data, i, Stroke::Markers),
                 Series::new(
-                    format!("{} fit", r.fit.shape.name()),
+                    if r.sd.is_some() {
+                        "differencing model".to_string()
+                    } else if r.pse.is_some() {
+                        "cumulative normal of ln x".to_string()
+                    } else {
+                        format!("{} fit", r.fit.shape.name())
+                    },
                     curve,
                     i,
                     Stroke::Solid,
