@@ -84,18 +84,34 @@ pub fn run(cmd: &StudyCmd) -> Result<Status, Failure> {
                 study.scene_source,
                 study.conditions.len(),
                 study.blocks.len(),
-                describe_method(&study.method)
+                describe_method(&study)
             );
             Ok(Status::Clean)
         }
     }
 }
 
-fn describe_method(m: &Method) -> String {
-    match m {
-        Method::Constant { deltas, repeats } => format!(
-            "constant stimuli: {} deltas × {repeats} repeats per condition",
-            deltas.len()
+fn describe_method(study: &Study) -> String {
+    match &study.method {
+        Method::Constant { repeats, .. } => {
+            let mut n: Vec<usize> = (0..study.conditions.len())
+                .map(|c| study.deltas(c).len())
+                .collect();
+            n.dedup();
+            let n: Vec<String> = n.iter().map(|k| k.to_string()).collect();
+            format!(
+                "constant stimuli: {} deltas × {repeats} repeats per condition",
+                n.join("/")
+            )
+        }
+        Method::Quest(q) => format!(
+            "QUEST (Bayesian placement at the posterior {}, prior {} ± {} log10, Weibull β = {}, lapse {}), {} trials per condition",
+            if q.place_at_mode { "mode" } else { "mean" },
+            q.start,
+            q.prior_sd,
+            q.beta,
+            q.lapse,
+            q.max_trials
         ),
         Method::Staircase(s) => format!(
             "{} interleaved 1-up/{}-down staircase(s) per condition (target {:.1} % correct), stop at {} trials or {} reversals",
@@ -131,7 +147,7 @@ fn study_run(
     eprintln!(
         "study `{}`: participant {participant}, session {session}, {}; answered by the simulated observer (a model, not data: W = {}, λ = {})",
         study.name,
-        describe_method(&study.method),
+        describe_method(&study),
         study.observer.weber_fraction,
         study.observer.lapse_rate
     );
@@ -154,6 +170,9 @@ fn study_run(
         stop_after,
     )
     .map_err(Failure::error)?;
+    for (c, est, (lo, hi)) in &s.quest {
+        println!("QUEST {c}: threshold {est:.4} [{lo:.4}, {hi:.4}] (posterior mean, 95 % credible interval)");
+    }
     println!(
         "{}: {} trial(s) run{}; {}",
         s.dir.display(),
@@ -190,31 +209,7 @@ fn analyse(dir: &Path, shape: &str, bootstrap: u32, seed: u64) -> Result<Status,
     };
     let (res, paths) = analyse_dir(dir, &opts).map_err(Failure::from)?;
     for r in &res {
-        println!(
-            "{} ({}, reference {}): {} trials, {} fit (α = {:.4}, β = {:.3}, lapse {:.3})",
-            r.condition,
-            r.vary,
-            r.reference_value,
-            r.trials,
-            r.fit.shape.name(),
-            r.fit.alpha,
-            r.fit.beta,
-            r.fit.lapse
-        );
-        println!(
-            "  JND (75 % correct) {:.4} [{:.4}, {:.4}] (95 % parametric bootstrap, {bootstrap} reps)",
-            r.jnd, r.jnd_ci.0, r.jnd_ci.1
-        );
-        println!(
-            "  Weber fraction {:.4} [{:.4}, {:.4}]",
-            r.weber, r.weber_ci.0, r.weber_ci.1
-        );
-        if let Some(e) = r.staircase_estimate {
-            println!("  staircase estimate (mean delta at reversals after the second) {e:.4}");
-        }
-        println!(
-            "  PSE: not defined by this design (the comparison is always the stiffer stimulus)"
-        );
+        print!("{}", haptic2d_lab::study::analyse::report(r, bootstrap));
     }
     for p in paths {
         println!("wrote {}", p.display());

@@ -126,7 +126,7 @@ fn study_check_and_run_refuse_bad_input_with_the_field_and_the_fix() {
         &bad,
         std::fs::read_to_string(shipped())
             .unwrap()
-            .replace("kind = \"2afc\"", "kind = \"3afc\""),
+            .replace("kind = \"2afc\"", "kind = \"magnitude-estimation\""),
     )
     .unwrap();
     let o = run(&["study", "check", bad.to_str().unwrap()]);

@@ -78,6 +78,9 @@ pub struct ConditionSection {
     /// The comparison parameter the method varies, `normal.KEY` or `friction.KEY`: the comparison
     /// presents the base stimulus with that parameter raised by the method's delta.
     pub vary: String,
+    /// Constant stimuli: this condition's own deltas (default: the method's), e.g. a PSE condition
+    /// whose comparison must reach far from the reference.
+    pub deltas: Option<Vec<f64>>,
 }
 
 /// `[method]`.
@@ -104,8 +107,18 @@ pub struct MethodSection {
     pub max_reversals: Option<u32>,
     /// Staircase: smallest delta (default: the smallest start / 64).
     pub min_delta: Option<f64>,
-    /// Staircase: largest delta (default: 4 × the largest start).
+    /// Staircase: largest delta (default: 4 × the largest start). QUEST: the grid's ends.
     pub max_delta: Option<f64>,
+    /// QUEST: the prior's centre, the expected threshold (delta).
+    pub start: Option<f64>,
+    /// QUEST: the prior's sd of log₁₀ threshold (default 0.5).
+    pub prior_sd: Option<f64>,
+    /// QUEST: the assumed Weibull slope (default 3.5).
+    pub beta: Option<f64>,
+    /// QUEST: the assumed lapse rate (default 0.01).
+    pub lapse: Option<f64>,
+    /// QUEST: `"mean"` (default) or `"mode"` of the posterior.
+    pub placement: Option<String>,
 }
 
 /// `[[block]]`.
@@ -132,6 +145,30 @@ pub struct ObserverSection {
     pub press_time: Option<f64>,
     /// Median decision time added to the exploration time (s).
     pub decision_time: Option<f64>,
+    /// `"press"` (default), `"tap"` or `"stroke"` (docs/STUDIES.md, the simulated observer).
+    pub exploration: Option<String>,
+    /// Same–different: the differencing criterion in units of the percept noise (default 1.8).
+    pub sd_criterion: Option<f64>,
+    /// Ramp time of each change of the press force (s), default 0 (a step).
+    pub press_ramp: Option<f64>,
+    /// The hand's damping on the probe's velocity (N·s/m), default 0.
+    pub hand_damping: Option<f64>,
+    /// Torsional stiffness of the hand's grip on the probe's angle (N·m/rad), default 0.
+    pub grip_stiffness: Option<f64>,
+    /// Torsional damping of the grip (N·m·s/rad), default 0.
+    pub grip_damping: Option<f64>,
+    /// Tap speed (m/s).
+    pub tap_speed: Option<f64>,
+    /// Tap window (s).
+    pub tap_window: Option<f64>,
+    /// Stroke normal force (N).
+    pub stroke_normal: Option<f64>,
+    /// Stroke tangential pushes `[F_t1, F_t2]` (N).
+    pub stroke_forces: Option<[f64; 2]>,
+    /// Stroke tremor amplitude (N).
+    pub tremor_amplitude: Option<f64>,
+    /// Stroke tremor frequency (Hz).
+    pub tremor_hz: Option<f64>,
 }
 
 /// The task of a study.
@@ -139,13 +176,42 @@ pub struct ObserverSection {
 pub enum Task {
     /// Two intervals (reference and comparison in random order), "which was stiffer?".
     TwoAfc,
+    /// Three intervals (two references and the comparison, in random order), "which was
+    /// stiffest?".
+    ThreeAfc,
+    /// Two intervals, "same or different?": half the trials present the reference twice, half
+    /// the reference and the comparison in random order.
+    SameDifferent,
 }
 
 impl Task {
-    /// The guess rate `γ` of the task (0.5 for two alternatives).
+    /// The guess rate `γ` of the task (1 / the number of intervals; same–different trials are
+    /// analysed by signal detection instead, see `analyse.rs`).
     pub fn guess_rate(self) -> f64 {
+        1.0 / self.intervals() as f64
+    }
+    /// The number of intervals of a trial.
+    pub fn intervals(self) -> usize {
         match self {
-            Task::TwoAfc => 0.5,
+            Task::TwoAfc | Task::SameDifferent => 2,
+            Task::ThreeAfc => 3,
+        }
+    }
+    /// The task as written in `session.json`.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Task::TwoAfc => "2afc: which interval was stiffer?",
+            Task::ThreeAfc => "3afc: which of three intervals was stiffest?",
+            Task::SameDifferent => "same-different: were the two intervals the same? (response 0 = same, 1 = different; comparison_interval 0 = a same trial)",
+        }
+    }
+    /// Parses `[task] kind` (as stored in a session's `study.toml`).
+    pub fn from_name(s: &str) -> Option<Task> {
+        match s {
+            "2afc" | "2ifc" => Some(Task::TwoAfc),
+            "3afc" | "3ifc" => Some(Task::ThreeAfc),
+            "same-different" => Some(Task::SameDifferent),
+            _ => None,
         }
     }
 }
@@ -165,6 +231,11 @@ pub struct Condition {
     pub reference_value: f64,
     /// The value of `vary` in the comparison base stimulus.
     pub base_value: f64,
+    /// A PSE condition: the comparison is another stimulus than the reference, so no answer is
+    /// correct; the analysis fits P(comparison named stiffer) against the comparison's value.
+    pub pse: bool,
+    /// Constant stimuli: the condition's own deltas (else the method's).
+    pub deltas: Option<Vec<f64>>,
 }
 
 /// A validated block.
@@ -257,6 +328,44 @@ impl Study {
         }
     }
 
+    /// The constant-stimuli deltas of condition `c`: its own, or the method's (empty for staircases).
+    pub fn deltas(&self, c: usize) -> &[f64] {
+        match (&self.conditions[c].deltas, &self.method) {
+            (Some(d), _) => d,
+            (None, Method::Constant { deltas, .. }) => deltas,
+            _ => &[],
+        }
+    }
+
+    /// The largest delta condition `c` can present (practice trials use it).
+    pub fn largest_delta(&self, c: usize) -> f64 {
+        match self.method {
+            Method::Constant { .. } => self
+                .deltas(c)
+                .iter()
+                .copied()
+                .fold(f64::NEG_INFINITY, f64::max),
+            _ => self.method.largest_delta(),
+        }
+    }
+
+    /// The smallest delta condition `c` can present.
+    pub fn smallest_delta(&self, c: usize) -> f64 {
+        match self.method {
+            Method::Constant { .. } => self.deltas(c).iter().copied().fold(f64::INFINITY, f64::min),
+            _ => self.method.smallest_delta(),
+        }
+    }
+
+    /// The delta of condition `c`'s practice trials: its largest constant delta, or the largest
+    /// staircase start.
+    pub fn practice_delta(&self, c: usize) -> f64 {
+        match self.method {
+            Method::Constant { .. } => self.largest_delta(c),
+            _ => self.method.practice_delta(),
+        }
+    }
+
     /// The index of the condition called `name`.
     pub fn condition_index(&self, name: &str) -> Option<usize> {
         self.conditions.iter().position(|c| c.name == name)
@@ -296,14 +405,14 @@ fn validate(
     dir: Option<&Path>,
     errs: &mut Vec<SceneError>,
 ) -> Option<Study> {
-    let task = match f.task.kind.as_str() {
-        "2afc" | "2ifc" => Task::TwoAfc,
-        other => {
+    let task = match Task::from_name(&f.task.kind) {
+        Some(t) => t,
+        None => {
             err(
                 errs,
                 "task.kind",
-                format!("unknown task `{other}`"),
-                "write kind = \"2afc\" (or \"2ifc\"); 3AFC, same–different and magnitude estimation are not built yet",
+                format!("unknown task `{}`", f.task.kind),
+                "write kind = \"2afc\" (or \"2ifc\"), \"3afc\" (or \"3ifc\") or \"same-different\"; magnitude estimation is not built yet",
             );
             Task::TwoAfc
         }
@@ -346,7 +455,8 @@ fn validate(
         );
     }
     let observer = ObserverParams::from_section(&f.observer, errs);
-    let method = Method::from_section(&f.method, errs);
+    let own = !f.conditions.is_empty() && f.conditions.iter().all(|c| c.deltas.is_some());
+    let method = Method::from_section(&f.method, own, errs);
     // Conditions.
     let mut conditions = Vec::new();
     if f.conditions.is_empty() {
@@ -420,11 +530,82 @@ fn validate(
                 }
             }
         };
-        let (Some(reference_value), Some(base_value)) =
-            (value(&c.reference, errs), value(&comparison, errs))
-        else {
+        // A PSE condition compares two different stimuli (e.g. a spring against a pulse wall):
+        // the reference need not set `vary`; its nominal value is then the comparison's base.
+        let pse = comparison != c.reference;
+        let Some(base_value) = value(&comparison, errs) else {
             continue;
         };
+        let reference_value = if pse {
+            stimulus::param_value(&f.stimuli[&c.reference], &vary).unwrap_or(base_value)
+        } else {
+            let Some(v) = value(&c.reference, errs) else {
+                continue;
+            };
+            v
+        };
+        if c.deltas.is_some() && f.method.kind != "constant" {
+            err(
+                errs,
+                &format!("{field}.deltas"),
+                "a condition's own deltas belong to the method of constant stimuli",
+                "remove them, or set [method] kind = \"constant\"",
+            );
+        }
+        if let Some(d) = &c.deltas {
+            if d.is_empty() || d.iter().any(|x| !x.is_finite()) {
+                err(
+                    errs,
+                    &format!("{field}.deltas"),
+                    format!("{d:?}"),
+                    "give at least one finite delta, e.g. deltas = [-300.0, 0.0, 300.0]",
+                );
+            }
+        }
+        let field_d = if c.deltas.is_some() {
+            format!("{field}.deltas")
+        } else {
+            "method.deltas".to_string()
+        };
+        if let Some(d) = c.deltas.as_ref().or(f.method.deltas.as_ref()) {
+            if !pse {
+                if let Some(x) = d.iter().find(|x| x.is_finite() && **x <= 0.0) {
+                    err(
+                        errs,
+                        &field_d,
+                        format!("{x} is not positive, and condition `{}` is a discrimination (its comparison is its reference)", c.name),
+                        "every delta of a discrimination must be > 0 (the comparison is the stiffer stimulus); negative deltas belong to a PSE condition, whose `comparison` is another stimulus",
+                    );
+                }
+            }
+        }
+        if pse && !matches!(f.task.kind.as_str(), "2afc" | "2ifc") {
+            err(
+                errs,
+                "task.kind",
+                format!(
+                    "condition `{}` compares two stimuli (a PSE design), which needs two intervals",
+                    c.name
+                ),
+                "use kind = \"2afc\" for PSE conditions",
+            );
+        }
+        if task == Task::SameDifferent && f.method.kind != "constant" {
+            err(
+                errs,
+                "method.kind",
+                "same–different trials are analysed by signal detection, and adaptive methods converge on a proportion correct",
+                "use kind = \"constant\" with a same–different task",
+            );
+        }
+        if pse && f.method.kind != "constant" {
+            err(
+                errs,
+                &format!("{field}.comparison"),
+                format!("condition `{}` compares two stimuli (a PSE design), and adaptive methods converge on a proportion correct", c.name),
+                "use kind = \"constant\" with deltas on both sides of the expected PSE",
+            );
+        }
         conditions.push(Condition {
             name: c.name.clone(),
             reference: c.reference.clone(),
@@ -432,6 +613,8 @@ fn validate(
             vary,
             reference_value,
             base_value,
+            pse,
+            deltas: c.deltas.clone(),
         });
     }
     // Blocks.
@@ -521,10 +704,15 @@ fn validate(
     // Every stimulus a condition can present must build a valid scene with the probe in it (checked
     // even when other fields have problems, so all are reported at once).
     {
-        let largest = study.method.largest_delta();
-        for c in &study.conditions {
-            for (which, delta) in [(&c.reference, None), (&c.comparison, Some(largest))] {
-                if delta.is_some_and(|d| !(d.is_finite() && d > 0.0)) {
+        for (ci, c) in study.conditions.iter().enumerate() {
+            let largest = study.largest_delta(ci);
+            let smallest = study.smallest_delta(ci);
+            let mut cases = vec![(&c.reference, None), (&c.comparison, Some(largest))];
+            if c.pse && smallest < 0.0 {
+                cases.push((&c.comparison, Some(smallest)));
+            }
+            for (which, delta) in cases {
+                if delta.is_some_and(|d| !d.is_finite() || (d <= 0.0 && !c.pse)) {
                     continue; // the method's own error is reported
                 }
                 let vary = delta.map(|d| (&c.vary, d));
@@ -545,8 +733,9 @@ fn validate(
                             s.field = format!("stimuli.{which}.{}", s.field);
                             if delta.is_some() {
                                 s.message = format!(
-                                    "{} (comparison at the largest delta {largest})",
-                                    s.message
+                                    "{} (comparison at delta {})",
+                                    s.message,
+                                    delta.unwrap_or(largest)
                                 );
                             }
                             // The same stimulus as reference and comparison: report it once.

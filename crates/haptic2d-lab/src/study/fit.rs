@@ -58,8 +58,11 @@ pub struct PsyFit {
     pub alpha: f64,
     /// Slope `β` (Weibull: dimensionless; normal: unit of `x`).
     pub beta: f64,
-    /// Guess rate `γ` (fixed).
+    /// Guess rate `γ` (fixed; with `symmetric`, it is `λ/2`).
     pub guess: f64,
+    /// The PSE form `P = λ/2 + (1 − λ)·F`: lapses answer at random on either side (a
+    /// "which was stiffer" judgement of two different stimuli, no correct answer).
+    pub symmetric: bool,
     /// Lapse rate `λ` (fitted).
     pub lapse: f64,
     /// Negative log-likelihood at the optimum.
@@ -73,7 +76,20 @@ impl PsyFit {
     }
     /// `P(correct | x)`.
     pub fn p(&self, x: f64) -> f64 {
-        self.guess + (1.0 - self.guess - self.lapse) * self.core(x)
+        let g = if self.symmetric {
+            self.lapse / 2.0
+        } else {
+            self.guess
+        };
+        g + (1.0 - g - self.lapse) * self.core(x)
+    }
+    /// The PSE form's just-noticeable difference: the distance from `F = 0.5` to `F = 0.75`
+    /// (`β·z₀.₇₅` for the normal).
+    pub fn spread(&self) -> f64 {
+        match self.shape {
+            Shape::Normal => self.beta * super::numeric::Z75,
+            Shape::Weibull => self.alpha * (4f64.ln()).powf(1.0 / self.beta) - self.threshold(),
+        }
     }
     /// The threshold: `x` at `F = 0.5`.
     pub fn threshold(&self) -> f64 {
@@ -109,6 +125,22 @@ fn nll(points: &[Point], p: &dyn Fn(f64) -> f64) -> f64 {
 
 /// Fits `points` by maximum likelihood, guess rate `guess`, lapse rate in `[0, max_lapse]`.
 pub fn fit(points: &[Point], shape: Shape, guess: f64, max_lapse: f64) -> Result<PsyFit, String> {
+    fit_form(points, shape, guess, false, max_lapse)
+}
+
+/// Fits the PSE form `λ/2 + (1 − λ)·F` (lapse rate in `[0, max_lapse]`): `F` a cumulative normal
+/// of the comparison's value, `α` the PSE.
+pub fn fit_pse(points: &[Point], max_lapse: f64) -> Result<PsyFit, String> {
+    fit_form(points, Shape::Normal, 0.0, true, max_lapse)
+}
+
+fn fit_form(
+    points: &[Point],
+    shape: Shape,
+    guess: f64,
+    symmetric: bool,
+    max_lapse: f64,
+) -> Result<PsyFit, String> {
     let pts: Vec<Point> = points.iter().copied().filter(|p| p.n > 0).collect();
     if pts.len() < 2 {
         return Err(format!(
@@ -140,7 +172,8 @@ pub fn fit(points: &[Point], shape: Shape, guess: f64, max_lapse: f64) -> Result
             return 1e300;
         }
         let (a, b, l) = unpack(t);
-        nll(&pts, &|x| guess + (1.0 - guess - l) * core(shape, x, a, b))
+        let g = if symmetric { l / 2.0 } else { guess };
+        nll(&pts, &|x| g + (1.0 - g - l) * core(shape, x, a, b))
     };
     let mut best: Option<(Vec<f64>, f64)> = None;
     let firsts: &[f64] = match shape {
@@ -169,6 +202,7 @@ pub fn fit(points: &[Point], shape: Shape, guess: f64, max_lapse: f64) -> Result
         alpha,
         beta,
         guess,
+        symmetric,
         lapse,
         nll: v,
     })
@@ -183,6 +217,24 @@ pub fn bootstrap_thresholds(
     seed: u64,
     max_lapse: f64,
 ) -> Vec<f64> {
+    let mut t: Vec<f64> = bootstrap(fitted, points, reps, seed, max_lapse)
+        .into_iter()
+        .map(|f| f.threshold())
+        .filter(|t| t.is_finite())
+        .collect();
+    t.sort_by(f64::total_cmp);
+    t
+}
+
+/// Parametric bootstrap: `reps` data sets drawn from `fitted` at the levels and trial counts of
+/// `points`, each refitted in the same form; returns the fits that converged.
+pub fn bootstrap(
+    fitted: &PsyFit,
+    points: &[Point],
+    reps: u32,
+    seed: u64,
+    max_lapse: f64,
+) -> Vec<PsyFit> {
     let mut rng = Rng::new(seed);
     let mut out = Vec::with_capacity(reps as usize);
     for _ in 0..reps {
@@ -194,14 +246,16 @@ pub fn bootstrap_thresholds(
                 Point { k, ..*p }
             })
             .collect();
-        if let Ok(f) = fit(&sim, fitted.shape, fitted.guess, max_lapse) {
-            let t = f.threshold();
-            if t.is_finite() {
-                out.push(t);
-            }
+        if let Ok(f) = fit_form(
+            &sim,
+            fitted.shape,
+            fitted.guess,
+            fitted.symmetric,
+            max_lapse,
+        ) {
+            out.push(f);
         }
     }
-    out.sort_by(f64::total_cmp);
     out
 }
 
@@ -228,6 +282,7 @@ mod tests {
             alpha: 120.0,
             beta: 2.5,
             guess: 0.5,
+            symmetric: false,
             lapse: 0.02,
             nll: 0.0,
         };

@@ -32,6 +32,27 @@ impl StaircaseSpec {
     }
 }
 
+/// QUEST's parameters (Watson & Pelli 1983; `quest.rs`).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct QuestSpec {
+    /// The prior's centre: the expected threshold (delta).
+    pub start: f64,
+    /// The prior's standard deviation of `log₁₀ T`.
+    pub prior_sd: f64,
+    /// The assumed Weibull slope `β`.
+    pub beta: f64,
+    /// The assumed lapse rate `δ`.
+    pub lapse: f64,
+    /// Stop after this many trials.
+    pub max_trials: u32,
+    /// The grid's smallest threshold and delta.
+    pub min_delta: f64,
+    /// The grid's largest threshold and delta.
+    pub max_delta: f64,
+    /// Place at the posterior mode (Watson & Pelli) instead of its mean.
+    pub place_at_mode: bool,
+}
+
 /// The method.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Method {
@@ -44,6 +65,8 @@ pub enum Method {
     },
     /// Interleaved transformed up/down staircases.
     Staircase(StaircaseSpec),
+    /// QUEST: Bayesian adaptive placement, one per condition, interleaved.
+    Quest(QuestSpec),
 }
 
 /// Largest number of trials a study may schedule per condition.
@@ -55,6 +78,16 @@ impl Method {
         match self {
             Method::Constant { deltas, .. } => deltas.iter().copied().fold(0.0, f64::max),
             Method::Staircase(s) => s.max_delta,
+            Method::Quest(q) => q.max_delta,
+        }
+    }
+
+    /// The smallest delta the method can present.
+    pub fn smallest_delta(&self) -> f64 {
+        match self {
+            Method::Constant { deltas, .. } => deltas.iter().copied().fold(f64::INFINITY, f64::min),
+            Method::Staircase(s) => s.min_delta,
+            Method::Quest(q) => q.min_delta,
         }
     }
 
@@ -63,11 +96,17 @@ impl Method {
         match self {
             Method::Constant { .. } => self.largest_delta(),
             Method::Staircase(s) => s.starts.iter().copied().fold(0.0, f64::max),
+            Method::Quest(q) => q.max_delta.min(4.0 * q.start),
         }
     }
 
     /// Validates `[method]`; problems go to `errs` with the field and the fix.
-    pub fn from_section(m: &MethodSection, errs: &mut Vec<SceneError>) -> Option<Method> {
+    /// `own_deltas`: every condition gives its own `deltas`, so `[method]` need not.
+    pub fn from_section(
+        m: &MethodSection,
+        own_deltas: bool,
+        errs: &mut Vec<SceneError>,
+    ) -> Option<Method> {
         let mut e = |field: &str, msg: String, fix: &str| {
             errs.push(SceneError::new(format!("method.{field}"), msg, fix))
         };
@@ -75,14 +114,16 @@ impl Method {
         match m.kind.as_str() {
             "constant" => {
                 let deltas = m.deltas.clone().unwrap_or_default();
-                if deltas.is_empty() {
+                if deltas.is_empty() && !own_deltas {
                     e("deltas", "the method of constant stimuli needs its deltas".into(), "e.g. deltas = [50.0, 100.0, 200.0] (comparison − reference, unit of `vary`)");
                 }
-                if let Some(d) = deltas.iter().find(|d| !positive(**d)) {
+                // The sign is checked per condition (file.rs): > 0 for a discrimination, any for
+                // a PSE condition.
+                if let Some(d) = deltas.iter().find(|d| !d.is_finite()) {
                     e(
                         "deltas",
-                        format!("{d} is not a positive number"),
-                        "every delta must be > 0: the comparison is the stiffer stimulus",
+                        format!("{d} is not a number"),
+                        "give finite deltas",
                     );
                 }
                 let repeats = m.repeats.unwrap_or(0);
@@ -200,11 +241,87 @@ impl Method {
                     max_delta,
                 }))
             }
+            "quest" => {
+                let start = m.start.unwrap_or(0.0);
+                if !positive(start) {
+                    e(
+                        "start",
+                        format!("{start}"),
+                        "give the expected threshold (a positive delta), e.g. start = 150.0",
+                    );
+                }
+                let prior_sd = m.prior_sd.unwrap_or(0.5);
+                if !(prior_sd.is_finite() && prior_sd > 0.0 && prior_sd <= 3.0) {
+                    e(
+                        "prior_sd",
+                        format!("{prior_sd}"),
+                        "give the prior's sd of log10(threshold) in (0, 3], e.g. 0.5",
+                    );
+                }
+                let beta = m.beta.unwrap_or(3.5);
+                if !(beta.is_finite() && (0.2..=20.0).contains(&beta)) {
+                    e("beta", format!("{beta}"), "give the Weibull slope in [0.2, 20], e.g. 3.5 (Watson & Pelli) or the slope a pilot fit gave");
+                }
+                let lapse = m.lapse.unwrap_or(0.01);
+                if !(lapse.is_finite() && (0.0..=0.2).contains(&lapse)) {
+                    e(
+                        "lapse",
+                        format!("{lapse}"),
+                        "give the assumed lapse rate in [0, 0.2], e.g. 0.01",
+                    );
+                }
+                let max_trials = m.max_trials.unwrap_or(0);
+                if max_trials == 0 || max_trials > MAX_TRIALS_PER_CONDITION {
+                    e("max_trials", format!("{max_trials}"), "give the stopping rule: 1 to 100000 trials per condition, e.g. max_trials = 80");
+                }
+                let min_delta = m.min_delta.unwrap_or(start / 100.0);
+                let max_delta = m.max_delta.unwrap_or(start * 100.0);
+                if !(positive(min_delta)
+                    && min_delta < start
+                    && max_delta.is_finite()
+                    && start < max_delta)
+                {
+                    e("min_delta", format!("[{min_delta}, {max_delta}]"), "give 0 < min_delta < start < max_delta (the grid of thresholds and deltas)");
+                }
+                let place_at_mode = match m.placement.as_deref() {
+                    None | Some("mean") => false,
+                    Some("mode") => true,
+                    Some(other) => {
+                        e(
+                            "placement",
+                            format!("unknown placement `{other}`"),
+                            "placement = \"mean\" (posterior mean, default) or \"mode\"",
+                        );
+                        false
+                    }
+                };
+                if m.deltas.is_some()
+                    || m.repeats.is_some()
+                    || m.rule.is_some()
+                    || m.starts.is_some()
+                {
+                    e(
+                        "kind",
+                        "deltas/repeats/rule/starts are not QUEST settings".into(),
+                        "remove them, or change kind",
+                    );
+                }
+                Some(Method::Quest(QuestSpec {
+                    start,
+                    prior_sd,
+                    beta,
+                    lapse,
+                    max_trials,
+                    min_delta,
+                    max_delta,
+                    place_at_mode,
+                }))
+            }
             other => {
                 e(
                     "kind",
                     format!("unknown method `{other}`"),
-                    "kind = \"constant\" or \"staircase\" (QUEST/QUEST+ is not built yet)",
+                    "kind = \"constant\", \"staircase\" or \"quest\"",
                 );
                 None
             }

@@ -1,26 +1,32 @@
-//! Perceptual studies (issue 40, first slice): study files, the trial schedule (method of constant
-//! stimuli, interleaved transformed up/down staircases), a simulated observer that explores the wall
-//! through the real world step and answers 2AFC trials (a **model**, never data), sessions written as
-//! per-trial TSV that resume without losing or repeating a trial, and the psychometric analysis.
+//! Perceptual studies (issue 40): study files, the trial schedule (method of constant stimuli,
+//! interleaved transformed up/down staircases, QUEST), 2AFC, 3AFC and same–different tasks,
+//! discrimination and PSE designs, a simulated observer that explores the wall through the real
+//! world step (pressing, tapping or stroking) and answers (a **model**, never data), sessions
+//! written as per-trial TSV that resume without losing or repeating a trial, and the analysis.
 //!
 //! - [`file`](mod@file): the study file (TOML) and its validation → [`Study`].
 //! - [`stimulus`]: a named parameter set applied to the scene → a [`World`](haptic2d::world::World).
-//! - [`method`], [`staircase`], [`schedule`]: what is presented when.
-//! - [`observer`]: the [`Observer`] trait and the [`SimulatedObserver`] model.
+//! - [`method`], [`staircase`], [`quest`], [`schedule`]: what is presented when.
+//! - [`observer`], [`explore`]: the [`Observer`] trait, the [`SimulatedObserver`] model and the
+//!   simulated hand's explorations.
 //! - [`trials`], [`session`]: the data on disk, running and resuming a session.
-//! - [`fit`], [`analyse`]: psychometric fits, bootstrap intervals, reports and plots.
+//! - [`fit`], [`same_different`], [`analyse`]: psychometric and signal-detection fits, bootstrap
+//!   intervals, reports and plots.
 //! - [`numeric`], [`rng`]: the normal CDF, Nelder–Mead and a seeded generator.
 //!
-//! Not built yet: answers from the browser page or device buttons, trials on a real device, MCAP per
-//! trial, QUEST, 3AFC/same–different/magnitude estimation, PsychoPy (see `docs/STUDIES.md`).
+//! Not built yet: answers from the browser page or device buttons, trials on the real-time loop or a
+//! device, MCAP per trial, QUEST+, magnitude estimation, PsychoPy (see `docs/STUDIES.md`).
 
 pub mod analyse;
+pub mod explore;
 pub mod file;
 pub mod fit;
 pub mod method;
 pub mod numeric;
 pub mod observer;
+pub mod quest;
 pub mod rng;
+pub mod same_different;
 pub mod schedule;
 pub mod session;
 pub mod staircase;

@@ -13,7 +13,8 @@
 //!    `σ = ln(1 + W)/(√2·z₀.₇₅)`: two intervals whose stiffnesses differ by the Weber fraction `W`
 //!    are then ordered correctly 75 % of the time (the JND at 75 % correct is `W·K`).
 //! 3. **Decision**: with probability `λ` (lapse rate) the model answers at random; otherwise it
-//!    names the interval of larger perceived stiffness.
+//!    names the interval of largest perceived stiffness (3AFC: each of the two reference intervals
+//!    is perceived with its own noise).
 //! 4. **Response time**: `2·2·press_time` of exploration plus a log-normal decision time of median
 //!    `decision_time` (log-sd 0.3): a placeholder, not a model of decision dynamics.
 //!
@@ -21,16 +22,15 @@
 //! noise, lapses and RTs come from a generator seeded by the session seed and the trial number, so a
 //! resumed session answers exactly as an uninterrupted one.
 
-use super::file::{ObserverSection, Study};
+use super::file::{ObserverSection, Study, Task};
 use super::numeric::Z75;
 use super::rng::{mix, Rng};
 use super::schedule::TrialSpec;
 use super::stimulus;
-use haptic2d::geom::Vec2;
-use haptic2d::load::{Load, Profile};
 use haptic2d::scene::SceneError;
-use haptic2d::world::World;
 use std::collections::HashMap;
+
+pub use super::explore::{explore, Exploration, Felt};
 
 /// The simulated observer's parameters (`[observer]` of the study file, or the CLI).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -45,6 +45,32 @@ pub struct ObserverParams {
     pub press_time: f64,
     /// Median decision time (s).
     pub decision_time: f64,
+    /// Same–different: the differencing rule's criterion, in units of the percept noise `σ`
+    /// ("different" when the two percepts differ by more).
+    pub sd_criterion: f64,
+    /// Press and stroke: each change of force is ramped linearly over this time (s); 0 = a step.
+    pub press_ramp: f64,
+    /// How the hand explores (press, tap or stroke).
+    pub exploration: Exploration,
+    /// The hand's damping on the probe's velocity during presses and strokes (N·s/m).
+    pub hand_damping: f64,
+    /// The hand's grip on the probe's orientation during presses and strokes: a torsional spring
+    /// to the starting angle (N·m/rad; 0 = the hand only pushes, the probe may turn).
+    pub grip_stiffness: f64,
+    /// The grip's torsional damping (N·m·s/rad).
+    pub grip_damping: f64,
+    /// Tap: the speed of the probe toward the wall (m/s).
+    pub tap_speed: f64,
+    /// Tap: the window after contact in which the wall force is felt (s).
+    pub tap_window: f64,
+    /// Stroke: the normal force pressing the probe on the wall (N).
+    pub stroke_normal: f64,
+    /// Stroke: the two tangential pushes `F_t1 < F_t2` (N).
+    pub stroke_forces: [f64; 2],
+    /// Stroke: the tremor's amplitude on the tangential push (N).
+    pub tremor_amplitude: f64,
+    /// Stroke: the tremor's frequency (Hz).
+    pub tremor_hz: f64,
 }
 
 impl Default for ObserverParams {
@@ -55,6 +81,18 @@ impl Default for ObserverParams {
             press_forces: [1.0, 2.0],
             press_time: 1.0,
             decision_time: 0.6,
+            sd_criterion: 1.8,
+            press_ramp: 0.0,
+            exploration: Exploration::Press,
+            hand_damping: 0.0,
+            grip_stiffness: 0.0,
+            grip_damping: 0.0,
+            tap_speed: 0.1,
+            tap_window: 0.01,
+            stroke_normal: 2.0,
+            stroke_forces: [0.1, 0.3],
+            tremor_amplitude: 0.05,
+            tremor_hz: 10.0,
         }
     }
 }
@@ -72,7 +110,30 @@ impl ObserverParams {
             press_forces: s.press_forces.unwrap_or(d.press_forces),
             press_time: s.press_time.unwrap_or(d.press_time),
             decision_time: s.decision_time.unwrap_or(d.decision_time),
+            press_ramp: s.press_ramp.unwrap_or(d.press_ramp),
+            sd_criterion: s.sd_criterion.unwrap_or(d.sd_criterion),
+            exploration: d.exploration,
+            hand_damping: s.hand_damping.unwrap_or(d.hand_damping),
+            grip_stiffness: s.grip_stiffness.unwrap_or(d.grip_stiffness),
+            grip_damping: s.grip_damping.unwrap_or(d.grip_damping),
+            tap_speed: s.tap_speed.unwrap_or(d.tap_speed),
+            tap_window: s.tap_window.unwrap_or(d.tap_window),
+            stroke_normal: s.stroke_normal.unwrap_or(d.stroke_normal),
+            stroke_forces: s.stroke_forces.unwrap_or(d.stroke_forces),
+            tremor_amplitude: s.tremor_amplitude.unwrap_or(d.tremor_amplitude),
+            tremor_hz: s.tremor_hz.unwrap_or(d.tremor_hz),
         };
+        let mut p = p;
+        if let Some(e) = &s.exploration {
+            match Exploration::from_name(e) {
+                Ok(x) => p.exploration = x,
+                Err(m) => errs.push(SceneError::new(
+                    "observer.exploration",
+                    m,
+                    "exploration = \"press\" (static stiffness), \"tap\" (rate-hardness) or \"stroke\" (tangential stick stiffness)",
+                )),
+            }
+        }
         let n = errs.len();
         p.check(&mut |field, msg, fix| {
             errs.push(SceneError::new(format!("observer.{field}"), msg, fix))
@@ -114,6 +175,94 @@ impl ObserverParams {
                 "give a press time in (0, 30] s, e.g. 1.0",
             );
         }
+        let c = self.sd_criterion;
+        if !(c.is_finite() && c > 0.0 && c <= 10.0) {
+            report(
+                "sd_criterion",
+                format!("{c}"),
+                "give the same–different criterion in (0, 10] units of the percept noise, e.g. 1.8",
+            );
+        }
+        let r = self.press_ramp;
+        if !(r.is_finite() && r >= 0.0 && r <= 0.8 * t) {
+            report(
+                "press_ramp",
+                format!("{r}"),
+                "give a ramp time in [0, 0.8·press_time] s, e.g. 0.5 with press_time = 1.0",
+            );
+        }
+        let b = self.hand_damping;
+        if !(b.is_finite() && (0.0..=200.0).contains(&b)) {
+            report(
+                "hand_damping",
+                format!("{b}"),
+                "give a damping in [0, 200] N·s/m, e.g. 10.0",
+            );
+        }
+        let g = self.grip_stiffness;
+        if !(g.is_finite() && (0.0..=50.0).contains(&g)) {
+            report(
+                "grip_stiffness",
+                format!("{g}"),
+                "give a torsional stiffness in [0, 50] N·m/rad, e.g. 20.0",
+            );
+        }
+        let gd = self.grip_damping;
+        if !(gd.is_finite() && (0.0..=1.0).contains(&gd)) {
+            report(
+                "grip_damping",
+                format!("{gd}"),
+                "give a torsional damping in [0, 1] N·m·s/rad, e.g. 0.02",
+            );
+        }
+        let v = self.tap_speed;
+        if !(v.is_finite() && v > 0.0 && v <= 2.0) {
+            report(
+                "tap_speed",
+                format!("{v}"),
+                "give a speed in (0, 2] m/s, e.g. 0.1",
+            );
+        }
+        let w = self.tap_window;
+        if !(w.is_finite() && w > 0.0 && w <= 0.5) {
+            report(
+                "tap_window",
+                format!("{w}"),
+                "give a window in (0, 0.5] s, e.g. 0.01",
+            );
+        }
+        let fnorm = self.stroke_normal;
+        if !(fnorm.is_finite() && fnorm > 0.0 && fnorm <= MAX_PRESS_N) {
+            report(
+                "stroke_normal",
+                format!("{fnorm}"),
+                "give 0 < F_n ≤ 50 N, e.g. 2.0",
+            );
+        }
+        let [t1, t2] = self.stroke_forces;
+        if !(t1.is_finite() && t2.is_finite() && 0.0 <= t1 && t1 < t2 && t2 <= MAX_PRESS_N) {
+            report(
+                "stroke_forces",
+                format!("[{t1}, {t2}]"),
+                "give 0 ≤ F_t1 < F_t2 ≤ 50 N, below the friction's break-away, e.g. [0.1, 0.3]",
+            );
+        }
+        let a = self.tremor_amplitude;
+        if !(a.is_finite() && (0.0..=MAX_PRESS_N).contains(&a)) {
+            report(
+                "tremor_amplitude",
+                format!("{a}"),
+                "give an amplitude in [0, 50] N, e.g. 0.05",
+            );
+        }
+        let h = self.tremor_hz;
+        if !(h.is_finite() && h > 0.0 && h <= 100.0) {
+            report(
+                "tremor_hz",
+                format!("{h}"),
+                "give a frequency in (0, 100] Hz, e.g. 10.0",
+            );
+        }
         let r = self.decision_time;
         if !(r.is_finite() && (0.0..=60.0).contains(&r)) {
             report(
@@ -133,7 +282,7 @@ impl ObserverParams {
 /// An answer to one trial.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Answer {
-    /// The interval (1 or 2) named as stiffer.
+    /// The interval (1 to the task's number) named as stiffer (stiffest).
     pub response: u8,
     /// Response time (s), measured from the start of the first interval.
     pub rt: f64,
@@ -145,67 +294,6 @@ pub trait Observer {
     fn answer(&mut self, study: &Study, spec: &TrialSpec) -> Result<Answer, String>;
     /// A short description for the session record (`simulated W=0.15 λ=0.02`).
     fn describe(&self) -> String;
-}
-
-/// What one exploration measured.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Felt {
-    /// Mean probe positions along `toward` at the end of the two presses (m).
-    pub x: [f64; 2],
-    /// Felt stiffness `(F2 − F1)/(x2 − x1)` (N/m).
-    pub stiffness: f64,
-}
-
-/// Presses the probe of `world` toward the wall as the model's step 1 says.
-pub fn explore(
-    mut world: World,
-    probe: usize,
-    toward: [f64; 2],
-    p: &ObserverParams,
-) -> Result<Felt, String> {
-    let dir = Vec2::new(toward[0], toward[1]);
-    world.loads.clear();
-    world.loads.push(Load {
-        body: probe,
-        force: dir * p.press_forces[0],
-        torque: 0.0,
-        per_mass: false,
-        profile: Profile::Constant,
-    });
-    let dt = world.params.dt;
-    let n = (p.press_time / dt).round().max(10.0) as usize;
-    let tail = (n as f64 * 0.4).ceil() as usize;
-    let mut x = [0.0; 2];
-    for (phase, &f) in p.press_forces.iter().enumerate() {
-        world.loads[0].force = dir * f;
-        let mut sum = 0.0;
-        for k in 0..n {
-            world.step();
-            if k >= n - tail {
-                let b = &world.bodies[probe];
-                sum += b.pose.pos.x * dir.x + b.pose.pos.y * dir.y;
-            }
-        }
-        x[phase] = sum / tail as f64;
-        let b = &world.bodies[probe];
-        let v = b.vel.x * dir.x + b.vel.y * dir.y;
-        if !v.is_finite() || v.abs() > 0.01 {
-            return Err(format!(
-                "the probe is still moving at {v:.3} m/s along `toward` after {:.2} s at {f} N: it did not come to rest against a wall (check `toward`, `probe` and the wall's damping, or lengthen observer.press_time)",
-                p.press_time
-            ));
-        }
-    }
-    let dx = x[1] - x[0];
-    if !(dx.is_finite() && dx > 0.0) {
-        return Err(format!(
-            "the probe did not move further toward the wall under the larger force (Δx = {dx:e} m): no stiffness to feel"
-        ));
-    }
-    Ok(Felt {
-        x,
-        stiffness: (p.press_forces[1] - p.press_forces[0]) / dx,
-    })
 }
 
 /// The simulated observer (a model; see the module documentation).
@@ -279,14 +367,42 @@ impl Observer for SimulatedObserver {
         let sigma = self.params.sigma();
         let p_ref = k_ref.ln() + sigma * rng.normal();
         let p_cmp = k_cmp.ln() + sigma * rng.normal();
+        let n = study.task.intervals();
+        // 3AFC: a second reference interval, perceived with its own noise (drawn after the 2AFC
+        // draws, so a 2AFC session's answers do not depend on this branch).
+        let p_ref2 = if n == 3 {
+            k_ref.ln() + sigma * rng.normal()
+        } else {
+            f64::NEG_INFINITY
+        };
         let lapse = rng.uniform() < self.params.lapse_rate;
-        let coin = 1 + rng.below(2) as u8;
+        let coin = 1 + rng.below(n) as u8;
+        let ci = spec.comparison_interval;
+        if study.task == Task::SameDifferent {
+            // The differencing rule: "different" (1) when the two percepts differ by more than
+            // the criterion (in units of the percept noise σ). A "same" trial (ci = 0) presents
+            // the reference twice: p_cmp is then replaced by a second reference percept.
+            let other = if ci == 0 {
+                k_ref.ln() + (p_cmp - k_cmp.ln())
+            } else {
+                p_cmp
+            };
+            let different = (other - p_ref).abs() > self.params.sd_criterion * sigma;
+            let response = if lapse { coin - 1 } else { u8::from(different) };
+            let rt = 4.0 * self.params.press_time
+                + self.params.decision_time * (0.3 * rng.normal()).exp();
+            return Ok(Answer { response, rt });
+        }
+        // The reference intervals in order: the ones that are not the comparison's.
+        let refs: Vec<u8> = (1..=n as u8).filter(|&i| i != ci).collect();
         let response = if lapse {
             coin
-        } else if p_cmp > p_ref {
-            spec.comparison_interval
+        } else if p_cmp > p_ref && p_cmp > p_ref2 {
+            ci
+        } else if p_ref >= p_ref2 {
+            refs[0]
         } else {
-            3 - spec.comparison_interval
+            refs[1]
         };
         let rt =
             4.0 * self.params.press_time + self.params.decision_time * (0.3 * rng.normal()).exp();
@@ -294,9 +410,21 @@ impl Observer for SimulatedObserver {
     }
 
     fn describe(&self) -> String {
+        let p = &self.params;
+        let how = match p.exploration {
+            Exploration::Press => format!("press_forces={:?} N", p.press_forces),
+            Exploration::Tap => format!(
+                "tap_speed={} m/s tap_window={} s",
+                p.tap_speed, p.tap_window
+            ),
+            Exploration::Stroke => format!(
+                "stroke_normal={} N stroke_forces={:?} N tremor={} N at {} Hz",
+                p.stroke_normal, p.stroke_forces, p.tremor_amplitude, p.tremor_hz
+            ),
+        };
         format!(
-            "simulated observer (a model, not data): weber_fraction={} lapse_rate={} press_forces={:?} N press_time={} s",
-            self.params.weber_fraction, self.params.lapse_rate, self.params.press_forces, self.params.press_time
+            "simulated observer (a model, not data): weber_fraction={} lapse_rate={} exploration={} {how} press_time={} s press_ramp={} s hand_damping={} N s/m grip={} N m/rad, {} N m s/rad",
+            p.weber_fraction, p.lapse_rate, p.exploration.name(), p.press_time, p.press_ramp, p.hand_damping, p.grip_stiffness, p.grip_damping
         )
     }
 }

@@ -5,8 +5,9 @@
 //! function of the seed and the answers: replaying a session's recorded answers reproduces it
 //! trial for trial (that is how a session resumes).
 
-use super::file::Study;
+use super::file::{Study, Task};
 use super::method::Method;
+use super::quest::Quest;
 use super::rng::Rng;
 use super::staircase::Staircase;
 
@@ -25,17 +26,65 @@ pub struct TrialSpec {
     pub track: Option<usize>,
     /// Comparison − base value of the varied parameter.
     pub delta: f64,
-    /// The interval (1 or 2) presenting the comparison.
+    /// The interval (1 to the task's number of intervals) presenting the comparison; 0 for a
+    /// same–different task's "same" trial (the reference in both intervals).
     pub comparison_interval: u8,
 }
 
-/// One staircase of the session.
+/// An adaptive track's state: a transformed up/down staircase or a QUEST.
+#[derive(Clone, Debug)]
+pub enum Tracker {
+    /// A staircase.
+    Stair(Staircase),
+    /// A QUEST.
+    Quest(Quest),
+}
+
+impl Tracker {
+    /// The delta of its next trial.
+    pub fn delta(&self) -> f64 {
+        match self {
+            Tracker::Stair(s) => s.delta,
+            Tracker::Quest(q) => q.delta,
+        }
+    }
+    /// Its stopping rule is met.
+    pub fn done(&self) -> bool {
+        match self {
+            Tracker::Stair(s) => s.done(),
+            Tracker::Quest(q) => q.done(),
+        }
+    }
+    /// Records an answer.
+    pub fn update(&mut self, correct: bool) {
+        match self {
+            Tracker::Stair(s) => s.update(correct),
+            Tracker::Quest(q) => q.update(correct),
+        }
+    }
+    /// The staircase, if it is one.
+    pub fn stair(&self) -> Option<&Staircase> {
+        match self {
+            Tracker::Stair(s) => Some(s),
+            Tracker::Quest(_) => None,
+        }
+    }
+    /// The QUEST, if it is one.
+    pub fn quest(&self) -> Option<&Quest> {
+        match self {
+            Tracker::Quest(q) => Some(q),
+            Tracker::Stair(_) => None,
+        }
+    }
+}
+
+/// One adaptive track of the session (a staircase or a QUEST).
 #[derive(Clone, Debug)]
 pub struct Track {
     /// Its condition.
     pub condition: usize,
     /// Its state.
-    pub stair: Staircase,
+    pub tracker: Tracker,
 }
 
 /// The schedule's state.
@@ -56,15 +105,26 @@ impl Schedule {
     /// A schedule for `study` from `seed`.
     pub fn new(study: &Study, seed: u64) -> Self {
         let mut tracks = Vec::new();
-        if let Method::Staircase(s) = &study.method {
-            for (c, _) in study.conditions.iter().enumerate() {
-                for &start in &s.starts {
+        match &study.method {
+            Method::Staircase(s) => {
+                for (c, _) in study.conditions.iter().enumerate() {
+                    for &start in &s.starts {
+                        tracks.push(Track {
+                            condition: c,
+                            tracker: Tracker::Stair(Staircase::new(s, start)),
+                        });
+                    }
+                }
+            }
+            Method::Quest(q) => {
+                for (c, _) in study.conditions.iter().enumerate() {
                     tracks.push(Track {
                         condition: c,
-                        stair: Staircase::new(s, start),
+                        tracker: Tracker::Quest(Quest::new(q, study.task.guess_rate())),
                     });
                 }
             }
+            Method::Constant { .. } => {}
         }
         Self {
             study: study.clone(),
@@ -82,9 +142,9 @@ impl Schedule {
         let b = &self.study.blocks[self.block];
         self.practice_left = b.practice;
         self.queue.clear();
-        if let Method::Constant { deltas, repeats } = &self.study.method {
+        if let Method::Constant { repeats, .. } = &self.study.method {
             for &c in &b.conditions {
-                for &d in deltas {
+                for &d in self.study.deltas(c) {
                     for _ in 0..*repeats {
                         self.queue.push((c, d));
                     }
@@ -99,14 +159,16 @@ impl Schedule {
     fn open_tracks(&self) -> Vec<usize> {
         let conds = &self.study.blocks[self.block].conditions;
         (0..self.tracks.len())
-            .filter(|&t| conds.contains(&self.tracks[t].condition) && !self.tracks[t].stair.done())
+            .filter(|&t| {
+                conds.contains(&self.tracks[t].condition) && !self.tracks[t].tracker.done()
+            })
             .collect()
     }
 
     fn block_left(&self) -> bool {
         match self.study.method {
             Method::Constant { .. } => !self.queue.is_empty(),
-            Method::Staircase(_) => !self.open_tracks().is_empty(),
+            Method::Staircase(_) | Method::Quest(_) => !self.open_tracks().is_empty(),
         }
     }
 
@@ -131,7 +193,7 @@ impl Schedule {
         let (condition, track, delta, practice) = if self.practice_left > 0 {
             self.practice_left -= 1;
             let c = conds[self.rng.below(conds.len())];
-            (c, None, self.study.method.practice_delta(), true)
+            (c, None, self.study.practice_delta(c), true)
         } else if let Some((c, d)) = self.queue.pop() {
             (c, None, d, false)
         } else {
@@ -140,11 +202,17 @@ impl Schedule {
             (
                 self.tracks[t].condition,
                 Some(t),
-                self.tracks[t].stair.delta,
+                self.tracks[t].tracker.delta(),
                 false,
             )
         };
-        let comparison_interval = 1 + self.rng.below(2) as u8;
+        // Same–different: a "same" trial (the reference twice) is comparison interval 0.
+        let same = self.study.task == Task::SameDifferent && self.rng.below(2) == 0;
+        let comparison_interval = if same {
+            0
+        } else {
+            1 + self.rng.below(self.study.task.intervals()) as u8
+        };
         Some(TrialSpec {
             trial: self.trial,
             block: self.block as u32 + 1,
@@ -159,7 +227,7 @@ impl Schedule {
     /// Records the answer to `spec` (moves its staircase).
     pub fn record(&mut self, spec: &TrialSpec, correct: bool) {
         if let Some(t) = spec.track {
-            self.tracks[t].stair.update(correct);
+            self.tracks[t].tracker.update(correct);
         }
     }
 
@@ -170,8 +238,14 @@ impl Schedule {
         let n = self.study.conditions.len() as u32;
         practice
             + match &self.study.method {
-                Method::Constant { deltas, repeats } => n * deltas.len() as u32 * repeats,
+                Method::Constant { repeats, .. } => {
+                    (0..self.study.conditions.len())
+                        .map(|c| self.study.deltas(c).len() as u32)
+                        .sum::<u32>()
+                        * repeats
+                }
                 Method::Staircase(s) => n * s.starts.len() as u32 * s.max_trials,
+                Method::Quest(q) => n * q.max_trials,
             }
     }
 }

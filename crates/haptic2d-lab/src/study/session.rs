@@ -7,7 +7,7 @@
 //! its row, or the study or seed changed and the run stops), and the remaining trials follow. No
 //! trial is lost or repeated.
 
-use super::file::Study;
+use super::file::{Study, Task};
 use super::observer::Observer;
 use super::rng::{hash_text, mix};
 use super::schedule::{Schedule, TrialSpec};
@@ -53,12 +53,24 @@ pub struct RunSummary {
     pub ran: u32,
     /// The session is complete.
     pub complete: bool,
+    /// QUEST's estimate per condition (name, threshold, 95 % credible interval), for QUEST studies.
+    pub quest: Vec<(String, f64, (f64, f64))>,
+}
+
+/// The answer names the comparison (or, same–different: says "different", 1, exactly when the
+/// comparison was presented).
+pub fn answer_correct(study: &Study, spec: &TrialSpec, response: u8) -> bool {
+    if study.task == Task::SameDifferent {
+        (response == 1) == (spec.comparison_interval != 0)
+    } else {
+        response == spec.comparison_interval
+    }
 }
 
 /// Row of `spec` answered `response` at `rt` s.
 fn row(study: &Study, sched: &Schedule, spec: &TrialSpec, response: u8, rt: f64) -> TrialRow {
     let c = &study.conditions[spec.condition];
-    let stair = spec.track.map(|t| &sched.tracks[t].stair);
+    let stair = spec.track.and_then(|t| sched.tracks[t].tracker.stair());
     TrialRow {
         trial: spec.trial,
         block: spec.block,
@@ -71,7 +83,7 @@ fn row(study: &Study, sched: &Schedule, spec: &TrialSpec, response: u8, rt: f64)
         delta: spec.delta,
         comparison_interval: spec.comparison_interval,
         response,
-        correct: response == spec.comparison_interval,
+        correct: (!c.pse).then_some(answer_correct(study, spec, response)),
         rt,
         reversals: stair.map(|s| s.reversals),
         run: stair.map(|s| s.run),
@@ -132,7 +144,7 @@ pub fn run(
                     tsv.display(), r.trial, r.condition, r.delta, r.comparison_interval, expect.condition, spec.delta, spec.comparison_interval
                 ));
             }
-            sched.record(&spec, r.correct);
+            sched.record(&spec, answer_correct(study, &spec, r.response));
             resumed += 1;
         }
         if complete < text.len() || text.is_empty() {
@@ -159,7 +171,7 @@ pub fn run(
             "session_seed": seed,
             "software": VERSION,
             "observer": observer.describe(),
-            "task": "2afc: which interval was stiffer?",
+            "task": study.task.describe(),
             "trials": "trials.tsv (docs/STUDIES.md)",
         });
         let mj = dir.join("session.json");
@@ -186,7 +198,7 @@ pub fn run(
             break;
         };
         let a = observer.answer(study, &spec)?;
-        sched.record(&spec, a.response == spec.comparison_interval);
+        sched.record(&spec, answer_correct(study, &spec, a.response));
         let r = row(study, &sched, &spec, a.response, a.rt);
         file.write_all(r.to_line().as_bytes())
             .map_err(|e| io(&tsv, e))?;
@@ -194,10 +206,21 @@ pub fn run(
         ran += 1;
         progress(spec.trial, planned);
     }
+    let quest = sched
+        .tracks
+        .iter()
+        .filter_map(|t| {
+            t.tracker.quest().map(|q| {
+                let (est, ci) = q.estimate();
+                (study.conditions[t.condition].name.clone(), est, ci)
+            })
+        })
+        .collect();
     Ok(RunSummary {
         dir,
         resumed,
         ran,
         complete,
+        quest,
     })
 }

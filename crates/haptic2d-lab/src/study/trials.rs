@@ -4,7 +4,8 @@
 //! Columns: `trial block practice condition track vary reference_value comparison_value delta
 //! comparison_interval response correct rt_s reversals run`. `track`, `reversals` and `run` (the
 //! staircase's state after the answer: its index, reversals so far and consecutive correct answers)
-//! are `-` for constant stimuli and practice. Numbers are written in Rust's shortest round-trip form,
+//! are `-` for constant stimuli and practice; `correct` is `-` in a PSE condition (no answer is
+//! correct when the comparison is another stimulus). Numbers are written in Rust's shortest round-trip form,
 //! so reading a row back gives the same values bit for bit.
 
 /// The header row.
@@ -35,8 +36,10 @@ pub struct TrialRow {
     pub comparison_interval: u8,
     /// Interval (1/2) named stiffer.
     pub response: u8,
-    /// The response named the comparison (the stiffer stimulus).
-    pub correct: bool,
+    /// The response named the comparison (the stiffer stimulus); `None` (`-`) in a PSE condition,
+    /// where the comparison is another stimulus and no answer is correct (there, the response
+    /// named the comparison iff `response == comparison_interval`).
+    pub correct: Option<bool>,
     /// Response time (s).
     pub rt: f64,
     /// Staircase reversals after this trial.
@@ -65,7 +68,7 @@ impl TrialRow {
             self.delta,
             self.comparison_interval,
             self.response,
-            u8::from(self.correct),
+            opt(&self.correct.map(u8::from)),
             self.rt,
             opt(&self.reversals),
             opt(&self.run),
@@ -106,11 +109,22 @@ impl TrialRow {
             delta: num(f[8], "delta")?,
             comparison_interval: num(f[9], "comparison_interval")?,
             response: num(f[10], "response")?,
-            correct: flag(f[11], "correct")?,
+            correct: if f[11] == "-" {
+                None
+            } else {
+                Some(flag(f[11], "correct")?)
+            },
             rt: num(f[12], "rt_s")?,
             reversals: opt_num(f[13], "reversals")?,
             run: opt_num(f[14], "run")?,
         })
+    }
+}
+
+impl TrialRow {
+    /// The response named the comparison stimulus (in either design).
+    pub fn comparison_chosen(&self) -> bool {
+        self.response == self.comparison_interval
     }
 }
 
@@ -150,7 +164,7 @@ mod tests {
             delta: 0.1 + 0.2,
             comparison_interval: 2,
             response: 1,
-            correct: false,
+            correct: Some(false),
             rt: 4.123456789012345,
             reversals: Some(2),
             run: Some(0),
