@@ -13,6 +13,8 @@ mod protocols_friction;
 mod released_handle;
 mod reproduce;
 mod stability;
+mod study_methods;
+mod study_pse;
 mod study_simulated;
 mod walls_w1_w9;
 mod world_f7;

@@ -237,7 +237,7 @@ fn stroking_feels_each_friction_models_stick_spring_and_dahls_drift() {
 /// physical PSEs; the pulse feels more than three times as stiff as its spring, SEH slightly stiffer
 /// (its extrapolation adds about half a sample's travel: at most 5/4.5 × 1000).
 #[test]
-#[ignore = "about 15 s per study in debug (six simulated participants); run: cargo test -p haptic2d-lab --test study_pse -- --ignored"]
+#[ignore = "about 15 s per study in debug (six simulated participants); run: cargo test -p haptic2d-lab --test it study_pse:: -- --ignored"]
 fn wall_laws_tap_study_recovers_each_laws_pse() {
     let (study, text) = load("wall-laws-tap.toml");
     let each = run_each(&study, &text);
@@ -256,7 +256,7 @@ fn wall_laws_tap_study_recovers_each_laws_pse() {
 /// (a) by pressing: the pulse and SEH walls' PSEs are their spring, 1000 N/m per corner; the
 /// hysteretic wall's is its secant, 857 N/m (derived above; the felt value is within 1 % of it).
 #[test]
-#[ignore = "about 15 s per study in debug (six simulated participants); run: cargo test -p haptic2d-lab --test study_pse -- --ignored"]
+#[ignore = "about 15 s per study in debug (six simulated participants); run: cargo test -p haptic2d-lab --test it study_pse:: -- --ignored"]
 fn wall_laws_press_study_finds_pulse_and_seh_equal_to_their_spring_and_hysteretic_softer() {
     let (study, text) = load("wall-laws-press.toml");
     let each = run_each(&study, &text);
@@ -269,7 +269,7 @@ fn wall_laws_press_study_finds_pulse_and_seh_equal_to_their_spring_and_hystereti
 /// and 2250), Dahl's lies below its drift-free 1737, and classical friction's rigid stick lies above
 /// every tested reset integrator.
 #[test]
-#[ignore = "about 15 s per study in debug (six simulated participants); run: cargo test -p haptic2d-lab --test study_pse -- --ignored"]
+#[ignore = "about 15 s per study in debug (six simulated participants); run: cargo test -p haptic2d-lab --test it study_pse:: -- --ignored"]
 fn friction_study_recovers_the_stick_springs_and_shows_dahls_drift_and_classicals_rigid_stick() {
     let (study, text) = load("friction-models.toml");
     let each = run_each(&study, &text);
