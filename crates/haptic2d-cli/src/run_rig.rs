@@ -391,7 +391,7 @@ impl Rig {
                 c.controller = config.controller;
                 c.slave = config.slave.clone();
                 c.safety = safety;
-                c.workspace = Some(*workspace);
+                c.workspace = *workspace;
                 RigSystem::TwoDof(Planar2System::new(world, c)?)
             }
         })

@@ -51,10 +51,7 @@ impl HaplySystem {
                 c.grasp = grasp;
                 // The device file's workspace square: the passive wall near its edge and the trip
                 // beyond it, as on every device (the same square `haptic2d run` gives the 2DIY).
-                c.workspace = Some(haptic2d::haptic::WorkspaceSquare::around(
-                    *center,
-                    *half_width,
-                ));
+                c.workspace = haptic2d::haptic::WorkspaceSquare::around(*center, *half_width);
                 Ok(HaplySystem::TwoDof(Planar2System::new(world, c)?))
             }
             HaplyKind::Twin(p) => {

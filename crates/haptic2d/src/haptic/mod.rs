@@ -15,6 +15,7 @@ pub mod planar2;
 pub mod plausibility;
 pub mod record;
 pub mod safety;
+pub mod safety_stage;
 pub mod system;
 pub mod workspace;
 
@@ -25,5 +26,6 @@ pub use mapping::DeviceMap;
 pub use plausibility::JointPlausibility;
 pub use record::{TickRecord, TICK_COLUMNS};
 pub use safety::{Safety, SafetyConfig, SafetyReason, SafetyTrip};
+pub use safety_stage::SafetyStage;
 pub use system::{HapticSystem, TickOutput};
 pub use workspace::{WorkspaceBound, WorkspaceSquare};

@@ -42,10 +42,9 @@ use crate::geom::Vec2;
 use crate::world::World;
 
 use super::config::ControllerKind;
-use super::limit_cycle::LimitCycleMonitor;
-use super::plausibility::JointPlausibility;
 use super::record::{TickRecord, FLAG_SAFETY};
 use super::safety::{Safety, SafetyConfig, SafetyReason, SafetyTrip};
+use super::safety_stage::SafetyStage;
 use super::workspace::{WorkspaceBound, WorkspaceSquare};
 
 mod steps;
@@ -78,10 +77,11 @@ pub struct Planar2Config {
     /// Keep the scene's loads on the slave body. Default false (the hand drives it).
     pub keep_slave_loads: bool,
     /// The workspace square of the device file (device frame) with its wall and trip, the same
-    /// bound as the twin pantograph's ([`WorkspaceBound`]). `None` (the default of [`Self::new`]):
-    /// no bound; `haptic2d run` always sets one (the 2DIY's and the Inverse3's `[workspace]`, or
-    /// [`WorkspaceSquare::five_bar`] for a device file without one).
-    pub workspace: Option<WorkspaceSquare>,
+    /// bound as the twin pantograph's ([`WorkspaceBound`], applied by the shared [`SafetyStage`]).
+    /// Every 2-DOF system has one: [`Self::new`] gives the linkage's reach square
+    /// ([`WorkspaceSquare::five_bar`]); a device file's `[workspace]` (the 2DIY's, the Inverse3's)
+    /// replaces it.
+    pub workspace: WorkspaceSquare,
 }
 
 impl Planar2Config {
@@ -98,7 +98,7 @@ impl Planar2Config {
             safety: SafetyConfig::default(),
             min_singularity_margin: 0.1,
             keep_slave_loads: false,
-            workspace: None,
+            workspace: WorkspaceSquare::five_bar(&linkage),
         }
     }
 }
@@ -129,19 +129,11 @@ pub struct Planar2System {
     world: World,
     slave: usize,
     filter: VelocityFilter,
-    safety: Safety,
-    workspace: Option<WorkspaceBound>,
-    plausibility: JointPlausibility,
-    limit_cycle: LimitCycleMonitor,
+    /// The shared safety steps: stall, plausibility, workspace bound, limit cycle, ramp, gate.
+    safety: SafetyStage,
     /// World point of the grasp at start (m): the first handle position maps here.
     world_origin: Vec2,
     device_origin: Option<Vec2>,
-    /// Ticks since the alignment at the first valid reading (the ramp's clock).
-    ramp_ticks: u64,
-    /// Ticks of the ramp, `round(ramp_time / T)` (0 = no ramp).
-    ramp_len: u64,
-    /// True once a tick has read the device (the stall check needs a previous tick).
-    started: bool,
     /// The page's twist target `θ_t` (rad), `None` = off (see the module doc).
     twist_target: Option<f64>,
     /// Torsion stiffness `K_t` (N·m/rad) and damping `B_t` (N·m·s/rad) of the twist target.
@@ -168,9 +160,7 @@ impl Planar2System {
             return Err("velocity_cutoff_hz must be > 0 Hz (default 50)".into());
         }
         config.safety.validate()?;
-        if let Some(w) = &config.workspace {
-            w.validate()?;
-        }
+        config.workspace.validate()?;
         let slave = match &config.slave {
             Some(name) => world
                 .body_index(name)
@@ -207,17 +197,16 @@ impl Planar2System {
             filter: VelocityFilter::new(config.velocity_cutoff_hz, dt),
             // The final gate clamps to the smaller motor limit (the saturation above already scales
             // each motor to its own) and trips above it by the default margin.
-            safety: Safety::new(
-                config.min_singularity_margin,
-                config.tau_max[0].min(config.tau_max[1]),
-                config.safety.torque_trip_margin,
+            safety: SafetyStage::new(
+                config.safety,
+                Safety::new(
+                    config.min_singularity_margin,
+                    config.tau_max[0].min(config.tau_max[1]),
+                    config.safety.torque_trip_margin,
+                ),
+                WorkspaceBound::of_square(&config.workspace, dt),
+                dt,
             ),
-            workspace: config.workspace.map(|w| WorkspaceBound::of_square(&w, dt)),
-            plausibility: JointPlausibility::new(&config.safety),
-            limit_cycle: LimitCycleMonitor::new(&config.safety, dt),
-            ramp_len: (config.safety.ramp_time / dt).round() as u64,
-            ramp_ticks: 0,
-            started: false,
             twist_target: None,
             twist_gains,
             config,
@@ -292,11 +281,7 @@ impl Planar2System {
     /// valid reading (exactly 0 before and at it), `N = round(ramp_time / T)`; 1 without a ramp.
     #[inline]
     pub fn ramp(&self) -> f64 {
-        if self.ramp_len == 0 {
-            1.0
-        } else {
-            (self.ramp_ticks as f64 / self.ramp_len as f64).min(1.0)
-        }
+        self.safety.ramp()
     }
 
     /// A paused sample: the handle is still read (its filter keeps tracking), no controller runs,
@@ -305,10 +290,7 @@ impl Planar2System {
     /// allocates.
     pub fn tick_paused(&mut self, q: &[f64; 2]) -> Planar2Output {
         let (k, t) = (self.world.tick(), self.world.time());
-        if let Some(reason) = self.plausibility.check_angles(q) {
-            self.safety.trip(k, t, reason);
-        }
-        self.limit_cycle.reset();
+        self.safety.supervise_paused((k, t), q);
         let mut x_m = [f64::NAN; 3];
         let mut margin = f64::NAN;
         match self.config.linkage.state(*q) {
@@ -319,11 +301,11 @@ impl Planar2System {
                 x_m = [p.x, p.y, 0.0];
                 margin = s.margin;
             }
-            Err(f) => self.safety.trip(k, t, SafetyReason::Device(f)),
+            Err(f) => self.safety.trip((k, t), SafetyReason::Device(f)),
         }
         let mut tau4 = [0.0; 4];
         let mut flags = 0u32;
-        if self.safety.gate(k, t, &mut tau4) {
+        if self.safety.gate((k, t), &mut tau4, false) {
             flags |= FLAG_SAFETY;
         }
         self.realign();
@@ -357,16 +339,14 @@ impl Planar2System {
     fn realign(&mut self) {
         self.device_origin = None;
         self.world_origin = grasp_world(&self.world, self.slave, self.config.grasp);
-        self.ramp_ticks = 0;
-        self.started = false;
+        self.safety.restart_ramp();
+        self.safety.restart_clock();
     }
 
     /// Re-arms the safety latch (an explicit user action): the next tick re-aligns and ramps in from
     /// zero, as at start-up.
     pub fn reset_safety(&mut self) {
-        self.safety.reset();
-        self.plausibility.reset();
-        self.limit_cycle.reset();
+        self.safety.rearm();
         self.realign();
     }
 
@@ -375,15 +355,13 @@ impl Planar2System {
     /// `device_wait` s of it waiting for the device, NaN = unknown) exceeds the stall limit `max(max_stall_periods·T, min_stall_time)`.
     /// Returns true when it tripped. Never allocates.
     pub fn check_stall(&mut self, elapsed: f64, device_wait: f64) -> bool {
-        let (k, t) = (self.world.tick(), self.world.time());
-        let limit = self.config.safety.stall_limit(self.dt);
-        self.safety
-            .check_stall(k, t, self.started, elapsed, device_wait, limit)
+        let at = (self.world.tick(), self.world.time());
+        self.safety.check_stall(at, elapsed, device_wait)
     }
 
-    /// The workspace bound the tick applies, if any.
-    pub fn workspace(&self) -> Option<&WorkspaceBound> {
-        self.workspace.as_ref()
+    /// The workspace bound the tick applies (every 2-DOF system has one).
+    pub fn workspace(&self) -> &WorkspaceBound {
+        self.safety.workspace()
     }
 
     /// Switches the teleoperation controller to `kind` from its reset state; the gains are checked
@@ -418,8 +396,8 @@ impl Planar2System {
 
     /// Latches the safety stop from outside (e.g. the device was lost): zero torques from now on.
     pub fn trip_device(&mut self, fault: DeviceFault) {
-        let (k, t) = (self.world.tick(), self.world.time());
-        self.safety.trip(k, t, SafetyReason::Device(fault));
+        let at = (self.world.tick(), self.world.time());
+        self.safety.trip(at, SafetyReason::Device(fault));
     }
 
     /// The world.

@@ -9,11 +9,10 @@ use crate::device::{DeviceFault, TwinPantograph};
 use crate::world::World;
 
 use super::config::{ControllerKind, HapticConfig};
-use super::limit_cycle::LimitCycleMonitor;
 use super::mapping::DeviceMap;
-use super::plausibility::JointPlausibility;
 use super::record::{TickRecord, FLAG_SAFETY};
 use super::safety::{Safety, SafetyConfig, SafetyReason, SafetyTrip};
+use super::safety_stage::SafetyStage;
 use super::workspace::WorkspaceBound;
 
 mod steps;
@@ -89,11 +88,8 @@ pub struct HapticSystem {
     world: World,
     slave: usize,
     map: DeviceMap,
-    workspace: WorkspaceBound,
-    plausibility: JointPlausibility,
-    limit_cycle: LimitCycleMonitor,
-    safety: Safety,
-    safety_config: SafetyConfig,
+    /// The shared safety steps: stall, plausibility, workspace bound, limit cycle, ramp, gate.
+    safety: SafetyStage,
     preload: f64,
     dt: f64,
     tau_prev: V4,
@@ -103,12 +99,6 @@ pub struct HapticSystem {
     hand_injection: V3,
     /// False until the first valid reading after construction, a re-arm or a pause.
     aligned: bool,
-    /// Ticks since the alignment (the ramp's clock).
-    ramp_ticks: u64,
-    /// Ticks of the ramp, `round(ramp_time / T)` (0 = no ramp).
-    ramp_len: u64,
-    /// True once any tick has read the device (the stall check needs a previous tick).
-    started: bool,
     record: TickRecord,
 }
 
@@ -198,24 +188,22 @@ impl HapticSystem {
             world,
             slave,
             map,
-            workspace: WorkspaceBound::new(&config.device, dt),
-            plausibility: JointPlausibility::new(&safety),
-            limit_cycle: LimitCycleMonitor::new(&safety, dt),
-            safety: Safety::new(
-                config.device.min_singularity_margin,
-                tau_max,
-                safety.torque_trip_margin,
+            safety: SafetyStage::new(
+                safety,
+                Safety::new(
+                    config.device.min_singularity_margin,
+                    tau_max,
+                    safety.torque_trip_margin,
+                ),
+                WorkspaceBound::new(&config.device, dt),
+                dt,
             ),
-            safety_config: safety,
             preload: config.preload,
             dt,
             tau_prev: [0.0; 4],
             injected: None,
             hand_injection: [0.0; 3],
             aligned: false,
-            ramp_ticks: 0,
-            ramp_len: (safety.ramp_time / dt).round() as u64,
-            started: false,
             record: TickRecord::default(),
         })
     }
@@ -280,16 +268,6 @@ impl HapticSystem {
         }
     }
 
-    /// The start-up ramp factor of this tick, `min(1, n / N)` (exactly 0 at the alignment tick).
-    #[inline]
-    fn ramp_factor(&self) -> f64 {
-        if self.ramp_len == 0 {
-            1.0
-        } else {
-            (self.ramp_ticks as f64 / self.ramp_len as f64).min(1.0)
-        }
-    }
-
     /// A paused sample (the live display's pause): the device is still estimated from the encoder
     /// angles `q` (rad; steps 1–2, so the pose unwrapping, the velocity filter and the hand-wrench
     /// observer keep tracking the handle while the user moves it), but neither controller runs, the
@@ -297,28 +275,25 @@ impl HapticSystem {
     /// device, the frozen slave and zero commands. Never allocates, locks, prints or does I/O.
     pub fn tick_paused(&mut self, q: &V4) -> TickOutput {
         let (k, t) = (self.world.tick(), self.world.time());
-        if let Some(reason) = self.plausibility.check_angles(q) {
-            self.safety.trip(k, t, reason);
-        }
-        self.limit_cycle.reset();
+        self.safety.supervise_paused((k, t), q);
         let mut closure_fault = false;
         let est = match self.device.estimate(q, &self.tau_prev) {
             Ok(e) => Some(e),
             Err(fault) => {
                 closure_fault = matches!(fault, DeviceFault::ClosureViolation { .. });
-                self.safety.trip(k, t, SafetyReason::Device(fault));
+                self.safety.trip((k, t), SafetyReason::Device(fault));
                 None
             }
         };
         let mut tau = [0.0; 4];
         let mut flags = 0u32;
-        if self.safety.gate(k, t, &mut tau) {
+        if self.safety.gate((k, t), &mut tau, false) {
             flags |= FLAG_SAFETY;
         }
         self.tau_prev = tau;
         // The handle moves while the slave is frozen: the next running tick re-aligns and ramps in.
         self.aligned = false;
-        self.started = false;
+        self.safety.restart_clock();
         if let Some(pc) = self.passivity.as_mut() {
             pc.idle();
         }
@@ -407,7 +382,7 @@ impl HapticSystem {
     }
     /// The workspace bound rendered from the device file.
     pub fn workspace(&self) -> &WorkspaceBound {
-        &self.workspace
+        self.safety.workspace()
     }
     /// The device estimator.
     pub fn device(&self) -> &TwinPantograph {
@@ -424,7 +399,7 @@ impl HapticSystem {
     /// Re-arms the safety latch (an explicit user action). The next tick re-aligns the mapping to the
     /// handle's measured pose and ramps the torques in again from zero, as at start-up.
     pub fn reset_safety(&mut self) {
-        self.safety.reset();
+        self.safety.rearm();
         // The estimates are stale after a fault (a stall, lost readings): restart the velocity filter
         // and the observer, keeping the θ unwrapping reference.
         let theta = self
@@ -433,9 +408,7 @@ impl HapticSystem {
             .map_or(self.map.device_origin[2], |p| p[2]);
         self.device.reset(theta);
         self.aligned = false;
-        self.started = false;
-        self.plausibility.reset();
-        self.limit_cycle.reset();
+        self.safety.restart_clock();
     }
 
     /// The stall check of [`Self::tick_elapsed`] on its own, for a device paced by the ticks (the
@@ -444,19 +417,17 @@ impl HapticSystem {
     /// `device_wait` s waiting for the device, NaN = unknown) exceeds the stall limit `max(max_stall_periods·T, min_stall_time)`; the
     /// next tick's torques are then zero. Returns true when it tripped. Never allocates.
     pub fn check_stall(&mut self, elapsed: f64, device_wait: f64) -> bool {
-        let (k, t) = (self.world.tick(), self.world.time());
-        let limit = self.safety_config.stall_limit(self.dt);
-        self.safety
-            .check_stall(k, t, self.started, elapsed, device_wait, limit)
+        let at = (self.world.tick(), self.world.time());
+        self.safety.check_stall(at, elapsed, device_wait)
     }
     /// The safety settings (ramp, stall limit, torque trip margin).
     pub fn safety_config(&self) -> &SafetyConfig {
-        &self.safety_config
+        self.safety.config()
     }
     /// The start-up ramp factor the next tick applies (0 at the first valid reading, 1 once ramped in).
     pub fn ramp(&self) -> f64 {
         if self.aligned {
-            self.ramp_factor()
+            self.safety.ramp()
         } else {
             0.0
         }

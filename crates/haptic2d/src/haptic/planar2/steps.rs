@@ -36,22 +36,18 @@ pub(super) struct Slave2 {
 impl Planar2System {
     /// Step 0. Stall and joint plausibility: the shared safety layer, as in `HapticSystem`.
     pub(super) fn supervise_input(&mut self, q: &[f64; 2], elapsed: f64, device_wait: f64) {
-        let (k, t) = (self.world.tick(), self.world.time());
-        self.check_stall(elapsed, device_wait);
-        self.started = true;
-        if let Some(reason) = self.plausibility.check(q, elapsed) {
-            self.safety.trip(k, t, reason);
-        }
+        let at = (self.world.tick(), self.world.time());
+        self.safety.supervise_input(at, q, elapsed, device_wait);
     }
 
     /// Steps 1–2. Handle point, Jacobian and singularity margin; filtered velocity; the device →
     /// world translation (anchored at the first valid reading). A fault or a singular pose trips.
     pub(super) fn sense(&mut self, q: &[f64; 2], flags: &mut u32) -> Handle {
-        let (k, t) = (self.world.tick(), self.world.time());
+        let at = (self.world.tick(), self.world.time());
         let st = match self.config.linkage.state(*q) {
             Ok(s) => Some(s),
             Err(f) => {
-                self.safety.trip(k, t, SafetyReason::Device(f));
+                self.safety.trip(at, SafetyReason::Device(f));
                 None
             }
         };
@@ -69,8 +65,7 @@ impl Planar2System {
             if s.margin < self.config.min_singularity_margin {
                 *flags |= FLAG_NEAR_SINGULAR;
                 self.safety.trip(
-                    k,
-                    t,
+                    at,
                     SafetyReason::Singularity {
                         margin: s.margin,
                         limit: self.config.min_singularity_margin,
@@ -126,12 +121,10 @@ impl Planar2System {
     /// Step 8b. The device file's workspace bound at the handle point (device frame; the device →
     /// world map is a translation, so velocity and force are the same in both).
     pub(super) fn workspace_wall(&mut self, h: &Handle, f_cm: &mut V3) {
-        let (k, t) = (self.world.tick(), self.world.time());
-        if let (Some(s), Some(w)) = (h.st, self.workspace.as_mut()) {
+        let at = (self.world.tick(), self.world.time());
+        if let Some(s) = h.st {
             let x = [s.e.x, s.e.y, 0.0];
-            if let Some(reason) = w.apply(&x, &h.v_m, f_cm) {
-                self.safety.trip(k, t, reason);
-            }
+            self.safety.workspace_wall(at, &x, &h.v_m, f_cm);
             f_cm[2] = 0.0;
         }
     }
@@ -145,7 +138,7 @@ impl Planar2System {
         f_cm: &V3,
         flags: &mut u32,
     ) -> ([f64; 4], bool) {
-        let (k, t) = (self.world.tick(), self.world.time());
+        let at = (self.world.tick(), self.world.time());
         let mut tau4 = [0.0; 4];
         if let (Some(s), false) = (h.st, self.safety.is_latched()) {
             let tau = jt_mul(&s.j, [f_cm[0], f_cm[1]]);
@@ -160,18 +153,15 @@ impl Planar2System {
             }
             let (t0, t1) = (tau[0] * scale, tau[1] * scale);
             let tau_max = [self.config.tau_max[0], self.config.tau_max[1], 0.0, 0.0];
-            if let Some(reason) = self.limit_cycle.observe(&[t0, t1, 0.0, 0.0], &tau_max) {
-                self.safety.trip(k, t, reason);
-            }
-            let ramp = self.ramp();
+            self.safety
+                .observe_limit_cycle(at, &[t0, t1, 0.0, 0.0], &tau_max);
+            let ramp = self.safety.ramp();
             tau4[0] = tau[0] * scale * ramp;
             tau4[1] = tau[1] * scale * ramp;
         }
-        let gated = self.safety.gate(k, t, &mut tau4);
+        let gated = self.safety.gate(at, &mut tau4, h.st.is_some());
         if gated {
             *flags |= FLAG_SAFETY;
-        } else if h.st.is_some() {
-            self.ramp_ticks = self.ramp_ticks.saturating_add(1);
         }
         (tau4, gated)
     }
