@@ -35,9 +35,8 @@
 
 use crate::control::coupling::VirtualCoupling;
 use crate::control::four_channel::FourChannel;
-use crate::device::filter::VelocityFilter;
 use crate::device::pantograph2::Pantograph2;
-use crate::device::DeviceFault;
+use crate::device::{CartesianDevice, DeviceFault, Pantograph2Device};
 use crate::geom::Vec2;
 use crate::world::World;
 
@@ -128,7 +127,8 @@ pub struct Planar2System {
     controller: Controller2,
     world: World,
     slave: usize,
-    filter: VelocityFilter,
+    /// The five-bar at the Cartesian boundary: handle point, filtered velocity, `τ = Jᵀ·f`.
+    device: Pantograph2Device,
     /// The shared safety steps: stall, plausibility, workspace bound, limit cycle, ramp, gate.
     safety: SafetyStage,
     /// World point of the grasp at start (m): the first handle position maps here.
@@ -194,7 +194,13 @@ impl Planar2System {
             world.loads.retain(|l| l.body != slave);
         }
         Ok(Self {
-            filter: VelocityFilter::new(config.velocity_cutoff_hz, dt),
+            device: Pantograph2Device::new(
+                config.linkage,
+                config.tau_max,
+                config.min_singularity_margin,
+                config.velocity_cutoff_hz,
+                dt,
+            ),
             // The final gate clamps to the smaller motor limit (the saturation above already scales
             // each motor to its own) and trips above it by the default margin.
             safety: SafetyStage::new(
@@ -245,7 +251,8 @@ impl Planar2System {
     /// after the previous tick (the loop's own interval, measured by the caller). A tick later than the
     /// stall limit ([`SafetyConfig::stall_limit`]) trips the latch with [`SafetyReason::Stall`] in this
     /// same tick (the device held its last torques unsupervised for that long); a NaN interval
-    /// counts as a stall. The filter and the world use the fixed period `T`.
+    /// counts as a stall. The device's velocity filter differentiates over the measured interval
+    /// (as the twin's does); the world steps by the fixed period `T`.
     pub fn tick_elapsed(&mut self, q: &[f64; 2], elapsed: f64) -> Planar2Output {
         self.tick_timed(q, elapsed, f64::NAN)
     }
@@ -257,7 +264,7 @@ impl Planar2System {
         let t = self.world.time();
         let mut flags = 0u32;
         self.supervise_input(q, elapsed, device_wait); // 0
-        let mut handle = self.sense(q, &mut flags); // 1–2
+        let mut handle = self.sense(q, elapsed, &mut flags); // 1–2
         let slave = self.contact_stage(); // 3–6
         handle.x_m[2] = slave.theta;
         handle.v_m[2] = slave.omega;
@@ -293,13 +300,13 @@ impl Planar2System {
         self.safety.supervise_paused((k, t), q);
         let mut x_m = [f64::NAN; 3];
         let mut margin = f64::NAN;
-        match self.config.linkage.state(*q) {
-            Ok(s) => {
-                let origin = self.device_origin.unwrap_or(s.e);
-                let p = s.e - origin + self.world_origin;
-                self.filter.update(&[p.x, p.y, 0.0]);
+        match self.device.sense(q, &[0.0; 4], self.dt) {
+            Ok(e) => {
+                let point = Vec2::new(e.pose[0], e.pose[1]);
+                let origin = self.device_origin.unwrap_or(point);
+                let p = point - origin + self.world_origin;
                 x_m = [p.x, p.y, 0.0];
-                margin = s.margin;
+                margin = self.device.margin();
             }
             Err(f) => self.safety.trip((k, t), SafetyReason::Device(f)),
         }

@@ -6,7 +6,7 @@ use super::HapticSystem;
 use crate::control::four_channel::TeleopSignals;
 use crate::control::passivity::explicit_damping_limit;
 use crate::device::linalg::{M3, V3, V4};
-use crate::device::{DeviceEstimate, DeviceFault};
+use crate::device::{CartesianDevice, DeviceEstimate, DeviceFault};
 use crate::geom::Vec2;
 use crate::haptic::record::{
     TickRecord, FLAG_NEAR_SINGULAR, FLAG_PASSIVITY_ACTIVE, FLAG_SAFETY, FLAG_SATURATED,
@@ -54,7 +54,7 @@ impl HapticSystem {
     /// whether it was the closure monitor.
     pub(super) fn sense(&mut self, q: &V4, elapsed: f64) -> (Option<DeviceEstimate>, bool) {
         let at = (self.world.tick(), self.world.time());
-        match self.device.estimate_elapsed(q, &self.tau_prev, elapsed) {
+        match self.device.sense(q, &self.tau_prev, elapsed) {
             Ok(e) => (Some(e), false),
             Err(fault) => {
                 let closure = matches!(fault, DeviceFault::ClosureViolation { .. });
@@ -180,14 +180,14 @@ impl HapticSystem {
         let mut tau = [0.0; 4];
         let mut wrench_scale = 0.0;
         if !self.safety.is_latched() {
-            match self.device.torques_for_wrench(f_dev, self.preload) {
+            match self.device.wrench_to_torques(f_dev, self.preload) {
                 Ok(cmd) => {
                     tau = cmd.tau;
                     wrench_scale = cmd.wrench_scale;
                     if cmd.saturated {
                         *flags |= FLAG_SATURATED;
                     }
-                    let tau_max = [self.safety.latch().tau_max; 4];
+                    let tau_max = self.device.tau_max();
                     self.safety.observe_limit_cycle(at, &cmd.tau, &tau_max);
                     if cmd.near_singular {
                         *flags |= FLAG_NEAR_SINGULAR;
