@@ -15,4 +15,5 @@ pub mod file_read;
 pub mod haply;
 #[cfg(feature = "inverse3")]
 pub mod inverse3;
+pub mod registry;
 pub mod udp;
