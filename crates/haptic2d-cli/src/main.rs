@@ -22,7 +22,6 @@ mod grip_twist;
 mod hand_arg;
 mod haply_arg;
 mod pipe;
-mod rig_system;
 mod run_log;
 mod run_rig;
 mod run_view;

@@ -12,11 +12,12 @@
 
 use crate::grip_twist::GripTwist;
 use crate::hand_arg::HandSpec;
-use crate::rig_system::RigSystem;
 use haptic2d::device::linalg::{V3, V4};
 use haptic2d::device::DeviceParams;
 use haptic2d::haptic::planar2::{Planar2Config, Planar2System};
-use haptic2d::haptic::{ControllerKind, HapticConfig, HapticSystem, SafetyConfig, TickOutput};
+use haptic2d::haptic::{
+    ControllerKind, DeviceSystem, HapticConfig, HapticSystem, SafetyConfig, TickOutput,
+};
 use haptic2d::world::World;
 use haptic2d_devices::device_safety::DeviceSafety;
 pub use haptic2d_devices::registry::{DeviceChoice, DeviceModel, MatchController, RealDevice};
@@ -63,7 +64,7 @@ fn plant_substeps(dt: f64) -> u32 {
 /// The haptic system and its device, owned by the loop thread.
 pub struct Rig {
     /// Device estimator, controller, passivity controller and world (twin or 2-DOF).
-    pub system: RigSystem,
+    pub system: DeviceSystem,
     /// The device I/O (a 2-DOF device fills `q[0..2]`).
     pub io: Box<dyn DeviceIo + Send>,
     /// The settings the system was built with; `controller` follows the page's selection. For a
@@ -130,7 +131,7 @@ impl Rig {
             _ => Box::new(Self::sim(&system, &config, &hand, target.as_ref())?),
         };
         Ok(Self {
-            system: RigSystem::Twin(system),
+            system: DeviceSystem::Twin(system),
             io,
             config,
             device,
@@ -201,7 +202,7 @@ impl Rig {
         world: World,
         config: &HapticConfig,
         limits: &RealLimits,
-    ) -> Result<RigSystem, String> {
+    ) -> Result<DeviceSystem, String> {
         // The device file's plausibility bounds and stall floor (its `[safety]` table).
         let safety = limits.safety.apply(SafetyConfig {
             max_stall_periods: limits.max_stall_periods + limits.wait_periods,
@@ -209,7 +210,7 @@ impl Rig {
         });
         Ok(match &limits.model {
             DeviceModel::Twin(_) => {
-                RigSystem::Twin(HapticSystem::with_safety(world, config, safety)?)
+                DeviceSystem::Twin(HapticSystem::with_safety(world, config, safety)?)
             }
             DeviceModel::FiveBar {
                 linkage,
@@ -225,7 +226,7 @@ impl Rig {
                 c.slave = config.slave.clone();
                 c.safety = safety;
                 c.workspace = *workspace;
-                RigSystem::TwoDof(Planar2System::new(world, c)?)
+                DeviceSystem::TwoDof(Planar2System::new(world, c)?)
             }
         })
     }
@@ -295,7 +296,7 @@ impl Rig {
         let elapsed_ns = self.interval.update(info);
         let wait_ns = std::mem::replace(&mut self.prev_read_wait_ns, self.read_wait_ns);
         // A sensed handle orientation turns the slave's twist target (2-DOF devices).
-        if let (Some(a), RigSystem::TwoDof(s)) = (self.io.handle_angle(), &mut self.system) {
+        if let (Some(a), DeviceSystem::TwoDof(s)) = (self.io.handle_angle(), &mut self.system) {
             let slave_angle = s.world().bodies[s.slave()].pose.angle;
             s.set_twist_target(self.grip.target(a, slave_angle));
         }
@@ -380,7 +381,7 @@ impl Rig {
                         self.target.as_ref(),
                     )?);
                 }
-                RigSystem::Twin(system)
+                DeviceSystem::Twin(system)
             }
         };
         self.system = system;
@@ -400,7 +401,7 @@ impl Rig {
     /// no hand follows a target. On a 2-DOF device (the real hand moves x and y) only the angle is
     /// used: it becomes the twist target of the slave's virtual torsion spring (the wheel / Q–E).
     pub fn set_hand_target(&mut self, world: V3) -> Option<V3> {
-        if let RigSystem::TwoDof(s) = &mut self.system {
+        if let DeviceSystem::TwoDof(s) = &mut self.system {
             s.set_twist_target(Some(world[2]));
             return Some(self.hand_target_world());
         }
@@ -419,9 +420,9 @@ impl Rig {
     /// the handle is.
     pub fn hand_target_world(&self) -> V3 {
         match (&self.target, &self.system) {
-            (Some(t), RigSystem::Twin(s)) => s.map().pose_to_world(&t.get()),
+            (Some(t), DeviceSystem::Twin(s)) => s.map().pose_to_world(&t.get()),
             // 2-DOF: the handle's x and y, and the twist target (else the slave's angle).
-            (_, RigSystem::TwoDof(s)) => {
+            (_, DeviceSystem::TwoDof(s)) => {
                 let h = self.system.handle_world();
                 [h[0], h[1], s.twist_target().unwrap_or(h[2])]
             }
@@ -873,7 +874,7 @@ mod tests {
         assert_eq!(set[2], 0.3);
         assert_ne!(set[0], 9.0, "x and y stay the handle's");
         match &rig.system {
-            RigSystem::TwoDof(s) => assert_eq!(s.twist_target(), Some(0.3)),
+            DeviceSystem::TwoDof(s) => assert_eq!(s.twist_target(), Some(0.3)),
             _ => unreachable!(),
         }
         assert_eq!(rig.hand_target_world()[2], 0.3);
@@ -883,7 +884,7 @@ mod tests {
             .unwrap()
             .world;
         rig.rebuild(world).unwrap();
-        assert!(matches!(rig.system, RigSystem::TwoDof(_)));
+        assert!(matches!(rig.system, DeviceSystem::TwoDof(_)));
         assert_eq!(rig.io.name(), "fake-board");
     }
 

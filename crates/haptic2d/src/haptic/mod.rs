@@ -8,6 +8,7 @@
 //! simulated time for tests and for the device-in-the-loop experiments of `haptic2d-lab`.
 
 pub mod config;
+pub mod device_system;
 pub mod experiment;
 pub mod limit_cycle;
 pub mod mapping;
@@ -20,6 +21,7 @@ pub mod system;
 pub mod workspace;
 
 pub use config::{ControllerKind, HapticConfig};
+pub use device_system::DeviceSystem;
 pub use experiment::DeviceInTheLoop;
 pub use limit_cycle::LimitCycleMonitor;
 pub use mapping::DeviceMap;
