@@ -8,6 +8,7 @@
 //! simulated time for tests and for the device-in-the-loop experiments of `haptic2d-lab`.
 
 pub mod config;
+mod controller;
 pub mod device_system;
 pub mod experiment;
 pub mod limit_cycle;

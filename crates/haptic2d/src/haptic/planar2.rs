@@ -33,14 +33,13 @@
 //! a translation set at the **first measured handle position** (the slave starts aligned with the
 //! handle wherever the user holds it). Never allocates, locks or does I/O in [`Planar2System::tick`].
 
-use crate::control::coupling::VirtualCoupling;
-use crate::control::four_channel::FourChannel;
 use crate::device::pantograph2::Pantograph2;
 use crate::device::{CartesianDevice, DeviceFault, Pantograph2Device};
 use crate::geom::Vec2;
 use crate::world::World;
 
-use super::config::ControllerKind;
+use super::config::{find_slave, ControllerKind};
+use super::controller::Controller;
 use super::record::{TickRecord, FLAG_SAFETY};
 use super::safety::{Safety, SafetyConfig, SafetyReason, SafetyTrip};
 use super::safety_stage::SafetyStage;
@@ -102,13 +101,6 @@ impl Planar2Config {
     }
 }
 
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[allow(clippy::large_enum_variant)]
-enum Controller2 {
-    FourChannel(FourChannel),
-    Coupling(VirtualCoupling),
-}
-
 /// What one 2-DOF tick hands back.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Planar2Output {
@@ -124,7 +116,7 @@ pub struct Planar2Output {
 #[derive(Clone, Debug)]
 pub struct Planar2System {
     config: Planar2Config,
-    controller: Controller2,
+    controller: Controller,
     world: World,
     slave: usize,
     /// The five-bar at the Cartesian boundary: handle point, filtered velocity, `τ = Jᵀ·f`.
@@ -161,32 +153,9 @@ impl Planar2System {
         }
         config.safety.validate()?;
         config.workspace.validate()?;
-        let slave = match &config.slave {
-            Some(name) => world
-                .body_index(name)
-                .ok_or_else(|| format!("slave body `{name}` not found"))?,
-            None => world
-                .bodies
-                .iter()
-                .position(|b| b.is_dynamic())
-                .ok_or("the scene has no dynamic body for the device to drive")?,
-        };
+        let slave = find_slave(&world, config.slave.as_deref())?;
         let body = &world.bodies[slave];
-        if !body.is_dynamic() {
-            return Err(format!("slave body `{}` is fixed", body.name));
-        }
-        let mass = [body.mass, body.mass, body.inertia];
-        let controller = match config.controller {
-            ControllerKind::FourChannel(g) => {
-                g.check_slave_mass(&mass, dt)?;
-                Controller2::FourChannel(FourChannel::new(g, dt)?)
-            }
-            ControllerKind::Coupling(g) => {
-                let c = VirtualCoupling::new(g)?;
-                c.check_slave_mass(&mass, dt)?;
-                Controller2::Coupling(c)
-            }
-        };
+        let controller = Controller::build(config.controller, &world, slave, dt)?;
         let world_origin = grasp_world(&world, slave, config.grasp);
         let wn = 2.0 * std::f64::consts::PI * TWIST_TARGET_HZ;
         let twist_gains = (body.inertia * wn * wn, 2.0 * body.inertia * wn);
@@ -374,19 +343,7 @@ impl Planar2System {
     /// Switches the teleoperation controller to `kind` from its reset state; the gains are checked
     /// against the slave's mass as in [`Self::new`], and on error the running controller is kept.
     pub fn set_controller(&mut self, kind: ControllerKind) -> Result<(), String> {
-        let body = &self.world.bodies[self.slave];
-        let mass = [body.mass, body.mass, body.inertia];
-        self.controller = match kind {
-            ControllerKind::FourChannel(g) => {
-                g.check_slave_mass(&mass, self.dt)?;
-                Controller2::FourChannel(FourChannel::new(g, self.dt)?)
-            }
-            ControllerKind::Coupling(g) => {
-                let c = VirtualCoupling::new(g)?;
-                c.check_slave_mass(&mass, self.dt)?;
-                Controller2::Coupling(c)
-            }
-        };
+        self.controller = Controller::build(kind, &self.world, self.slave, self.dt)?;
         self.config.controller = kind;
         Ok(())
     }

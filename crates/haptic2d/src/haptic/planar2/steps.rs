@@ -2,7 +2,7 @@
 //! order; the numbers are DESIGN §1's, as in the twin's `system/steps.rs`). None allocates, locks,
 //! prints or does I/O.
 
-use super::{Controller2, Planar2System};
+use super::Planar2System;
 use crate::control::four_channel::TeleopSignals;
 use crate::device::linalg::V3;
 use crate::device::{CartesianDevice, DeviceEstimate};
@@ -113,10 +113,7 @@ impl Planar2System {
             f_e: [s.f_e[0], s.f_e[1], 0.0],
             master_mass: self.device.mass_matrix(),
         };
-        let (mut f_cm, mut f_cs) = match &mut self.controller {
-            Controller2::FourChannel(c) => c.step(&signals),
-            Controller2::Coupling(c) => c.step(&signals),
-        };
+        let (mut f_cm, mut f_cs) = self.controller.step(&signals);
         f_cm[2] = 0.0;
         f_cs[2] = 0.0;
         (f_cm, f_cs)

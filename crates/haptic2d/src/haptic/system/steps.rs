@@ -83,6 +83,11 @@ impl HapticSystem {
     /// Returns the slave as the controller sees it.
     pub(super) fn contact_stage(&mut self) -> SlaveState {
         self.world.begin_step();
+        self.slave_state()
+    }
+
+    /// The slave body as the world holds it now: pose, twist and the contact wrench it exerts.
+    pub(super) fn slave_state(&self) -> SlaveState {
         let body = &self.world.bodies[self.slave];
         let cw = self.world.contact_wrench(self.slave);
         SlaveState {
