@@ -272,7 +272,10 @@ fn run_haply(a: &HaplyArgs) -> Result<u8, (u8, String)> {
 fn run_inverse3(_a: &Inverse3Args) -> Result<u8, (u8, String)> {
     Err((
         exit::BAD_INPUT,
-        format!("emulate inverse3: {}", crate::inverse3_arg::NOT_BUILT),
+        format!(
+            "emulate inverse3: {}",
+            haptic2d_devices::registry::inverse3::NOT_BUILT
+        ),
     ))
 }
 

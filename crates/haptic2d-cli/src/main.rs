@@ -24,14 +24,11 @@ mod foxglove_live;
 mod grip_twist;
 mod hand_arg;
 mod haply_arg;
-mod inverse3_arg;
 mod pipe;
-mod rig_system;
 mod run_log;
 mod run_rig;
 mod run_view;
 mod scene_arg;
-mod udp_arg;
 mod world_link_arg;
 mod world_mcap;
 

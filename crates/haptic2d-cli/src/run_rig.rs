@@ -2,26 +2,9 @@
 //! it drives (simulated twin pantograph with a simulated hand, a replay, or a real device), built
 //! from a scene's world and rebuilt when the live display resets or switches the scene.
 //!
-//! # Adding a real device (the extension point)
-//!
-//! Every real device runs in this one loop (real-time thread, watchdog, safety latch, CSV/MCAP
-//! logs, signals and exit codes, the browser display). To add one, e.g. `--device udp:ADDR:PORT`:
-//!
-//! 1. a variant of [`DeviceChoice`] and its branch in [`DeviceChoice::parse`] (two lines);
-//! 2. its arm in [`DeviceChoice::load_real`], calling a glue function in its own file
-//!    (`haply_arg::real_device`, `udp_arg::real_device`, …) that reads and checks the device file
-//!    **without opening anything** and returns a [`RealDevice`]:
-//!    - its [`DeviceModel`]: [`DeviceModel::Twin`] (4 joints, MODELS §10, a [`DeviceParams`]) or
-//!      [`DeviceModel::FiveBar`] (2 joints: the linkage and the motor torque limit; the system is the
-//!      2-DOF [`Planar2System`](haptic2d::haptic::planar2::Planar2System));
-//!    - the device's own reply timeout (`wait_periods`, periods: a silent device is its driver's
-//!      [`DeviceError::Lost`](haptic2d_rt::DeviceError::Lost) → exit 4), the watchdog's
-//!      missed-deadline limit and the stall limit on the loop's own time;
-//!    - optionally a `match_controller` that adapts the gains to the device;
-//!    - an `open` closure that opens and hand-shakes the device at the control period and returns
-//!      it as a [`DeviceIo`]; a 2-joint driver implements
-//!      [`Device2Io`](haptic2d_rt::io::Device2Io) and is wrapped in
-//!      [`Joints2`](haptic2d_rt::io::Joints2).
+//! The real devices (`--device haply:…`, `udp:…`, `inverse3…`) come from the device registry of
+//! `haptic2d-devices` ([`haptic2d_devices::registry`], re-exported here): the device choice, the
+//! model the system is built for, and the closure that opens the device.
 //!
 //! The rig does the rest: the stability gate with the hand released (`--allow-unstable`), zero
 //! torques until the first valid reading and the start-up ramp of the shared safety layer, the
@@ -29,172 +12,23 @@
 
 use crate::grip_twist::GripTwist;
 use crate::hand_arg::HandSpec;
-use crate::rig_system::RigSystem;
 use haptic2d::device::linalg::{V3, V4};
-use haptic2d::device::pantograph2::Pantograph2;
 use haptic2d::device::DeviceParams;
 use haptic2d::haptic::planar2::{Planar2Config, Planar2System};
 use haptic2d::haptic::{
-    ControllerKind, HapticConfig, HapticSystem, SafetyConfig, TickOutput, WorkspaceSquare,
+    ControllerKind, DeviceSystem, HapticConfig, HapticSystem, SafetyConfig, TickOutput,
 };
 use haptic2d::world::World;
 use haptic2d_devices::device_safety::DeviceSafety;
+pub use haptic2d_devices::registry::{DeviceChoice, DeviceModel, MatchController, RealDevice};
 use haptic2d_rt::clock::now_ns;
 use haptic2d_rt::io::DEFAULT_REPLAY_COLUMNS;
 use haptic2d_rt::{
     DeviceError, DeviceIo, ReplayDevice, ReplayEnd, SafetyInput, SharedTarget, SimIo, TickInfo,
     TickInterval, WatchdogConfig,
 };
-use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Duration;
-
-/// The device the loop drives.
-#[derive(Clone, Debug, PartialEq)]
-pub enum DeviceChoice {
-    /// The simulated twin pantograph, pushed by the simulated hand.
-    Sim,
-    /// Recorded encoder angles `q1..q4` (rad) played back from a CSV file, or the encoders of an
-    /// MCAP tick log (`.mcap`).
-    Replay(PathBuf),
-    /// A Haply board: the `PATH` of `haply:PATH`, or `auto` (device file: `--device-file`).
-    Haply(String),
-    /// A device on the open UDP protocol listening at the `ADDR:PORT` of `udp:ADDR:PORT`.
-    Udp(String),
-    /// A Haply Inverse3 through the Inverse Service at the `URL` of `inverse3:URL` (`None`: the
-    /// device file's, default `http://localhost:10001`).
-    Inverse3(Option<String>),
-}
-
-impl DeviceChoice {
-    /// Parses `--device`: `sim`, `replay:FILE.csv|FILE.mcap` or `haply:PATH|haply:auto`; the error
-    /// says how to fix it.
-    pub fn parse(s: &str) -> Result<Self, String> {
-        if s == "sim" {
-            return Ok(DeviceChoice::Sim);
-        }
-        if let Some(f) = s.strip_prefix("replay:") {
-            if f.is_empty() {
-                return Err("--device replay:FILE.csv needs a file name".into());
-            }
-            return Ok(DeviceChoice::Replay(PathBuf::from(f)));
-        }
-        if let Some(p) = s.strip_prefix("haply:") {
-            if p.is_empty() {
-                return Err("--device haply: needs a port: haply:PATH (e.g. haply:/dev/ttyACM0) or haply:auto".into());
-            }
-            return Ok(DeviceChoice::Haply(p.to_string()));
-        }
-        if let Some(a) = s.strip_prefix("udp:") {
-            return Ok(DeviceChoice::Udp(a.to_string()));
-        }
-        if s == "inverse3" {
-            return Ok(DeviceChoice::Inverse3(None));
-        }
-        if let Some(u) = s.strip_prefix("inverse3:") {
-            return Ok(DeviceChoice::Inverse3(Some(u.to_string())));
-        }
-        Err(format!(
-            "--device `{s}` is not available\n    fix: use --device sim (the simulated twin pantograph), replay:FILE.csv, haply:PATH|haply:auto, udp:ADDR:PORT or inverse3[:URL]"
-        ))
-    }
-
-    /// True for a device that moves a person's hand (anything but the simulation and a replay).
-    pub fn is_real(&self) -> bool {
-        !matches!(self, DeviceChoice::Sim | DeviceChoice::Replay(_))
-    }
-
-    /// For a real device, reads and checks its device file `device_file` (nothing is opened yet);
-    /// `None` for the simulated device and a replay. Errors name the file, the field and the fix.
-    /// `allow_remote` (`--allow-remote-device`) lets a UDP device be beyond loopback.
-    pub fn load_real(
-        &self,
-        device_file: Option<&Path>,
-        allow_remote: bool,
-    ) -> Result<Option<RealDevice>, String> {
-        Ok(match self {
-            DeviceChoice::Sim | DeviceChoice::Replay(_) => None,
-            DeviceChoice::Haply(port) => Some(crate::haply_arg::real_device(port, device_file)?),
-            DeviceChoice::Udp(addr) => Some(crate::udp_arg::real_device(
-                addr,
-                device_file,
-                allow_remote,
-            )?),
-            DeviceChoice::Inverse3(url) => Some(crate::inverse3_arg::real_device(
-                url.as_deref(),
-                device_file,
-            )?),
-        })
-    }
-}
-
-/// What the haptic system needs to know of a real device.
-#[derive(Clone, Debug, PartialEq)]
-pub enum DeviceModel {
-    /// A twin pantograph (4 joints `q11, q12, q21, q22`; MODELS §10) with these parameters.
-    Twin(DeviceParams),
-    /// A 2-DOF five-bar (joints `q1, q2` in `q[0..2]`) with this linkage (m) and motor torque limit
-    /// `tau_max` (N·m, both motors).
-    FiveBar {
-        /// The linkage (m).
-        linkage: Pantograph2,
-        /// Motor torque limit (N·m).
-        tau_max: f64,
-        /// Centre of the workspace (m, the linkage's frame): where the stability gate linearises.
-        center: [f64; 2],
-        /// The workspace square of the device file (m, the linkage's frame) with its wall and
-        /// trip: the bound the 2-DOF tick applies, as the twin's from its parameters.
-        workspace: WorkspaceSquare,
-        /// The dynamics `haptic2d device identify` measured (the device file's `[identified]`),
-        /// used by the stability gate in place of the built-in estimates; `None`: not measured.
-        identified: Option<haptic2d_devices::haply::identified::Identified>,
-    },
-}
-
-/// Opens a real device at the control period: handshake done, ready for the first tick.
-pub type OpenDevice = Box<dyn FnOnce(Duration) -> Result<Box<dyn DeviceIo + Send>, String> + Send>;
-
-/// A real device whose device file has been read and checked, not yet opened.
-pub struct RealDevice {
-    /// Name in messages, e.g. `haply:/dev/ttyACM0`.
-    pub name: String,
-    /// Its model.
-    pub model: DeviceModel,
-    /// For the start line: where the parameters came from, the kind, the limits.
-    pub summary: String,
-    /// The longest the driver waits for the device in one read before it reports it lost
-    /// (periods). The stall check leaves this wait to the driver (see [`Rig::tick_system`]).
-    pub wait_periods: f64,
-    /// The watchdog's limit of consecutive missed deadlines (`None`: off).
-    pub max_missed_run: Option<u32>,
-    /// The loop's own delay between two ticks that trips the stall check (periods, ≥ 1; the shared
-    /// safety layer's default is 5).
-    pub max_stall_periods: f64,
-    /// The device file's `[safety]` table: plausibility bounds and the stall floor.
-    pub safety: DeviceSafety,
-    /// Matches the controller to the device (e.g. the Haply twin's θ gains to its crank); `None`
-    /// keeps the controller as chosen.
-    pub match_controller: Option<MatchController>,
-    /// Opens it.
-    pub open: OpenDevice,
-}
-
-/// Adjusts a controller's gains to a device.
-pub type MatchController = Box<dyn Fn(ControllerKind) -> ControllerKind + Send>;
-
-impl std::fmt::Debug for RealDevice {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("RealDevice")
-            .field("name", &self.name)
-            .field("model", &self.model)
-            .field("summary", &self.summary)
-            .field("wait_periods", &self.wait_periods)
-            .field("max_missed_run", &self.max_missed_run)
-            .field("max_stall_periods", &self.max_stall_periods)
-            .field("safety", &self.safety)
-            .finish_non_exhaustive()
-    }
-}
 
 /// The limits of a real device the rig keeps after opening it (to rebuild its system).
 #[derive(Clone, Debug, PartialEq)]
@@ -230,7 +64,7 @@ fn plant_substeps(dt: f64) -> u32 {
 /// The haptic system and its device, owned by the loop thread.
 pub struct Rig {
     /// Device estimator, controller, passivity controller and world (twin or 2-DOF).
-    pub system: RigSystem,
+    pub system: DeviceSystem,
     /// The device I/O (a 2-DOF device fills `q[0..2]`).
     pub io: Box<dyn DeviceIo + Send>,
     /// The settings the system was built with; `controller` follows the page's selection. For a
@@ -297,7 +131,7 @@ impl Rig {
             _ => Box::new(Self::sim(&system, &config, &hand, target.as_ref())?),
         };
         Ok(Self {
-            system: RigSystem::Twin(system),
+            system: DeviceSystem::Twin(system),
             io,
             config,
             device,
@@ -368,7 +202,7 @@ impl Rig {
         world: World,
         config: &HapticConfig,
         limits: &RealLimits,
-    ) -> Result<RigSystem, String> {
+    ) -> Result<DeviceSystem, String> {
         // The device file's plausibility bounds and stall floor (its `[safety]` table).
         let safety = limits.safety.apply(SafetyConfig {
             max_stall_periods: limits.max_stall_periods + limits.wait_periods,
@@ -376,7 +210,7 @@ impl Rig {
         });
         Ok(match &limits.model {
             DeviceModel::Twin(_) => {
-                RigSystem::Twin(HapticSystem::with_safety(world, config, safety)?)
+                DeviceSystem::Twin(HapticSystem::with_safety(world, config, safety)?)
             }
             DeviceModel::FiveBar {
                 linkage,
@@ -391,8 +225,8 @@ impl Rig {
                 c.controller = config.controller;
                 c.slave = config.slave.clone();
                 c.safety = safety;
-                c.workspace = Some(*workspace);
-                RigSystem::TwoDof(Planar2System::new(world, c)?)
+                c.workspace = *workspace;
+                DeviceSystem::TwoDof(Planar2System::new(world, c)?)
             }
         })
     }
@@ -462,7 +296,7 @@ impl Rig {
         let elapsed_ns = self.interval.update(info);
         let wait_ns = std::mem::replace(&mut self.prev_read_wait_ns, self.read_wait_ns);
         // A sensed handle orientation turns the slave's twist target (2-DOF devices).
-        if let (Some(a), RigSystem::TwoDof(s)) = (self.io.handle_angle(), &mut self.system) {
+        if let (Some(a), DeviceSystem::TwoDof(s)) = (self.io.handle_angle(), &mut self.system) {
             let slave_angle = s.world().bodies[s.slave()].pose.angle;
             s.set_twist_target(self.grip.target(a, slave_angle));
         }
@@ -547,7 +381,7 @@ impl Rig {
                         self.target.as_ref(),
                     )?);
                 }
-                RigSystem::Twin(system)
+                DeviceSystem::Twin(system)
             }
         };
         self.system = system;
@@ -567,7 +401,7 @@ impl Rig {
     /// no hand follows a target. On a 2-DOF device (the real hand moves x and y) only the angle is
     /// used: it becomes the twist target of the slave's virtual torsion spring (the wheel / Q–E).
     pub fn set_hand_target(&mut self, world: V3) -> Option<V3> {
-        if let RigSystem::TwoDof(s) = &mut self.system {
+        if let DeviceSystem::TwoDof(s) = &mut self.system {
             s.set_twist_target(Some(world[2]));
             return Some(self.hand_target_world());
         }
@@ -586,9 +420,9 @@ impl Rig {
     /// the handle is.
     pub fn hand_target_world(&self) -> V3 {
         match (&self.target, &self.system) {
-            (Some(t), RigSystem::Twin(s)) => s.map().pose_to_world(&t.get()),
+            (Some(t), DeviceSystem::Twin(s)) => s.map().pose_to_world(&t.get()),
             // 2-DOF: the handle's x and y, and the twist target (else the slave's angle).
-            (_, RigSystem::TwoDof(s)) => {
+            (_, DeviceSystem::TwoDof(s)) => {
                 let h = self.system.handle_world();
                 [h[0], h[1], s.twist_target().unwrap_or(h[2])]
             }
@@ -649,6 +483,8 @@ pub enum RealOpenError {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use haptic2d::device::pantograph2::Pantograph2;
+    use haptic2d::haptic::WorkspaceSquare;
     use haptic2d::scene::builtin;
     use haptic2d_rt::Watchdog;
 
@@ -936,7 +772,7 @@ mod tests {
     #[test]
     fn a_haply_file_velocity_bound_and_stall_floor_are_honoured() {
         a_file_velocity_bound_is_honoured(
-            |p| crate::haply_arg::real_device("/dev/null", Some(p)).unwrap(),
+            |p| haptic2d_devices::registry::haply::real_device("/dev/null", Some(p)).unwrap(),
             "haply-2diy-gen3.toml",
         );
     }
@@ -944,7 +780,10 @@ mod tests {
     #[test]
     fn a_udp_file_velocity_bound_and_stall_floor_are_honoured() {
         a_file_velocity_bound_is_honoured(
-            |p| crate::udp_arg::real_device("127.0.0.1:5005", Some(p), false).unwrap(),
+            |p| {
+                haptic2d_devices::registry::udp::real_device("127.0.0.1:5005", Some(p), false)
+                    .unwrap()
+            },
             "udp-pantograph.toml",
         );
     }
@@ -953,7 +792,7 @@ mod tests {
     #[cfg(feature = "inverse3")]
     fn an_inverse3_file_velocity_bound_and_stall_floor_are_honoured() {
         a_file_velocity_bound_is_honoured(
-            |p| crate::inverse3_arg::real_device(None, Some(p)).unwrap(),
+            |p| haptic2d_devices::registry::inverse3::real_device(None, Some(p)).unwrap(),
             "inverse3.toml",
         );
     }
@@ -1035,7 +874,7 @@ mod tests {
         assert_eq!(set[2], 0.3);
         assert_ne!(set[0], 9.0, "x and y stay the handle's");
         match &rig.system {
-            RigSystem::TwoDof(s) => assert_eq!(s.twist_target(), Some(0.3)),
+            DeviceSystem::TwoDof(s) => assert_eq!(s.twist_target(), Some(0.3)),
             _ => unreachable!(),
         }
         assert_eq!(rig.hand_target_world()[2], 0.3);
@@ -1045,7 +884,7 @@ mod tests {
             .unwrap()
             .world;
         rig.rebuild(world).unwrap();
-        assert!(matches!(rig.system, RigSystem::TwoDof(_)));
+        assert!(matches!(rig.system, DeviceSystem::TwoDof(_)));
         assert_eq!(rig.io.name(), "fake-board");
     }
 

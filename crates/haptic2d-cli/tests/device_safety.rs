@@ -51,9 +51,8 @@ impl Loop {
         let world = builtin("box-in-walls", Some(RATE)).unwrap().unwrap().world;
         let mut c = Planar2Config::new(linkage(), 0.123);
         c.controller = ControllerKind::from_name(controller).unwrap();
-        if bound {
-            c.workspace = Some(WorkspaceSquare::around(CENTRE, HALF_WIDTH));
-        }
+        // Every 2-DOF system has a bound; "without" is a square far past the linkage's reach (1 m).
+        c.workspace = WorkspaceSquare::around(CENTRE, if bound { HALF_WIDTH } else { 1.0 });
         let mut plant = Plant2::new(linkage(), Vec2::new(CENTRE[0], CENTRE[1])).unwrap();
         plant.i_j /= lighter;
         plant.m_e /= lighter;

@@ -17,5 +17,6 @@ pub mod file_read;
 pub mod haply;
 #[cfg(feature = "inverse3")]
 pub mod inverse3;
+pub mod registry;
 pub mod udp;
 pub mod world_link;

@@ -20,8 +20,8 @@ use inverse3_support::*;
 use std::time::Instant;
 
 use haptic2d::haptic::planar2::{Planar2Config, Planar2System};
-use haptic2d::haptic::ControllerKind;
-use haptic2d_devices::inverse3::planar::{virtual_linkage, virtual_torque_limit};
+use haptic2d::haptic::{ControllerKind, WorkspaceSquare};
+use haptic2d_devices::inverse3::planar::{virtual_center, virtual_linkage, virtual_torque_limit};
 use haptic2d_devices::inverse3::{Emulator3Config, Hand3};
 use haptic2d_rt::io::Device2Io;
 
@@ -57,6 +57,8 @@ fn the_box_hits_the_wall_and_the_emulated_cursor_is_pushed_back() {
     world.bodies[i].pose.pos.x = 0.04;
     let mut c = Planar2Config::new(virtual_linkage(), virtual_torque_limit(file.force_limit));
     c.controller = ControllerKind::from_name("coupling").unwrap();
+    // The square `haptic2d run` gives the Inverse3: the device file's, around the virtual centre.
+    c.workspace = WorkspaceSquare::around(virtual_center(), file.half_width);
     let mut system = Planar2System::new(world, c).unwrap();
     let t0 = Instant::now();
     let mut tail: Vec<Sample> = Vec::new();

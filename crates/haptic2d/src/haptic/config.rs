@@ -6,6 +6,7 @@ use crate::control::four_channel::FourChannelGains;
 use crate::control::passivity::PlanarPassivity;
 use crate::device::linalg::V3;
 use crate::device::{DeviceParams, ObserverKind};
+use crate::world::World;
 
 /// Which teleoperation controller couples the device to the slave (§11).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -99,4 +100,34 @@ impl Default for HapticConfig {
             preload: 0.0,
         }
     }
+}
+
+/// The slave body of a haptic system in `world`: the body named `name`, or the first dynamic body
+/// (`None`). Errors (not found, with the bodies' names; a fixed body; no dynamic body) name the fix.
+pub fn find_slave(world: &World, name: Option<&str>) -> Result<usize, String> {
+    let slave = match name {
+        Some(name) => world.body_index(name).ok_or_else(|| {
+            format!(
+                "slave body `{name}` not found; bodies: {}",
+                world
+                    .bodies
+                    .iter()
+                    .map(|b| b.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )
+        })?,
+        None => world
+            .bodies
+            .iter()
+            .position(|b| b.is_dynamic())
+            .ok_or("the scene has no dynamic body for the device to drive")?,
+    };
+    if !world.bodies[slave].is_dynamic() {
+        return Err(format!(
+            "slave body `{}` is fixed; the device needs a dynamic body",
+            world.bodies[slave].name
+        ));
+    }
+    Ok(slave)
 }

@@ -8,6 +8,8 @@
 //! simulated time for tests and for the device-in-the-loop experiments of `haptic2d-lab`.
 
 pub mod config;
+mod controller;
+pub mod device_system;
 pub mod experiment;
 pub mod limit_cycle;
 pub mod mapping;
@@ -15,15 +17,18 @@ pub mod planar2;
 pub mod plausibility;
 pub mod record;
 pub mod safety;
+pub mod safety_stage;
 pub mod system;
 pub mod workspace;
 
 pub use config::{ControllerKind, HapticConfig};
+pub use device_system::DeviceSystem;
 pub use experiment::DeviceInTheLoop;
 pub use limit_cycle::LimitCycleMonitor;
 pub use mapping::DeviceMap;
 pub use plausibility::JointPlausibility;
 pub use record::{TickRecord, TICK_COLUMNS};
 pub use safety::{Safety, SafetyConfig, SafetyReason, SafetyTrip};
+pub use safety_stage::SafetyStage;
 pub use system::{HapticSystem, TickOutput};
 pub use workspace::{WorkspaceBound, WorkspaceSquare};

@@ -33,19 +33,16 @@
 //! a translation set at the **first measured handle position** (the slave starts aligned with the
 //! handle wherever the user holds it). Never allocates, locks or does I/O in [`Planar2System::tick`].
 
-use crate::control::coupling::VirtualCoupling;
-use crate::control::four_channel::FourChannel;
-use crate::device::filter::VelocityFilter;
 use crate::device::pantograph2::Pantograph2;
-use crate::device::DeviceFault;
+use crate::device::{CartesianDevice, DeviceFault, Pantograph2Device};
 use crate::geom::Vec2;
 use crate::world::World;
 
-use super::config::ControllerKind;
-use super::limit_cycle::LimitCycleMonitor;
-use super::plausibility::JointPlausibility;
+use super::config::{find_slave, ControllerKind};
+use super::controller::Controller;
 use super::record::{TickRecord, FLAG_SAFETY};
 use super::safety::{Safety, SafetyConfig, SafetyReason, SafetyTrip};
+use super::safety_stage::SafetyStage;
 use super::workspace::{WorkspaceBound, WorkspaceSquare};
 
 mod steps;
@@ -78,10 +75,11 @@ pub struct Planar2Config {
     /// Keep the scene's loads on the slave body. Default false (the hand drives it).
     pub keep_slave_loads: bool,
     /// The workspace square of the device file (device frame) with its wall and trip, the same
-    /// bound as the twin pantograph's ([`WorkspaceBound`]). `None` (the default of [`Self::new`]):
-    /// no bound; `haptic2d run` always sets one (the 2DIY's and the Inverse3's `[workspace]`, or
-    /// [`WorkspaceSquare::five_bar`] for a device file without one).
-    pub workspace: Option<WorkspaceSquare>,
+    /// bound as the twin pantograph's ([`WorkspaceBound`], applied by the shared [`SafetyStage`]).
+    /// Every 2-DOF system has one: [`Self::new`] gives the linkage's reach square
+    /// ([`WorkspaceSquare::five_bar`]); a device file's `[workspace]` (the 2DIY's, the Inverse3's)
+    /// replaces it.
+    pub workspace: WorkspaceSquare,
 }
 
 impl Planar2Config {
@@ -98,16 +96,9 @@ impl Planar2Config {
             safety: SafetyConfig::default(),
             min_singularity_margin: 0.1,
             keep_slave_loads: false,
-            workspace: None,
+            workspace: WorkspaceSquare::five_bar(&linkage),
         }
     }
-}
-
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[allow(clippy::large_enum_variant)]
-enum Controller2 {
-    FourChannel(FourChannel),
-    Coupling(VirtualCoupling),
 }
 
 /// What one 2-DOF tick hands back.
@@ -125,23 +116,16 @@ pub struct Planar2Output {
 #[derive(Clone, Debug)]
 pub struct Planar2System {
     config: Planar2Config,
-    controller: Controller2,
+    controller: Controller,
     world: World,
     slave: usize,
-    filter: VelocityFilter,
-    safety: Safety,
-    workspace: Option<WorkspaceBound>,
-    plausibility: JointPlausibility,
-    limit_cycle: LimitCycleMonitor,
+    /// The five-bar at the Cartesian boundary: handle point, filtered velocity, `τ = Jᵀ·f`.
+    device: Pantograph2Device,
+    /// The shared safety steps: stall, plausibility, workspace bound, limit cycle, ramp, gate.
+    safety: SafetyStage,
     /// World point of the grasp at start (m): the first handle position maps here.
     world_origin: Vec2,
     device_origin: Option<Vec2>,
-    /// Ticks since the alignment at the first valid reading (the ramp's clock).
-    ramp_ticks: u64,
-    /// Ticks of the ramp, `round(ramp_time / T)` (0 = no ramp).
-    ramp_len: u64,
-    /// True once a tick has read the device (the stall check needs a previous tick).
-    started: bool,
     /// The page's twist target `θ_t` (rad), `None` = off (see the module doc).
     twist_target: Option<f64>,
     /// Torsion stiffness `K_t` (N·m/rad) and damping `B_t` (N·m·s/rad) of the twist target.
@@ -168,35 +152,10 @@ impl Planar2System {
             return Err("velocity_cutoff_hz must be > 0 Hz (default 50)".into());
         }
         config.safety.validate()?;
-        if let Some(w) = &config.workspace {
-            w.validate()?;
-        }
-        let slave = match &config.slave {
-            Some(name) => world
-                .body_index(name)
-                .ok_or_else(|| format!("slave body `{name}` not found"))?,
-            None => world
-                .bodies
-                .iter()
-                .position(|b| b.is_dynamic())
-                .ok_or("the scene has no dynamic body for the device to drive")?,
-        };
+        config.workspace.validate()?;
+        let slave = find_slave(&world, config.slave.as_deref())?;
         let body = &world.bodies[slave];
-        if !body.is_dynamic() {
-            return Err(format!("slave body `{}` is fixed", body.name));
-        }
-        let mass = [body.mass, body.mass, body.inertia];
-        let controller = match config.controller {
-            ControllerKind::FourChannel(g) => {
-                g.check_slave_mass(&mass, dt)?;
-                Controller2::FourChannel(FourChannel::new(g, dt)?)
-            }
-            ControllerKind::Coupling(g) => {
-                let c = VirtualCoupling::new(g)?;
-                c.check_slave_mass(&mass, dt)?;
-                Controller2::Coupling(c)
-            }
-        };
+        let controller = Controller::build(config.controller, &world, slave, dt)?;
         let world_origin = grasp_world(&world, slave, config.grasp);
         let wn = 2.0 * std::f64::consts::PI * TWIST_TARGET_HZ;
         let twist_gains = (body.inertia * wn * wn, 2.0 * body.inertia * wn);
@@ -204,20 +163,25 @@ impl Planar2System {
             world.loads.retain(|l| l.body != slave);
         }
         Ok(Self {
-            filter: VelocityFilter::new(config.velocity_cutoff_hz, dt),
+            device: Pantograph2Device::new(
+                config.linkage,
+                config.tau_max,
+                config.min_singularity_margin,
+                config.velocity_cutoff_hz,
+                dt,
+            ),
             // The final gate clamps to the smaller motor limit (the saturation above already scales
             // each motor to its own) and trips above it by the default margin.
-            safety: Safety::new(
-                config.min_singularity_margin,
-                config.tau_max[0].min(config.tau_max[1]),
-                config.safety.torque_trip_margin,
+            safety: SafetyStage::new(
+                config.safety,
+                Safety::new(
+                    config.min_singularity_margin,
+                    config.tau_max[0].min(config.tau_max[1]),
+                    config.safety.torque_trip_margin,
+                ),
+                WorkspaceBound::of_square(&config.workspace, dt),
+                dt,
             ),
-            workspace: config.workspace.map(|w| WorkspaceBound::of_square(&w, dt)),
-            plausibility: JointPlausibility::new(&config.safety),
-            limit_cycle: LimitCycleMonitor::new(&config.safety, dt),
-            ramp_len: (config.safety.ramp_time / dt).round() as u64,
-            ramp_ticks: 0,
-            started: false,
             twist_target: None,
             twist_gains,
             config,
@@ -256,7 +220,8 @@ impl Planar2System {
     /// after the previous tick (the loop's own interval, measured by the caller). A tick later than the
     /// stall limit ([`SafetyConfig::stall_limit`]) trips the latch with [`SafetyReason::Stall`] in this
     /// same tick (the device held its last torques unsupervised for that long); a NaN interval
-    /// counts as a stall. The filter and the world use the fixed period `T`.
+    /// counts as a stall. The device's velocity filter differentiates over the measured interval
+    /// (as the twin's does); the world steps by the fixed period `T`.
     pub fn tick_elapsed(&mut self, q: &[f64; 2], elapsed: f64) -> Planar2Output {
         self.tick_timed(q, elapsed, f64::NAN)
     }
@@ -268,7 +233,7 @@ impl Planar2System {
         let t = self.world.time();
         let mut flags = 0u32;
         self.supervise_input(q, elapsed, device_wait); // 0
-        let mut handle = self.sense(q, &mut flags); // 1–2
+        let mut handle = self.sense(q, elapsed, &mut flags); // 1–2
         let slave = self.contact_stage(); // 3–6
         handle.x_m[2] = slave.theta;
         handle.v_m[2] = slave.omega;
@@ -292,11 +257,7 @@ impl Planar2System {
     /// valid reading (exactly 0 before and at it), `N = round(ramp_time / T)`; 1 without a ramp.
     #[inline]
     pub fn ramp(&self) -> f64 {
-        if self.ramp_len == 0 {
-            1.0
-        } else {
-            (self.ramp_ticks as f64 / self.ramp_len as f64).min(1.0)
-        }
+        self.safety.ramp()
     }
 
     /// A paused sample: the handle is still read (its filter keeps tracking), no controller runs,
@@ -305,25 +266,22 @@ impl Planar2System {
     /// allocates.
     pub fn tick_paused(&mut self, q: &[f64; 2]) -> Planar2Output {
         let (k, t) = (self.world.tick(), self.world.time());
-        if let Some(reason) = self.plausibility.check_angles(q) {
-            self.safety.trip(k, t, reason);
-        }
-        self.limit_cycle.reset();
+        self.safety.supervise_paused((k, t), q);
         let mut x_m = [f64::NAN; 3];
         let mut margin = f64::NAN;
-        match self.config.linkage.state(*q) {
-            Ok(s) => {
-                let origin = self.device_origin.unwrap_or(s.e);
-                let p = s.e - origin + self.world_origin;
-                self.filter.update(&[p.x, p.y, 0.0]);
+        match self.device.sense(q, &[0.0; 4], self.dt) {
+            Ok(e) => {
+                let point = Vec2::new(e.pose[0], e.pose[1]);
+                let origin = self.device_origin.unwrap_or(point);
+                let p = point - origin + self.world_origin;
                 x_m = [p.x, p.y, 0.0];
-                margin = s.margin;
+                margin = self.device.margin();
             }
-            Err(f) => self.safety.trip(k, t, SafetyReason::Device(f)),
+            Err(f) => self.safety.trip((k, t), SafetyReason::Device(f)),
         }
         let mut tau4 = [0.0; 4];
         let mut flags = 0u32;
-        if self.safety.gate(k, t, &mut tau4) {
+        if self.safety.gate((k, t), &mut tau4, false) {
             flags |= FLAG_SAFETY;
         }
         self.realign();
@@ -357,16 +315,14 @@ impl Planar2System {
     fn realign(&mut self) {
         self.device_origin = None;
         self.world_origin = grasp_world(&self.world, self.slave, self.config.grasp);
-        self.ramp_ticks = 0;
-        self.started = false;
+        self.safety.restart_ramp();
+        self.safety.restart_clock();
     }
 
     /// Re-arms the safety latch (an explicit user action): the next tick re-aligns and ramps in from
     /// zero, as at start-up.
     pub fn reset_safety(&mut self) {
-        self.safety.reset();
-        self.plausibility.reset();
-        self.limit_cycle.reset();
+        self.safety.rearm();
         self.realign();
     }
 
@@ -375,33 +331,19 @@ impl Planar2System {
     /// `device_wait` s of it waiting for the device, NaN = unknown) exceeds the stall limit `max(max_stall_periods·T, min_stall_time)`.
     /// Returns true when it tripped. Never allocates.
     pub fn check_stall(&mut self, elapsed: f64, device_wait: f64) -> bool {
-        let (k, t) = (self.world.tick(), self.world.time());
-        let limit = self.config.safety.stall_limit(self.dt);
-        self.safety
-            .check_stall(k, t, self.started, elapsed, device_wait, limit)
+        let at = (self.world.tick(), self.world.time());
+        self.safety.check_stall(at, elapsed, device_wait)
     }
 
-    /// The workspace bound the tick applies, if any.
-    pub fn workspace(&self) -> Option<&WorkspaceBound> {
-        self.workspace.as_ref()
+    /// The workspace bound the tick applies (every 2-DOF system has one).
+    pub fn workspace(&self) -> &WorkspaceBound {
+        self.safety.workspace()
     }
 
     /// Switches the teleoperation controller to `kind` from its reset state; the gains are checked
     /// against the slave's mass as in [`Self::new`], and on error the running controller is kept.
     pub fn set_controller(&mut self, kind: ControllerKind) -> Result<(), String> {
-        let body = &self.world.bodies[self.slave];
-        let mass = [body.mass, body.mass, body.inertia];
-        self.controller = match kind {
-            ControllerKind::FourChannel(g) => {
-                g.check_slave_mass(&mass, self.dt)?;
-                Controller2::FourChannel(FourChannel::new(g, self.dt)?)
-            }
-            ControllerKind::Coupling(g) => {
-                let c = VirtualCoupling::new(g)?;
-                c.check_slave_mass(&mass, self.dt)?;
-                Controller2::Coupling(c)
-            }
-        };
+        self.controller = Controller::build(kind, &self.world, self.slave, self.dt)?;
         self.config.controller = kind;
         Ok(())
     }
@@ -418,8 +360,8 @@ impl Planar2System {
 
     /// Latches the safety stop from outside (e.g. the device was lost): zero torques from now on.
     pub fn trip_device(&mut self, fault: DeviceFault) {
-        let (k, t) = (self.world.tick(), self.world.time());
-        self.safety.trip(k, t, SafetyReason::Device(fault));
+        let at = (self.world.tick(), self.world.time());
+        self.safety.trip(at, SafetyReason::Device(fault));
     }
 
     /// The world.

@@ -1,60 +1,22 @@
 //! [`HapticSystem`]: device + controller + passivity controller + world, and the per-sample
 //! [`HapticSystem::tick`] in the order of §0.5.
 
-use crate::control::coupling::VirtualCoupling;
-use crate::control::four_channel::{FourChannel, TeleopSignals};
 use crate::control::passivity::PlanarPassivity;
 use crate::device::linalg::{V3, V4};
-use crate::device::{DeviceFault, TwinPantograph};
+use crate::device::TwinPantograph;
 use crate::world::World;
 
-use super::config::{ControllerKind, HapticConfig};
-use super::limit_cycle::LimitCycleMonitor;
+use super::config::{find_slave, ControllerKind, HapticConfig};
+use super::controller::Controller;
 use super::mapping::DeviceMap;
-use super::plausibility::JointPlausibility;
 use super::record::{TickRecord, FLAG_SAFETY};
-use super::safety::{Safety, SafetyConfig, SafetyReason, SafetyTrip};
+use super::safety::{Safety, SafetyConfig, SafetyTrip};
+use super::safety_stage::SafetyStage;
 use super::workspace::WorkspaceBound;
 
 mod steps;
 
-/// The running controller (one of the §11 architectures).
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[allow(clippy::large_enum_variant)]
-enum Controller {
-    FourChannel(FourChannel),
-    Coupling(VirtualCoupling),
-}
-
-impl Controller {
-    /// A controller `kind` in its reset state, its gains checked against the mass of the slave body
-    /// `slave` of `world` at period `dt` (§6.4).
-    fn build(kind: ControllerKind, world: &World, slave: usize, dt: f64) -> Result<Self, String> {
-        let body = &world.bodies[slave];
-        let mass = [body.mass, body.mass, body.inertia];
-        Ok(match kind {
-            ControllerKind::FourChannel(g) => {
-                g.check_slave_mass(&mass, dt)
-                    .map_err(|e| format!("{e} (slave body `{}`)", body.name))?;
-                Controller::FourChannel(FourChannel::new(g, dt)?)
-            }
-            ControllerKind::Coupling(g) => {
-                let c = VirtualCoupling::new(g)?;
-                c.check_slave_mass(&mass, dt)
-                    .map_err(|e| format!("{e} (slave body `{}`)", body.name))?;
-                Controller::Coupling(c)
-            }
-        })
-    }
-
-    #[inline]
-    fn step(&mut self, s: &TeleopSignals) -> (V3, V3) {
-        match self {
-            Controller::FourChannel(c) => c.step(s),
-            Controller::Coupling(c) => c.step(s),
-        }
-    }
-}
+use steps::PortOutput;
 
 /// What one tick hands back to the caller.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -89,11 +51,8 @@ pub struct HapticSystem {
     world: World,
     slave: usize,
     map: DeviceMap,
-    workspace: WorkspaceBound,
-    plausibility: JointPlausibility,
-    limit_cycle: LimitCycleMonitor,
-    safety: Safety,
-    safety_config: SafetyConfig,
+    /// The shared safety steps: stall, plausibility, workspace bound, limit cycle, ramp, gate.
+    safety: SafetyStage,
     preload: f64,
     dt: f64,
     tau_prev: V4,
@@ -103,12 +62,6 @@ pub struct HapticSystem {
     hand_injection: V3,
     /// False until the first valid reading after construction, a re-arm or a pause.
     aligned: bool,
-    /// Ticks since the alignment (the ramp's clock).
-    ramp_ticks: u64,
-    /// Ticks of the ramp, `round(ramp_time / T)` (0 = no ramp).
-    ramp_len: u64,
-    /// True once any tick has read the device (the stall check needs a previous tick).
-    started: bool,
     record: TickRecord,
 }
 
@@ -129,31 +82,8 @@ impl HapticSystem {
     ) -> Result<Self, String> {
         safety.validate()?;
         let dt = world.params.dt;
-        let slave = match &config.slave {
-            Some(name) => world.body_index(name).ok_or_else(|| {
-                format!(
-                    "slave body `{name}` not found; bodies: {}",
-                    world
-                        .bodies
-                        .iter()
-                        .map(|b| b.name.as_str())
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                )
-            })?,
-            None => world
-                .bodies
-                .iter()
-                .position(|b| b.is_dynamic())
-                .ok_or("the scene has no dynamic body for the device to drive")?,
-        };
+        let slave = find_slave(&world, config.slave.as_deref())?;
         let body = &world.bodies[slave];
-        if !body.is_dynamic() {
-            return Err(format!(
-                "slave body `{}` is fixed; the device needs a dynamic body",
-                body.name
-            ));
-        }
         let world_origin = [body.pose.pos.x, body.pose.pos.y, body.pose.angle];
         let controller = Controller::build(config.controller, &world, slave, dt)?;
         if let Some(p) = &config.passivity {
@@ -198,24 +128,22 @@ impl HapticSystem {
             world,
             slave,
             map,
-            workspace: WorkspaceBound::new(&config.device, dt),
-            plausibility: JointPlausibility::new(&safety),
-            limit_cycle: LimitCycleMonitor::new(&safety, dt),
-            safety: Safety::new(
-                config.device.min_singularity_margin,
-                tau_max,
-                safety.torque_trip_margin,
+            safety: SafetyStage::new(
+                safety,
+                Safety::new(
+                    config.device.min_singularity_margin,
+                    tau_max,
+                    safety.torque_trip_margin,
+                ),
+                WorkspaceBound::new(&config.device, dt),
+                dt,
             ),
-            safety_config: safety,
             preload: config.preload,
             dt,
             tau_prev: [0.0; 4],
             injected: None,
             hand_injection: [0.0; 3],
             aligned: false,
-            ramp_ticks: 0,
-            ramp_len: (safety.ramp_time / dt).round() as u64,
-            started: false,
             record: TickRecord::default(),
         })
     }
@@ -267,27 +195,7 @@ impl HapticSystem {
         self.integrate(&f_cs, motor.tau); // 10
         let f_cm = self.map.wrench_to_world(&f_dev);
         self.record_tick(t, est, &slave, (f_cm, f_cs), &port, motor.tau, flags); // 11
-        TickOutput {
-            torques: motor.tau,
-            tripped: self.safety.is_latched(),
-            margin: if est.is_some() {
-                self.device.margin()
-            } else {
-                0.0
-            },
-            closure_fault,
-            record: self.record,
-        }
-    }
-
-    /// The start-up ramp factor of this tick, `min(1, n / N)` (exactly 0 at the alignment tick).
-    #[inline]
-    fn ramp_factor(&self) -> f64 {
-        if self.ramp_len == 0 {
-            1.0
-        } else {
-            (self.ramp_ticks as f64 / self.ramp_len as f64).min(1.0)
-        }
+        self.output(motor.tau, est.is_some(), closure_fault)
     }
 
     /// A paused sample (the live display's pause): the device is still estimated from the encoder
@@ -296,67 +204,38 @@ impl HapticSystem {
     /// world is not stepped (its time stands still) and the torques are zero. The record shows the
     /// device, the frozen slave and zero commands. Never allocates, locks, prints or does I/O.
     pub fn tick_paused(&mut self, q: &V4) -> TickOutput {
-        let (k, t) = (self.world.tick(), self.world.time());
-        if let Some(reason) = self.plausibility.check_angles(q) {
-            self.safety.trip(k, t, reason);
-        }
-        self.limit_cycle.reset();
-        let mut closure_fault = false;
-        let est = match self.device.estimate(q, &self.tau_prev) {
-            Ok(e) => Some(e),
-            Err(fault) => {
-                closure_fault = matches!(fault, DeviceFault::ClosureViolation { .. });
-                self.safety.trip(k, t, SafetyReason::Device(fault));
-                None
-            }
-        };
+        let t = self.world.time();
+        self.safety.supervise_paused((self.world.tick(), t), q);
+        let (est, closure_fault) = self.sense(q, self.dt); // 1–2
         let mut tau = [0.0; 4];
         let mut flags = 0u32;
-        if self.safety.gate(k, t, &mut tau) {
+        if self.safety.gate((self.world.tick(), t), &mut tau, false) {
             flags |= FLAG_SAFETY;
         }
         self.tau_prev = tau;
         // The handle moves while the slave is frozen: the next running tick re-aligns and ramps in.
         self.aligned = false;
-        self.started = false;
+        self.safety.restart_clock();
         if let Some(pc) = self.passivity.as_mut() {
             pc.idle();
         }
-        let body = &self.world.bodies[self.slave];
-        let cw = self.world.contact_wrench(self.slave);
-        let ledger = self.world.ledger();
-        let (x_m, v_m, w_h) = est.map_or(([0.0; 3], [0.0; 3], [0.0; 3]), |e| {
-            (e.pose, e.velocity, e.hand_wrench)
-        });
-        self.record = TickRecord {
-            t,
-            x_m,
-            v_m,
-            w_h,
-            x_s: [body.pose.pos.x, body.pose.pos.y, body.pose.angle],
-            v_s: [body.vel.x, body.vel.y, body.omega],
-            f_cm: [0.0; 3],
-            f_cs: [0.0; 3],
-            f_e: [-cw.force.x, -cw.force.y, -cw.torque],
-            tau,
-            contacts: self.world.contacts().contact_count() as u32,
-            kinetic: ledger.kinetic,
-            stored: ledger.stored,
-            applied_work: ledger.applied_work,
+        let slave = self.slave_state();
+        let port = PortOutput {
+            f_port: [0.0; 3],
             po_energy: self.passivity.as_ref().map_or(0.0, |p| p.e_obs()),
             alpha: [0.0; 3],
-            margin: self.device.margin(),
-            closure_error: est.map_or(f64::NAN, |e| e.closure_error),
-            flags,
         };
+        self.record_tick(t, est, &slave, ([0.0; 3], [0.0; 3]), &port, tau, flags); // 11
+        self.output(tau, est.is_some(), closure_fault)
+    }
+
+    /// The tick's output: the torques (N·m) written now, the latch, the singularity margin when the
+    /// device was read (`sensed`; 0 otherwise), the closure monitor's verdict and the record.
+    fn output(&self, torques: V4, sensed: bool, closure_fault: bool) -> TickOutput {
         TickOutput {
-            torques: tau,
+            torques,
             tripped: self.safety.is_latched(),
-            margin: if est.is_some() {
-                self.device.margin()
-            } else {
-                0.0
-            },
+            margin: if sensed { self.device.margin() } else { 0.0 },
             closure_fault,
             record: self.record,
         }
@@ -407,7 +286,7 @@ impl HapticSystem {
     }
     /// The workspace bound rendered from the device file.
     pub fn workspace(&self) -> &WorkspaceBound {
-        &self.workspace
+        self.safety.workspace()
     }
     /// The device estimator.
     pub fn device(&self) -> &TwinPantograph {
@@ -424,7 +303,7 @@ impl HapticSystem {
     /// Re-arms the safety latch (an explicit user action). The next tick re-aligns the mapping to the
     /// handle's measured pose and ramps the torques in again from zero, as at start-up.
     pub fn reset_safety(&mut self) {
-        self.safety.reset();
+        self.safety.rearm();
         // The estimates are stale after a fault (a stall, lost readings): restart the velocity filter
         // and the observer, keeping the θ unwrapping reference.
         let theta = self
@@ -433,9 +312,7 @@ impl HapticSystem {
             .map_or(self.map.device_origin[2], |p| p[2]);
         self.device.reset(theta);
         self.aligned = false;
-        self.started = false;
-        self.plausibility.reset();
-        self.limit_cycle.reset();
+        self.safety.restart_clock();
     }
 
     /// The stall check of [`Self::tick_elapsed`] on its own, for a device paced by the ticks (the
@@ -444,19 +321,17 @@ impl HapticSystem {
     /// `device_wait` s waiting for the device, NaN = unknown) exceeds the stall limit `max(max_stall_periods·T, min_stall_time)`; the
     /// next tick's torques are then zero. Returns true when it tripped. Never allocates.
     pub fn check_stall(&mut self, elapsed: f64, device_wait: f64) -> bool {
-        let (k, t) = (self.world.tick(), self.world.time());
-        let limit = self.safety_config.stall_limit(self.dt);
-        self.safety
-            .check_stall(k, t, self.started, elapsed, device_wait, limit)
+        let at = (self.world.tick(), self.world.time());
+        self.safety.check_stall(at, elapsed, device_wait)
     }
     /// The safety settings (ramp, stall limit, torque trip margin).
     pub fn safety_config(&self) -> &SafetyConfig {
-        &self.safety_config
+        self.safety.config()
     }
     /// The start-up ramp factor the next tick applies (0 at the first valid reading, 1 once ramped in).
     pub fn ramp(&self) -> f64 {
         if self.aligned {
-            self.ramp_factor()
+            self.safety.ramp()
         } else {
             0.0
         }

@@ -1,4 +1,5 @@
-//! Checkable behaviour of the twin-pantograph device model, spec §10.8 (D1–D6).
+//! Checkable behaviour of the twin-pantograph device model, spec §10.8 (D1–D6), and of the 2-DOF
+//! five-bar behind the `CartesianDevice` boundary (issue 37).
 
 #![allow(clippy::needless_range_loop)] // index loops mirror the matrix formulas
 
@@ -484,4 +485,97 @@ fn d_sensing_defaults() {
     assert_eq!(q.l1, 0.11);
     assert_eq!(q.l2, 0.13);
     assert!(toml::from_str::<DeviceParams>("l3 = 1.0").is_err());
+}
+
+// ---- The 2-DOF five-bar at the Cartesian boundary (issue 37) ----
+
+use haptic2d::device::pantograph2::Pantograph2;
+use haptic2d::device::{CartesianDevice, Pantograph2Device};
+
+/// The gen 3 2DIY linkage (m) and a device on it: τ_max 0.123 N·m, margin limit 0.1, 50 Hz filter.
+fn five_bar() -> (Pantograph2, Pantograph2Device) {
+    let l = Pantograph2::new(0.038, 0.07, 0.09).unwrap();
+    (l, Pantograph2Device::new(l, [0.123; 2], 0.1, 50.0, T))
+}
+
+/// `J = ∂E/∂q` by central differences of the forward kinematics alone (not the closed form).
+fn fd_jacobian(l: &Pantograph2, q: [f64; 2]) -> [[f64; 2]; 2] {
+    let h = 1e-6;
+    let mut j = [[0.0; 2]; 2];
+    for c in 0..2 {
+        let (mut qp, mut qm) = (q, q);
+        qp[c] += h;
+        qm[c] -= h;
+        let (ep, em) = (l.fk(qp).unwrap(), l.fk(qm).unwrap());
+        j[0][c] = (ep.x - em.x) / (2.0 * h);
+        j[1][c] = (ep.y - em.y) / (2.0 * h);
+    }
+    j
+}
+
+#[test]
+fn the_five_bar_device_maps_a_handle_force_to_jt_f() {
+    let (l, mut dev) = five_bar();
+    assert_eq!(
+        dev.wrench_to_torques(&[1.0, 0.0, 0.0], 0.0),
+        Err(DeviceFault::NoPose)
+    );
+    let q = l.ik(Vec2::new(0.019, 0.10)).unwrap();
+    dev.sense(&q, &[0.0; 4], T).unwrap();
+    let j = fd_jacobian(&l, q);
+    // A force small enough not to saturate; the moment has no motor on a five-bar.
+    let f = [0.3, -0.2, 5.0];
+    let cmd = dev.wrench_to_torques(&f, 0.0).unwrap();
+    for i in 0..2 {
+        let expected = j[0][i] * f[0] + j[1][i] * f[1];
+        assert!(
+            (cmd.tau[i] - expected).abs() < 1e-7,
+            "tau[{i}] = {} against {expected}",
+            cmd.tau[i]
+        );
+    }
+    assert_eq!([cmd.tau[2], cmd.tau[3]], [0.0, 0.0]);
+    assert!(!cmd.saturated && cmd.wrench_scale == 1.0 && !cmd.near_singular);
+    assert_eq!(dev.tau_max(), [0.123, 0.123, 0.0, 0.0]);
+}
+
+#[test]
+fn the_five_bar_device_saturates_keeping_the_torque_direction() {
+    let (l, mut dev) = five_bar();
+    let q = l.ik(Vec2::new(0.019, 0.10)).unwrap();
+    dev.sense(&q, &[0.0; 4], T).unwrap();
+    let small = dev.wrench_to_torques(&[0.3, -0.2, 0.0], 0.0).unwrap();
+    let big = dev.wrench_to_torques(&[300.0, -200.0, 0.0], 0.0).unwrap();
+    let peak = big.tau[0].abs().max(big.tau[1].abs());
+    assert!((peak - 0.123).abs() < 1e-12, "{peak}");
+    assert!(big.saturated && big.wrench_scale < 1.0);
+    // Same direction: the ratio τ_1/τ_2 of the unsaturated command.
+    assert!(
+        (big.tau[0] / big.tau[1] - small.tau[0] / small.tau[1]).abs() < 1e-9,
+        "{:?} against {:?}",
+        big.tau,
+        small.tau
+    );
+}
+
+/// §10.7's filter on the handle point, in the device frame: the first reading reads zero velocity;
+/// a 1 mm step in x over one period then reads `α·(0.001/T)` with `α = 1 − exp(−2π·50·T)`.
+#[test]
+fn the_five_bar_device_reads_the_handle_point_and_its_filtered_velocity() {
+    let (l, mut dev) = five_bar();
+    let (e0, e1) = (Vec2::new(0.019, 0.10), Vec2::new(0.020, 0.10));
+    let first = dev.sense(&l.ik(e0).unwrap(), &[0.0; 4], T).unwrap();
+    assert!((first.pose[0] - e0.x).abs() < 1e-12 && (first.pose[1] - e0.y).abs() < 1e-12);
+    assert_eq!(first.pose[2], 0.0);
+    assert_eq!(first.velocity, [0.0; 3]);
+    assert_eq!(first.hand_wrench, [0.0; 3]);
+    let second = dev.sense(&l.ik(e1).unwrap(), &[0.0; 4], T).unwrap();
+    let alpha = 1.0 - (-std::f64::consts::TAU * 50.0 * T).exp();
+    assert!(
+        (second.velocity[0] - alpha * 0.001 / T).abs() < 1e-9,
+        "{:?}",
+        second.velocity
+    );
+    assert!(second.velocity[1].abs() < 1e-9 && second.velocity[2] == 0.0);
+    assert!(dev.margin() > 0.1 && dev.margin() <= 1.0);
 }

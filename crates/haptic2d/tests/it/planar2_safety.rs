@@ -123,7 +123,7 @@ fn planar2_past_the_edge_the_handle_feels_the_same_wall_as_the_twin() {
     // and the controller see the same handle, so the difference of their device commands is the
     // wall alone. The handle starts inside (the bound arms there), moves 2 mm past the +x edge and
     // is held there.
-    let make = |square: Option<WorkspaceSquare>| {
+    let make = |square: WorkspaceSquare| {
         let world = builtin("box-in-walls", Some(1000.0))
             .unwrap()
             .unwrap()
@@ -134,9 +134,10 @@ fn planar2_past_the_edge_the_handle_feels_the_same_wall_as_the_twin() {
         c.workspace = square;
         Planar2System::new(world, c).unwrap()
     };
-    let mut walled = make(Some(WorkspaceSquare::around([0.019, 0.10], 0.03)));
-    let mut free = make(None);
-    assert_eq!(walled.workspace().unwrap().stiffness, 2000.0);
+    let mut walled = make(WorkspaceSquare::around([0.019, 0.10], 0.03));
+    // "Without": a square far past the linkage's reach (1 m), whose wall the handle never meets.
+    let mut free = make(WorkspaceSquare::around([0.019, 0.10], 1.0));
+    assert_eq!(walled.workspace().stiffness, 2000.0);
     let path = (0..=160)
         .map(|i| 0.0002 * i as f64)
         .chain(std::iter::repeat_n(0.032, 200));
@@ -172,7 +173,7 @@ fn planar2_beyond_the_trip_distance_the_latch_trips() {
         .unwrap()
         .world;
     let mut c = Planar2Config::new(linkage(), 0.123);
-    c.workspace = Some(WorkspaceSquare::around([0.019, 0.10], 0.03));
+    c.workspace = WorkspaceSquare::around([0.019, 0.10], 0.03);
     let mut sys = Planar2System::new(world, c).unwrap();
     let mut dx = 0.0;
     for _ in 0..400 {
@@ -190,19 +191,43 @@ fn planar2_beyond_the_trip_distance_the_latch_trips() {
         matches!(trip.reason, SafetyReason::Workspace { axis: 0, edge, .. } if (edge - 0.049).abs() < 1e-12),
         "{trip}"
     );
-    // Without a square (Planar2Config::new's default) the same walk does not trip there.
+}
+
+/// Issue 37 (the 2-DOF path lacked the twin's bound: `Planar2Config::new` had none, so a 2-DOF
+/// system built without a device-file square let the handle run off under torque): with the
+/// defaults alone, a handle driven out of its workspace latches. The default square is the
+/// linkage's reach square, (0.019, 0.088) ± 0.032 m for this geometry, so walking +x along
+/// y = 0.10 m from the centre trips 10 mm past the edge x = 0.051 m, with the workspace reason.
+#[test]
+fn a_two_dof_handle_driven_outside_its_workspace_latches_with_the_default_config() {
     let world = builtin("box-in-walls", Some(1000.0))
         .unwrap()
         .unwrap()
         .world;
     let mut sys = Planar2System::new(world, Planar2Config::new(linkage(), 0.123)).unwrap();
-    assert!(sys.workspace().is_none());
+    let square = WorkspaceSquare::five_bar(&linkage());
+    let edge = square.centre[0] + square.half_width;
+    assert!((edge - 0.051).abs() < 1e-12, "{edge}");
     let mut dx = 0.0;
-    while dx < 0.043 {
-        sys.tick(&q_at(dx));
+    let mut tripped_at = None;
+    while dx < 0.06 {
+        let out = sys.tick(&q_at(dx));
+        if out.tripped {
+            assert_eq!(out.torques, [0.0; 2]);
+            tripped_at = Some(0.019 + dx);
+            break;
+        }
         dx += 0.0002;
     }
-    assert!(sys.safety_trip().is_none(), "{:?}", sys.safety_trip());
+    let x = tripped_at.unwrap_or_else(|| panic!("no trip up to x = {}", 0.019 + dx));
+    assert!(x - edge > 0.01 && x - edge < 0.0103, "tripped at x = {x}");
+    let trip = sys.safety_trip().expect("tripped");
+    assert!(
+        matches!(trip.reason, SafetyReason::Workspace { axis: 0, edge: e, .. } if (e - edge).abs() < 1e-12),
+        "{trip}"
+    );
+    // Latched: the handle brought back inside gets no torque until a re-arm.
+    assert_eq!(sys.tick(&q_at(0.0)).torques, [0.0; 2]);
 }
 
 /// The square of a five-bar whose device file has none (a UDP pantograph): for the 2DIY gen 3

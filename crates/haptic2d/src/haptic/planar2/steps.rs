@@ -2,19 +2,21 @@
 //! order; the numbers are DESIGN §1's, as in the twin's `system/steps.rs`). None allocates, locks,
 //! prints or does I/O.
 
-use super::{Controller2, Planar2System};
+use super::Planar2System;
 use crate::control::four_channel::TeleopSignals;
 use crate::device::linalg::V3;
-use crate::device::pantograph2::{jt_mul, Pantograph2State};
+use crate::device::{CartesianDevice, DeviceEstimate};
 use crate::geom::{cross, Vec2};
 use crate::haptic::record::{TickRecord, FLAG_NEAR_SINGULAR, FLAG_SAFETY, FLAG_SATURATED};
 use crate::haptic::safety::SafetyReason;
 
-/// The handle as sensed this tick: the linkage state (`None` after a fault), the handle pose and
-/// twist in world coordinates (m, rad; m/s, rad/s; the rotation entries are filled from the slave).
+/// The handle as sensed this tick: the device's estimate (device frame; `None` after a fault), its
+/// singularity margin (NaN without a reading), the handle pose and twist in world coordinates (m,
+/// rad; m/s, rad/s; the rotation entries are filled from the slave).
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Handle {
-    pub st: Option<Pantograph2State>,
+    pub est: Option<DeviceEstimate>,
+    pub margin: f64,
     pub x_m: V3,
     pub v_m: V3,
 }
@@ -36,43 +38,40 @@ pub(super) struct Slave2 {
 impl Planar2System {
     /// Step 0. Stall and joint plausibility: the shared safety layer, as in `HapticSystem`.
     pub(super) fn supervise_input(&mut self, q: &[f64; 2], elapsed: f64, device_wait: f64) {
-        let (k, t) = (self.world.tick(), self.world.time());
-        self.check_stall(elapsed, device_wait);
-        self.started = true;
-        if let Some(reason) = self.plausibility.check(q, elapsed) {
-            self.safety.trip(k, t, reason);
-        }
+        let at = (self.world.tick(), self.world.time());
+        self.safety.supervise_input(at, q, elapsed, device_wait);
     }
 
-    /// Steps 1–2. Handle point, Jacobian and singularity margin; filtered velocity; the device →
-    /// world translation (anchored at the first valid reading). A fault or a singular pose trips.
-    pub(super) fn sense(&mut self, q: &[f64; 2], flags: &mut u32) -> Handle {
-        let (k, t) = (self.world.tick(), self.world.time());
-        let st = match self.config.linkage.state(*q) {
-            Ok(s) => Some(s),
+    /// Steps 1–2. The device's handle point and filtered velocity over `elapsed` (s), its
+    /// singularity margin, and the device → world translation (anchored at the first valid
+    /// reading). A fault or a singular pose trips.
+    pub(super) fn sense(&mut self, q: &[f64; 2], elapsed: f64, flags: &mut u32) -> Handle {
+        let at = (self.world.tick(), self.world.time());
+        let est = match self.device.sense(q, &[0.0; 4], elapsed) {
+            Ok(e) => Some(e),
             Err(f) => {
-                self.safety.trip(k, t, SafetyReason::Device(f));
+                self.safety.trip(at, SafetyReason::Device(f));
                 None
             }
         };
         let mut h = Handle {
-            st,
+            est,
+            margin: self.device.margin(),
             x_m: [f64::NAN; 3],
             v_m: [0.0; 3],
         };
-        if let Some(s) = st {
-            let origin = *self.device_origin.get_or_insert(s.e);
-            let p = s.e - origin + self.world_origin;
-            let v = self.filter.update(&[p.x, p.y, 0.0]);
+        if let Some(e) = est {
+            let point = Vec2::new(e.pose[0], e.pose[1]);
+            let origin = *self.device_origin.get_or_insert(point);
+            let p = point - origin + self.world_origin;
             h.x_m = [p.x, p.y, 0.0];
-            h.v_m = [v[0], v[1], 0.0];
-            if s.margin < self.config.min_singularity_margin {
+            h.v_m = [e.velocity[0], e.velocity[1], 0.0];
+            if h.margin < self.config.min_singularity_margin {
                 *flags |= FLAG_NEAR_SINGULAR;
                 self.safety.trip(
-                    k,
-                    t,
+                    at,
                     SafetyReason::Singularity {
-                        margin: s.margin,
+                        margin: h.margin,
                         limit: self.config.min_singularity_margin,
                     },
                 );
@@ -102,7 +101,7 @@ impl Planar2System {
     /// Step 7. The controller on x and y (the θ channel sees no error: the rotation is left to the
     /// world); both commands zero without a reading or while latched.
     pub(super) fn teleoperate(&mut self, h: &Handle, s: &Slave2) -> (V3, V3) {
-        if h.st.is_none() || self.safety.is_latched() {
+        if h.est.is_none() || self.safety.is_latched() {
             return ([0.0; 3], [0.0; 3]);
         }
         let signals = TeleopSignals {
@@ -112,12 +111,9 @@ impl Planar2System {
             x_s: [s.pg.x, s.pg.y, s.theta],
             v_s: [s.vg.x, s.vg.y, s.omega],
             f_e: [s.f_e[0], s.f_e[1], 0.0],
-            master_mass: [[0.0; 3]; 3],
+            master_mass: self.device.mass_matrix(),
         };
-        let (mut f_cm, mut f_cs) = match &mut self.controller {
-            Controller2::FourChannel(c) => c.step(&signals),
-            Controller2::Coupling(c) => c.step(&signals),
-        };
+        let (mut f_cm, mut f_cs) = self.controller.step(&signals);
         f_cm[2] = 0.0;
         f_cs[2] = 0.0;
         (f_cm, f_cs)
@@ -126,52 +122,42 @@ impl Planar2System {
     /// Step 8b. The device file's workspace bound at the handle point (device frame; the device →
     /// world map is a translation, so velocity and force are the same in both).
     pub(super) fn workspace_wall(&mut self, h: &Handle, f_cm: &mut V3) {
-        let (k, t) = (self.world.tick(), self.world.time());
-        if let (Some(s), Some(w)) = (h.st, self.workspace.as_mut()) {
-            let x = [s.e.x, s.e.y, 0.0];
-            if let Some(reason) = w.apply(&x, &h.v_m, f_cm) {
-                self.safety.trip(k, t, reason);
-            }
+        let at = (self.world.tick(), self.world.time());
+        if let Some(e) = h.est {
+            self.safety.workspace_wall(at, &e.pose, &h.v_m, f_cm);
             f_cm[2] = 0.0;
         }
     }
 
-    /// Step 9. `τ = Jᵀ·f_cm`, direction-preserving saturation, the limit-cycle monitor, the start-up
-    /// ramp and the safety gate. Returns the four torques (N·m; the last two always 0) and whether
-    /// the gate zeroed them.
+    /// Step 9. The device's `τ = Jᵀ·f_cm` with direction-preserving saturation, the limit-cycle
+    /// monitor, the start-up ramp and the safety gate. Returns the four torques (N·m; the last two
+    /// always 0) and whether the gate zeroed them.
     pub(super) fn motor_torques(
         &mut self,
         h: &Handle,
         f_cm: &V3,
         flags: &mut u32,
     ) -> ([f64; 4], bool) {
-        let (k, t) = (self.world.tick(), self.world.time());
+        let at = (self.world.tick(), self.world.time());
         let mut tau4 = [0.0; 4];
-        if let (Some(s), false) = (h.st, self.safety.is_latched()) {
-            let tau = jt_mul(&s.j, [f_cm[0], f_cm[1]]);
-            let mut scale: f64 = 1.0;
-            for (t, max) in tau.iter().zip(self.config.tau_max) {
-                if t.abs() > max {
-                    scale = scale.min(max / t.abs());
+        if let (Some(_), false) = (h.est, self.safety.is_latched()) {
+            match self.device.wrench_to_torques(f_cm, 0.0) {
+                Ok(cmd) => {
+                    if cmd.saturated {
+                        *flags |= FLAG_SATURATED;
+                    }
+                    let tau_max = self.device.tau_max();
+                    self.safety.observe_limit_cycle(at, &cmd.tau, &tau_max);
+                    let ramp = self.safety.ramp();
+                    tau4[0] = cmd.tau[0] * ramp;
+                    tau4[1] = cmd.tau[1] * ramp;
                 }
+                Err(fault) => self.safety.trip(at, SafetyReason::Torques(fault)),
             }
-            if scale < 1.0 {
-                *flags |= FLAG_SATURATED;
-            }
-            let (t0, t1) = (tau[0] * scale, tau[1] * scale);
-            let tau_max = [self.config.tau_max[0], self.config.tau_max[1], 0.0, 0.0];
-            if let Some(reason) = self.limit_cycle.observe(&[t0, t1, 0.0, 0.0], &tau_max) {
-                self.safety.trip(k, t, reason);
-            }
-            let ramp = self.ramp();
-            tau4[0] = tau[0] * scale * ramp;
-            tau4[1] = tau[1] * scale * ramp;
         }
-        let gated = self.safety.gate(k, t, &mut tau4);
+        let gated = self.safety.gate(at, &mut tau4, h.est.is_some());
         if gated {
             *flags |= FLAG_SAFETY;
-        } else if h.st.is_some() {
-            self.ramp_ticks = self.ramp_ticks.saturating_add(1);
         }
         (tau4, gated)
     }
@@ -221,7 +207,7 @@ impl Planar2System {
             applied_work: ledger.applied_work,
             po_energy: 0.0,
             alpha: [0.0; 3],
-            margin: h.st.map_or(f64::NAN, |st| st.margin),
+            margin: h.margin,
             closure_error: 0.0,
             flags,
         };

@@ -6,7 +6,7 @@ use super::HapticSystem;
 use crate::control::four_channel::TeleopSignals;
 use crate::control::passivity::explicit_damping_limit;
 use crate::device::linalg::{M3, V3, V4};
-use crate::device::{DeviceEstimate, DeviceFault};
+use crate::device::{CartesianDevice, DeviceEstimate, DeviceFault};
 use crate::geom::Vec2;
 use crate::haptic::record::{
     TickRecord, FLAG_NEAR_SINGULAR, FLAG_PASSIVITY_ACTIVE, FLAG_SAFETY, FLAG_SATURATED,
@@ -44,12 +44,8 @@ impl HapticSystem {
     /// Step 0. Stall: the device held the previous torques for `elapsed` seconds, unsupervised.
     /// Plausibility: a joint reading no hand can produce is a fault of the encoder or driver.
     pub(super) fn supervise_input(&mut self, q: &V4, elapsed: f64, device_wait: f64) {
-        let (k, t) = (self.world.tick(), self.world.time());
-        self.check_stall(elapsed, device_wait);
-        self.started = true;
-        if let Some(reason) = self.plausibility.check(q, elapsed) {
-            self.safety.trip(k, t, reason);
-        }
+        let at = (self.world.tick(), self.world.time());
+        self.safety.supervise_input(at, q, elapsed, device_wait);
     }
 
     /// Steps 1–2. Device pose by forward kinematics (θ unwrapped, closure monitor), filtered
@@ -57,12 +53,12 @@ impl HapticSystem {
     /// §10.6, §10.7), both over the measured interval. A fault trips the latch; the flag says
     /// whether it was the closure monitor.
     pub(super) fn sense(&mut self, q: &V4, elapsed: f64) -> (Option<DeviceEstimate>, bool) {
-        let (k, t) = (self.world.tick(), self.world.time());
-        match self.device.estimate_elapsed(q, &self.tau_prev, elapsed) {
+        let at = (self.world.tick(), self.world.time());
+        match self.device.sense(q, &self.tau_prev, elapsed) {
             Ok(e) => (Some(e), false),
             Err(fault) => {
                 let closure = matches!(fault, DeviceFault::ClosureViolation { .. });
-                self.safety.trip(k, t, SafetyReason::Device(fault));
+                self.safety.trip(at, SafetyReason::Device(fault));
                 (None, closure)
             }
         }
@@ -78,7 +74,7 @@ impl HapticSystem {
             self.map.device_origin = e.pose;
             self.map.world_origin = [body.pose.pos.x, body.pose.pos.y, body.pose.angle];
             self.aligned = true;
-            self.ramp_ticks = 0;
+            self.safety.restart_ramp();
         }
     }
 
@@ -87,6 +83,11 @@ impl HapticSystem {
     /// Returns the slave as the controller sees it.
     pub(super) fn contact_stage(&mut self) -> SlaveState {
         self.world.begin_step();
+        self.slave_state()
+    }
+
+    /// The slave body as the world holds it now: pose, twist and the contact wrench it exerts.
+    pub(super) fn slave_state(&self) -> SlaveState {
         let body = &self.world.bodies[self.slave];
         let cw = self.world.contact_wrench(self.slave);
         SlaveState {
@@ -166,12 +167,11 @@ impl HapticSystem {
     /// Step 8b. Workspace bound (device file): a passive wall just past the edge of the workspace
     /// square, and a trip beyond it. Returns the wrench for the motors (handle coordinates).
     pub(super) fn workspace_wall(&mut self, est: Option<DeviceEstimate>, f_port: V3) -> V3 {
-        let (k, t) = (self.world.tick(), self.world.time());
+        let at = (self.world.tick(), self.world.time());
         let mut f_dev = f_port;
         if let Some(e) = est {
-            if let Some(reason) = self.workspace.apply(&e.pose, &e.velocity, &mut f_dev) {
-                self.safety.trip(k, t, reason);
-            }
+            self.safety
+                .workspace_wall(at, &e.pose, &e.velocity, &mut f_dev);
         }
         f_dev
     }
@@ -181,48 +181,44 @@ impl HapticSystem {
     /// or a request above τ_max by more than the margin zeroes the torques in this same tick; a
     /// request just above τ_max is clamped to it.
     pub(super) fn motor_torques(&mut self, f_dev: &V3, flags: &mut u32) -> MotorOutput {
-        let (k, t) = (self.world.tick(), self.world.time());
+        let at = (self.world.tick(), self.world.time());
         let mut tau = [0.0; 4];
         let mut wrench_scale = 0.0;
         if !self.safety.is_latched() {
-            match self.device.torques_for_wrench(f_dev, self.preload) {
+            match self.device.wrench_to_torques(f_dev, self.preload) {
                 Ok(cmd) => {
                     tau = cmd.tau;
                     wrench_scale = cmd.wrench_scale;
                     if cmd.saturated {
                         *flags |= FLAG_SATURATED;
                     }
-                    let tau_max = [self.safety.tau_max; 4];
-                    if let Some(reason) = self.limit_cycle.observe(&cmd.tau, &tau_max) {
-                        self.safety.trip(k, t, reason);
-                    }
+                    let tau_max = self.device.tau_max();
+                    self.safety.observe_limit_cycle(at, &cmd.tau, &tau_max);
                     if cmd.near_singular {
                         *flags |= FLAG_NEAR_SINGULAR;
+                        let limit = self.safety.latch().min_margin;
                         self.safety.trip(
-                            k,
-                            t,
+                            at,
                             SafetyReason::Singularity {
                                 margin: cmd.margin,
-                                limit: self.safety.min_margin,
+                                limit,
                             },
                         );
                     }
                 }
-                Err(fault) => self.safety.trip(k, t, SafetyReason::Torques(fault)),
+                Err(fault) => self.safety.trip(at, SafetyReason::Torques(fault)),
             }
         }
-        let ramp = self.ramp_factor();
+        let ramp = self.safety.ramp();
         tau.iter_mut().for_each(|v| *v *= ramp);
         if let Some((i, v)) = self.injected.take() {
             tau[i] = v;
         }
         let peak_before = tau.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        let gated = self.safety.gate(k, t, &mut tau);
+        let gated = self.safety.gate(at, &mut tau, self.aligned);
         let peak_after = tau.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         if gated {
             *flags |= FLAG_SAFETY;
-        } else if self.aligned {
-            self.ramp_ticks = self.ramp_ticks.saturating_add(1);
         }
         let applied = if gated || peak_before == 0.0 {
             0.0

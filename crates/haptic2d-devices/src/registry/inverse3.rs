@@ -1,23 +1,22 @@
 //! `haptic2d run --device inverse3[:URL] [--device-file FILE]`: a Haply Inverse3 through its Inverse
 //! Service (the `haply` client crate) as a real device of the one run loop (the extension point in
-//! `run_rig.rs`), in planar mode. `URL` is the service's address, `http://HOST:PORT` (the WebSocket
+//! [`super`]), in planar mode. `URL` is the service's address, `http://HOST:PORT` (the WebSocket
 //! is `ws://HOST:PORT/`); without it the device file's `[service]` (default
 //! `http://localhost:10001`, `ws://localhost:10001/`). The device file (default the shipped
 //! devices/inverse3.toml) maps two device axes to the world plane and holds the third; the system is
-//! the 2-DOF system on the driver's virtual five-bar (see `haptic2d_devices::inverse3::planar`).
-
+//! the 2-DOF system on the driver's virtual five-bar (see `crate::inverse3::planar`).
 //!
-//! The driver is behind the `inverse3` feature of haptic2d-cli (off by default: it brings Haply's
-//! client with its HTTP/TLS stack); without it `--device inverse3` is refused as bad input with the
+//! The driver is behind the `inverse3` feature of haptic2d-devices (haptic2d-cli's `inverse3`
+//! turns it on; off by default: it brings Haply's client with its HTTP/TLS stack); without it `--device inverse3` is refused as bad input with the
 //! command that builds it ([`NOT_BUILT`]).
 
 #[cfg(feature = "inverse3")]
-use crate::run_rig::DeviceModel;
-use crate::run_rig::RealDevice;
+use super::DeviceModel;
+use super::RealDevice;
 #[cfg(feature = "inverse3")]
-use haptic2d_devices::inverse3::planar::{virtual_center, virtual_linkage, virtual_torque_limit};
+use crate::inverse3::planar::{virtual_center, virtual_linkage, virtual_torque_limit};
 #[cfg(feature = "inverse3")]
-use haptic2d_devices::inverse3::{Inverse3Device, Inverse3DeviceFile};
+use crate::inverse3::{Inverse3Device, Inverse3DeviceFile};
 #[cfg(feature = "inverse3")]
 use haptic2d_rt::io::Joints2;
 #[cfg(feature = "inverse3")]
@@ -26,7 +25,6 @@ use std::path::Path;
 
 /// Why `--device inverse3` and `emulate inverse3` are refused by a build without the `inverse3`
 /// feature, and how to get them.
-#[cfg_attr(feature = "inverse3", allow(dead_code))]
 pub const NOT_BUILT: &str = "the Haply Inverse3 driver is not in this build (the `inverse3` feature is off by default: it needs Haply's client with its HTTP/TLS stack and OpenSSL headers)\n    fix: cargo install --path crates/haptic2d-cli --features inverse3   (or cargo run --release --features inverse3 -- run --device inverse3)";
 
 /// Without the `inverse3` feature: the URL is checked, then the device refused ([`NOT_BUILT`]).
@@ -72,7 +70,7 @@ pub fn real_device(url: Option<&str>, device_file: Option<&Path>) -> Result<Real
         file = file.with_service(http, ws);
     }
     let name = format!("inverse3:{}", file.http_url);
-    let axis = |a: haptic2d_devices::inverse3::device_file::SignedAxis| {
+    let axis = |a: crate::inverse3::device_file::SignedAxis| {
         format!(
             "{}{}",
             if a.sign < 0.0 { "-" } else { "" },

@@ -1,6 +1,6 @@
 //! `haptic2d run --device udp:ADDR:PORT [--device-file FILE]`: a device on the open UDP protocol
 //! (docs/DEVICE-PROTOCOL.md) as a real device of the one run loop (the extension point in
-//! `run_rig.rs`). The device listens at ADDR:PORT; the device file (default: the reference
+//! [`super`]). The device listens at ADDR:PORT; the device file (default: the reference
 //! pantograph, devices/udp-pantograph.toml) says whether joints or a pose come in, what goes out
 //! and which linkage applies; the system is the 2-DOF pantograph system. When the device closes
 //! (end of the run, a lost device, Ctrl-C) the network counters are printed on stdout:
@@ -12,9 +12,10 @@
 //! warning; without `protocol.key_file` (protocol version 1, unauthenticated) only loopback is
 //! allowed, with a warning.
 
-use crate::run_rig::{DeviceModel, RealDevice};
-use haptic2d_devices::udp::{UdpDevice, UdpDeviceFile};
+use super::{DeviceModel, RealDevice};
+use crate::udp::{UdpDevice, UdpDeviceFile};
 use haptic2d_rt::{DeviceError, DeviceIo};
+use std::io::Write;
 use std::net::{IpAddr, SocketAddr, ToSocketAddrs};
 use std::path::Path;
 
@@ -164,7 +165,8 @@ impl DeviceIo for Counted {
 
 impl Drop for Counted {
     fn drop(&mut self) {
-        crate::outln!("udp: {}", self.0.counters());
+        // A closed or broken stdout is not an error here (nothing else to report it to).
+        let _ = writeln!(std::io::stdout().lock(), "udp: {}", self.0.counters());
     }
 }
 

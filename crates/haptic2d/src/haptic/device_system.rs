@@ -1,20 +1,25 @@
-//! [`RigSystem`]: the haptic system inside the rig of `haptic2d run`, for either kind of device —
-//! the twin pantograph (4 joints, x, y, θ: [`HapticSystem`], MODELS §10–§11; the simulated device,
-//! a replay, the Haply twin) or a 2-DOF five-bar (2 joints, x and y of a grasp point:
-//! [`Planar2System`]; a Haply 2DIY, and any other 2-DOF device). The loop, the watchdog, the logs
-//! and the display see one interface; each method says what the 2-DOF form does differently.
+//! [`DeviceSystem`]: the haptic system for either kind of device — the twin pantograph (4 joints,
+//! x, y, θ: [`HapticSystem`], MODELS §10–§11; the simulated device, a replay, the Haply twin) or a
+//! 2-DOF five-bar (2 joints, x and y of a grasp point: [`Planar2System`]; a Haply 2DIY, a UDP
+//! five-bar, the Inverse3). The one enum every front end drives (the rig of `haptic2d run`, the
+//! Haply closed loop of `haptic2d-devices`): the loop, the watchdog, the logs and the display see
+//! one interface; each method says what the 2-DOF form does differently.
 
-use haptic2d::control::passivity::PlanarPassivity;
-use haptic2d::device::linalg::{V3, V4};
-use haptic2d::device::TwinKinematics;
-use haptic2d::haptic::planar2::{Planar2Output, Planar2System};
-use haptic2d::haptic::{ControllerKind, HapticSystem, SafetyTrip, TickOutput, TickRecord};
-use haptic2d::world::World;
+use crate::control::passivity::PlanarPassivity;
+use crate::device::linalg::{V3, V4};
+use crate::device::TwinKinematics;
+use crate::world::World;
 
-/// The system the rig drives.
+use super::config::ControllerKind;
+use super::planar2::{Planar2Output, Planar2System};
+use super::record::TickRecord;
+use super::safety::SafetyTrip;
+use super::system::{HapticSystem, TickOutput};
+
+/// The system a device drives.
 #[derive(Clone, Debug)]
 #[allow(clippy::large_enum_variant)]
-pub enum RigSystem {
+pub enum DeviceSystem {
     /// The twin pantograph: x, y and θ.
     Twin(HapticSystem),
     /// A 2-DOF five-bar holding the slave at a grasp point: x and y; the rotation is left to the
@@ -38,19 +43,19 @@ fn widen(o: Planar2Output) -> TickOutput {
     }
 }
 
-impl RigSystem {
+impl DeviceSystem {
     /// One tick on joint angles `q` (rad) taken `elapsed` s after the previous tick (the interval
     /// the device's signals are differentiated over; `None`: one period, a device paced by the
     /// ticks), or a paused tick. Never allocates.
     #[inline]
     pub fn tick(&mut self, q: &V4, elapsed: Option<f64>, paused: bool) -> TickOutput {
         match self {
-            RigSystem::Twin(s) => match (paused, elapsed) {
+            DeviceSystem::Twin(s) => match (paused, elapsed) {
                 (true, _) => s.tick_paused(q),
                 (false, None) => s.tick(q),
                 (false, Some(e)) => s.tick_elapsed(q, e),
             },
-            RigSystem::TwoDof(s) => {
+            DeviceSystem::TwoDof(s) => {
                 let q2 = [q[0], q[1]];
                 widen(match (paused, elapsed) {
                     (true, _) => s.tick_paused(&q2),
@@ -67,8 +72,8 @@ impl RigSystem {
     #[inline]
     pub fn tick_timed(&mut self, q: &V4, elapsed: f64, device_wait: f64) -> TickOutput {
         match self {
-            RigSystem::Twin(s) => s.tick_timed(q, elapsed, device_wait),
-            RigSystem::TwoDof(s) => widen(s.tick_timed(&[q[0], q[1]], elapsed, device_wait)),
+            DeviceSystem::Twin(s) => s.tick_timed(q, elapsed, device_wait),
+            DeviceSystem::TwoDof(s) => widen(s.tick_timed(&[q[0], q[1]], elapsed, device_wait)),
         }
     }
 
@@ -78,40 +83,40 @@ impl RigSystem {
     #[inline]
     pub fn check_stall(&mut self, elapsed: f64, device_wait: f64) -> bool {
         match self {
-            RigSystem::Twin(s) => s.check_stall(elapsed, device_wait),
-            RigSystem::TwoDof(s) => s.check_stall(elapsed, device_wait),
+            DeviceSystem::Twin(s) => s.check_stall(elapsed, device_wait),
+            DeviceSystem::TwoDof(s) => s.check_stall(elapsed, device_wait),
         }
     }
 
     /// The world.
     pub fn world(&self) -> &World {
         match self {
-            RigSystem::Twin(s) => s.world(),
-            RigSystem::TwoDof(s) => s.world(),
+            DeviceSystem::Twin(s) => s.world(),
+            DeviceSystem::TwoDof(s) => s.world(),
         }
     }
 
     /// Mutable access to the world (between ticks).
     pub fn world_mut(&mut self) -> &mut World {
         match self {
-            RigSystem::Twin(s) => s.world_mut(),
-            RigSystem::TwoDof(s) => s.world_mut(),
+            DeviceSystem::Twin(s) => s.world_mut(),
+            DeviceSystem::TwoDof(s) => s.world_mut(),
         }
     }
 
     /// Index of the slave body.
     pub fn slave(&self) -> usize {
         match self {
-            RigSystem::Twin(s) => s.slave(),
-            RigSystem::TwoDof(s) => s.slave(),
+            DeviceSystem::Twin(s) => s.slave(),
+            DeviceSystem::TwoDof(s) => s.slave(),
         }
     }
 
     /// The latched safety trip, if any.
     pub fn safety_trip(&self) -> Option<SafetyTrip> {
         match self {
-            RigSystem::Twin(s) => s.safety_trip(),
-            RigSystem::TwoDof(s) => s.safety_trip(),
+            DeviceSystem::Twin(s) => s.safety_trip(),
+            DeviceSystem::TwoDof(s) => s.safety_trip(),
         }
     }
 
@@ -119,16 +124,16 @@ impl RigSystem {
     /// handle point already in world coordinates).
     pub fn last_record(&self) -> &TickRecord {
         match self {
-            RigSystem::Twin(s) => s.last_record(),
-            RigSystem::TwoDof(s) => s.last_record(),
+            DeviceSystem::Twin(s) => s.last_record(),
+            DeviceSystem::TwoDof(s) => s.last_record(),
         }
     }
 
     /// Switches the controller (checked against the slave's mass; on error nothing changes).
     pub fn set_controller(&mut self, kind: ControllerKind) -> Result<(), String> {
         match self {
-            RigSystem::Twin(s) => s.set_controller(kind),
-            RigSystem::TwoDof(s) => s.set_controller(kind),
+            DeviceSystem::Twin(s) => s.set_controller(kind),
+            DeviceSystem::TwoDof(s) => s.set_controller(kind),
         }
     }
 
@@ -136,24 +141,24 @@ impl RigSystem {
     /// 2-DOF device.
     pub fn twin_kinematics(&self) -> Option<&TwinKinematics> {
         match self {
-            RigSystem::Twin(s) => Some(&s.device().kin),
-            RigSystem::TwoDof(_) => None,
+            DeviceSystem::Twin(s) => Some(&s.device().kin),
+            DeviceSystem::TwoDof(_) => None,
         }
     }
 
     /// The passivity controller, if the twin runs one (never on a 2-DOF device).
     pub fn passivity(&self) -> Option<&PlanarPassivity> {
         match self {
-            RigSystem::Twin(s) => s.passivity(),
-            RigSystem::TwoDof(_) => None,
+            DeviceSystem::Twin(s) => s.passivity(),
+            DeviceSystem::TwoDof(_) => None,
         }
     }
 
     /// The twin system, if this is one.
     pub fn twin(&self) -> Option<&HapticSystem> {
         match self {
-            RigSystem::Twin(s) => Some(s),
-            RigSystem::TwoDof(_) => None,
+            DeviceSystem::Twin(s) => Some(s),
+            DeviceSystem::TwoDof(_) => None,
         }
     }
 
@@ -161,14 +166,14 @@ impl RigSystem {
     /// mapping is the translation anchored at the first handle reading (zero before it).
     pub fn device_to_world(&self) -> [f64; 2] {
         match self {
-            RigSystem::Twin(s) => {
+            DeviceSystem::Twin(s) => {
                 let m = s.map();
                 [
                     m.world_origin[0] - m.device_origin[0],
                     m.world_origin[1] - m.device_origin[1],
                 ]
             }
-            RigSystem::TwoDof(s) => match s.device_origin() {
+            DeviceSystem::TwoDof(s) => match s.device_origin() {
                 Some(d) => {
                     let w = s.world_origin();
                     [w.x - d.x, w.y - d.y]
@@ -180,9 +185,15 @@ impl RigSystem {
 
     /// Where the handle is, in world coordinates (m, m, rad; a 2-DOF handle's θ is the slave's).
     pub fn handle_world(&self) -> V3 {
+        self.handle_world_of(self.last_record())
+    }
+
+    /// The handle pose of `record` (one of this system's tick records) in world coordinates (m, m,
+    /// rad): the twin's record holds the device pose, mapped here; the 2-DOF record holds it already.
+    pub fn handle_world_of(&self, record: &TickRecord) -> V3 {
         match self {
-            RigSystem::Twin(s) => s.map().pose_to_world(&s.last_record().x_m),
-            RigSystem::TwoDof(s) => s.last_record().x_m,
+            DeviceSystem::Twin(s) => s.map().pose_to_world(&record.x_m),
+            DeviceSystem::TwoDof(_) => record.x_m,
         }
     }
 }
