@@ -144,6 +144,8 @@ enum LoopEnd {
     Watchdog(String),
     /// The haptic tick's own safety latch tripped (reported by `system.safety_trip()`).
     SafetyLatch,
+    /// The world diverged (MODELS §0.5 step 12): its time (s) and why.
+    WorldDiverged(String),
 }
 
 /// Runs the haptic loop: validate the options, build the rig, start the display and the logger,
@@ -469,6 +471,16 @@ impl LoopState<'_> {
             });
             return TickControl::Stop;
         }
+        // MODELS §0.5 step 12: a world that diverged in this tick stops the loop before its
+        // torques reach the device.
+        if let Some(d) = system.world().divergence() {
+            io.zero_torques();
+            let t = system.world().time();
+            self.end = Some(LoopEnd::WorldDiverged(format!(
+                "the world diverged at t = {t:.4} s: {d}\n    torques were set to zero and latched; fix: lower the contact stiffness or raise the rate (docs/SCENES.md)"
+            )));
+            return TickControl::Stop;
+        }
         if let Err(e) = io.write_torques(&tau) {
             io.zero_torques();
             self.end = Some(LoopEnd::DeviceLost(e.to_string()));
@@ -534,6 +546,7 @@ fn end_status(end: Option<&LoopEnd>, interrupted: bool) -> (Status, Option<Strin
         Some(LoopEnd::Watchdog(msg)) => (Status::SafetyStop, Some(msg.clone())),
         // The latch's own report (`system.safety_trip()`) is printed above.
         Some(LoopEnd::SafetyLatch) => (Status::SafetyStop, None),
+        Some(LoopEnd::WorldDiverged(msg)) => (Status::Diverged, Some(msg.clone())),
         None if interrupted => (
             Status::Interrupted,
             Some("interrupted by a signal (SIGINT or SIGTERM)".into()),
@@ -701,6 +714,7 @@ mod tests {
             (Some(LoopEnd::SafetyLatch), false, 3),
             // A safety stop in the tick the signal arrived is still a safety stop.
             (Some(LoopEnd::SafetyLatch), true, 3),
+            (Some(LoopEnd::WorldDiverged("x".into())), false, 6),
             (None, true, 130),
             (None, false, 0),
         ];

@@ -311,7 +311,13 @@ pub fn run_2d(case: &WallCase) -> Result<(Trace, Fig4Measured), String> {
         tr.v.push(s.v_n);
         tr.theta.push(bd.pose.angle);
         tr.omega.push(bd.omega);
-        w.step();
+        if let Some(d) = w.step() {
+            return Err(format!(
+                "fig4 {}: the world diverged at t = {:.4} s: {d}",
+                case.name,
+                w.time()
+            ));
+        }
         tr.f.push(w.contact_wrench(b).force.x);
         max_omega = max_omega.max(w.bodies[b].omega.abs());
     }

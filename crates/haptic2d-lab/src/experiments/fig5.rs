@@ -404,6 +404,9 @@ pub fn run_case(
         let out = l
             .step()
             .map_err(|e| format!("fig5 {name}: simulated device failed: {e}"))?;
+        if let Some(d) = l.system.world().divergence() {
+            return Err(format!("fig5 {name}: the world diverged: {d}"));
+        }
         gap.push(box_gap(&out.record.x_s, [0.02, 0.01]));
         records.push(out.record);
         if out.tripped {

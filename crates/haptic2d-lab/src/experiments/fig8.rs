@@ -307,6 +307,9 @@ pub fn run_case(
         let out = l
             .step()
             .map_err(|e| format!("fig8 {name}: simulated device failed: {e}"))?;
+        if let Some(d) = l.system.world().divergence() {
+            return Err(format!("fig8 {name}: the world diverged: {d}"));
+        }
         records.push(out.record);
         push.push(f_world);
         if out.tripped {

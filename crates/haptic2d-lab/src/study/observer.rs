@@ -180,7 +180,12 @@ pub fn explore(
         world.loads[0].force = dir * f;
         let mut sum = 0.0;
         for k in 0..n {
-            world.step();
+            if let Some(d) = world.step() {
+                return Err(format!(
+                    "the simulated observer's world diverged at t = {:.4} s: {d}",
+                    world.time()
+                ));
+            }
             if k >= n - tail {
                 let b = &world.bodies[probe];
                 sum += b.pose.pos.x * dir.x + b.pose.pos.y * dir.y;
