@@ -25,9 +25,10 @@ pub use params::WorldParams;
 
 use crate::body::Body;
 use crate::collide::{mark_seams, speed_limit, Collider, LocalStage};
+use crate::contact::solver::ChainDamping;
 use crate::contact::{ContactSet, VeContact, Wrench2};
 use crate::geom::{Pose, Rot, Vec2};
-use crate::integrate::{ChainDamping, EnergyLedger};
+use crate::integrate::EnergyLedger;
 use crate::laws::friction::FrictionModel;
 use crate::laws::normal::NormalModel;
 use crate::load::Load;
@@ -222,7 +223,7 @@ impl World {
         self.contact_wrench[i]
     }
     /// The implicit chain damper: rows damped, sweeps run and warm-start scale of the last
-    /// sample (`integrate/chain_damping.rs`).
+    /// sample (`contact/solver/chain/`).
     #[inline]
     pub fn chain_damper(&self) -> &ChainDamping {
         &self.chain

@@ -1,7 +1,8 @@
 //! The rates, margins and options of a world ([`WorldParams`]).
 
+use crate::contact::solver::{DEFAULT_CHAIN_SWEEPS, DEFAULT_CHAIN_TAU};
 use crate::contact::ContactParams;
-use crate::integrate::{IntegrationMode, DEFAULT_CHAIN_SWEEPS, DEFAULT_CHAIN_TAU};
+use crate::integrate::IntegrationMode;
 
 /// Rates, margins and options of a world.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -31,7 +32,7 @@ pub struct WorldParams {
     pub guard: Option<f64>,
     /// Contact state machine and impact options.
     pub contact: ContactParams,
-    /// Damping time `τ` (s) of the implicit chain damper (`integrate/chain_damping.rs`): contacts
+    /// Damping time `τ` (s) of the implicit chain damper (`contact/solver/chain/`): contacts
     /// of bodies that touch two or more others get an extra normal damper `m_c/τ` on the
     /// end-of-sample velocity, so stacks come to rest. `None` = off. Default 0.2 ms.
     pub chain_tau: Option<f64>,
