@@ -16,7 +16,7 @@
 //! against the same F7-5 bound.
 
 use crate::csv::write_columns;
-use crate::figure::{Figure, FigureContext, FigureReport};
+use crate::figures::{Figure, FigureContext, FigureReport};
 use crate::harness::peg::{PegHarness, PegPush, PegResult};
 use crate::plot::{write_panels, Panel, Series, Stroke};
 use crate::schema::{CaseMetrics, Check, Dimension, Fig7Measured, FigureMetrics, Measured};

@@ -1,4 +1,4 @@
-//! Figs. 5–6: the walls with the device in the loop (`crate::experiments::fig5`): a 0.5 kg box held on
+//! Figs. 5–6: the walls with the device in the loop (`crate::scenarios::walls_with_device`): a 0.5 kg box held on
 //! the simulated twin pantograph, released 0.02 m from the left wall and pushed into it by a constant
 //! 2 N, 500 Hz, 10 s, one case per wall (SEH, ZOH, braking pulse, hysteretic). Each claim is carried
 //! by a named configuration on the spec's device, with its reason and `haptic2d stability`'s verdict
@@ -8,7 +8,7 @@
 //! the virtual coupling, every carrier with the push injected into the hand-force estimate (issue 36
 //! item 4), and the default on the capstan-friction device without and with friction compensation
 //! (item 3). A sweep of the device damping under the §11.1 table
-//! ([`crate::fig5_sweep`]) shows where that table's claims hold.
+//! ([`crate::figures::fig5_sweep`]) shows where that table's claims hold.
 //!
 //! Pass criteria (the paper's claim; numbers from the spec's W6/W7 with W7's 0.06 m/s taken relative to
 //! the 0.40 m/s first entry), `v1` the measured first entry speed:
@@ -20,11 +20,13 @@
 //! - hysteretic (Fig. 6, "stable soon"): the first three contact ratios < 0.85 and ≤ 6 separations.
 
 use crate::csv::write_columns;
-use crate::experiments::fig5::{run_case, Fig5Case, Fig5Expectation, Fig5Params, FIG5_CASES};
-use crate::experiments::{with_capstan_friction, Protocol};
-use crate::fig5_sweep;
-use crate::figure::{Figure, FigureContext, FigureReport};
+use crate::figures::fig5_sweep;
+use crate::figures::{Figure, FigureContext, FigureReport};
 use crate::plot::{write_panels, Panel, Series, Stroke};
+use crate::scenarios::walls_with_device::{
+    run_case, Fig5Case, Fig5Expectation, Fig5Params, FIG5_CASES,
+};
+use crate::scenarios::{with_capstan_friction, Protocol};
 use crate::schema::{CaseMetrics, Check, Dimension, Fig4Measured, FigureMetrics, Measured};
 use rayon::prelude::*;
 use std::fmt::Write as _;
@@ -221,7 +223,7 @@ impl Figure for Fig5 {
             let p = &ctrl[*i].1;
             let stability = crate::design::verdict_line(
                 &p.haptic_config()?,
-                &crate::experiments::fig5::wall_world(normal, p.rate)?,
+                &crate::scenarios::walls_with_device::wall_world(normal, p.rate)?,
                 p.rate,
             );
             let mut case = CaseMetrics::new(
@@ -357,7 +359,7 @@ fn report(m: &FigureMetrics, sweep: &str) -> String {
          ### Every run\n\n\
          | controller/wall | separations | entry speeds (m/s) | contact ratios | settle (s) | check | pass |\n\
          |---|---|---|---|---|---|---|",
-        crate::figure::claims_table(m)
+        crate::figures::claims_table(m)
     );
     for c in &m.cases {
         let Measured::Fig4(x) = &c.measured else {

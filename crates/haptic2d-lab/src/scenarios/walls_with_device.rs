@@ -24,7 +24,7 @@
 //!
 //! **Which runs carry the claims (issue 36).** Each claim is carried by a named configuration on the
 //! spec's device (§10.2, joint `f_v = 1e-4`, no calibrated damping), chosen for a reason the report
-//! states beside `haptic2d stability`'s verdict (see `crate::fig5`): the hysteretic wall by the
+//! states beside `haptic2d stability`'s verdict (see `crate::figures::fig5`): the hysteretic wall by the
 //! default controller ([`Fig5Params::default`]: `FourChannelGains::local_force_feedback`, `C6 = −1`,
 //! `C5 = 2`), the pulse wall by the former default (`C6 = −1`, `C5 = 0`, `D_m = 2`), and the SEH and
 //! ZOH bouncing by the paper's §11.1 table ([`Fig5Params::paper_controller`]), which is unstable

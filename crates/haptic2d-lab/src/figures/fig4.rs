@@ -14,7 +14,7 @@
 //! `|ω| < 1e-9 rad/s` for the paper method (see [`checks_2d`]).
 
 use crate::csv::write_columns;
-use crate::figure::{Figure, FigureContext, FigureReport};
+use crate::figures::{Figure, FigureContext, FigureReport};
 use crate::harness::wall::{run_wall, EntryImpulse, WallConfig};
 use crate::plot::{write_panels, Panel, Series, Stroke};
 use crate::schema::{CaseMetrics, Check, Dimension, Fig4Measured, FigureMetrics, Measured};
