@@ -7,7 +7,7 @@
    - `DESIGN §N[.M]`   -> a numbered heading of docs/ARCHITECTURE.md,
    - `DEVICES §N[.M]`  -> a numbered heading of docs/DEVICES.md,
    - `MODELS §X` and a bare `§X` -> a numbered heading of docs/MODELS.md (`## 7.`, `### 7.3`, and the
-     appendices' letters: `§A`, `§F`),
+     appendices' letters: `§A`, `§E`),
    where a reference to `§7.3.2` is satisfied by `7.3.2`, and one to a section whose number exists only
    as a part of a heading list (e.g. `§1–§4`) is checked number by number.
    References to the paper's own sections are written `paper §N` and are not checked.
@@ -67,7 +67,7 @@ def headings(path):
         n = counts.get(base, 0)
         counts[base] = n + 1
         slugs.add(base if n == 0 else f"{base}-{n}")
-        # "7.3 The LCP solver", "0. Conventions", "Appendix F. Frictional impacts", "F. …", "9.5a …"
+        # "7.3 The LCP solver", "0. Conventions", "Appendix E. Frictional impacts", "F. …", "9.5a …"
         num = re.match(r"^(?:Part\s+)?(?:Appendix\s+)?([0-9]+(?:\.[0-9]+)*[a-z]?|[A-Z])[.\s:]", text)
         current = num.group(1).rstrip(".") if num else None
         if current:

@@ -345,7 +345,7 @@ impl ContactSet {
         let any_colliding = (work.create || !self.events.is_empty())
             && self.create(tick, dt, colliders, bodies, past, normal, friction);
         if any_colliding {
-            // Impact friction mode and coefficient (default μ = the friction model's μ_k; docs/MODELS.md §F).
+            // Impact friction mode and coefficient (default μ = the friction model's μ_k; docs/MODELS.md §E).
             let mu = (self.params.impact_mu)
                 .unwrap_or_else(|| crate::contact::default_impact_mu(friction));
             self.solver.set_friction(self.params.impact_friction, mu);
