@@ -176,7 +176,7 @@ pub fn margin(kind: &ControllerKind, cases: &[StudyCase]) -> Result<Margin, Stri
 }
 
 /// What a held hand feels on the x axis, quasi-statically (low frequency, the hand-force estimate
-/// equal to the hand force), from the linear loop of [`AxisController`] with the spec device's
+/// equal to the hand force), from the linear loop of [`AxisController`] with the §10.2 device's
 /// handle inertia `m` and damping `b` (world units).
 ///
 /// - free motion at constant velocity: master `0 = k_m·e + (1 + g_mh)·f_h − (d_m + b)·v`, slave

@@ -1,7 +1,7 @@
 //! Figs. 5–6: the walls with the device in the loop (`crate::scenarios::walls_with_device`): a 0.5 kg box held on
 //! the simulated twin pantograph, released 0.02 m from the left wall and pushed into it by a constant
 //! 2 N, 500 Hz, 10 s, one case per wall (SEH, ZOH, braking pulse, hysteretic). Each claim is carried
-//! by a named configuration on the spec's device, with its reason and `haptic2d stability`'s verdict
+//! by a named configuration on the §10.2 device, with its reason and `haptic2d stability`'s verdict
 //! (`carrier`): the hysteretic wall by the default, the pulse wall by the former default, SEH and
 //! ZOH by the §11.1 table (unstable released there, refused on a real device). Comparison runs: every
 //! other configuration on every wall, the §11.1 table on a device damped at twice Colgate's bound,
@@ -10,7 +10,7 @@
 //! (item 3). A sweep of the device damping under the §11.1 table
 //! ([`crate::figures::fig5_sweep`]) shows where that table's claims hold.
 //!
-//! Pass criteria (the paper's claim; numbers from the spec's W6/W7 with W7's 0.06 m/s taken relative to
+//! Pass criteria (the paper's claim; numbers from §5.10's W6/W7 with W7's 0.06 m/s taken relative to
 //! the 0.40 m/s first entry), `v1` the measured first entry speed:
 //!
 //! - SEH, ZOH (Fig. 5, "keeps bouncing"): ≥ 2 separations in the last 2 s and no settle time;
@@ -31,7 +31,7 @@ use crate::schema::{CaseMetrics, Check, Dimension, Fig4Measured, FigureMetrics, 
 use rayon::prelude::*;
 use std::fmt::Write as _;
 
-/// The runs: `(name, parameters)`: the default controller on the spec's device, the §11.1 table on
+/// The runs: `(name, parameters)`: the default controller on the §10.2 device, the §11.1 table on
 /// the same device, the §11.1 table on a device damped at twice Colgate's bound, the virtual
 /// coupling, and the former default (master-side local force feedback only). Which run carries which wall's claim: [`carrier`].
 fn controllers(ctx: Option<&FigureContext>) -> Result<Vec<(String, Fig5Params)>, String> {

@@ -38,7 +38,7 @@ impl Protocol {
     }
 }
 
-/// The device file of the friction comparison runs (issue 36 item 3): the spec device with
+/// The device file of the friction comparison runs (issue 36 item 3): the §10.2 device with
 /// realistic joint Coulomb friction and its friction compensation.
 pub const CAPSTAN_FRICTION_FILE: &str = "devices/twin-pantograph-capstan-friction.toml";
 
@@ -46,7 +46,7 @@ const CAPSTAN_FRICTION_TOML: &str =
     include_str!("../../../../devices/twin-pantograph-capstan-friction.toml");
 
 /// The device of [`CAPSTAN_FRICTION_FILE`] (its joint Coulomb friction `f_c`, the compensation
-/// fraction and deadband), every other field the spec's default.
+/// fraction and deadband), every other field its §10.2 default.
 pub fn capstan_friction_device() -> Result<haptic2d::device::DeviceParams, String> {
     haptic2d::scene::device_params_from_toml(CAPSTAN_FRICTION_TOML, CAPSTAN_FRICTION_FILE, None)
         .map_err(|e| e.to_string())

@@ -11,7 +11,7 @@
 //! Cases: SEH (marginally passive) and ZOH (active) — Fig. 5: the block keeps bouncing; braking pulse
 //! and hysteretic wall — Fig. 6: contact stability at the first impact with the pulse, soon with the
 //! hysteretic wall. Metrics per case from the slave's trajectory after the release (§13.1 definitions:
-//! separations, entry/exit speeds, contact ratios, settle time). Pass criteria (the spec's W6/W7
+//! separations, entry/exit speeds, contact ratios, settle time). Pass criteria (§5.10's W6/W7
 //! thresholds, with W7's absolute 0.06 m/s made relative to the 0.40 m/s entry of §5.10), `v1` the
 //! measured first entry speed:
 //!
@@ -36,7 +36,7 @@
 //! sense of §11.4 (no hand impedance). With the §11.1 table (`C2 = 1`) the released loop of handle,
 //! slave and wall spring is unstable in continuous time — the §11.4 polynomial for this device and
 //! wall (m ≈ 0.445 kg, b ≈ 0.028 N·s/m, K = 2000 N/m) has roots `+2.4 ± 67j`, and the sampled-data
-//! growth at 500 Hz is about +19 1/s (`haptic2d stability`). That is what made the spec-device runs
+//! growth at 500 Hz is about +19 1/s (`haptic2d stability`). That is what made the §10.2-device runs
 //! "active" (SEH contact ratios above 1) — not Colgate's `b > K·T/2`: the instability is there
 //! before sampling, and the 5 N·s/m of calibrated damping works because it moves the polynomial's
 //! roots left (stable above `b ≈ 2.65 N·s/m`), not because it exceeds `K·T/2`. With `C6 = −1`
@@ -90,8 +90,8 @@ pub struct Fig5Params {
     /// The device's physical damping as a multiple of Colgate's bound (§5.4). `Some(m)`: the joint
     /// viscous friction `f_v` of `haptic.device` is replaced by the value that gives the handle an x
     /// damping `b_x = f_v·(J_aᵀJ_a)_xx = m·K·T/2` at its start pose, `K` = [`WALL_STIFFNESS`], `T` the
-    /// control period (see [`colgate_joint_damping`]); `None`: `haptic.device.f_v` as given (the spec's
-    /// \[REC\] 1e-4 N·m·s/rad by default, i.e. m ≈ 0.014). Default `None` (the spec device);
+    /// control period (see [`colgate_joint_damping`]); `None`: `haptic.device.f_v` as given (§10.2's
+    /// \[REC\] 1e-4 N·m·s/rad by default, i.e. m ≈ 0.014). Default `None` (the §10.2 device);
     /// [`Fig5Params::calibrated_damping`] uses 2.
     pub colgate_margin: Option<f64>,
     /// The haptic system's safety settings (start-up ramp, stall limit, torque trip margin).
@@ -128,7 +128,7 @@ impl Fig5Params {
         }
     }
 
-    /// Same as [`Fig5Params::paper_controller`] (the §11.1 table on the spec's undamped device).
+    /// Same as [`Fig5Params::paper_controller`] (the §11.1 table on the undamped §10.2 device).
     pub fn spec_device() -> Self {
         Self::paper_controller()
     }
@@ -176,7 +176,7 @@ pub const WALL_STIFFNESS: f64 = 2000.0;
 /// `b_x = f_v·(J_aᵀJ_a)_xx`; at the workspace centre `(J_aᵀJ_a)_xx ≈ 277 m⁻²`. With the spec's
 /// `f_v = 1e-4` that is 0.028 N·s/m against `K·T/2 = 2 N·s/m` at 500 Hz. Margin 2 needs
 /// `f_v ≈ 1.44e-2 N·m·s/rad`: the back-EMF damping `n_g²·K_t²/R` of a voltage-driven motor with
-/// `K_t = 25 mN·m/A`, `R = 4.3 Ω` and the spec's `n_g = 10`.
+/// `K_t = 25 mN·m/A`, `R = 4.3 Ω` and §10.2's `n_g = 10`.
 pub fn colgate_joint_damping(h: &HapticConfig, rate: f64, margin: f64) -> Result<f64, String> {
     if !(margin.is_finite() && margin >= 0.0 && rate.is_finite() && rate > 0.0) {
         return Err(format!(
