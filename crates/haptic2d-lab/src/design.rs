@@ -278,7 +278,7 @@ pub fn fig5_claims(p5: &walls_with_device::Fig5Params) -> Vec<ClaimOutcome> {
                 Ok(c) => ClaimOutcome {
                     claim: format!("fig5/{name}"),
                     pass: c.metrics.pass,
-                    detail: crate::figures::fig5::check(&c).detail,
+                    detail: walls_with_device::check(&c).detail,
                 },
                 Err(e) => ClaimOutcome {
                     claim: format!("fig5/{name}"),

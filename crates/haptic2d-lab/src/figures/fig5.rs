@@ -23,11 +23,9 @@ use crate::csv::write_columns;
 use crate::figures::fig5_sweep;
 use crate::figures::{Figure, FigureContext, FigureReport};
 use crate::plot::{write_panels, Panel, Series, Stroke};
-use crate::scenarios::walls_with_device::{
-    run_case, Fig5Case, Fig5Expectation, Fig5Params, FIG5_CASES,
-};
+use crate::scenarios::walls_with_device::{check, run_case, Fig5Case, Fig5Params, FIG5_CASES};
 use crate::scenarios::{with_capstan_friction, Protocol};
-use crate::schema::{CaseMetrics, Check, Dimension, Fig4Measured, FigureMetrics, Measured};
+use crate::schema::{CaseMetrics, Dimension, Fig4Measured, FigureMetrics, Measured};
 use rayon::prelude::*;
 use std::fmt::Write as _;
 
@@ -144,46 +142,6 @@ fn fmt(v: &[f64], n: usize) -> String {
         .map(|x| format!("{x:.3}"))
         .collect::<Vec<_>>()
         .join(", ")
-}
-
-/// The claim's check for case `c` (see the module docs).
-pub fn check(c: &Fig5Case) -> Check {
-    let m = &c.metrics;
-    let b = &m.bounce;
-    let v1 = m.first_entry_speed;
-    let (id, detail) = match c.expectation {
-        Fig5Expectation::KeepsBouncing => (
-            "F5-bounce",
-            format!(
-                "{} separations in the last 2 s (≥ 2), settle time {} (none)",
-                m.late_separations,
-                b.settle_time.map_or("none".into(), |t| format!("{t:.2} s"))
-            ),
-        ),
-        Fig5Expectation::SettlesAtFirstImpact => (
-            "F6-pulse",
-            format!(
-                "first ratio {} (≤ 0.4); max entry after the 2nd impact {:.3} m/s (< 0.15·v1 = {:.3}); {} separations in the last 2 s (0)",
-                b.contact_ratios.first().map_or("none".into(), |r| format!("{r:.3}")),
-                b.entry_speeds.iter().skip(2).copied().fold(0.0, f64::max),
-                0.15 * v1,
-                m.late_separations
-            ),
-        ),
-        Fig5Expectation::SettlesSoon => (
-            "F6-hysteretic",
-            format!(
-                "first ratios [{}] (< 0.85); {} separations (≤ 6)",
-                fmt(&b.contact_ratios, 3),
-                b.separations()
-            ),
-        ),
-    };
-    let detail = match &c.stopped {
-        Some(why) => format!("safety stop: {why}; {detail}"),
-        None => detail,
-    };
-    Check::new(id, m.pass, detail)
 }
 
 /// The Figs. 5–6 figure.

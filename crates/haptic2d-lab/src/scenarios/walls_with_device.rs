@@ -48,6 +48,7 @@
 //! box, i.e. force reflection `C2 = 1`, which is exactly the released-unstable path; no design of
 //! the study of issue 36 (`tests/design_search.rs`, 700+ candidates, MODELS.md §11.4) has both.
 
+use crate::schema::Check;
 use haptic2d::control::coupling::CouplingGains;
 use haptic2d::control::four_channel::FourChannelGains;
 use haptic2d::device::dynamics::LumpedDynamics;
@@ -499,4 +500,50 @@ pub fn run(p: &Fig5Params) -> Result<Vec<Fig5Case>, String> {
         .iter()
         .map(|(name, normal, e)| run_case(p, name, normal, *e))
         .collect()
+}
+
+/// The claim's check for case `c`: its pass criterion (module docs) as a [`Check`] with the
+/// numbers behind it, a safety stop named first.
+pub fn check(c: &Fig5Case) -> Check {
+    let m = &c.metrics;
+    let b = &m.bounce;
+    let v1 = m.first_entry_speed;
+    let (id, detail) = match c.expectation {
+        Fig5Expectation::KeepsBouncing => (
+            "F5-bounce",
+            format!(
+                "{} separations in the last 2 s (≥ 2), settle time {} (none)",
+                m.late_separations,
+                b.settle_time.map_or("none".into(), |t| format!("{t:.2} s"))
+            ),
+        ),
+        Fig5Expectation::SettlesAtFirstImpact => (
+            "F6-pulse",
+            format!(
+                "first ratio {} (≤ 0.4); max entry after the 2nd impact {:.3} m/s (< 0.15·v1 = {:.3}); {} separations in the last 2 s (0)",
+                b.contact_ratios.first().map_or("none".into(), |r| format!("{r:.3}")),
+                b.entry_speeds.iter().skip(2).copied().fold(0.0, f64::max),
+                0.15 * v1,
+                m.late_separations
+            ),
+        ),
+        Fig5Expectation::SettlesSoon => (
+            "F6-hysteretic",
+            format!(
+                "first ratios [{}] (< 0.85); {} separations (≤ 6)",
+                b.contact_ratios
+                    .iter()
+                    .take(3)
+                    .map(|x| format!("{x:.3}"))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                b.separations()
+            ),
+        ),
+    };
+    let detail = match &c.stopped {
+        Some(why) => format!("safety stop: {why}; {detail}"),
+        None => detail,
+    };
+    Check::new(id, m.pass, detail)
 }
