@@ -705,6 +705,81 @@ mod tests {
         assert!(why.unwrap().contains("device lost"));
     }
 
+    /// A device that answers every read and counts the writes and zeroings it gets.
+    struct Counting {
+        q: [f64; 4],
+        writes: std::sync::Arc<std::sync::atomic::AtomicU32>,
+        zeroed: std::sync::Arc<std::sync::atomic::AtomicBool>,
+    }
+
+    impl DeviceIo for Counting {
+        fn read_encoders(&mut self) -> Result<[f64; 4], DeviceError> {
+            Ok(self.q)
+        }
+        fn write_torques(&mut self, _tau: &[f64; 4]) -> Result<(), DeviceError> {
+            self.writes
+                .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            Ok(())
+        }
+        fn zero_torques(&mut self) {
+            self.zeroed
+                .store(true, std::sync::atomic::Ordering::Relaxed);
+        }
+        fn name(&self) -> &str {
+            "counting"
+        }
+    }
+
+    #[test]
+    fn a_world_that_diverges_stops_the_loop_before_its_torques_are_written_with_status_6() {
+        use std::sync::atomic::Ordering::Relaxed;
+        let scene = scene_arg::load("box-in-walls", Some(1000.0)).unwrap();
+        let mut rig = Rig::new(
+            scene.world,
+            &scene.source,
+            HapticConfig::default(),
+            DeviceChoice::Sim,
+            HandSpec::Follow,
+        )
+        .unwrap();
+        let q = rig.io.read_encoders().unwrap();
+        let writes = std::sync::Arc::new(std::sync::atomic::AtomicU32::new(0));
+        let zeroed = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+        rig.io = Box::new(Counting {
+            q,
+            writes: writes.clone(),
+            zeroed: zeroed.clone(),
+        });
+        let slave = rig
+            .system
+            .world()
+            .bodies
+            .iter()
+            .position(|b| b.is_dynamic())
+            .unwrap();
+        let mut state = state_with(&mut rig);
+        assert_eq!(state.tick(&info(0)), TickControl::Continue);
+        assert_eq!(writes.load(Relaxed), 1);
+        // A non-finite slave velocity: the world's own check (MODELS §0.5 step 12) stops it.
+        state.rig.system.world_mut().bodies[slave].vel.x = f64::NAN;
+        assert_eq!(state.tick(&info(1)), TickControl::Stop);
+        assert_eq!(
+            writes.load(Relaxed),
+            1,
+            "no torques written after the divergence"
+        );
+        assert!(zeroed.load(Relaxed), "the torques were zeroed");
+        let end = state.end.take();
+        let (status, why) = end_status(end.as_ref(), false);
+        assert_eq!(status, Status::Diverged);
+        assert_eq!(status.code(), 6);
+        let why = why.unwrap();
+        assert!(
+            why.contains("the world diverged") && why.contains("vx = NaN"),
+            "{why}"
+        );
+    }
+
     #[test]
     fn every_way_a_run_ends_has_its_documented_status() {
         let cases = [
