@@ -5,7 +5,7 @@
 //! contact forces and integration (§0.5 step 7), so the tick calls [`World::begin_step`], reads the slave
 //! state and contact wrench, sets the drive with [`World::set_drive`], then calls [`World::finish_step`].
 //!
-//! The folder holds one concept a file: [`step`](self) the two halves of a sample as a list of
+//! The folder holds one concept a file: the two halves of a sample as a list of
 //! numbered stages (`step.rs`), the borrowed [`StepContext`] the contact stage runs on
 //! (`context.rs`), and the state each stage keeps between samples: the proximity stage's schedule
 //! (`proximity.rs`), the swept test (`swept.rs`), the passivity guard (`guard.rs`) and the

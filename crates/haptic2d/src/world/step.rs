@@ -15,7 +15,7 @@ impl World {
     /// energy, i.e. [`begin_step`](Self::begin_step) of sample 0; the next `begin_step` (or
     /// [`step`](Self::step)) then goes straight on to its integration. Afterwards the ledger's
     /// `stored` and `initial` include the energy of bodies that start interpenetrating, and
-    /// [`ContactSet::contact_count`] their records, so a `t = 0` log row reports them (the built-in
+    /// [`ContactSet::contact_count`](crate::contact::ContactSet::contact_count) their records, so a `t = 0` log row reports them (the built-in
     /// peg-in-hole starts with 1 mm of overlap on 4 contacts: `4·½·K_c·(1 mm)²`).
     ///
     /// Call it after the world is set up (bodies, drives, parameters) and before the first row;
