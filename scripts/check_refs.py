@@ -7,13 +7,15 @@
    - `DESIGN §N[.M]`   -> a numbered heading of docs/ARCHITECTURE.md,
    - `DEVICES §N[.M]`  -> a numbered heading of docs/DEVICES.md,
    - `MODELS §X` and a bare `§X` -> a numbered heading of docs/MODELS.md (`## 7.`, `### 7.3`, and the
-     appendices' letters: `§A`, `§F`),
+     appendices' letters: `§A`, `§E`),
    where a reference to `§7.3.2` is satisfied by `7.3.2`, and one to a section whose number exists only
    as a part of a heading list (e.g. `§1–§4`) is checked number by number.
    References to the paper's own sections are written `paper §N` and are not checked.
 
 Prints every broken reference as `file:line: what` and exits 1 if there is any; 0 otherwise.
-Usage: python3 scripts/check_refs.py [--verbose]
+Usage: python3 scripts/check_refs.py [--verbose] [--self-test]
+(`--self-test` runs the checker on a small repository it makes, with one reference of each kind
+broken and one of each kind sound, and fails unless it finds exactly the broken ones.)
 """
 
 import re
@@ -67,7 +69,7 @@ def headings(path):
         n = counts.get(base, 0)
         counts[base] = n + 1
         slugs.add(base if n == 0 else f"{base}-{n}")
-        # "7.3 The LCP solver", "0. Conventions", "Appendix F. Frictional impacts", "F. …", "9.5a …"
+        # "7.3 The LCP solver", "0. Conventions", "Appendix E. Frictional impacts", "F. …", "9.5a …"
         num = re.match(r"^(?:Part\s+)?(?:Appendix\s+)?([0-9]+(?:\.[0-9]+)*[a-z]?|[A-Z])[.\s:]", text)
         current = num.group(1).rstrip(".") if num else None
         if current:
@@ -75,8 +77,68 @@ def headings(path):
     return slugs, numbers
 
 
+def self_test():
+    """The checker against a repository with known sound and broken references."""
+    global ROOT
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as tmp:
+        root = Path(tmp)
+        (root / "docs").mkdir()
+        (root / "docs/MODELS.md").write_text(
+            "# Models\n\n## 1. Friction\n\n### 1.2 Dahl\n\n## Appendix E. Impacts\n", encoding="utf-8"
+        )
+        (root / "docs/ARCHITECTURE.md").write_text("# Map\n\n## 3. Commands\n", encoding="utf-8")
+        (root / "docs/GOOD.md").write_text(
+            "[m](MODELS.md#12-dahl), [a](ARCHITECTURE.md), §1.2, §E, MODELS §1, DESIGN §3, paper §9\n",
+            encoding="utf-8",
+        )
+        (root / "docs/BAD.md").write_text(
+            "[x](NOPE.md)\n[y](MODELS.md#no-such-heading)\nsee §9.9\nsee DESIGN §4\n", encoding="utf-8"
+        )
+        (root / "lib.rs").write_text("//! the order of §1.3 and §F\n", encoding="utf-8")
+        subprocess.run(["git", "init", "-q"], cwd=root, check=True)
+        subprocess.run(["git", "add", "-A"], cwd=root, check=True)
+        saved, ROOT = ROOT, root
+        try:
+            problems = find_problems()
+        finally:
+            ROOT = saved
+    expected = {
+        "docs/BAD.md:1: link to a missing file `NOPE.md`",
+        "docs/BAD.md:2: no heading `#no-such-heading` in MODELS.md",
+        "docs/BAD.md:3: `MODELS §9.9`: no section 9.9 in docs/MODELS.md",
+        "docs/BAD.md:4: `DESIGN §4`: no section 4 in docs/ARCHITECTURE.md",
+        "lib.rs:1: `MODELS §1.3`: no section 1.3 in docs/MODELS.md",
+        "lib.rs:1: `MODELS §F`: no section F in docs/MODELS.md",
+    }
+    found = set(problems)
+    if found != expected:
+        print("check_refs self-test FAILED")
+        for p in sorted(expected - found):
+            print(f"  not found: {p}")
+        for p in sorted(found - expected):
+            print(f"  unexpected: {p}")
+        return 1
+    print(f"check_refs self-test: the {len(expected)} broken references found, no sound one reported")
+    return 0
+
+
 def main():
+    if "--self-test" in sys.argv:
+        return self_test()
     verbose = "--verbose" in sys.argv
+    problems, md_count, count = find_problems(with_counts=True)
+    if verbose:
+        print(f"check_refs: {md_count} Markdown files, {count} section references")
+    for p in problems:
+        print(p)
+    print(f"check_refs: {len(problems)} broken reference(s)")
+    return 1 if problems else 0
+
+
+def find_problems(with_counts=False):
+    """Every broken reference as `file:line: what` (with the counts of files and references read)."""
     problems = []
     md_files = tracked((".md",))
     cache = {}
@@ -142,12 +204,9 @@ def main():
                     continue
                 if num not in heads(doc)[1]:
                     problems.append(f"{f.relative_to(ROOT)}:{i}: `{kind} §{num}`: no section {num} in {doc.relative_to(ROOT)}")
-    if verbose:
-        print(f"check_refs: {len(md_files)} Markdown files, {count} section references")
-    for p in problems:
-        print(p)
-    print(f"check_refs: {len(problems)} broken reference(s)")
-    return 1 if problems else 0
+    if with_counts:
+        return problems, len(md_files), count
+    return problems
 
 
 if __name__ == "__main__":

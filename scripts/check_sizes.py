@@ -12,7 +12,8 @@ Exceptions live in scripts/size_allowlist.txt, one per line: `fn PATH::NAME LINE
 too, so an allow-listed item cannot quietly get longer. An entry that no longer exceeds the limit
 is reported as stale (and fails), so the list only shrinks.
 
-Test code (files under tests/, benches/, examples/ and `#[cfg(test)]` modules) is not checked.
+Test code (files under tests/, benches/, examples/, `#[cfg(test)]` modules, and the files of modules
+declared `#[cfg(test)] mod NAME;`) is not checked.
 The parser is a brace counter that skips strings, chars, and comments; it is not a Rust parser, but
 it only has to find where a `fn` body ends.
 """
@@ -98,14 +99,37 @@ def block_end(lines, start):
     return None
 
 
+TEST_MOD_RE = re.compile(r"^\s*(?:pub(?:\([^)]*\))?\s+)?mod\s+(\w+)\s*;")
+
+
+def test_module_files(path, lines, k):
+    """The files of the module declared `mod NAME;` on line k of `path` (NAME.rs, NAME/mod.rs)."""
+    m = TEST_MOD_RE.match(lines[k]) if k < len(lines) else None
+    if not m:
+        return []
+    d, f = os.path.split(path)
+    if f not in ("mod.rs", "lib.rs", "main.rs"):
+        d = os.path.join(d, f[:-3])
+    return [os.path.normpath(os.path.join(d, m.group(1) + ".rs")),
+            os.path.normpath(os.path.join(d, m.group(1), "mod.rs"))]
+
+
+TEST_FILES = set()
+
+
 def scan(path):
     """Returns (non-test line count, [(fn name, first line, length)]) for one file."""
     text = strip_code(open(path, encoding="utf-8").read())
     lines = text.split("\n")
     test_lines = set()
+    if os.path.normpath(path) in TEST_FILES:
+        test_lines = set(range(len(lines)))
     k = 0
     while k < len(lines):
         if CFG_TEST_RE.match(lines[k]):
+            # `#[cfg(test)] mod NAME;`: the module's file is test code.
+            for f in test_module_files(path, lines, k + 1):
+                TEST_FILES.add(f)
             end = block_end(lines, k + 1)
             if end is not None:
                 test_lines.update(range(k, end + 1))

@@ -204,7 +204,7 @@ fn run(args: &Args) -> Result<(), String> {
                     &dynamic,
                     dt,
                     secs,
-                    &mut || hc.borrow_mut().step(),
+                    &mut || drop(hc.borrow_mut().step()),
                     &mut || {
                         hc.borrow()
                             .bodies
@@ -283,7 +283,7 @@ fn run(args: &Args) -> Result<(), String> {
         let reference = std::cell::RefCell::new(reference::Reference::new(64 << 10));
         let mut samples = {
             let (mut fh, mut fr, mut f4, mut f1) =
-                (|| h.step(), || r.step(), || b4.step(), || b1.step());
+                (|| drop(h.step()), || r.step(), || b4.step(), || b1.step());
             let mut fref = || reference.borrow_mut().step();
             timing::interleaved(
                 args.clock,

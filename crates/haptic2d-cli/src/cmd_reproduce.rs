@@ -19,7 +19,7 @@ pub fn run(
     strict: bool,
     controller_file: Option<&Path>,
 ) -> Result<(), Failure> {
-    let names = haptic2d_lab::figure::figure_names();
+    let names = haptic2d_lab::figures::figure_names();
     if figure != "all" && !names.contains(&figure) {
         return Err(format!(
             "unknown figure `{figure}`; valid: all, {}\n    fix: e.g. haptic2d reproduce fig4 (Figs. 5–6 are `fig5`, Figs. 8–11 `fig8`)",

@@ -144,6 +144,8 @@ enum LoopEnd {
     Watchdog(String),
     /// The haptic tick's own safety latch tripped (reported by `system.safety_trip()`).
     SafetyLatch,
+    /// The world diverged (MODELS §0.5 step 12): its time (s) and why.
+    WorldDiverged(String),
 }
 
 /// Runs the haptic loop: validate the options, build the rig, start the display and the logger,
@@ -469,6 +471,16 @@ impl LoopState<'_> {
             });
             return TickControl::Stop;
         }
+        // MODELS §0.5 step 12: a world that diverged in this tick stops the loop before its
+        // torques reach the device.
+        if let Some(d) = system.world().divergence() {
+            io.zero_torques();
+            let t = system.world().time();
+            self.end = Some(LoopEnd::WorldDiverged(format!(
+                "the world diverged at t = {t:.4} s: {d}\n    torques were set to zero and latched; fix: lower the contact stiffness or raise the rate (docs/SCENES.md)"
+            )));
+            return TickControl::Stop;
+        }
         if let Err(e) = io.write_torques(&tau) {
             io.zero_torques();
             self.end = Some(LoopEnd::DeviceLost(e.to_string()));
@@ -534,6 +546,7 @@ fn end_status(end: Option<&LoopEnd>, interrupted: bool) -> (Status, Option<Strin
         Some(LoopEnd::Watchdog(msg)) => (Status::SafetyStop, Some(msg.clone())),
         // The latch's own report (`system.safety_trip()`) is printed above.
         Some(LoopEnd::SafetyLatch) => (Status::SafetyStop, None),
+        Some(LoopEnd::WorldDiverged(msg)) => (Status::Diverged, Some(msg.clone())),
         None if interrupted => (
             Status::Interrupted,
             Some("interrupted by a signal (SIGINT or SIGTERM)".into()),
@@ -692,6 +705,81 @@ mod tests {
         assert!(why.unwrap().contains("device lost"));
     }
 
+    /// A device that answers every read and counts the writes and zeroings it gets.
+    struct Counting {
+        q: [f64; 4],
+        writes: std::sync::Arc<std::sync::atomic::AtomicU32>,
+        zeroed: std::sync::Arc<std::sync::atomic::AtomicBool>,
+    }
+
+    impl DeviceIo for Counting {
+        fn read_encoders(&mut self) -> Result<[f64; 4], DeviceError> {
+            Ok(self.q)
+        }
+        fn write_torques(&mut self, _tau: &[f64; 4]) -> Result<(), DeviceError> {
+            self.writes
+                .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            Ok(())
+        }
+        fn zero_torques(&mut self) {
+            self.zeroed
+                .store(true, std::sync::atomic::Ordering::Relaxed);
+        }
+        fn name(&self) -> &str {
+            "counting"
+        }
+    }
+
+    #[test]
+    fn a_world_that_diverges_stops_the_loop_before_its_torques_are_written_with_status_6() {
+        use std::sync::atomic::Ordering::Relaxed;
+        let scene = scene_arg::load("box-in-walls", Some(1000.0)).unwrap();
+        let mut rig = Rig::new(
+            scene.world,
+            &scene.source,
+            HapticConfig::default(),
+            DeviceChoice::Sim,
+            HandSpec::Follow,
+        )
+        .unwrap();
+        let q = rig.io.read_encoders().unwrap();
+        let writes = std::sync::Arc::new(std::sync::atomic::AtomicU32::new(0));
+        let zeroed = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+        rig.io = Box::new(Counting {
+            q,
+            writes: writes.clone(),
+            zeroed: zeroed.clone(),
+        });
+        let slave = rig
+            .system
+            .world()
+            .bodies
+            .iter()
+            .position(|b| b.is_dynamic())
+            .unwrap();
+        let mut state = state_with(&mut rig);
+        assert_eq!(state.tick(&info(0)), TickControl::Continue);
+        assert_eq!(writes.load(Relaxed), 1);
+        // A non-finite slave velocity: the world's own check (MODELS §0.5 step 12) stops it.
+        state.rig.system.world_mut().bodies[slave].vel.x = f64::NAN;
+        assert_eq!(state.tick(&info(1)), TickControl::Stop);
+        assert_eq!(
+            writes.load(Relaxed),
+            1,
+            "no torques written after the divergence"
+        );
+        assert!(zeroed.load(Relaxed), "the torques were zeroed");
+        let end = state.end.take();
+        let (status, why) = end_status(end.as_ref(), false);
+        assert_eq!(status, Status::Diverged);
+        assert_eq!(status.code(), 6);
+        let why = why.unwrap();
+        assert!(
+            why.contains("the world diverged") && why.contains("vx = NaN"),
+            "{why}"
+        );
+    }
+
     #[test]
     fn every_way_a_run_ends_has_its_documented_status() {
         let cases = [
@@ -701,6 +789,7 @@ mod tests {
             (Some(LoopEnd::SafetyLatch), false, 3),
             // A safety stop in the tick the signal arrived is still a safety stop.
             (Some(LoopEnd::SafetyLatch), true, 3),
+            (Some(LoopEnd::WorldDiverged("x".into())), false, 6),
             (None, true, 130),
             (None, false, 0),
         ];

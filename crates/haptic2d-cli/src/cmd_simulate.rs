@@ -1,6 +1,7 @@
 //! `haptic2d simulate`: the world alone, headless, as fast as possible.
 //!
-//! Every sample is checked for divergence ([`divergence`]: a non-finite state or one beyond the
+//! Every sample is checked for divergence by the step itself ([`World::step`](haptic2d::world::World::step):
+//! a non-finite state or one beyond the
 //! documented magnitudes) *before* its row is written, so a CSV never holds a NaN or runaway row.
 //! SIGINT/SIGTERM stop the run after the current sample: the rows so far are flushed, the summary
 //! printed, and the exit status is 130.
@@ -8,7 +9,7 @@
 use crate::exit::{Failure, Status};
 use crate::scene_arg;
 use crate::world_mcap::{OverlapSummary, WorldOut};
-use haptic2d::scene::{divergence, MAX_SAMPLES};
+use haptic2d::scene::MAX_SAMPLES;
 use haptic2d_rt::signal::install_stop_signals;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::path::Path;
@@ -102,8 +103,7 @@ pub fn run(a: &SimulateArgs) -> Result<Status, Failure> {
             status = Status::Interrupted;
             break;
         }
-        world.step();
-        if let Some(d) = divergence(&world) {
+        if let Some(d) = world.step() {
             // The rows so far are kept (flushed below); this one is not written.
             if let Some(c) = csv.take() {
                 c.finish(&overlap)

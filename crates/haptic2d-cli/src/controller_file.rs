@@ -66,7 +66,7 @@ mod tests {
         // The paper-rate study's coupling is the one `reproduce fig8` runs at 500 Hz / scale 1.
         assert_eq!(
             load(&shipped("coupling-paper-rate.toml")).unwrap(),
-            ControllerKind::Coupling(haptic2d_lab::fig8::PAPER_RATE_COUPLING)
+            ControllerKind::Coupling(haptic2d_lab::figures::fig8::PAPER_RATE_COUPLING)
         );
         let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../controllers");
         for e in std::fs::read_dir(dir).unwrap() {

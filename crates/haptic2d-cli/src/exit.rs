@@ -25,7 +25,8 @@ pub enum Status {
     DeviceLost = 4,
     /// `simulate --strict`: the energy excess exceeded the §13.1 bound.
     EnergyExcess = 5,
-    /// `simulate`: the world diverged (a non-finite state or one beyond the documented magnitudes).
+    /// `simulate`, `run`: the world diverged (a non-finite state or one beyond the documented
+    /// magnitudes; MODELS §0.5 step 12).
     Diverged = 6,
     /// Interrupted by SIGINT (Ctrl-C) or SIGTERM: the run stopped early, logs complete.
     Interrupted = 130,
@@ -53,7 +54,7 @@ Exit codes:
   3    safety stop: the safety latch or the watchdog zeroed the torques (run)
   4    the device was lost (run)
   5    energy excess above the §13.1 bound (simulate --strict; always a warning otherwise)
-  6    the simulation diverged (simulate)
+  6    the simulation diverged (simulate; run: after zeroing the torques)
   130  interrupted by SIGINT or SIGTERM (run, simulate: summary printed, logs end on a whole row;
        log convert: no output left behind)
   141  (shell status) ended by SIGPIPE: the reader of the output closed it, e.g. `| head -1`

@@ -3,7 +3,7 @@
 //! every built-in scene, 0.5, 1 and 2 kHz, with and without the one-sample output delay), its
 //! **transparency** (quasi-static values of the linear loop: what a held hand feels in free motion
 //! and at a wall), and the **claims** of Figs. 5–6 and 8–11 it reproduces (the device-in-the-loop
-//! runs of [`crate::experiments`], unchanged criteria). The study itself is
+//! runs of [`crate::scenarios`], unchanged criteria). The study itself is
 //! `tests/design_search.rs`.
 
 use haptic2d::control::coupling::VirtualCoupling;
@@ -11,7 +11,7 @@ use haptic2d::device::linalg::V3;
 use haptic2d::haptic::{ControllerKind, HapticConfig};
 use haptic2d::scene::{Scene, BUILTIN};
 
-use crate::experiments::{fig5, fig8};
+use crate::scenarios::{peg_with_device, walls_with_device};
 use crate::stability::loop_model::axis_controller;
 use crate::stability::{AxisController, LoopModel, AXES, MIN_DECAY_RATE};
 
@@ -176,7 +176,7 @@ pub fn margin(kind: &ControllerKind, cases: &[StudyCase]) -> Result<Margin, Stri
 }
 
 /// What a held hand feels on the x axis, quasi-statically (low frequency, the hand-force estimate
-/// equal to the hand force), from the linear loop of [`AxisController`] with the spec device's
+/// equal to the hand force), from the linear loop of [`AxisController`] with the §10.2 device's
 /// handle inertia `m` and damping `b` (world units).
 ///
 /// - free motion at constant velocity: master `0 = k_m·e + (1 + g_mh)·f_h − (d_m + b)·v`, slave
@@ -252,33 +252,33 @@ pub struct ClaimOutcome {
 }
 
 /// Runs the 4 walls of Figs. 5–6 and the 5 friction models of Figs. 8–11 with `kind` (every other
-/// setting of [`fig5::Fig5Params::default`] and [`fig8::Fig8Params::default`]).
+/// setting of [`walls_with_device::Fig5Params::default`] and [`peg_with_device::Fig8Params::default`]).
 pub fn claims(kind: &ControllerKind) -> Result<Vec<ClaimOutcome>, String> {
     let haptic = HapticConfig {
         controller: *kind,
         ..HapticConfig::default()
     };
-    let mut out = fig5_claims(&fig5::Fig5Params {
+    let mut out = fig5_claims(&walls_with_device::Fig5Params {
         haptic: haptic.clone(),
-        ..fig5::Fig5Params::default()
+        ..walls_with_device::Fig5Params::default()
     });
-    out.extend(fig8_claims(&fig8::Fig8Params {
+    out.extend(fig8_claims(&peg_with_device::Fig8Params {
         haptic,
-        ..fig8::Fig8Params::default()
+        ..peg_with_device::Fig8Params::default()
     }));
     Ok(out)
 }
 
 /// The 4 walls of Figs. 5–6 with the settings `p5` (a run that fails counts as not passing).
-pub fn fig5_claims(p5: &fig5::Fig5Params) -> Vec<ClaimOutcome> {
-    fig5::FIG5_CASES
+pub fn fig5_claims(p5: &walls_with_device::Fig5Params) -> Vec<ClaimOutcome> {
+    walls_with_device::FIG5_CASES
         .iter()
         .map(
-            |(name, normal, e)| match fig5::run_case(p5, name, normal, *e) {
+            |(name, normal, e)| match walls_with_device::run_case(p5, name, normal, *e) {
                 Ok(c) => ClaimOutcome {
                     claim: format!("fig5/{name}"),
                     pass: c.metrics.pass,
-                    detail: crate::fig5::check(&c).detail,
+                    detail: walls_with_device::check(&c).detail,
                 },
                 Err(e) => ClaimOutcome {
                     claim: format!("fig5/{name}"),
@@ -292,11 +292,11 @@ pub fn fig5_claims(p5: &fig5::Fig5Params) -> Vec<ClaimOutcome> {
 
 /// The 5 friction models of Figs. 8–11 with the settings `p8` (rate, mapping scale, protocol,
 /// device and controller); a run that fails or stops counts as not passing.
-pub fn fig8_claims(p8: &fig8::Fig8Params) -> Vec<ClaimOutcome> {
-    fig8::FIG8_CASES
+pub fn fig8_claims(p8: &peg_with_device::Fig8Params) -> Vec<ClaimOutcome> {
+    peg_with_device::FIG8_CASES
         .iter()
         .map(
-            |(name, model, drift)| match fig8::run_case(p8, name, model, *drift) {
+            |(name, model, drift)| match peg_with_device::run_case(p8, name, model, *drift) {
                 Ok(c) => {
                     let min_adv = c
                         .metrics

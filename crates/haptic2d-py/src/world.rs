@@ -111,21 +111,12 @@ fn columns_dict<'py>(py: Python<'py>, cols: WorldColumns) -> PyResult<Bound<'py,
     Ok(d)
 }
 
-/// The first body with a non-finite state, if any.
-fn diverged(world: &World) -> Option<String> {
-    world
-        .bodies
-        .iter()
-        .find(|b| {
-            !(b.pose.pos.is_finite() && b.pose.angle.is_finite() && b.vel.is_finite() && b.omega.is_finite())
-        })
-        .map(|b| {
-            format!(
-                "the simulation diverged at t = {:.4} s: body \"{}\" has a non-finite state\n    fix: lower the contact stiffness or raise the rate (see the minimum-mass rule, docs/SCENES.md)",
-                world.time(),
-                b.name
-            )
-        })
+/// The message for a world that has diverged (the world's own check, MODELS §0.5 step 12).
+fn diverged_message(world: &World, d: &haptic2d::scene::Divergence) -> String {
+    format!(
+        "the simulation diverged at t = {:.4} s: {d}\n    fix: lower the contact stiffness or raise the rate (see the minimum-mass rule, docs/SCENES.md)",
+        world.time()
+    )
 }
 
 #[pymethods]
@@ -176,26 +167,29 @@ impl PyWorld {
         self.clone()
     }
 
-    /// Advances `n` samples of `T` each.
+    /// Advances `n` samples of `T` each; a `FloatingPointError` if the world diverges (MODELS
+    /// §0.5 step 12: a non-finite state or one beyond the divergence bounds).
     #[pyo3(signature = (n=1))]
     fn step(&mut self, py: Python<'_>, n: i64) -> PyResult<()> {
         if n < 0 {
             return Err(value_error(format!("n must be >= 0 steps, got {n}")));
         }
         let n = n as u64;
-        if n < DETACH_STEPS {
+        let w = &mut self.world;
+        let steps = |w: &mut World| -> Result<(), String> {
             for _ in 0..n {
-                self.world.step();
-            }
-        } else {
-            let w = &mut self.world;
-            py.detach(|| {
-                for _ in 0..n {
-                    w.step();
+                if let Some(d) = w.step() {
+                    return Err(diverged_message(w, &d));
                 }
-            });
-        }
-        Ok(())
+            }
+            Ok(())
+        };
+        let done = if n < DETACH_STEPS {
+            steps(w)
+        } else {
+            py.detach(|| steps(w))
+        };
+        done.map_err(pyo3::exceptions::PyFloatingPointError::new_err)
     }
 
     /// Runs `duration` s (rounded to whole samples) and returns the `haptic2d simulate` CSV columns,
@@ -228,11 +222,8 @@ impl PyWorld {
             let mut cols = WorldColumns::new(w, rows);
             cols.push(w);
             for k in 1..=ticks {
-                w.step();
-                if k % 256 == 0 {
-                    if let Some(msg) = diverged(w) {
-                        return Err(msg);
-                    }
+                if let Some(d) = w.step() {
+                    return Err(diverged_message(w, &d));
                 }
                 if k % every == 0 {
                     cols.push(w);

@@ -5,7 +5,7 @@
 //! against a stiff contact, the master (inertia `m`, tiny physical damping `b`) and the slave on the
 //! contact spring `K_e` form a loop that is unstable **in continuous time**, before any sampling: the
 //! released characteristic polynomial of §11.4 ([`axis::AxisModel::released_polynomial`]) has roots
-//! at `+2.4 ± 67j` for the spec device on the Fig. 4 box and `+30 ± 185j` for the peg's y axis at
+//! at `+2.4 ± 67j` for the §10.2 device on the Fig. 4 box and `+30 ± 185j` for the peg's y axis at
 //! world scale 2. Sampling faster does not help; Colgate's `b > K·T/2` is a different (sampling)
 //! mechanism and is not what limits these runs. Local force feedback `C6 = −1` (so `C2 = 0`, the
 //! three-channel form of Hashtrudi-Zaad and Salcudean, still transparent by §11.1's conditions)

@@ -115,6 +115,18 @@ fn grip(world: &World, probe: usize, theta0: f64, p: &ObserverParams) -> f64 {
     -p.grip_stiffness * (b.pose.angle - theta0) - p.grip_damping * b.omega
 }
 
+/// One world step; a divergence (the step's own check, MODELS §0.5) ends the exploration with
+/// an error instead of a percept.
+fn step(world: &mut World) -> Result<(), String> {
+    match world.step() {
+        None => Ok(()),
+        Some(d) => Err(format!(
+            "the simulated observer's world diverged at t = {:.4} s: {d}",
+            world.time()
+        )),
+    }
+}
+
 fn press(mut world: World, probe: usize, dir: Vec2, p: &ObserverParams) -> Result<Felt, String> {
     hand(&mut world, probe, dir * p.press_forces[0]);
     let theta0 = world.bodies[probe].pose.angle;
@@ -130,7 +142,7 @@ fn press(mut world: World, probe: usize, dir: Vec2, p: &ObserverParams) -> Resul
             let now = ramp(from, f, k as f64 * dt, p.press_ramp);
             world.loads[0].force = dir * now - v * p.hand_damping;
             world.loads[0].torque = grip(&world, probe, theta0, p);
-            world.step();
+            step(&mut world)?;
             if k >= n - tail {
                 sum += along(&world, probe, dir).0;
             }
@@ -173,17 +185,23 @@ fn depth(world: &World, probe: usize) -> f64 {
 
 /// Launches the probe at `v` (no hand force) and steps until the wall pushes back; returns the
 /// number of steps taken, with the world after the first step with a wall force.
-fn launch(world: &mut World, probe: usize, dir: Vec2, v: f64, max_steps: usize) -> Option<usize> {
+fn launch(
+    world: &mut World,
+    probe: usize,
+    dir: Vec2,
+    v: f64,
+    max_steps: usize,
+) -> Result<Option<usize>, String> {
     world.loads.clear();
     world.bodies[probe].vel = dir * v;
     world.bodies[probe].omega = 0.0;
     for k in 1..=max_steps {
-        world.step();
+        step(world)?;
         if wall_force(world, probe, dir) > 0.0 {
-            return Some(k);
+            return Ok(Some(k));
         }
     }
-    None
+    Ok(None)
 }
 
 /// The tap, phase-locked: a first launch at `tap_speed` finds when the probe crosses the surface
@@ -197,7 +215,7 @@ fn tap(world: World, probe: usize, dir: Vec2, p: &ObserverParams) -> Result<Felt
     let max_steps = (5.0 / dt) as usize;
     let v = p.tap_speed;
     let mut first = world.clone();
-    let k1 = launch(&mut first, probe, dir, v, max_steps).ok_or_else(|| {
+    let k1 = launch(&mut first, probe, dir, v, max_steps)?.ok_or_else(|| {
         "the tapping probe met no wall within 5 s (check `toward` and `probe`)".to_string()
     })?;
     // Position after step k is x0 + v·k·T; the contact force of step k is computed at x0 + v·(k−1)·T.
@@ -211,7 +229,7 @@ fn tap(world: World, probe: usize, dir: Vec2, p: &ObserverParams) -> Result<Felt
     }
     let v2 = v * crossing / ((n + 0.5) * dt);
     let mut second = world;
-    let k2 = launch(&mut second, probe, dir, v2, max_steps)
+    let k2 = launch(&mut second, probe, dir, v2, max_steps)?
         .ok_or_else(|| "the phase-locked tap met no wall".to_string())?;
     if k2 != n as usize + 2 {
         return Err(format!(
@@ -222,7 +240,7 @@ fn tap(world: World, probe: usize, dir: Vec2, p: &ObserverParams) -> Result<Felt
     let window = (p.tap_window / dt).round().max(1.0) as usize;
     let mut peak = wall_force(&second, probe, dir);
     for _ in 1..window {
-        second.step();
+        step(&mut second)?;
         peak = peak.max(wall_force(&second, probe, dir));
     }
     let rh = peak / (window as f64 * dt * v2);
@@ -257,11 +275,11 @@ fn stroke(mut world: World, probe: usize, dir: Vec2, p: &ObserverParams) -> Resu
         let v = world.bodies[probe].vel;
         world.loads[0].force = dir * fnow + t * (ft + tremor) - v * p.hand_damping;
         world.loads[0].torque = grip(world, probe, theta0, p);
-        world.step();
+        step(world)
     };
     for k in 0..n {
         let fnow = ramp(0.0, fnorm, k as f64 * dt, p.press_ramp);
-        push(&mut world, fnow, 0.0, false, k);
+        push(&mut world, fnow, 0.0, false, k)?;
     }
     let v = along(&world, probe, dir).1;
     if !v.is_finite() || v.abs() > 0.01 {
@@ -276,7 +294,7 @@ fn stroke(mut world: World, probe: usize, dir: Vec2, p: &ObserverParams) -> Resu
         let mut sum = 0.0;
         for k in 0..n {
             let now = ramp(from, ft, k as f64 * dt, p.press_ramp);
-            push(&mut world, fnorm, now, true, k);
+            push(&mut world, fnorm, now, true, k)?;
             if k >= n - tail {
                 sum += along(&world, probe, t).0;
             }

@@ -525,7 +525,7 @@ fn design_study_frontier() {
 #[ignore = "measurement: 3 configurations x 3 settings x 5 friction models (run with --release)"]
 fn claims_at_the_paper_rate_and_with_joint_friction() {
     use haptic2d::haptic::HapticConfig;
-    use haptic2d_lab::experiments::fig8::{run, Fig8Params};
+    use haptic2d_lab::scenarios::peg_with_device::{run, Fig8Params};
     let former = ControllerKind::FourChannel(FourChannelGains::master_force_feedback());
     let soft = ControllerKind::Coupling(CouplingGains {
         k: [390.625, 390.625, 0.125],
@@ -659,9 +659,9 @@ fn paper_rate_study_refined() {
 /// Scores `grid` as described at [`paper_rate_study`].
 fn paper_rate_grid(grid: Vec<Params>) {
     use haptic2d::haptic::HapticConfig;
-    use haptic2d_lab::experiments::fig5::Fig5Params;
-    use haptic2d_lab::experiments::fig8::Fig8Params;
-    use haptic2d_lab::experiments::Protocol;
+    use haptic2d_lab::scenarios::peg_with_device::Fig8Params;
+    use haptic2d_lab::scenarios::walls_with_device::Fig5Params;
+    use haptic2d_lab::scenarios::Protocol;
     let cases = design::study_cases().expect("cases");
     let feel_model = cases
         .iter()
@@ -791,8 +791,8 @@ fn paper_rate_grid(grid: Vec<Params>) {
 #[ignore = "measurement: 6 compensation settings x 5 friction models (run with --release)"]
 fn friction_compensation_settings() {
     use haptic2d::haptic::HapticConfig;
-    use haptic2d_lab::experiments::fig8::Fig8Params;
-    use haptic2d_lab::experiments::with_capstan_friction;
+    use haptic2d_lab::scenarios::peg_with_device::Fig8Params;
+    use haptic2d_lab::scenarios::with_capstan_friction;
     let settings: Vec<(f64, f64)> = [0.8, 1.0]
         .into_iter()
         .flat_map(|c| [0.0, 0.01, 0.05].map(|d| (c, d)))

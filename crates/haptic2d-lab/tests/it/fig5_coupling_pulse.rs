@@ -26,7 +26,7 @@
 //! face's contact count rather than the sample's; that changes the §5.7 law and is left open.)
 
 use haptic2d::haptic::safety::SafetyConfig;
-use haptic2d_lab::experiments::fig5::{run_case, Fig5Case, Fig5Expectation, Fig5Params};
+use haptic2d_lab::scenarios::walls_with_device::{run_case, Fig5Case, Fig5Expectation, Fig5Params};
 
 fn pulse(p: &Fig5Params) -> Fig5Case {
     run_case(p, "pulse", "pulse", Fig5Expectation::SettlesAtFirstImpact).expect("run")

@@ -1,4 +1,4 @@
-//! Figs. 5–6 with the device in the loop (see `haptic2d_lab::experiments::fig5`, whose module docs give the
+//! Figs. 5–6 with the device in the loop (see `haptic2d_lab::scenarios::walls_with_device`, whose module docs give the
 //! pass criteria and the derivation of the device damping): the paper's claim is that the block keeps
 //! bouncing on the marginally passive (SEH) and active (ZOH) walls, settles at the first impact with
 //! the pulse wall and soon with the hysteretic wall.
@@ -13,7 +13,7 @@
 //!   needs 3 impacts (first ratio 0.49) and the hysteretic wall keeps bouncing (48 separations).
 //! - Virtual coupling on the damped device: dissipative, every wall settles.
 
-use haptic2d_lab::experiments::fig5::{run, Fig5Case, Fig5Params};
+use haptic2d_lab::scenarios::walls_with_device::{run, Fig5Case, Fig5Params};
 
 fn case<'a>(cases: &'a [Fig5Case], name: &str) -> &'a Fig5Case {
     cases.iter().find(|c| c.name == name).expect("case")
@@ -70,7 +70,7 @@ fn fig5_fig6_four_channel_damped_device_reproduces_every_wall() {
 fn fig5_colgate_joint_damping_gives_the_handle_margin_k_t_over_2() {
     use haptic2d::device::dynamics::LumpedDynamics;
     use haptic2d::device::linalg::{j_mul_v, jt_mul_v};
-    use haptic2d_lab::experiments::fig5::{colgate_joint_damping, WALL_STIFFNESS};
+    use haptic2d_lab::scenarios::walls_with_device::{colgate_joint_damping, WALL_STIFFNESS};
     let p = Fig5Params::default();
     for margin in [0.5, 2.0] {
         let mut h = p.haptic.clone();
@@ -189,11 +189,11 @@ fn fig5_former_default_settles_the_pulse_wall() {
         },
         ..Fig5Params::default()
     };
-    let c = haptic2d_lab::experiments::fig5::run_case(
+    let c = haptic2d_lab::scenarios::walls_with_device::run_case(
         &p,
         "pulse",
         "pulse",
-        haptic2d_lab::experiments::fig5::Fig5Expectation::SettlesAtFirstImpact,
+        haptic2d_lab::scenarios::walls_with_device::Fig5Expectation::SettlesAtFirstImpact,
     )
     .expect("runs");
     report("former default", std::slice::from_ref(&c));

@@ -1,4 +1,4 @@
-//! Figs. 8–11 with the device in the loop (see `haptic2d_lab::experiments::fig8`): the paper's claim is that
+//! Figs. 8–11 with the device in the loop (see `haptic2d_lab::scenarios::peg_with_device`): the paper's claim is that
 //! classical friction drifts while the other models stick and slip. Thresholds are §13.2's F7-1 (drift:
 //! `min creep_k ≥ 5e-4 m`), F7-2 (stick: `max |creep_k| ≤ 2e-4 m`) and F7-3 (slip: `advance_k > 5e-3 m`).
 //!
@@ -16,7 +16,7 @@
 //!   y/θ oscillation grows until corners unload, and every run ends in a safety stop at the
 //!   workspace bound.
 
-use haptic2d_lab::experiments::fig8::{run, Fig8Case, Fig8Params};
+use haptic2d_lab::scenarios::peg_with_device::{run, Fig8Case, Fig8Params};
 
 fn report(label: &str, cases: &[Fig8Case]) {
     for c in cases {
@@ -112,7 +112,7 @@ fn fig8_stick_check_uses_abs_creep() {
         },
         ..Fig8Params::default()
     };
-    let c = haptic2d_lab::experiments::fig8::run_case(
+    let c = haptic2d_lab::scenarios::peg_with_device::run_case(
         &former,
         "classical-as-stick",
         "classical",

@@ -7,7 +7,7 @@ use haptic2d::haptic::experiment::DeviceInTheLoop;
 use haptic2d::haptic::system::HapticSystem;
 use haptic2d::haptic::ControllerKind;
 use haptic2d::haptic::HapticConfig;
-use haptic2d_lab::experiments::{capstan_friction_device, with_capstan_friction};
+use haptic2d_lab::scenarios::{capstan_friction_device, with_capstan_friction};
 
 #[test]
 fn capstan_friction_file_has_realistic_joint_friction_and_a_bounded_compensation() {

@@ -77,7 +77,9 @@ class World:
 
     # -- stepping ----------------------------------------------------------------------------
     def step(self, n: int = 1) -> None:
-        """Advances ``n`` samples of ``T`` seconds each (``n >= 256`` releases the GIL)."""
+        """Advances ``n`` samples of ``T`` seconds each (``n >= 256`` releases the GIL). Raises
+        ``FloatingPointError`` if the world diverges (a non-finite state or one beyond the
+        divergence bounds, docs/MODELS.md §0.5 step 12)."""
         self._w.step(n)
 
     def run(self, duration: float, every: int = 1) -> Dict[str, np.ndarray]:
@@ -86,7 +88,8 @@ class World:
         work.applied, contacts, overlap`` and per dynamic body ``NAME.x, NAME.y, NAME.theta, NAME.vx,
         NAME.vy, NAME.omega`` (m, rad, m/s, rad/s, J). The first row is the state before the run,
         then every ``every``-th sample. The loop runs in Rust with the GIL released. Raises
-        ``FloatingPointError`` if a body's state becomes non-finite.
+        ``FloatingPointError`` if the world diverges (a non-finite state or one beyond the
+        divergence bounds, docs/MODELS.md §0.5 step 12).
         """
         duration = positive("duration", duration)
         every = count("every", every, 1)

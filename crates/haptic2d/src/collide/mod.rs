@@ -3,7 +3,7 @@
 //! (closest-feature tracking, signed distances, VE candidates).
 //!
 //! - [`gjk_distance`] (`gjk.rs`): GJK distance with hill-climbing support and warm start (§9.2);
-//! - [`BroadPhase`] (`broad.rs`): inflated AABBs, sort-and-sweep, GJK → proximity set (§9.1);
+//! - [`BroadPhase`] (`broad/`): inflated AABBs, sort-and-sweep, GJK → proximity set (§9.1);
 //! - [`FeatureTracker`] (`tracker.rs`): Lin–Canny closest features per pair (§9.3);
 //! - [`LocalStage`] (`local.rs`): one tracker per proximate pair, VE candidates (§9.4–9.5);
 //! - [`mark_seams`] (`seam.rs`): the internal edges of multi-piece bodies, never contact normals;

@@ -12,7 +12,7 @@
 //! width of the polygon): then the nearest line is still the crossed one and the record stores at
 //! most `½·K_c·δ_c²`, as a slow contact does.
 //!
-//! # The test (after integration, world.rs)
+//! # The test (after integration, `world/swept.rs`)
 //!
 //! Poses move linearly over the sample, `p(λ) = p_0 + λ·Δp`, `θ(λ) = θ_0 + λ·Δθ`, `λ ∈ [0, 1]`.
 //! A body point `c + R(θ)·r` then moves at most `M_i = |Δp_i| + |Δθ_i|·ρ_i` per sample (`ρ_i` the
@@ -29,7 +29,7 @@
 //! face, shallow, and the impact (or the contact law) takes it from there. A pair that slides in
 //! contact keeps `D` near `D(0)` and is not touched.
 //!
-//! Putting a body back to `λ_t` (world.rs) interpolates its velocity too, `v = v_0 + λ_t·Δv`: the
+//! Putting a body back to `λ_t` (`world/swept.rs`) interpolates its velocity too, `v = v_0 + λ_t·Δv`: the
 //! body lives only the fraction `λ_t` of the sample. For the semi-implicit step under a held
 //! force `F`, `ΔE_kin − W = λ·F·T·(λ·T·a/2 − T·a) ≤ 0` for `λ ≤ 1`, so the put-back is passive,
 //! like the full step (which is the case `λ = 1`). Box2D v3 does the same for fast bodies
@@ -40,7 +40,7 @@
 //!
 //! The test runs on the proximity set, so a pair must be proximate before it can be swept: the
 //! global stage is re-run whenever a body may have moved more than `(δ_prox − δ_c)/2` since the
-//! last update (world.rs), which covers every pair as long as each body moves less than
+//! last update (`world/proximity.rs`), which covers every pair as long as each body moves less than
 //! `(δ_prox − δ_c)/2` per sample (20 mm with the defaults: 20 m/s at 1 kHz, 10 m/s at 500 Hz);
 //! [`speed_limit`] gives that bound for a world. Poses are interpolated linearly, so a body that
 //! turns by more than about a radian per sample is swept only approximately.

@@ -1,5 +1,5 @@
 //! Simultaneous impacts with Coulomb friction and Poisson restitution, passive by construction
-//! (issue 16; derivation in docs/MODELS.md "Frictional impacts (issue 16)", §F).
+//! (issue 16; derivation in docs/MODELS.md "Frictional impacts (issue 16)", §E).
 //!
 //! Per contact `i` (normal `n_i`, tangent `t_i = perp(n_i)`) the impulse is `p_n,i·n_i + p_t,i·t_i`
 //! with `p_n,i ≥ 0` and `|p_t,i| ≤ μ·p_n,i` (the 2-D friction cone is an exact interval). The impact
@@ -15,7 +15,7 @@
 //! exact enumeration; larger sets (or an enumeration that finds no solution) by projected
 //! Gauss–Seidel on the body twists with the convergence test of [`PGS_TOL`].
 //!
-//! **Energy guarantee.** Compression is dissipative (proved in §F.4), restitution with friction is
+//! **Energy guarantee.** Compression is dissipative (proved in §E.4), restitution with friction is
 //! not always (Stronge). After restitution the kinetic energy is checked; if it rose, the
 //! restitution impulse is scaled by the largest `α ∈ [0, 1]` that returns it to the pre-impact value
 //! (closed form below). The plastic correction is a compression (dissipative). A last check scales

@@ -1,5 +1,5 @@
 //! The mixed LCP of one frictional impact phase, solved exactly by enumeration (issue 16,
-//! docs/MODELS.md "Frictional impacts", §F.3).
+//! docs/MODELS.md "Frictional impacts", §E.3).
 //!
 //! Unknowns: per contact `i` a normal impulse `p_n,i` and a tangential impulse `p_t,i` (N·s), stacked
 //! as `x = (p_n,0, p_t,0, p_n,1, p_t,1, …)`. Velocities after the phase: `w = A·x + b` (m/s), with `A`

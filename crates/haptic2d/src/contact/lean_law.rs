@@ -177,7 +177,7 @@ mod tests {
     /// 1 m/s at step 0, shoved sideways at step 300 so that the friction springs carry load; at
     /// step 700 `Kr` drops by a fifth and the top box is tossed up, so that it lands with the new
     /// prototype while the others keep their records). With the impact surface offset on
-    /// (docs/MODELS.md §F.7), the landings' impacts leave some slots with an offset.
+    /// (docs/MODELS.md §E.7), the landings' impacts leave some slots with an offset.
     #[test]
     fn leaving_the_lean_slots_mid_run_changes_no_trajectory() {
         let world = crate::scene::builtin("pile:20", None)

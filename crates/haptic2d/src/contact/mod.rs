@@ -11,6 +11,7 @@ mod lean_law;
 mod manager;
 mod params;
 mod record;
+pub mod solver;
 #[cfg(test)]
 mod test_pile;
 

@@ -32,7 +32,7 @@ pub struct LawState<N = NormalModel, F = FrictionModel> {
     /// Friction-model state (a copy of the world's prototype, taken when the record was created).
     pub friction: F,
     /// Normal-law state (a copy of the world's prototype, taken when the record was created) with
-    /// the surface offset of a resolved impact ([`ContactNormal`], docs/MODELS.md §F.7).
+    /// the surface offset of a resolved impact ([`ContactNormal`], docs/MODELS.md §E.7).
     pub normal: ContactNormal<N>,
 }
 

@@ -18,7 +18,7 @@ pub struct EnergyLedger {
     /// impact did not add kinetic energy (restitution scaled, or the whole jump); 0 without friction.
     pub impact_energy_fallbacks: u64,
     /// Kinetic energy removed by the implicit chain damper so far (J, ≥ 0 up to rounding;
-    /// `integrate/chain_damping.rs`).
+    /// `contact/solver/chain/`).
     pub chain_damping_loss: f64,
 }
 

@@ -276,7 +276,7 @@ fn incline_ramped(friction: &str, phi: f64, size: [f64; 2], ramp: f64) -> World 
 /// slip force is `Kr·p0 = μ_k·F_n` exactly. Expected: `d = (v₀ − 2β·v₀·T/m)²/(2·μ_k·g)` = 0.11743 m,
 /// tolerance the two samples of travel of the classical case (`2·v₀·T`) plus the strain term's
 /// `2·v₀·2.5e-3/(2 μ_k g)` = 0.64 mm. This is the law as specified, kept; after any velocity jump
-/// (an impact) it brakes by `β·|S0|·T` per contact in the next sample (docs/MODELS.md §F.7).
+/// (an impact) it brakes by `β·|S0|·T` per contact in the next sample (docs/MODELS.md §E.7).
 #[test]
 fn reset_integrator_meets_the_textbook_incline_and_stopping_distance() {
     let (beta, t, m) = (20.0, 1e-3, 1.0);

@@ -235,7 +235,7 @@ fn box_dropped_flat_at_1_khz_follows_the_spec_law_in_the_impact_sample() {
     );
 }
 
-/// The same drop with `impact_surface_offset = true` (docs/MODELS.md §F.7,
+/// The same drop with `impact_surface_offset = true` (docs/MODELS.md §E.7,
 /// `laws/normal/impact_offset.rs`): the record's law starts at the detection depth, so the
 /// restitution law alone sets the rebound. Regression for issue 16's finding:
 ///

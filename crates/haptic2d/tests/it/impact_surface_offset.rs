@@ -1,4 +1,4 @@
-//! `[contact] impact_surface_offset = true` (issue 16, docs/MODELS.md §F.7) keeps the worlds
+//! `[contact] impact_surface_offset = true` (issue 16, docs/MODELS.md §E.7) keeps the worlds
 //! passive: the offset only lowers a record's normal force, so the ledger excess stays within the
 //! issue's 1 mJ bound on the polygon drop of issue 10 (r8, impacts and friction on) and on a
 //! 100-box pile, and the pile still settles without deep interpenetration (the offset adds at most

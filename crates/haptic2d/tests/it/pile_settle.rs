@@ -1,5 +1,5 @@
 //! Piles and stacks come to rest (issue 17, item 4), passively: the implicit chain damper
-//! (`integrate/chain_damping.rs`) damps the slow collective modes of stacks that the explicit
+//! (`contact/solver/chain/`) damps the slow collective modes of stacks that the explicit
 //! per-contact dampers leave almost undamped; no sleeping, no velocity clamping.
 //!
 //! `tall_column_*` run in CI (a 40-box column, the same modal problem as the 40-row pile:1000);

@@ -1,5 +1,5 @@
 //! The global proximity stage spread over the samples of its period (`WorldParams::proximity_spread`,
-//! `collide/broad.rs`): the set in use from sample `(k+1)·N_g` is the set of the poses at `k·N_g`,
+//! `collide/broad/`): the set in use from sample `(k+1)·N_g` is the set of the poses at `k·N_g`,
 //! and a world with the spread keeps the same contacts as one without it when nothing moves fast.
 
 use haptic2d::collide::{BroadPhase, DEFAULT_DELTA_PROX};

@@ -105,7 +105,7 @@ impl ContactSet {
         for e in self.entries.iter_mut() {
             if e.state == Some(ContactState::Colliding) {
                 e.state = Some(ContactState::Continuous);
-                // Option (docs/MODELS.md §F.7; default off = §7.2 step 4): the restitution law has
+                // Option (docs/MODELS.md §E.7; default off = §7.2 step 4): the restitution law has
                 // set the velocity, so the depth the discrete detection found is not paid back as
                 // spring impulse (the law's surface moves in to it), and the distance history
                 // before the jump no longer predicts the motion, so the SEH estimate restarts from

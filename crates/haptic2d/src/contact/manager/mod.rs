@@ -24,16 +24,14 @@ mod invariant;
 mod release;
 mod sync;
 
-use crate::body::Body;
-use crate::collide::{Collider, VeCandidate, DEFAULT_DELTA_C, NEAR_PARALLEL_ANGLE};
+use crate::collide::{VeCandidate, DEFAULT_DELTA_C, NEAR_PARALLEL_ANGLE};
 use crate::contact::impact::{ImpactRow, ImpactSolver};
 use crate::contact::law_pool::LawPool;
 use crate::contact::params::ContactParams;
 use crate::contact::record::{ContactEvent, LawState, Loaded, LoadedContact, VeContact};
-use crate::geom::{Pose, Rot, Vec2};
-use crate::laws::friction::FrictionModel;
-use crate::laws::normal::NormalModel;
-use crate::stage_time::{Lap, Stage, StageTimes};
+use crate::geom::{Pose, Vec2};
+use crate::stage_time::{Lap, Stage};
+use crate::world::StepContext;
 
 /// Per-body contact wrench of one sample: force (N) and torque about the COM (N·m).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -303,22 +301,25 @@ impl ContactSet {
     /// another line of B by more than `δ_c` to that edge (or releases it if the vertex is outside
     /// B): its stored energy then drops, never rises. Debug builds assert the invariant for every
     /// record at the end of every sample.
-    #[allow(clippy::too_many_arguments)]
-    pub fn step(
-        &mut self,
-        tick: u64,
-        dt: f64,
-        candidates: &[VeCandidate],
-        from_scan: &[bool],
-        colliders: &[Collider],
-        bodies: &mut [Body],
-        rots: &[Rot],
-        past: &PastPoses<'_>,
-        normal: &NormalModel,
-        friction: &FrictionModel,
-        wrenches: &mut [Wrench2],
-        times: &mut StageTimes,
-    ) {
+    ///
+    /// Everything the stage reads and writes of the world comes in one borrowed
+    /// [`StepContext`] (Box2D's `b2StepContext`).
+    pub fn step(&mut self, ctx: StepContext<'_>) {
+        let StepContext {
+            tick,
+            dt,
+            candidates,
+            from_scan,
+            colliders,
+            bodies,
+            rots,
+            past,
+            normal,
+            friction,
+            wrenches,
+            times,
+        } = ctx;
+        let past = &past;
         let mut lap = Lap::start();
         self.events.clear();
         self.last_impact_loss = 0.0;
@@ -344,7 +345,7 @@ impl ContactSet {
         let any_colliding = (work.create || !self.events.is_empty())
             && self.create(tick, dt, colliders, bodies, past, normal, friction);
         if any_colliding {
-            // Impact friction mode and coefficient (default μ = the friction model's μ_k; docs/MODELS.md §F).
+            // Impact friction mode and coefficient (default μ = the friction model's μ_k; docs/MODELS.md §E).
             let mu = (self.params.impact_mu)
                 .unwrap_or_else(|| crate::contact::default_impact_mu(friction));
             self.solver.set_friction(self.params.impact_friction, mu);

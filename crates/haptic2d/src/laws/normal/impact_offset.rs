@@ -1,5 +1,5 @@
 //! A contact's normal law with the surface offset of a resolved impact (issue 16, docs/MODELS.md
-//! §F.7): the penetration that the discrete detection left at the impact sample is not paid back
+//! §E.7): the penetration that the discrete detection left at the impact sample is not paid back
 //! as spring impulse.
 //!
 //! A record created Colliding is detected up to `|C0|·T` inside the surface (the vertex crossed it

@@ -5,7 +5,8 @@
 //! is replaced by the sinusoidal unidirectional force." Here: the peg-in-hole scene (0.2 kg peg, 1 mm
 //! interference per wall, the scene's pure SEH stiffness `Kc = 1000 N/m` per corner, `Bc = 0`) with its
 //! friction replaced by each model (per-contact defaults), the simulated twin pantograph at 1 kHz and,
-//! by default, the virtual-coupling controller (§11.2). The peg starts inside the hole (the push-in is
+//! by default, the four-channel controller with local force feedback (below; the virtual coupling
+//! of §11.2 is a comparison run). The peg starts inside the hole (the push-in is
 //! optional, [`Fig8Params::push_in`]); the hand grips the handle until `t_release`, then lets go and
 //! the push `F_pk·(1 − cos 2πft)/2` along +x acts on the handle (the phase is measured from t = 0, so
 //! it starts from zero at a whole number of periods); y and θ of the handle are then free.
@@ -307,6 +308,9 @@ pub fn run_case(
         let out = l
             .step()
             .map_err(|e| format!("fig8 {name}: simulated device failed: {e}"))?;
+        if let Some(d) = l.system.world().divergence() {
+            return Err(format!("fig8 {name}: the world diverged: {d}"));
+        }
         records.push(out.record);
         push.push(f_world);
         if out.tripped {

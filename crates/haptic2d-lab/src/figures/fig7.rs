@@ -16,7 +16,7 @@
 //! against the same F7-5 bound.
 
 use crate::csv::write_columns;
-use crate::figure::{Figure, FigureContext, FigureReport};
+use crate::figures::{Figure, FigureContext, FigureReport};
 use crate::harness::peg::{PegHarness, PegPush, PegResult};
 use crate::plot::{write_panels, Panel, Series, Stroke};
 use crate::schema::{CaseMetrics, Check, Dimension, Fig7Measured, FigureMetrics, Measured};
@@ -149,7 +149,12 @@ pub fn run_2d(case: &str, f_pk: f64, guard: Option<f64>) -> Result<Run2d, String
         r.v.push(vx);
         r.f_push.push(push.at(t));
         // Stored energy after this sample's update, as in the 1-D harness.
-        w.step();
+        if let Some(d) = w.step() {
+            return Err(format!(
+                "fig7 {case}: the world diverged at t = {:.4} s: {d}",
+                w.time()
+            ));
+        }
         r.f_friction.push(w.contact_wrench(peg).force.x);
         r.u_f.push(w.ledger().stored + (ke - 0.5 * mass * vx * vx));
     }

@@ -1,14 +1,14 @@
 //! The paper's device-in-the-loop experiments, as library code: each runs a
 //! [`HapticSystem`](haptic2d::haptic::HapticSystem) closed around the simulated twin pantograph and a
 //! simulated hand ([`DeviceInTheLoop`](haptic2d::haptic::DeviceInTheLoop)) and measures the claim.
-//! The [`Figure`](crate::Figure)s of [`crate::fig5`] and [`crate::fig8`] turn them into data, plots
+//! The [`Figure`](crate::Figure)s of [`crate::figures::fig5`] and [`crate::figures::fig8`] turn them into data, plots
 //! and the report.
 //!
-//! - [`fig5`]: Figs. 5–6, the walls on the haptic interface.
-//! - [`fig8`]: Figs. 8–11, the peg in a tight hole, one friction model per case.
+//! - [`walls_with_device`]: Figs. 5–6, the walls on the haptic interface.
+//! - [`peg_with_device`]: Figs. 8–11, the peg in a tight hole, one friction model per case.
 
-pub mod fig5;
-pub mod fig8;
+pub mod peg_with_device;
+pub mod walls_with_device;
 
 /// How "the hand is replaced by a constant force" (Figs. 5–6; the sinusoidal force of Figs. 8–11)
 /// is read (issue 36 item 4). The paper's force information is observer-based, so the force could
@@ -38,7 +38,7 @@ impl Protocol {
     }
 }
 
-/// The device file of the friction comparison runs (issue 36 item 3): the spec device with
+/// The device file of the friction comparison runs (issue 36 item 3): the §10.2 device with
 /// realistic joint Coulomb friction and its friction compensation.
 pub const CAPSTAN_FRICTION_FILE: &str = "devices/twin-pantograph-capstan-friction.toml";
 
@@ -46,7 +46,7 @@ const CAPSTAN_FRICTION_TOML: &str =
     include_str!("../../../../devices/twin-pantograph-capstan-friction.toml");
 
 /// The device of [`CAPSTAN_FRICTION_FILE`] (its joint Coulomb friction `f_c`, the compensation
-/// fraction and deadband), every other field the spec's default.
+/// fraction and deadband), every other field its §10.2 default.
 pub fn capstan_friction_device() -> Result<haptic2d::device::DeviceParams, String> {
     haptic2d::scene::device_params_from_toml(CAPSTAN_FRICTION_TOML, CAPSTAN_FRICTION_FILE, None)
         .map_err(|e| e.to_string())

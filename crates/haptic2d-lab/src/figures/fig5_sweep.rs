@@ -1,13 +1,13 @@
-//! The Figs. 5–6 device-damping sweep: every wall of `crate::experiments::fig5` with the four-channel
+//! The Figs. 5–6 device-damping sweep: every wall of `crate::scenarios::walls_with_device` with the four-channel
 //! loop, on devices whose physical damping is `margin` times Colgate's bound `K·T/2` (see
-//! `crate::experiments::fig5::colgate_joint_damping`). It shows where the four claims hold together
+//! `crate::scenarios::walls_with_device::colgate_joint_damping`). It shows where the four claims hold together
 //! and why the experiment's default margin is 2: it was identified from this sweep, not measured on
 //! the paper's device, so the reproduction at that margin is a consistency check (such a device
 //! exists), not a prediction.
 
 use crate::csv::write_columns;
-use crate::experiments::fig5::{run_case, Fig5Params, FIG5_CASES};
 use crate::plot::{write_panels, Panel, Series, Stroke};
+use crate::scenarios::walls_with_device::{run_case, Fig5Params, FIG5_CASES};
 use indicatif::ProgressBar;
 use rayon::prelude::*;
 use std::fmt::Write as _;

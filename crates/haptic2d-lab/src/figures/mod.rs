@@ -3,7 +3,13 @@
 //! A figure computes its cases (in parallel with rayon), writes its CSV series and plots into
 //! `DIR/<figure>/`, and returns its metrics and a Markdown section. [`reproduce`] writes
 //! `DIR/<figure>/metrics.json` and `DIR/<figure>/report.md` for each selected figure, then assembles
-//! `DIR/REPORT.md` from the sections of every registered figure found in `DIR`.
+//! `DIR/REPORT.md` from the sections of every registered figure found in `DIR`. One file a figure.
+
+pub mod fig4;
+pub mod fig5;
+pub mod fig5_sweep;
+pub mod fig7;
+pub mod fig8;
 
 use crate::schema::FigureMetrics;
 use haptic2d::haptic::ControllerKind;
@@ -49,10 +55,10 @@ pub trait Figure: Send + Sync {
 /// Every registered figure, in report order. Add new figures here.
 pub fn registry() -> Vec<Box<dyn Figure>> {
     vec![
-        Box::new(crate::fig4::Fig4),
-        Box::new(crate::fig5::Fig5),
-        Box::new(crate::fig7::Fig7),
-        Box::new(crate::fig8::Fig8),
+        Box::new(crate::figures::fig4::Fig4),
+        Box::new(crate::figures::fig5::Fig5),
+        Box::new(crate::figures::fig7::Fig7),
+        Box::new(crate::figures::fig8::Fig8),
     ]
 }
 

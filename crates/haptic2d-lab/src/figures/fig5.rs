@@ -1,16 +1,16 @@
-//! Figs. 5–6: the walls with the device in the loop (`crate::experiments::fig5`): a 0.5 kg box held on
+//! Figs. 5–6: the walls with the device in the loop (`crate::scenarios::walls_with_device`): a 0.5 kg box held on
 //! the simulated twin pantograph, released 0.02 m from the left wall and pushed into it by a constant
 //! 2 N, 500 Hz, 10 s, one case per wall (SEH, ZOH, braking pulse, hysteretic). Each claim is carried
-//! by a named configuration on the spec's device, with its reason and `haptic2d stability`'s verdict
+//! by a named configuration on the §10.2 device, with its reason and `haptic2d stability`'s verdict
 //! (`carrier`): the hysteretic wall by the default, the pulse wall by the former default, SEH and
 //! ZOH by the §11.1 table (unstable released there, refused on a real device). Comparison runs: every
 //! other configuration on every wall, the §11.1 table on a device damped at twice Colgate's bound,
 //! the virtual coupling, every carrier with the push injected into the hand-force estimate (issue 36
 //! item 4), and the default on the capstan-friction device without and with friction compensation
 //! (item 3). A sweep of the device damping under the §11.1 table
-//! ([`crate::fig5_sweep`]) shows where that table's claims hold.
+//! ([`crate::figures::fig5_sweep`]) shows where that table's claims hold.
 //!
-//! Pass criteria (the paper's claim; numbers from the spec's W6/W7 with W7's 0.06 m/s taken relative to
+//! Pass criteria (the paper's claim; numbers from §5.10's W6/W7 with W7's 0.06 m/s taken relative to
 //! the 0.40 m/s first entry), `v1` the measured first entry speed:
 //!
 //! - SEH, ZOH (Fig. 5, "keeps bouncing"): ≥ 2 separations in the last 2 s and no settle time;
@@ -20,16 +20,16 @@
 //! - hysteretic (Fig. 6, "stable soon"): the first three contact ratios < 0.85 and ≤ 6 separations.
 
 use crate::csv::write_columns;
-use crate::experiments::fig5::{run_case, Fig5Case, Fig5Expectation, Fig5Params, FIG5_CASES};
-use crate::experiments::{with_capstan_friction, Protocol};
-use crate::fig5_sweep;
-use crate::figure::{Figure, FigureContext, FigureReport};
+use crate::figures::fig5_sweep;
+use crate::figures::{Figure, FigureContext, FigureReport};
 use crate::plot::{write_panels, Panel, Series, Stroke};
-use crate::schema::{CaseMetrics, Check, Dimension, Fig4Measured, FigureMetrics, Measured};
+use crate::scenarios::walls_with_device::{check, run_case, Fig5Case, Fig5Params, FIG5_CASES};
+use crate::scenarios::{with_capstan_friction, Protocol};
+use crate::schema::{CaseMetrics, Dimension, Fig4Measured, FigureMetrics, Measured};
 use rayon::prelude::*;
 use std::fmt::Write as _;
 
-/// The runs: `(name, parameters)`: the default controller on the spec's device, the §11.1 table on
+/// The runs: `(name, parameters)`: the default controller on the §10.2 device, the §11.1 table on
 /// the same device, the §11.1 table on a device damped at twice Colgate's bound, the virtual
 /// coupling, and the former default (master-side local force feedback only). Which run carries which wall's claim: [`carrier`].
 fn controllers(ctx: Option<&FigureContext>) -> Result<Vec<(String, Fig5Params)>, String> {
@@ -144,46 +144,6 @@ fn fmt(v: &[f64], n: usize) -> String {
         .join(", ")
 }
 
-/// The claim's check for case `c` (see the module docs).
-pub fn check(c: &Fig5Case) -> Check {
-    let m = &c.metrics;
-    let b = &m.bounce;
-    let v1 = m.first_entry_speed;
-    let (id, detail) = match c.expectation {
-        Fig5Expectation::KeepsBouncing => (
-            "F5-bounce",
-            format!(
-                "{} separations in the last 2 s (≥ 2), settle time {} (none)",
-                m.late_separations,
-                b.settle_time.map_or("none".into(), |t| format!("{t:.2} s"))
-            ),
-        ),
-        Fig5Expectation::SettlesAtFirstImpact => (
-            "F6-pulse",
-            format!(
-                "first ratio {} (≤ 0.4); max entry after the 2nd impact {:.3} m/s (< 0.15·v1 = {:.3}); {} separations in the last 2 s (0)",
-                b.contact_ratios.first().map_or("none".into(), |r| format!("{r:.3}")),
-                b.entry_speeds.iter().skip(2).copied().fold(0.0, f64::max),
-                0.15 * v1,
-                m.late_separations
-            ),
-        ),
-        Fig5Expectation::SettlesSoon => (
-            "F6-hysteretic",
-            format!(
-                "first ratios [{}] (< 0.85); {} separations (≤ 6)",
-                fmt(&b.contact_ratios, 3),
-                b.separations()
-            ),
-        ),
-    };
-    let detail = match &c.stopped {
-        Some(why) => format!("safety stop: {why}; {detail}"),
-        None => detail,
-    };
-    Check::new(id, m.pass, detail)
-}
-
 /// The Figs. 5–6 figure.
 pub struct Fig5;
 
@@ -221,7 +181,7 @@ impl Figure for Fig5 {
             let p = &ctrl[*i].1;
             let stability = crate::design::verdict_line(
                 &p.haptic_config()?,
-                &crate::experiments::fig5::wall_world(normal, p.rate)?,
+                &crate::scenarios::walls_with_device::wall_world(normal, p.rate)?,
                 p.rate,
             );
             let mut case = CaseMetrics::new(
@@ -357,7 +317,7 @@ fn report(m: &FigureMetrics, sweep: &str) -> String {
          ### Every run\n\n\
          | controller/wall | separations | entry speeds (m/s) | contact ratios | settle (s) | check | pass |\n\
          |---|---|---|---|---|---|---|",
-        crate::figure::claims_table(m)
+        crate::figures::claims_table(m)
     );
     for c in &m.cases {
         let Measured::Fig4(x) = &c.measured else {

@@ -1,4 +1,4 @@
-//! Figs. 8–11: the peg in a tight hole with the device in the loop (`crate::experiments::fig8`): the
+//! Figs. 8–11: the peg in a tight hole with the device in the loop (`crate::scenarios::peg_with_device`): the
 //! 0.2 kg peg of `peg-in-hole` (1 mm interference, 1 N per corner), one friction model per case, the
 //! simulated twin pantograph at 1 kHz with mapping scale 2; the hand grips the handle for 1 s, then
 //! lets go and `F_pk (1 − cos 2πt)/2` with `F_pk = 2.1 N` (world) pushes the handle along x; y and θ
@@ -17,10 +17,10 @@
 //! is an energy port the ledger does not close).
 
 use crate::csv::write_columns;
-use crate::experiments::fig8::{run_case, Fig8Case, Fig8Params, FIG8_CASES};
-use crate::experiments::{with_capstan_friction, Protocol};
-use crate::figure::{Figure, FigureContext, FigureReport};
+use crate::figures::{Figure, FigureContext, FigureReport};
 use crate::plot::{write_panels, Panel, Series, Stroke};
+use crate::scenarios::peg_with_device::{run_case, Fig8Case, Fig8Params, FIG8_CASES};
+use crate::scenarios::{with_capstan_friction, Protocol};
 use crate::schema::{CaseMetrics, Check, Dimension, Fig7Measured, FigureMetrics, Measured};
 use rayon::prelude::*;
 use std::fmt::Write as _;
@@ -218,7 +218,8 @@ impl Figure for Fig8 {
         for (i, j, c) in &done {
             let p = &ctrl[*i].1;
             let model = format!("{}/{}", ctrl[*i].0, c.name);
-            let (world, haptic) = crate::experiments::fig8::case_world(p, FIG8_CASES[*j].1)?;
+            let (world, haptic) =
+                crate::scenarios::peg_with_device::case_world(p, FIG8_CASES[*j].1)?;
             let mut case = CaseMetrics::new(
                 &model,
                 Dimension::TwoD,
@@ -337,7 +338,7 @@ fn report(m: &FigureMetrics) -> String {
          ### Every run\n\n\
          | controller/model | creep_k (m) | advance_k (m) | max abs y (m) | max abs θ (rad) | pass |\n\
          |---|---|---|---|---|---|",
-        crate::figure::claims_table(m)
+        crate::figures::claims_table(m)
     );
     for c in &m.cases {
         let Measured::Fig7(x) = &c.measured else {

@@ -11,7 +11,7 @@
 //! Cases: SEH (marginally passive) and ZOH (active) — Fig. 5: the block keeps bouncing; braking pulse
 //! and hysteretic wall — Fig. 6: contact stability at the first impact with the pulse, soon with the
 //! hysteretic wall. Metrics per case from the slave's trajectory after the release (§13.1 definitions:
-//! separations, entry/exit speeds, contact ratios, settle time). Pass criteria (the spec's W6/W7
+//! separations, entry/exit speeds, contact ratios, settle time). Pass criteria (§5.10's W6/W7
 //! thresholds, with W7's absolute 0.06 m/s made relative to the 0.40 m/s entry of §5.10), `v1` the
 //! measured first entry speed:
 //!
@@ -24,7 +24,7 @@
 //!
 //! **Which runs carry the claims (issue 36).** Each claim is carried by a named configuration on the
 //! spec's device (§10.2, joint `f_v = 1e-4`, no calibrated damping), chosen for a reason the report
-//! states beside `haptic2d stability`'s verdict (see `crate::fig5`): the hysteretic wall by the
+//! states beside `haptic2d stability`'s verdict (see `crate::figures::fig5`): the hysteretic wall by the
 //! default controller ([`Fig5Params::default`]: `FourChannelGains::local_force_feedback`, `C6 = −1`,
 //! `C5 = 2`), the pulse wall by the former default (`C6 = −1`, `C5 = 0`, `D_m = 2`), and the SEH and
 //! ZOH bouncing by the paper's §11.1 table ([`Fig5Params::paper_controller`]), which is unstable
@@ -36,7 +36,7 @@
 //! sense of §11.4 (no hand impedance). With the §11.1 table (`C2 = 1`) the released loop of handle,
 //! slave and wall spring is unstable in continuous time — the §11.4 polynomial for this device and
 //! wall (m ≈ 0.445 kg, b ≈ 0.028 N·s/m, K = 2000 N/m) has roots `+2.4 ± 67j`, and the sampled-data
-//! growth at 500 Hz is about +19 1/s (`haptic2d stability`). That is what made the spec-device runs
+//! growth at 500 Hz is about +19 1/s (`haptic2d stability`). That is what made the §10.2-device runs
 //! "active" (SEH contact ratios above 1) — not Colgate's `b > K·T/2`: the instability is there
 //! before sampling, and the 5 N·s/m of calibrated damping works because it moves the polynomial's
 //! roots left (stable above `b ≈ 2.65 N·s/m`), not because it exceeds `K·T/2`. With `C6 = −1`
@@ -48,6 +48,7 @@
 //! box, i.e. force reflection `C2 = 1`, which is exactly the released-unstable path; no design of
 //! the study of issue 36 (`tests/design_search.rs`, 700+ candidates, MODELS.md §11.4) has both.
 
+use crate::schema::Check;
 use haptic2d::control::coupling::CouplingGains;
 use haptic2d::control::four_channel::FourChannelGains;
 use haptic2d::device::dynamics::LumpedDynamics;
@@ -90,8 +91,8 @@ pub struct Fig5Params {
     /// The device's physical damping as a multiple of Colgate's bound (§5.4). `Some(m)`: the joint
     /// viscous friction `f_v` of `haptic.device` is replaced by the value that gives the handle an x
     /// damping `b_x = f_v·(J_aᵀJ_a)_xx = m·K·T/2` at its start pose, `K` = [`WALL_STIFFNESS`], `T` the
-    /// control period (see [`colgate_joint_damping`]); `None`: `haptic.device.f_v` as given (the spec's
-    /// \[REC\] 1e-4 N·m·s/rad by default, i.e. m ≈ 0.014). Default `None` (the spec device);
+    /// control period (see [`colgate_joint_damping`]); `None`: `haptic.device.f_v` as given (§10.2's
+    /// \[REC\] 1e-4 N·m·s/rad by default, i.e. m ≈ 0.014). Default `None` (the §10.2 device);
     /// [`Fig5Params::calibrated_damping`] uses 2.
     pub colgate_margin: Option<f64>,
     /// The haptic system's safety settings (start-up ramp, stall limit, torque trip margin).
@@ -128,7 +129,7 @@ impl Fig5Params {
         }
     }
 
-    /// Same as [`Fig5Params::paper_controller`] (the §11.1 table on the spec's undamped device).
+    /// Same as [`Fig5Params::paper_controller`] (the §11.1 table on the undamped §10.2 device).
     pub fn spec_device() -> Self {
         Self::paper_controller()
     }
@@ -176,7 +177,7 @@ pub const WALL_STIFFNESS: f64 = 2000.0;
 /// `b_x = f_v·(J_aᵀJ_a)_xx`; at the workspace centre `(J_aᵀJ_a)_xx ≈ 277 m⁻²`. With the spec's
 /// `f_v = 1e-4` that is 0.028 N·s/m against `K·T/2 = 2 N·s/m` at 500 Hz. Margin 2 needs
 /// `f_v ≈ 1.44e-2 N·m·s/rad`: the back-EMF damping `n_g²·K_t²/R` of a voltage-driven motor with
-/// `K_t = 25 mN·m/A`, `R = 4.3 Ω` and the spec's `n_g = 10`.
+/// `K_t = 25 mN·m/A`, `R = 4.3 Ω` and §10.2's `n_g = 10`.
 pub fn colgate_joint_damping(h: &HapticConfig, rate: f64, margin: f64) -> Result<f64, String> {
     if !(margin.is_finite() && margin >= 0.0 && rate.is_finite() && rate > 0.0) {
         return Err(format!(
@@ -404,6 +405,9 @@ pub fn run_case(
         let out = l
             .step()
             .map_err(|e| format!("fig5 {name}: simulated device failed: {e}"))?;
+        if let Some(d) = l.system.world().divergence() {
+            return Err(format!("fig5 {name}: the world diverged: {d}"));
+        }
         gap.push(box_gap(&out.record.x_s, [0.02, 0.01]));
         records.push(out.record);
         if out.tripped {
@@ -496,4 +500,50 @@ pub fn run(p: &Fig5Params) -> Result<Vec<Fig5Case>, String> {
         .iter()
         .map(|(name, normal, e)| run_case(p, name, normal, *e))
         .collect()
+}
+
+/// The claim's check for case `c`: its pass criterion (module docs) as a [`Check`] with the
+/// numbers behind it, a safety stop named first.
+pub fn check(c: &Fig5Case) -> Check {
+    let m = &c.metrics;
+    let b = &m.bounce;
+    let v1 = m.first_entry_speed;
+    let (id, detail) = match c.expectation {
+        Fig5Expectation::KeepsBouncing => (
+            "F5-bounce",
+            format!(
+                "{} separations in the last 2 s (≥ 2), settle time {} (none)",
+                m.late_separations,
+                b.settle_time.map_or("none".into(), |t| format!("{t:.2} s"))
+            ),
+        ),
+        Fig5Expectation::SettlesAtFirstImpact => (
+            "F6-pulse",
+            format!(
+                "first ratio {} (≤ 0.4); max entry after the 2nd impact {:.3} m/s (< 0.15·v1 = {:.3}); {} separations in the last 2 s (0)",
+                b.contact_ratios.first().map_or("none".into(), |r| format!("{r:.3}")),
+                b.entry_speeds.iter().skip(2).copied().fold(0.0, f64::max),
+                0.15 * v1,
+                m.late_separations
+            ),
+        ),
+        Fig5Expectation::SettlesSoon => (
+            "F6-hysteretic",
+            format!(
+                "first ratios [{}] (< 0.85); {} separations (≤ 6)",
+                b.contact_ratios
+                    .iter()
+                    .take(3)
+                    .map(|x| format!("{x:.3}"))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                b.separations()
+            ),
+        ),
+    };
+    let detail = match &c.stopped {
+        Some(why) => format!("safety stop: {why}; {detail}"),
+        None => detail,
+    };
+    Check::new(id, m.pass, detail)
 }

@@ -14,7 +14,7 @@
 //! `|ω| < 1e-9 rad/s` for the paper method (see [`checks_2d`]).
 
 use crate::csv::write_columns;
-use crate::figure::{Figure, FigureContext, FigureReport};
+use crate::figures::{Figure, FigureContext, FigureReport};
 use crate::harness::wall::{run_wall, EntryImpulse, WallConfig};
 use crate::plot::{write_panels, Panel, Series, Stroke};
 use crate::schema::{CaseMetrics, Check, Dimension, Fig4Measured, FigureMetrics, Measured};
@@ -311,7 +311,13 @@ pub fn run_2d(case: &WallCase) -> Result<(Trace, Fig4Measured), String> {
         tr.v.push(s.v_n);
         tr.theta.push(bd.pose.angle);
         tr.omega.push(bd.omega);
-        w.step();
+        if let Some(d) = w.step() {
+            return Err(format!(
+                "fig4 {}: the world diverged at t = {:.4} s: {d}",
+                case.name,
+                w.time()
+            ));
+        }
         tr.f.push(w.contact_wrench(b).force.x);
         max_omega = max_omega.max(w.bodies[b].omega.abs());
     }
