@@ -1233,40 +1233,7 @@ pub fn sat_depth(a: &Collider, b: &Collider) -> f64 {
 /// [`sat_depth`] with its axis: `(depth, u)`, `u` the unit direction in which `a` moves
 /// (relative to `b`) to separate by `depth`; `u = 0` when the pair is apart.
 pub fn sat_axis(a: &Collider, b: &Collider) -> (f64, Vec2) {
-    let seams = a.seams != 0 || b.seams != 0;
-    let mut best = (f64::INFINITY, Vec2::ZERO);
-    let mut fallback = (f64::INFINITY, Vec2::ZERO);
-    for (p, q, sign) in [(a, b, -1.0), (b, a, 1.0)] {
-        for e in 0..p.len() {
-            // Overlap along n_e: how far q's deepest vertex is behind p's edge line e.
-            let min_d = q
-                .world_vertices()
-                .iter()
-                .map(|&v| p.edge_distance(e, v))
-                .fold(f64::INFINITY, f64::min);
-            if min_d >= 0.0 {
-                return (0.0, Vec2::ZERO);
-            }
-            if seams && p.is_seam(e) {
-                continue;
-            }
-            let u = p.world_normals()[e] * sign;
-            if -min_d < fallback.0 {
-                fallback = (-min_d, u);
-            }
-            let through = seams && (through_seam(b, u) || through_seam(a, -u));
-            if !through && -min_d < best.0 {
-                best = (-min_d, u);
-            }
-        }
-    }
-    if best.0.is_finite() {
-        best
-    } else if fallback.0.is_finite() {
-        fallback
-    } else {
-        (0.0, Vec2::ZERO)
-    }
+    super::clip::sat_face(a, b).map_or((0.0, Vec2::ZERO), |f| (f.depth, f.axis))
 }
 
 /// Whether moving a body relative to `c` along `u` has a component out through a seam of `c`

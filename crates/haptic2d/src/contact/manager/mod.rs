@@ -7,7 +7,7 @@
 //!
 //! The step runs in stages, one file each, in the order of the spec (called in this order by
 //! [`ContactSet::step`]): [`sync`] (merge and measure), [`release`] (§8.2 rules 4–5), [`hand_over`]
-//! (the depth invariant), [`create`] (§8.2 rules 1–2, §8.3), [`impacts`] (§7), [`forces`] (§1–§4,
+//! (the depth invariant), [`create`] (§8.2 rules 1–2, §8.3), [`clip`] (crossing corners held on the separating axis, §9.5b), [`impacts`] (§7), [`forces`] (§1–§4,
 //! §5.9); [`invariant`] holds the depth invariant's checks.
 //!
 //! The merge's pass, which measures every pair, also applies the tests of release, hand-over
@@ -16,6 +16,7 @@
 //! forces) instead of five. The merge changes the set in place, moving only the entries
 //! between its changes.
 
+mod clip;
 mod create;
 mod forces;
 mod hand_over;
@@ -69,6 +70,9 @@ pub struct ContactSet {
     /// The differences the last merge found (`sync`), reused.
     changes: Vec<sync::Change>,
     pending: Vec<VeContact>,
+    /// Scratch of `clip_crossing`: the pairs to test, and one pair's clip keys.
+    crossing: Vec<(u32, u32)>,
+    clip_keys: Vec<VeCandidate>,
     events: Vec<ContactEvent>,
     rows: Vec<ImpactRow>,
     /// The entries (indices) of this sample's impact set, ascending (empty without an impact).
@@ -121,6 +125,8 @@ impl ContactSet {
             laws: LawPool::with_capacity(64),
             changes: Vec::with_capacity(64),
             pending: Vec::with_capacity(16),
+            crossing: Vec::with_capacity(16),
+            clip_keys: Vec::with_capacity(16),
             events: Vec::with_capacity(64),
             rows: Vec::with_capacity(16),
             row_entry: Vec::with_capacity(16),
@@ -343,6 +349,9 @@ impl ContactSet {
         // may start another one in the same sample.
         let any_colliding = (work.create || !self.events.is_empty())
             && self.create(tick, dt, colliders, bodies, past, normal, friction);
+        // Crossing corners: a pair overlapping deeper than its records is held on its
+        // separating axis (`clip`, issue 35).
+        self.clip_crossing(tick, colliders, bodies, past, normal, friction);
         if any_colliding {
             // Impact friction mode and coefficient (default μ = the friction model's μ_k; docs/MODELS.md §F).
             let mu = (self.params.impact_mu)
