@@ -25,6 +25,14 @@
 use super::{Collider, VeCandidate};
 use crate::geom::Vec2;
 
+/// How much deeper than a pair's deepest record (or, with no vertex inside, than nothing) its
+/// separating-axis overlap may run before its clip pairs take over, as a fraction of `δ_c` (0.5:
+/// 1 mm with the default `δ_c`). Below it the records are the vertex scan's and the crossed-edge
+/// rule's (the depth invariant allows a record `δ_c` off its vertex's nearest line), so ordinary
+/// contacts (a face on a face, a corner in a face) never reach it and keep their trajectories bit
+/// for bit.
+pub const CLIP_MARGIN: f64 = 0.5;
+
 /// The separating-axis result of an overlapping pair with its reference face.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SatFace {
@@ -84,6 +92,14 @@ pub fn sat_face(a: &Collider, b: &Collider) -> Option<SatFace> {
         }
     }
     best.or(fallback)
+}
+
+/// Whether `u` is an admissible separating axis for moving `a` relative to `b` (no component out
+/// through a seam of either, see [`sat_depth`](super::sat_depth)): only then does the overlap along
+/// `u` bound the pair's separating-axis depth from above.
+pub fn admissible_axis(a: &Collider, b: &Collider, u: Vec2) -> bool {
+    (a.seams == 0 && b.seams == 0)
+        || !(super::local::through_seam(b, u) || super::local::through_seam(a, -u))
 }
 
 /// The edge of `i` whose outward normal is most antiparallel to `n` (the incident edge; the

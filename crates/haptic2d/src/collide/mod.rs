@@ -31,7 +31,7 @@ mod toi;
 mod tracker;
 
 pub use broad::{required_delta_prox, BroadPhase, BroadStats, DEFAULT_DELTA_PROX};
-pub use clip::{clip_pairs, incident_edge, sat_face, SatFace};
+pub use clip::{admissible_axis, clip_pairs, incident_edge, sat_face, SatFace, CLIP_MARGIN};
 pub use collider::Collider;
 pub use gjk::{
     gjk_distance, support_hill_climb, GjkCache, GjkOutput, GJK_EPS_ABS, GJK_EPS_REL,

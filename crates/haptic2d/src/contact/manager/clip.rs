@@ -31,23 +31,18 @@
 //! own normal (`O(n)`, the deepest vertex of the vertex polygon behind its edge line): the pair's
 //! overlap is no more than that, so a record for which it is within the margin of the record's
 //! own depth clears its pair, and the separating-axis test runs only for the pairs none of whose
-//! records clears it.
+//! records clears it. (On a piece with seams the record's normal clears the pair only if it is an
+//! admissible axis: a body sunk into the joint of a floor and a wall slab has its one record on
+//! the slab's corner, whose normal would move the body out through the joint.)
 
 use super::sync::new_entry;
 use super::ContactSet;
 use super::PastPoses;
 use crate::body::Body;
-use crate::collide::{clip_pairs, sat_face, Collider, VeCandidate};
+use crate::collide::{admissible_axis, clip_pairs, sat_face, Collider, VeCandidate, CLIP_MARGIN};
 use crate::contact::record::{ContactEvent, ContactState, EventKind, VeContact, NO_LAW};
 use crate::laws::friction::FrictionModel;
 use crate::laws::normal::NormalModel;
-
-/// How much deeper than a pair's deepest record its separating-axis overlap may run before the
-/// clip records take over, as a fraction of `δ_c` (0.5: 1 mm with the default `δ_c`). Below it
-/// the records are the vertex scan's and the crossed-edge rule's (the depth invariant allows a
-/// record `δ_c` off its vertex's nearest line), so ordinary contacts (a face on a face, a corner
-/// in a face) never reach it and keep their trajectories bit for bit.
-pub const CLIP_MARGIN: f64 = 0.5;
 
 impl ContactSet {
     /// Holds every pair whose overlap exceeds its deepest record's depth by more than
@@ -74,10 +69,17 @@ impl ContactSet {
                 .iter()
                 .map(|&v| -cb.edge_distance(edge, v))
                 .fold(f64::NEG_INFINITY, f64::max);
-            if along > -e.d[0] + margin {
+            // The overlap along the record's normal bounds the pair's only if that axis is
+            // admissible (a seam's piece is cleared through its surface only, `sat_depth`).
+            let admissible = !cb.is_seam(edge) && admissible_axis(ca, cb, e.n);
+            if along > -e.d[0] + margin || !admissible {
                 let (a, b) = (e.key.vertex_collider, e.key.edge_collider);
                 self.crossing.push((a.min(b), a.max(b)));
             }
+        }
+        // Pairs that lost a loaded record out of its edge range this sample (`release`).
+        for &(pair, _) in &self.dropped {
+            self.crossing.push(pair);
         }
         if self.crossing.is_empty() {
             return;
@@ -87,13 +89,18 @@ impl ContactSet {
         self.pending.clear();
         for k in 0..self.crossing.len() {
             let (ia, ib) = self.crossing[k];
-            // The pair's records: deepest depth, any Colliding, any record that clears the pair.
-            let mut deepest = f64::NEG_INFINITY;
+            let in_pair = |key: &VeCandidate| {
+                let pair = (key.vertex_collider, key.edge_collider);
+                pair == (ia, ib) || pair == (ib, ia)
+            };
+            // The pair's records: deepest depth, any Colliding.
+            let mut deepest = 0.0f64;
             let mut colliding = false;
-            for e in self.entries.iter().filter(|e| {
-                let pair = (e.key.vertex_collider, e.key.edge_collider);
-                e.is_contact() && (pair == (ia, ib) || pair == (ib, ia))
-            }) {
+            for e in self
+                .entries
+                .iter()
+                .filter(|e| e.is_contact() && in_pair(&e.key))
+            {
                 deepest = deepest.max(-e.d[0]);
                 colliding |= e.state == Some(ContactState::Colliding);
             }
@@ -104,7 +111,15 @@ impl ContactSet {
             let Some(face) = sat_face(a, b) else {
                 continue;
             };
-            if !face.admissible || face.depth <= deepest + margin {
+            // A loaded record that left its edge's range deeper than every record left: the
+            // pair's support went with it, and its depth goes to the clip records at once.
+            let dropped = self
+                .dropped
+                .iter()
+                .filter(|(pair, _)| *pair == (ia, ib))
+                .fold(0.0f64, |m, &(_, d)| m.max(d));
+            let lost = dropped > deepest && face.depth > deepest;
+            if !face.admissible || (face.depth <= deepest + margin && !lost) {
                 continue;
             }
             self.clip_keys.clear();
@@ -115,11 +130,33 @@ impl ContactSet {
                 self.params.eps_s,
                 &mut self.clip_keys,
             );
+            if self.clip_keys.is_empty() {
+                continue;
+            }
+            // The pool: the effective depths of the pair's records released out of their edge
+            // range this sample.
+            self.pool.clear();
+            for &(pair, depth) in &self.dropped {
+                if pair == (ia, ib) {
+                    self.pool.push(depth);
+                }
+            }
+            self.dropped.retain(|&(pair, _)| pair != (ia, ib));
+            // Largest last (popped first).
+            self.pool.sort_unstable_by(f64::total_cmp);
+            // The clip pairs deepest first.
+            let geo = |key: &VeCandidate| {
+                let ca = &colliders[key.vertex_collider as usize];
+                let cb = &colliders[key.edge_collider as usize];
+                cb.edge_distance(key.edge as usize, ca.world_vertices()[key.vertex as usize])
+            };
+            self.clip_keys.sort_by(|x, y| geo(x).total_cmp(&geo(y)));
             for c in 0..self.clip_keys.len() {
                 let key = self.clip_keys[c];
                 self.hold(tick, key, colliders, bodies, past, normal, friction);
             }
         }
+        self.dropped.clear();
         if !self.pending.is_empty() {
             self.entries.extend_from_slice(&self.pending);
             self.entries.sort_unstable_by_key(|e| e.key);
@@ -128,8 +165,9 @@ impl ContactSet {
     }
 
     /// Makes the clip pair `key` a Continuous record (module docs): nothing if it is one; the
-    /// vertex's record on another edge of the same collider handed over with its effective depth,
-    /// or a new record with its surface at the vertex.
+    /// vertex's record on another edge of the same collider is handed over with its effective
+    /// depth; otherwise a record whose law starts at the largest effective depth left in the pool
+    /// (capped at its own depth), or with its surface at the vertex when the pool is empty.
     #[allow(clippy::too_many_arguments)]
     fn hold(
         &mut self,
@@ -153,9 +191,7 @@ impl ContactSet {
         {
             return;
         }
-        // The vertex's effective depth on its present record (0: none, its surface at the vertex).
-        let mut kept = 0.0f64;
-        if let Some(old) = self
+        let kept = if let Some(old) = self
             .entries
             .iter()
             .position(|e| group(&e.key) && e.is_contact())
@@ -165,7 +201,7 @@ impl ContactSet {
                 return;
             }
             let offset = self.laws.get(e.law).map_or(0.0, |l| l.normal.offset());
-            kept = (-e.d[0] - offset).max(0.0);
+            let kept = (-e.d[0] - offset).max(0.0);
             let e = &mut self.entries[old];
             e.state = None;
             self.laws.release(e.law);
@@ -177,7 +213,10 @@ impl ContactSet {
                 key: e.key,
                 kind: EventKind::Released,
             });
-        }
+            kept
+        } else {
+            self.pool.pop().unwrap_or(0.0)
+        };
         let start = |n: &mut VeContact, laws: &mut crate::contact::law_pool::LawPool| {
             n.state = Some(ContactState::Continuous);
             n.since = tick;
@@ -193,22 +232,17 @@ impl ContactSet {
             Ok(t) => {
                 let n = &mut self.entries[t];
                 start(n, &mut self.laws);
-                self.events.push(ContactEvent {
-                    tick,
-                    key,
-                    kind: EventKind::Created(ContactState::Continuous),
-                });
             }
             Err(_) => {
                 let mut n = new_entry(tick, key, colliders, bodies, past);
                 start(&mut n, &mut self.laws);
-                self.events.push(ContactEvent {
-                    tick,
-                    key,
-                    kind: EventKind::Created(ContactState::Continuous),
-                });
                 self.pending.push(n);
             }
         }
+        self.events.push(ContactEvent {
+            tick,
+            key,
+            kind: EventKind::Created(ContactState::Continuous),
+        });
     }
 }

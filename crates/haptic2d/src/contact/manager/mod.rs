@@ -73,6 +73,10 @@ pub struct ContactSet {
     /// Scratch of `clip_crossing`: the pairs to test, and one pair's clip keys.
     crossing: Vec<(u32, u32)>,
     clip_keys: Vec<VeCandidate>,
+    /// Effective depths handed from released records to a crossing pair's clip records (`clip`),
+    /// and the records released out of their edge range this sample, with their pair (a < b).
+    pool: Vec<f64>,
+    dropped: Vec<((u32, u32), f64)>,
     events: Vec<ContactEvent>,
     rows: Vec<ImpactRow>,
     /// The entries (indices) of this sample's impact set, ascending (empty without an impact).
@@ -127,6 +131,8 @@ impl ContactSet {
             pending: Vec::with_capacity(16),
             crossing: Vec::with_capacity(16),
             clip_keys: Vec::with_capacity(16),
+            pool: Vec::with_capacity(16),
+            dropped: Vec::with_capacity(16),
             events: Vec::with_capacity(64),
             rows: Vec::with_capacity(16),
             row_entry: Vec::with_capacity(16),
@@ -327,6 +333,7 @@ impl ContactSet {
     ) {
         let mut lap = Lap::start();
         self.events.clear();
+        self.dropped.clear();
         self.last_impact_loss = 0.0;
         self.row_entry.clear();
         self.struck_entry.clear();
