@@ -180,3 +180,83 @@ pub fn clip_pairs(
     }
     out.len() - start
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::{ConvexPolygon, Pose};
+
+    fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> ConvexPolygon {
+        ConvexPolygon::new(vec![
+            Vec2::new(x0, y0),
+            Vec2::new(x1, y0),
+            Vec2::new(x1, y1),
+            Vec2::new(x0, y1),
+        ])
+        .unwrap()
+    }
+
+    /// A diamond whose lowest corner went through a thin shelf (no vertex of either inside the
+    /// other): the shelf's top is the reference face, the depth is the corner's depth below it,
+    /// and the one clip pair is that corner against the top.
+    #[test]
+    fn crossed_corner_clips_to_the_corner_on_the_reference_face() {
+        let h = 0.02;
+        let shelf = Collider::new(0, false, rect(-0.1, -0.001, 0.1, 0.0), &Pose::default());
+        let diamond = ConvexPolygon::new(vec![
+            Vec2::new(0.0, -h),
+            Vec2::new(h, 0.0),
+            Vec2::new(0.0, h),
+            Vec2::new(-h, 0.0),
+        ])
+        .unwrap();
+        let d = Collider::new(1, true, diamond, &Pose::new(0.0, h - 0.0015, 0.0));
+        let f = sat_face(&shelf, &d).unwrap();
+        assert!((f.depth - 0.0015).abs() < 1e-12, "{f:?}");
+        assert!(f.reference_is_first && f.face == 2 && f.admissible, "{f:?}");
+        assert!((f.axis - Vec2::new(0.0, -1.0)).length() < 1e-12);
+        let mut out = Vec::new();
+        assert_eq!(clip_pairs((0, &shelf), (1, &d), &f, 1e-4, &mut out), 1);
+        let corner = VeCandidate {
+            vertex_collider: 1,
+            vertex: 0,
+            edge_collider: 0,
+            edge: 2,
+        };
+        assert_eq!(out, vec![corner]);
+    }
+
+    /// Box2D's clip point at a side plane as a VE pair: a box overlapping the top-right corner
+    /// of a slab by 0.1 m below its top and 0.5 m inside its right side. Reference: the slab's
+    /// top (depth 0.1); incident: the box's bottom. The box's bottom-left vertex is behind the
+    /// top inside its range; its bottom-right one is outside the range, and the bottom edge
+    /// crosses the side plane `x = 1` at `P = (1, −0.1)`, behind the top: the pair (slab corner
+    /// `(1, 0)`, box bottom), depth 0.1 = `t·(−n_I·n_f)` with `t` = 0.1.
+    #[test]
+    fn side_plane_crossing_gives_the_reference_corner_against_the_incident_edge() {
+        let slab = Collider::new(0, false, rect(-1.0, -1.0, 1.0, 0.0), &Pose::default());
+        let b = Collider::new(1, true, rect(0.5, -0.1, 1.5, 0.9), &Pose::default());
+        let f = sat_face(&slab, &b).unwrap();
+        assert!((f.depth - 0.1).abs() < 1e-12 && f.reference_is_first && f.face == 2);
+        assert_eq!(incident_edge(&b, slab.world_normals()[2]), Some(0));
+        let mut out = Vec::new();
+        clip_pairs((0, &slab), (1, &b), &f, 1e-4, &mut out);
+        let v = |vc, v, ec, e| VeCandidate {
+            vertex_collider: vc,
+            vertex: v,
+            edge_collider: ec,
+            edge: e,
+        };
+        assert_eq!(out, vec![v(1, 0, 0, 2), v(0, 2, 1, 0)]);
+        let depth = -b.edge_distance(0, slab.world_vertices()[2]);
+        assert!((depth - 0.1).abs() < 1e-12);
+    }
+
+    /// Apart: no face.
+    #[test]
+    fn separated_pairs_have_no_reference_face() {
+        let a = Collider::new(0, false, rect(0.0, 0.0, 1.0, 1.0), &Pose::default());
+        let b = Collider::new(1, true, rect(1.5, 0.0, 2.5, 1.0), &Pose::default());
+        assert_eq!(sat_face(&a, &b), None);
+    }
+}

@@ -58,9 +58,10 @@ impl ContactSet {
         friction: &FrictionModel,
     ) {
         let margin = CLIP_MARGIN * self.delta_c;
-        // Pairs (a < b) with a record whose own-axis test fails.
-        self.crossing.clear();
-        for e in self.entries.iter().filter(|e| e.is_contact()) {
+        // The own-axis test of a record: the overlap along its normal is within the margin of
+        // its depth, on an admissible axis (a seam's piece is cleared through its surface only,
+        // `sat_depth`); then the pair's overlap is too.
+        let clears = |e: &VeContact| {
             let ca = &colliders[e.key.vertex_collider as usize];
             let cb = &colliders[e.key.edge_collider as usize];
             let edge = e.key.edge as usize;
@@ -69,15 +70,20 @@ impl ContactSet {
                 .iter()
                 .map(|&v| -cb.edge_distance(edge, v))
                 .fold(f64::NEG_INFINITY, f64::max);
-            // The overlap along the record's normal bounds the pair's only if that axis is
-            // admissible (a seam's piece is cleared through its surface only, `sat_depth`).
-            let admissible = !cb.is_seam(edge) && admissible_axis(ca, cb, e.n);
-            if along > -e.d[0] + margin || !admissible {
-                let (a, b) = (e.key.vertex_collider, e.key.edge_collider);
-                self.crossing.push((a.min(b), a.max(b)));
+            along <= -e.d[0] + margin && !cb.is_seam(edge) && admissible_axis(ca, cb, e.n)
+        };
+        let pair_of = |key: &VeCandidate| {
+            let (a, b) = (key.vertex_collider, key.edge_collider);
+            (a.min(b), a.max(b))
+        };
+        // Pairs (a < b) with a record whose own-axis test fails, and those that lost a loaded
+        // record out of its edge range this sample (`release`).
+        self.crossing.clear();
+        for e in self.entries.iter().filter(|e| e.is_contact()) {
+            if !clears(e) {
+                self.crossing.push(pair_of(&e.key));
             }
         }
-        // Pairs that lost a loaded record out of its edge range this sample (`release`).
         for &(pair, _) in &self.dropped {
             self.crossing.push(pair);
         }
@@ -86,31 +92,25 @@ impl ContactSet {
         }
         self.crossing.sort_unstable();
         self.crossing.dedup();
+        // Each such pair's records, in one pass: deepest depth, any Colliding, any that clears it.
+        self.crossing_info.clear();
+        self.crossing_info
+            .resize(self.crossing.len(), (0.0, false, false));
+        for e in self.entries.iter().filter(|e| e.is_contact()) {
+            if let Ok(k) = self.crossing.binary_search(&pair_of(&e.key)) {
+                let info = &mut self.crossing_info[k];
+                info.0 = info.0.max(-e.d[0]);
+                info.1 |= e.state == Some(ContactState::Colliding);
+                info.2 = info.2 || clears(e);
+            }
+        }
         self.pending.clear();
         for k in 0..self.crossing.len() {
             let (ia, ib) = self.crossing[k];
-            let in_pair = |key: &VeCandidate| {
-                let pair = (key.vertex_collider, key.edge_collider);
-                pair == (ia, ib) || pair == (ib, ia)
-            };
-            // The pair's records: deepest depth, any Colliding.
-            let mut deepest = 0.0f64;
-            let mut colliding = false;
-            for e in self
-                .entries
-                .iter()
-                .filter(|e| e.is_contact() && in_pair(&e.key))
-            {
-                deepest = deepest.max(-e.d[0]);
-                colliding |= e.state == Some(ContactState::Colliding);
-            }
+            let (deepest, colliding, cleared) = self.crossing_info[k];
             if colliding {
                 continue;
             }
-            let (a, b) = (&colliders[ia as usize], &colliders[ib as usize]);
-            let Some(face) = sat_face(a, b) else {
-                continue;
-            };
             // A loaded record that left its edge's range deeper than every record left: the
             // pair's support went with it, and its depth goes to the clip records at once.
             let dropped = self
@@ -118,6 +118,13 @@ impl ContactSet {
                 .iter()
                 .filter(|(pair, _)| *pair == (ia, ib))
                 .fold(0.0f64, |m, &(_, d)| m.max(d));
+            if cleared && dropped <= deepest {
+                continue;
+            }
+            let (a, b) = (&colliders[ia as usize], &colliders[ib as usize]);
+            let Some(face) = sat_face(a, b) else {
+                continue;
+            };
             let lost = dropped > deepest && face.depth > deepest;
             if !face.admissible || (face.depth <= deepest + margin && !lost) {
                 continue;

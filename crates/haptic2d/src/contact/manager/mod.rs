@@ -72,6 +72,8 @@ pub struct ContactSet {
     pending: Vec<VeContact>,
     /// Scratch of `clip_crossing`: the pairs to test, and one pair's clip keys.
     crossing: Vec<(u32, u32)>,
+    /// Per pair of `crossing`: deepest record (m), any Colliding, any record clearing it.
+    crossing_info: Vec<(f64, bool, bool)>,
     clip_keys: Vec<VeCandidate>,
     /// Effective depths handed from released records to a crossing pair's clip records (`clip`),
     /// and the records released out of their edge range this sample, with their pair (a < b).
@@ -130,6 +132,7 @@ impl ContactSet {
             changes: Vec::with_capacity(64),
             pending: Vec::with_capacity(16),
             crossing: Vec::with_capacity(16),
+            crossing_info: Vec::with_capacity(16),
             clip_keys: Vec::with_capacity(16),
             pool: Vec::with_capacity(16),
             dropped: Vec::with_capacity(16),
