@@ -358,7 +358,13 @@ fn random_polygon_scenes_create_no_energy() {
 }
 
 #[test]
-#[ignore = "long variant: 2000 scenes of up to 6 bodies, 2 s each (minutes)"]
+/// Known failure (issue 35 item 4, open part): passive (worst excess 1.5e-8 J), but 3 of the 2000
+/// scenes hide an overlap more than `HIDDEN_EXCESS` beyond the allowance (seeds 11574: 31.0 mm,
+/// 10010: 12.1 mm, both impacts off; 11996: 10.6 mm, impacts on; 11669 and 11666 exceed the
+/// allowance by 7.2 and 5.2 mm); each of these scenes' largest overlap is with the multi-piece
+/// walls. Before the clip contacts 379 scenes hid more than 5 mm (up to 105 mm), now 14 (up to
+/// 60 mm).
+#[ignore = "long variant: 2000 scenes of up to 6 bodies, 2 s each (about a minute); fails its hidden-overlap assertion on 3 scenes (against the multi-piece walls, see the doc comment)"]
 fn random_polygon_scenes_create_no_energy_long() {
     suite(
         10_000,

@@ -14,13 +14,19 @@
 //!   `σ' = max(0, δ' − (δ − σ))` (`δ`, `δ'` the depths on the old and new edge, `σ` the old
 //!   offset), so the spring pushes as hard as before, now along the separating axis, and stores
 //!   `½·K·(δ' − σ')² ≤ ½·K·(δ − σ)²`: never more than before;
-//! - a vertex without a record starts one whose surface is at the vertex (`σ' = δ'`): it stores
-//!   nothing at creation and resists any further sinking (as the records found inside a seam
-//!   piece, `create.rs`).
+//! - a vertex without a record takes the largest effective depth left in the **pool** (capped at
+//!   its own depth): the effective depths of the pair's records released in this sample because
+//!   their vertex left the edge's range (`release.rs`), each used once. When such a record was
+//!   deeper than every record the pair has left, the pair's support went with it, and the stage
+//!   acts at once, whatever the margin (a box tilting on a stacked corner);
+//! - otherwise it starts with its surface at the vertex (`σ' = δ'`): it stores nothing at
+//!   creation and resists any further sinking (as the records found inside a seam piece,
+//!   `create.rs`).
 //!
 //! After the switch each record is an ordinary VE spring `½·K·(δ' − σ')²` on a fixed key, a
 //! function of the poses whose offset only shrinks where the spring is slack, so the stage adds
-//! no energy (the ledger's `E_stored` can only drop at a switch; the friction state starts at
+//! no energy (at a switch the new law's input depth is that of an energy the pair stored at the
+//! start of the sample, or zero, so `E_stored` never rises there; the friction state starts at
 //! zero, which drops its spring energy). The overlap that was there stays (its energy was already
 //! dissipated where the records lost it); from then on the pair is supported along its separating
 //! axis like a face on a face, so it does not grow by more than the springs' compression under
