@@ -41,8 +41,15 @@
 //!   vertex is strictly inside and the walk certifies "apart" at ~1e-20 m: hence the vertex scan
 //!   below `ε_abs`.
 //!
+//!   **Crossing corners** (addition, issue 35, §9.5b): a penetrating pair with no vertex strictly
+//!   inside the other polygon (corners crossed through each other's edges) whose separating-axis
+//!   overlap exceeds `CLIP_MARGIN·δ_c` gets its reference face's clip pairs (`clip.rs`) instead
+//!   (not flagged as the vertex scan's: they are not nearest lines). The contact manager starts
+//!   them with their surface at the vertex (`create.rs`, found inside).
+//!
 //! Candidates are sorted and deduplicated so that everything downstream is deterministic.
 
+use super::clip::{clip_pairs, sat_face, CLIP_MARGIN};
 use super::gjk::GJK_EPS_ABS;
 use super::reuse::{PairCandidates, Slack, SLOT};
 use super::tracker::{ClosestFeatures, Feature, FeatureTracker, TrackStatus};
@@ -746,8 +753,22 @@ impl LocalStage {
         let (a, b) = (sa, sb);
         match f.status {
             TrackStatus::Penetrating => {
-                ctx.vertices_against(a, b, out, &mut Slack::new());
-                ctx.vertices_against(b, a, out, &mut Slack::new());
+                let mark = out.len();
+                let inside_a = ctx.vertices_against(a, b, out, &mut Slack::new());
+                let inside_b = ctx.vertices_against(b, a, out, &mut Slack::new());
+                // Crossing corners with no vertex inside (§9.5b): the reference face's clip
+                // pairs, if the pair overlaps by more than the clip margin (`clip.rs`).
+                if inside_a.is_none() && inside_b.is_none() {
+                    if let Some(face) = sat_face(a.c, b.c) {
+                        if face.admissible && face.depth > CLIP_MARGIN * delta_c {
+                            let scanned = out.len();
+                            if clip_pairs((a.id, a.c), (b.id, b.c), &face, ctx.eps_s, out) > 0 {
+                                replace_scanned(out, mark, scanned);
+                                return false;
+                            }
+                        }
+                    }
+                }
                 true
             }
             // Closer than GJK's ε_abs, "apart" is not a certificate: two equal boxes stacked
@@ -769,6 +790,26 @@ impl LocalStage {
             TrackStatus::Separated => false,
         }
     }
+}
+
+/// Drops from `out[mark..scanned]` (a pair's vertex scan) every candidate whose vertex has a clip
+/// pair in `out[scanned..]`, keeping the order: one candidate per vertex, the clip pair (a vertex
+/// the scan proposes with no vertex inside is within `δ_c` outside a line; its clip pair holds it
+/// along the separating axis).
+fn replace_scanned(out: &mut Vec<VeCandidate>, mark: usize, scanned: usize) {
+    let mut keep = mark;
+    for i in mark..out.len() {
+        let c = out[i];
+        let clipped = i < scanned
+            && out[scanned..]
+                .iter()
+                .any(|k| (k.vertex_collider, k.vertex) == (c.vertex_collider, c.vertex));
+        if !clipped {
+            out[keep] = c;
+            keep += 1;
+        }
+    }
+    out.truncate(keep);
 }
 
 /// Sorts and deduplicates `out` (the candidates of one update) with their flags `flag`
@@ -1233,40 +1274,7 @@ pub fn sat_depth(a: &Collider, b: &Collider) -> f64 {
 /// [`sat_depth`] with its axis: `(depth, u)`, `u` the unit direction in which `a` moves
 /// (relative to `b`) to separate by `depth`; `u = 0` when the pair is apart.
 pub fn sat_axis(a: &Collider, b: &Collider) -> (f64, Vec2) {
-    let seams = a.seams != 0 || b.seams != 0;
-    let mut best = (f64::INFINITY, Vec2::ZERO);
-    let mut fallback = (f64::INFINITY, Vec2::ZERO);
-    for (p, q, sign) in [(a, b, -1.0), (b, a, 1.0)] {
-        for e in 0..p.len() {
-            // Overlap along n_e: how far q's deepest vertex is behind p's edge line e.
-            let min_d = q
-                .world_vertices()
-                .iter()
-                .map(|&v| p.edge_distance(e, v))
-                .fold(f64::INFINITY, f64::min);
-            if min_d >= 0.0 {
-                return (0.0, Vec2::ZERO);
-            }
-            if seams && p.is_seam(e) {
-                continue;
-            }
-            let u = p.world_normals()[e] * sign;
-            if -min_d < fallback.0 {
-                fallback = (-min_d, u);
-            }
-            let through = seams && (through_seam(b, u) || through_seam(a, -u));
-            if !through && -min_d < best.0 {
-                best = (-min_d, u);
-            }
-        }
-    }
-    if best.0.is_finite() {
-        best
-    } else if fallback.0.is_finite() {
-        fallback
-    } else {
-        (0.0, Vec2::ZERO)
-    }
+    super::clip::sat_face(a, b).map_or((0.0, Vec2::ZERO), |f| (f.depth, f.axis))
 }
 
 /// Whether moving a body relative to `c` along `u` has a component out through a seam of `c`

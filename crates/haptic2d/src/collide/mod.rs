@@ -6,6 +6,8 @@
 //! - [`BroadPhase`] (`broad/`): inflated AABBs, sort-and-sweep, GJK → proximity set (§9.1);
 //! - [`FeatureTracker`] (`tracker.rs`): Lin–Canny closest features per pair (§9.3);
 //! - [`LocalStage`] (`local.rs`): one tracker per proximate pair, VE candidates (§9.4–9.5);
+//! - [`sat_face`], [`clip_pairs`] (`clip.rs`): the reference face of an overlapping pair and its
+//!   clip contacts (Box2D's polygon clipping as vertex–edge pairs, crossing corners);
 //! - [`mark_seams`] (`seam.rs`): the internal edges of multi-piece bodies, never contact normals;
 //! - [`swept_put_back`] (`toi.rs`): the swept test (time of impact) for bodies too fast for one
 //!   sample, and the speed limits the world guarantees ([`speed_limit`], [`allowed_depth`]).
@@ -18,6 +20,7 @@
 //! ```
 
 mod broad;
+mod clip;
 mod collider;
 mod gjk;
 mod local;
@@ -28,6 +31,7 @@ mod toi;
 mod tracker;
 
 pub use broad::{required_delta_prox, BroadPhase, BroadStats, DEFAULT_DELTA_PROX};
+pub use clip::{admissible_axis, clip_pairs, incident_edge, sat_face, SatFace, CLIP_MARGIN};
 pub use collider::Collider;
 pub use gjk::{
     gjk_distance, support_hill_climb, GjkCache, GjkOutput, GJK_EPS_ABS, GJK_EPS_REL,

@@ -16,6 +16,7 @@
 //! `cargo test -p haptic2d --test it passivity_random:: -- --nocapture` prints the one-line summary;
 //! `-- --ignored` runs the long variant (2000 scenes of up to 6 bodies, 2 s each).
 
+use haptic2d::collide::{CLIP_MARGIN, DEFAULT_DELTA_C};
 use haptic2d::scene::Scene;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -24,21 +25,31 @@ use std::fmt::Write as _;
 /// The passivity bound on the excess, per scene (J).
 const EXCESS_TOL: f64 = 1e-3;
 /// Bound on the largest overlap of two bodies in any scene (m, separating-axis depth,
-/// `World::max_overlap`): the geometry the suite asserts besides passivity (issue 35). Measured
-/// over the 300 scenes: median 19.0 mm, largest 126.4 mm (main before issue 35: 126.9 mm, the
-/// same scenes): heavy bodies (made denser for the minimum-mass rule) resting on the softest
-/// laws sink by about `m·g/K` into the floor. So this is a regression bound (a body that sinks
-/// through the 100 mm floor, or tunnels, exceeds it), not a derived one.
-///
-/// Not yet tightened (issue 35 item 4, crossing corners, still open). Measured on 5 December
-/// 2026 (branch dev-contacts, a throwaway print of the largest overlap beside the deepest
-/// contact record at each sample, world-wide, not per pair): in 45 of the 300 scenes the overlap
-/// was at some sample more than 5 mm above the deepest record (up to 102 mm against 36 mm,
-/// seed 283), 43 of them with impacts off, in the first 0.2–0.5 s: a body the springs alone stop
-/// late sinks until its corners cross the other body's, where a vertex's nearest edge line is
-/// shallow. A bound derived from a fix (an edge–edge or clipping contact for crossing corners)
-/// is still to come.
+/// `World::max_overlap`). Measured over the 300 scenes: median 18.5 mm, largest 126.4 mm (main
+/// before issue 35: 126.9 mm, the same scenes): heavy bodies (made denser for the minimum-mass
+/// rule) resting on the softest laws sink by about `m·g/K` into the floor, and that depth is the
+/// records' own (seen, not hidden). So this is a regression bound (a body that sinks through the
+/// 100 mm floor, or tunnels, exceeds it), not a derived one; the geometry the suite derives is
+/// the hidden overlap below.
 const OVERLAP_BOUND: f64 = 0.15;
+/// The hidden overlap (issue 35 item 4, docs/MODELS.md §9.5b): at every sample, the world's
+/// largest overlap less its deepest contact record. Derived allowance: the clip contacts act
+/// when a pair's overlap exceeds its deepest record by `CLIP_MARGIN·δ_c` (1 mm), before the
+/// sample's integration, which can then move two bodies by at most their one-sample motion
+/// (`2·T·max(|v| + |ω|·LEVER)`, measured each sample), so `hidden ≤ CLIP_MARGIN·δ_c + motion`.
+/// Measured on branch `corners` (5 December 2026): that holds in 299 of the 300 scenes; seed 291
+/// (impacts off) exceeds it by 6.1 mm at a seam joint: a triangle's corner 2 mm into the floor
+/// slab *under* the right wall slab (the floor's top edge is partly covered, so it stays a
+/// surface there and its record pushes the corner up, into the wall slab), while the wall slab's
+/// overlap (6–13 mm along x, the only admissible axis) has as clip pair only the slab's corner
+/// against the triangle's edge, a record already. So the bound asserted is the allowance plus
+/// `HIDDEN_EXCESS` = 8 mm, a measured figure; before the clip contacts (same scenes) 45 scenes
+/// hid more than 5 mm, up to 76.3 mm.
+const HIDDEN_EXCESS: f64 = 0.008;
+/// Lever (m) of a body's spin in the one-sample motion bound: a vertex of a generated polygon is
+/// at most `r ≤ 80 mm` from the polygon's frame origin, and its centre of mass is inside it, so
+/// at most `2r` from any vertex.
+const LEVER: f64 = 0.16;
 /// Side of the closed box (m); the walls are 0.1 m thick outside it.
 const BOX: f64 = 0.6;
 
@@ -198,6 +209,11 @@ struct Outcome {
     excess: f64,
     /// Largest overlap of two bodies over the run (m, separating-axis depth, `World::max_overlap`).
     overlap: f64,
+    /// Largest hidden overlap over the run (m): the world's largest overlap less its deepest
+    /// contact record, at one sample.
+    hidden: f64,
+    /// Largest hidden overlap beyond its allowance (m, `HIDDEN_ALLOWANCE`; ≤ 0 when it holds).
+    beyond: f64,
     normal: &'static str,
     friction: &'static str,
     impacts: bool,
@@ -213,19 +229,35 @@ fn max_excess(seed: u64, g: &Gen) -> Outcome {
     w.prime();
     let mut worst = w.ledger().excess();
     let mut overlap = w.max_overlap().depth;
+    let mut hidden = 0.0f64;
+    let dt = w.params.dt;
+    let mut beyond = f64::NEG_INFINITY;
     for _ in 0..(g.seconds / w.params.dt).round() as usize {
+        // One sample's relative motion of two bodies, at most (see `HIDDEN_ALLOWANCE`).
+        let motion = 2.0
+            * dt
+            * w.bodies
+                .iter()
+                .filter(|b| b.is_dynamic())
+                .map(|b| b.vel.length() + b.omega.abs() * LEVER)
+                .fold(0.0, f64::max);
         w.step();
         worst = worst.max(w.ledger().excess());
         let o = w.max_overlap();
         if o.depth > overlap {
             overlap = o.depth;
         }
+        let deepest = w.contact_records().map(|c| -c.d[0]).fold(0.0, f64::max);
+        hidden = hidden.max(o.depth - deepest);
+        beyond = beyond.max(o.depth - deepest - CLIP_MARGIN * DEFAULT_DELTA_C - motion);
     }
     assert!(worst.is_finite(), "scene {seed} diverged\n{text}");
     Outcome {
         seed,
         excess: worst,
         overlap,
+        hidden,
+        beyond,
         normal,
         friction,
         impacts,
@@ -248,6 +280,37 @@ fn suite(first_seed: u64, scenes: u64, g: &Gen) {
     let mut overlaps: Vec<f64> = results.iter().map(|r| r.overlap).collect();
     overlaps.sort_by(f64::total_cmp);
     let beyond_5mm = overlaps.iter().filter(|&&o| o > 0.005).count();
+    let mut hidden: Vec<(f64, u64, bool)> = results
+        .iter()
+        .map(|r| (r.hidden, r.seed, r.impacts))
+        .collect();
+    hidden.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let hidden_over: Vec<_> = results
+        .iter()
+        .filter(|r| r.beyond > HIDDEN_EXCESS)
+        .collect();
+    let mut beyond: Vec<(f64, u64, bool)> = results
+        .iter()
+        .map(|r| (r.beyond, r.seed, r.impacts))
+        .collect();
+    beyond.sort_by(|a, b| b.0.total_cmp(&a.0));
+    println!(
+        "passivity_random: hidden overlap beyond its allowance: worst {:.3} mm; scenes above: {:?}",
+        beyond[0].0 * 1e3,
+        beyond
+            .iter()
+            .filter(|b| b.0 > 0.0)
+            .map(|b| (b.1, b.2, (b.0 * 1e6).round() / 1e3))
+            .collect::<Vec<_>>()
+    );
+    println!(
+        "passivity_random: hidden overlap (largest overlap less deepest record): max {:.2} mm (scene {}, impacts {}); {} scenes above 5 mm, {} above 2 mm",
+        hidden[0].0 * 1e3,
+        hidden[0].1,
+        hidden[0].2,
+        hidden.iter().filter(|h| h.0 > 0.005).count(),
+        hidden.iter().filter(|h| h.0 > 0.002).count(),
+    );
     println!(
         "passivity_random: {scenes} scenes (seeds {first_seed}..{}), up to {} bodies, {} s each: \
          worst excess {worst:.3e} J (scene {worst_seed}), {} above {EXCESS_TOL} J",
@@ -262,6 +325,12 @@ fn suite(first_seed: u64, scenes: u64, g: &Gen) {
         overlaps[overlaps.len() - 1] * 1e3,
         deep.len(),
         OVERLAP_BOUND * 1e3
+    );
+    assert!(
+        hidden_over.is_empty(),
+        "{} scenes hid an overlap more than {HIDDEN_EXCESS} m beyond CLIP_MARGIN·δ_c plus one \
+         sample's motion: {hidden_over:#?}",
+        hidden_over.len()
     );
     assert!(
         deep.is_empty(),
@@ -289,7 +358,13 @@ fn random_polygon_scenes_create_no_energy() {
 }
 
 #[test]
-#[ignore = "long variant: 2000 scenes of up to 6 bodies, 2 s each (minutes)"]
+/// Known failure (issue 35 item 4, open part): passive (worst excess 1.5e-8 J), but 3 of the 2000
+/// scenes hide an overlap more than `HIDDEN_EXCESS` beyond the allowance (seeds 11574: 31.0 mm,
+/// 10010: 12.1 mm, both impacts off; 11996: 10.6 mm, impacts on; 11669 and 11666 exceed the
+/// allowance by 7.2 and 5.2 mm); each of these scenes' largest overlap is with the multi-piece
+/// walls. Before the clip contacts 379 scenes hid more than 5 mm (up to 105 mm), now 14 (up to
+/// 60 mm).
+#[ignore = "long variant: 2000 scenes of up to 6 bodies, 2 s each (about a minute); fails its hidden-overlap assertion on 3 scenes (against the multi-piece walls, see the doc comment)"]
 fn random_polygon_scenes_create_no_energy_long() {
     suite(
         10_000,

@@ -204,7 +204,10 @@ impl ContactSet {
 /// of `laws/normal/impact_offset.rs`, `σ = δ`): it stores nothing at creation, resists any
 /// further penetration, and follows the vertex back out. The overlap stays (reported by
 /// [`World::max_overlap`](crate::world::World::max_overlap)), and no energy appears. Records at
-/// `t = 0` (no history) keep their depth, as before. Only pieces with seams: elsewhere a record
+/// `t = 0` (no history) keep their depth, as before. The same for a pair the vertex scan did not
+/// propose (issue 35, §9.5b): the clip pairs of crossing corners with no vertex inside, whose
+/// depth nothing paid for either (a separated pair's closest-feature candidates are never
+/// `δ_c` behind their line). Otherwise only pieces with seams: elsewhere a record
 /// released and created again deep (a recollision, a vertex past an edge's end) would lose its
 /// depth each time and let a body sink (random scenes fell 100 mm into the floor).
 fn found_inside(
@@ -214,7 +217,9 @@ fn found_inside(
     laws: &mut crate::contact::law_pool::LawPool,
 ) {
     let seams = colliders[e.key.edge_collider as usize].seams != 0;
-    if seams && e.hist >= 2 && e.d[0] < 0.0 && e.d[1] < -delta_c {
+    // A clip pair of crossing corners (`collide/clip.rs`, not the vertex scan's) found deep.
+    let clip = !e.nearest_edge;
+    if (seams || clip) && e.hist >= 2 && e.d[0] < 0.0 && e.d[1] < -delta_c {
         laws.impact_resolved(e.law, e.d, 0);
     }
 }

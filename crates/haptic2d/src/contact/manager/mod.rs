@@ -7,7 +7,7 @@
 //!
 //! The step runs in stages, one file each, in the order of the spec (called in this order by
 //! [`ContactSet::step`]): [`sync`] (merge and measure), [`release`] (§8.2 rules 4–5), [`hand_over`]
-//! (the depth invariant), [`create`] (§8.2 rules 1–2, §8.3), [`impacts`] (§7), [`forces`] (§1–§4,
+//! (the depth invariant), [`create`] (§8.2 rules 1–2, §8.3), [`clip`] (crossing corners held on the separating axis, §9.5b), [`impacts`] (§7), [`forces`] (§1–§4,
 //! §5.9); [`invariant`] holds the depth invariant's checks.
 //!
 //! The merge's pass, which measures every pair, also applies the tests of release, hand-over
@@ -16,6 +16,7 @@
 //! forces) instead of five. The merge changes the set in place, moving only the entries
 //! between its changes.
 
+mod clip;
 mod create;
 mod forces;
 mod hand_over;
@@ -67,6 +68,15 @@ pub struct ContactSet {
     /// The differences the last merge found (`sync`), reused.
     changes: Vec<sync::Change>,
     pending: Vec<VeContact>,
+    /// Scratch of `clip_crossing`: the pairs to test, and one pair's clip keys.
+    crossing: Vec<(u32, u32)>,
+    /// Per pair of `crossing`: deepest record (m), any Colliding, any record clearing it.
+    crossing_info: Vec<(f64, bool, bool)>,
+    clip_keys: Vec<VeCandidate>,
+    /// Effective depths handed from released records to a crossing pair's clip records (`clip`),
+    /// and the records released out of their edge range this sample, with their pair (a < b).
+    pool: Vec<f64>,
+    dropped: Vec<((u32, u32), f64)>,
     events: Vec<ContactEvent>,
     rows: Vec<ImpactRow>,
     /// The entries (indices) of this sample's impact set, ascending (empty without an impact).
@@ -119,6 +129,11 @@ impl ContactSet {
             laws: LawPool::with_capacity(64),
             changes: Vec::with_capacity(64),
             pending: Vec::with_capacity(16),
+            crossing: Vec::with_capacity(16),
+            crossing_info: Vec::with_capacity(16),
+            clip_keys: Vec::with_capacity(16),
+            pool: Vec::with_capacity(16),
+            dropped: Vec::with_capacity(16),
             events: Vec::with_capacity(64),
             rows: Vec::with_capacity(16),
             row_entry: Vec::with_capacity(16),
@@ -322,6 +337,7 @@ impl ContactSet {
         let past = &past;
         let mut lap = Lap::start();
         self.events.clear();
+        self.dropped.clear();
         self.last_impact_loss = 0.0;
         self.row_entry.clear();
         self.struck_entry.clear();
@@ -344,6 +360,9 @@ impl ContactSet {
         // may start another one in the same sample.
         let any_colliding = (work.create || !self.events.is_empty())
             && self.create(tick, dt, colliders, bodies, past, normal, friction);
+        // Crossing corners: a pair overlapping deeper than its records is held on its
+        // separating axis (`clip`, issue 35).
+        self.clip_crossing(tick, colliders, bodies, past, normal, friction);
         if any_colliding {
             // Impact friction mode and coefficient (default μ = the friction model's μ_k; docs/MODELS.md §E).
             let mu = (self.params.impact_mu)

@@ -13,6 +13,16 @@ impl ContactSet {
                 continue;
             }
             if e.d[0] > p.delta_off || !e.in_range(p.eps_s) {
+                // A loaded record leaving its edge's range: its effective depth may go to its
+                // pair's clip records (crossing corners, `clip.rs`) in this sample.
+                if e.d[0] <= p.delta_off {
+                    let offset = self.laws.get(e.law).map_or(0.0, |l| l.normal.offset());
+                    let depth = -e.d[0] - offset;
+                    if depth > 0.0 {
+                        let (a, b) = (e.key.vertex_collider, e.key.edge_collider);
+                        self.dropped.push(((a.min(b), a.max(b)), depth));
+                    }
+                }
                 e.state = None;
                 self.laws.release(e.law);
                 e.law = NO_LAW;

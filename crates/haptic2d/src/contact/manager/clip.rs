@@ -1,0 +1,261 @@
+//! Stage 4b of the contact step (issue 35, crossing corners; docs/MODELS.md §9.5b): a pair whose
+//! separating-axis overlap runs deeper than its deepest record is held on its reference face.
+//!
+//! Where corners cross, each polygon's corner can sit on a *side* face of the other: the records'
+//! normals are nearly perpendicular to the load and antagonistic, they hold none of it, and the
+//! bodies sink into each other (`stack-5-polygons-interpenetrate.toml`), while every vertex stays
+//! within a few millimetres of some line of the other polygon. When a pair's overlap `D`
+//! ([`sat_face`]) exceeds the depth of its deepest record by more than [`CLIP_MARGIN`]·`δ_c`, its
+//! clip pairs ([`clip_pairs`]: Box2D's reference-face clipping as vertex–edge pairs) become
+//! Continuous records:
+//!
+//! - a vertex with a record on another edge of the same polygon is **handed over** to its clip
+//!   edge with its law's effective depth kept: the new law's surface offset is
+//!   `σ' = max(0, δ' − (δ − σ))` (`δ`, `δ'` the depths on the old and new edge, `σ` the old
+//!   offset), so the spring pushes as hard as before, now along the separating axis, and stores
+//!   `½·K·(δ' − σ')² ≤ ½·K·(δ − σ)²`: never more than before;
+//! - a vertex without a record takes the largest effective depth left in the **pool** (capped at
+//!   its own depth): the effective depths of the pair's records released in this sample because
+//!   their vertex left the edge's range (`release.rs`), each used once. When such a record was
+//!   deeper than every record the pair has left, the pair's support went with it, and the stage
+//!   acts at once, whatever the margin (a box tilting on a stacked corner);
+//! - otherwise it starts with its surface at the vertex (`σ' = δ'`): it stores nothing at
+//!   creation and resists any further sinking (as the records found inside a seam piece,
+//!   `create.rs`).
+//!
+//! After the switch each record is an ordinary VE spring `½·K·(δ' − σ')²` on a fixed key, a
+//! function of the poses whose offset only shrinks where the spring is slack, so the stage adds
+//! no energy (at a switch the new law's input depth is that of an energy the pair stored at the
+//! start of the sample, or zero, so `E_stored` never rises there; the friction state starts at
+//! zero, which drops its spring energy). The overlap that was there stays (its energy was already
+//! dissipated where the records lost it); from then on the pair is supported along its separating
+//! axis like a face on a face, so it does not grow by more than the springs' compression under
+//! the load. Every clip pair is no deeper than `D` (see `collide/clip.rs`), so the records satisfy
+//! the depth invariant's overlap bound and the hand-over stage keeps them.
+//!
+//! **Cost.** Every sample each record is tested against the overlap of the two polygons along its
+//! own normal (`O(n)`, the deepest vertex of the vertex polygon behind its edge line): the pair's
+//! overlap is no more than that, so a record for which it is within the margin of the record's
+//! own depth clears its pair, and the separating-axis test runs only for the pairs none of whose
+//! records clears it. (On a piece with seams the record's normal clears the pair only if it is an
+//! admissible axis: a body sunk into the joint of a floor and a wall slab has its one record on
+//! the slab's corner, whose normal would move the body out through the joint.)
+
+use super::sync::new_entry;
+use super::ContactSet;
+use super::PastPoses;
+use crate::body::Body;
+use crate::collide::{admissible_axis, clip_pairs, sat_face, Collider, VeCandidate, CLIP_MARGIN};
+use crate::contact::record::{ContactEvent, ContactState, EventKind, VeContact, NO_LAW};
+use crate::laws::friction::FrictionModel;
+use crate::laws::normal::NormalModel;
+
+impl ContactSet {
+    /// Holds every pair whose overlap exceeds its deepest record's depth by more than
+    /// `CLIP_MARGIN·δ_c` on its reference face (module docs). Runs after `create`, before the
+    /// impacts; a pair with a Colliding record waits for its impact.
+    pub(super) fn clip_crossing(
+        &mut self,
+        tick: u64,
+        colliders: &[Collider],
+        bodies: &[Body],
+        past: &PastPoses<'_>,
+        normal: &NormalModel,
+        friction: &FrictionModel,
+    ) {
+        let margin = CLIP_MARGIN * self.delta_c;
+        // The own-axis test of a record: the overlap along its normal is within the margin of
+        // its depth, on an admissible axis (a seam's piece is cleared through its surface only,
+        // `sat_depth`); then the pair's overlap is too.
+        let clears = |e: &VeContact| {
+            let ca = &colliders[e.key.vertex_collider as usize];
+            let cb = &colliders[e.key.edge_collider as usize];
+            let edge = e.key.edge as usize;
+            let along = ca
+                .world_vertices()
+                .iter()
+                .map(|&v| -cb.edge_distance(edge, v))
+                .fold(f64::NEG_INFINITY, f64::max);
+            along <= -e.d[0] + margin && !cb.is_seam(edge) && admissible_axis(ca, cb, e.n)
+        };
+        let pair_of = |key: &VeCandidate| {
+            let (a, b) = (key.vertex_collider, key.edge_collider);
+            (a.min(b), a.max(b))
+        };
+        // Pairs (a < b) with a record whose own-axis test fails, and those that lost a loaded
+        // record out of its edge range this sample (`release`).
+        self.crossing.clear();
+        for e in self.entries.iter().filter(|e| e.is_contact()) {
+            if !clears(e) {
+                self.crossing.push(pair_of(&e.key));
+            }
+        }
+        for &(pair, _) in &self.dropped {
+            self.crossing.push(pair);
+        }
+        if self.crossing.is_empty() {
+            return;
+        }
+        self.crossing.sort_unstable();
+        self.crossing.dedup();
+        // Each such pair's records, in one pass: deepest depth, any Colliding, any that clears it.
+        self.crossing_info.clear();
+        self.crossing_info
+            .resize(self.crossing.len(), (0.0, false, false));
+        for e in self.entries.iter().filter(|e| e.is_contact()) {
+            if let Ok(k) = self.crossing.binary_search(&pair_of(&e.key)) {
+                let info = &mut self.crossing_info[k];
+                info.0 = info.0.max(-e.d[0]);
+                info.1 |= e.state == Some(ContactState::Colliding);
+                info.2 = info.2 || clears(e);
+            }
+        }
+        self.pending.clear();
+        for k in 0..self.crossing.len() {
+            let (ia, ib) = self.crossing[k];
+            let (deepest, colliding, cleared) = self.crossing_info[k];
+            if colliding {
+                continue;
+            }
+            // A loaded record that left its edge's range deeper than every record left: the
+            // pair's support went with it, and its depth goes to the clip records at once.
+            let dropped = self
+                .dropped
+                .iter()
+                .filter(|(pair, _)| *pair == (ia, ib))
+                .fold(0.0f64, |m, &(_, d)| m.max(d));
+            if cleared && dropped <= deepest {
+                continue;
+            }
+            let (a, b) = (&colliders[ia as usize], &colliders[ib as usize]);
+            let Some(face) = sat_face(a, b) else {
+                continue;
+            };
+            let lost = dropped > deepest && face.depth > deepest;
+            if !face.admissible || (face.depth <= deepest + margin && !lost) {
+                continue;
+            }
+            self.clip_keys.clear();
+            clip_pairs(
+                (ia, a),
+                (ib, b),
+                &face,
+                self.params.eps_s,
+                &mut self.clip_keys,
+            );
+            if self.clip_keys.is_empty() {
+                continue;
+            }
+            // The pool: the effective depths of the pair's records released out of their edge
+            // range this sample.
+            self.pool.clear();
+            for &(pair, depth) in &self.dropped {
+                if pair == (ia, ib) {
+                    self.pool.push(depth);
+                }
+            }
+            self.dropped.retain(|&(pair, _)| pair != (ia, ib));
+            // Largest last (popped first).
+            self.pool.sort_unstable_by(f64::total_cmp);
+            // The clip pairs deepest first.
+            let geo = |key: &VeCandidate| {
+                let ca = &colliders[key.vertex_collider as usize];
+                let cb = &colliders[key.edge_collider as usize];
+                cb.edge_distance(key.edge as usize, ca.world_vertices()[key.vertex as usize])
+            };
+            self.clip_keys.sort_by(|x, y| geo(x).total_cmp(&geo(y)));
+            for c in 0..self.clip_keys.len() {
+                let key = self.clip_keys[c];
+                self.hold(tick, key, colliders, bodies, past, normal, friction);
+            }
+        }
+        self.dropped.clear();
+        if !self.pending.is_empty() {
+            self.entries.extend_from_slice(&self.pending);
+            self.entries.sort_unstable_by_key(|e| e.key);
+            self.pending.clear();
+        }
+    }
+
+    /// Makes the clip pair `key` a Continuous record (module docs): nothing if it is one; the
+    /// vertex's record on another edge of the same collider is handed over with its effective
+    /// depth; otherwise a record whose law starts at the largest effective depth left in the pool
+    /// (capped at its own depth), or with its surface at the vertex when the pool is empty.
+    #[allow(clippy::too_many_arguments)]
+    fn hold(
+        &mut self,
+        tick: u64,
+        key: VeCandidate,
+        colliders: &[Collider],
+        bodies: &[Body],
+        past: &PastPoses<'_>,
+        normal: &NormalModel,
+        friction: &FrictionModel,
+    ) {
+        let group = |x: &VeCandidate| {
+            (x.vertex_collider, x.vertex, x.edge_collider)
+                == (key.vertex_collider, key.vertex, key.edge_collider)
+        };
+        if self
+            .entries
+            .iter()
+            .chain(&self.pending)
+            .any(|e| e.key == key && e.is_contact())
+        {
+            return;
+        }
+        let kept = if let Some(old) = self
+            .entries
+            .iter()
+            .position(|e| group(&e.key) && e.is_contact())
+        {
+            let e = &self.entries[old];
+            if e.state != Some(ContactState::Continuous) {
+                return;
+            }
+            let offset = self.laws.get(e.law).map_or(0.0, |l| l.normal.offset());
+            let kept = (-e.d[0] - offset).max(0.0);
+            let e = &mut self.entries[old];
+            e.state = None;
+            self.laws.release(e.law);
+            e.law = NO_LAW;
+            e.f_n = 0.0;
+            e.f_t = 0.0;
+            self.events.push(ContactEvent {
+                tick,
+                key: e.key,
+                kind: EventKind::Released,
+            });
+            kept
+        } else {
+            self.pool.pop().unwrap_or(0.0)
+        };
+        let start = |n: &mut VeContact, laws: &mut crate::contact::law_pool::LawPool| {
+            n.state = Some(ContactState::Continuous);
+            n.since = tick;
+            n.m_eff = 0.0;
+            n.s_g = n.s.clamp(0.0, n.len);
+            n.s_entry = n.s_g;
+            n.law = laws.acquire(normal, friction, n.s_g);
+            // Offset σ' = δ' − kept (the law's depth history shifted by it, `impact_offset.rs`).
+            let depth = (-n.d[0]).max(0.0);
+            laws.impact_resolved(n.law, [-depth, -kept.min(depth), 0.0], 2);
+        };
+        match self.entries.binary_search_by(|x| x.key.cmp(&key)) {
+            Ok(t) => {
+                let n = &mut self.entries[t];
+                start(n, &mut self.laws);
+            }
+            Err(_) => {
+                let mut n = new_entry(tick, key, colliders, bodies, past);
+                start(&mut n, &mut self.laws);
+                self.pending.push(n);
+            }
+        }
+        self.events.push(ContactEvent {
+            tick,
+            key,
+            kind: EventKind::Created(ContactState::Continuous),
+        });
+    }
+}
