@@ -19,6 +19,7 @@ mod conformance_impacts_truth;
 mod contact_g1_g2;
 mod contacts_truth;
 mod control_x1_x3;
+mod crossing_corners;
 mod device_d1_d6;
 mod device_params_files;
 mod fixed_body_velocity;

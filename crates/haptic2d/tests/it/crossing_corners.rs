@@ -11,7 +11,7 @@ use haptic2d::collide::{CLIP_MARGIN, DEFAULT_DELTA_C};
 use haptic2d::scene::Scene;
 use haptic2d::world::World;
 
-const STACK: &str = include_str!("repro/stack-5-polygons-interpenetrate.toml");
+const STACK: &str = include_str!("../repro/stack-5-polygons-interpenetrate.toml");
 
 fn world(text: &str, name: &str) -> World {
     let mut w = Scene::from_toml(text, name, None)
