@@ -9,6 +9,7 @@
 use crate::exit::{Failure, Status};
 use crate::scene_arg;
 use crate::world_mcap::{OverlapSummary, WorldOut};
+use haptic2d::world::World;
 use haptic2d::scene::MAX_SAMPLES;
 use haptic2d_rt::signal::install_stop_signals;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -168,6 +169,26 @@ pub fn run(a: &SimulateArgs) -> Result<Status, Failure> {
         "max (kinetic + stored) − (initial + applied work) over the run: {max_excess:.3e} J; contacts now {}, at most {max_contacts}",
         world.contacts().contact_count(),
     );
+    print_contacts(&world, max_depth, &overlap);
+    if let Some(p) = a.out {
+        println!("wrote {}", p.display());
+    }
+    if max_excess > ENERGY_EXCESS_BOUND_J {
+        eprintln!(
+            "warning: the world generated energy: excess {max_excess:.3e} J above the bound {ENERGY_EXCESS_BOUND_J:e} J (§13.1){}",
+            if a.strict { "" } else { " (--strict makes this exit 5)" }
+        );
+        if a.strict && status == Status::Clean {
+            status = Status::EnergyExcess;
+        }
+    }
+    Ok(status)
+}
+
+/// The summary's contact lines: the deepest contact penetration (now and over the run, `max_depth`
+/// in m), the true largest overlap of two bodies, and the large-impact-island counters when any
+/// large island occurred.
+fn print_contacts(world: &World, max_depth: f64, overlap: &OverlapSummary) {
     let depth_now = world.contact_records().map(|c| -c.d[0]).fold(0.0, f64::max);
     println!(
         "deepest contact penetration: {:.3} mm at the end, {:.3} mm over the run",
@@ -196,17 +217,4 @@ pub fn run(a: &SimulateArgs) -> Result<Status, Failure> {
             budget.islands, budget.row_updates, budget.phases_cut, budget.restitution_scaled
         );
     }
-    if let Some(p) = a.out {
-        println!("wrote {}", p.display());
-    }
-    if max_excess > ENERGY_EXCESS_BOUND_J {
-        eprintln!(
-            "warning: the world generated energy: excess {max_excess:.3e} J above the bound {ENERGY_EXCESS_BOUND_J:e} J (§13.1){}",
-            if a.strict { "" } else { " (--strict makes this exit 5)" }
-        );
-        if a.strict && status == Status::Clean {
-            status = Status::EnergyExcess;
-        }
-    }
-    Ok(status)
 }

@@ -144,7 +144,7 @@ fn assert_pse_recovered(each: &[Vec<ConditionResult>], name: &str, expected: f64
 /// A tapped mass on a spring: the probe (m = 0.5 kg) meets two corner springs k in parallel
 /// (K = 2k) at speed v, crossing the surface at mid-sample. The force at the window's last sample,
 /// (N_w − ½)·T after the crossing, is `K·v·sin(ω t)/ω` (`ω² = K/m`: the free mass–spring solution,
-/// Thomson, Theory of Vibration, §2.1), so the rate-hardness is `K·sin(ω t)/(ω·N_w·T)`.
+/// Thomson, Theory of Vibration, section 2.1), so the rate-hardness is `K·sin(ω t)/(ω·N_w·T)`.
 #[test]
 fn tapping_a_spring_gives_the_rate_hardness_of_the_mass_spring_solution() {
     let (study, _) = load("wall-laws-tap.toml");

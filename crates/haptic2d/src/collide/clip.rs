@@ -181,6 +181,51 @@ pub fn clip_pairs(
     out.len() - start
 }
 
+/// Crossing corners with no vertex inside (§9.5b): when the pair overlaps by more than the clip
+/// margin, the reference face's clip pairs ([`clip_pairs`]) replace the vertex scan in `out[mark..]`.
+/// Returns whether they did.
+pub fn clip_crossing_corners(
+    a: (u32, &Collider),
+    b: (u32, &Collider),
+    eps_s: f64,
+    delta_c: f64,
+    mark: usize,
+    out: &mut Vec<VeCandidate>,
+) -> bool {
+    let Some(face) = sat_face(a.1, b.1) else {
+        return false;
+    };
+    if !(face.admissible && face.depth > CLIP_MARGIN * delta_c) {
+        return false;
+    }
+    let scanned = out.len();
+    if clip_pairs(a, b, &face, eps_s, out) > 0 {
+        replace_scanned(out, mark, scanned);
+        return true;
+    }
+    false
+}
+
+/// Drops from `out[mark..scanned]` (a pair's vertex scan) every candidate whose vertex has a clip
+/// pair in `out[scanned..]`, keeping the order: one candidate per vertex, the clip pair (a vertex
+/// the scan proposes with no vertex inside is within `δ_c` outside a line; its clip pair holds it
+/// along the separating axis).
+fn replace_scanned(out: &mut Vec<VeCandidate>, mark: usize, scanned: usize) {
+    let mut keep = mark;
+    for i in mark..out.len() {
+        let c = out[i];
+        let clipped = i < scanned
+            && out[scanned..]
+                .iter()
+                .any(|k| (k.vertex_collider, k.vertex) == (c.vertex_collider, c.vertex));
+        if !clipped {
+            out[keep] = c;
+            keep += 1;
+        }
+    }
+    out.truncate(keep);
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -49,7 +49,7 @@
 //!
 //! Candidates are sorted and deduplicated so that everything downstream is deterministic.
 
-use super::clip::{clip_pairs, sat_face, CLIP_MARGIN};
+use super::clip::clip_crossing_corners;
 use super::gjk::GJK_EPS_ABS;
 use super::reuse::{PairCandidates, Slack, SLOT};
 use super::tracker::{ClosestFeatures, Feature, FeatureTracker, TrackStatus};
@@ -756,20 +756,11 @@ impl LocalStage {
                 let mark = out.len();
                 let inside_a = ctx.vertices_against(a, b, out, &mut Slack::new());
                 let inside_b = ctx.vertices_against(b, a, out, &mut Slack::new());
-                // Crossing corners with no vertex inside (§9.5b): the reference face's clip
-                // pairs, if the pair overlaps by more than the clip margin (`clip.rs`).
-                if inside_a.is_none() && inside_b.is_none() {
-                    if let Some(face) = sat_face(a.c, b.c) {
-                        if face.admissible && face.depth > CLIP_MARGIN * delta_c {
-                            let scanned = out.len();
-                            if clip_pairs((a.id, a.c), (b.id, b.c), &face, ctx.eps_s, out) > 0 {
-                                replace_scanned(out, mark, scanned);
-                                return false;
-                            }
-                        }
-                    }
-                }
-                true
+                // Crossing corners with no vertex inside (§9.5b).
+                let clipped = inside_a.is_none()
+                    && inside_b.is_none()
+                    && clip_crossing_corners((a.id, a.c), (b.id, b.c), ctx.eps_s, delta_c, mark, out);
+                !clipped
             }
             // Closer than GJK's ε_abs, "apart" is not a certificate: two equal boxes stacked
             // corner on corner overlap with every vertex of each exactly on a side line of the
@@ -792,25 +783,6 @@ impl LocalStage {
     }
 }
 
-/// Drops from `out[mark..scanned]` (a pair's vertex scan) every candidate whose vertex has a clip
-/// pair in `out[scanned..]`, keeping the order: one candidate per vertex, the clip pair (a vertex
-/// the scan proposes with no vertex inside is within `δ_c` outside a line; its clip pair holds it
-/// along the separating axis).
-fn replace_scanned(out: &mut Vec<VeCandidate>, mark: usize, scanned: usize) {
-    let mut keep = mark;
-    for i in mark..out.len() {
-        let c = out[i];
-        let clipped = i < scanned
-            && out[scanned..]
-                .iter()
-                .any(|k| (k.vertex_collider, k.vertex) == (c.vertex_collider, c.vertex));
-        if !clipped {
-            out[keep] = c;
-            keep += 1;
-        }
-    }
-    out.truncate(keep);
-}
 
 /// Sorts and deduplicates `out` (the candidates of one update) with their flags `flag`
 /// (parallel; a key proposed twice keeps the flag only if both had it): a counting sort by vertex

@@ -146,17 +146,7 @@ impl ContactSet {
             if self.clip_keys.is_empty() {
                 continue;
             }
-            // The pool: the effective depths of the pair's records released out of their edge
-            // range this sample.
-            self.pool.clear();
-            for &(pair, depth) in &self.dropped {
-                if pair == (ia, ib) {
-                    self.pool.push(depth);
-                }
-            }
-            self.dropped.retain(|&(pair, _)| pair != (ia, ib));
-            // Largest last (popped first).
-            self.pool.sort_unstable_by(f64::total_cmp);
+            self.take_dropped_pool((ia, ib));
             // The clip pairs deepest first.
             let geo = |key: &VeCandidate| {
                 let ca = &colliders[key.vertex_collider as usize];
@@ -175,6 +165,19 @@ impl ContactSet {
             self.entries.sort_unstable_by_key(|e| e.key);
             self.pending.clear();
         }
+    }
+
+    /// Fills the pool with the effective depths (m) of `pair`'s records released out of their
+    /// edge range this sample, largest last (popped first), and takes them out of `dropped`.
+    fn take_dropped_pool(&mut self, pair: (u32, u32)) {
+        self.pool.clear();
+        for &(p, depth) in &self.dropped {
+            if p == pair {
+                self.pool.push(depth);
+            }
+        }
+        self.dropped.retain(|&(p, _)| p != pair);
+        self.pool.sort_unstable_by(f64::total_cmp);
     }
 
     /// Makes the clip pair `key` a Continuous record (module docs): nothing if it is one; the
