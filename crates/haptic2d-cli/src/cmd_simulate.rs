@@ -9,8 +9,8 @@
 use crate::exit::{Failure, Status};
 use crate::scene_arg;
 use crate::world_mcap::{OverlapSummary, WorldOut};
-use haptic2d::world::World;
 use haptic2d::scene::MAX_SAMPLES;
+use haptic2d::world::World;
 use haptic2d_rt::signal::install_stop_signals;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::path::Path;

@@ -759,7 +759,14 @@ impl LocalStage {
                 // Crossing corners with no vertex inside (§9.5b).
                 let clipped = inside_a.is_none()
                     && inside_b.is_none()
-                    && clip_crossing_corners((a.id, a.c), (b.id, b.c), ctx.eps_s, delta_c, mark, out);
+                    && clip_crossing_corners(
+                        (a.id, a.c),
+                        (b.id, b.c),
+                        ctx.eps_s,
+                        delta_c,
+                        mark,
+                        out,
+                    );
                 !clipped
             }
             // Closer than GJK's ε_abs, "apart" is not a certificate: two equal boxes stacked
@@ -782,7 +789,6 @@ impl LocalStage {
         }
     }
 }
-
 
 /// Sorts and deduplicates `out` (the candidates of one update) with their flags `flag`
 /// (parallel; a key proposed twice keeps the flag only if both had it): a counting sort by vertex
