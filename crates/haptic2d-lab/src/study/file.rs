@@ -405,18 +405,7 @@ fn validate(
     dir: Option<&Path>,
     errs: &mut Vec<SceneError>,
 ) -> Option<Study> {
-    let task = match Task::from_name(&f.task.kind) {
-        Some(t) => t,
-        None => {
-            err(
-                errs,
-                "task.kind",
-                format!("unknown task `{}`", f.task.kind),
-                "write kind = \"2afc\" (or \"2ifc\"), \"3afc\" (or \"3ifc\") or \"same-different\"; magnitude estimation is not built yet",
-            );
-            Task::TwoAfc
-        }
-    };
+    let task = task_from(&f.task, errs);
     let (scene_text, scene_source) = match scene_text(&f.scene, dir) {
         Ok(t) => t,
         Err(e) => {
@@ -424,6 +413,52 @@ fn validate(
             return None;
         }
     };
+    let toward = head_fields(&f, errs);
+    let observer = ObserverParams::from_section(&f.observer, errs);
+    let own = !f.conditions.is_empty() && f.conditions.iter().all(|c| c.deltas.is_some());
+    let method = Method::from_section(&f.method, own, errs);
+    let conditions = conditions_from(&f, task, errs);
+    let blocks = blocks_from(&f, conditions.len(), errs);
+    let method = method?;
+    let study = Study {
+        name: f.name.clone().unwrap_or_else(|| "study".into()),
+        description: f.description.clone().unwrap_or_default(),
+        source: source.to_string(),
+        scene_text,
+        scene_source,
+        rate: f.rate,
+        probe: f.probe.clone(),
+        toward,
+        seed: f.seed,
+        task,
+        stimuli: f.stimuli.clone(),
+        conditions,
+        method,
+        blocks,
+        observer: observer.unwrap_or_default(),
+    };
+    check_worlds(&study, errs)?;
+    Some(study)
+}
+
+/// `[task]`: the task (an unknown one is reported and taken as 2AFC).
+fn task_from(t: &TaskSection, errs: &mut Vec<SceneError>) -> Task {
+    match Task::from_name(&t.kind) {
+        Some(t) => t,
+        None => {
+            err(
+                errs,
+                "task.kind",
+                format!("unknown task `{}`", t.kind),
+                "write kind = \"2afc\" (or \"2ifc\"), \"3afc\" (or \"3ifc\") or \"same-different\"; magnitude estimation is not built yet",
+            );
+            Task::TwoAfc
+        }
+    }
+}
+
+/// The top-level `rate`, `toward` and `[stimuli]`; returns the unit `toward`.
+fn head_fields(f: &StudyFile, errs: &mut Vec<SceneError>) -> [f64; 2] {
     if let Some(r) = f.rate {
         if !(r.is_finite() && r > 0.0) {
             err(
@@ -454,11 +489,11 @@ fn validate(
             "add e.g. [stimuli.spring] normal = { model = \"paper\", kc = 1000.0 }",
         );
     }
-    let observer = ObserverParams::from_section(&f.observer, errs);
-    let own = !f.conditions.is_empty() && f.conditions.iter().all(|c| c.deltas.is_some());
-    let method = Method::from_section(&f.method, own, errs);
-    // Conditions.
-    let mut conditions = Vec::new();
+    toward
+}
+
+/// The `[[condition]]` tables; a condition with a problem is reported and left out.
+fn conditions_from(f: &StudyFile, task: Task, errs: &mut Vec<SceneError>) -> Vec<Condition> {
     if f.conditions.is_empty() {
         err(
             errs,
@@ -467,209 +502,213 @@ fn validate(
             "add a [[condition]] with name, reference and vary",
         );
     }
-    for (i, c) in f.conditions.iter().enumerate() {
-        let field = format!("condition[{i}]");
-        if f.conditions[..i].iter().any(|o| o.name == c.name) {
+    (0..f.conditions.len())
+        .filter_map(|i| condition_from(f, i, task, errs))
+        .collect()
+}
+
+/// `[[condition]]` number `i`.
+fn condition_from(
+    f: &StudyFile,
+    i: usize,
+    task: Task,
+    errs: &mut Vec<SceneError>,
+) -> Option<Condition> {
+    let c = &f.conditions[i];
+    let field = format!("condition[{i}]");
+    condition_name(f, i, &field, errs);
+    let comparison = c.comparison.clone().unwrap_or_else(|| c.reference.clone());
+    let mut ok = true;
+    for (key, s) in [("reference", &c.reference), ("comparison", &comparison)] {
+        if !f.stimuli.contains_key(s) {
+            ok = false;
             err(
                 errs,
-                &format!("{field}.name"),
-                format!("`{}` is used twice", c.name),
-                "give every condition its own name",
+                &format!("{field}.{key}"),
+                format!("no stimulus called `{s}`"),
+                format!(
+                    "use one of: {}",
+                    f.stimuli.keys().cloned().collect::<Vec<_>>().join(", ")
+                ),
             );
         }
-        if c.name.is_empty() || c.name.contains(['\t', '\n']) {
+    }
+    let vary = match Param::parse(&c.vary) {
+        Ok(p) => p,
+        Err(e) => {
             err(
                 errs,
-                &format!("{field}.name"),
-                "must be non-empty, without tabs or newlines",
-                "e.g. name = \"spring-1000\"",
+                &format!("{field}.vary"),
+                e,
+                "write vary = \"normal.KEY\" or \"friction.KEY\", e.g. \"normal.kc\"",
             );
+            return None;
         }
-        let comparison = c.comparison.clone().unwrap_or_else(|| c.reference.clone());
-        let mut ok = true;
-        for (key, s) in [("reference", &c.reference), ("comparison", &comparison)] {
-            if !f.stimuli.contains_key(s) {
-                ok = false;
-                err(
-                    errs,
-                    &format!("{field}.{key}"),
-                    format!("no stimulus called `{s}`"),
-                    format!(
-                        "use one of: {}",
-                        f.stimuli.keys().cloned().collect::<Vec<_>>().join(", ")
-                    ),
-                );
-            }
+    };
+    if !ok {
+        return None;
+    }
+    // A PSE condition compares two different stimuli (e.g. a spring against a pulse wall):
+    // the reference need not set `vary`; its nominal value is then the comparison's base.
+    let pse = comparison != c.reference;
+    let base_value = stimulus_value(f, &comparison, &vary, errs)?;
+    let reference_value = if pse {
+        stimulus::param_value(&f.stimuli[&c.reference], &vary).unwrap_or(base_value)
+    } else {
+        stimulus_value(f, &c.reference, &vary, errs)?
+    };
+    condition_deltas(f, c, &field, pse, errs);
+    condition_method(f, c, &field, pse, task, errs);
+    Some(Condition {
+        name: c.name.clone(),
+        reference: c.reference.clone(),
+        comparison,
+        vary,
+        reference_value,
+        base_value,
+        pse,
+        deltas: c.deltas.clone(),
+    })
+}
+
+/// The name of condition `i`: unique, non-empty, without tabs or newlines.
+fn condition_name(f: &StudyFile, i: usize, field: &str, errs: &mut Vec<SceneError>) {
+    let c = &f.conditions[i];
+    if f.conditions[..i].iter().any(|o| o.name == c.name) {
+        err(
+            errs,
+            &format!("{field}.name"),
+            format!("`{}` is used twice", c.name),
+            "give every condition its own name",
+        );
+    }
+    if c.name.is_empty() || c.name.contains(['\t', '\n']) {
+        err(
+            errs,
+            &format!("{field}.name"),
+            "must be non-empty, without tabs or newlines",
+            "e.g. name = \"spring-1000\"",
+        );
+    }
+}
+
+/// The value of `vary` in stimulus `name` (which the method varies, so it must set it).
+fn stimulus_value(
+    f: &StudyFile,
+    name: &str,
+    vary: &Param,
+    errs: &mut Vec<SceneError>,
+) -> Option<f64> {
+    match stimulus::param_value(&f.stimuli[name], vary) {
+        Ok(v) => Some(v),
+        Err(e) => {
+            err(
+                errs,
+                &format!("stimuli.{name}.{vary}"),
+                e,
+                format!("set {vary} in stimulus `{name}` (the method varies it)"),
+            );
+            None
         }
-        let vary = match Param::parse(&c.vary) {
-            Ok(p) => p,
-            Err(e) => {
-                err(
-                    errs,
-                    &format!("{field}.vary"),
-                    e,
-                    "write vary = \"normal.KEY\" or \"friction.KEY\", e.g. \"normal.kc\"",
-                );
-                continue;
-            }
-        };
-        if !ok {
-            continue;
-        }
-        let value = |name: &str, errs: &mut Vec<SceneError>| -> Option<f64> {
-            match stimulus::param_value(&f.stimuli[name], &vary) {
-                Ok(v) => Some(v),
-                Err(e) => {
-                    err(
-                        errs,
-                        &format!("stimuli.{name}.{vary}"),
-                        e,
-                        format!("set {vary} in stimulus `{name}` (the method varies it)"),
-                    );
-                    None
-                }
-            }
-        };
-        // A PSE condition compares two different stimuli (e.g. a spring against a pulse wall):
-        // the reference need not set `vary`; its nominal value is then the comparison's base.
-        let pse = comparison != c.reference;
-        let Some(base_value) = value(&comparison, errs) else {
-            continue;
-        };
-        let reference_value = if pse {
-            stimulus::param_value(&f.stimuli[&c.reference], &vary).unwrap_or(base_value)
-        } else {
-            let Some(v) = value(&c.reference, errs) else {
-                continue;
-            };
-            v
-        };
-        if c.deltas.is_some() && f.method.kind != "constant" {
+    }
+}
+
+/// A condition's own deltas, and the sign of the deltas it presents.
+fn condition_deltas(
+    f: &StudyFile,
+    c: &ConditionSection,
+    field: &str,
+    pse: bool,
+    errs: &mut Vec<SceneError>,
+) {
+    if c.deltas.is_some() && f.method.kind != "constant" {
+        err(
+            errs,
+            &format!("{field}.deltas"),
+            "a condition's own deltas belong to the method of constant stimuli",
+            "remove them, or set [method] kind = \"constant\"",
+        );
+    }
+    if let Some(d) = &c.deltas {
+        if d.is_empty() || d.iter().any(|x| !x.is_finite()) {
             err(
                 errs,
                 &format!("{field}.deltas"),
-                "a condition's own deltas belong to the method of constant stimuli",
-                "remove them, or set [method] kind = \"constant\"",
+                format!("{d:?}"),
+                "give at least one finite delta, e.g. deltas = [-300.0, 0.0, 300.0]",
             );
         }
-        if let Some(d) = &c.deltas {
-            if d.is_empty() || d.iter().any(|x| !x.is_finite()) {
+    }
+    let field_d = if c.deltas.is_some() {
+        format!("{field}.deltas")
+    } else {
+        "method.deltas".to_string()
+    };
+    if let Some(d) = c.deltas.as_ref().or(f.method.deltas.as_ref()) {
+        if !pse {
+            if let Some(x) = d.iter().find(|x| x.is_finite() && **x <= 0.0) {
                 err(
                     errs,
-                    &format!("{field}.deltas"),
-                    format!("{d:?}"),
-                    "give at least one finite delta, e.g. deltas = [-300.0, 0.0, 300.0]",
+                    &field_d,
+                    format!("{x} is not positive, and condition `{}` is a discrimination (its comparison is its reference)", c.name),
+                    "every delta of a discrimination must be > 0 (the comparison is the stiffer stimulus); negative deltas belong to a PSE condition, whose `comparison` is another stimulus",
                 );
             }
         }
-        let field_d = if c.deltas.is_some() {
-            format!("{field}.deltas")
-        } else {
-            "method.deltas".to_string()
-        };
-        if let Some(d) = c.deltas.as_ref().or(f.method.deltas.as_ref()) {
-            if !pse {
-                if let Some(x) = d.iter().find(|x| x.is_finite() && **x <= 0.0) {
-                    err(
-                        errs,
-                        &field_d,
-                        format!("{x} is not positive, and condition `{}` is a discrimination (its comparison is its reference)", c.name),
-                        "every delta of a discrimination must be > 0 (the comparison is the stiffer stimulus); negative deltas belong to a PSE condition, whose `comparison` is another stimulus",
-                    );
-                }
-            }
-        }
-        if pse && !matches!(f.task.kind.as_str(), "2afc" | "2ifc") {
-            err(
-                errs,
-                "task.kind",
-                format!(
-                    "condition `{}` compares two stimuli (a PSE design), which needs two intervals",
-                    c.name
-                ),
-                "use kind = \"2afc\" for PSE conditions",
-            );
-        }
-        if task == Task::SameDifferent && f.method.kind != "constant" {
-            err(
-                errs,
-                "method.kind",
-                "same–different trials are analysed by signal detection, and adaptive methods converge on a proportion correct",
-                "use kind = \"constant\" with a same–different task",
-            );
-        }
-        if pse && f.method.kind != "constant" {
-            err(
-                errs,
-                &format!("{field}.comparison"),
-                format!("condition `{}` compares two stimuli (a PSE design), and adaptive methods converge on a proportion correct", c.name),
-                "use kind = \"constant\" with deltas on both sides of the expected PSE",
-            );
-        }
-        conditions.push(Condition {
-            name: c.name.clone(),
-            reference: c.reference.clone(),
-            comparison,
-            vary,
-            reference_value,
-            base_value,
-            pse,
-            deltas: c.deltas.clone(),
-        });
     }
-    // Blocks.
+}
+
+/// The task and method a condition needs: PSE conditions and same–different tasks need two
+/// intervals and constant stimuli.
+fn condition_method(
+    f: &StudyFile,
+    c: &ConditionSection,
+    field: &str,
+    pse: bool,
+    task: Task,
+    errs: &mut Vec<SceneError>,
+) {
+    if pse && !matches!(f.task.kind.as_str(), "2afc" | "2ifc") {
+        err(
+            errs,
+            "task.kind",
+            format!(
+                "condition `{}` compares two stimuli (a PSE design), which needs two intervals",
+                c.name
+            ),
+            "use kind = \"2afc\" for PSE conditions",
+        );
+    }
+    if task == Task::SameDifferent && f.method.kind != "constant" {
+        err(
+            errs,
+            "method.kind",
+            "same–different trials are analysed by signal detection, and adaptive methods converge on a proportion correct",
+            "use kind = \"constant\" with a same–different task",
+        );
+    }
+    if pse && f.method.kind != "constant" {
+        err(
+            errs,
+            &format!("{field}.comparison"),
+            format!("condition `{}` compares two stimuli (a PSE design), and adaptive methods converge on a proportion correct", c.name),
+            "use kind = \"constant\" with deltas on both sides of the expected PSE",
+        );
+    }
+}
+
+/// The `[[block]]` tables (default: one block of the `n_conditions` valid conditions).
+fn blocks_from(f: &StudyFile, n_conditions: usize, errs: &mut Vec<SceneError>) -> Vec<Block> {
     let mut blocks = Vec::new();
     if f.blocks.is_empty() {
         blocks.push(Block {
-            conditions: (0..conditions.len()).collect(),
+            conditions: (0..n_conditions).collect(),
             practice: 0,
         });
     }
     let mut used = vec![false; f.conditions.len()];
     for (i, b) in f.blocks.iter().enumerate() {
-        let field = format!("block[{i}]");
-        let mut idx = Vec::new();
-        if b.conditions.is_empty() {
-            err(
-                errs,
-                &format!("{field}.conditions"),
-                "lists no condition",
-                "list the condition names this block runs",
-            );
-        }
-        for name in &b.conditions {
-            match f.conditions.iter().position(|c| &c.name == name) {
-                Some(k) if used[k] => err(
-                    errs,
-                    &format!("{field}.conditions"),
-                    format!("condition `{name}` is already in an earlier block"),
-                    "put each condition in one block",
-                ),
-                Some(k) => {
-                    used[k] = true;
-                    idx.push(k);
-                }
-                None => err(
-                    errs,
-                    &format!("{field}.conditions"),
-                    format!("no condition called `{name}`"),
-                    "use the names of the [[condition]] tables",
-                ),
-            }
-        }
-        let practice = b.practice.unwrap_or(0);
-        if practice > 1000 {
-            err(
-                errs,
-                &format!("{field}.practice"),
-                format!("{practice} practice trials"),
-                "use at most 1000",
-            );
-        }
-        blocks.push(Block {
-            conditions: idx,
-            practice,
-        });
+        blocks.push(block_from(f, i, b, &mut used, errs));
     }
     if !f.blocks.is_empty() {
         for (k, u) in used.iter().enumerate() {
@@ -683,70 +722,108 @@ fn validate(
             }
         }
     }
-    let method = method?;
-    let study = Study {
-        name: f.name.clone().unwrap_or_else(|| "study".into()),
-        description: f.description.clone().unwrap_or_default(),
-        source: source.to_string(),
-        scene_text,
-        scene_source,
-        rate: f.rate,
-        probe: f.probe.clone(),
-        toward,
-        seed: f.seed,
-        task,
-        stimuli: f.stimuli.clone(),
-        conditions,
-        method,
-        blocks,
-        observer: observer.unwrap_or_default(),
-    };
-    // Every stimulus a condition can present must build a valid scene with the probe in it (checked
-    // even when other fields have problems, so all are reported at once).
-    {
-        for (ci, c) in study.conditions.iter().enumerate() {
-            let largest = study.largest_delta(ci);
-            let smallest = study.smallest_delta(ci);
-            let mut cases = vec![(&c.reference, None), (&c.comparison, Some(largest))];
-            if c.pse && smallest < 0.0 {
-                cases.push((&c.comparison, Some(smallest)));
+    blocks
+}
+
+/// `[[block]]` number `i`; `used` marks the conditions of this and earlier blocks.
+fn block_from(
+    f: &StudyFile,
+    i: usize,
+    b: &BlockSection,
+    used: &mut [bool],
+    errs: &mut Vec<SceneError>,
+) -> Block {
+    let field = format!("block[{i}]");
+    let mut idx = Vec::new();
+    if b.conditions.is_empty() {
+        err(
+            errs,
+            &format!("{field}.conditions"),
+            "lists no condition",
+            "list the condition names this block runs",
+        );
+    }
+    for name in &b.conditions {
+        match f.conditions.iter().position(|c| &c.name == name) {
+            Some(k) if used[k] => err(
+                errs,
+                &format!("{field}.conditions"),
+                format!("condition `{name}` is already in an earlier block"),
+                "put each condition in one block",
+            ),
+            Some(k) => {
+                used[k] = true;
+                idx.push(k);
             }
-            for (which, delta) in cases {
-                if delta.is_some_and(|d| !d.is_finite() || (d <= 0.0 && !c.pse)) {
-                    continue; // the method's own error is reported
-                }
-                let vary = delta.map(|d| (&c.vary, d));
-                match stimulus::world(&study, which, vary) {
-                    Ok(w) => {
-                        if w.body_index(&study.probe).is_none() {
-                            err(
-                                errs,
-                                "probe",
-                                format!("the scene has no body called `{}`", study.probe),
-                                "name a dynamic body of the scene",
-                            );
-                            return None;
-                        }
+            None => err(
+                errs,
+                &format!("{field}.conditions"),
+                format!("no condition called `{name}`"),
+                "use the names of the [[condition]] tables",
+            ),
+        }
+    }
+    let practice = b.practice.unwrap_or(0);
+    if practice > 1000 {
+        err(
+            errs,
+            &format!("{field}.practice"),
+            format!("{practice} practice trials"),
+            "use at most 1000",
+        );
+    }
+    Block {
+        conditions: idx,
+        practice,
+    }
+}
+
+/// Every stimulus a condition can present must build a valid scene with the probe in it (checked
+/// even when other fields have problems, so all are reported at once). `None`: the scene has no
+/// probe (reported).
+fn check_worlds(study: &Study, errs: &mut Vec<SceneError>) -> Option<()> {
+    for (ci, c) in study.conditions.iter().enumerate() {
+        let largest = study.largest_delta(ci);
+        let smallest = study.smallest_delta(ci);
+        let mut cases = vec![(&c.reference, None), (&c.comparison, Some(largest))];
+        if c.pse && smallest < 0.0 {
+            cases.push((&c.comparison, Some(smallest)));
+        }
+        for (which, delta) in cases {
+            if delta.is_some_and(|d| !d.is_finite() || (d <= 0.0 && !c.pse)) {
+                continue; // the method's own error is reported
+            }
+            let vary = delta.map(|d| (&c.vary, d));
+            match stimulus::world(study, which, vary) {
+                Ok(w) => {
+                    if w.body_index(&study.probe).is_none() {
+                        err(
+                            errs,
+                            "probe",
+                            format!("the scene has no body called `{}`", study.probe),
+                            "name a dynamic body of the scene",
+                        );
+                        return None;
                     }
-                    Err(e) => {
-                        for mut s in e {
-                            s.field = format!("stimuli.{which}.{}", s.field);
-                            if delta.is_some() {
-                                s.message = format!(
-                                    "{} (comparison at delta {})",
-                                    s.message,
-                                    delta.unwrap_or(largest)
-                                );
-                            }
-                            // The same stimulus as reference and comparison: report it once.
-                            if !errs.iter().any(|e| e.field == s.field) {
-                                errs.push(s);
-                            }
+                }
+                Err(e) => {
+                    for mut s in e {
+                        s.field = format!("stimuli.{which}.{}", s.field);
+                        if delta.is_some() {
+                            s.message = format!(
+                                "{} (comparison at delta {})",
+                                s.message,
+                                delta.unwrap_or(largest)
+                            );
+                        }
+                        // The same stimulus as reference and comparison: report it once.
+                        if !errs.iter().any(|e| e.field == s.field) {
+                            errs.push(s);
                         }
                     }
                 }
             }
         }
     }
-    Some(study)
+    Some(())
 }

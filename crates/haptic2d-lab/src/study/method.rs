@@ -110,213 +110,10 @@ impl Method {
         let mut e = |field: &str, msg: String, fix: &str| {
             errs.push(SceneError::new(format!("method.{field}"), msg, fix))
         };
-        let positive = |x: f64| x.is_finite() && x > 0.0;
         match m.kind.as_str() {
-            "constant" => {
-                let deltas = m.deltas.clone().unwrap_or_default();
-                if deltas.is_empty() && !own_deltas {
-                    e("deltas", "the method of constant stimuli needs its deltas".into(), "e.g. deltas = [50.0, 100.0, 200.0] (comparison − reference, unit of `vary`)");
-                }
-                // The sign is checked per condition (file.rs): > 0 for a discrimination, any for
-                // a PSE condition.
-                if let Some(d) = deltas.iter().find(|d| !d.is_finite()) {
-                    e(
-                        "deltas",
-                        format!("{d} is not a number"),
-                        "give finite deltas",
-                    );
-                }
-                let repeats = m.repeats.unwrap_or(0);
-                if repeats == 0 || repeats > MAX_TRIALS_PER_CONDITION {
-                    e(
-                        "repeats",
-                        format!("{repeats} repeats"),
-                        "give 1 to 100000 presentations per delta, e.g. repeats = 20",
-                    );
-                }
-                for k in [
-                    "rule",
-                    "starts",
-                    "step_factor",
-                    "initial_step_factor",
-                    "max_trials",
-                    "max_reversals",
-                    "min_delta",
-                    "max_delta",
-                ] {
-                    let given = match k {
-                        "rule" => m.rule.is_some(),
-                        "starts" => m.starts.is_some(),
-                        "step_factor" => m.step_factor.is_some(),
-                        "initial_step_factor" => m.initial_step_factor.is_some(),
-                        "max_trials" => m.max_trials.is_some(),
-                        "max_reversals" => m.max_reversals.is_some(),
-                        "min_delta" => m.min_delta.is_some(),
-                        _ => m.max_delta.is_some(),
-                    };
-                    if given {
-                        e(
-                            k,
-                            "is a staircase setting".into(),
-                            "remove it, or set kind = \"staircase\"",
-                        );
-                    }
-                }
-                Some(Method::Constant { deltas, repeats })
-            }
-            "staircase" => {
-                let down = match m.rule.as_deref() {
-                    Some("1-up-2-down") => 2,
-                    Some("1-up-3-down") => 3,
-                    other => {
-                        e("rule", format!("unknown rule {other:?}"), "rule = \"1-up-2-down\" (70.7 % correct) or \"1-up-3-down\" (79.4 %); weighted up/down is not built yet");
-                        2
-                    }
-                };
-                let starts = m.starts.clone().unwrap_or_default();
-                if starts.is_empty() || starts.len() > 8 || starts.iter().any(|s| !positive(*s)) {
-                    e("starts", format!("{starts:?}"), "give 1 to 8 positive starting deltas, one per interleaved staircase, e.g. starts = [400.0, 50.0]");
-                }
-                let step = m.step_factor.unwrap_or(0.0);
-                if !(step.is_finite() && step > 1.0 && step <= 10.0) {
-                    e(
-                        "step_factor",
-                        format!("{step}"),
-                        "give a factor in (1, 10], e.g. step_factor = 1.25",
-                    );
-                }
-                let initial = m.initial_step_factor.unwrap_or(step);
-                if !(initial.is_finite() && initial > 1.0 && initial <= 10.0) {
-                    e(
-                        "initial_step_factor",
-                        format!("{initial}"),
-                        "give a factor in (1, 10], e.g. 2.0, or remove it",
-                    );
-                }
-                let max_trials = m.max_trials.unwrap_or(0);
-                let max_reversals = m.max_reversals.unwrap_or(u32::MAX);
-                if max_trials == 0 || max_trials > MAX_TRIALS_PER_CONDITION {
-                    e("max_trials", format!("{max_trials}"), "give the stopping rule: 1 to 100000 trials per staircase, e.g. max_trials = 60");
-                }
-                if max_reversals == 0 {
-                    e(
-                        "max_reversals",
-                        "0".into(),
-                        "give at least 1, or remove it (stop on trials alone)",
-                    );
-                }
-                let lo = starts.iter().copied().fold(f64::INFINITY, f64::min);
-                let hi = starts.iter().copied().fold(0.0, f64::max);
-                let min_delta = m.min_delta.unwrap_or(lo / 64.0);
-                let max_delta = m.max_delta.unwrap_or(4.0 * hi);
-                if !(positive(min_delta) && min_delta <= lo) {
-                    e(
-                        "min_delta",
-                        format!("{min_delta}"),
-                        "give a positive delta no larger than the smallest start",
-                    );
-                }
-                if !(max_delta.is_finite() && max_delta >= hi) {
-                    e(
-                        "max_delta",
-                        format!("{max_delta}"),
-                        "give a delta at least the largest start",
-                    );
-                }
-                if m.deltas.is_some() || m.repeats.is_some() {
-                    e(
-                        "deltas",
-                        "deltas/repeats are constant-stimuli settings".into(),
-                        "remove them, or set kind = \"constant\"",
-                    );
-                }
-                Some(Method::Staircase(StaircaseSpec {
-                    down,
-                    starts,
-                    step_factor: step,
-                    initial_step_factor: initial,
-                    max_trials,
-                    max_reversals,
-                    min_delta,
-                    max_delta,
-                }))
-            }
-            "quest" => {
-                let start = m.start.unwrap_or(0.0);
-                if !positive(start) {
-                    e(
-                        "start",
-                        format!("{start}"),
-                        "give the expected threshold (a positive delta), e.g. start = 150.0",
-                    );
-                }
-                let prior_sd = m.prior_sd.unwrap_or(0.5);
-                if !(prior_sd.is_finite() && prior_sd > 0.0 && prior_sd <= 3.0) {
-                    e(
-                        "prior_sd",
-                        format!("{prior_sd}"),
-                        "give the prior's sd of log10(threshold) in (0, 3], e.g. 0.5",
-                    );
-                }
-                let beta = m.beta.unwrap_or(3.5);
-                if !(beta.is_finite() && (0.2..=20.0).contains(&beta)) {
-                    e("beta", format!("{beta}"), "give the Weibull slope in [0.2, 20], e.g. 3.5 (Watson & Pelli) or the slope a pilot fit gave");
-                }
-                let lapse = m.lapse.unwrap_or(0.01);
-                if !(lapse.is_finite() && (0.0..=0.2).contains(&lapse)) {
-                    e(
-                        "lapse",
-                        format!("{lapse}"),
-                        "give the assumed lapse rate in [0, 0.2], e.g. 0.01",
-                    );
-                }
-                let max_trials = m.max_trials.unwrap_or(0);
-                if max_trials == 0 || max_trials > MAX_TRIALS_PER_CONDITION {
-                    e("max_trials", format!("{max_trials}"), "give the stopping rule: 1 to 100000 trials per condition, e.g. max_trials = 80");
-                }
-                let min_delta = m.min_delta.unwrap_or(start / 100.0);
-                let max_delta = m.max_delta.unwrap_or(start * 100.0);
-                if !(positive(min_delta)
-                    && min_delta < start
-                    && max_delta.is_finite()
-                    && start < max_delta)
-                {
-                    e("min_delta", format!("[{min_delta}, {max_delta}]"), "give 0 < min_delta < start < max_delta (the grid of thresholds and deltas)");
-                }
-                let place_at_mode = match m.placement.as_deref() {
-                    None | Some("mean") => false,
-                    Some("mode") => true,
-                    Some(other) => {
-                        e(
-                            "placement",
-                            format!("unknown placement `{other}`"),
-                            "placement = \"mean\" (posterior mean, default) or \"mode\"",
-                        );
-                        false
-                    }
-                };
-                if m.deltas.is_some()
-                    || m.repeats.is_some()
-                    || m.rule.is_some()
-                    || m.starts.is_some()
-                {
-                    e(
-                        "kind",
-                        "deltas/repeats/rule/starts are not QUEST settings".into(),
-                        "remove them, or change kind",
-                    );
-                }
-                Some(Method::Quest(QuestSpec {
-                    start,
-                    prior_sd,
-                    beta,
-                    lapse,
-                    max_trials,
-                    min_delta,
-                    max_delta,
-                    place_at_mode,
-                }))
-            }
+            "constant" => Some(constant_from(m, own_deltas, &mut e)),
+            "staircase" => Some(Method::Staircase(staircase_from(m, &mut e))),
+            "quest" => Some(Method::Quest(quest_from(m, &mut e))),
             other => {
                 e(
                     "kind",
@@ -326,5 +123,222 @@ impl Method {
                 None
             }
         }
+    }
+}
+
+/// A problem of `[method]`: `(field, message, fix)`.
+type Report<'a> = dyn FnMut(&str, String, &str) + 'a;
+
+fn positive(x: f64) -> bool {
+    x.is_finite() && x > 0.0
+}
+
+/// `[method]` of kind `"constant"`.
+fn constant_from(m: &MethodSection, own_deltas: bool, e: &mut Report) -> Method {
+    let deltas = m.deltas.clone().unwrap_or_default();
+    if deltas.is_empty() && !own_deltas {
+        e(
+            "deltas",
+            "the method of constant stimuli needs its deltas".into(),
+            "e.g. deltas = [50.0, 100.0, 200.0] (comparison − reference, unit of `vary`)",
+        );
+    }
+    // The sign is checked per condition (file.rs): > 0 for a discrimination, any for
+    // a PSE condition.
+    if let Some(d) = deltas.iter().find(|d| !d.is_finite()) {
+        e(
+            "deltas",
+            format!("{d} is not a number"),
+            "give finite deltas",
+        );
+    }
+    let repeats = m.repeats.unwrap_or(0);
+    if repeats == 0 || repeats > MAX_TRIALS_PER_CONDITION {
+        e(
+            "repeats",
+            format!("{repeats} repeats"),
+            "give 1 to 100000 presentations per delta, e.g. repeats = 20",
+        );
+    }
+    let staircase_settings = [
+        ("rule", m.rule.is_some()),
+        ("starts", m.starts.is_some()),
+        ("step_factor", m.step_factor.is_some()),
+        ("initial_step_factor", m.initial_step_factor.is_some()),
+        ("max_trials", m.max_trials.is_some()),
+        ("max_reversals", m.max_reversals.is_some()),
+        ("min_delta", m.min_delta.is_some()),
+        ("max_delta", m.max_delta.is_some()),
+    ];
+    for (k, given) in staircase_settings {
+        if given {
+            e(
+                k,
+                "is a staircase setting".into(),
+                "remove it, or set kind = \"staircase\"",
+            );
+        }
+    }
+    Method::Constant { deltas, repeats }
+}
+
+/// `[method]` of kind `"staircase"`.
+fn staircase_from(m: &MethodSection, e: &mut Report) -> StaircaseSpec {
+    let down = match m.rule.as_deref() {
+        Some("1-up-2-down") => 2,
+        Some("1-up-3-down") => 3,
+        other => {
+            e("rule", format!("unknown rule {other:?}"), "rule = \"1-up-2-down\" (70.7 % correct) or \"1-up-3-down\" (79.4 %); weighted up/down is not built yet");
+            2
+        }
+    };
+    let starts = m.starts.clone().unwrap_or_default();
+    if starts.is_empty() || starts.len() > 8 || starts.iter().any(|s| !positive(*s)) {
+        e("starts", format!("{starts:?}"), "give 1 to 8 positive starting deltas, one per interleaved staircase, e.g. starts = [400.0, 50.0]");
+    }
+    let step = m.step_factor.unwrap_or(0.0);
+    if !(step.is_finite() && step > 1.0 && step <= 10.0) {
+        e(
+            "step_factor",
+            format!("{step}"),
+            "give a factor in (1, 10], e.g. step_factor = 1.25",
+        );
+    }
+    let initial = m.initial_step_factor.unwrap_or(step);
+    if !(initial.is_finite() && initial > 1.0 && initial <= 10.0) {
+        e(
+            "initial_step_factor",
+            format!("{initial}"),
+            "give a factor in (1, 10], e.g. 2.0, or remove it",
+        );
+    }
+    let max_trials = m.max_trials.unwrap_or(0);
+    let max_reversals = m.max_reversals.unwrap_or(u32::MAX);
+    if max_trials == 0 || max_trials > MAX_TRIALS_PER_CONDITION {
+        e(
+            "max_trials",
+            format!("{max_trials}"),
+            "give the stopping rule: 1 to 100000 trials per staircase, e.g. max_trials = 60",
+        );
+    }
+    if max_reversals == 0 {
+        e(
+            "max_reversals",
+            "0".into(),
+            "give at least 1, or remove it (stop on trials alone)",
+        );
+    }
+    let lo = starts.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = starts.iter().copied().fold(0.0, f64::max);
+    let min_delta = m.min_delta.unwrap_or(lo / 64.0);
+    let max_delta = m.max_delta.unwrap_or(4.0 * hi);
+    if !(positive(min_delta) && min_delta <= lo) {
+        e(
+            "min_delta",
+            format!("{min_delta}"),
+            "give a positive delta no larger than the smallest start",
+        );
+    }
+    if !(max_delta.is_finite() && max_delta >= hi) {
+        e(
+            "max_delta",
+            format!("{max_delta}"),
+            "give a delta at least the largest start",
+        );
+    }
+    if m.deltas.is_some() || m.repeats.is_some() {
+        e(
+            "deltas",
+            "deltas/repeats are constant-stimuli settings".into(),
+            "remove them, or set kind = \"constant\"",
+        );
+    }
+    StaircaseSpec {
+        down,
+        starts,
+        step_factor: step,
+        initial_step_factor: initial,
+        max_trials,
+        max_reversals,
+        min_delta,
+        max_delta,
+    }
+}
+
+/// `[method]` of kind `"quest"`.
+fn quest_from(m: &MethodSection, e: &mut Report) -> QuestSpec {
+    let start = m.start.unwrap_or(0.0);
+    if !positive(start) {
+        e(
+            "start",
+            format!("{start}"),
+            "give the expected threshold (a positive delta), e.g. start = 150.0",
+        );
+    }
+    let prior_sd = m.prior_sd.unwrap_or(0.5);
+    if !(prior_sd.is_finite() && prior_sd > 0.0 && prior_sd <= 3.0) {
+        e(
+            "prior_sd",
+            format!("{prior_sd}"),
+            "give the prior's sd of log10(threshold) in (0, 3], e.g. 0.5",
+        );
+    }
+    let beta = m.beta.unwrap_or(3.5);
+    if !(beta.is_finite() && (0.2..=20.0).contains(&beta)) {
+        e("beta", format!("{beta}"), "give the Weibull slope in [0.2, 20], e.g. 3.5 (Watson & Pelli) or the slope a pilot fit gave");
+    }
+    let lapse = m.lapse.unwrap_or(0.01);
+    if !(lapse.is_finite() && (0.0..=0.2).contains(&lapse)) {
+        e(
+            "lapse",
+            format!("{lapse}"),
+            "give the assumed lapse rate in [0, 0.2], e.g. 0.01",
+        );
+    }
+    let max_trials = m.max_trials.unwrap_or(0);
+    if max_trials == 0 || max_trials > MAX_TRIALS_PER_CONDITION {
+        e(
+            "max_trials",
+            format!("{max_trials}"),
+            "give the stopping rule: 1 to 100000 trials per condition, e.g. max_trials = 80",
+        );
+    }
+    let min_delta = m.min_delta.unwrap_or(start / 100.0);
+    let max_delta = m.max_delta.unwrap_or(start * 100.0);
+    if !(positive(min_delta) && min_delta < start && max_delta.is_finite() && start < max_delta) {
+        e(
+            "min_delta",
+            format!("[{min_delta}, {max_delta}]"),
+            "give 0 < min_delta < start < max_delta (the grid of thresholds and deltas)",
+        );
+    }
+    let place_at_mode = match m.placement.as_deref() {
+        None | Some("mean") => false,
+        Some("mode") => true,
+        Some(other) => {
+            e(
+                "placement",
+                format!("unknown placement `{other}`"),
+                "placement = \"mean\" (posterior mean, default) or \"mode\"",
+            );
+            false
+        }
+    };
+    if m.deltas.is_some() || m.repeats.is_some() || m.rule.is_some() || m.starts.is_some() {
+        e(
+            "kind",
+            "deltas/repeats/rule/starts are not QUEST settings".into(),
+            "remove them, or change kind",
+        );
+    }
+    QuestSpec {
+        start,
+        prior_sd,
+        beta,
+        lapse,
+        max_trials,
+        min_delta,
+        max_delta,
+        place_at_mode,
     }
 }

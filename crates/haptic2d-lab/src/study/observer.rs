@@ -143,6 +143,20 @@ impl ObserverParams {
 
     /// Checks the ranges; each problem is reported as `(field, message, fix)`.
     pub fn check(&self, report: &mut dyn FnMut(&str, String, &str)) {
+        self.check_press(report);
+        self.check_tap_stroke(report);
+        let r = self.decision_time;
+        if !(r.is_finite() && (0.0..=60.0).contains(&r)) {
+            report(
+                "decision_time",
+                format!("{r}"),
+                "give a time in [0, 60] s, e.g. 0.6",
+            );
+        }
+    }
+
+    /// [`check`](Self::check) of the perception and the press: Weber fraction to grip damping.
+    fn check_press(&self, report: &mut dyn FnMut(&str, String, &str)) {
         let w = self.weber_fraction;
         if !(w.is_finite() && w > 0.0 && w <= 5.0) {
             report(
@@ -215,6 +229,10 @@ impl ObserverParams {
                 "give a torsional damping in [0, 1] N·m·s/rad, e.g. 0.02",
             );
         }
+    }
+
+    /// [`check`](Self::check) of the tap and the stroke.
+    fn check_tap_stroke(&self, report: &mut dyn FnMut(&str, String, &str)) {
         let v = self.tap_speed;
         if !(v.is_finite() && v > 0.0 && v <= 2.0) {
             report(
@@ -261,14 +279,6 @@ impl ObserverParams {
                 "tremor_hz",
                 format!("{h}"),
                 "give a frequency in (0, 100] Hz, e.g. 10.0",
-            );
-        }
-        let r = self.decision_time;
-        if !(r.is_finite() && (0.0..=60.0).contains(&r)) {
-            report(
-                "decision_time",
-                format!("{r}"),
-                "give a time in [0, 60] s, e.g. 0.6",
             );
         }
     }

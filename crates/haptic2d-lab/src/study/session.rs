@@ -108,59 +108,11 @@ pub fn run(
     check_participant(participant)?;
     let dir = session_dir(out, participant, session);
     let tsv = dir.join("trials.tsv");
-    let copy = dir.join("study.toml");
     let seed = session_seed(study.seed, participant, session);
     let mut sched = Schedule::new(study, seed);
-    let io = |p: &Path, e: std::io::Error| format!("{}: {e}", p.display());
-    let mut resumed = 0;
-    if tsv.exists() {
-        let stored = std::fs::read_to_string(&copy).map_err(|e| io(&copy, e))?;
-        if stored != study_text {
-            return Err(format!(
-                "{} holds a session of a different study file (its study.toml differs)\n    fix: give another --out, --participant or --session, or the study file this session was started with",
-                dir.display()
-            ));
-        }
-        let text = std::fs::read_to_string(&tsv).map_err(|e| io(&tsv, e))?;
-        let (rows, complete) =
-            trials::read(&text).map_err(|e| format!("{}: {e}", tsv.display()))?;
-        for r in &rows {
-            let spec = sched.next_trial().ok_or_else(|| {
-                format!(
-                    "{}: row {} is beyond the end of the schedule",
-                    tsv.display(),
-                    r.trial
-                )
-            })?;
-            let expect = row(study, &sched, &spec, r.response, r.rt);
-            let same = spec.trial == r.trial
-                && spec.practice == r.practice
-                && expect.condition == r.condition
-                && spec.delta == r.delta
-                && spec.comparison_interval == r.comparison_interval;
-            if !same {
-                return Err(format!(
-                    "{}: trial {} does not match the study's schedule (recorded {} delta {} interval {}, scheduled {} delta {} interval {}): the study file or its seed changed\n    fix: resume with the study file the session was started with",
-                    tsv.display(), r.trial, r.condition, r.delta, r.comparison_interval, expect.condition, spec.delta, spec.comparison_interval
-                ));
-            }
-            sched.record(&spec, answer_correct(study, &spec, r.response));
-            resumed += 1;
-        }
-        if complete < text.len() || text.is_empty() {
-            // Drop the cut line (or write the header of an empty file).
-            let f = std::fs::OpenOptions::new()
-                .write(true)
-                .open(&tsv)
-                .map_err(|e| io(&tsv, e))?;
-            f.set_len(complete as u64).map_err(|e| io(&tsv, e))?;
-            if complete == 0 {
-                std::fs::write(&tsv, format!("{HEADER}\n")).map_err(|e| io(&tsv, e))?;
-            }
-        }
+    let resumed = if tsv.exists() {
+        resume(study, study_text, &dir, &mut sched)?
     } else {
-        std::fs::create_dir_all(&dir).map_err(|e| io(&dir, e))?;
-        std::fs::write(&copy, study_text).map_err(|e| io(&copy, e))?;
         let meta = serde_json::json!({
             "study": study.name,
             "study_file": study.source,
@@ -174,14 +126,9 @@ pub fn run(
             "task": study.task.describe(),
             "trials": "trials.tsv (docs/STUDIES.md)",
         });
-        let mj = dir.join("session.json");
-        std::fs::write(
-            &mj,
-            serde_json::to_string_pretty(&meta).unwrap_or_default() + "\n",
-        )
-        .map_err(|e| io(&mj, e))?;
-        std::fs::write(&tsv, format!("{HEADER}\n")).map_err(|e| io(&tsv, e))?;
-    }
+        start(study_text, &dir, &meta)?;
+        0
+    };
     let mut file = std::fs::OpenOptions::new()
         .append(true)
         .open(&tsv)
@@ -223,4 +170,83 @@ pub fn run(
         complete,
         quest,
     })
+}
+
+/// An I/O error on `p`, for messages.
+fn io(p: &Path, e: std::io::Error) -> String {
+    format!("{}: {e}", p.display())
+}
+
+/// Starts a new session in `dir`: the study file's copy, `meta` as `session.json` and the header
+/// of `trials.tsv`.
+fn start(study_text: &str, dir: &Path, meta: &serde_json::Value) -> Result<(), String> {
+    let tsv = dir.join("trials.tsv");
+    let copy = dir.join("study.toml");
+    std::fs::create_dir_all(dir).map_err(|e| io(dir, e))?;
+    std::fs::write(&copy, study_text).map_err(|e| io(&copy, e))?;
+    let mj = dir.join("session.json");
+    std::fs::write(
+        &mj,
+        serde_json::to_string_pretty(meta).unwrap_or_default() + "\n",
+    )
+    .map_err(|e| io(&mj, e))?;
+    std::fs::write(&tsv, format!("{HEADER}\n")).map_err(|e| io(&tsv, e))?;
+    Ok(())
+}
+
+/// Resumes the session in `dir`: checks its study file, replays its rows into `sched` and drops a
+/// line cut short. Returns the number of trials replayed.
+fn resume(
+    study: &Study,
+    study_text: &str,
+    dir: &Path,
+    sched: &mut Schedule,
+) -> Result<u32, String> {
+    let tsv = dir.join("trials.tsv");
+    let copy = dir.join("study.toml");
+    let stored = std::fs::read_to_string(&copy).map_err(|e| io(&copy, e))?;
+    if stored != study_text {
+        return Err(format!(
+            "{} holds a session of a different study file (its study.toml differs)\n    fix: give another --out, --participant or --session, or the study file this session was started with",
+            dir.display()
+        ));
+    }
+    let text = std::fs::read_to_string(&tsv).map_err(|e| io(&tsv, e))?;
+    let (rows, complete) = trials::read(&text).map_err(|e| format!("{}: {e}", tsv.display()))?;
+    let mut resumed = 0;
+    for r in &rows {
+        let spec = sched.next_trial().ok_or_else(|| {
+            format!(
+                "{}: row {} is beyond the end of the schedule",
+                tsv.display(),
+                r.trial
+            )
+        })?;
+        let expect = row(study, sched, &spec, r.response, r.rt);
+        let same = spec.trial == r.trial
+            && spec.practice == r.practice
+            && expect.condition == r.condition
+            && spec.delta == r.delta
+            && spec.comparison_interval == r.comparison_interval;
+        if !same {
+            return Err(format!(
+                "{}: trial {} does not match the study's schedule (recorded {} delta {} interval {}, scheduled {} delta {} interval {}): the study file or its seed changed\n    fix: resume with the study file the session was started with",
+                tsv.display(), r.trial, r.condition, r.delta, r.comparison_interval, expect.condition, spec.delta, spec.comparison_interval
+            ));
+        }
+        sched.record(&spec, answer_correct(study, &spec, r.response));
+        resumed += 1;
+    }
+    if complete < text.len() || text.is_empty() {
+        // Drop the cut line (or write the header of an empty file).
+        let f = std::fs::OpenOptions::new()
+            .write(true)
+            .open(&tsv)
+            .map_err(|e| io(&tsv, e))?;
+        f.set_len(complete as u64).map_err(|e| io(&tsv, e))?;
+        if complete == 0 {
+            std::fs::write(&tsv, format!("{HEADER}\n")).map_err(|e| io(&tsv, e))?;
+        }
+    }
+    Ok(resumed)
 }

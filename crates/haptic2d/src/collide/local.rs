@@ -757,17 +757,9 @@ impl LocalStage {
                 let inside_a = ctx.vertices_against(a, b, out, &mut Slack::new());
                 let inside_b = ctx.vertices_against(b, a, out, &mut Slack::new());
                 // Crossing corners with no vertex inside (§9.5b).
-                let clipped = inside_a.is_none()
-                    && inside_b.is_none()
-                    && clip_crossing_corners(
-                        (a.id, a.c),
-                        (b.id, b.c),
-                        ctx.eps_s,
-                        delta_c,
-                        mark,
-                        out,
-                    );
-                !clipped
+                let (pa, pb) = ((a.id, a.c), (b.id, b.c));
+                let none_inside = inside_a.is_none() && inside_b.is_none();
+                !(none_inside && clip_crossing_corners(pa, pb, ctx.eps_s, delta_c, mark, out))
             }
             // Closer than GJK's ε_abs, "apart" is not a certificate: two equal boxes stacked
             // corner on corner overlap with every vertex of each exactly on a side line of the
