@@ -85,7 +85,7 @@ def strip_code(text):
 
 def block_end(lines, start):
     """Index of the line that closes the first `{` at or after line `start` (None if a `;` ends it first)."""
-    depth, opened = 0, False
+    depth, opened, nest = 0, False, 0
     for k in range(start, len(lines)):
         for ch in lines[k]:
             if ch == "{":
@@ -94,7 +94,12 @@ def block_end(lines, start):
                 depth -= 1
                 if opened and depth == 0:
                     return k
-            elif ch == ";" and not opened and depth == 0:
+            elif ch in "([" and not opened:
+                nest += 1
+            elif ch in ")]" and not opened:
+                nest -= 1
+            # A `;` inside the signature's brackets (`-> [f64; 2]`) does not end a declaration.
+            elif ch == ";" and not opened and depth == 0 and nest == 0:
                 return None
     return None
 
