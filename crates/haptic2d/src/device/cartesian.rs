@@ -11,7 +11,7 @@
 //! wrench f (N, N, N·m) ──wrench_to_torques──▶ τ = Jᵀ·f, saturated keeping its direction (N·m)
 //! ```
 //!
-//! Implemented by the twin pantograph ([`TwinPantograph`](super::TwinPantograph): 4 joints, x, y
+//! Implemented by the twin pantograph ([`TwinPantograph`]: 4 joints, x, y
 //! and θ, redundant) and the 2-DOF five-bar ([`Pantograph2Device`](super::pantograph2_device::Pantograph2Device):
 //! 2 joints, x and y; a Haply 2DIY, a UDP five-bar, the Inverse3 through its virtual five-bar).
 

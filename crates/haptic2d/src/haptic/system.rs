@@ -317,7 +317,7 @@ impl HapticSystem {
 
     /// The stall check of [`Self::tick_elapsed`] on its own, for a device paced by the ticks (the
     /// simulated plant) whose signals are differentiated over one period but whose loop can still
-    /// stall: trips ([`SafetyReason::Stall`]) when `elapsed` (s since the previous tick; of which
+    /// stall: trips ([`SafetyReason::Stall`](super::safety::SafetyReason::Stall)) when `elapsed` (s since the previous tick; of which
     /// `device_wait` s waiting for the device, NaN = unknown) exceeds the stall limit `max(max_stall_periods·T, min_stall_time)`; the
     /// next tick's torques are then zero. Returns true when it tripped. Never allocates.
     pub fn check_stall(&mut self, elapsed: f64, device_wait: f64) -> bool {
