@@ -1,6 +1,6 @@
 //! End-to-end tests of the `haptic2d` binary: what a new user types.
 
-mod common;
+use crate::common;
 
 use common::{haptic2d, text};
 

@@ -11,7 +11,7 @@ use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
 
-mod common;
+use crate::common;
 use common::{text, turn};
 
 use haptic2d_devices::haply::{HaplyDeviceFile, HaplyKind};
