@@ -5,7 +5,8 @@
 //! those commands call, in-process: every case must end in `Ok` or a clear `Err` — no panic, no
 //! case slower than a second, and no single allocation larger than a small multiple of the file
 //! (a counting global allocator measures it: the `mcap` crate reserved 4 GiB for a 113 KB file).
-//! The regression files of the issue are in tests/data.
+//! The regression files of the issue (../shared/repro/len-max.mcap, replay-nan-safety-exit0.mcap)
+//! are rebuilt here from their descriptions (`len_max_log`, `cut_log`), not tracked as recordings.
 
 use haptic2d_rt::io::{ReplayDevice, ReplayEnd, DEFAULT_REPLAY_COLUMNS};
 use haptic2d_rt::mcap::columns::{tick_row, TICK_TABLE};
@@ -77,30 +78,7 @@ impl Rng {
 
 /// A small valid MCAP log: 40 ticks of box-in-walls with the world channels, chunked like a run's.
 fn seed_mcap() -> Vec<u8> {
-    let mut world = haptic2d::scene::builtin("box-in-walls", Some(1000.0))
-        .unwrap()
-        .unwrap()
-        .world;
-    world.prime();
-    let mut scene = BTreeMap::new();
-    scene.insert("scene_name".to_string(), "box-in-walls".to_string());
-    let mut setup = McapSetup::for_world(&world, scene, true);
-    setup.scene_update_hz = 100.0;
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("seed.mcap");
-    let file = std::fs::File::create(&path).unwrap();
-    let mut sink = McapSink::new(std::io::BufWriter::new(file), setup).unwrap();
-    let mut sample = WorldSample::default();
-    for i in 0..40u64 {
-        world.step();
-        sample.capture(&world);
-        let q = [0.1 + i as f64 * 1e-4, 2.9, 0.2, 3.0];
-        let row = tick_row(i, 1_000_000 * i, 0, &q, &Default::default());
-        sink.write_tick_row(i, 1_000_000 * i, &row).unwrap();
-        sink.write_world(i, 1_000_000 * i, &sample).unwrap();
-    }
-    sink.finish(&[]).unwrap();
-    std::fs::read(&path).unwrap()
+    log_of(40)
 }
 
 /// Byte offsets of every record's 8-byte length field (top level and inside chunks), and of every
@@ -387,20 +365,80 @@ fn fuzzed_csv_logs_are_read_or_refused_never_a_panic_a_hang_or_a_huge_allocation
     tally.assert_clean("CSV");
 }
 
-fn data(name: &str) -> Vec<u8> {
-    std::fs::read(
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("tests/data")
-            .join(name),
-    )
-    .unwrap()
+/// The top-level records of an MCAP file after its magic: (byte offset, opcode, declared length),
+/// up to the first whose length runs past the end. Written from the MCAP specification
+/// (<https://mcap.dev/spec>: opcode u8, length u64 LE, body), apart from the reader under test.
+fn top_level(b: &[u8]) -> Vec<(usize, u8, u64)> {
+    let mut out = Vec::new();
+    let mut pos = 8;
+    while pos + 9 <= b.len() {
+        let len = u64::from_le_bytes(b[pos + 1..pos + 9].try_into().unwrap());
+        out.push((pos, b[pos], len));
+        match usize::try_from(len)
+            .ok()
+            .and_then(|l| (pos + 9).checked_add(l))
+        {
+            Some(next) if next <= b.len() => pos = next,
+            _ => break,
+        }
+    }
+    out
+}
+
+/// A log of `ticks` samples of box-in-walls at 1 kHz: tick rows with made-up encoder angles, and
+/// the world (scene updates at 100 Hz).
+fn log_of(ticks: u64) -> Vec<u8> {
+    let mut world = haptic2d::scene::builtin("box-in-walls", Some(1000.0))
+        .unwrap()
+        .unwrap()
+        .world;
+    world.prime();
+    let mut scene = BTreeMap::new();
+    scene.insert("scene_name".to_string(), "box-in-walls".to_string());
+    let mut setup = McapSetup::for_world(&world, scene, true);
+    setup.scene_update_hz = 100.0;
+    let mut out = Vec::new();
+    let mut sink = McapSink::new(std::io::Cursor::new(&mut out), setup).unwrap();
+    let mut sample = WorldSample::default();
+    for i in 0..ticks {
+        world.step();
+        sample.capture(&world);
+        let q = [0.1 + i as f64 * 1e-4, 2.9, 0.2, 3.0];
+        let row = tick_row(i, 1_000_000 * i, 0, &q, &Default::default());
+        sink.write_tick_row(i, 1_000_000 * i, &row).unwrap();
+        sink.write_world(i, 1_000_000 * i, &sample).unwrap();
+    }
+    sink.finish(&[]).unwrap();
+    out
+}
+
+/// `../shared/repro/len-max.mcap`, rebuilt from its description (a whole log whose Header
+/// record, at byte 8, declares a length of 2⁶⁴ − 1) instead of tracked as a recording.
+fn len_max_log() -> Vec<u8> {
+    let mut b = seed_mcap();
+    assert_eq!(b[8], 0x01, "a log starts with its Header record");
+    b[9..17].copy_from_slice(&u64::MAX.to_le_bytes());
+    b
+}
+
+/// `../shared/repro/replay-nan-safety-exit0.mcap`, rebuilt from its description: a run log whose
+/// Header's opcode is flipped to an unknown one (0xb6, as in the repro: a reader skips it), cut
+/// halfway into its second Chunk record. Returns the bytes and that chunk's offset.
+fn cut_log() -> (Vec<u8>, usize) {
+    let mut b = log_of(3000);
+    let chunks: Vec<_> = top_level(&b).into_iter().filter(|r| r.1 == 0x06).collect();
+    assert!(chunks.len() >= 2, "one chunk only: {:?}", top_level(&b));
+    let (at, _, len) = chunks[1];
+    b[8] = 0xb6;
+    b.truncate(at + 9 + len as usize / 2);
+    (b, at)
 }
 
 #[test]
 fn record_length_of_2_pow_64_minus_1_is_a_clear_error_not_a_panic() {
-    // ../shared/repro/len-max.mcap: the Header's length field is 2⁶⁴ − 1; `log info`, `log
+    // ../shared/repro/len-max.mcap (rebuilt by `len_max_log`): the Header's length field is 2⁶⁴ − 1; `log info`, `log
     // convert` and `replay:` panicked inside the mcap crate (exit 101).
-    let b = data("len-max.mcap");
+    let b = len_max_log();
     LARGEST.with(|m| m.set(0));
     for r in [
         read_info(&b, "len-max.mcap").map(|_| ()),
@@ -419,15 +457,17 @@ fn record_length_of_2_pow_64_minus_1_is_a_clear_error_not_a_panic() {
 
 #[test]
 fn a_log_cut_inside_a_chunk_replays_its_whole_ticks_before_the_cut() {
-    // ../shared/repro/replay-nan-safety-exit0.mcap: a run log cut inside its second chunk (and its
+    // ../shared/repro/replay-nan-safety-exit0.mcap (rebuilt by `cut_log`): a run log cut inside its second chunk (and its
     // Header's opcode flipped to an unknown one, which a reader skips). The ticks before the cut
     // are read; the file is reported as cut, not complete.
-    let b = data("replay-nan-safety-exit0.mcap");
+    let (b, chunk_at) = cut_log();
     let info = read_info(&b, "cut.mcap").unwrap();
     assert!(!info.complete);
     let cut = info.damage.as_deref().unwrap();
     assert!(
-        cut.contains("the file ends inside a Chunk record at byte 13190"),
+        cut.contains(&format!(
+            "the file ends inside a Chunk record at byte {chunk_at}"
+        )),
         "{cut}"
     );
     let q = encoders_of(&b, "cut.mcap").unwrap();

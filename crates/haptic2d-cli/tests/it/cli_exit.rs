@@ -281,13 +281,47 @@ fn clap_usage_errors_exit_2() {
 }
 
 /// The regression logs of issue 38 (kept with the reader's tests in haptic2d-rt).
-fn repro(name: &str) -> String {
-    common::root()
-        .join("crates/haptic2d-rt/tests/data")
-        .join(name)
-        .to_str()
-        .unwrap()
-        .to_string()
+/// The two hostile logs of `../shared/repro/`, rebuilt from their descriptions out of a log this
+/// binary records (`run --log`, 1.5 s) instead of tracked as recordings: `len-max.mcap`, the log
+/// with its Header record (byte 8) declaring a length of 2⁶⁴ − 1; and
+/// `replay-nan-safety-exit0.mcap`, the log with its Header's opcode flipped to an unknown one
+/// (0xb6, skipped by a reader) and cut halfway into its second Chunk record. Returns their paths.
+fn hostile_logs(dir: &tempfile::TempDir) -> (String, String) {
+    let rec = dir.path().join("rec.mcap");
+    let o = haptic2d(&[
+        "run",
+        "--headless",
+        "--no-rt",
+        "--duration",
+        "1.5",
+        "--log",
+        rec.to_str().unwrap(),
+    ]);
+    assert_eq!(code(&o), 0, "{}", text(&o));
+    let log = std::fs::read(&rec).unwrap();
+    assert_eq!(log[8], 0x01, "a log starts with its Header record");
+    // Top-level records after the magic (MCAP spec: opcode u8, length u64 LE, body).
+    let mut chunks = Vec::new();
+    let mut pos = 8;
+    while pos + 9 <= log.len() {
+        let len = u64::from_le_bytes(log[pos + 1..pos + 9].try_into().unwrap()) as usize;
+        if log[pos] == 0x06 {
+            chunks.push((pos, len));
+        }
+        pos += 9 + len;
+    }
+    assert!(chunks.len() >= 2, "one chunk only in a 1.5 s run log");
+    let mut len_max = log.clone();
+    len_max[9..17].copy_from_slice(&u64::MAX.to_le_bytes());
+    let (at, len) = chunks[1];
+    let mut cut = log[..at + 9 + len / 2].to_vec();
+    cut[8] = 0xb6;
+    let path = |name: &str, bytes: &[u8]| {
+        let p = dir.path().join(name);
+        std::fs::write(&p, bytes).unwrap();
+        p.to_str().unwrap().to_string()
+    };
+    (path("cut.mcap", &cut), path("len-max.mcap", &len_max))
 }
 
 /// Issue 38 item 3 and issue 39 items 5 and 7: every command into every ending, with its code and
@@ -299,8 +333,7 @@ fn every_command_ends_with_its_documented_exit_code_and_message() {
     let dir = tempfile::tempdir().unwrap();
     let zero_replay = write(&dir, "zero.csv", "q1,q2,q3,q4\n0,0,0,0\n0,0,0,0\n");
     let out_file = write(&dir, "a-file", "not a folder");
-    let cut = repro("replay-nan-safety-exit0.mcap");
-    let len_max = repro("len-max.mcap");
+    let (cut, len_max) = hostile_logs(&dir);
     let csv_out = dir.path().join("out.csv");
     let csv_out = csv_out.to_str().unwrap();
     let replay_cut = format!("replay:{cut}");
