@@ -297,7 +297,9 @@ fn hostile_logs(dir: &tempfile::TempDir) -> (String, String) {
         "--log",
         rec.to_str().unwrap(),
     ]);
-    assert_eq!(code(&o), 0, "{}", text(&o));
+    // Any whole log will do: a run a loaded machine stalls (a safety stop, exit 3) still leaves
+    // one, ending on a whole tick.
+    assert!(matches!(code(&o), 0 | 3), "{}", text(&o));
     let log = std::fs::read(&rec).unwrap();
     assert_eq!(log[8], 0x01, "a log starts with its Header record");
     // Top-level records after the magic (MCAP spec: opcode u8, length u64 LE, body).
