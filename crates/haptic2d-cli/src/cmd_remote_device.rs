@@ -4,10 +4,12 @@
 //! sends through the master port's TDPA passivity controller. Every period:
 //!
 //! ```text
-//! encoders → pose, twist (TwinPantograph::estimate)          stall check (Safety::check_stall)
+//! encoders → pose, twist (TwinPantograph::estimate)          stall, joint plausibility (SafetyStage)
 //! newest world message (authenticated, by sequence number)    lost link: none for --link-timeout-ms → latch
 //! force · ramp → TDPA master port (energy in from the world)  workspace bound (trip past it)
-//! → torques (redundancy, saturation) → Safety::gate → motors  book the force really applied
+//! → torques (redundancy, saturation) → limit cycle, gate → motors   book the force really applied
+//!
+//! The safety steps are the shared `SafetyStage`, the same as every device's in `run`.
 //! send: handle pose and twist from the start pose, the applied force, the port's energies
 //! ```
 //!
@@ -20,10 +22,12 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use haptic2d::control::tdpa::{planar_balance, PlanarTdpa};
+use haptic2d::device::cartesian::CartesianDevice;
 use haptic2d::device::linalg::V3;
 use haptic2d::device::{DeviceParams, ObserverKind, TwinPantograph};
 use haptic2d::haptic::safety::{Safety, SafetyConfig, SafetyReason};
 use haptic2d::haptic::workspace::WorkspaceBound;
+use haptic2d::haptic::SafetyStage;
 use haptic2d_devices::world_link::message::{FLAG_BYE, FLAG_LATCHED, FLAG_TDPA};
 use haptic2d_devices::world_link::{
     LinkEndpoint, PortMessage, KIND_TO_DEVICE, KIND_TO_WORLD, PORT_LEN,
@@ -153,10 +157,9 @@ struct DeviceSide {
     io: SimIo,
     push: Option<(Push, Arc<SharedTarget>)>,
     dev: TwinPantograph,
-    safety: Safety,
-    workspace: WorkspaceBound,
-    stall_limit: f64,
-    ramp_len: u64,
+    /// The tick's safety steps, the same as every device's (stall, joint plausibility, workspace
+    /// bound, limit cycle, ramp, final gate).
+    safety: SafetyStage,
     origin: V3,
     tdpa: bool,
     ports: PlanarTdpa,
@@ -194,8 +197,8 @@ impl DeviceSide {
             Ok(e) => e,
             Err(f) => return self.stop(t, Latch::Safety(SafetyReason::Device(f))),
         };
-        self.safety
-            .check_stall(k, t, self.ticks > 0, elapsed, f64::NAN, self.stall_limit);
+        let at = (k, t);
+        self.safety.supervise_input(at, &q, elapsed, f64::NAN);
         // The world's newest message, and the lost-link check.
         if let Some(m) = self.ep.poll(KIND_TO_DEVICE) {
             let now = now_ns();
@@ -220,7 +223,7 @@ impl DeviceSide {
         }
         // The world's force, ramped in, through the master port's passivity controller.
         let (x, v) = (est.pose, est.velocity);
-        let ramp = (self.ticks as f64 / self.ramp_len.max(1) as f64).min(1.0);
+        let ramp = self.safety.ramp();
         let (f_req, far) = self.last.map_or(([0.0; 3], [0.0; 3]), |m| {
             (m.force.map(|f| f * ramp), m.energy_in)
         });
@@ -233,24 +236,22 @@ impl DeviceSide {
         };
         // Local safety: the workspace bound, the torques, the gate.
         let mut w = f_net;
-        if let Some(r) = self.workspace.apply(&x, &v, &mut w) {
-            self.safety.trip(k, t, r);
-        }
+        self.safety.workspace_wall(at, &x, &v, &mut w);
         let mut scale = 0.0;
         self.tau = [0.0; 4];
         match self.dev.torques_for_wrench(&w, 0.0) {
-            Ok(c) if c.near_singular => self.safety.trip(
-                k,
-                t,
-                SafetyReason::Singularity {
-                    margin: c.margin,
-                    limit: self.safety.min_margin,
-                },
-            ),
+            Ok(c) if c.near_singular => {
+                let limit = self.safety.latch().min_margin;
+                let margin = c.margin;
+                self.safety
+                    .trip(at, SafetyReason::Singularity { margin, limit })
+            }
             Ok(c) => (self.tau, scale) = (c.tau, c.wrench_scale),
-            Err(f) => self.safety.trip(k, t, SafetyReason::Torques(f)),
+            Err(f) => self.safety.trip(at, SafetyReason::Torques(f)),
         }
-        if self.safety.gate(k, t, &mut self.tau) {
+        let tau_max = self.dev.tau_max();
+        self.safety.observe_limit_cycle(at, &self.tau, &tau_max);
+        if self.safety.gate(at, &mut self.tau, true) {
             scale = 0.0;
         }
         let applied = f_net.map(|f| f * scale);
@@ -409,14 +410,16 @@ pub fn run(a: &RemoteDeviceArgs) -> Result<Status, Failure> {
         io,
         push,
         dev,
-        safety: Safety::new(
-            params.min_singularity_margin,
-            params.tau_max,
-            safety_config.torque_trip_margin,
+        safety: SafetyStage::new(
+            safety_config,
+            Safety::new(
+                params.min_singularity_margin,
+                params.tau_max,
+                safety_config.torque_trip_margin,
+            ),
+            WorkspaceBound::new(&params, dt),
+            dt,
         ),
-        workspace: WorkspaceBound::new(&params, dt),
-        stall_limit: safety_config.stall_limit(dt),
-        ramp_len: (safety_config.ramp_time / dt).round() as u64,
         origin,
         tdpa: !a.link.no_tdpa,
         ports: PlanarTdpa::default(),
