@@ -17,7 +17,7 @@ use std::process::{Child, Command, Stdio};
 use std::sync::mpsc;
 use std::time::Duration;
 
-use crate::common;
+mod common;
 use common::{turn, wait_with_limit};
 
 const BIN: &str = env!("CARGO_BIN_EXE_haptic2d");
@@ -353,10 +353,10 @@ fn teleop_of_two_simulated_devices_reproduces_the_wall_contact_at_the_master() {
 /// reported as passed where it cannot run: it needs `unshare -n`, the privilege to make a network
 /// namespace and a kernel with the netem qdisc (`sch_netem`; the VM this was written on lacks it,
 /// so this path has not run there). Run where they exist:
-/// `cargo test -p haptic2d-cli --test it cli_teleop::netem -- --ignored`; without them it fails and
+/// `cargo test -p haptic2d-cli --test cli_teleop netem -- --ignored`; without them it fails and
 /// says which is missing.
 #[test]
-#[ignore = "needs a network namespace with the netem qdisc (root, sch_netem): cargo test -p haptic2d-cli --test it cli_teleop::netem -- --ignored"]
+#[ignore = "needs a network namespace with the netem qdisc (root, sch_netem): cargo test -p haptic2d-cli --test cli_teleop netem -- --ignored"]
 fn netem_in_a_namespace_at_50_ms_and_5_percent_with_tdpa_creates_no_energy() {
     let _t = turn();
     let netem = "ip link set lo up && tc qdisc add dev lo root netem delay 25ms loss 5%";

@@ -2,7 +2,7 @@
 //! every log ending on a whole row, exit status 130 (interrupted). Signals are sent with
 //! `libc::kill` to the spawned binary.
 
-use crate::common;
+mod common;
 
 use std::path::Path;
 use std::process::{Child, Command, Stdio};

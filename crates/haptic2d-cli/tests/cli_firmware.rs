@@ -18,7 +18,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-use crate::common;
+mod common;
 use common::patient_device_file;
 
 const BIN: &str = env!("CARGO_BIN_EXE_haptic2d");

@@ -1,6 +1,6 @@
 //! End-to-end tests of the `haptic2d` binary: what a new user types.
 
-use crate::common;
+mod common;
 
 use common::{haptic2d, text};
 

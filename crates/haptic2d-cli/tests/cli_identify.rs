@@ -11,7 +11,7 @@ use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
 
-use crate::common;
+mod common;
 use common::{text, turn};
 
 use haptic2d_devices::haply::{HaplyDeviceFile, HaplyKind};

@@ -18,7 +18,7 @@ use std::process::{Child, Command, Stdio};
 use std::thread;
 use std::time::Duration;
 
-use crate::common;
+mod common;
 use common::{column, patient_device_file, text, turn};
 
 const BIN: &str = env!("CARGO_BIN_EXE_haptic2d");

@@ -4,7 +4,7 @@
 //! bulk of the fuzzing runs in-process in haptic2d-rt's tests/log_fuzz.rs (1 200 MCAP and 1 200
 //! CSV cases); this runs a few dozen through the binary, which adds the commands' own code.
 
-use crate::common;
+mod common;
 
 use common::{haptic2d, text, wait_with_limit};
 use std::process::{Command, Stdio};

@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-use crate::common;
+mod common;
 use common::{column, text, turn};
 
 const BIN: &str = env!("CARGO_BIN_EXE_haptic2d");

@@ -16,7 +16,7 @@ use std::sync::Arc;
 use std::thread;
 use std::time::Duration;
 
-use crate::common;
+mod common;
 use common::{patient_device_file, root, text, turn};
 
 const BIN: &str = env!("CARGO_BIN_EXE_haptic2d");

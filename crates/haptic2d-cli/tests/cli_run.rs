@@ -1,7 +1,7 @@
 //! `haptic2d run`: a short headless run prints the timing summary and logs one row per tick; bad
 //! options fail with a clear message and a non-zero exit.
 
-use crate::common;
+mod common;
 
 use common::{haptic2d, text, turn};
 use std::process::Command;

@@ -3,7 +3,7 @@
 //! conversion is lossless; `--device replay:x.mcap` replays a recording; `simulate --out x.mcap`;
 //! the Foxglove live server serves a loopback client and survives a malformed message.
 
-use crate::common;
+mod common;
 
 use common::{haptic2d, text};
 use haptic2d_rt::mcap::columns::{TickRow, Val, LOOP_COLUMN_COUNT, TICK_TABLE};

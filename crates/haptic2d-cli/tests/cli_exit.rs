@@ -3,7 +3,7 @@
 //! input, 3 safety stop, 4 lost device (unit-tested in `cmd_run`), 5 energy excess under `--strict`,
 //! 6 divergence, 130 interrupted (tests/cli_signals.rs).
 
-use crate::common;
+mod common;
 
 use common::{haptic2d, text};
 use std::process::Output;
@@ -33,7 +33,7 @@ fn write(dir: &tempfile::TempDir, name: &str, text: &str) -> String {
     p.to_str().unwrap().to_string()
 }
 
-const BOX_IN_WALLS: &str = include_str!("../../../../scenes/box-in-walls.toml");
+const BOX_IN_WALLS: &str = include_str!("../../../scenes/box-in-walls.toml");
 
 #[test]
 fn help_lists_the_exit_codes() {

@@ -1,7 +1,7 @@
 //! `haptic2d stability` end to end (issue 11): a verdict per axis and the poles, for the default
 //! configuration and for the spec's, and the plot files.
 
-use crate::common;
+mod common;
 
 use common::{haptic2d, text};
 

@@ -3,7 +3,7 @@
 //! parser; here each example printed in the help is run with `--help` appended, which clap refuses
 //! when an option before it is unknown or its value does not parse.)
 
-use crate::common;
+mod common;
 
 use common::{haptic2d, text};
 
