@@ -45,22 +45,8 @@ pub struct CheckArgs {
     pub pulse_torque: f64,
 }
 
-/// Subcommands of `haptic2d device`.
-#[derive(clap::Subcommand, Debug)]
-pub enum DeviceCommand {
-    /// Read the angles and the pose; with --pulse confirm the motor directions.
-    Check(CheckArgs),
-    /// Measure a 2DIY's inertia and damping from small torque pulses (hand released) and write
-    /// them to the device file's [identified] table for the stability gate.
-    Identify(crate::cmd_device_identify::IdentifyArgs),
-}
-
-/// Runs `device SUBCOMMAND`.
-pub fn run(c: &DeviceCommand) -> ExitCode {
-    let a = match c {
-        DeviceCommand::Check(a) => a,
-        DeviceCommand::Identify(a) => return crate::cmd_device_identify::run(a),
-    };
+/// Runs `device check`.
+pub fn run(a: &CheckArgs) -> ExitCode {
     match check(a) {
         Ok(code) => ExitCode::from(code),
         Err((code, msg)) => fail(code, &msg),

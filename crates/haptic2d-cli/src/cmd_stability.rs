@@ -6,13 +6,13 @@
 
 use crate::device_arg;
 use crate::exit::Failure;
-use crate::run_rig::DeviceModel;
 use crate::scene_arg;
 use haptic2d::device::pantograph2::Pantograph2;
 use haptic2d::geom::Vec2;
 use haptic2d::haptic::{ControllerKind, HapticConfig};
 use haptic2d_devices::haply::identified::Identified;
 use haptic2d_devices::haply::{HaplyDeviceFile, HaplyKind, Plant2};
+use haptic2d_devices::registry::DeviceModel;
 use haptic2d_lab::stability::planar2::{
     analyse_planar2, check_released_stability_planar2, FiveBarDynamics,
 };

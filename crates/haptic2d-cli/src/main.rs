@@ -1,6 +1,7 @@
 //! `haptic2d`: the command-line tool of the haptic2d project.
 
 mod cmd_check;
+mod cmd_device;
 mod cmd_device_check;
 mod cmd_device_identify;
 mod cmd_devices;
@@ -92,7 +93,7 @@ enum Command {
     /// Device tools: `device check --device haply:PATH [--pulse]`, `device identify`.
     Device {
         #[command(subcommand)]
-        command: cmd_device_check::DeviceCommand,
+        command: cmd_device::DeviceCommand,
     },
     /// Validate a scene file and explain every problem found.
     Check {
@@ -317,7 +318,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Emulate(args) => return cmd_emulate::run(&args),
         Command::Devices => return cmd_devices::run(),
-        Command::Device { command } => return cmd_device_check::run(&command),
+        Command::Device { command } => return cmd_device::run(&command),
         Command::Run(args) => cmd_run::run(&args),
         Command::ServeWorld(args) => cmd_serve_world::run(&args),
         Command::RemoteDevice(args) => cmd_remote_device::run(&args),

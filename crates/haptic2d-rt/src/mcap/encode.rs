@@ -4,8 +4,18 @@
 
 use crate::mcap::columns::{tick_row, write_json_f64, write_key, write_row_members, TickRow};
 use crate::mcap::record::{LoggedTick, WorldSample};
-use crate::mcap::writer::BodyGeom;
 use std::io::Write;
+
+/// A body's name and outline, for the names in the messages and the `SceneUpdate` drawing.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BodyGeom {
+    /// Body name.
+    pub name: String,
+    /// True for a dynamic body.
+    pub dynamic: bool,
+    /// The body's collider polygons, body frame (m), counter-clockwise.
+    pub outlines: Vec<Vec<[f64; 2]>>,
+}
 
 /// Scale of the contact-force lines drawn in the `SceneUpdate` (m per N): 1 N draws 1 mm.
 pub const FORCE_LINE_M_PER_N: f64 = 1e-3;

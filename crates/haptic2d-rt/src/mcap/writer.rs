@@ -30,18 +30,7 @@ use std::io::{Seek, Write};
 /// small next to the full-rate channels.
 pub const DEFAULT_SCENE_UPDATE_HZ: f64 = 60.0;
 
-pub use crate::mcap::encode::FORCE_LINE_M_PER_N;
-
-/// A body's name and outline, for the names in the messages and the `SceneUpdate` drawing.
-#[derive(Clone, Debug, PartialEq)]
-pub struct BodyGeom {
-    /// Body name.
-    pub name: String,
-    /// True for a dynamic body.
-    pub dynamic: bool,
-    /// The body's collider polygons, body frame (m), counter-clockwise.
-    pub outlines: Vec<Vec<[f64; 2]>>,
-}
+pub use crate::mcap::encode::{BodyGeom, FORCE_LINE_M_PER_N};
 
 /// What a log says about its run, fixed at the start.
 #[derive(Clone, Debug, Default)]
