@@ -114,9 +114,9 @@ fn describe_method(study: &Study) -> String {
             q.max_trials
         ),
         Method::Staircase(s) => format!(
-            "{} interleaved 1-up/{}-down staircase(s) per condition (target {:.1} % correct), stop at {} trials or {} reversals",
+            "{} interleaved {} staircase(s) per condition (target {:.1} % correct), stop at {} trials or {} reversals",
             s.starts.len(),
-            s.down,
+            s.rule_name(),
             100.0 * s.target(),
             s.max_trials,
             s.max_reversals

@@ -93,8 +93,11 @@ pub struct MethodSection {
     pub deltas: Option<Vec<f64>>,
     /// Constant stimuli: presentations of each delta per condition.
     pub repeats: Option<u32>,
-    /// Staircase: `"1-up-2-down"` (→ 70.7 % correct) or `"1-up-3-down"` (→ 79.4 %).
+    /// Staircase: `"1-up-2-down"` (→ 70.7 % correct), `"1-up-3-down"` (→ 79.4 %) or
+    /// `"weighted"` (Kaernbach 1991, converging on `target`).
     pub rule: Option<String>,
+    /// Weighted staircase: the proportion correct it converges on, in (0.5, 0.99).
+    pub target: Option<f64>,
     /// Staircase: the starting delta of each interleaved staircase of a condition.
     pub starts: Option<Vec<f64>>,
     /// Staircase: multiplicative step (down = delta / f, up = delta · f), > 1.

@@ -7,8 +7,12 @@ use haptic2d::scene::SceneError;
 /// A transformed up/down staircase's parameters.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct StaircaseSpec {
-    /// Consecutive correct answers for one step down (2 → 70.7 %, 3 → 79.4 % correct).
+    /// Consecutive correct answers for one step down (2 → 70.7 %, 3 → 79.4 % correct; 1 for a
+    /// weighted staircase).
     pub down: u32,
+    /// The up step in units of the down step (in `log Δ`): 1 for Levitt's transformed rules;
+    /// `p/(1 − p)` for Kaernbach's weighted up/down targeting `p` (1991).
+    pub up_weight: f64,
     /// Starting delta of each interleaved staircase of a condition.
     pub starts: Vec<f64>,
     /// Multiplicative step factor (> 1).
@@ -26,9 +30,24 @@ pub struct StaircaseSpec {
 }
 
 impl StaircaseSpec {
-    /// The proportion correct the rule converges to, `0.5^(1/down)` (Levitt 1971).
+    /// The rule's name for reports: `1-up/2-down`, `1-up/3-down` or `weighted up/down (up = w × down)`.
+    pub fn rule_name(&self) -> String {
+        if self.down == 1 {
+            format!("weighted up/down (up = {:.2} × down)", self.up_weight)
+        } else {
+            format!("1-up/{}-down", self.down)
+        }
+    }
+
+    /// The proportion correct the rule converges to: `0.5^(1/down)` for Levitt's transformed
+    /// rules (1971); `w/(1 + w)` for Kaernbach's weighted up/down (1991) with up weight `w`, where
+    /// the expected step `p·s_down − (1 − p)·w·s_down` vanishes.
     pub fn target(&self) -> f64 {
-        0.5f64.powf(1.0 / f64::from(self.down))
+        if self.down == 1 {
+            self.up_weight / (1.0 + self.up_weight)
+        } else {
+            0.5f64.powf(1.0 / f64::from(self.down))
+        }
     }
 }
 
@@ -184,14 +203,22 @@ fn constant_from(m: &MethodSection, own_deltas: bool, e: &mut Report) -> Method 
 
 /// `[method]` of kind `"staircase"`.
 fn staircase_from(m: &MethodSection, e: &mut Report) -> StaircaseSpec {
-    let down = match m.rule.as_deref() {
-        Some("1-up-2-down") => 2,
-        Some("1-up-3-down") => 3,
+    let (down, up_weight) = match m.rule.as_deref() {
+        Some("1-up-2-down") => (2, 1.0),
+        Some("1-up-3-down") => (3, 1.0),
+        Some("weighted") => (1, weighted_up_weight(m.target, e)),
         other => {
-            e("rule", format!("unknown rule {other:?}"), "rule = \"1-up-2-down\" (70.7 % correct) or \"1-up-3-down\" (79.4 %); weighted up/down is not built yet");
-            2
+            e("rule", format!("unknown rule {other:?}"), "rule = \"1-up-2-down\" (70.7 % correct), \"1-up-3-down\" (79.4 %) or \"weighted\" (Kaernbach 1991: any target, e.g. target = 0.75)");
+            (2, 1.0)
         }
     };
+    if m.target.is_some() && m.rule.as_deref() != Some("weighted") {
+        e(
+            "target",
+            "only a weighted staircase takes a target".into(),
+            "remove it, or set rule = \"weighted\"",
+        );
+    }
     let starts = m.starts.clone().unwrap_or_default();
     if starts.is_empty() || starts.len() > 8 || starts.iter().any(|s| !positive(*s)) {
         e("starts", format!("{starts:?}"), "give 1 to 8 positive starting deltas, one per interleaved staircase, e.g. starts = [400.0, 50.0]");
@@ -255,6 +282,7 @@ fn staircase_from(m: &MethodSection, e: &mut Report) -> StaircaseSpec {
     }
     StaircaseSpec {
         down,
+        up_weight,
         starts,
         step_factor: step,
         initial_step_factor: initial,
@@ -262,6 +290,22 @@ fn staircase_from(m: &MethodSection, e: &mut Report) -> StaircaseSpec {
         max_reversals,
         min_delta,
         max_delta,
+    }
+}
+
+/// The up weight `p/(1 − p)` of a weighted staircase targeting `p` (Kaernbach 1991).
+fn weighted_up_weight(target: Option<f64>, e: &mut Report) -> f64 {
+    let guessless = 0.5;
+    match target {
+        Some(p) if p.is_finite() && p > guessless && p < 0.99 => p / (1.0 - p),
+        other => {
+            e(
+                "target",
+                format!("{other:?}"),
+                "give the proportion correct a weighted staircase converges on, in (0.5, 0.99), e.g. target = 0.75",
+            );
+            3.0
+        }
     }
 }
 

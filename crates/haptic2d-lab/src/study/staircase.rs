@@ -1,6 +1,8 @@
 //! The state of one transformed up/down staircase (Levitt 1971): `down` consecutive correct answers
 //! lower the delta by the step factor, one wrong answer raises it; a change of direction is a
-//! reversal. The first two reversals use the initial step factor.
+//! reversal. The first two reversals use the initial step factor. A weighted staircase (Kaernbach
+//! 1991: `down` = 1) steps down by the factor `f` after every correct answer and up by `f^w` after
+//! every wrong one, `w = p/(1 − p)`, so that it converges on `p` correct.
 
 use super::method::StaircaseSpec;
 
@@ -64,7 +66,7 @@ impl Staircase {
         let next = if dir < 0 {
             self.delta / f
         } else {
-            self.delta * f
+            self.delta * f.powf(self.spec.up_weight)
         };
         self.delta = next.clamp(self.spec.min_delta, self.spec.max_delta);
     }
@@ -77,6 +79,7 @@ mod tests {
     fn spec(down: u32) -> StaircaseSpec {
         StaircaseSpec {
             down,
+            up_weight: 1.0,
             starts: vec![100.0],
             step_factor: 2.0,
             initial_step_factor: 2.0,
@@ -132,5 +135,47 @@ mod tests {
             "2-down targets √½"
         );
         assert!((spec(3).target() - 0.7937).abs() < 1e-4);
+    }
+
+    /// Kaernbach (1991): a weighted staircase targeting `p` steps up by `p/(1 − p)` down steps,
+    /// and on an observer whose proportion correct is the logistic `P(Δ)` its deltas settle where
+    /// `P = p`: with small steps the median of the second half of a long run is within 5 % of
+    /// `P⁻¹(p)`.
+    #[test]
+    fn a_weighted_staircase_converges_on_its_target_proportion() {
+        use crate::study::rng::Rng;
+        for &p in &[0.6, 0.75, 0.9] {
+            let s = StaircaseSpec {
+                down: 1,
+                up_weight: p / (1.0 - p),
+                starts: vec![100.0],
+                step_factor: 1.02,
+                initial_step_factor: 1.02,
+                max_trials: 40_000,
+                max_reversals: u32::MAX,
+                min_delta: 0.01,
+                max_delta: 1e4,
+            };
+            assert!((s.target() - p).abs() < 1e-12);
+            // 2AFC: P(Δ) = 0.5 + 0.5·(1 − exp(−(Δ/50)²)); P⁻¹(p) = 50·sqrt(−ln(2 − 2p)).
+            let prob = |d: f64| 0.5 + 0.5 * (1.0 - (-(d / 50.0).powi(2)).exp());
+            let expected = 50.0 * (-(2.0 - 2.0 * p).ln()).sqrt();
+            let mut st = Staircase::new(&s, 100.0);
+            let mut rng = Rng::new(7);
+            let mut late = Vec::new();
+            for k in 0..40_000 {
+                let correct = rng.uniform() < prob(st.delta);
+                if k >= 20_000 {
+                    late.push(st.delta.ln());
+                }
+                st.update(correct);
+            }
+            late.sort_by(f64::total_cmp);
+            let median = late[late.len() / 2].exp();
+            assert!(
+                (median / expected - 1.0).abs() < 0.05,
+                "p = {p}: settles at {median}, expected {expected}"
+            );
+        }
     }
 }

@@ -163,34 +163,12 @@ fn resuming_with_a_different_study_file_is_refused() {
     assert!(e.contains("different study file"), "{e}");
 }
 
-/// Interleaved 1-up/2-down staircases converge near the observer's 70.7 %-correct increment, which
-/// follows from the model: P(correct) = λ/2 + (1 − λ)·Φ(ln(1 + Δ/K)/(σ√2)), σ√2 = ln(1 + W)/z₀.₇₅.
-#[test]
-fn interleaved_staircases_converge_near_the_models_70_percent_point() {
-    let text = std::fs::read_to_string(shipped()).unwrap().replace(
-        "kind = \"constant\"        # method of constant stimuli\ndeltas = [30.0, 60.0, 100.0, 150.0, 220.0, 320.0, 480.0]   # N/m added to kc in the comparison\nrepeats = 40             # presentations of each delta",
-        "kind = \"staircase\"\nrule = \"1-up-2-down\"\nstarts = [500.0, 40.0]\nstep_factor = 1.26\ninitial_step_factor = 2.0\nmax_trials = 100\nmax_reversals = 30",
-    );
-    assert!(text.contains("staircase"));
-    let study = Study::from_toml(&text, "staircase", shipped().parent()).unwrap();
-    let dir = tempfile::tempdir().unwrap();
-    run_all(&study, &text, dir.path(), "S01", None);
-    let (rows, _) = trials::read(
-        &std::fs::read_to_string(dir.path().join("sub-S01/ses-1/trials.tsv")).unwrap(),
-    )
-    .unwrap();
-    let res = analyse_rows(
-        &rows,
-        &AnalyseOptions {
-            bootstrap: 50,
-            ..Default::default()
-        },
-    )
-    .unwrap();
-    let est = res[0].staircase_estimate.unwrap();
+/// The model's delta (N/m, at the 1000 N/m reference) answered correctly with proportion `p`:
+/// P(correct) = λ/2 + (1 − λ)·Φ(ln(1 + Δ/K)/(σ√2)), σ√2 = ln(1 + W)/z₀.₇₅.
+fn model_point(study: &Study, p: f64) -> f64 {
     let (w, l) = (study.observer.weber_fraction, study.observer.lapse_rate);
-    let z = (std::f64::consts::FRAC_1_SQRT_2 - l / 2.0) / (1.0 - l); // Φ(...) at the 70.7 % point
-                                                                     // Φ⁻¹ by bisection on the library's Φ (tested against the table).
+    let z = (p - l / 2.0) / (1.0 - l); // Φ(...) at the point
+                                       // Φ⁻¹ by bisection on the library's Φ (tested against the table).
     let (mut lo, mut hi) = (-5.0, 5.0);
     for _ in 0..100 {
         let m = 0.5 * (lo + hi);
@@ -201,13 +179,119 @@ fn interleaved_staircases_converge_near_the_models_70_percent_point() {
         }
     }
     let s2 = (1.0 + w).ln() / haptic2d_lab::study::numeric::Z75;
-    let target = 1000.0 * ((lo * s2).exp() - 1.0);
+    1000.0 * ((lo * s2).exp() - 1.0)
+}
+
+/// Runs the shipped constant-stimuli study with `method` in place of its method, for participant
+/// `id`, and returns the staircase estimate of its one condition and its number of tracks.
+fn staircase_estimate(method: &str, id: &str) -> (Study, f64, usize) {
+    let text = std::fs::read_to_string(shipped()).unwrap().replace(
+        "kind = \"constant\"        # method of constant stimuli\ndeltas = [30.0, 60.0, 100.0, 150.0, 220.0, 320.0, 480.0]   # N/m added to kc in the comparison\nrepeats = 40             # presentations of each delta",
+        method,
+    );
+    assert!(text.contains("staircase"));
+    let study = Study::from_toml(&text, "staircase", shipped().parent()).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    run_all(&study, &text, dir.path(), id, None);
+    let (rows, _) = trials::read(
+        &std::fs::read_to_string(dir.path().join(format!("sub-{id}/ses-1/trials.tsv"))).unwrap(),
+    )
+    .unwrap();
+    let res = analyse_rows(
+        &rows,
+        &AnalyseOptions {
+            bootstrap: 50,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    (
+        study,
+        res[0].staircase_estimate.unwrap(),
+        res[0].tracks.len(),
+    )
+}
+
+/// Interleaved 1-up/2-down staircases converge near the observer's 70.7 %-correct increment, which
+/// follows from the model ([`model_point`]).
+#[test]
+fn interleaved_staircases_converge_near_the_models_70_percent_point() {
+    let (study, est, tracks) = staircase_estimate(
+        "kind = \"staircase\"\nrule = \"1-up-2-down\"\nstarts = [500.0, 40.0]\nstep_factor = 1.26\ninitial_step_factor = 2.0\nmax_trials = 100\nmax_reversals = 30",
+        "S01",
+    );
+    let target = model_point(&study, std::f64::consts::FRAC_1_SQRT_2);
     eprintln!("staircase estimate {est} N/m, model's 70.7 % point {target} N/m");
     assert!(
         (est / target - 1.0).abs() < 0.35,
         "staircase estimate {est}, model's 70.7 % point {target}"
     );
-    assert_eq!(res[0].tracks.len(), 2, "two interleaved staircases");
+    assert_eq!(tracks, 2, "two interleaved staircases");
+}
+
+/// A weighted up/down staircase (Kaernbach 1991) targeting 85 % correct converges near the
+/// model's 85 % point, well above its 70.7 % point (so the test tells the rules apart). The mean
+/// of the reversal deltas of one participant scatters by about ±15 % around it with these steps
+/// (and the arithmetic mean of asymmetric reversals leans high), so four participants are
+/// averaged.
+#[test]
+fn a_weighted_staircase_converges_near_the_models_point_at_its_target() {
+    let method = "kind = \"staircase\"\nrule = \"weighted\"\ntarget = 0.85\nstarts = [500.0, 40.0]\nstep_factor = 1.1\ninitial_step_factor = 1.5\nmax_trials = 120\nmax_reversals = 40";
+    let mut sum = 0.0;
+    let mut study = None;
+    for id in ["W01", "W02", "W03", "W04"] {
+        let (s, est, tracks) = staircase_estimate(method, id);
+        assert_eq!(tracks, 2);
+        sum += est;
+        study = Some(s);
+    }
+    let study = study.unwrap();
+    let est = sum / 4.0;
+    let target = model_point(&study, 0.85);
+    let levitt = model_point(&study, std::f64::consts::FRAC_1_SQRT_2);
+    eprintln!("weighted staircase estimate {est} N/m (4 participants), model's 85 % point {target} N/m (70.7 %: {levitt})");
+    assert!(target > 1.4 * levitt, "{target} vs {levitt}");
+    assert!(
+        (est / target - 1.0).abs() < 0.25,
+        "weighted staircase estimate {est}, model's 85 % point {target}"
+    );
+}
+
+/// A weighted staircase needs its target in (0.5, 0.99); a target on another rule is refused.
+#[test]
+fn a_weighted_staircase_without_a_valid_target_is_refused_with_the_fix() {
+    let base = std::fs::read_to_string(shipped()).unwrap();
+    let with = |m: &str| {
+        base.replace(
+            "kind = \"constant\"        # method of constant stimuli\ndeltas = [30.0, 60.0, 100.0, 150.0, 220.0, 320.0, 480.0]   # N/m added to kc in the comparison\nrepeats = 40             # presentations of each delta",
+            m,
+        )
+    };
+    let stair = "kind = \"staircase\"\nstarts = [500.0]\nstep_factor = 1.2\nmax_trials = 50\n";
+    for (method, field) in [
+        (format!("{stair}rule = \"weighted\""), "method.target"),
+        (
+            format!("{stair}rule = \"weighted\"\ntarget = 0.4"),
+            "method.target",
+        ),
+        (
+            format!("{stair}rule = \"1-up-2-down\"\ntarget = 0.8"),
+            "method.target",
+        ),
+    ] {
+        let e = Study::from_toml(&with(&method), "bad.toml", shipped().parent())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(field) && e.contains("fix:"), "{method}: {e}");
+    }
+    let ok = with(&format!("{stair}rule = \"weighted\"\ntarget = 0.8"));
+    let s = Study::from_toml(&ok, "ok.toml", shipped().parent()).unwrap();
+    match s.method {
+        haptic2d_lab::study::method::Method::Staircase(sp) => {
+            assert!((sp.target() - 0.8).abs() < 1e-12)
+        }
+        _ => panic!("not a staircase"),
+    }
 }
 
 /// A study file's mistakes are reported with the field and the fix, all at once.
