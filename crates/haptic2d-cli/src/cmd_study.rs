@@ -113,6 +113,10 @@ fn describe_method(study: &Study) -> String {
             q.lapse,
             q.max_trials
         ),
+        Method::QuestPlus(q) => format!(
+            "QUEST+ (placement by least expected entropy over threshold and slope, prior {} ± {} log10, slopes {:?}, lapse {}), {} trials per condition",
+            q.start, q.prior_sd, q.slopes, q.lapse, q.max_trials
+        ),
         Method::Staircase(s) => format!(
             "{} interleaved {} staircase(s) per condition (target {:.1} % correct), stop at {} trials or {} reversals",
             s.starts.len(),
@@ -170,8 +174,16 @@ fn study_run(
         stop_after,
     )
     .map_err(Failure::error)?;
+    let quest = if s.slopes.is_empty() {
+        "QUEST"
+    } else {
+        "QUEST+"
+    };
     for (c, est, (lo, hi)) in &s.quest {
-        println!("QUEST {c}: threshold {est:.4} [{lo:.4}, {hi:.4}] (posterior mean, 95 % credible interval)");
+        println!("{quest} {c}: threshold {est:.4} [{lo:.4}, {hi:.4}] (posterior mean, 95 % credible interval)");
+    }
+    for (c, b) in &s.slopes {
+        println!("QUEST+ {c}: Weibull slope {b:.2} (posterior mean)");
     }
     println!(
         "{}: {} trial(s) run{}; {}",

@@ -122,6 +122,8 @@ pub struct MethodSection {
     pub lapse: Option<f64>,
     /// QUEST: `"mean"` (default) or `"mode"` of the posterior.
     pub placement: Option<String>,
+    /// QUEST+: the Weibull slopes the posterior spans (default [`super::method::DEFAULT_SLOPES`]).
+    pub slopes: Option<Vec<f64>>,
 }
 
 /// `[[block]]`.

@@ -72,6 +72,29 @@ pub struct QuestSpec {
     pub place_at_mode: bool,
 }
 
+/// QUEST+'s parameters (Watson 2017; `quest_plus.rs`): QUEST's, with a grid of slopes instead of
+/// one assumed slope.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct QuestPlusSpec {
+    /// The threshold prior's centre: the expected threshold (delta).
+    pub start: f64,
+    /// The threshold prior's standard deviation of `log₁₀ T`.
+    pub prior_sd: f64,
+    /// The Weibull slopes `β` the posterior spans (uniform prior).
+    pub slopes: Vec<f64>,
+    /// The assumed lapse rate `δ`.
+    pub lapse: f64,
+    /// Stop after this many trials.
+    pub max_trials: u32,
+    /// The grid's smallest threshold and delta.
+    pub min_delta: f64,
+    /// The grid's largest threshold and delta.
+    pub max_delta: f64,
+}
+
+/// QUEST+'s default slope grid: Weibull slopes from shallow to steep.
+pub const DEFAULT_SLOPES: [f64; 7] = [0.75, 1.0, 1.5, 2.0, 3.0, 4.5, 7.0];
+
 /// The method.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Method {
@@ -86,6 +109,8 @@ pub enum Method {
     Staircase(StaircaseSpec),
     /// QUEST: Bayesian adaptive placement, one per condition, interleaved.
     Quest(QuestSpec),
+    /// QUEST+: placement by least expected entropy over threshold and slope, one per condition.
+    QuestPlus(QuestPlusSpec),
 }
 
 /// Largest number of trials a study may schedule per condition.
@@ -98,6 +123,7 @@ impl Method {
             Method::Constant { deltas, .. } => deltas.iter().copied().fold(0.0, f64::max),
             Method::Staircase(s) => s.max_delta,
             Method::Quest(q) => q.max_delta,
+            Method::QuestPlus(q) => q.max_delta,
         }
     }
 
@@ -107,6 +133,7 @@ impl Method {
             Method::Constant { deltas, .. } => deltas.iter().copied().fold(f64::INFINITY, f64::min),
             Method::Staircase(s) => s.min_delta,
             Method::Quest(q) => q.min_delta,
+            Method::QuestPlus(q) => q.min_delta,
         }
     }
 
@@ -116,6 +143,7 @@ impl Method {
             Method::Constant { .. } => self.largest_delta(),
             Method::Staircase(s) => s.starts.iter().copied().fold(0.0, f64::max),
             Method::Quest(q) => q.max_delta.min(4.0 * q.start),
+            Method::QuestPlus(q) => q.max_delta.min(4.0 * q.start),
         }
     }
 
@@ -133,11 +161,12 @@ impl Method {
             "constant" => Some(constant_from(m, own_deltas, &mut e)),
             "staircase" => Some(Method::Staircase(staircase_from(m, &mut e))),
             "quest" => Some(Method::Quest(quest_from(m, &mut e))),
+            "quest+" => Some(Method::QuestPlus(quest_plus_from(m, &mut e))),
             other => {
                 e(
                     "kind",
                     format!("unknown method `{other}`"),
-                    "kind = \"constant\", \"staircase\" or \"quest\"",
+                    "kind = \"constant\", \"staircase\", \"quest\" or \"quest+\"",
                 );
                 None
             }
@@ -306,6 +335,40 @@ fn weighted_up_weight(target: Option<f64>, e: &mut Report) -> f64 {
             );
             3.0
         }
+    }
+}
+
+/// `[method]` of kind `"quest+"`: QUEST's settings, with `slopes` instead of `beta`/`placement`.
+fn quest_plus_from(m: &MethodSection, e: &mut Report) -> QuestPlusSpec {
+    if m.beta.is_some() || m.placement.is_some() {
+        e(
+            "beta",
+            "QUEST+ estimates the slope and places by expected entropy: beta/placement are QUEST settings".into(),
+            "give the slopes the posterior spans instead, e.g. slopes = [0.75, 1.0, 1.5, 2.0, 3.0, 4.5, 7.0], or set kind = \"quest\"",
+        );
+    }
+    let q = quest_from(m, e);
+    let slopes = m.slopes.clone().unwrap_or_else(|| DEFAULT_SLOPES.to_vec());
+    if slopes.is_empty()
+        || slopes.len() > 16
+        || slopes
+            .iter()
+            .any(|b| !(b.is_finite() && (0.2..=20.0).contains(b)))
+    {
+        e(
+            "slopes",
+            format!("{slopes:?}"),
+            "give 1 to 16 Weibull slopes in [0.2, 20], e.g. slopes = [0.75, 1.0, 1.5, 2.0, 3.0, 4.5, 7.0]",
+        );
+    }
+    QuestPlusSpec {
+        start: q.start,
+        prior_sd: q.prior_sd,
+        slopes,
+        lapse: q.lapse,
+        max_trials: q.max_trials,
+        min_delta: q.min_delta,
+        max_delta: q.max_delta,
     }
 }
 

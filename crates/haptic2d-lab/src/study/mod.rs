@@ -25,6 +25,7 @@ pub mod method;
 pub mod numeric;
 pub mod observer;
 pub mod quest;
+pub mod quest_plus;
 pub mod rng;
 pub mod same_different;
 pub mod schedule;

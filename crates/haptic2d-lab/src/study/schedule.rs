@@ -8,6 +8,7 @@
 use super::file::{Study, Task};
 use super::method::Method;
 use super::quest::Quest;
+use super::quest_plus::QuestPlus;
 use super::rng::Rng;
 use super::staircase::Staircase;
 
@@ -31,13 +32,15 @@ pub struct TrialSpec {
     pub comparison_interval: u8,
 }
 
-/// An adaptive track's state: a transformed up/down staircase or a QUEST.
+/// An adaptive track's state: a transformed up/down staircase, a QUEST or a QUEST+.
 #[derive(Clone, Debug)]
 pub enum Tracker {
     /// A staircase.
     Stair(Staircase),
     /// A QUEST.
     Quest(Quest),
+    /// A QUEST+.
+    QuestPlus(QuestPlus),
 }
 
 impl Tracker {
@@ -46,6 +49,7 @@ impl Tracker {
         match self {
             Tracker::Stair(s) => s.delta,
             Tracker::Quest(q) => q.delta,
+            Tracker::QuestPlus(q) => q.delta,
         }
     }
     /// Its stopping rule is met.
@@ -53,6 +57,7 @@ impl Tracker {
         match self {
             Tracker::Stair(s) => s.done(),
             Tracker::Quest(q) => q.done(),
+            Tracker::QuestPlus(q) => q.done(),
         }
     }
     /// Records an answer.
@@ -60,20 +65,36 @@ impl Tracker {
         match self {
             Tracker::Stair(s) => s.update(correct),
             Tracker::Quest(q) => q.update(correct),
+            Tracker::QuestPlus(q) => q.update(correct),
         }
     }
     /// The staircase, if it is one.
     pub fn stair(&self) -> Option<&Staircase> {
         match self {
             Tracker::Stair(s) => Some(s),
-            Tracker::Quest(_) => None,
+            Tracker::Quest(_) | Tracker::QuestPlus(_) => None,
         }
     }
     /// The QUEST, if it is one.
     pub fn quest(&self) -> Option<&Quest> {
         match self {
             Tracker::Quest(q) => Some(q),
+            Tracker::Stair(_) | Tracker::QuestPlus(_) => None,
+        }
+    }
+    /// A Bayesian track's threshold estimate and 95 % credible interval (QUEST or QUEST+).
+    pub fn estimate(&self) -> Option<(f64, (f64, f64))> {
+        match self {
+            Tracker::Quest(q) => Some(q.estimate()),
+            Tracker::QuestPlus(q) => Some(q.estimate()),
             Tracker::Stair(_) => None,
+        }
+    }
+    /// QUEST+'s slope estimate (posterior mean), if it is one.
+    pub fn slope_estimate(&self) -> Option<f64> {
+        match self {
+            Tracker::QuestPlus(q) => Some(q.slope_estimate()),
+            Tracker::Stair(_) | Tracker::Quest(_) => None,
         }
     }
 }
@@ -124,6 +145,14 @@ impl Schedule {
                     });
                 }
             }
+            Method::QuestPlus(q) => {
+                for (c, _) in study.conditions.iter().enumerate() {
+                    tracks.push(Track {
+                        condition: c,
+                        tracker: Tracker::QuestPlus(QuestPlus::new(q, study.task.guess_rate())),
+                    });
+                }
+            }
             Method::Constant { .. } => {}
         }
         Self {
@@ -168,7 +197,9 @@ impl Schedule {
     fn block_left(&self) -> bool {
         match self.study.method {
             Method::Constant { .. } => !self.queue.is_empty(),
-            Method::Staircase(_) | Method::Quest(_) => !self.open_tracks().is_empty(),
+            Method::Staircase(_) | Method::Quest(_) | Method::QuestPlus(_) => {
+                !self.open_tracks().is_empty()
+            }
         }
     }
 
@@ -246,6 +277,7 @@ impl Schedule {
                 }
                 Method::Staircase(s) => n * s.starts.len() as u32 * s.max_trials,
                 Method::Quest(q) => n * q.max_trials,
+                Method::QuestPlus(q) => n * q.max_trials,
             }
     }
 }

@@ -53,8 +53,11 @@ pub struct RunSummary {
     pub ran: u32,
     /// The session is complete.
     pub complete: bool,
-    /// QUEST's estimate per condition (name, threshold, 95 % credible interval), for QUEST studies.
+    /// QUEST's or QUEST+'s estimate per condition (name, threshold, 95 % credible interval), for
+    /// QUEST and QUEST+ studies.
     pub quest: Vec<(String, f64, (f64, f64))>,
+    /// QUEST+'s slope estimate per condition (name, posterior mean of β), for QUEST+ studies.
+    pub slopes: Vec<(String, f64)>,
 }
 
 /// The answer names the comparison (or, same–different: says "different", 1, exactly when the
@@ -157,10 +160,18 @@ pub fn run(
         .tracks
         .iter()
         .filter_map(|t| {
-            t.tracker.quest().map(|q| {
-                let (est, ci) = q.estimate();
-                (study.conditions[t.condition].name.clone(), est, ci)
-            })
+            t.tracker
+                .estimate()
+                .map(|(est, ci)| (study.conditions[t.condition].name.clone(), est, ci))
+        })
+        .collect();
+    let slopes = sched
+        .tracks
+        .iter()
+        .filter_map(|t| {
+            t.tracker
+                .slope_estimate()
+                .map(|b| (study.conditions[t.condition].name.clone(), b))
         })
         .collect();
     Ok(RunSummary {
@@ -169,6 +180,7 @@ pub fn run(
         ran,
         complete,
         quest,
+        slopes,
     })
 }
 

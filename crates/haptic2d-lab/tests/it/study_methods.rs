@@ -56,6 +56,39 @@ fn quest_recovers_the_simulated_observers_threshold_within_its_credible_interval
     );
 }
 
+/// QUEST+ (`studies/stiffness-walls-questplus.toml`, 80 trials per condition, the QUEST study's
+/// prior) on four simulated participants: at least 6 of the 8 credible intervals contain the
+/// model's threshold `W·kc` (75 and 150 N/m; as for QUEST, the model's log-normal is not QUEST+'s
+/// Weibull, so the nominal 95 % is not exact), and the slope estimates lie where a Weibull fitted
+/// to the model's function does (β ≈ 1.1–1.2, docs/STUDIES.md): their mean within [0.8, 2.0],
+/// far from the grid's ends (0.75, 7).
+#[test]
+fn quest_plus_recovers_the_simulated_observers_threshold_and_a_plausible_slope() {
+    let (study, text) = load("stiffness-walls-questplus.toml");
+    let dir = tempfile::tempdir().unwrap();
+    let (mut hits, mut slopes) = (0, Vec::new());
+    for id in ["q1", "q2", "q3", "q4"] {
+        let s = run_one(&study, &text, dir.path(), id);
+        assert!(s.complete);
+        assert_eq!(s.ran, 4 + 2 * 80);
+        assert_eq!((s.quest.len(), s.slopes.len()), (2, 2));
+        for (name, est, (lo, hi)) in &s.quest {
+            let kc = study.conditions[study.condition_index(name).unwrap()].reference_value;
+            let truth = study.observer.weber_fraction * kc;
+            eprintln!("{id} {name}: {est:.1} [{lo:.1}, {hi:.1}], model {truth}");
+            hits += usize::from(*lo <= truth && truth <= *hi);
+        }
+        slopes.extend(s.slopes.iter().map(|(_, b)| *b));
+    }
+    let mean = slopes.iter().sum::<f64>() / slopes.len() as f64;
+    eprintln!("slopes {slopes:?}, mean {mean}");
+    assert!(
+        hits >= 6,
+        "{hits} of 8 intervals contain the model's threshold"
+    );
+    assert!((0.8..=2.0).contains(&mean), "slopes {slopes:?}");
+}
+
 /// The model's 3AFC proportion correct without lapses: the comparison's percept beats both
 /// references', `∫φ(u)·Φ(u + d)² du`, `d = ln(ratio)/σ` (Simpson's rule on [−8, 8]).
 fn three_afc_correct(ratio: f64, sigma: f64) -> f64 {
