@@ -45,6 +45,10 @@ pub struct StudyFile {
     /// Parameters of the simulated observer (a model, not data).
     #[serde(default)]
     pub observer: ObserverSection,
+    /// The block order across participants: `"none"` (default), `"reverse"`, `"williams"`.
+    pub counterbalance: Option<String>,
+    /// When the session rests.
+    pub breaks: Option<super::order::BreaksSection>,
 }
 
 /// `[task]`.
@@ -285,6 +289,10 @@ pub struct Study {
     pub blocks: Vec<Block>,
     /// The simulated observer's parameters.
     pub observer: ObserverParams,
+    /// The block order across participants (`order.rs`).
+    pub counterbalance: super::order::Counterbalance,
+    /// When the session rests (`order.rs`).
+    pub breaks: super::order::Breaks,
 }
 
 impl Study {
@@ -424,6 +432,7 @@ fn validate(
     let method = Method::from_section(&f.method, own, errs);
     let conditions = conditions_from(&f, task, errs);
     let blocks = blocks_from(&f, conditions.len(), errs);
+    let (counterbalance, breaks) = super::order::from_file(&f, errs);
     let method = method?;
     let study = Study {
         name: f.name.clone().unwrap_or_else(|| "study".into()),
@@ -441,6 +450,8 @@ fn validate(
         method,
         blocks,
         observer: observer.unwrap_or_default(),
+        counterbalance,
+        breaks,
     };
     check_worlds(&study, errs)?;
     Some(study)

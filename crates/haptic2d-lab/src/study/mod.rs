@@ -24,6 +24,7 @@ pub mod fit;
 pub mod method;
 pub mod numeric;
 pub mod observer;
+pub mod order;
 pub mod quest;
 pub mod quest_plus;
 pub mod rng;

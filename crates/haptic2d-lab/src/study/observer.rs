@@ -304,6 +304,11 @@ pub trait Observer {
     fn answer(&mut self, study: &Study, spec: &TrialSpec) -> Result<Answer, String>;
     /// A short description for the session record (`simulated W=0.15 λ=0.02`).
     fn describe(&self) -> String;
+    /// A rest break before `next` (the study's `[breaks]`, `order.rs`): a person gets a break
+    /// screen and continues when ready; the default (the simulated observer) needs none.
+    fn rest(&mut self, _study: &Study, _next: &TrialSpec) -> Result<(), String> {
+        Ok(())
+    }
 }
 
 /// The simulated observer (a model; see the module documentation).

@@ -30,6 +30,8 @@ pub struct TrialSpec {
     /// The interval (1 to the task's number of intervals) presenting the comparison; 0 for a
     /// same–different task's "same" trial (the reference in both intervals).
     pub comparison_interval: u8,
+    /// A rest break comes before this trial (the study's `[breaks]`).
+    pub rest_before: bool,
 }
 
 /// An adaptive track's state: a transformed up/down staircase, a QUEST or a QUEST+.
@@ -113,6 +115,9 @@ pub struct Track {
 pub struct Schedule {
     study: Study,
     rng: Rng,
+    /// The blocks' indices in the order they run (counterbalancing, `order.rs`).
+    order: Vec<usize>,
+    /// Position in `order`.
     block: usize,
     started: bool,
     practice_left: u32,
@@ -120,11 +125,20 @@ pub struct Schedule {
     /// The staircases (all conditions; empty for constant stimuli).
     pub tracks: Vec<Track>,
     trial: u32,
+    /// The next trial is the first of its block.
+    first_of_block: bool,
 }
 
 impl Schedule {
-    /// A schedule for `study` from `seed`.
+    /// A schedule for `study` from `seed`, its blocks in the file's order.
     pub fn new(study: &Study, seed: u64) -> Self {
+        Self::ordered(study, seed, (0..study.blocks.len()).collect())
+    }
+
+    /// A schedule for `study` from `seed`, running its blocks in `order` (a permutation of the
+    /// block indices: a participant's counterbalanced order, `order.rs`).
+    pub fn ordered(study: &Study, seed: u64, order: Vec<usize>) -> Self {
+        debug_assert_eq!(order.len(), study.blocks.len());
         let mut tracks = Vec::new();
         match &study.method {
             Method::Staircase(s) => {
@@ -158,17 +172,19 @@ impl Schedule {
         Self {
             study: study.clone(),
             rng: Rng::new(seed),
+            order,
             block: 0,
             started: false,
             practice_left: 0,
             queue: Vec::new(),
             tracks,
             trial: 0,
+            first_of_block: true,
         }
     }
 
     fn start_block(&mut self) {
-        let b = &self.study.blocks[self.block];
+        let b = &self.study.blocks[self.order[self.block]];
         self.practice_left = b.practice;
         self.queue.clear();
         if let Method::Constant { repeats, .. } = &self.study.method {
@@ -186,7 +202,7 @@ impl Schedule {
     }
 
     fn open_tracks(&self) -> Vec<usize> {
-        let conds = &self.study.blocks[self.block].conditions;
+        let conds = &self.study.blocks[self.order[self.block]].conditions;
         (0..self.tracks.len())
             .filter(|&t| {
                 conds.contains(&self.tracks[t].condition) && !self.tracks[t].tracker.done()
@@ -218,9 +234,15 @@ impl Schedule {
             }
             self.block += 1;
             self.started = false;
+            self.first_of_block = true;
         }
         self.trial += 1;
-        let conds = self.study.blocks[self.block].conditions.clone();
+        let breaks = self.study.breaks;
+        let rest_before =
+            (breaks.every > 0 && self.trial > 1 && (self.trial - 1).is_multiple_of(breaks.every))
+                || (breaks.between_blocks && self.block > 0 && self.first_of_block);
+        self.first_of_block = false;
+        let conds = self.study.blocks[self.order[self.block]].conditions.clone();
         let (condition, track, delta, practice) = if self.practice_left > 0 {
             self.practice_left -= 1;
             let c = conds[self.rng.below(conds.len())];
@@ -246,12 +268,13 @@ impl Schedule {
         };
         Some(TrialSpec {
             trial: self.trial,
-            block: self.block as u32 + 1,
+            block: self.order[self.block] as u32 + 1,
             practice,
             condition,
             track,
             delta,
             comparison_interval,
+            rest_before,
         })
     }
 

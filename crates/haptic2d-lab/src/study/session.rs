@@ -9,6 +9,7 @@
 
 use super::file::{Study, Task};
 use super::observer::Observer;
+use super::order::block_order;
 use super::rng::{hash_text, mix};
 use super::schedule::{Schedule, TrialSpec};
 use super::trials::{self, TrialRow, HEADER};
@@ -112,7 +113,8 @@ pub fn run(
     let dir = session_dir(out, participant, session);
     let tsv = dir.join("trials.tsv");
     let seed = session_seed(study.seed, participant, session);
-    let mut sched = Schedule::new(study, seed);
+    let order = block_order(study.counterbalance, study.blocks.len(), participant)?;
+    let mut sched = Schedule::ordered(study, seed, order.clone());
     let resumed = if tsv.exists() {
         resume(study, study_text, &dir, &mut sched)?
     } else {
@@ -127,6 +129,7 @@ pub fn run(
             "software": VERSION,
             "observer": observer.describe(),
             "task": study.task.describe(),
+            "block_order": order.iter().map(|b| b + 1).collect::<Vec<_>>(),
             "trials": "trials.tsv (docs/STUDIES.md)",
         });
         start(study_text, &dir, &meta)?;
@@ -147,6 +150,9 @@ pub fn run(
             complete = true;
             break;
         };
+        if spec.rest_before {
+            observer.rest(study, &spec)?;
+        }
         let a = observer.answer(study, &spec)?;
         sched.record(&spec, answer_correct(study, &spec, a.response));
         let r = row(study, &sched, &spec, a.response, a.rt);

@@ -210,3 +210,109 @@ fn same_different_recovers_the_models_jnd_and_criterion_within_their_intervals()
         sd.same_trials
     );
 }
+
+/// Counts the rest breaks it is given and answers as the simulated observer.
+struct Resting {
+    inner: SimulatedObserver,
+    rests_before: Vec<u32>,
+}
+
+impl haptic2d_lab::study::Observer for Resting {
+    fn answer(
+        &mut self,
+        study: &Study,
+        spec: &haptic2d_lab::study::schedule::TrialSpec,
+    ) -> Result<haptic2d_lab::study::observer::Answer, String> {
+        self.inner.answer(study, spec)
+    }
+    fn describe(&self) -> String {
+        self.inner.describe()
+    }
+    fn rest(
+        &mut self,
+        _study: &Study,
+        next: &haptic2d_lab::study::schedule::TrialSpec,
+    ) -> Result<(), String> {
+        self.rests_before.push(next.trial);
+        Ok(())
+    }
+}
+
+/// Two one-condition blocks counterbalanced by a Williams square: odd- and even-numbered
+/// participants run them in opposite orders (trials.tsv's `block` column and session.json say
+/// which), an ID without a number is refused, and `[breaks]` rests before every 25th trial and
+/// between the blocks — the observer is told before exactly those trials.
+#[test]
+fn blocks_are_counterbalanced_by_participant_number_and_breaks_come_where_the_file_says() {
+    let (_, text) = load("stiffness-walls-staircase.toml");
+    let text = text
+        .replace(
+            "seed = 41\n",
+            "seed = 41\ncounterbalance = \"williams\"\n",
+        )
+        .replace(
+            "[[block]]\nconditions = [\"spring-500\", \"spring-1000\"]\npractice = 4\n",
+            "[[block]]\nconditions = [\"spring-500\"]\npractice = 2\n\n[[block]]\nconditions = [\"spring-1000\"]\npractice = 2\n\n[breaks]\nevery = 25\nbetween_blocks = true\n",
+        )
+        .replace("max_trials = 120", "max_trials = 20")
+        .replace("max_reversals = 24", "max_reversals = 100");
+    assert!(
+        text.contains("williams") && text.contains("[breaks]"),
+        "{text}"
+    );
+    let study = Study::from_toml(&text, "cb.toml", None).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let mut firsts = Vec::new();
+    for id in ["P01", "P02"] {
+        let mut obs = Resting {
+            inner: SimulatedObserver::new(study.observer, session_seed(study.seed, id, 1)),
+            rests_before: Vec::new(),
+        };
+        let s = run(
+            &study,
+            &text,
+            dir.path(),
+            id,
+            1,
+            &mut obs,
+            &mut |_, _| {},
+            None,
+        )
+        .unwrap();
+        assert!(s.complete);
+        let rows = std::fs::read_to_string(s.dir.join("trials.tsv")).unwrap();
+        let (rows, _) = haptic2d_lab::study::trials::read(&rows).unwrap();
+        // 2 + 2·20 trials per block.
+        assert_eq!(rows.len(), 84);
+        let first_block = rows[0].block;
+        assert!(rows[..42].iter().all(|r| r.block == first_block));
+        assert!(rows[42..].iter().all(|r| r.block != first_block));
+        let meta = std::fs::read_to_string(s.dir.join("session.json")).unwrap();
+        let order = haptic2d_lab::study::order::williams_row(2, if id == "P01" { 1 } else { 2 });
+        assert_eq!(first_block as usize, order[0] + 1, "{id}");
+        assert!(meta.contains("\"block_order\""), "{meta}");
+        firsts.push(first_block);
+        let mut want = vec![26, 51, 76, 43];
+        want.sort_unstable();
+        let mut got = obs.rests_before.clone();
+        got.sort_unstable();
+        assert_eq!(got, want, "{id}: rests before trials {got:?}");
+    }
+    assert_ne!(
+        firsts[0], firsts[1],
+        "participants 1 and 2 start with different blocks"
+    );
+    let mut obs = SimulatedObserver::new(study.observer, 1);
+    let e = run(
+        &study,
+        &text,
+        dir.path(),
+        "anna",
+        1,
+        &mut obs,
+        &mut |_, _| {},
+        None,
+    )
+    .unwrap_err();
+    assert!(e.contains("ends in no number") && e.contains("fix:"), "{e}");
+}
