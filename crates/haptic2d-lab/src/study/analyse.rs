@@ -35,6 +35,8 @@ pub struct AnalyseOptions {
     pub guess: f64,
     /// The sessions are same–different trials (signal detection, `same_different.rs`).
     pub same_different: bool,
+    /// The sessions are magnitude estimation (Stevens' power law, `magnitude.rs`).
+    pub magnitude: bool,
 }
 
 impl Default for AnalyseOptions {
@@ -46,6 +48,7 @@ impl Default for AnalyseOptions {
             max_lapse: 0.06,
             guess: 0.5,
             same_different: false,
+            magnitude: false,
         }
     }
 }
@@ -81,6 +84,8 @@ pub struct ConditionResult {
     pub pse: Option<Pse>,
     /// The differencing model of a same–different condition.
     pub sd: Option<SdResult>,
+    /// The power law of a magnitude-estimation condition.
+    pub magnitude: Option<super::magnitude::MagnitudeResult>,
 }
 
 /// A same–different condition's fit (`same_different.rs`).
@@ -164,6 +169,11 @@ pub fn analyse_rows(
             out.push(analyse_sd(name, first, &rs, opts, ci as u64)?);
             continue;
         }
+        if opts.magnitude {
+            let seed = super::magnitude::seed(opts.seed, ci as u64);
+            out.push(super::magnitude::analyse(name, &rs, opts.bootstrap, seed)?);
+            continue;
+        }
         let is_pse = rs.iter().any(|r| r.correct.is_none());
         let mut levels: BTreeMap<u64, Point> = BTreeMap::new();
         for r in &rs {
@@ -228,6 +238,7 @@ pub fn analyse_rows(
             tracks,
             pse: None,
             sd: None,
+            magnitude: None,
         });
     }
     if out.is_empty() {
@@ -302,6 +313,7 @@ fn analyse_sd(
         staircase_estimate: None,
         tracks: BTreeMap::new(),
         pse: None,
+        magnitude: None,
         sd: Some(SdResult {
             fit: f,
             criterion_ci: q(&|b| b.criterion),
@@ -380,6 +392,7 @@ fn analyse_pse(
         staircase_estimate: None,
         tracks: BTreeMap::new(),
         sd: None,
+        magnitude: None,
         pse: Some(Pse {
             value: pse(&f),
             ci: pse_ci,
@@ -598,6 +611,7 @@ pub fn analyse_dir(
     }
     opts.guess = task.unwrap_or(Task::TwoAfc).guess_rate();
     opts.same_different = task == Some(Task::SameDifferent);
+    opts.magnitude = task == Some(Task::Magnitude);
     let opts = &opts;
     let mut rows = Vec::new();
     for s in &sessions {
@@ -611,6 +625,11 @@ pub fn analyse_dir(
     let levels = dir.join("analysis-levels.tsv");
     std::fs::write(&levels, levels_tsv(&res)).map_err(|e| format!("{}: {e}", levels.display()))?;
     let mut paths = vec![tsv, levels];
+    if opts.magnitude {
+        let title = format!("{} session(s): magnitude estimation", sessions.len());
+        paths.extend(super::magnitude::write(dir, &res, &title)?);
+        return Ok((res, paths));
+    }
     paths.extend(plot(
         &res,
         &dir.join("psychometric"),
@@ -636,6 +655,9 @@ pub fn report(r: &ConditionResult, bootstrap: u32) -> String {
         r.fit.beta,
         r.fit.lapse
     );
+    if let Some(m) = &r.magnitude {
+        return super::magnitude::report(r, m, bootstrap);
+    }
     if let Some(sd) = &r.sd {
         return format!(
             "{} ({}, reference {}): {} trials ({} same), differencing model: d' = {:.3}·ln(1 + Δ/{}), criterion {:.3} [{:.3}, {:.3}], false alarms {:.3}\n  JND (d' = 0.954, the 2AFC 75 % point) {:.4} [{:.4}, {:.4}] (95 % parametric bootstrap, {bootstrap} reps)\n  Weber fraction {:.4} [{:.4}, {:.4}]\n",

@@ -57,6 +57,9 @@ pub struct StudyFile {
 pub struct TaskSection {
     /// `"2afc"` or `"2ifc"`: two intervals, one reference and one comparison; "which was stiffer?".
     pub kind: String,
+    /// Magnitude estimation: the number the reference (the modulus, first interval) stands for
+    /// (default 100).
+    pub modulus: Option<f64>,
 }
 
 /// `[stimuli.NAME]`: a parameter set; each table is a scene file's `[normal]`/`[friction]` table.
@@ -158,6 +161,8 @@ pub struct ObserverSection {
     pub exploration: Option<String>,
     /// Same–different: the differencing criterion in units of the percept noise (default 1.8).
     pub sd_criterion: Option<f64>,
+    /// Magnitude estimation: Stevens' exponent on the percepts (default 0.8).
+    pub magnitude_exponent: Option<f64>,
     /// Ramp time of each change of the press force (s), default 0 (a step).
     pub press_ramp: Option<f64>,
     /// The hand's damping on the probe's velocity (N·s/m), default 0.
@@ -191,6 +196,9 @@ pub enum Task {
     /// Two intervals, "same or different?": half the trials present the reference twice, half
     /// the reference and the comparison in random order.
     SameDifferent,
+    /// Magnitude estimation (Stevens 1957): the reference (the modulus) then the comparison;
+    /// "if the first was [`Study::modulus`], what number is the second?".
+    Magnitude,
 }
 
 impl Task {
@@ -202,7 +210,7 @@ impl Task {
     /// The number of intervals of a trial.
     pub fn intervals(self) -> usize {
         match self {
-            Task::TwoAfc | Task::SameDifferent => 2,
+            Task::TwoAfc | Task::SameDifferent | Task::Magnitude => 2,
             Task::ThreeAfc => 3,
         }
     }
@@ -212,6 +220,7 @@ impl Task {
             Task::TwoAfc => "2afc: which interval was stiffer?",
             Task::ThreeAfc => "3afc: which of three intervals was stiffest?",
             Task::SameDifferent => "same-different: were the two intervals the same? (response 0 = same, 1 = different; comparison_interval 0 = a same trial)",
+            Task::Magnitude => "magnitude: the first interval is the modulus; what number is the second? (column magnitude; response 0)",
         }
     }
     /// Parses `[task] kind` (as stored in a session's `study.toml`).
@@ -220,6 +229,7 @@ impl Task {
             "2afc" | "2ifc" => Some(Task::TwoAfc),
             "3afc" | "3ifc" => Some(Task::ThreeAfc),
             "same-different" => Some(Task::SameDifferent),
+            "magnitude" => Some(Task::Magnitude),
             _ => None,
         }
     }
@@ -289,6 +299,8 @@ pub struct Study {
     pub blocks: Vec<Block>,
     /// The simulated observer's parameters.
     pub observer: ObserverParams,
+    /// Magnitude estimation: the number the reference stands for.
+    pub modulus: f64,
     /// The block order across participants (`order.rs`).
     pub counterbalance: super::order::Counterbalance,
     /// When the session rests (`order.rs`).
@@ -433,6 +445,7 @@ fn validate(
     let conditions = conditions_from(&f, task, errs);
     let blocks = blocks_from(&f, conditions.len(), errs);
     let (counterbalance, breaks) = super::order::from_file(&f, errs);
+    let modulus = modulus_from(&f, task, errs);
     let method = method?;
     let study = Study {
         name: f.name.clone().unwrap_or_else(|| "study".into()),
@@ -450,11 +463,33 @@ fn validate(
         method,
         blocks,
         observer: observer.unwrap_or_default(),
+        modulus,
         counterbalance,
         breaks,
     };
     check_worlds(&study, errs)?;
     Some(study)
+}
+
+/// `[task] modulus`: magnitude estimation's number for the reference (default 100).
+fn modulus_from(f: &StudyFile, task: Task, errs: &mut Vec<SceneError>) -> f64 {
+    let m = f.task.modulus.unwrap_or(100.0);
+    if f.task.modulus.is_some() && task != Task::Magnitude {
+        err(
+            errs,
+            "task.modulus",
+            "only magnitude estimation has a modulus",
+            "remove it, or set kind = \"magnitude\"",
+        );
+    } else if !(m.is_finite() && m > 0.0) {
+        err(
+            errs,
+            "task.modulus",
+            format!("{m}"),
+            "give the positive number the reference stands for, e.g. modulus = 100.0",
+        );
+    }
+    m
 }
 
 /// `[task]`: the task (an unknown one is reported and taken as 2AFC).
@@ -466,7 +501,7 @@ fn task_from(t: &TaskSection, errs: &mut Vec<SceneError>) -> Task {
                 errs,
                 "task.kind",
                 format!("unknown task `{}`", t.kind),
-                "write kind = \"2afc\" (or \"2ifc\"), \"3afc\" (or \"3ifc\") or \"same-different\"; magnitude estimation is not built yet",
+                "write kind = \"2afc\" (or \"2ifc\"), \"3afc\" (or \"3ifc\"), \"same-different\" or \"magnitude\"",
             );
             Task::TwoAfc
         }
@@ -661,7 +696,7 @@ fn condition_deltas(
         "method.deltas".to_string()
     };
     if let Some(d) = c.deltas.as_ref().or(f.method.deltas.as_ref()) {
-        if !pse {
+        if !pse && f.task.kind != "magnitude" {
             if let Some(x) = d.iter().find(|x| x.is_finite() && **x <= 0.0) {
                 err(
                     errs,
@@ -693,6 +728,14 @@ fn condition_method(
                 c.name
             ),
             "use kind = \"2afc\" for PSE conditions",
+        );
+    }
+    if task == Task::Magnitude && f.method.kind != "constant" {
+        err(
+            errs,
+            "method.kind",
+            "magnitude estimation presents fixed levels; adaptive methods converge on a proportion correct",
+            "use kind = \"constant\" with deltas on both sides of the reference (the comparison's value must stay valid)",
         );
     }
     if task == Task::SameDifferent && f.method.kind != "constant" {

@@ -21,6 +21,7 @@ pub mod analyse;
 pub mod explore;
 pub mod file;
 pub mod fit;
+pub mod magnitude;
 pub mod method;
 pub mod numeric;
 pub mod observer;

@@ -48,6 +48,9 @@ pub struct ObserverParams {
     /// Same–different: the differencing rule's criterion, in units of the percept noise `σ`
     /// ("different" when the two percepts differ by more).
     pub sd_criterion: f64,
+    /// Magnitude estimation: the exponent `a` of Stevens' power law on the percepts (the number
+    /// is `modulus·(K̂_cmp/K̂_ref)^a`).
+    pub magnitude_exponent: f64,
     /// Press and stroke: each change of force is ramped linearly over this time (s); 0 = a step.
     pub press_ramp: f64,
     /// How the hand explores (press, tap or stroke).
@@ -82,6 +85,7 @@ impl Default for ObserverParams {
             press_time: 1.0,
             decision_time: 0.6,
             sd_criterion: 1.8,
+            magnitude_exponent: 0.8,
             press_ramp: 0.0,
             exploration: Exploration::Press,
             hand_damping: 0.0,
@@ -112,6 +116,7 @@ impl ObserverParams {
             decision_time: s.decision_time.unwrap_or(d.decision_time),
             press_ramp: s.press_ramp.unwrap_or(d.press_ramp),
             sd_criterion: s.sd_criterion.unwrap_or(d.sd_criterion),
+            magnitude_exponent: s.magnitude_exponent.unwrap_or(d.magnitude_exponent),
             exploration: d.exploration,
             hand_damping: s.hand_damping.unwrap_or(d.hand_damping),
             grip_stiffness: s.grip_stiffness.unwrap_or(d.grip_stiffness),
@@ -195,6 +200,14 @@ impl ObserverParams {
                 "sd_criterion",
                 format!("{c}"),
                 "give the same–different criterion in (0, 10] units of the percept noise, e.g. 1.8",
+            );
+        }
+        let a = self.magnitude_exponent;
+        if !(a.is_finite() && a > 0.0 && a <= 5.0) {
+            report(
+                "magnitude_exponent",
+                format!("{a}"),
+                "give Stevens' exponent in (0, 5], e.g. 0.8",
             );
         }
         let r = self.press_ramp;
@@ -292,8 +305,12 @@ impl ObserverParams {
 /// An answer to one trial.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Answer {
-    /// The interval (1 to the task's number) named as stiffer (stiffest).
+    /// The interval (1 to the task's number) named as stiffer (stiffest); 0 in magnitude
+    /// estimation.
     pub response: u8,
+    /// Magnitude estimation: the number given to the comparison (the reference being the study's
+    /// modulus); `None` in the other tasks.
+    pub magnitude: Option<f64>,
     /// Response time (s), measured from the start of the first interval.
     pub rt: f64,
 }
@@ -406,7 +423,24 @@ impl Observer for SimulatedObserver {
             let response = if lapse { coin - 1 } else { u8::from(different) };
             let rt = 4.0 * self.params.press_time
                 + self.params.decision_time * (0.3 * rng.normal()).exp();
-            return Ok(Answer { response, rt });
+            return Ok(Answer {
+                response,
+                rt,
+                magnitude: None,
+            });
+        }
+        if study.task == Task::Magnitude {
+            // Stevens' power law on the percepts: the comparison's number is the modulus times
+            // the ratio of perceived stiffnesses raised to the exponent `a` (no lapses: a number
+            // is always given).
+            let m = study.modulus * (self.params.magnitude_exponent * (p_cmp - p_ref)).exp();
+            let rt = 4.0 * self.params.press_time
+                + self.params.decision_time * (0.3 * rng.normal()).exp();
+            return Ok(Answer {
+                response: 0,
+                rt,
+                magnitude: Some(m),
+            });
         }
         // The reference intervals in order: the ones that are not the comparison's.
         let refs: Vec<u8> = (1..=n as u8).filter(|&i| i != ci).collect();
@@ -421,7 +455,11 @@ impl Observer for SimulatedObserver {
         };
         let rt =
             4.0 * self.params.press_time + self.params.decision_time * (0.3 * rng.normal()).exp();
-        Ok(Answer { response, rt })
+        Ok(Answer {
+            response,
+            rt,
+            magnitude: None,
+        })
     }
 
     fn describe(&self) -> String {

@@ -263,6 +263,8 @@ impl Schedule {
         let same = self.study.task == Task::SameDifferent && self.rng.below(2) == 0;
         let comparison_interval = if same {
             0
+        } else if self.study.task == Task::Magnitude {
+            2 // the modulus first, then the comparison
         } else {
             1 + self.rng.below(self.study.task.intervals()) as u8
         };

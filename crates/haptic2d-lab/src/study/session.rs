@@ -8,7 +8,7 @@
 //! trial is lost or repeated.
 
 use super::file::{Study, Task};
-use super::observer::Observer;
+use super::observer::{Answer, Observer};
 use super::order::block_order;
 use super::rng::{hash_text, mix};
 use super::schedule::{Schedule, TrialSpec};
@@ -72,7 +72,8 @@ pub fn answer_correct(study: &Study, spec: &TrialSpec, response: u8) -> bool {
 }
 
 /// Row of `spec` answered `response` at `rt` s.
-fn row(study: &Study, sched: &Schedule, spec: &TrialSpec, response: u8, rt: f64) -> TrialRow {
+fn row(study: &Study, sched: &Schedule, spec: &TrialSpec, a: &Answer) -> TrialRow {
+    let (response, rt) = (a.response, a.rt);
     let c = &study.conditions[spec.condition];
     let stair = spec.track.and_then(|t| sched.tracks[t].tracker.stair());
     TrialRow {
@@ -87,10 +88,12 @@ fn row(study: &Study, sched: &Schedule, spec: &TrialSpec, response: u8, rt: f64)
         delta: spec.delta,
         comparison_interval: spec.comparison_interval,
         response,
-        correct: (!c.pse).then_some(answer_correct(study, spec, response)),
+        correct: (!c.pse && study.task != Task::Magnitude)
+            .then_some(answer_correct(study, spec, response)),
         rt,
         reversals: stair.map(|s| s.reversals),
         run: stair.map(|s| s.run),
+        magnitude: a.magnitude,
     }
 }
 
@@ -155,7 +158,7 @@ pub fn run(
         }
         let a = observer.answer(study, &spec)?;
         sched.record(&spec, answer_correct(study, &spec, a.response));
-        let r = row(study, &sched, &spec, a.response, a.rt);
+        let r = row(study, &sched, &spec, &a);
         file.write_all(r.to_line().as_bytes())
             .map_err(|e| io(&tsv, e))?;
         file.sync_data().map_err(|e| io(&tsv, e))?;
@@ -240,7 +243,12 @@ fn resume(
                 r.trial
             )
         })?;
-        let expect = row(study, sched, &spec, r.response, r.rt);
+        let answer = Answer {
+            response: r.response,
+            rt: r.rt,
+            magnitude: r.magnitude,
+        };
+        let expect = row(study, sched, &spec, &answer);
         let same = spec.trial == r.trial
             && spec.practice == r.practice
             && expect.condition == r.condition

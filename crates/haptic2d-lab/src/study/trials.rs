@@ -2,14 +2,19 @@
 //! psychophysics tools read (a header row, then one trial per row; practice trials flagged).
 //!
 //! Columns: `trial block practice condition track vary reference_value comparison_value delta
-//! comparison_interval response correct rt_s reversals run`. `track`, `reversals` and `run` (the
+//! comparison_interval response correct rt_s reversals run magnitude`. `magnitude` is the number
+//! given in magnitude estimation, `-` in the other tasks (files of 15 columns, written before it
+//! existed, still read). `track`, `reversals` and `run` (the
 //! staircase's state after the answer: its index, reversals so far and consecutive correct answers)
 //! are `-` for constant stimuli and practice; `correct` is `-` in a PSE condition (no answer is
 //! correct when the comparison is another stimulus). Numbers are written in Rust's shortest round-trip form,
 //! so reading a row back gives the same values bit for bit.
 
 /// The header row.
-pub const HEADER: &str = "trial\tblock\tpractice\tcondition\ttrack\tvary\treference_value\tcomparison_value\tdelta\tcomparison_interval\tresponse\tcorrect\trt_s\treversals\trun";
+pub const HEADER: &str = "trial\tblock\tpractice\tcondition\ttrack\tvary\treference_value\tcomparison_value\tdelta\tcomparison_interval\tresponse\tcorrect\trt_s\treversals\trun\tmagnitude";
+
+/// The header before the `magnitude` column (still read).
+const HEADER_15: &str = "trial\tblock\tpractice\tcondition\ttrack\tvary\treference_value\tcomparison_value\tdelta\tcomparison_interval\tresponse\tcorrect\trt_s\treversals\trun";
 
 /// One answered trial.
 #[derive(Clone, Debug, PartialEq)]
@@ -46,6 +51,8 @@ pub struct TrialRow {
     pub reversals: Option<u32>,
     /// Staircase consecutive-correct count after this trial.
     pub run: Option<u32>,
+    /// Magnitude estimation: the number given to the comparison.
+    pub magnitude: Option<f64>,
 }
 
 fn opt<T: std::fmt::Display>(v: &Option<T>) -> String {
@@ -56,7 +63,7 @@ impl TrialRow {
     /// The row as a TSV line (with its newline).
     pub fn to_line(&self) -> String {
         format!(
-            "{}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\n",
+            "{}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\n",
             self.trial,
             self.block,
             u8::from(self.practice),
@@ -72,14 +79,15 @@ impl TrialRow {
             self.rt,
             opt(&self.reversals),
             opt(&self.run),
+            opt(&self.magnitude),
         )
     }
 
     /// Parses a TSV line (without its newline); the error names the column.
     pub fn parse(line: &str) -> Result<TrialRow, String> {
         let f: Vec<&str> = line.split('\t').collect();
-        if f.len() != 15 {
-            return Err(format!("{} columns, expected 15", f.len()));
+        if f.len() != 15 && f.len() != 16 {
+            return Err(format!("{} columns, expected 16", f.len()));
         }
         fn num<T: std::str::FromStr>(s: &str, col: &str) -> Result<T, String> {
             s.parse()
@@ -117,6 +125,10 @@ impl TrialRow {
             rt: num(f[12], "rt_s")?,
             reversals: opt_num(f[13], "reversals")?,
             run: opt_num(f[14], "run")?,
+            magnitude: match f.get(15) {
+                Some(m) => opt_num(m, "magnitude")?,
+                None => None,
+            },
         })
     }
 }
@@ -136,7 +148,7 @@ pub fn read(text: &str) -> Result<(Vec<TrialRow>, usize), String> {
     let mut lines = text[..complete].lines();
     match lines.next() {
         None => return Ok((Vec::new(), 0)),
-        Some(h) if h == HEADER => {}
+        Some(h) if h == HEADER || h == HEADER_15 => {}
         Some(h) => return Err(format!("line 1 is not the trials.tsv header (got `{h}`)")),
     }
     let mut rows = Vec::new();
@@ -168,6 +180,7 @@ mod tests {
             rt: 4.123456789012345,
             reversals: Some(2),
             run: Some(0),
+            magnitude: None,
         };
         let line = r.to_line();
         assert_eq!(TrialRow::parse(line.trim_end_matches('\n')).unwrap(), r);
@@ -175,5 +188,19 @@ mod tests {
         let (rows, len) = read(&text).unwrap();
         assert_eq!(rows, vec![r]);
         assert_eq!(len, HEADER.len() + 1 + line.len());
+    }
+
+    /// A magnitude round-trips bit for bit, and a file written before the `magnitude` column
+    /// (15 columns) is still read, its rows without a magnitude.
+    #[test]
+    fn a_magnitude_round_trips_and_a_fifteen_column_file_is_still_read() {
+        let line =
+            "1\t1\t0\tc\t-\tnormal.kc\t1000\t1200\t200\t2\t0\t-\t4.5\t-\t-\t131.7890123456789\n";
+        let (rows, _) = read(&format!("{HEADER}\n{line}")).unwrap();
+        assert_eq!(rows[0].magnitude, Some(131.7890123456789));
+        assert_eq!(rows[0].to_line(), line);
+        let old = "1\t1\t0\tc\t-\tnormal.kc\t1000\t1200\t200\t2\t1\t1\t4.5\t-\t-\n";
+        let (rows, _) = read(&format!("{HEADER_15}\n{old}")).unwrap();
+        assert_eq!((rows[0].magnitude, rows[0].correct), (None, Some(true)));
     }
 }

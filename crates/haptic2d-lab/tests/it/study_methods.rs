@@ -316,3 +316,71 @@ fn blocks_are_counterbalanced_by_participant_number_and_breaks_come_where_the_fi
     .unwrap_err();
     assert!(e.contains("ends in no number") && e.contains("fix:"), "{e}");
 }
+
+/// Magnitude estimation (`studies/stiffness-magnitude.toml`) on the simulated observer: its
+/// numbers are `modulus·(K̂_cmp/K̂_ref)^a` on noisy percepts of the felt stiffnesses, so the power law
+/// fitted against the rendered `kc` has the exponent `a·s`, with `s` the slope of `ln K_felt`
+/// against `ln kc` over the tested levels (the world's physics: the felt stiffness of a box pressed
+/// on two corners is not exactly proportional to `kc`). The analysis' 95 % interval over two
+/// participants' trials contains `a·s`, and the fitted scale is near the modulus.
+#[test]
+fn magnitude_estimation_recovers_the_observers_exponent_on_the_felt_stiffness() {
+    let (study, text) = load("stiffness-magnitude.toml");
+    let dir = tempfile::tempdir().unwrap();
+    for id in ["m1", "m2"] {
+        assert!(run_one(&study, &text, dir.path(), id).complete);
+    }
+    // s: least squares of ln K_felt on ln kc over the levels, from the observer's own exploration.
+    let mut obs = SimulatedObserver::new(study.observer, 1);
+    let base = study.conditions[0].base_value;
+    let deltas = study.deltas(0).to_vec();
+    let pts: Vec<(f64, f64)> = deltas
+        .iter()
+        .map(|&d| {
+            let k = obs.felt(&study, 0, true, d).unwrap();
+            ((base + d).ln(), k.ln())
+        })
+        .collect();
+    let n = pts.len() as f64;
+    let (mx, my) = pts
+        .iter()
+        .fold((0.0, 0.0), |(a, b), (x, y)| (a + x / n, b + y / n));
+    let s = pts.iter().map(|(x, y)| (x - mx) * (y - my)).sum::<f64>()
+        / pts.iter().map(|(x, _)| (x - mx).powi(2)).sum::<f64>();
+    let expected = study.observer.magnitude_exponent * s;
+    let (res, paths) = analyse_dir(dir.path(), &AnalyseOptions::default()).unwrap();
+    let m = res[0].magnitude.as_ref().unwrap();
+    eprintln!(
+        "exponent {} [{}, {}], expected a·s = {} (s = {s}), scale {}",
+        m.exponent, m.exponent_ci.0, m.exponent_ci.1, expected, m.scale
+    );
+    assert!(m.exponent_ci.0 <= expected && expected <= m.exponent_ci.1);
+    assert!(m.exponent_ci.1 - m.exponent_ci.0 < 0.3);
+    assert!(
+        (m.scale / study.modulus - 1.0).abs() < 0.15,
+        "scale {}",
+        m.scale
+    );
+    assert!(paths.iter().any(|p| p.ends_with("magnitude.tsv")));
+}
+
+/// A modulus belongs to magnitude estimation only, and magnitude estimation needs constant stimuli.
+#[test]
+fn a_magnitude_study_needs_constant_stimuli_and_a_modulus_belongs_to_it_alone() {
+    let (_, text) = load("stiffness-magnitude.toml");
+    let bad = text.replace(
+        "kind = \"constant\"\ndeltas = [-700.0, -500.0, -250.0, 0.0, 400.0, 1000.0, 2000.0]   # N/m: comparison Kc 300 … 3000\nrepeats = 8",
+        "kind = \"quest\"\nstart = 300.0\nmax_trials = 20",
+    );
+    let e = Study::from_toml(&bad, "bad.toml", None)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("method.kind") && e.contains("magnitude"), "{e}");
+    let (_, two) = load("stiffness-walls.toml");
+    let bad = two.replace("kind = \"2afc\"", "kind = \"2afc\"\nmodulus = 10.0");
+    assert!(bad.contains("modulus"));
+    let e = Study::from_toml(&bad, "bad.toml", None)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("task.modulus"), "{e}");
+}
