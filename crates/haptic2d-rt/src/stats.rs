@@ -43,6 +43,9 @@ pub struct TimingStats {
     first_wake_ns: u64,
     last_wake_ns: u64,
     last_end_ns: u64,
+    worst_compute_ns: u64,
+    worst_tick: u64,
+    worst_wake_ns: u64,
 }
 
 impl TimingStats {
@@ -63,6 +66,9 @@ impl TimingStats {
             first_wake_ns: 0,
             last_wake_ns: 0,
             last_end_ns: 0,
+            worst_compute_ns: 0,
+            worst_tick: 0,
+            worst_wake_ns: 0,
         }
     }
 
@@ -77,6 +83,11 @@ impl TimingStats {
             self.first_wake_ns = woke_ns;
         }
         self.ticks += 1;
+        if compute > self.worst_compute_ns || self.ticks == 1 {
+            self.worst_compute_ns = compute;
+            self.worst_tick = self.ticks;
+            self.worst_wake_ns = woke_ns;
+        }
         self.last_wake_ns = woke_ns;
         self.last_end_ns = end_ns;
         self.lateness.record(lateness);
@@ -141,6 +152,12 @@ impl TimingStats {
             achieved_rate_hz,
             lateness_us: Percentiles::of(&self.lateness),
             compute_us: Percentiles::of(&self.compute),
+            worst_compute_tick: self.worst_tick,
+            worst_compute_at_s: if self.ticks > 0 {
+                self.worst_wake_ns.saturating_sub(self.first_deadline_ns) as f64 * 1e-9
+            } else {
+                0.0
+            },
             rt,
         }
     }
@@ -205,6 +222,10 @@ pub struct TimingSummary {
     pub lateness_us: Percentiles,
     /// Compute time `end − wake`, µs.
     pub compute_us: Percentiles,
+    /// The tick (from 1) whose compute time was the largest (the first such tick); 0 without ticks.
+    pub worst_compute_tick: u64,
+    /// When that tick woke, s after the first deadline.
+    pub worst_compute_at_s: f64,
     /// The real-time setup report, when the loop asked for real-time treatment.
     pub rt: Option<RtReport>,
 }
@@ -236,9 +257,50 @@ impl fmt::Display for TimingSummary {
                 p.p50, p.p99, p.p999, p.max, p.mean
             )?;
         }
+        if self.worst_compute_tick > 0 {
+            write!(
+                f,
+                "\n  worst compute: tick {} at {:.3} s",
+                self.worst_compute_tick, self.worst_compute_at_s
+            )?;
+        }
         if let Some(rt) = &self.rt {
             write!(f, "\n  {rt}")?;
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The summary names the tick with the largest compute time and when it woke, so that a run's
+    /// worst tick can be found in its log.
+    #[test]
+    fn the_summary_names_the_tick_of_the_worst_compute_time() {
+        let mut s = TimingStats::new(1000.0, 1_000_000);
+        let t0 = 5_000_000_000;
+        for (k, compute_ns) in [10_000u64, 50_000, 20_000, 50_000].into_iter().enumerate() {
+            let deadline = t0 + k as u64 * 1_000_000;
+            s.record_tick(deadline, deadline + 1_000, deadline + 1_000 + compute_ns);
+        }
+        let sum = s.summary(None);
+        assert_eq!(
+            sum.worst_compute_tick, 2,
+            "the first tick of the largest compute"
+        );
+        assert!(
+            (sum.worst_compute_at_s - 1.001e-3).abs() < 1e-12,
+            "{}",
+            sum.worst_compute_at_s
+        );
+        assert!(
+            sum.to_string().contains("worst compute: tick 2 at 0.001 s"),
+            "{sum}"
+        );
+        let empty = TimingStats::new(1000.0, 1_000_000).summary(None);
+        assert_eq!(empty.worst_compute_tick, 0);
+        assert!(!empty.to_string().contains("worst compute"));
     }
 }
