@@ -1,5 +1,6 @@
 //! The haptic loop split at the network (issue 41, docs/TELEOP.md): `haptic2d serve-world` and
-//! `haptic2d remote-device` as two processes over loopback, authenticated with a shared key.
+//! `haptic2d run --world udp:…` (or its alias `remote-device`) as two processes over loopback,
+//! authenticated with a shared key.
 //!
 //! The acceptance test: 50 ms round trip (25 ms injected on each side) and 5 % loss on each side,
 //! the simulated hand pushes the handle so that the world's box goes into a stiff wall; with
@@ -143,14 +144,16 @@ impl World {
     }
 }
 
+/// The device side as `run --device sim --world udp:…`.
 fn device(world: &World, key: &PathBuf, extra: &[&str]) -> (i32, String) {
+    device_as(&["run", "--device", "sim"], world, key, extra)
+}
+
+/// The device side started as `command` (`run …` or the alias `remote-device`).
+fn device_as(command: &[&str], world: &World, key: &PathBuf, extra: &[&str]) -> (i32, String) {
     let child = Command::new(BIN)
-        .args([
-            "remote-device",
-            "--world",
-            &format!("udp:{}", world.addr),
-            "--key",
-        ])
+        .args(command)
+        .args(["--world", &format!("udp:{}", world.addr), "--key"])
         .arg(key)
         .args(extra)
         .stdout(Stdio::piped())
@@ -305,7 +308,9 @@ fn a_silent_world_latches_zero_torques_and_says_lost_link() {
 fn a_device_side_with_another_key_gets_no_session() {
     let _t = turn();
     let world = World::start(&key_file("k1", 0x11), &["--accept-timeout", "3"]);
-    let (status, text) = device(
+    // Through the alias `remote-device`, which runs the same device side.
+    let (status, text) = device_as(
+        &["remote-device"],
         &world,
         &key_file("k2", 0x22),
         &["--duration", "1", "--connect-timeout", "0.5"],
@@ -314,6 +319,64 @@ fn a_device_side_with_another_key_gets_no_session() {
     assert!(text.contains("no WELCOME"), "{text}");
     let w = world.finish(Duration::from_secs(10));
     assert!(!w.contains("session "), "{w}");
+}
+
+/// `run`'s split-loop options need `--world`, and across a network `run` refuses what belongs to a
+/// local world or a device not built for it yet, each with the fix (exit 2, before any socket).
+#[test]
+fn run_refuses_split_loop_options_without_world_and_local_world_options_with_it() {
+    let key = key_file("refuse", 0x44);
+    let k = key.to_str().unwrap();
+    let cases: &[(&[&str], &str)] = &[
+        (&["run", "--key", k, "--duration", "1"], "need --world"),
+        (&["run", "--push", "-0.01,0,0.05,0.5"], "need --world"),
+        (
+            &[
+                "run",
+                "--world",
+                "udp:127.0.0.1:9",
+                "--key",
+                k,
+                "--device",
+                "haply:auto",
+            ],
+            "simulated twin pantograph only",
+        ),
+        (
+            &[
+                "run",
+                "--world",
+                "udp:127.0.0.1:9",
+                "--key",
+                k,
+                "--log",
+                "x.mcap",
+            ],
+            "--log does not apply",
+        ),
+        (
+            &[
+                "run",
+                "--world",
+                "udp:127.0.0.1:9",
+                "--key",
+                k,
+                "--passivity",
+            ],
+            "does not apply",
+        ),
+        (&["run", "--world", "udp:127.0.0.1:9"], "needs --key FILE"),
+        (
+            &["run", "--world", "127.0.0.1:9", "--key", k],
+            "expected udp:HOST:PORT",
+        ),
+    ];
+    for (args, what) in cases {
+        let o = common::haptic2d(args);
+        let t = common::text(&o);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {t}");
+        assert!(t.contains(what) && t.contains("fix:"), "{args:?}: {t}");
+    }
 }
 
 /// `haptic2d teleop` with two simulated devices: the slave's wall contact is felt at the master
