@@ -7,7 +7,9 @@
 pub mod delayed_wall;
 pub mod link;
 pub mod teleop;
+pub mod wave;
 
-pub use delayed_wall::{run_delayed_wall, DelayedWall, DelayedWallResult};
+pub use delayed_wall::{run_delayed_wall, DelayedWall, DelayedWallResult, LinkMode};
 pub use link::{Impairment, Link};
 pub use teleop::{run_teleop, Teleop, TeleopResult};
+pub use wave::{WaveMaster, WaveMsg, WaveParams, WaveSlave};
