@@ -33,10 +33,25 @@ pub struct TeleopArgs {
     /// Turn the time-domain passivity controllers off (to see the delayed link create energy).
     #[arg(long)]
     pub no_tdpa: bool,
+    /// Instead of a teleoperation run: write the delay figures into DIR (created if missing): the
+    /// lab's wall-contact and released-handle runs for round trips 0, 10, 50, 200 ms and loss 0,
+    /// 5, 10 % with TDPA, waves and neither, as a table (teleop-delays.md, .csv) and a plot per
+    /// round trip (teleop-delay-<ms>ms.svg, .png); the table is printed too (docs/TELEOP.md).
+    #[arg(long, value_name = "DIR")]
+    pub figures: Option<std::path::PathBuf>,
 }
 
 /// Runs `teleop`.
 pub fn run(a: &TeleopArgs) -> Result<Status, Failure> {
+    if let Some(dir) = &a.figures {
+        let (rows, files) =
+            haptic2d_lab::network::figures::write_delay_figures(dir).map_err(Failure::error)?;
+        outln!("{}", haptic2d_lab::network::figures::markdown(&rows));
+        for f in files {
+            outln!("wrote {}", f.display());
+        }
+        return Ok(Status::Clean);
+    }
     for (which, v) in [("--master", &a.master), ("--slave", &a.slave)] {
         if v != "sim" {
             return Err(Failure::from(format!(

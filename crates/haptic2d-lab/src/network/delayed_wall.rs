@@ -160,8 +160,42 @@ struct ToDevice {
     wave: WaveMsg,
 }
 
+/// One sample of a traced run (SI units).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TracePoint {
+    /// Time (s).
+    pub t: f64,
+    /// Handle position (m).
+    pub x_m: f64,
+    /// Body position (m).
+    pub x_s: f64,
+    /// Force of the link on the handle (N).
+    pub f_m: f64,
+    /// Force of the wall on the body (N).
+    pub f_wall: f64,
+    /// The network's energy created so far (J).
+    pub created: f64,
+}
+
 /// Runs `cfg`.
 pub fn run_delayed_wall(cfg: &DelayedWall) -> DelayedWallResult {
+    simulate(cfg, None)
+}
+
+/// Runs `cfg` and keeps every `every`-th sample (at least 1).
+pub fn run_delayed_wall_traced(
+    cfg: &DelayedWall,
+    every: usize,
+) -> (DelayedWallResult, Vec<TracePoint>) {
+    let mut trace = Vec::new();
+    let r = simulate(cfg, Some((&mut trace, every.max(1) as u64)));
+    (r, trace)
+}
+
+fn simulate(
+    cfg: &DelayedWall,
+    mut trace: Option<(&mut Vec<TracePoint>, u64)>,
+) -> DelayedWallResult {
     let dt = cfg.dt;
     let n = (cfg.duration / dt).round() as u64;
     let mut up: Link<ToWorld> = Link::new(cfg.link);
@@ -281,6 +315,18 @@ pub fn run_delayed_wall(cfg: &DelayedWall) -> DelayedWallResult {
             err_sum += (f_m.abs() - f_wall.abs()).abs();
             wall_sum += f_wall.abs();
             window += 1;
+        }
+        if let Some((tr, every)) = trace.as_mut() {
+            if k % *every == 0 {
+                tr.push(TracePoint {
+                    t,
+                    x_m,
+                    x_s,
+                    f_m,
+                    f_wall,
+                    created: NetworkEnergy::of(&master, &slave).created,
+                });
+            }
         }
         if separation.is_nan() && !held {
             separation = (x_m - x_s).abs();

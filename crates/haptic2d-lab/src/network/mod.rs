@@ -5,6 +5,7 @@
 //! process split over UDP is `haptic2d serve-world` / `remote-device` (docs/TELEOP.md).
 
 pub mod delayed_wall;
+pub mod figures;
 pub mod link;
 pub mod teleop;
 pub mod wave;
