@@ -106,6 +106,10 @@ pub fn run(a: &TeleopArgs) -> Result<Status, Failure> {
         r.dissipated
     );
     outln!(
+        "plants: energy created {:.6} J as the two devices really received it (applied force × true displacement per period; the ports book it against their filtered velocities)",
+        r.plant_created
+    );
+    outln!(
         "contact (last second): wall force on the slave {:.3} N, force of the master on the hand {:.3} N, mean |difference| {:.3} N",
         r.wall_force,
         r.master_force,
