@@ -39,6 +39,10 @@ pub struct TeleopArgs {
     /// round trip (teleop-delay-<ms>ms.svg, .png); the table is printed too (docs/TELEOP.md).
     #[arg(long, value_name = "DIR")]
     pub figures: Option<std::path::PathBuf>,
+    /// The coupling and the ports use the devices' 50 Hz filtered velocity instead of the
+    /// unfiltered rate of the pose: reproduces the 10 ms chatter (docs/TELEOP.md).
+    #[arg(long)]
+    pub filtered_velocity: bool,
 }
 
 /// Runs `teleop`.
@@ -80,15 +84,17 @@ pub fn run(a: &TeleopArgs) -> Result<Status, Failure> {
     let link = Impairment::delay_loss(a.delay_ms.round() as u32, a.loss, a.seed);
     let cfg = Teleop {
         duration: a.duration,
+        filtered_velocity: a.filtered_velocity,
         ..Teleop::new(link, !a.no_tdpa)
     };
     let r = run_teleop(&cfg).map_err(Failure::error)?;
     outln!(
-        "teleop: master sim, slave sim, {:.1} s at 1 kHz, round trip {} ms, loss {:.1} % each way, TDPA {}",
+        "teleop: master sim, slave sim, {:.1} s at 1 kHz, round trip {} ms, loss {:.1} % each way, TDPA {}, velocities {}",
         a.duration,
         2 * link.delay,
         a.loss * 100.0,
-        if a.no_tdpa { "off" } else { "on" }
+        if a.no_tdpa { "off" } else { "on" },
+        if a.filtered_velocity { "filtered (50 Hz)" } else { "unfiltered rate" }
     );
     outln!(
         "the grip's target moves {:.0} mm left at {:.0} mm/s from {} s; the slave's wall is {:.0} mm left ({} N/m)",
