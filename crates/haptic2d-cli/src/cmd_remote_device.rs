@@ -488,7 +488,7 @@ fn run_device_side(p: &Plan) -> Result<Status, Failure> {
         ep.peer(),
         p.hand,
         p.rate,
-        if a.link.no_tdpa { "off" } else { "on" },
+        if a.link.tdpa() { "on" } else { "off" },
         a.link.describe(p.rate)
     );
     let timeout_periods = (a.link.link_timeout_ms * 1e-3 * p.rate).ceil() as u64;
@@ -507,7 +507,7 @@ fn run_device_side(p: &Plan) -> Result<Status, Failure> {
             dt,
         ),
         origin,
-        tdpa: !a.link.no_tdpa,
+        tdpa: a.link.tdpa(),
         ports: PlanarTdpa::default(),
         outbox: a.link.outbox(p.rate),
         // Round trips and arrival intervals of up to an hour are kept (beyond, counted only).

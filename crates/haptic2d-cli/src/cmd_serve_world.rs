@@ -264,7 +264,7 @@ pub fn run(a: &ServeWorldArgs) -> Result<Status, Failure> {
         body.name,
         body.mass,
         a.rate,
-        if a.link.no_tdpa { "off" } else { "on" },
+        if a.link.tdpa() { "on" } else { "off" },
         a.link.describe(a.rate)
     );
     outln!("serve-world: listening on {local}");
@@ -288,7 +288,7 @@ pub fn run(a: &ServeWorldArgs) -> Result<Status, Failure> {
         alpha_max,
         k,
         b,
-        tdpa: !a.link.no_tdpa,
+        tdpa: a.link.tdpa(),
         ports: PlanarTdpa::default(),
         outbox: a.link.outbox(a.rate),
         stats: LinkStats::with_capacity(((a.duration.unwrap_or(600.0) + 5.0) * a.rate) as usize),

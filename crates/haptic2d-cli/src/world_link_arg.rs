@@ -18,6 +18,11 @@ pub struct LinkArgs {
     /// what the link does without it. Never on a real device.
     #[arg(long)]
     pub no_tdpa: bool,
+    /// What keeps the link passive: `tdpa` (time-domain passivity on both ports), or `none` (the
+    /// ports only observe; the same as --no-tdpa). `wave` (wave variables) runs in the lab
+    /// (`haptic2d teleop --figures`) and is refused here: not built across the two processes yet.
+    #[arg(long, value_name = "tdpa|wave|none", default_value = "tdpa")]
+    pub link: String,
     /// No authentic datagram from the other end for this long (ms) counts as a lost link: the
     /// device side latches zero torques and says why; the world side stops driving the slave.
     #[arg(long, default_value_t = 100.0, value_name = "MS")]
@@ -54,6 +59,11 @@ impl LinkArgs {
                 self.loss
             ));
         }
+        match self.link.as_str() {
+            "tdpa" | "none" => {}
+            "wave" => return Err("--link wave: wave variables run in the lab's simulated link (haptic2d teleop --figures DIR, docs/TELEOP.md) but not yet across the two processes\n    fix: --link tdpa".into()),
+            other => return Err(format!("--link {other}: expected tdpa, wave or none\n    fix: --link tdpa")),
+        }
         match &self.key {
             Some(k) => UdpKey::from_file(k),
             None => Err("the world link needs --key FILE (the same key on both ends)\n    fix: head -c 32 /dev/urandom | od -An -tx1 | tr -d ' \\n' > world.key; chmod 600 world.key".into()),
@@ -64,10 +74,16 @@ impl LinkArgs {
     pub fn any_given(&self) -> bool {
         self.key.is_some()
             || self.no_tdpa
+            || self.link != "tdpa"
             || self.link_timeout_ms != 100.0
             || self.delay_ms != 0.0
             || self.loss != 0.0
             || self.seed != 1
+    }
+
+    /// True when this end runs its TDPA passivity controller (`--link tdpa` without --no-tdpa).
+    pub fn tdpa(&self) -> bool {
+        !self.no_tdpa && self.link == "tdpa"
     }
 
     /// The impairment in periods of `rate_hz`, `None` when there is none.

@@ -213,7 +213,8 @@ fn pushed_into_the_wall(tdpa: bool, tag: &str) -> Pushed {
         "300",
     ];
     if !tdpa {
-        common.push("--no-tdpa");
+        // `--link none` (the same as --no-tdpa) on both ends.
+        common.extend(["--link", "none"]);
     }
     let mut w_args = common.clone();
     w_args.extend(["--seed", "2"]);
@@ -366,6 +367,22 @@ fn run_refuses_split_loop_options_without_world_and_local_world_options_with_it(
             "does not apply",
         ),
         (&["run", "--world", "udp:127.0.0.1:9"], "needs --key FILE"),
+        (
+            &[
+                "run",
+                "--world",
+                "udp:127.0.0.1:9",
+                "--key",
+                k,
+                "--link",
+                "wave",
+            ],
+            "not yet across the two processes",
+        ),
+        (
+            &["serve-world", "box-in-walls", "--key", k, "--link", "waves"],
+            "expected tdpa, wave or none",
+        ),
         (
             &["run", "--world", "127.0.0.1:9", "--key", k],
             "expected udp:HOST:PORT",
