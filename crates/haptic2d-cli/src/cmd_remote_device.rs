@@ -195,6 +195,9 @@ struct DeviceSide {
     origin: V3,
     tdpa: bool,
     ports: PlanarTdpa,
+    /// The port's energy as the plant really received it: the applied force times the simulated
+    /// plant's true displacement over the period.
+    plant_ledger: PlanarTdpa,
     ep: LinkEndpoint,
     outbox: Outbox,
     stats: LinkStats,
@@ -253,7 +256,9 @@ impl DeviceSide {
             };
             return self.stop(t, lost);
         }
-        // The world's force, ramped in, through the master port's passivity controller.
+        // The world's force, ramped in, through the master port's passivity controller. (Unlike
+        // the lab's teleop, the port keeps the filtered velocity: measured over the split loop,
+        // the plants' true ledger showed no gain from the unfiltered rate; docs/TELEOP.md.)
         let (x, v) = (est.pose, est.velocity);
         let ramp = self.safety.ramp();
         let (f_req, far) = self.last.map_or(([0.0; 3], [0.0; 3]), |m| {
@@ -295,9 +300,13 @@ impl DeviceSide {
         self.max_force = self.max_force.max(applied[0].hypot(applied[1]));
         let d = (x[0] - self.origin[0]).hypot(x[1] - self.origin[1]);
         self.max_excursion = self.max_excursion.max(d);
+        let before = self.io.plant().pose();
         if self.io.write_torques(&self.tau).is_err() {
             return self.stop(t, Latch::DeviceIo);
         }
+        let after = self.io.plant().pose();
+        let moved: V3 = std::array::from_fn(|i| (after[i] - before[i]) / dt);
+        self.plant_ledger.observe(&applied, &moved, dt);
         self.send(k, &x, &v, &applied, 0);
         self.ticks += 1;
         match self.safety.trip_info() {
@@ -509,6 +518,7 @@ fn run_device_side(p: &Plan) -> Result<Status, Failure> {
         origin,
         tdpa: a.link.tdpa(),
         ports: PlanarTdpa::default(),
+        plant_ledger: PlanarTdpa::default(),
         outbox: a.link.outbox(p.rate),
         // Round trips and arrival intervals of up to an hour are kept (beyond, counted only).
         stats: LinkStats::with_capacity(
@@ -566,6 +576,12 @@ fn report(
     outln!("{summary}");
     let mine = side.ports.totals();
     outln!("master port (device): {}", energies(mine));
+    let plant = side.plant_ledger.totals();
+    outln!(
+        "master port (plant, true displacement): energy in {:.6} J, out {:.6} J",
+        plant.0,
+        plant.1
+    );
     if let Some(m) = side.last {
         let (i, o) = (
             m.energy_in.iter().sum::<f64>(),
