@@ -442,6 +442,23 @@ fn teleop_of_two_simulated_devices_reproduces_the_wall_contact_at_the_master() {
     assert_eq!(o.status.code(), Some(2), "{}", common::text(&o));
 }
 
+/// `haptic2d teleop --figures DIR` writes the delay table (Markdown, CSV) and one plot per round
+/// trip into the directory the user gives, and prints the table (docs/TELEOP.md).
+#[test]
+fn teleop_figures_writes_the_table_and_a_plot_per_round_trip_into_the_given_dir() {
+    let dir = key_file("figures", 0x01).with_file_name("figs");
+    let o = common::haptic2d(&["teleop", "--figures", dir.to_str().unwrap()]);
+    let t = common::text(&o);
+    assert!(o.status.success(), "{t}");
+    assert!(t.contains("| 50 ms | 5 % | wave |"), "{t}");
+    for f in ["teleop-delays.md", "teleop-delays.csv"] {
+        assert!(dir.join(f).exists(), "{f}: {t}");
+    }
+    for rt in [0, 10, 50, 200] {
+        assert!(dir.join(format!("teleop-delay-{rt}ms.svg")).exists(), "{t}");
+    }
+}
+
 /// The acceptance run through Linux netem instead of the built-in impairment (issue 41 item 3):
 /// both processes in a network namespace of their own whose loopback delays every datagram by
 /// 25 ms and drops 5 % (so 50 ms round trip, 5 % loss each way). Ignored, so that it is never
