@@ -1,5 +1,5 @@
-//! `haptic2d remote-device --world udp:HOST:PORT --key FILE`: the device side of the haptic loop
-//! split at a network (issue 41, docs/TELEOP.md). It runs the device (the simulated twin
+//! `haptic2d run --world udp:HOST:PORT --key FILE` (alias: `haptic2d remote-device --world …`): the
+//! device side of the haptic loop split at a network (issue 41, docs/TELEOP.md). It runs the device (the simulated twin
 //! pantograph and its simulated hand) with its local safety, and renders the force the world side
 //! sends through the master port's TDPA passivity controller. Every period:
 //!
@@ -13,9 +13,10 @@
 //! send: handle pose and twist from the start pose, the applied force, the port's energies
 //! ```
 //!
-//! Any latch zeroes the torques in the same period, stops the loop and says why (exit 3). This is
-//! a command of its own, beside `run`, because `run`'s tick is one `HapticSystem` holding device and
-//! world together (crates/haptic2d/src/haptic/), which this split does not change.
+//! Any latch zeroes the torques in the same period, stops the loop and says why (exit 3). `run`
+//! dispatches here on `--world` before building its rig: `run`'s own tick is one `HapticSystem`
+//! holding device and world together (crates/haptic2d/src/haptic/), which this split does not
+//! change; the device side is this loop, with the same `SafetyStage` as that tick.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -45,7 +46,7 @@ use crate::world_link_arg::{energies, LinkArgs, LinkStats, Outbox};
 /// Examples of `remote-device --help`.
 pub const EXAMPLES: &[crate::Example] = &[
     (
-        "The simulated device held still, for 10 s, against a world side on this machine",
+        "The simulated device held still, for 10 s, against a world side on this machine (the same as `haptic2d run --world udp:127.0.0.1:7420 --key world.key --duration 10`)",
         "haptic2d remote-device --world udp:127.0.0.1:7420 --key world.key",
     ),
     (
@@ -58,7 +59,37 @@ pub const EXAMPLES: &[crate::Example] = &[
     ),
 ];
 
-/// `remote-device`'s options.
+/// The device side's own options, shared by `run --world` and its alias `remote-device`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct DeviceSideArgs {
+    /// A scripted push by the gripping hand (`--hand follow`: a spring–damper, 300 N/m, 5 N·s/m):
+    /// from time AT (s) its target moves from the start pose by (DX, DY) (m) at SPEED (m/s), then
+    /// stays; e.g. `-0.015,0,0.05,0.6` pushes 15 mm to the left from 0.6 s (with --world only).
+    #[arg(long, value_name = "DX,DY,SPEED,AT", allow_hyphen_values = true)]
+    pub push: Option<String>,
+    /// A tick later than this many periods after the previous one is a stall (the latch trips;
+    /// with --world only: `run`'s own tick has its stall limit in the watchdog).
+    #[arg(long, default_value_t = 5.0)]
+    pub max_stall_periods: f64,
+    /// Wait at most this long (s) for the world side's WELCOME (with --world only).
+    #[arg(long, default_value_t = 5.0)]
+    pub connect_timeout: f64,
+    #[command(flatten)]
+    pub link: LinkArgs,
+}
+
+impl DeviceSideArgs {
+    /// True when any of these options was given (`run` accepts them with `--world` only).
+    pub fn any_given(&self) -> bool {
+        self.push.is_some()
+            || self.max_stall_periods != 5.0
+            || self.connect_timeout != 5.0
+            || self.link.any_given()
+    }
+}
+
+/// `remote-device`'s options: an alias of `run --device sim --world udp:HOST:PORT` kept for the
+/// scripts that use it.
 #[derive(clap::Args, Debug)]
 pub struct RemoteDeviceArgs {
     /// The world side: `udp:HOST:PORT` of a `haptic2d serve-world`.
@@ -68,11 +99,6 @@ pub struct RemoteDeviceArgs {
     /// script:HOLD,FX,FY,TAU,PUSH[,RFX,RFY,RTAU].
     #[arg(long, default_value = "follow")]
     pub hand: String,
-    /// A scripted push by the gripping hand (`--hand follow`: a spring–damper, 300 N/m, 5 N·s/m):
-    /// from time AT (s) its target moves from the start pose by (DX, DY) (m) at SPEED (m/s), then
-    /// stays; e.g. `-0.015,0,0.05,0.6` pushes 15 mm to the left from 0.6 s.
-    #[arg(long, value_name = "DX,DY,SPEED,AT", allow_hyphen_values = true)]
-    pub push: Option<String>,
     /// Run for this long (s).
     #[arg(long, default_value_t = 10.0)]
     pub duration: f64,
@@ -82,14 +108,20 @@ pub struct RemoteDeviceArgs {
     /// Normal scheduling instead of real-time priority for the device loop.
     #[arg(long)]
     pub no_rt: bool,
-    /// A tick later than this many periods after the previous one is a stall (the latch trips).
-    #[arg(long, default_value_t = 5.0)]
-    pub max_stall_periods: f64,
-    /// Wait at most this long (s) for the world side's WELCOME.
-    #[arg(long, default_value_t = 5.0)]
-    pub connect_timeout: f64,
     #[command(flatten)]
-    pub link: LinkArgs,
+    pub side: DeviceSideArgs,
+}
+
+/// One device side to run, from `run --world` or `remote-device`.
+struct Plan<'a> {
+    world: &'a str,
+    hand: &'a str,
+    /// Run length (s); `None`: until a signal.
+    duration: Option<f64>,
+    rate: f64,
+    rt: bool,
+    spin_us: Option<f64>,
+    side: &'a DeviceSideArgs,
 }
 
 /// Why the device side latched zero torques.
@@ -163,6 +195,9 @@ struct DeviceSide {
     origin: V3,
     tdpa: bool,
     ports: PlanarTdpa,
+    /// The port's energy as the plant really received it: the applied force times the simulated
+    /// plant's true displacement over the period.
+    plant_ledger: PlanarTdpa,
     ep: LinkEndpoint,
     outbox: Outbox,
     stats: LinkStats,
@@ -221,7 +256,9 @@ impl DeviceSide {
             };
             return self.stop(t, lost);
         }
-        // The world's force, ramped in, through the master port's passivity controller.
+        // The world's force, ramped in, through the master port's passivity controller. (Unlike
+        // the lab's teleop, the port keeps the filtered velocity: measured over the split loop,
+        // the plants' true ledger showed no gain from the unfiltered rate; docs/TELEOP.md.)
         let (x, v) = (est.pose, est.velocity);
         let ramp = self.safety.ramp();
         let (f_req, far) = self.last.map_or(([0.0; 3], [0.0; 3]), |m| {
@@ -263,9 +300,13 @@ impl DeviceSide {
         self.max_force = self.max_force.max(applied[0].hypot(applied[1]));
         let d = (x[0] - self.origin[0]).hypot(x[1] - self.origin[1]);
         self.max_excursion = self.max_excursion.max(d);
+        let before = self.io.plant().pose();
         if self.io.write_torques(&self.tau).is_err() {
             return self.stop(t, Latch::DeviceIo);
         }
+        let after = self.io.plant().pose();
+        let moved: V3 = std::array::from_fn(|i| (after[i] - before[i]) / dt);
+        self.plant_ledger.observe(&applied, &moved, dt);
         self.send(k, &x, &v, &applied, 0);
         self.ticks += 1;
         match self.safety.trip_info() {
@@ -345,23 +386,77 @@ fn world_addr(s: &str) -> Result<&str, String> {
         })
 }
 
-/// Runs `remote-device`.
+/// Runs `remote-device` (the same as `run --device sim --world …`).
 pub fn run(a: &RemoteDeviceArgs) -> Result<Status, Failure> {
-    let key = a.link.key().map_err(Failure::from)?;
-    let addr = world_addr(&a.world).map_err(Failure::from)?;
-    let hand = HandSpec::parse(&a.hand).map_err(Failure::from)?;
-    if !(a.duration.is_finite() && a.duration > 0.0) {
+    run_device_side(&Plan {
+        world: &a.world,
+        hand: &a.hand,
+        duration: Some(a.duration),
+        rate: a.rate,
+        rt: !a.no_rt,
+        spin_us: None,
+        side: &a.side,
+    })
+}
+
+/// Runs `run --world udp:HOST:PORT`: the device side of the split loop. `run`'s options that
+/// belong to a local world (its log, display feeds, controller, passivity on the device port) are
+/// refused with the reason; so is a device other than the simulated one (not built yet).
+pub fn run_from_run(a: &crate::cmd_run::RunArgs, world: &str) -> Result<Status, Failure> {
+    let refuse = |what: &str| -> Result<Status, Failure> {
+        Err(Failure::from(format!(
+            "--world {world}: {what} does not apply to the device side of a split loop (the world, its controller and its logs are on the world side, `haptic2d serve-world`)\n    fix: leave it out, or run without --world"
+        )))
+    };
+    if a.device != "sim" {
         return Err(Failure::from(format!(
-            "--duration must be > 0 s (got {})",
-            a.duration
+            "--world {world} --device {}: across a network the device side runs the simulated twin pantograph only so far (docs/TELEOP.md, \"Not built yet\")\n    fix: --device sim",
+            a.device
         )));
+    }
+    if a.log.is_some() {
+        return refuse("--log");
+    }
+    if a.foxglove.is_some() {
+        return refuse("--foxglove");
+    }
+    if a.passivity {
+        return refuse("--passivity (the link has its own passivity controller, --link)");
+    }
+    if a.controller_file.is_some() || a.controller != "four-channel" {
+        return refuse("--controller / --controller-file");
+    }
+    if a.device_file.is_some() {
+        return refuse("--device-file");
+    }
+    crate::cmd_run::check_rate(a.rate)?;
+    run_device_side(&Plan {
+        world,
+        hand: a.hand.as_deref().unwrap_or("follow"),
+        duration: a.duration,
+        rate: a.rate,
+        rt: !a.no_rt,
+        spin_us: a.spin_us,
+        side: &a.remote,
+    })
+}
+
+fn run_device_side(p: &Plan) -> Result<Status, Failure> {
+    let a = p.side;
+    let key = a.link.key().map_err(Failure::from)?;
+    let addr = world_addr(p.world).map_err(Failure::from)?;
+    let hand = HandSpec::parse(p.hand).map_err(Failure::from)?;
+    if let Some(d) = p.duration {
+        if !(d.is_finite() && d > 0.0 && d <= crate::cmd_run::MAX_RUN_DURATION_S) {
+            return Err(Failure::from(format!("--duration must be > 0 s (got {d})")));
+        }
     }
     let safety_config = SafetyConfig {
         max_stall_periods: a.max_stall_periods,
         ..SafetyConfig::default()
     };
     safety_config.validate().map_err(Failure::from)?;
-    let dt = 1.0 / a.rate;
+    let dt = 1.0 / p.rate;
     let params = DeviceParams::default();
     let origin = [params.workspace_center_x, params.workspace_center_y, 0.0];
     let mut io = SimIo::new(
@@ -382,7 +477,7 @@ pub fn run(a: &RemoteDeviceArgs) -> Result<Status, Failure> {
         Some(_) => {
             return Err(Failure::from(format!(
                 "--push moves the gripping hand's target: it needs --hand follow (got --hand {})",
-                a.hand
+                p.hand
             )))
         }
     };
@@ -397,15 +492,15 @@ pub fn run(a: &RemoteDeviceArgs) -> Result<Status, Failure> {
     )
     .map_err(Failure::error)?;
     outln!(
-        "remote-device: session {:016x} with the world at {}, simulated twin pantograph, hand {}, {} Hz, TDPA {}, impairment: {}",
+        "device side: session {:016x} with the world at {}, simulated twin pantograph, hand {}, {} Hz, TDPA {}, impairment: {}; no display (the world is on the world side)",
         ep.session(),
         ep.peer(),
-        a.hand,
-        a.rate,
-        if a.link.no_tdpa { "off" } else { "on" },
-        a.link.describe(a.rate)
+        p.hand,
+        p.rate,
+        if a.link.tdpa() { "on" } else { "off" },
+        a.link.describe(p.rate)
     );
-    let timeout_periods = (a.link.link_timeout_ms * 1e-3 * a.rate).ceil() as u64;
+    let timeout_periods = (a.link.link_timeout_ms * 1e-3 * p.rate).ceil() as u64;
     let mut side = DeviceSide {
         io,
         push,
@@ -421,16 +516,20 @@ pub fn run(a: &RemoteDeviceArgs) -> Result<Status, Failure> {
             dt,
         ),
         origin,
-        tdpa: !a.link.no_tdpa,
+        tdpa: a.link.tdpa(),
         ports: PlanarTdpa::default(),
-        outbox: a.link.outbox(a.rate),
-        stats: LinkStats::with_capacity(((a.duration + 1.0) * a.rate) as usize),
+        plant_ledger: PlanarTdpa::default(),
+        outbox: a.link.outbox(p.rate),
+        // Round trips and arrival intervals of up to an hour are kept (beyond, counted only).
+        stats: LinkStats::with_capacity(
+            ((p.duration.unwrap_or(3600.0).min(3600.0) + 1.0) * p.rate) as usize,
+        ),
         ep,
         interval: TickInterval::new(),
         timeout_periods,
         // The first message needs the world's start and both delays on top.
-        first_timeout_periods: timeout_periods.max((a.rate as u64).max(1))
-            + 2 * (a.link.delay_ms * 1e-3 * a.rate) as u64,
+        first_timeout_periods: timeout_periods.max((p.rate as u64).max(1))
+            + 2 * (a.link.delay_ms * 1e-3 * p.rate) as u64,
         last: None,
         last_k: 0,
         last_arrival_ns: 0,
@@ -443,12 +542,13 @@ pub fn run(a: &RemoteDeviceArgs) -> Result<Status, Failure> {
         latch: None,
     };
     let config = LoopConfig {
-        rate_hz: a.rate,
-        duration: Some(Duration::from_secs_f64(a.duration)),
-        rt: !a.no_rt,
-        spin_us: (0.4e6 / a.rate).min(400.0),
+        rate_hz: p.rate,
+        duration: p.duration.map(Duration::from_secs_f64),
+        rt: p.rt,
+        spin_us: p.spin_us.unwrap_or((0.4e6 / p.rate).min(400.0)),
         ..LoopConfig::default()
     };
+    config.validate().map_err(Failure::from)?;
     let summary = std::thread::scope(|s| {
         std::thread::Builder::new()
             .name("haptic2d-rt".into())
@@ -476,6 +576,12 @@ fn report(
     outln!("{summary}");
     let mine = side.ports.totals();
     outln!("master port (device): {}", energies(mine));
+    let plant = side.plant_ledger.totals();
+    outln!(
+        "master port (plant, true displacement): energy in {:.6} J, out {:.6} J",
+        plant.0,
+        plant.1
+    );
     if let Some(m) = side.last {
         let (i, o) = (
             m.energy_in.iter().sum::<f64>(),

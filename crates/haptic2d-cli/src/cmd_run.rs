@@ -118,6 +118,17 @@ pub struct RunArgs {
     /// needs a protocol.key_file). Multicast and broadcast addresses are refused regardless.
     #[arg(long)]
     pub allow_remote_device: bool,
+    /// The world across a network: `udp:HOST:PORT` of a `haptic2d serve-world SCENE` (docs/TELEOP.md).
+    /// This process is then the device side of the split loop (the simulated device, --hand, its
+    /// local safety and the link's passivity controller); SCENE is the world side's, not read here.
+    #[arg(long, value_name = "udp:HOST:PORT")]
+    pub world: Option<String>,
+    /// The device side's options (with --world only).
+    #[command(
+        flatten,
+        next_help_heading = "The device side of a split loop (with --world)"
+    )]
+    pub remote: crate::cmd_remote_device::DeviceSideArgs,
 }
 
 /// `--duration` upper bound (s): about 116 days, far beyond any session, and small enough that the
@@ -151,6 +162,13 @@ enum LoopEnd {
 /// Runs the haptic loop: validate the options, build the rig, start the display and the logger,
 /// run the loop until the duration ends, a signal arrives or the tick stops it, then report.
 pub fn run(a: &RunArgs) -> Result<Status, Failure> {
+    match &a.world {
+        Some(w) => return crate::cmd_remote_device::run_from_run(a, w),
+        None if a.remote.any_given() => {
+            return Err("--key, --push, --link and the other options of a split loop need --world udp:HOST:PORT\n    fix: add --world udp:HOST:PORT (a `haptic2d serve-world`), or leave them out".into())
+        }
+        None => {}
+    }
     let opts = validate_options(a)?;
     let scene = scene_arg::load(&a.scene, Some(a.rate))?;
     for w in &scene.warnings {
@@ -359,7 +377,7 @@ fn parse_foxglove(s: &str) -> Result<SocketAddr, Failure> {
 }
 
 /// `--rate`: positive, finite and at most the world's documented maximum rate.
-fn check_rate(rate: f64) -> Result<(), Failure> {
+pub(crate) fn check_rate(rate: f64) -> Result<(), Failure> {
     if !(rate.is_finite() && rate > 0.0 && rate <= MAX_RATE_HZ) {
         return Err(format!(
             "--rate must be a positive number of Hz up to {MAX_RATE_HZ:e}, got {rate}\n    fix: e.g. --rate 1000"

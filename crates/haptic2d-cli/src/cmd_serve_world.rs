@@ -81,6 +81,9 @@ struct WorldSide {
     b: [f64; 3],
     tdpa: bool,
     ports: PlanarTdpa,
+    /// The port's energy as the slave body really received it: the applied force times its
+    /// displacement over the world step.
+    plant_ledger: PlanarTdpa,
     ep: LinkEndpoint,
     outbox: Outbox,
     stats: LinkStats,
@@ -145,6 +148,9 @@ impl WorldSide {
         self.world
             .set_drive(self.slave, Vec2::new(f_s[0], f_s[1]), f_s[2]);
         self.world.step();
+        let (x_after, _) = self.slave_state();
+        let moved: [f64; 3] = std::array::from_fn(|i| (x_after[i] - x_s[i]) / dt);
+        self.plant_ledger.observe(&f_s, &moved, dt);
         let wall = self.world.contact_wrench(self.slave).force;
         let (wall, coupling) = (wall.x.hypot(wall.y), f_s[0].hypot(f_s[1]));
         if live && wall > 0.01 {
@@ -264,7 +270,7 @@ pub fn run(a: &ServeWorldArgs) -> Result<Status, Failure> {
         body.name,
         body.mass,
         a.rate,
-        if a.link.no_tdpa { "off" } else { "on" },
+        if a.link.tdpa() { "on" } else { "off" },
         a.link.describe(a.rate)
     );
     outln!("serve-world: listening on {local}");
@@ -288,8 +294,9 @@ pub fn run(a: &ServeWorldArgs) -> Result<Status, Failure> {
         alpha_max,
         k,
         b,
-        tdpa: !a.link.no_tdpa,
+        tdpa: a.link.tdpa(),
         ports: PlanarTdpa::default(),
+        plant_ledger: PlanarTdpa::default(),
         outbox: a.link.outbox(a.rate),
         stats: LinkStats::with_capacity(((a.duration.unwrap_or(600.0) + 5.0) * a.rate) as usize),
         ep,
@@ -325,6 +332,12 @@ pub fn run(a: &ServeWorldArgs) -> Result<Status, Failure> {
 fn report(side: &mut WorldSide, summary: &haptic2d_rt::TimingSummary) {
     outln!("{summary}");
     outln!("world port (slave): {}", energies(side.ports.totals()));
+    let plant = side.plant_ledger.totals();
+    outln!(
+        "world port (body, true displacement): energy in {:.6} J, out {:.6} J",
+        plant.0,
+        plant.1
+    );
     let c = side.ep.counters;
     outln!(
         "link: {} received, {} stale, {} bad MAC, {} wrong session, {} malformed, {} send errors, {} dropped by the test impairment; {} periods live; largest coupling force {:.3} N",

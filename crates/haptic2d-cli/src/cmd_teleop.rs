@@ -33,10 +33,29 @@ pub struct TeleopArgs {
     /// Turn the time-domain passivity controllers off (to see the delayed link create energy).
     #[arg(long)]
     pub no_tdpa: bool,
+    /// Instead of a teleoperation run: write the delay figures into DIR (created if missing): the
+    /// lab's wall-contact and released-handle runs for round trips 0, 10, 50, 200 ms and loss 0,
+    /// 5, 10 % with TDPA, waves and neither, as a table (teleop-delays.md, .csv) and a plot per
+    /// round trip (teleop-delay-<ms>ms.svg, .png); the table is printed too (docs/TELEOP.md).
+    #[arg(long, value_name = "DIR")]
+    pub figures: Option<std::path::PathBuf>,
+    /// The coupling and the ports use the devices' 50 Hz filtered velocity instead of the
+    /// unfiltered rate of the pose: reproduces the 10 ms chatter (docs/TELEOP.md).
+    #[arg(long)]
+    pub filtered_velocity: bool,
 }
 
 /// Runs `teleop`.
 pub fn run(a: &TeleopArgs) -> Result<Status, Failure> {
+    if let Some(dir) = &a.figures {
+        let (rows, files) =
+            haptic2d_lab::network::figures::write_delay_figures(dir).map_err(Failure::error)?;
+        outln!("{}", haptic2d_lab::network::figures::markdown(&rows));
+        for f in files {
+            outln!("wrote {}", f.display());
+        }
+        return Ok(Status::Clean);
+    }
     for (which, v) in [("--master", &a.master), ("--slave", &a.slave)] {
         if v != "sim" {
             return Err(Failure::from(format!(
@@ -65,15 +84,17 @@ pub fn run(a: &TeleopArgs) -> Result<Status, Failure> {
     let link = Impairment::delay_loss(a.delay_ms.round() as u32, a.loss, a.seed);
     let cfg = Teleop {
         duration: a.duration,
+        filtered_velocity: a.filtered_velocity,
         ..Teleop::new(link, !a.no_tdpa)
     };
     let r = run_teleop(&cfg).map_err(Failure::error)?;
     outln!(
-        "teleop: master sim, slave sim, {:.1} s at 1 kHz, round trip {} ms, loss {:.1} % each way, TDPA {}",
+        "teleop: master sim, slave sim, {:.1} s at 1 kHz, round trip {} ms, loss {:.1} % each way, TDPA {}, velocities {}",
         a.duration,
         2 * link.delay,
         a.loss * 100.0,
-        if a.no_tdpa { "off" } else { "on" }
+        if a.no_tdpa { "off" } else { "on" },
+        if a.filtered_velocity { "filtered (50 Hz)" } else { "unfiltered rate" }
     );
     outln!(
         "the grip's target moves {:.0} mm left at {:.0} mm/s from {} s; the slave's wall is {:.0} mm left ({} N/m)",
@@ -89,6 +110,10 @@ pub fn run(a: &TeleopArgs) -> Result<Status, Failure> {
         r.network.energy_out,
         r.network.created,
         r.dissipated
+    );
+    outln!(
+        "plants: energy created {:.6} J as the two devices really received it (applied force × true displacement per period; the ports book it against their filtered velocities)",
+        r.plant_created
     );
     outln!(
         "contact (last second): wall force on the slave {:.3} N, force of the master on the hand {:.3} N, mean |difference| {:.3} N",

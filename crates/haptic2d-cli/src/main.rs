@@ -138,8 +138,8 @@ enum Command {
     /// authenticated UDP, with TDPA on its port (docs/TELEOP.md).
     #[command(after_help = examples_help(cmd_serve_world::EXAMPLES))]
     ServeWorld(cmd_serve_world::ServeWorldArgs),
-    /// The device side of a loop split at the network: the simulated twin pantograph with its
-    /// local safety, rendering a `serve-world` through TDPA (docs/TELEOP.md).
+    /// The device side of a loop split at the network (an alias of `run --device sim --world
+    /// udp:HOST:PORT`): the simulated twin pantograph with its local safety (docs/TELEOP.md).
     #[command(after_help = examples_help(cmd_remote_device::EXAMPLES))]
     RemoteDevice(cmd_remote_device::RemoteDeviceArgs),
     /// Bilateral teleoperation of two simulated devices across a simulated link, with TDPA: the

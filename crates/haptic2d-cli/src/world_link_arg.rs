@@ -1,5 +1,5 @@
-//! What `serve-world` and `remote-device` share (issue 41, docs/TELEOP.md): the key, the TDPA
-//! switch, the link timeout, the impairment in front of the socket, and the link's statistics.
+//! What `serve-world` and the device side (`run --world`, alias `remote-device`) share (issue 41,
+//! docs/TELEOP.md): the key, the TDPA switch, the link timeout, the impairment in front of the socket, and the link's statistics.
 
 use std::path::PathBuf;
 
@@ -11,13 +11,18 @@ use haptic2d_lab::network::{Impairment, Link};
 #[derive(clap::Args, Debug, Clone)]
 pub struct LinkArgs {
     /// The shared key file (hex, `chmod 600`), as for a UDP device (docs/DEVICE-PROTOCOL.md §3);
-    /// both ends need the same one.
+    /// both ends need the same one. Required on both ends.
     #[arg(long, value_name = "FILE")]
-    pub key: PathBuf,
+    pub key: Option<PathBuf>,
     /// Turn the time-domain passivity controller off on this end (its port only observes): to see
     /// what the link does without it. Never on a real device.
     #[arg(long)]
     pub no_tdpa: bool,
+    /// What keeps the link passive: `tdpa` (time-domain passivity on both ports), or `none` (the
+    /// ports only observe; the same as --no-tdpa). `wave` (wave variables) runs in the lab
+    /// (`haptic2d teleop --figures`) and is refused here: not built across the two processes yet.
+    #[arg(long, value_name = "tdpa|wave|none", default_value = "tdpa")]
+    pub link: String,
     /// No authentic datagram from the other end for this long (ms) counts as a lost link: the
     /// device side latches zero torques and says why; the world side stops driving the slave.
     #[arg(long, default_value_t = 100.0, value_name = "MS")]
@@ -54,7 +59,31 @@ impl LinkArgs {
                 self.loss
             ));
         }
-        UdpKey::from_file(&self.key)
+        match self.link.as_str() {
+            "tdpa" | "none" => {}
+            "wave" => return Err("--link wave: wave variables run in the lab's simulated link (haptic2d teleop --figures DIR, docs/TELEOP.md) but not yet across the two processes\n    fix: --link tdpa".into()),
+            other => return Err(format!("--link {other}: expected tdpa, wave or none\n    fix: --link tdpa")),
+        }
+        match &self.key {
+            Some(k) => UdpKey::from_file(k),
+            None => Err("the world link needs --key FILE (the same key on both ends)\n    fix: head -c 32 /dev/urandom | od -An -tx1 | tr -d ' \\n' > world.key; chmod 600 world.key".into()),
+        }
+    }
+
+    /// True when any of these options was given (for `run`, which accepts them with `--world` only).
+    pub fn any_given(&self) -> bool {
+        self.key.is_some()
+            || self.no_tdpa
+            || self.link != "tdpa"
+            || self.link_timeout_ms != 100.0
+            || self.delay_ms != 0.0
+            || self.loss != 0.0
+            || self.seed != 1
+    }
+
+    /// True when this end runs its TDPA passivity controller (`--link tdpa` without --no-tdpa).
+    pub fn tdpa(&self) -> bool {
+        !self.no_tdpa && self.link == "tdpa"
     }
 
     /// The impairment in periods of `rate_hz`, `None` when there is none.

@@ -5,12 +5,49 @@
 //! The device side sends the handle's position and velocity (and, with TDPA, its port's
 //! energy-in); the world side runs the coupling `F_c = K_c·(x_m − x_s) + B_c·(v_m − v_s)` on the
 //! delayed handle state, drives the body with it and sends the reaction `−F_c` back (with its
-//! port's energy-in). With `tdpa`, each side runs a [`TdpaPort`] on its force output; without, the
-//! ports only observe. The result books the network's energy balance (`created = out − in`, J),
+//! port's energy-in). With [`LinkMode::Tdpa`], each side runs a [`TdpaPort`] on its force output;
+//! with [`LinkMode::None`], the ports only observe; with [`LinkMode::Wave`] the link carries wave
+//! variables instead ([`super::wave`]: the body follows the wave link's commanded point `x_d`
+//! through the same coupling) and the ports only observe. The result books the network's energy balance (`created = out − in`, J),
 //! the largest force on the handle, and the transparency in contact.
 
 use super::link::{Impairment, Link};
+use super::wave::{WaveMaster, WaveMsg, WaveParams, WaveSlave};
 use haptic2d::control::tdpa::{NetworkEnergy, TdpaPort};
+
+/// What keeps the link passive (`--link tdpa|wave|none`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LinkMode {
+    /// Nothing: the ports only observe (the comparison runs).
+    None,
+    /// Time-domain passivity on both ports.
+    Tdpa,
+    /// Wave variables with the budgeted drift compensation.
+    Wave(WaveParams),
+}
+
+impl LinkMode {
+    /// `tdpa`, `wave` (default wave parameters) or `none`.
+    pub fn parse(s: &str) -> Result<Self, String> {
+        match s {
+            "tdpa" => Ok(Self::Tdpa),
+            "wave" => Ok(Self::Wave(WaveParams::default())),
+            "none" => Ok(Self::None),
+            _ => Err(format!(
+                "--link {s}: expected tdpa, wave or none\n    fix: e.g. --link wave"
+            )),
+        }
+    }
+
+    /// The name `parse` reads.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::None => "none",
+            Self::Tdpa => "tdpa",
+            Self::Wave(_) => "wave",
+        }
+    }
+}
 
 /// One run's settings. SI units.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -21,8 +58,8 @@ pub struct DelayedWall {
     pub duration: f64,
     /// The link in each direction (delay in samples; the round trip is twice it).
     pub link: Impairment,
-    /// Time-domain passivity on both ports.
-    pub tdpa: bool,
+    /// What keeps the link passive.
+    pub mode: LinkMode,
     /// Handle mass (kg) and viscous friction (N·s/m).
     pub m_device: f64,
     /// Handle viscous friction (N·s/m).
@@ -54,11 +91,16 @@ impl DelayedWall {
     /// 0.05 m/s towards a 5 000 N/m wall 40 mm away until its target is 20 mm past the wall; the
     /// hand lets go at 2.5 s; coupling 600 N/m, 4 N·s/m; body 0.3 kg.
     pub fn new(link: Impairment, tdpa: bool) -> Self {
+        Self::with_mode(link, if tdpa { LinkMode::Tdpa } else { LinkMode::None })
+    }
+
+    /// The default experiment with the link kept passive by `mode`.
+    pub fn with_mode(link: Impairment, mode: LinkMode) -> Self {
         Self {
             dt: 1e-3,
             duration: 4.0,
             link,
-            tdpa,
+            mode,
             m_device: 0.2,
             b_device: 0.2,
             k_hand: 300.0,
@@ -94,6 +136,9 @@ pub struct DelayedWallResult {
     /// `|x_m − x_s|` at the release (m): the handle–body separation, the coupling's deflection
     /// `F/K_c` plus any position drift the passivity controllers caused.
     pub separation: f64,
+    /// `|x_m − x_s|` at the end of the run, 1.5 s after the release with nothing pushing (m): the
+    /// position drift the link left between master and slave.
+    pub drift: f64,
     /// Messages lost in both directions.
     pub lost: u64,
 }
@@ -104,6 +149,7 @@ struct ToWorld {
     x: f64,
     v: f64,
     e_in: f64,
+    wave: WaveMsg,
 }
 
 /// The world side's message: force for the handle (N), its port's energy-in (J).
@@ -111,10 +157,45 @@ struct ToWorld {
 struct ToDevice {
     f: f64,
     e_in: f64,
+    wave: WaveMsg,
+}
+
+/// One sample of a traced run (SI units).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TracePoint {
+    /// Time (s).
+    pub t: f64,
+    /// Handle position (m).
+    pub x_m: f64,
+    /// Body position (m).
+    pub x_s: f64,
+    /// Force of the link on the handle (N).
+    pub f_m: f64,
+    /// Force of the wall on the body (N).
+    pub f_wall: f64,
+    /// The network's energy created so far (J).
+    pub created: f64,
 }
 
 /// Runs `cfg`.
 pub fn run_delayed_wall(cfg: &DelayedWall) -> DelayedWallResult {
+    simulate(cfg, None)
+}
+
+/// Runs `cfg` and keeps every `every`-th sample (at least 1).
+pub fn run_delayed_wall_traced(
+    cfg: &DelayedWall,
+    every: usize,
+) -> (DelayedWallResult, Vec<TracePoint>) {
+    let mut trace = Vec::new();
+    let r = simulate(cfg, Some((&mut trace, every.max(1) as u64)));
+    (r, trace)
+}
+
+fn simulate(
+    cfg: &DelayedWall,
+    mut trace: Option<(&mut Vec<TracePoint>, u64)>,
+) -> DelayedWallResult {
     let dt = cfg.dt;
     let n = (cfg.duration / dt).round() as u64;
     let mut up: Link<ToWorld> = Link::new(cfg.link);
@@ -130,42 +211,86 @@ pub fn run_delayed_wall(cfg: &DelayedWall) -> DelayedWallResult {
     let mut separation = f64::NAN;
     let alpha_m = 2.0 * cfg.m_device / dt;
     let alpha_s = 2.0 * cfg.m_body / dt;
+    let wp = match cfg.mode {
+        LinkMode::Wave(p) => p,
+        _ => WaveParams::default(),
+    };
+    let (mut wave_m, mut wave_s) = (WaveMaster::new(wp), WaveSlave::new(wp, 0.0));
     for k in 0..n {
         let t = k as f64 * dt;
-        // Device side: read the newest force, apply the master port's controller.
-        let (f_req, far_s) = down.receive(k).map_or((0.0, 0.0), |m| (m.f, m.e_in));
-        let f_m = if cfg.tdpa {
-            master.step(f_req, v_m, far_s, dt, alpha_m)
+        let (f_m, f_s);
+        if let LinkMode::Wave(_) = cfg.mode {
+            // Device side: the newest returning wave (once), the handle's force, the wave out.
+            let (f, out) = wave_m.step(x_m, v_m, down.deliver(k).map(|m| m.wave), dt);
+            master.observe(f, v_m, dt);
+            f_m = f;
+            up.send(
+                k,
+                ToWorld {
+                    x: x_m,
+                    v: v_m,
+                    e_in: 0.0,
+                    wave: out,
+                },
+            );
+            // World side: the newest forward wave (once) drives x_d, which pulls the body.
+            let s = wave_s.step(
+                up.deliver(k).map(|m| m.wave),
+                x_s,
+                v_s,
+                cfg.k_coupling,
+                cfg.b_coupling,
+                dt,
+            );
+            slave.observe(s.force, s.v_d, dt);
+            f_s = s.force;
+            down.send(
+                k,
+                ToDevice {
+                    f: 0.0,
+                    e_in: 0.0,
+                    wave: s.msg,
+                },
+            );
         } else {
-            master.observe(f_req, v_m, dt);
-            f_req
-        };
-        up.send(
-            k,
-            ToWorld {
-                x: x_m,
-                v: v_m,
-                e_in: master.energy_in(),
-            },
-        );
-        // World side: the coupling on the newest handle state, the slave port's controller.
-        let (xm_r, vm_r, far_m) = up
-            .receive(k)
-            .map_or((0.0, 0.0, 0.0), |m| (m.x, m.v, m.e_in));
-        let f_c = cfg.k_coupling * (xm_r - x_s) + cfg.b_coupling * (vm_r - v_s);
-        let f_s = if cfg.tdpa {
-            slave.step(f_c, v_s, far_m, dt, alpha_s)
-        } else {
-            slave.observe(f_c, v_s, dt);
-            f_c
-        };
-        down.send(
-            k,
-            ToDevice {
-                f: -f_s,
-                e_in: slave.energy_in(),
-            },
-        );
+            let tdpa = cfg.mode == LinkMode::Tdpa;
+            // Device side: read the newest force, apply the master port's controller.
+            let (f_req, far_s) = down.receive(k).map_or((0.0, 0.0), |m| (m.f, m.e_in));
+            f_m = if tdpa {
+                master.step(f_req, v_m, far_s, dt, alpha_m)
+            } else {
+                master.observe(f_req, v_m, dt);
+                f_req
+            };
+            up.send(
+                k,
+                ToWorld {
+                    x: x_m,
+                    v: v_m,
+                    e_in: master.energy_in(),
+                    wave: WaveMsg::default(),
+                },
+            );
+            // World side: the coupling on the newest handle state, the slave port's controller.
+            let (xm_r, vm_r, far_m) = up
+                .receive(k)
+                .map_or((0.0, 0.0, 0.0), |m| (m.x, m.v, m.e_in));
+            let f_c = cfg.k_coupling * (xm_r - x_s) + cfg.b_coupling * (vm_r - v_s);
+            f_s = if tdpa {
+                slave.step(f_c, v_s, far_m, dt, alpha_s)
+            } else {
+                slave.observe(f_c, v_s, dt);
+                f_c
+            };
+            down.send(
+                k,
+                ToDevice {
+                    f: -f_s,
+                    e_in: slave.energy_in(),
+                    wave: WaveMsg::default(),
+                },
+            );
+        }
         // The wall on the body, the hand on the handle.
         let f_wall = if x_s > cfg.x_wall {
             -cfg.k_wall * (x_s - cfg.x_wall)
@@ -191,6 +316,18 @@ pub fn run_delayed_wall(cfg: &DelayedWall) -> DelayedWallResult {
             wall_sum += f_wall.abs();
             window += 1;
         }
+        if let Some((tr, every)) = trace.as_mut() {
+            if k % *every == 0 {
+                tr.push(TracePoint {
+                    t,
+                    x_m,
+                    x_s,
+                    f_m,
+                    f_wall,
+                    created: NetworkEnergy::of(&master, &slave).created,
+                });
+            }
+        }
         if separation.is_nan() && !held {
             separation = (x_m - x_s).abs();
         }
@@ -207,6 +344,7 @@ pub fn run_delayed_wall(cfg: &DelayedWall) -> DelayedWallResult {
         force_error: err_sum / w,
         wall_force: wall_sum / w,
         separation,
+        drift: (x_m - x_s).abs(),
         lost: up.lost + down.lost,
     }
 }
@@ -253,5 +391,46 @@ mod tests {
         assert!(r.wall_force > 3.0, "{r:?}");
         assert!(r.force_error < 0.1 * r.wall_force, "{r:?}");
         assert!(r.max_handle_force < 10.0, "{r:?}");
+    }
+
+    fn wave(round_trip_ms: u32, loss: f64, p: WaveParams) -> DelayedWallResult {
+        let link = Impairment::delay_loss(round_trip_ms / 2, loss, 11);
+        run_delayed_wall(&DelayedWall::with_mode(link, LinkMode::Wave(p)))
+    }
+
+    #[test]
+    fn waves_keep_the_network_passive_at_every_delay_and_loss() {
+        for rt in [0, 10, 50, 200] {
+            for loss in [0.0, 0.05, 0.1] {
+                let r = wave(rt, loss, WaveParams::default());
+                assert!(
+                    r.network.created <= 1e-3,
+                    "round trip {rt} ms, loss {loss}: created {} J ({r:?})",
+                    r.network.created
+                );
+                assert!(r.max_handle_force < 10.0, "{rt} ms {loss}: {r:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn with_waves_the_wall_is_felt_and_the_slave_does_not_wander_at_50_and_200_ms_with_5_percent_loss(
+    ) {
+        // Measured (docs/TELEOP.md): wall 2.9 N at 50 ms, 1.8 N at 200 ms (the hand pushes 20 mm
+        // past the wall through the hand spring, coupling and wave impedance in series); drift at
+        // the end under 7 mm.
+        for (rt, min_wall) in [(50, 2.5), (200, 1.5)] {
+            let r = wave(rt, 0.05, WaveParams::default());
+            assert!(r.wall_force > min_wall, "{rt} ms: {r:?}");
+            assert!(r.drift < 7e-3, "{rt} ms: {r:?}");
+        }
+    }
+
+    #[test]
+    fn a_50_ms_round_trip_without_any_passivity_runs_away_where_waves_do_not() {
+        let none = run(50, 0.05, false);
+        let waves = wave(50, 0.05, WaveParams::default());
+        assert!(none.network.created > 1.0, "{none:?}");
+        assert!(waves.network.created <= 1e-3, "{waves:?}");
     }
 }

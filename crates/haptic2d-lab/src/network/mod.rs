@@ -5,9 +5,12 @@
 //! process split over UDP is `haptic2d serve-world` / `remote-device` (docs/TELEOP.md).
 
 pub mod delayed_wall;
+pub mod figures;
 pub mod link;
 pub mod teleop;
+pub mod wave;
 
-pub use delayed_wall::{run_delayed_wall, DelayedWall, DelayedWallResult};
+pub use delayed_wall::{run_delayed_wall, DelayedWall, DelayedWallResult, LinkMode};
 pub use link::{Impairment, Link};
 pub use teleop::{run_teleop, Teleop, TeleopResult};
+pub use wave::{WaveMaster, WaveMsg, WaveParams, WaveSlave};

@@ -49,6 +49,13 @@ pub struct Teleop {
     pub k_wall: f64,
     /// Wall damping (N·s/m).
     pub b_wall: f64,
+    /// Both devices' parameters (default: the spec's, with the 50 Hz velocity filter of §10.7).
+    pub device: DeviceParams,
+    /// The coupling and the TDPA ports use the devices' filtered velocity (§10.7, 50 Hz: about
+    /// 3 ms of lag) instead of the unfiltered rate `(x_k − x_{k−1})/T` of the measured pose (the
+    /// default). The filtered velocity makes the contact chatter at 8–12 ms round trips and hides
+    /// the energy from the ports' observers (docs/TELEOP.md, "The 10 ms chatter").
+    pub filtered_velocity: bool,
 }
 
 impl Teleop {
@@ -68,6 +75,8 @@ impl Teleop {
             wall_x: -0.005,
             k_wall: 2000.0,
             b_wall: 2.0,
+            device: DeviceParams::default(),
+            filtered_velocity: false,
         }
     }
 }
@@ -95,6 +104,12 @@ pub struct TeleopResult {
     pub samples: u64,
     /// Why it stopped early, if it did.
     pub fault: Option<&'static str>,
+    /// The energy the network created as the plants really received it (J): each period's applied
+    /// force times the plant's true displacement over the period (`F_k·(x_{k+1} − x_k)`, exact for
+    /// a force held over the period), over both ports. `network` books the same forces against
+    /// the *estimated* (filtered) velocities the ports see; the two differ when the filter's lag
+    /// matters (docs/TELEOP.md, "The 10 ms chatter").
+    pub plant_created: f64,
 }
 
 /// Master → slave: pose, twist, energy in.
@@ -118,6 +133,8 @@ struct Side {
     dev: TwinPantograph,
     port: PlanarTdpa,
     tau: [f64; 4],
+    /// The pose measured last sample.
+    prev: Option<V3>,
 }
 
 impl Side {
@@ -129,14 +146,20 @@ impl Side {
             dev,
             port: PlanarTdpa::default(),
             tau: [0.0; 4],
+            prev: None,
         })
     }
 
-    /// Reads the encoders: (pose, twist).
-    fn sense(&mut self) -> Result<(V3, V3), &'static str> {
+    /// Reads the encoders: (pose, twist), the twist filtered (`filtered`) or the unfiltered rate
+    /// `(x_k − x_{k−1})/T` of the measured pose (zero on the first sample).
+    fn sense(&mut self, filtered: bool, dt: f64) -> Result<(V3, V3), &'static str> {
         let q = self.plant.encoders().map_err(|_| "encoders")?;
         let e = self.dev.estimate(&q, &self.tau).map_err(|_| "kinematics")?;
-        Ok((e.pose, e.velocity))
+        let raw = self.prev.map_or([0.0; 3], |p| {
+            std::array::from_fn(|i| (e.pose[i] - p[i]) / dt)
+        });
+        self.prev = Some(e.pose);
+        Ok((e.pose, if filtered { e.velocity } else { raw }))
     }
 
     /// The port's controller on `f_req` against `far` (J), torques, booking: returns the force
@@ -174,7 +197,7 @@ impl Side {
 
 /// Runs `cfg`. Errors only for a device that cannot be built.
 pub fn run_teleop(cfg: &Teleop) -> Result<TeleopResult, String> {
-    let p = DeviceParams::default();
+    let p = cfg.device;
     let o = [p.workspace_center_x, p.workspace_center_y, 0.0];
     let dt = cfg.dt;
     let (mut m, mut s) = (Side::new(&p, o, dt)?, Side::new(&p, o, dt)?);
@@ -188,10 +211,13 @@ pub fn run_teleop(cfg: &Teleop) -> Result<TeleopResult, String> {
     let (mut wall_sum, mut mf_sum, mut err_sum, mut window) = (0.0, 0.0, 0.0, 0u64);
     let (mut max_f, mut max_pen, mut separation) = (0.0f64, 0.0f64, 0.0);
     let mut fault = None;
+    // The plants' true ledger (see `TeleopResult::plant_created`).
+    let (mut true_m, mut true_s) = (PlanarTdpa::default(), PlanarTdpa::default());
     let mut k = 0;
     while k < n {
         let t = k as f64 * dt;
-        let ((xm, vm), (xs, vs)) = match (m.sense(), s.sense()) {
+        let fv = cfg.filtered_velocity;
+        let ((xm, vm), (xs, vs)) = match (m.sense(fv, dt), s.sense(fv, dt)) {
             (Ok(a), Ok(b)) => (a, b),
             (Err(e), _) | (_, Err(e)) => {
                 fault = Some(e);
@@ -223,10 +249,11 @@ pub fn run_teleop(cfg: &Teleop) -> Result<TeleopResult, String> {
             });
             (f, u.e_in)
         });
-        if s.drive(&f_c, &vs, &far_m, cfg.tdpa, dt).is_err() {
+        let Ok(f_s) = s.drive(&f_c, &vs, &far_m, cfg.tdpa, dt) else {
             fault = Some("slave torques");
             break;
-        }
+        };
+        let (pm0, ps0) = (m.plant.pose(), s.plant.pose());
         down.send(
             k,
             Down {
@@ -266,10 +293,14 @@ pub fn run_teleop(cfg: &Teleop) -> Result<TeleopResult, String> {
             fault = Some("plant");
             break;
         }
+        let rate = |a: &V3, b: &V3| -> V3 { std::array::from_fn(|i| (b[i] - a[i]) / dt) };
+        true_m.observe(&f_m, &rate(&pm0, &m.plant.pose()), dt);
+        true_s.observe(&f_s, &rate(&ps0, &s.plant.pose()), dt);
         k += 1;
     }
     let w = window.max(1) as f64;
     let (mt, st) = (m.port.totals(), s.port.totals());
+    let (tm, ts) = (true_m.totals(), true_s.totals());
     Ok(TeleopResult {
         network: planar_balance((mt.0, mt.1), (st.0, st.1)),
         dissipated: mt.2 + st.2,
@@ -281,6 +312,7 @@ pub fn run_teleop(cfg: &Teleop) -> Result<TeleopResult, String> {
         separation,
         samples: k,
         fault,
+        plant_created: planar_balance((tm.0, tm.1), (ts.0, ts.1)).created,
     })
 }
 
@@ -326,5 +358,61 @@ mod tests {
     fn without_tdpa_teleoperation_at_a_50_ms_round_trip_creates_energy() {
         let r = run(50, 0.05, false);
         assert!(r.network.created > 0.01, "{r:?}");
+    }
+
+    /// The 10 ms chatter (docs/TELEOP.md): at round trips of 8–12 ms the contact chatters with
+    /// and without TDPA while the ports' books say the network absorbs energy. The books pair the
+    /// applied force with the devices' *filtered* velocity (first-order 50 Hz, about 3 ms of lag);
+    /// the plants, measured by their true displacement, receive energy from the network. The
+    /// observer is fooled, so TDPA does not act.
+    #[test]
+    fn at_a_10_ms_round_trip_the_ports_books_miss_the_energy_the_plants_receive() {
+        for tdpa in [true, false] {
+            let r = run_teleop(&Teleop {
+                filtered_velocity: true,
+                ..Teleop::new(Impairment::delay_loss(5, 0.0, 5), tdpa)
+            })
+            .unwrap();
+            assert!(r.network.created < -0.1, "books: {r:?}");
+            assert!(r.plant_created > 0.1, "plants: {r:?}");
+            assert!(r.force_error > 0.2, "no chatter: {r:?}");
+        }
+        // Where nothing chatters the two ledgers agree.
+        let r = run(0, 0.0, true);
+        assert!((r.network.created - r.plant_created).abs() < 2e-3, "{r:?}");
+    }
+
+    /// With a 300 Hz velocity filter (about 0.5 ms of lag) the same 10 ms round trip does not
+    /// chatter and the plants receive no energy: the filter's lag, not the link, drives it.
+    #[test]
+    fn with_a_300_hz_velocity_filter_the_10_ms_round_trip_does_not_chatter() {
+        let mut cfg = Teleop::new(Impairment::delay_loss(5, 0.0, 5), true);
+        cfg.filtered_velocity = true;
+        cfg.device.velocity_cutoff_hz = 300.0;
+        let r = run_teleop(&cfg).unwrap();
+        assert!(r.force_error < 0.05 * r.wall_force, "{r:?}");
+        assert!(r.plant_created <= 1e-3, "{r:?}");
+    }
+
+    /// The fix: the coupling and the ports on the unfiltered rate. From 0 to 20 ms round trip,
+    /// with and without TDPA, no chatter (force error < 3 % of the wall force; measured ≤ 0.004 N
+    /// from 6 to 20 ms, 0.028 N without delay, against 0.3–0.9 N filtered at 8–12 ms)
+    /// and the plants receive no energy; at 50 and 200 ms with TDPA the plants receive a few mJ
+    /// (measured 3.6–10 mJ: the books pair the force with this period's rate, the plant moves over
+    /// the next), against 0.23–0.26 J with the filtered velocity at 50 ms.
+    #[test]
+    fn on_unfiltered_rates_no_round_trip_up_to_20_ms_chatters_and_the_plants_receive_no_energy() {
+        for d in [0, 3, 4, 5, 6, 10] {
+            for tdpa in [true, false] {
+                let r = run(2 * d, 0.0, tdpa);
+                assert!(r.force_error < 0.03 * r.wall_force, "{d}: {r:?}");
+                assert!(r.plant_created <= 1e-3, "{d}: {r:?}");
+            }
+        }
+        for (rt, loss) in [(50, 0.0), (50, 0.05), (50, 0.1), (200, 0.1)] {
+            let r = run(rt, loss, true);
+            assert!(r.plant_created < 0.01, "{rt} ms: {r:?}");
+            assert!(r.force_error < 0.05 * r.wall_force, "{rt} ms: {r:?}");
+        }
     }
 }
