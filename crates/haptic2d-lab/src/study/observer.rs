@@ -294,11 +294,13 @@ impl ObserverParams {
 pub struct Answer {
     /// The interval (1 to the task's number) named as stiffer (stiffest).
     pub response: u8,
-    /// Response time (s), measured from the start of the first interval.
+    /// Response time (s): the simulated observer's from the start of the first interval (a model);
+    /// the browser page's from the answer prompt (measured).
     pub rt: f64,
 }
 
-/// Anything that answers trials: the simulated observer now; a browser page or device buttons later.
+/// Anything that answers trials: the simulated observer, or a participant on the browser page
+/// (`haptic2d study run --observer browser`).
 pub trait Observer {
     /// Presents `spec` and returns the answer.
     fn answer(&mut self, study: &Study, spec: &TrialSpec) -> Result<Answer, String>;
