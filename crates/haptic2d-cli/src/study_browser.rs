@@ -85,79 +85,10 @@ pub fn run(
     stop_after: Option<u32>,
     o: &BrowserOptions,
 ) -> Result<Status, Failure> {
-    let (lo, hi) = INTERVAL_RANGE_S;
-    if !(o.interval_s.is_finite() && (lo..=hi).contains(&o.interval_s)) {
-        return Err(format!(
-            "--interval {}: give the exploration time per interval in seconds, {lo} to {hi}\n    fix: e.g. --interval 3",
-            o.interval_s
-        )
-        .into());
-    }
-    let bind: SocketAddr = o.bind.parse().map_err(|e| {
-        format!(
-            "--bind `{}` is not an ADDRESS:PORT ({e})\n    fix: e.g. --bind 127.0.0.1:8080",
-            o.bind
-        )
-    })?;
+    let bind = check_options(o)?;
     haptic2d_lab::study::session::check_participant(participant)?;
     let (study, text) = Study::read(file).map_err(Failure::from)?;
-    let first = &study.conditions[0].reference;
-    let scene_text = stimulus::scene_text(&study, first, None).map_err(scene_errors)?;
-    let scene = Scene::from_toml(&scene_text, &study.scene_source, study.rate)
-        .map_err(|e| scene_errors(e.errors))?;
-    let dt = scene.world.params.dt;
-    let rate = 1.0 / dt;
-    let device = DeviceChoice::parse(&o.device)?;
-    if matches!(device, DeviceChoice::Replay(_)) {
-        return Err("--device replay:… plays recorded motion: nobody explores a stimulus\n    fix: --device sim or a real device".into());
-    }
-    let real = device.load_real(o.device_file.as_deref(), o.allow_remote_device)?;
-    let device_params = match &real {
-        Some(r) => match &r.model {
-            DeviceModel::Twin(p) => *p,
-            DeviceModel::FiveBar { .. } => haptic2d::device::DeviceParams::default(),
-        },
-        None => device_arg::resolve(o.device_file.as_deref(), &scene, dt)?.params,
-    };
-    let mut config = HapticConfig {
-        device: device_params,
-        ..HapticConfig::default()
-    };
-    if let Some(m) = real.as_ref().and_then(|r| r.match_controller.as_ref()) {
-        config.controller = m(config.controller);
-    }
-    if let (Some(r), false) = (&real, o.allow_unstable) {
-        crate::cmd_stability::check_real_device(&r.model, &config, &scene.world)?;
-    }
-    let loaded = LoadedScene {
-        name: study.name.clone(),
-        description: study.description.clone(),
-        world: scene.world.clone(),
-    };
-    let mut rig = match real {
-        None => Rig::new(scene.world, &scene.source, config, device, HandSpec::Follow)?,
-        Some(r) => {
-            Rig::with_real(scene.world, &scene.source, config, device, r).map_err(|e| match e {
-                RealOpenError::Config(m) => Failure::from(m),
-                RealOpenError::Open(m) => Failure {
-                    status: Status::DeviceLost,
-                    message: m,
-                },
-            })?
-        }
-    };
-    if !o.allow_unstable {
-        rig.enforce_released_stability();
-    }
-    let slave = rig.system.slave();
-    if rig.system.world().body_index(&study.probe) != Some(slave) {
-        return Err(format!(
-            "the study's probe `{}` is not the body the handle drives (`{}`)\n    fix: set probe to the scene's driven body",
-            study.probe,
-            rig.system.world().bodies[slave].name
-        )
-        .into());
-    }
+    let (mut rig, loaded, rate) = build_rig(&study, o)?;
     let seed = session_seed(study.seed, participant, session);
     let planned = Schedule::new(&study, seed).planned();
 
@@ -254,8 +185,99 @@ pub fn run(
     if let Some(trip) = rig.system.safety_trip() {
         crate::outln!("{trip}");
     }
+    finish(end, observer.early, session_result)
+}
+
+/// Checks the options that need no file: `--interval` and `--bind`.
+fn check_options(o: &BrowserOptions) -> Result<SocketAddr, Failure> {
+    let (lo, hi) = INTERVAL_RANGE_S;
+    if !(o.interval_s.is_finite() && (lo..=hi).contains(&o.interval_s)) {
+        return Err(format!(
+            "--interval {}: give the exploration time per interval in seconds, {lo} to {hi}\n    fix: e.g. --interval 3",
+            o.interval_s
+        )
+        .into());
+    }
+    o.bind.parse::<SocketAddr>().map_err(|e| {
+        Failure::from(format!(
+            "--bind `{}` is not an ADDRESS:PORT ({e})\n    fix: e.g. --bind 127.0.0.1:8080",
+            o.bind
+        ))
+    })
+}
+
+/// Builds the rig (device, system, the study's first reference stimulus in the world) as `haptic2d
+/// run` does, gated by the released-stability check for a real device. Returns the rig, the scene
+/// for the display and the loop rate (Hz).
+fn build_rig(study: &Study, o: &BrowserOptions) -> Result<(Rig, LoadedScene, f64), Failure> {
+    let first = &study.conditions[0].reference;
+    let scene_text = stimulus::scene_text(study, first, None).map_err(scene_errors)?;
+    let scene = Scene::from_toml(&scene_text, &study.scene_source, study.rate)
+        .map_err(|e| scene_errors(e.errors))?;
+    let dt = scene.world.params.dt;
+    let rate = 1.0 / dt;
+    let device = DeviceChoice::parse(&o.device)?;
+    if matches!(device, DeviceChoice::Replay(_)) {
+        return Err("--device replay:… plays recorded motion: nobody explores a stimulus\n    fix: --device sim or a real device".into());
+    }
+    let real = device.load_real(o.device_file.as_deref(), o.allow_remote_device)?;
+    let device_params = match &real {
+        Some(r) => match &r.model {
+            DeviceModel::Twin(p) => *p,
+            DeviceModel::FiveBar { .. } => haptic2d::device::DeviceParams::default(),
+        },
+        None => device_arg::resolve(o.device_file.as_deref(), &scene, dt)?.params,
+    };
+    let mut config = HapticConfig {
+        device: device_params,
+        ..HapticConfig::default()
+    };
+    if let Some(m) = real.as_ref().and_then(|r| r.match_controller.as_ref()) {
+        config.controller = m(config.controller);
+    }
+    if let (Some(r), false) = (&real, o.allow_unstable) {
+        crate::cmd_stability::check_real_device(&r.model, &config, &scene.world)?;
+    }
+    let loaded = LoadedScene {
+        name: study.name.clone(),
+        description: study.description.clone(),
+        world: scene.world.clone(),
+    };
+    let mut rig = match real {
+        None => Rig::new(scene.world, &scene.source, config, device, HandSpec::Follow)?,
+        Some(r) => {
+            Rig::with_real(scene.world, &scene.source, config, device, r).map_err(|e| match e {
+                RealOpenError::Config(m) => Failure::from(m),
+                RealOpenError::Open(m) => Failure {
+                    status: Status::DeviceLost,
+                    message: m,
+                },
+            })?
+        }
+    };
+    if !o.allow_unstable {
+        rig.enforce_released_stability();
+    }
+    let slave = rig.system.slave();
+    if rig.system.world().body_index(&study.probe) != Some(slave) {
+        return Err(format!(
+            "the study's probe `{}` is not the body the handle drives (`{}`)\n    fix: set probe to the scene's driven body",
+            study.probe,
+            rig.system.world().bodies[slave].name
+        )
+        .into());
+    }
+    Ok((rig, loaded, rate))
+}
+
+/// Reports how the session ended and returns the exit status.
+fn finish(
+    end: Option<LoopEnd>,
+    early: Option<EarlyEnd>,
+    session_result: Result<haptic2d_lab::study::RunSummary, String>,
+) -> Result<Status, Failure> {
     let resume_hint = "run the same command again to resume at the next unanswered trial";
-    let (status, why) = match (end, observer.early) {
+    let (status, why) = match (end, early) {
         (Some(LoopEnd::DeviceLost(m)), _) => (
             Status::DeviceLost,
             format!("{m}\n    torques were set to zero and latched"),
