@@ -1,8 +1,10 @@
 //! `haptic2d study`: perceptual studies (docs/STUDIES.md). `study run FILE --observer simulated`
-//! runs (or resumes) a session headless on the simulated observer; `study analyse DIR` fits the
+//! runs (or resumes) a session headless on the simulated observer; `--observer browser` runs it on
+//! the real-time haptic loop with answers from the browser page (`study_browser.rs`); `study analyse DIR` fits the
 //! psychometric functions and draws them; `study check FILE` validates a study file.
 
 use crate::exit::{Failure, Status};
+use crate::study_browser::BrowserOptions;
 use haptic2d_lab::study::analyse::{analyse_dir, AnalyseOptions};
 use haptic2d_lab::study::fit::Shape;
 use haptic2d_lab::study::method::Method;
@@ -18,9 +20,37 @@ pub enum StudyCmd {
         /// The study file (TOML, docs/STUDIES.md), e.g. studies/stiffness-walls.toml.
         file: PathBuf,
         /// Who answers: `simulated` (the simulated observer, a model, parameters in the file's
-        /// [observer]). The browser page and device buttons are not built yet.
+        /// [observer]) or `browser` (a participant on the real-time haptic loop, answering on the
+        /// browser page: open the URL printed at startup). Device buttons are not built yet.
         #[arg(long, default_value = "simulated")]
         observer: String,
+        /// With --observer browser: the device, as `haptic2d run --device` (sim, haply:…, udp:…,
+        /// inverse3[:URL]).
+        #[arg(long, default_value = "sim")]
+        device: String,
+        /// With --observer browser: the device file, as `haptic2d run --device-file`.
+        #[arg(long, value_name = "FILE.toml")]
+        device_file: Option<PathBuf>,
+        /// With --observer browser: address of the page.
+        #[arg(long, default_value = "127.0.0.1:8080")]
+        bind: String,
+        /// With --observer browser: exploration time per interval (s of loop time; paused time
+        /// does not count).
+        #[arg(long, default_value_t = 3.0, allow_negative_numbers = true)]
+        interval: f64,
+        /// With --observer browser: normal scheduling instead of real-time.
+        #[arg(long)]
+        no_rt: bool,
+        /// With --observer browser: the page's commands need the token on loopback too.
+        #[arg(long)]
+        require_token: bool,
+        /// With --observer browser: drive a real device even if `haptic2d stability` finds it
+        /// unstable with the hand released.
+        #[arg(long)]
+        allow_unstable: bool,
+        /// With --observer browser: let --device udp:ADDR:PORT be beyond loopback.
+        #[arg(long)]
+        allow_remote_device: bool,
         /// Output folder (one sub-ID/ses-N directory per participant and session inside).
         #[arg(long, default_value = "study-data")]
         out: PathBuf,
@@ -68,6 +98,39 @@ pub fn run(cmd: &StudyCmd) -> Result<Status, Failure> {
             participant,
             session,
             stop_after,
+            device,
+            device_file,
+            bind,
+            interval,
+            no_rt,
+            require_token,
+            allow_unstable,
+            allow_remote_device,
+        } if observer == "browser" => crate::study_browser::run(
+            file,
+            out,
+            participant,
+            *session,
+            *stop_after,
+            &BrowserOptions {
+                device: device.clone(),
+                device_file: device_file.clone(),
+                bind: bind.clone(),
+                interval_s: *interval,
+                no_rt: *no_rt,
+                require_token: *require_token,
+                allow_unstable: *allow_unstable,
+                allow_remote_device: *allow_remote_device,
+            },
+        ),
+        StudyCmd::Run {
+            file,
+            observer,
+            out,
+            participant,
+            session,
+            stop_after,
+            ..
         } => study_run(file, observer, out, participant, *session, *stop_after),
         StudyCmd::Analyse {
             dir,
@@ -142,7 +205,7 @@ fn study_run(
 ) -> Result<Status, Failure> {
     if observer != "simulated" {
         return Err(Failure::from(format!(
-            "--observer {observer}: only `simulated` is built (the simulated observer, a model)\n    fix: --observer simulated; answers from the browser page or device buttons are not built yet"
+            "--observer {observer}: unknown observer\n    fix: --observer simulated (the simulated observer, a model) or --observer browser (a participant on the browser page); device buttons are not built yet"
         )));
     }
     let (study, text) = Study::read(file).map_err(Failure::from)?;

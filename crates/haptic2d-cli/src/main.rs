@@ -30,6 +30,8 @@ mod run_log;
 mod run_rig;
 mod run_view;
 mod scene_arg;
+mod study_browser;
+mod study_present;
 mod world_link_arg;
 mod world_mcap;
 

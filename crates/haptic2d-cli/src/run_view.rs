@@ -31,6 +31,9 @@ use haptic2d_view::{
 };
 use std::net::SocketAddr;
 
+/// Why a study command is refused by `haptic2d run`.
+const NO_STUDY: &str = "no study is running (haptic2d study run --observer browser)";
+
 /// The scene the loop runs, as loaded (the world at its initial state, kept for resets).
 pub struct LoadedScene {
     /// Scene name.
@@ -54,6 +57,9 @@ pub struct LiveView {
     /// The impact friction mode the page selected (kept likewise); `None` = the scene's own.
     impact_friction: Option<ImpactFriction>,
     paused: bool,
+    /// `haptic2d study run --observer browser`: the study loop takes the page's answers and stop
+    /// request here (`None` outside a study: they are refused).
+    study: Option<StudyInbox>,
     /// Built-in scenes the loop cannot run at its rate, with the reason (the server refuses them
     /// first; this is the loop's own check).
     too_heavy: Vec<(&'static str, String)>,
@@ -101,13 +107,50 @@ pub fn start(
         friction: None,
         impact_friction: None,
         paused: false,
+        study: None,
         too_heavy,
     };
     view.publish_scene(rig);
     Ok((server, view))
 }
 
+/// The page's study commands since the study loop last looked (the hook of `study_browser`).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct StudyInbox {
+    /// The last answer `(trial, choice)` not yet taken.
+    pub answer: Option<(u32, u8)>,
+    /// The page asked to stop the session.
+    pub stop: bool,
+}
+
 impl LiveView {
+    /// Accept the page's study commands (answers, stop) from now on; the study loop takes them with
+    /// [`take_study`](Self::take_study).
+    pub fn enable_study(&mut self) {
+        self.study = Some(StudyInbox::default());
+    }
+
+    /// The study commands received since the last call (cleared). Wait-free.
+    #[inline]
+    pub fn take_study(&mut self) -> StudyInbox {
+        self.study.map_or_else(StudyInbox::default, |s| {
+            self.study = Some(StudyInbox::default());
+            s
+        })
+    }
+
+    /// The study trial shown in the next frames. Wait-free.
+    #[inline]
+    pub fn set_study_view(&mut self, v: Option<haptic2d_view::StudyView>) {
+        self.hub.set_study(v);
+    }
+
+    /// Pages connected now.
+    #[inline]
+    pub fn viewers(&self) -> usize {
+        self.hub.viewers()
+    }
+
     /// True while the page has paused the world.
     #[inline]
     pub fn paused(&self) -> bool {
@@ -149,6 +192,22 @@ impl LiveView {
     }
 
     fn apply(&mut self, cmd: Command, rig: &mut Rig) -> Result<(), String> {
+        // A study owns the scene, the laws and the controller: the page cannot change the stimulus.
+        if self.study.is_some()
+            && matches!(
+                cmd,
+                Command::SwitchScene { .. }
+                    | Command::Reset
+                    | Command::SetWallLaw { .. }
+                    | Command::SetFriction { .. }
+                    | Command::SetImpactFriction { .. }
+                    | Command::SetController { .. }
+            )
+        {
+            return Err(
+                "refused during a study: the study sets the scene, laws and controller".into(),
+            );
+        }
         match cmd {
             Command::SetHandTarget { x, y, theta } => {
                 // Ignored without a `follow` hand (a replay, or a scripted/free hand).
@@ -195,6 +254,16 @@ impl LiveView {
             }
             Command::Pause => self.paused = true,
             Command::Resume => self.paused = false,
+            Command::Answer { trial, choice } => {
+                let inbox = self.study.as_mut().ok_or(NO_STUDY)?;
+                // Two answers in one tick: the first stands, the second is refused by the
+                // study loop as an answer outside the answer phase.
+                if inbox.answer.is_some() {
+                    return Err("one answer per tick: refused".into());
+                }
+                inbox.answer = Some((trial, choice));
+            }
+            Command::StopStudy => self.study.as_mut().ok_or(NO_STUDY)?.stop = true,
         }
         Ok(())
     }

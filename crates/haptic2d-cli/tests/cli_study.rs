@@ -141,13 +141,31 @@ fn study_check_and_run_refuse_bad_input_with_the_field_and_the_fix() {
         "run",
         shipped().to_str().unwrap(),
         "--observer",
-        "browser",
+        "buttons",
         "--out",
         dir.path().to_str().unwrap(),
     ]);
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     assert!(
-        text(&o).contains("only `simulated` is built"),
+        text(&o).contains("unknown observer") && text(&o).contains("--observer browser"),
+        "{}",
+        text(&o)
+    );
+    // The browser session checks its options before anything starts.
+    let o = run(&[
+        "study",
+        "run",
+        shipped().to_str().unwrap(),
+        "--observer",
+        "browser",
+        "--interval",
+        "0",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(
+        text(&o).contains("--interval") && text(&o).contains("fix:"),
         "{}",
         text(&o)
     );

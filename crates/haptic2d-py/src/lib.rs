@@ -8,6 +8,7 @@ mod haptic;
 mod harness;
 mod harness_py;
 mod lab;
+mod study;
 mod world;
 
 use pyo3::prelude::*;
@@ -24,6 +25,7 @@ fn _haptic2d(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(lab::sweep_task, m)?)?;
     m.add_function(wrap_pyfunction!(lab::sweep_models, m)?)?;
     m.add_function(wrap_pyfunction!(lab::reproduce, m)?)?;
+    m.add_function(wrap_pyfunction!(study::study_present, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

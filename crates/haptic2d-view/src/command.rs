@@ -18,6 +18,9 @@ pub const MAX_MESSAGE_BYTES: usize = 4096;
 /// Largest accepted coordinate of a hand target (m or rad, absolute value).
 pub const MAX_TARGET_COORDINATE: f64 = 1000.0;
 
+/// Largest trial number an answer may name.
+pub const MAX_TRIAL: u64 = 1_000_000;
+
 /// The controllers the page can select: the named configurations of `haptic2d run --controller`
 /// ([`haptic2d::haptic::ControllerKind::from_name`]), with the same names.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -107,6 +110,14 @@ impl ControllerKind {
 /// - [`Reset`](Command::Reset): reload the current scene to its initial state (as `SwitchScene` to
 ///   the current scene, keeping the selected laws and controller) and publish its `SceneInfo` again;
 ///   the paused state is kept.
+/// - [`Answer`](Command::Answer) (`haptic2d study run --observer browser` only): the participant's
+///   answer to trial `trial`. The loop accepts it only for the trial it is presenting, while it
+///   waits for the answer, and only a choice the study's task offers; any other answer (an old
+///   trial, a double click, a choice the task has not) is refused with a message and changes
+///   nothing. Without a running study it is refused.
+/// - [`StopStudy`](Command::StopStudy): end the study session after the current trial's answer is
+///   saved (an unanswered trial is not written: the session resumes at it). Torques go to zero as
+///   the loop stops. Without a running study it is refused.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Command {
     /// Move the hand target to `(x, y, theta)` (m, m, rad, world frame; θ unwrapped).
@@ -149,6 +160,16 @@ pub enum Command {
     Resume,
     /// Restart the current scene.
     Reset,
+    /// A study participant's answer (`haptic2d study run --observer browser`).
+    Answer {
+        /// The trial answered (from 1, as the page shows it).
+        trial: u32,
+        /// The interval named (1 to 3: "first", "second", "third"), or, in a same–different task,
+        /// 0 = "same" and 1 = "different".
+        choice: u8,
+    },
+    /// End the study session (it resumes at its next unanswered trial).
+    StopStudy,
 }
 
 impl Command {
@@ -164,6 +185,8 @@ impl Command {
             Command::Pause => "pause",
             Command::Resume => "resume",
             Command::Reset => "reset",
+            Command::Answer { .. } => "answer",
+            Command::StopStudy => "stop_study",
         }
     }
 }
@@ -183,6 +206,8 @@ enum Incoming {
     Pause {},
     Resume {},
     Reset {},
+    Answer { trial: u64, choice: u64 },
+    StopStudy {},
 }
 
 /// A checked client message.
@@ -253,6 +278,23 @@ pub fn parse_client_message(text: &str) -> Result<ClientMessage, String> {
         Incoming::Pause {} => Command::Pause,
         Incoming::Resume {} => Command::Resume,
         Incoming::Reset {} => Command::Reset,
+        Incoming::Answer { trial, choice } => {
+            if !(1..=MAX_TRIAL).contains(&trial) {
+                return Err(format!(
+                    "answer.trial = {trial} is out of range (1 to {MAX_TRIAL})"
+                ));
+            }
+            if choice > 3 {
+                return Err(format!(
+                    "answer.choice = {choice} is out of range (1 to 3 = the interval named; same–different: 0 = same, 1 = different)"
+                ));
+            }
+            Command::Answer {
+                trial: trial as u32,
+                choice: choice as u8,
+            }
+        }
+        Incoming::StopStudy {} => Command::StopStudy,
     };
     Ok(ClientMessage::Command(cmd))
 }
@@ -307,6 +349,21 @@ mod tests {
         assert_eq!(ok(r#"{"type":"resume"}"#), Command::Resume);
         assert_eq!(ok(r#"{"type":"reset"}"#), Command::Reset);
         assert_eq!(
+            ok(r#"{"type":"answer","trial":7,"choice":2}"#),
+            Command::Answer {
+                trial: 7,
+                choice: 2
+            }
+        );
+        assert_eq!(
+            ok(r#"{"type":"answer","trial":1,"choice":0}"#),
+            Command::Answer {
+                trial: 1,
+                choice: 0
+            }
+        );
+        assert_eq!(ok(r#"{"type":"stop_study"}"#), Command::StopStudy);
+        assert_eq!(
             parse_client_message(r#"{"type":"hello","token":"abc"}"#),
             Ok(ClientMessage::Hello {
                 token: "abc".into()
@@ -350,6 +407,18 @@ mod tests {
             ),
             (r#"{"type":"set_controller","name":"nope"}"#, "four-channel"),
             ("[]", "malformed"),
+            (r#"{"type":"answer","trial":0,"choice":1}"#, "trial"),
+            (r#"{"type":"answer","trial":2000000,"choice":1}"#, "trial"),
+            (r#"{"type":"answer","trial":-1,"choice":1}"#, "malformed"),
+            (r#"{"type":"answer","trial":1.5,"choice":1}"#, "malformed"),
+            (r#"{"type":"answer","trial":3,"choice":4}"#, "choice"),
+            (r#"{"type":"answer","trial":3}"#, "malformed"),
+            (
+                r#"{"type":"answer","trial":3,"choice":1,"rt":0.2}"#,
+                "malformed",
+            ),
+            (r#"{"type":"answer","trial":"3","choice":1}"#, "malformed"),
+            (r#"{"type":"stop_study","now":true}"#, "malformed"),
         ] {
             let e = parse_client_message(msg).expect_err(msg);
             assert!(e.contains(needle), "{msg}: {e}");

@@ -192,6 +192,37 @@ pub struct Frame {
     pub energy: Energies,
     /// Loop timing.
     pub timing: LoopTiming,
+    /// The study trial being run (`haptic2d study run --observer browser`), set by the hub
+    /// ([`ViewHub::set_study`](crate::ViewHub::set_study)); absent outside a study.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub study: Option<StudyView>,
+}
+
+/// What the page shows of a study trial (`{"study": {…}}` in a frame).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct StudyView {
+    /// The trial presented (from 1; 0 before the first).
+    pub trial: u32,
+    /// Trials planned in the session (an upper bound for adaptive methods).
+    pub planned: u32,
+    /// Trials answered in the session so far (resumed ones included).
+    pub done: u32,
+    /// The interval presented (1 to `intervals`; 0 outside a presentation).
+    pub interval: u8,
+    /// Intervals per trial (2 or 3).
+    pub intervals: u8,
+    /// `"starting"` (waiting for the next trial), `"free_space"` (the next interval's stimulus is
+    /// installed once the handle leaves the wall), `"presenting"`, `"answer"` (waiting for the
+    /// answer), `"stopping"` (the session ends).
+    pub phase: &'static str,
+    /// Seconds left in the interval presented (s).
+    pub remaining_s: f64,
+    /// The task: `"2afc"`, `"3afc"` or `"same-different"` (which buttons the page shows).
+    pub task: &'static str,
+    /// Answers refused so far (an old trial, a choice the task has not, outside the answer phase).
+    pub refused: u32,
+    /// The session's last answer was saved for this trial (0: none yet).
+    pub last_saved: u32,
 }
 
 impl Clone for Frame {

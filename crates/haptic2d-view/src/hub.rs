@@ -10,7 +10,7 @@
 //!   nobody watches.
 
 use crate::command::Command;
-use crate::frame::{Frame, FrameInputs};
+use crate::frame::{Frame, FrameInputs, StudyView};
 use crate::scene_info::SceneInfo;
 use haptic2d::world::World;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -34,6 +34,7 @@ pub struct ViewHub {
     next_frame_s: f64,
     frame_seq: u64,
     scene_seq: u64,
+    study: Option<StudyView>,
 }
 
 /// The server thread's end of a [`ViewHub`]; give it to [`ViewServer::start`](crate::ViewServer::start).
@@ -69,6 +70,7 @@ impl ViewHub {
                 next_frame_s: 0.0,
                 frame_seq: 0,
                 scene_seq: 0,
+                study: None,
             },
             ServerEnd {
                 frames: fout,
@@ -109,6 +111,7 @@ impl ViewHub {
         let (seq, scene_seq) = (self.frame_seq, self.scene_seq);
         let f = self.frames.input_buffer_mut();
         f.capture(world, inputs);
+        f.study = self.study;
         f.seq = seq;
         f.scene_seq = scene_seq;
         self.frames.publish();
@@ -134,6 +137,12 @@ impl ViewHub {
             .map_err(|_| "the display server is not taking scene descriptions".to_string())?;
         self.scene_seq = seq;
         Ok(seq)
+    }
+
+    /// The study trial the next frames show (`None` outside a study). Wait-free, no allocation.
+    #[inline]
+    pub fn set_study(&mut self, study: Option<StudyView>) {
+        self.study = study;
     }
 
     /// Sequence number of the last published scene (0 before the first).

@@ -40,7 +40,7 @@ pub mod timing;
 pub use command::{
     parse_client_message, ClientMessage, Command, ControllerKind, MAX_MESSAGE_BYTES,
 };
-pub use frame::{ContactView, DeviceView, Energies, Frame, FrameInputs, LoopTiming};
+pub use frame::{ContactView, DeviceView, Energies, Frame, FrameInputs, LoopTiming, StudyView};
 pub use hub::{ServerEnd, ViewHub, DEFAULT_FRAME_RATE_HZ};
 pub use scene_budget::{assess_builtin_scenes, SceneCost, DEFAULT_STEP_FRACTION};
 pub use scene_info::{BodyShape, DeviceGeometry, SceneInfo};

@@ -14,8 +14,10 @@
 //!   intervals, reports and plots.
 //! - [`numeric`], [`rng`]: the normal CDF, Nelder–Mead and a seeded generator.
 //!
-//! Not built yet: answers from the browser page or device buttons, trials on the real-time loop or a
-//! device, MCAP per trial, QUEST+, magnitude estimation, PsychoPy (see `docs/STUDIES.md`).
+//! Trials on the real-time loop with answers from the browser page are the CLI's
+//! (`haptic2d study run --observer browser`, an [`Observer`] in `haptic2d-cli/src/study_browser.rs`).
+//! Not built yet: device buttons, MCAP per trial, QUEST+, magnitude estimation, PsychoPy (see
+//! `docs/STUDIES.md`).
 
 pub mod analyse;
 pub mod explore;

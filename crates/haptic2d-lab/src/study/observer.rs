@@ -311,18 +311,20 @@ pub struct Answer {
     /// Magnitude estimation: the number given to the comparison (the reference being the study's
     /// modulus); `None` in the other tasks.
     pub magnitude: Option<f64>,
-    /// Response time (s), measured from the start of the first interval.
+    /// Response time (s): the simulated observer's from the start of the first interval (a model);
+    /// the browser page's from the answer prompt (measured).
     pub rt: f64,
 }
 
-/// Anything that answers trials: the simulated observer now; a browser page or device buttons later.
+/// Anything that answers trials: the simulated observer, or a participant on the browser page
+/// (`haptic2d study run --observer browser`).
 pub trait Observer {
     /// Presents `spec` and returns the answer.
     fn answer(&mut self, study: &Study, spec: &TrialSpec) -> Result<Answer, String>;
     /// A short description for the session record (`simulated W=0.15 λ=0.02`).
     fn describe(&self) -> String;
-    /// A rest break before `next` (the study's `[breaks]`, `order.rs`): a person gets a break
-    /// screen and continues when ready; the default (the simulated observer) needs none.
+    /// A rest break before `next` (the study's `[breaks]`, `order.rs`). The default (the simulated
+    /// observer, and the browser page for now) does nothing.
     fn rest(&mut self, _study: &Study, _next: &TrialSpec) -> Result<(), String> {
         Ok(())
     }

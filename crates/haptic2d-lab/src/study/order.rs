@@ -11,8 +11,8 @@
 //!
 //! `[breaks]`: `every = N` rests before every `N`-th trial of the session, and `between_blocks =
 //! true` before the first trial of every block after the first. The observer is told
-//! ([`super::Observer::rest`]); the simulated observer needs none, a person at the browser page gets
-//! a break screen.
+//! ([`super::Observer::rest`]) before that trial; the simulated observer needs none (the browser
+//! page does not show a break screen yet: docs/STUDIES.md, What is not built yet).
 
 use super::file::StudyFile;
 use haptic2d::scene::SceneError;

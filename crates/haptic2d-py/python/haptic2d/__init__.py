@@ -9,6 +9,7 @@ API in SI units and hands results back as NumPy arrays.
   around the simulated twin pantograph and a simulated hand.
 - :func:`sweep_walls`: stiffness x damping sweeps of the wall laws on any executor.
 - :func:`reproduce`: the paper's figures, as ``haptic2d reproduce`` writes them.
+- :func:`present`: one stimulus of a study file, explored by the simulated hand (for PsychoPy loops).
 - :func:`read_log`: a CSV written by ``haptic2d simulate --out`` or ``haptic2d run --log``.
 """
 
@@ -18,6 +19,7 @@ from ._haptic2d import SceneError, __version__
 from ._world import World, CONTACT_DTYPE
 from ._haptic import HapticSystem
 from ._lab import sweep_walls, reproduce, read_log, SWEEP_CLASSES
+from ._study import present
 from . import harness
 
 __all__ = [
@@ -28,6 +30,7 @@ __all__ = [
     "sweep_walls",
     "reproduce",
     "read_log",
+    "present",
     "SWEEP_CLASSES",
     "harness",
     "__version__",

@@ -15,6 +15,7 @@ __all__ = [
     "sweep_task",
     "sweep_models",
     "reproduce",
+    "study_present",
     "__version__",
 ]
 
@@ -129,3 +130,6 @@ def sweep_models() -> List[str]: ...
 def reproduce(
     figure: str, out: Union[str, "os.PathLike[str]"]
 ) -> Tuple[str, float, List[Tuple[str, int, int, int, List[str]]]]: ...
+def study_present(
+    study: Union[str, "os.PathLike[str]"], condition: str, delta: Optional[float] = None
+) -> Tuple[float, List[float], float, str]: ...

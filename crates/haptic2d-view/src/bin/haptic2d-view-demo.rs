@@ -247,6 +247,9 @@ impl Demo {
                 self.paused = false;
                 Ok(None)
             }
+            Command::Answer { .. } | Command::StopStudy => {
+                Err("no study is running (haptic2d study run --observer browser)".to_string())
+            }
         };
         match result {
             Ok(Some((mut fresh, info))) => {

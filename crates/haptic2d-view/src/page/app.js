@@ -166,7 +166,85 @@
       f.energy.passivity == null ? NaN : f.energy.passivity * 1e3]);
     charts[2].push(f.t, [f.timing.lateness_p50_us, f.timing.lateness_p99_us, f.timing.lateness_max_us]);
     updatePanel(f);
+    updateStudy(f.study);
   }
+
+  // ---------------------------------------------------------------- study (haptic2d study run --observer browser)
+  const CHOICES = {
+    "2afc": { q: "Which interval was stiffer?", c: [[1, "First", "1"], [2, "Second", "2"]] },
+    "3afc": { q: "Which interval was stiffest?", c: [[1, "First", "1"], [2, "Second", "2"], [3, "Third", "3"]] },
+    "same-different": { q: "Were the two intervals the same or different?", c: [[0, "Same", "S"], [1, "Different", "D"]] },
+  };
+  const study = { view: null, built: "", answeredTrial: 0, sent: [], transitions: [] };
+  function updateStudy(v) {
+    const last = study.transitions[study.transitions.length - 1];
+    if (v && (!last || last.trial !== v.trial || last.phase !== v.phase || last.interval !== v.interval)) {
+      study.transitions.push({ trial: v.trial, phase: v.phase, interval: v.interval });
+      if (study.transitions.length > 500) study.transitions.shift();
+    }
+    study.view = v || null;
+    document.body.classList.toggle("study-mode", !!v);
+    if (!v) return;
+    const spec = CHOICES[v.task] || CHOICES["2afc"];
+    const shape = `${v.task}/${v.intervals}`;
+    if (study.built !== shape) {
+      study.built = shape;
+      $("study-choices").replaceChildren(...spec.c.map(([choice, label, key]) => {
+        const b = document.createElement("button");
+        b.textContent = `${label} (${key})`;
+        b.dataset.choice = String(choice);
+        b.onclick = () => answer(choice);
+        return b;
+      }));
+      $("study-intervals").replaceChildren(...Array.from({ length: v.intervals }, (_, i) => {
+        const sp = document.createElement("span");
+        sp.textContent = `interval ${i + 1}`;
+        return sp;
+      }));
+      $("study-keys").textContent = `keys: ${spec.c.map((c) => c[2]).join(" / ")} answer · Space pause · Esc stop`;
+    }
+    $("study-progress").textContent = v.trial
+      ? `Trial ${v.trial} of at most ${v.planned} · ${v.done} answered`
+      : `${v.done} of at most ${v.planned} answered`;
+    const waiting = v.phase === "answer" && study.answeredTrial !== v.trial;
+    const paused = state.lastFrame && state.lastFrame.paused;
+    let prompt;
+    switch (v.phase) {
+      case "presenting": prompt = `Interval ${v.interval} of ${v.intervals}: explore the wall (${v.remaining_s.toFixed(1)} s)`; break;
+      case "free_space": prompt = `Lift the handle off the wall: interval ${v.interval} starts in free space`; break;
+      case "answer": prompt = waiting ? spec.q : "Saving the answer…"; break;
+      case "stopping": prompt = "Session stopped: the torques are off. It resumes at this trial."; break;
+      default: prompt = "Next trial…";
+    }
+    if (paused && v.phase !== "stopping") prompt = "Paused (no force): press Space or Resume to continue";
+    $("study-prompt").textContent = prompt;
+    [...$("study-intervals").children].forEach((sp, i) => sp.classList.toggle("now", v.phase === "presenting" && v.interval === i + 1));
+    [...$("study-choices").children].forEach((b) => { b.disabled = !waiting || paused; });
+    $("study-pause").textContent = paused ? "Resume (Space)" : "Pause (Space)";
+  }
+  function answer(choice) {
+    const v = study.view;
+    if (!v || v.phase !== "answer" || study.answeredTrial === v.trial) return false;
+    if (state.lastFrame && state.lastFrame.paused) return false;
+    if (!send({ type: "answer", trial: v.trial, choice })) return false;
+    study.answeredTrial = v.trial; // one answer per trial from this page
+    study.sent.push({ trial: v.trial, choice });
+    [...$("study-choices").children].forEach((b) => { b.disabled = true; });
+    $("study-prompt").textContent = "Saving the answer…";
+    return true;
+  }
+  $("study-pause").onclick = () => send({ type: state.lastFrame && state.lastFrame.paused ? "resume" : "pause" });
+  $("study-stop").onclick = () => send({ type: "stop_study" });
+  window.addEventListener("keydown", (ev) => {
+    const v = study.view;
+    if (!v || ev.repeat) return;
+    if (ev.target && (ev.target.tagName === "SELECT" || ev.target.tagName === "INPUT")) return;
+    if (ev.key === "Escape") { send({ type: "stop_study" }); ev.preventDefault(); return; }
+    if (ev.key === " ") { $("study-pause").click(); ev.preventDefault(); return; }
+    const spec = CHOICES[v.task] || CHOICES["2afc"];
+    const hit = spec.c.find((c) => c[2].toLowerCase() === ev.key.toLowerCase());
+    if (hit) { answer(hit[0]); ev.preventDefault(); }
+  });
 
   function fmt(v, d) { return (v === null || v === undefined || !isFinite(v)) ? "—" : v.toFixed(d); }
 
@@ -574,6 +652,10 @@
     get acks() { return state.acks.slice(); },
     get target() { return state.target && state.target.slice(); },
     get commandsSent() { return state.commandsSent; },
+    get study() { return study.view; },
+    get answersSent() { return study.sent.slice(); },
+    // The study phases the page saw, in order ({trial, phase, interval}), for tests.
+    get studyTransitions() { return study.transitions.slice(); },
     send,
     // World point (m) → viewport pixel, for tests that drive the pointer.
     worldToClient(x, y) {

@@ -1,0 +1,607 @@
+//! `haptic2d study run FILE --observer browser`: a study session on the real-time haptic loop, the
+//! participant answering on the browser page (docs/STUDIES.md, "A session with people").
+//!
+//! The main thread runs the session exactly as the simulated observer's path does
+//! ([`haptic2d_lab::study::run`]: the schedule, `trials.tsv` appended and synced per answer, resume
+//! from the log); its observer, [`BrowserObserver`], builds each trial's stimuli (the laws of every
+//! interval, allocated here, never in a tick), hands the [`Plan`] to the loop through a wait-free
+//! ring and waits for the answer. The loop thread runs the haptic tick of `haptic2d run` (device,
+//! system, watchdog, display) with the [`Presenter`] in it: stimulus switches in free space, the
+//! intervals, the answer and its response time (see `study_present.rs`).
+//!
+//! A SIGINT or SIGTERM, the page's stop button, a lost device or a safety stop end the loop (torques
+//! zeroed and latched as in `haptic2d run`); the trial in progress is not written, so running the
+//! same command again resumes at it.
+
+use crate::device_arg;
+use crate::exit::{Failure, Status};
+use crate::hand_arg::HandSpec;
+use crate::run_rig::{DeviceChoice, DeviceModel, RealOpenError, Rig};
+use crate::run_view::{self, LiveView, LoadedScene};
+use crate::study_present::{Event, Plan, Presenter, MAX_INTERVALS};
+use haptic2d::haptic::HapticConfig;
+use haptic2d::laws::friction::FrictionModel;
+use haptic2d::laws::normal::NormalModel;
+use haptic2d::scene::Scene;
+use haptic2d_lab::study::observer::{Answer, Observer};
+use haptic2d_lab::study::schedule::{Schedule, TrialSpec};
+use haptic2d_lab::study::{run as run_session, session_seed, stimulus, Study};
+use haptic2d_rt::clock::now_ns;
+use haptic2d_rt::signal::install_stop_signals;
+use haptic2d_rt::{run_loop, DeviceError, FaultKind, LoopConfig, TickControl, TickInfo, Watchdog};
+use std::collections::HashMap;
+use std::net::SocketAddr;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Duration;
+
+/// Shortest and longest interval (s).
+pub const INTERVAL_RANGE_S: (f64, f64) = (0.05, 600.0);
+
+/// The options of the browser session.
+#[derive(Clone, Debug)]
+pub struct BrowserOptions {
+    /// `--device` (as `haptic2d run`).
+    pub device: String,
+    /// `--device-file`.
+    pub device_file: Option<PathBuf>,
+    /// `--bind` of the page.
+    pub bind: String,
+    /// `--interval`: exploration time per interval (s).
+    pub interval_s: f64,
+    /// `--no-rt`: normal scheduling.
+    pub no_rt: bool,
+    /// `--require-token`.
+    pub require_token: bool,
+    /// `--allow-unstable`.
+    pub allow_unstable: bool,
+    /// `--allow-remote-device`.
+    pub allow_remote_device: bool,
+}
+
+/// Why the loop stopped, when the tick stopped it.
+enum LoopEnd {
+    DeviceLost(String),
+    Watchdog(String),
+    SafetyLatch,
+    Diverged(String),
+}
+
+/// Why the session ended early (from the observer's side).
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum EarlyEnd {
+    /// The page's stop button.
+    Page,
+    /// The loop ended (a signal, or the tick stopped it).
+    Loop,
+}
+
+/// Runs (or resumes) the session with answers from the browser page.
+pub fn run(
+    file: &Path,
+    out: &Path,
+    participant: &str,
+    session: u32,
+    stop_after: Option<u32>,
+    o: &BrowserOptions,
+) -> Result<Status, Failure> {
+    let bind = check_options(o)?;
+    haptic2d_lab::study::session::check_participant(participant)?;
+    let (study, text) = Study::read(file).map_err(Failure::from)?;
+    let (mut rig, loaded, rate) = build_rig(&study, o)?;
+    let seed = session_seed(study.seed, participant, session);
+    let planned = Schedule::new(&study, seed).planned();
+
+    let (server, mut view) = run_view::start(bind, &rig, loaded, rate, o.require_token)?;
+    view.enable_study();
+    crate::outln!("{}", server.banner());
+    let stop = install_stop_signals()?;
+    let watchdog = Watchdog::new(rig.watchdog_config())?;
+    let loop_config = LoopConfig {
+        rate_hz: rate,
+        duration: None,
+        rt: !o.no_rt,
+        spin_us: (0.4e6 / rate).min(400.0),
+        ..LoopConfig::default()
+    };
+    loop_config.validate()?;
+    let (plan_tx, plan_rx) = rtrb::RingBuffer::<Plan>::new(2);
+    let (event_tx, event_rx) = rtrb::RingBuffer::<Event>::new(16);
+    eprintln!(
+        "study `{}`: participant {participant}, session {session}, {} trial(s) planned; device {}, {} Hz, {} s per interval; answers from the page (Ctrl-C or the page's Stop ends the session; it resumes)",
+        study.name,
+        planned,
+        rig.io.name(),
+        rate,
+        o.interval_s
+    );
+
+    let ended = AtomicBool::new(false);
+    let mut state = StudyLoop {
+        rig: &mut rig,
+        view,
+        watchdog,
+        presenter: Presenter::new(study.task, o.interval_s),
+        plans: plan_rx,
+        events: event_tx,
+        end: None,
+    };
+    let mut observer = BrowserObserver {
+        plans: plan_tx,
+        events: event_rx,
+        ended: &ended,
+        planned,
+        laws: HashMap::new(),
+        early: None,
+    };
+    let (session_result, timing) = std::thread::scope(|s| {
+        let handle = std::thread::Builder::new()
+            .name("haptic2d-rt".into())
+            .spawn_scoped(s, || {
+                let r = run_loop(&loop_config, &stop, |info| state.tick(&info));
+                ended.store(true, Ordering::SeqCst);
+                r
+            });
+        let handle = match handle {
+            Ok(h) => h,
+            Err(e) => {
+                return (
+                    Err(format!("cannot start the real-time loop thread: {e}")),
+                    None,
+                )
+            }
+        };
+        let mut progress = |done: u32, planned: u32| {
+            eprintln!("  trial {done} of at most {planned} answered");
+        };
+        let r = run_session(
+            &study,
+            &text,
+            out,
+            participant,
+            session,
+            &mut observer,
+            &mut progress,
+            stop_after,
+        );
+        // The session is over (complete, stopped or failed): end the loop.
+        stop.store(true, Ordering::SeqCst);
+        let timing = handle.join().ok();
+        (r, timing)
+    });
+    // Zero torques before anything else.
+    state.rig.io.zero_torques();
+    let end = state.end.take();
+    drop(state);
+    server.shutdown();
+    if let Some(Ok(t)) = &timing {
+        crate::outln!(
+            "on time: {:.3} % of {} deadlines ({} overruns)",
+            t.on_time_fraction * 100.0,
+            t.deadlines,
+            t.overruns
+        );
+    }
+    if let Some(trip) = rig.system.safety_trip() {
+        crate::outln!("{trip}");
+    }
+    finish(end, observer.early, session_result)
+}
+
+/// Checks the options that need no file: `--interval` and `--bind`.
+fn check_options(o: &BrowserOptions) -> Result<SocketAddr, Failure> {
+    let (lo, hi) = INTERVAL_RANGE_S;
+    if !(o.interval_s.is_finite() && (lo..=hi).contains(&o.interval_s)) {
+        return Err(format!(
+            "--interval {}: give the exploration time per interval in seconds, {lo} to {hi}\n    fix: e.g. --interval 3",
+            o.interval_s
+        )
+        .into());
+    }
+    o.bind.parse::<SocketAddr>().map_err(|e| {
+        Failure::from(format!(
+            "--bind `{}` is not an ADDRESS:PORT ({e})\n    fix: e.g. --bind 127.0.0.1:8080",
+            o.bind
+        ))
+    })
+}
+
+/// Builds the rig (device, system, the study's first reference stimulus in the world) as `haptic2d
+/// run` does, gated by the released-stability check for a real device. Returns the rig, the scene
+/// for the display and the loop rate (Hz).
+fn build_rig(study: &Study, o: &BrowserOptions) -> Result<(Rig, LoadedScene, f64), Failure> {
+    if study.task == haptic2d_lab::study::file::Task::Magnitude {
+        return Err("this study is magnitude estimation, and the browser page has no number entry yet\n    fix: run it with --observer simulated, or use a 2AFC, 3AFC or same-different task with people".into());
+    }
+    let first = &study.conditions[0].reference;
+    let scene_text = stimulus::scene_text(study, first, None).map_err(scene_errors)?;
+    let scene = Scene::from_toml(&scene_text, &study.scene_source, study.rate)
+        .map_err(|e| scene_errors(e.errors))?;
+    let dt = scene.world.params.dt;
+    let rate = 1.0 / dt;
+    let device = DeviceChoice::parse(&o.device)?;
+    if matches!(device, DeviceChoice::Replay(_)) {
+        return Err("--device replay:… plays recorded motion: nobody explores a stimulus\n    fix: --device sim or a real device".into());
+    }
+    let real = device.load_real(o.device_file.as_deref(), o.allow_remote_device)?;
+    let device_params = match &real {
+        Some(r) => match &r.model {
+            DeviceModel::Twin(p) => *p,
+            DeviceModel::FiveBar { .. } => haptic2d::device::DeviceParams::default(),
+        },
+        None => device_arg::resolve(o.device_file.as_deref(), &scene, dt)?.params,
+    };
+    let mut config = HapticConfig {
+        device: device_params,
+        ..HapticConfig::default()
+    };
+    if let Some(m) = real.as_ref().and_then(|r| r.match_controller.as_ref()) {
+        config.controller = m(config.controller);
+    }
+    if let (Some(r), false) = (&real, o.allow_unstable) {
+        crate::cmd_stability::check_real_device(&r.model, &config, &scene.world)?;
+    }
+    let loaded = LoadedScene {
+        name: study.name.clone(),
+        description: study.description.clone(),
+        world: scene.world.clone(),
+    };
+    let mut rig = match real {
+        None => Rig::new(scene.world, &scene.source, config, device, HandSpec::Follow)?,
+        Some(r) => {
+            Rig::with_real(scene.world, &scene.source, config, device, r).map_err(|e| match e {
+                RealOpenError::Config(m) => Failure::from(m),
+                RealOpenError::Open(m) => Failure {
+                    status: Status::DeviceLost,
+                    message: m,
+                },
+            })?
+        }
+    };
+    if !o.allow_unstable {
+        rig.enforce_released_stability();
+    }
+    let slave = rig.system.slave();
+    if rig.system.world().body_index(&study.probe) != Some(slave) {
+        return Err(format!(
+            "the study's probe `{}` is not the body the handle drives (`{}`)\n    fix: set probe to the scene's driven body",
+            study.probe,
+            rig.system.world().bodies[slave].name
+        )
+        .into());
+    }
+    Ok((rig, loaded, rate))
+}
+
+/// Reports how the session ended and returns the exit status.
+fn finish(
+    end: Option<LoopEnd>,
+    early: Option<EarlyEnd>,
+    session_result: Result<haptic2d_lab::study::RunSummary, String>,
+) -> Result<Status, Failure> {
+    let resume_hint = "run the same command again to resume at the next unanswered trial";
+    let (status, why) = match (end, early) {
+        (Some(LoopEnd::DeviceLost(m)), _) => (
+            Status::DeviceLost,
+            format!("{m}\n    torques were set to zero and latched"),
+        ),
+        (Some(LoopEnd::Watchdog(m)), _) => (Status::SafetyStop, m),
+        (Some(LoopEnd::SafetyLatch), _) => (Status::SafetyStop, "safety stop".into()),
+        (Some(LoopEnd::Diverged(m)), _) => (Status::Diverged, m),
+        (None, Some(EarlyEnd::Page)) => (Status::Clean, "stopped from the page".into()),
+        (None, Some(EarlyEnd::Loop)) => (
+            Status::Interrupted,
+            "interrupted by a signal (SIGINT or SIGTERM)".into(),
+        ),
+        (None, None) => match session_result {
+            Ok(s) => {
+                crate::outln!(
+                    "{}: {} trial(s) run{}; {}",
+                    s.dir.display(),
+                    s.ran,
+                    if s.resumed > 0 {
+                        format!(" after {} resumed from trials.tsv", s.resumed)
+                    } else {
+                        String::new()
+                    },
+                    if s.complete {
+                        format!(
+                            "session complete\nnext: haptic2d study analyse {}",
+                            s.dir.display()
+                        )
+                    } else {
+                        format!("session not complete: {resume_hint}")
+                    }
+                );
+                return Ok(Status::Clean);
+            }
+            Err(e) => return Err(Failure::error(e)),
+        },
+    };
+    crate::outln!("stopped: {why}; the trials answered are in trials.tsv; {resume_hint}");
+    Ok(status)
+}
+
+fn scene_errors(e: Vec<haptic2d::scene::SceneError>) -> Failure {
+    Failure::from(
+        e.iter()
+            .map(|s| s.to_string())
+            .collect::<Vec<_>>()
+            .join("\n"),
+    )
+}
+
+/// The observer whose answers come from the page through the loop.
+struct BrowserObserver<'a> {
+    plans: rtrb::Producer<Plan>,
+    events: rtrb::Consumer<Event>,
+    ended: &'a AtomicBool,
+    planned: u32,
+    /// The laws of a stimulus: (condition, comparison, delta bits) → (normal, friction).
+    laws: HashMap<(usize, bool, u64), (NormalModel, FrictionModel)>,
+    early: Option<EarlyEnd>,
+}
+
+impl BrowserObserver<'_> {
+    fn stimulus(
+        &mut self,
+        study: &Study,
+        c: usize,
+        comparison: bool,
+        delta: f64,
+    ) -> Result<(NormalModel, FrictionModel), String> {
+        let key = (c, comparison, if comparison { delta.to_bits() } else { 0 });
+        if let Some(l) = self.laws.get(&key) {
+            return Ok(*l);
+        }
+        let cond = &study.conditions[c];
+        let (name, vary) = if comparison {
+            (&cond.comparison, Some((&cond.vary, delta)))
+        } else {
+            (&cond.reference, None)
+        };
+        let w = stimulus::world(study, name, vary).map_err(|e| {
+            e.iter()
+                .map(|s| s.to_string())
+                .collect::<Vec<_>>()
+                .join("; ")
+        })?;
+        let l = (w.normal, w.friction);
+        self.laws.insert(key, l);
+        Ok(l)
+    }
+}
+
+impl Observer for BrowserObserver<'_> {
+    fn answer(&mut self, study: &Study, spec: &TrialSpec) -> Result<Answer, String> {
+        let n = study.task.intervals();
+        let reference = self.stimulus(study, spec.condition, false, 0.0)?;
+        let comparison = self.stimulus(study, spec.condition, true, spec.delta)?;
+        let mut laws = [reference; MAX_INTERVALS];
+        for (i, l) in laws.iter_mut().enumerate().take(n) {
+            if usize::from(spec.comparison_interval) == i + 1 {
+                *l = comparison;
+            }
+        }
+        let plan = Plan {
+            trial: spec.trial,
+            done: spec.trial - 1,
+            planned: self.planned,
+            intervals: n as u8,
+            laws,
+        };
+        self.plans
+            .push(plan)
+            .map_err(|_| "the loop is not taking trials".to_string())?;
+        loop {
+            while let Ok(ev) = self.events.pop() {
+                match ev {
+                    Event::Answered {
+                        trial,
+                        choice,
+                        rt_s,
+                    } if trial == spec.trial => {
+                        return Ok(Answer {
+                            response: choice,
+                            rt: rt_s,
+                            magnitude: None,
+                        })
+                    }
+                    Event::Answered { .. } => {}
+                    Event::Stop => {
+                        self.early = Some(EarlyEnd::Page);
+                        return Err("the session was stopped from the page".into());
+                    }
+                }
+            }
+            if self.ended.load(Ordering::SeqCst) {
+                self.early = Some(EarlyEnd::Loop);
+                return Err("the haptic loop stopped".into());
+            }
+            std::thread::sleep(Duration::from_millis(2));
+        }
+    }
+
+    fn describe(&self) -> String {
+        "browser (a participant answering on the page)".into()
+    }
+}
+
+/// Everything one tick touches, owned by the loop thread while it runs.
+struct StudyLoop<'r> {
+    rig: &'r mut Rig,
+    view: LiveView,
+    watchdog: Watchdog,
+    presenter: Presenter,
+    plans: rtrb::Consumer<Plan>,
+    events: rtrb::Producer<Event>,
+    end: Option<LoopEnd>,
+}
+
+impl StudyLoop<'_> {
+    /// One tick: the page's commands, the presenter (stimulus switch, interval, answer), then the
+    /// haptic tick of `haptic2d run` (device read, system, watchdog, device write) and the display.
+    /// Allocation-free in steady state.
+    fn tick(&mut self, info: &TickInfo) -> TickControl {
+        self.view.apply_commands(self.rig);
+        let inbox = self.view.take_study();
+        let paused = self.view.paused();
+        if let Ok(plan) = self.plans.pop() {
+            self.presenter.start(plan);
+        }
+        let slave = self.rig.system.slave();
+        let watched = self.view.viewers() > 0;
+        if let Some(ev) = self.presenter.tick(
+            self.rig.system.world_mut(),
+            slave,
+            info.period_s,
+            paused,
+            watched,
+            now_ns(),
+            inbox.answer,
+            inbox.stop,
+        ) {
+            // The ring holds 16 events and the main thread drains it every 2 ms.
+            let _ = self.events.push(ev);
+        }
+        let (q, lost) = match self.rig.read() {
+            Ok(q) => (q, None),
+            Err(e) => ([f64::NAN; 4], Some(e)),
+        };
+        let out = self.rig.tick_system(&q, info, paused);
+        let mut tau = out.torques;
+        let safety = self.rig.safety_input(info, &out, lost.is_some());
+        let Rig { system, io, .. } = &mut *self.rig;
+        let guard = self.watchdog.guard(&safety, &mut tau);
+        if let Some(e) = lost {
+            io.zero_torques();
+            self.end = Some(LoopEnd::DeviceLost(match e {
+                DeviceError::EndOfData => "the device's data ended".into(),
+                e => e.to_string(),
+            }));
+            return TickControl::Stop;
+        }
+        if let Some(d) = system.world().divergence() {
+            io.zero_torques();
+            self.end = Some(LoopEnd::Diverged(format!(
+                "the world diverged at t = {:.4} s: {d}\n    torques were set to zero and latched",
+                system.world().time()
+            )));
+            return TickControl::Stop;
+        }
+        if let Err(e) = io.write_torques(&tau) {
+            io.zero_torques();
+            self.end = Some(LoopEnd::DeviceLost(e.to_string()));
+            return TickControl::Stop;
+        }
+        if let Err(f) = guard {
+            io.zero_torques();
+            self.end = Some(match f.kind {
+                FaultKind::DeviceLost => LoopEnd::DeviceLost(f.to_string()),
+                _ => LoopEnd::Watchdog(f.to_string()),
+            });
+            return TickControl::Stop;
+        }
+        if out.tripped {
+            io.zero_torques();
+            self.end = Some(LoopEnd::SafetyLatch);
+            return TickControl::Stop;
+        }
+        self.view.set_study_view(Some(self.presenter.view()));
+        self.view.after_tick(info, self.rig);
+        TickControl::Continue
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::study_present::{in_free_space, Phase};
+    use haptic2d::scene::builtin;
+    use haptic2d_lab::study::file::Task;
+
+    /// One tick of the simulated rig with the presenter in it (as `StudyLoop::tick`, without the
+    /// display and the watchdog); returns the presenter's event and the slave's contact force (N).
+    fn step(rig: &mut Rig, p: &mut Presenter) -> (Option<Event>, f64) {
+        let slave = rig.system.slave();
+        let ev = p.tick(
+            rig.system.world_mut(),
+            slave,
+            1e-3,
+            false,
+            true,
+            0,
+            None,
+            false,
+        );
+        let q = rig.io.read_encoders().unwrap();
+        let out = rig.system.tick(&q, None, false);
+        rig.io.write_torques(&out.torques).unwrap();
+        let w = rig.system.world().contact_wrench(slave);
+        (ev, w.force.x.hypot(w.force.y))
+    }
+
+    /// The stimulus switch is passive: while the handle presses the wall the next interval's law
+    /// is not installed (the wall keeps the law being felt), and it is installed at the first tick
+    /// in which the slave has no contact, where its contact force is zero before and after the
+    /// switch: no step in the force the participant feels.
+    #[test]
+    fn stimulus_switch_waits_for_free_space_so_the_felt_force_never_steps() {
+        let scene = builtin("box-in-walls", Some(1000.0)).unwrap().unwrap();
+        let mut rig = Rig::new(
+            scene.world,
+            "box-in-walls",
+            HapticConfig::default(),
+            DeviceChoice::Sim,
+            HandSpec::Follow,
+        )
+        .unwrap();
+        let home = rig.hand_target_world();
+        let before = rig.system.world().normal;
+        let minsky = NormalModel::from_name("minsky", true).unwrap();
+        assert_ne!(before, minsky);
+        let f = rig.system.world().friction;
+        let mut p = Presenter::new(Task::TwoAfc, 0.5);
+        // Press the box into the left wall.
+        rig.set_hand_target([-0.01, 0.0, 0.0]);
+        let mut force = 0.0;
+        for _ in 0..3000 {
+            force = step(&mut rig, &mut p).1;
+        }
+        let slave = rig.system.slave();
+        assert!(
+            !in_free_space(rig.system.world(), slave),
+            "the box presses the wall"
+        );
+        assert!(force > 0.1, "the wall pushes back: {force} N");
+        assert!(p.start(Plan {
+            trial: 1,
+            done: 0,
+            planned: 1,
+            intervals: 2,
+            laws: [(minsky, f); MAX_INTERVALS],
+        }));
+        for _ in 0..500 {
+            step(&mut rig, &mut p);
+            assert_eq!(p.phase(), Phase::FreeSpace(0));
+            assert_eq!(rig.system.world().normal, before, "no switch in contact");
+        }
+        // Back to free space: the switch happens at the first free tick, at zero contact force.
+        rig.set_hand_target(home);
+        let mut last_force = force;
+        for k in 0..5000 {
+            let free_before = in_free_space(rig.system.world(), slave);
+            let (_, f_after) = step(&mut rig, &mut p);
+            if let Phase::Presenting(..) = p.phase() {
+                assert!(free_before, "installed only in free space (tick {k})");
+                assert_eq!(last_force, 0.0, "zero contact force before the switch");
+                assert_eq!(f_after, 0.0, "zero contact force after the switch");
+                assert_eq!(rig.system.world().normal, minsky);
+                return;
+            }
+            assert_eq!(rig.system.world().normal, before);
+            last_force = f_after;
+        }
+        panic!("the box never left the wall");
+    }
+}

@@ -1,0 +1,370 @@
+//! The study trial on the real-time loop (`haptic2d study run --observer browser`): the per-tick
+//! state machine that presents a trial's intervals and takes its answer. It runs inside the haptic
+//! tick: no allocation, no lock, no I/O.
+//!
+//! Per trial (a [`Plan`], built on the main thread with each interval's laws already made):
+//!
+//! 1. **free space**: the interval's stimulus (wall law and friction model, with the trial's
+//!    parameters) is installed in the world at the first tick in which the slave body has **no
+//!    contact record**. Its contact force is then zero before and after the switch, so the switch
+//!    cannot make a step in the force the participant feels; while the handle rests on or presses
+//!    the wall, the previous stimulus stays (the page asks the participant to lift the handle off).
+//! 2. **presenting**: the participant explores for `interval_s` of loop time (paused ticks do not
+//!    count), then the next interval starts at 1.
+//! 3. **answer**: after the last interval the page shows the answer buttons; the response time is
+//!    the monotonic time from entering this phase (the prompt) to the tick that takes the answer.
+//!    Only an answer naming the current trial with a choice the task offers is taken; any other is
+//!    counted as refused and changes nothing.
+//!
+//! The device's own safety (torques ramped in from zero at the start, clamped, latched to zero on a
+//! stall or a lost device) is the loop's, unchanged.
+
+use haptic2d::laws::friction::FrictionModel;
+use haptic2d::laws::normal::NormalModel;
+use haptic2d::world::World;
+use haptic2d_lab::study::file::Task;
+use haptic2d_view::StudyView;
+
+/// Most intervals a trial has (3AFC).
+pub const MAX_INTERVALS: usize = 3;
+
+/// One trial to present, prepared off the loop thread.
+#[derive(Clone, Copy, Debug)]
+pub struct Plan {
+    /// Trial number (from 1).
+    pub trial: u32,
+    /// Trials answered in the session before this one.
+    pub done: u32,
+    /// Trials planned in the session (an upper bound for adaptive methods).
+    pub planned: u32,
+    /// Intervals of the trial (2 or 3).
+    pub intervals: u8,
+    /// Each interval's wall law and friction model (the first `intervals` are used).
+    pub laws: [(NormalModel, FrictionModel); MAX_INTERVALS],
+}
+
+/// What the presenter reports to the main thread.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Event {
+    /// The participant answered `trial` with `choice`, `rt_s` seconds after the prompt.
+    Answered {
+        /// The trial answered.
+        trial: u32,
+        /// The choice (the interval named from 1, or same–different 0 = same, 1 = different).
+        choice: u8,
+        /// Response time (s, monotonic clock, from the prompt to the tick that took the answer).
+        rt_s: f64,
+    },
+    /// The page asked to stop the session.
+    Stop,
+}
+
+/// Where the trial is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Phase {
+    /// No trial: waiting for the next plan.
+    Idle,
+    /// Interval `k` (from 0) is installed once the slave leaves every contact.
+    FreeSpace(u8),
+    /// Interval `k` is presented; `left_s` seconds remain.
+    Presenting(u8, f64),
+    /// Waiting for the answer since `prompt_ns` (monotonic ns).
+    Answer(u64),
+    /// The session ends.
+    Stopping,
+}
+
+/// The state machine (see the module documentation).
+#[derive(Clone, Debug)]
+pub struct Presenter {
+    task: Task,
+    interval_s: f64,
+    plan: Option<Plan>,
+    phase: Phase,
+    refused: u32,
+    last_saved: u32,
+    done: u32,
+    planned: u32,
+}
+
+/// The choices `task` offers.
+pub fn valid_choice(task: Task, choice: u8) -> bool {
+    match task {
+        Task::TwoAfc => (1..=2).contains(&choice),
+        Task::ThreeAfc => (1..=3).contains(&choice),
+        Task::SameDifferent => choice <= 1,
+    }
+}
+
+/// The task's name on the page.
+pub fn task_name(task: Task) -> &'static str {
+    match task {
+        Task::TwoAfc => "2afc",
+        Task::ThreeAfc => "3afc",
+        Task::SameDifferent => "same-different",
+    }
+}
+
+/// True when body `slave` has no contact record in `world` (free space).
+pub fn in_free_space(world: &World, slave: usize) -> bool {
+    !world
+        .contact_records()
+        .any(|c| c.body_a == slave || c.body_b == slave)
+}
+
+impl Presenter {
+    /// A presenter for `task` with intervals of `interval_s` seconds of loop time.
+    pub fn new(task: Task, interval_s: f64) -> Self {
+        Self {
+            task,
+            interval_s,
+            plan: None,
+            phase: Phase::Idle,
+            refused: 0,
+            last_saved: 0,
+            done: 0,
+            planned: 0,
+        }
+    }
+
+    /// The phase now.
+    #[cfg(test)]
+    pub fn phase(&self) -> Phase {
+        self.phase
+    }
+
+    /// Answers refused so far.
+    #[cfg(test)]
+    pub fn refused(&self) -> u32 {
+        self.refused
+    }
+
+    /// Starts presenting `plan` (ignored unless idle: one trial at a time).
+    pub fn start(&mut self, plan: Plan) -> bool {
+        if self.phase != Phase::Idle {
+            return false;
+        }
+        self.done = plan.done;
+        self.planned = plan.planned;
+        self.plan = Some(plan);
+        self.phase = Phase::FreeSpace(0);
+        true
+    }
+
+    /// One tick: `dt` seconds of loop time (s) not `paused`, at monotonic time `now_ns`, with the
+    /// page's `answer` and `stop` request since the last tick; a trial's first interval starts
+    /// only while `watched` (a page is connected: nobody is presented a stimulus without the page
+    /// that names the interval). Installs an interval's laws in `world` (only with `slave` in free
+    /// space). Returns what the main thread must know. Allocation-free.
+    #[allow(clippy::too_many_arguments)]
+    pub fn tick(
+        &mut self,
+        world: &mut World,
+        slave: usize,
+        dt: f64,
+        paused: bool,
+        watched: bool,
+        now_ns: u64,
+        answer: Option<(u32, u8)>,
+        stop: bool,
+    ) -> Option<Event> {
+        if self.phase == Phase::Stopping {
+            return None;
+        }
+        if stop {
+            self.phase = Phase::Stopping;
+            return Some(Event::Stop);
+        }
+        let mut event = None;
+        match (self.phase, self.plan) {
+            (Phase::FreeSpace(k), Some(plan))
+                if (k > 0 || watched) && !paused && in_free_space(world, slave) =>
+            {
+                let (n, f) = plan.laws[usize::from(k)];
+                world.normal = n;
+                world.friction = f;
+                self.phase = Phase::Presenting(k, self.interval_s);
+            }
+            (Phase::Presenting(k, left), Some(plan)) => {
+                let left = if paused { left } else { left - dt };
+                self.phase = if left > 0.0 {
+                    Phase::Presenting(k, left)
+                } else if k + 1 < plan.intervals {
+                    Phase::FreeSpace(k + 1)
+                } else {
+                    Phase::Answer(now_ns)
+                };
+            }
+            (Phase::Answer(prompt), Some(plan)) => {
+                if let Some((trial, choice)) = answer {
+                    if trial == plan.trial && valid_choice(self.task, choice) {
+                        event = Some(Event::Answered {
+                            trial,
+                            choice,
+                            rt_s: now_ns.saturating_sub(prompt) as f64 * 1e-9,
+                        });
+                        self.last_saved = trial;
+                        self.done = plan.done + 1;
+                        self.plan = None;
+                        self.phase = Phase::Idle;
+                        return event;
+                    }
+                    self.refused += 1;
+                }
+                return None;
+            }
+            _ => {}
+        }
+        if answer.is_some() {
+            // Not the answer phase: an early or late answer (a double click) is refused.
+            self.refused += 1;
+        }
+        event
+    }
+
+    /// What the page shows.
+    pub fn view(&self) -> StudyView {
+        let (interval, phase, remaining_s) = match self.phase {
+            Phase::Idle => (0, "starting", 0.0),
+            Phase::FreeSpace(k) => (k + 1, "free_space", self.interval_s),
+            Phase::Presenting(k, left) => (k + 1, "presenting", left.max(0.0)),
+            Phase::Answer(_) => (0, "answer", 0.0),
+            Phase::Stopping => (0, "stopping", 0.0),
+        };
+        StudyView {
+            trial: self.plan.map_or(0, |p| p.trial),
+            planned: self.planned,
+            done: self.done,
+            interval,
+            intervals: self.plan.map_or(self.task_intervals(), |p| p.intervals),
+            phase,
+            remaining_s,
+            task: task_name(self.task),
+            refused: self.refused,
+            last_saved: self.last_saved,
+        }
+    }
+
+    fn task_intervals(&self) -> u8 {
+        self.task.intervals() as u8
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use haptic2d::scene::builtin;
+
+    /// Two different stimuli: the paper's wall and Minsky's.
+    pub(crate) fn two_laws() -> [(NormalModel, FrictionModel); MAX_INTERVALS] {
+        let paper = NormalModel::from_name("paper", true).unwrap();
+        let minsky = NormalModel::from_name("minsky", true).unwrap();
+        let f = FrictionModel::default();
+        [(paper, f), (minsky, f), (minsky, f)]
+    }
+
+    fn plan(_world: &World, trial: u32) -> Plan {
+        Plan {
+            trial,
+            done: trial - 1,
+            planned: 10,
+            intervals: 2,
+            laws: two_laws(),
+        }
+    }
+
+    #[test]
+    fn answers_for_another_trial_or_outside_the_answer_phase_are_refused() {
+        let scene = builtin("box-in-walls", Some(1000.0)).unwrap().unwrap();
+        let mut w = scene.world;
+        let slave = w.body_index("box").unwrap();
+        let mut p = Presenter::new(Task::TwoAfc, 0.01);
+        assert!(p.start(plan(&w, 3)));
+        assert!(!p.start(plan(&w, 4)), "one trial at a time");
+        // An answer while presenting is refused.
+        assert_eq!(
+            p.tick(&mut w, slave, 1e-3, false, true, 0, Some((3, 1)), false),
+            None
+        );
+        assert_eq!(p.refused(), 1);
+        let mut t = 0;
+        while !matches!(p.phase(), Phase::Answer(_)) {
+            t += 1_000_000;
+            assert_eq!(
+                p.tick(&mut w, slave, 1e-3, false, true, t, None, false),
+                None
+            );
+            assert!(t < 100_000_000, "the intervals end");
+        }
+        let prompt = t;
+        // Another trial, an impossible choice: refused, still waiting.
+        assert_eq!(
+            p.tick(&mut w, slave, 1e-3, false, true, t, Some((2, 1)), false),
+            None
+        );
+        assert_eq!(
+            p.tick(&mut w, slave, 1e-3, false, true, t, Some((3, 3)), false),
+            None
+        );
+        assert_eq!(
+            p.tick(&mut w, slave, 1e-3, false, true, t, Some((3, 0)), false),
+            None
+        );
+        assert_eq!(p.refused(), 4);
+        assert!(matches!(p.phase(), Phase::Answer(_)));
+        let ev = p.tick(
+            &mut w,
+            slave,
+            1e-3,
+            false,
+            true,
+            prompt + 640_000_000,
+            Some((3, 2)),
+            false,
+        );
+        assert_eq!(
+            ev,
+            Some(Event::Answered {
+                trial: 3,
+                choice: 2,
+                rt_s: 0.64
+            })
+        );
+        assert_eq!(p.phase(), Phase::Idle);
+        // A second click on the same answer: refused.
+        assert_eq!(
+            p.tick(&mut w, slave, 1e-3, false, true, t, Some((3, 2)), false),
+            None
+        );
+        assert_eq!(p.refused(), 5);
+        assert_eq!(p.view().last_saved, 3);
+        assert_eq!(p.view().done, 3);
+    }
+
+    #[test]
+    fn paused_ticks_do_not_count_toward_an_interval() {
+        let scene = builtin("box-in-walls", Some(1000.0)).unwrap().unwrap();
+        let mut w = scene.world;
+        let slave = w.body_index("box").unwrap();
+        let mut p = Presenter::new(Task::TwoAfc, 0.005);
+        p.start(plan(&w, 1));
+        p.tick(&mut w, slave, 1e-3, false, true, 0, None, false);
+        assert_eq!(p.phase(), Phase::Presenting(0, 0.005));
+        for _ in 0..100 {
+            p.tick(&mut w, slave, 1e-3, true, true, 0, None, false);
+        }
+        assert_eq!(p.phase(), Phase::Presenting(0, 0.005));
+        for _ in 0..5 {
+            p.tick(&mut w, slave, 1e-3, false, true, 0, None, false);
+        }
+        assert_eq!(p.phase(), Phase::FreeSpace(1));
+    }
+
+    #[test]
+    fn same_different_takes_same_and_different_and_three_afc_takes_three_intervals() {
+        assert!(valid_choice(Task::SameDifferent, 0) && valid_choice(Task::SameDifferent, 1));
+        assert!(!valid_choice(Task::SameDifferent, 2));
+        assert!(!valid_choice(Task::TwoAfc, 0) && !valid_choice(Task::TwoAfc, 3));
+        assert!(valid_choice(Task::ThreeAfc, 3) && !valid_choice(Task::ThreeAfc, 0));
+    }
+}
