@@ -93,6 +93,8 @@ pub fn valid_choice(task: Task, choice: u8) -> bool {
         Task::TwoAfc => (1..=2).contains(&choice),
         Task::ThreeAfc => (1..=3).contains(&choice),
         Task::SameDifferent => choice <= 1,
+        // A number, not a choice: refused before the session starts (`study_browser::build_rig`).
+        Task::Magnitude => false,
     }
 }
 
@@ -102,6 +104,7 @@ pub fn task_name(task: Task) -> &'static str {
         Task::TwoAfc => "2afc",
         Task::ThreeAfc => "3afc",
         Task::SameDifferent => "same-different",
+        Task::Magnitude => "magnitude",
     }
 }
 
