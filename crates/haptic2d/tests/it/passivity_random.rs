@@ -239,6 +239,8 @@ struct Outcome {
     overlap: f64,
     /// The scene's derived bound on it (m, [`overlap_bound`]).
     bound: f64,
+    /// Dynamic bodies whose centre of mass ended outside the walls' outer faces.
+    escaped: usize,
     /// Largest hidden overlap over the run (m): the world's largest overlap less its deepest
     /// contact record, at one sample.
     hidden: f64,
@@ -284,11 +286,22 @@ fn max_excess(seed: u64, g: &Gen) -> Outcome {
         beyond = beyond.max(o.depth - deepest - CLIP_MARGIN * DEFAULT_DELTA_C - motion);
     }
     assert!(worst.is_finite(), "scene {seed} diverged\n{text}");
+    // Bodies whose centre of mass left the box (through a wall, the floor or the ceiling).
+    let escaped = w
+        .bodies
+        .iter()
+        .filter(|b| b.is_dynamic())
+        .filter(|b| {
+            let p = b.pose.pos;
+            !(-0.1..=BOX + 0.1).contains(&p.x) || !(-0.1..=BOX + 0.1).contains(&p.y)
+        })
+        .count();
     Outcome {
         seed,
         excess: worst,
         overlap,
         bound,
+        escaped,
         hidden,
         beyond,
         normal,
@@ -311,6 +324,17 @@ fn suite_of(seeds: Vec<u64>, g: &Gen) {
     let (worst_seed, worst) = (results[0].seed, results[0].excess);
     let over: Vec<_> = results.iter().filter(|r| r.excess > EXCESS_TOL).collect();
     let deep: Vec<_> = results.iter().filter(|r| r.overlap > r.bound).collect();
+    let escaped: Vec<(u64, usize, bool)> = results
+        .iter()
+        .filter(|r| r.escaped > 0)
+        .map(|r| (r.seed, r.escaped, r.impacts))
+        .collect();
+    println!(
+        "passivity_random: {} scenes end with a body outside the box (known failure, \
+         `random_polygon_scenes_keep_their_bodies_in_the_box`); first (seed, bodies, impacts): {:?}",
+        escaped.len(),
+        &escaped[..escaped.len().min(8)]
+    );
     let tightest = results
         .iter()
         .map(|r| (r.overlap / r.bound, r.seed))
@@ -420,6 +444,8 @@ fn random_polygon_scenes_create_no_energy_long() {
 /// scenes hid 31.0, 12.1 and 10.6 mm beyond the allowance (11574 and 10010 impacts off, 11996
 /// on; a 0.2 m/s triangle sunk 50 mm into the floor slid wholly under the left wall). Now the
 /// wall slab's faces hold vertices across its seam (`collide/seam.rs`): within the allowance.
+/// (Scene 11574 also loses a body through the floor early on, at about 1.4 s 7 m below the box:
+/// the known failure of `random_polygon_scenes_keep_their_bodies_in_the_box`.)
 #[test]
 fn corners_under_a_wall_slab_are_not_pushed_into_it() {
     let seeds = vec![11574, 10010, 11996];
@@ -429,5 +455,34 @@ fn corners_under_a_wall_slab_are_not_pushed_into_it() {
             max_bodies: 6,
             seconds: 2.0,
         },
+    );
+}
+
+/// Known failure (found 5 December 2026, branch `s25-seam`; the same on main): in 43 of the 300
+/// scenes (352 of the 2000 of the long variant), mostly with impacts off, a dynamic body
+/// ends outside the box, through the floor or a wall. Seed 6: a 45 kg polygon (made denser for
+/// the minimum-mass rule) on `minsky` with `k` = 3360 N/m has a static compression
+/// `m·g/k` ≈ 131 mm, more than the 100 mm floor slab: no spring of that law can hold it, and it
+/// sinks through the floor (75.7 mm overlap as it leaves at 2.55 m/s). A body that has left
+/// overlaps nothing, so the suite's overlap measures cannot see it, and [`overlap_bound`]'s
+/// premise (every centre of mass above `Y_LOW`) fails in those scenes. `check` warns per body when
+/// a spring cannot stop it within half a part's thickness (`scene::spring_stop_speed`); a static
+/// load beyond the thinnest part's thickness is not checked.
+#[test]
+#[ignore = "known failure: 43 of 300 scenes end with a body outside the box (see the doc comment)"]
+fn random_polygon_scenes_keep_their_bodies_in_the_box() {
+    let g = Gen {
+        max_bodies: 4,
+        seconds: 2.0,
+    };
+    let escaped: Vec<(u64, usize)> = (1..=300)
+        .map(|seed| max_excess(seed, &g))
+        .filter(|r| r.escaped > 0)
+        .map(|r| (r.seed, r.escaped))
+        .collect();
+    assert!(
+        escaped.is_empty(),
+        "{} scenes end with bodies outside the box (seed, bodies): {escaped:?}",
+        escaped.len()
     );
 }
