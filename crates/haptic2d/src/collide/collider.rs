@@ -116,6 +116,25 @@ impl Collider {
         self.reach.iter().fold(0.0f64, |m, &(_, r)| m.max(r))
     }
 
+    /// Whether the box `aabb` (world) reaches beyond the line of one of the
+    /// [`across`](Self::across) seams (a vertex inside it can be across that seam). False
+    /// without such seams.
+    pub fn beyond_across(&self, aabb: &Aabb) -> bool {
+        self.across != 0
+            && self.reach.iter().any(|&(e, _)| {
+                let (n, v) = (
+                    self.world_normals()[e as usize],
+                    self.world_vertices()[e as usize],
+                );
+                // The box's support along the seam's outward normal.
+                let far = Vec2::new(
+                    if n.x >= 0.0 { aabb.max.x } else { aabb.min.x },
+                    if n.y >= 0.0 { aabb.max.y } else { aabb.min.y },
+                );
+                n.dot(far - v) > 0.0
+            })
+    }
+
     /// The edge range of edge `e` (m, edge coordinates, before any `ε_s`): `[0, L]`, extended
     /// at an end where the edge meets an [`across`](Self::across) seam by that seam's reach
     /// (the face continues into the covering piece under this one).

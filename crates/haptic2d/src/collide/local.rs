@@ -740,7 +740,8 @@ impl LocalStage {
         // every sample.
         let under = (a.across | b.across) != 0
             && f.status == TrackStatus::Separated
-            && f.distance <= a.max_reach().max(b.max_reach());
+            && f.distance <= a.max_reach().max(b.max_reach())
+            && (a.beyond_across(&b.aabb) || b.beyond_across(&a.aabb));
         // A separated pair farther than δ_c may wait until its bodies have moved its gap.
         self.gaps[k] = match f.status {
             TrackStatus::Separated if f.distance > delta_c + GAP_GUARD && !under => Gap {
@@ -1080,6 +1081,8 @@ impl Ctx {
             let mut near_lines = 0u32;
             // The nearest line of all, seams included: whether the vertex is inside B.
             let mut max_all = f64::NEG_INFINITY;
+            // The nearest seam line: whether the vertex is across a seam.
+            let mut max_seam = f64::NEG_INFINITY;
             for (e, (&e0, &n)) in b_starts.iter().zip(b_normals).enumerate() {
                 // = `b.c.edge_distance(e, p)`
                 let d = n.dot(p - e0);
@@ -1097,6 +1100,7 @@ impl Ctx {
                 }
                 max_all = max_all.max(d);
                 if b.c.seams != 0 && b.c.is_seam(e) {
+                    max_seam = max_seam.max(d);
                     // A seam is no surface of B's body: never the vertex's contact normal.
                     slack.decided((self.delta_c - d).min((d + self.delta_c).abs()));
                     continue;
@@ -1121,7 +1125,7 @@ impl Ctx {
             // Outside B only across seams that face a partly covered edge, within their reach:
             // in the piece under B, at B's concave corner with it (`Collider::across_seam`).
             let across_only =
-                across && max_all > 0.0 && max_d <= 0.0 && b.c.across_seam(p).is_some();
+                across && max_seam > 0.0 && max_d <= 0.0 && b.c.across_seam(p).is_some();
             if max_d == f64::NEG_INFINITY || (max_all > max_d && max_all > 0.0 && !across_only) {
                 // Every edge of B is a seam, or the vertex is outside B across a seam: the
                 // neighbouring pieces' surfaces hold it.
@@ -1129,9 +1133,10 @@ impl Ctx {
                 continue;
             }
             if across {
-                // `across_only` is decided by the signs of `max_all` and `max_d`.
-                slack.decided(max_all.abs());
-                if max_all > 0.0 {
+                // `across_only` is decided by the signs of `max_seam` and then `max_d` (the
+                // reach tests are recorded in the loop above).
+                slack.decided(max_seam.abs());
+                if max_seam > 0.0 {
                     slack.decided(max_d.abs());
                 }
             }
