@@ -84,33 +84,9 @@ impl ContactSet {
         };
         // Pairs (a < b) with a record whose own-axis test fails, and those that lost a loaded
         // record out of its edge range this sample (`release`).
-        //
-        // A pair one of whose records clears it needs no other record tested: the second pass
-        // skips it whatever its other records show (unless a record of it was dropped, which
-        // lists it below anyway). Records are sorted by key, so those of one vertex collider are
-        // adjacent: within its run the edge colliders already cleared are remembered (up to
-        // `SEEN`), and their further records skip the `O(n)` test. The pairs listed, and so the
-        // stage's outcome, are those of testing every record, less pairs that are skipped below.
-        const SEEN: usize = 8;
         self.crossing.clear();
-        let mut run = u32::MAX;
-        let mut seen = [u32::MAX; SEEN];
-        let mut n_seen = 0usize;
         for e in self.entries.iter().filter(|e| e.is_contact()) {
-            if e.key.vertex_collider != run {
-                run = e.key.vertex_collider;
-                n_seen = 0;
-            }
-            let other = e.key.edge_collider;
-            if seen[..n_seen].contains(&other) {
-                continue;
-            }
-            if clears(e) {
-                if n_seen < SEEN {
-                    seen[n_seen] = other;
-                    n_seen += 1;
-                }
-            } else {
+            if !clears(e) {
                 self.crossing.push(pair_of(&e.key));
             }
         }
