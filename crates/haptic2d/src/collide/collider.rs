@@ -21,6 +21,16 @@ pub struct Collider {
     /// covered by another piece (`seam.rs`), and so never a contact normal. 0 for a lone piece;
     /// set by [`mark_seams`](super::mark_seams) (the world does it when it is built).
     pub seams: u128,
+    /// Seams that face a *partly* covered edge of another piece (the wall slab's bottom on the
+    /// floor slab's top, `seam.rs`): bit `e` set when the pieces across seam `e` reach
+    /// [`reach`](Self::reach) beyond its line. A vertex across such a seam, within the reach and
+    /// inside this piece's other lines, is in the covering piece *under this one*, and this
+    /// piece's surface lines hold it there too (the concave corner's second face).
+    pub across: u128,
+    /// `(e, r)` for each seam `e` of [`across`](Self::across): how far (m) the covering pieces
+    /// extend beyond the seam's line (the least, over them, of their extent behind it). Built
+    /// with the world, only read in a step.
+    pub reach: Vec<(u32, f64)>,
 }
 
 impl Collider {
@@ -34,6 +44,8 @@ impl Collider {
             world: vec![Vec2::ZERO; 2 * n],
             aabb: Aabb::EMPTY,
             seams: 0,
+            across: 0,
+            reach: Vec::new(),
         };
         c.update(pose);
         c
@@ -83,6 +95,83 @@ impl Collider {
     #[inline(always)]
     pub fn is_seam(&self, e: usize) -> bool {
         e < 128 && (self.seams >> e) & 1 == 1
+    }
+
+    /// How far (m) the covering pieces extend beyond seam `e` (0 unless `e` is in
+    /// [`across`](Self::across)).
+    #[inline]
+    pub fn reach(&self, e: usize) -> f64 {
+        if e >= 128 || (self.across >> e) & 1 == 0 {
+            return 0.0;
+        }
+        self.reach
+            .iter()
+            .find(|&&(f, _)| f as usize == e)
+            .map_or(0.0, |&(_, r)| r)
+    }
+
+    /// The largest [`reach`](Self::reach) of its seams (m; 0 without `across` seams).
+    #[inline]
+    pub fn max_reach(&self) -> f64 {
+        self.reach.iter().fold(0.0f64, |m, &(_, r)| m.max(r))
+    }
+
+    /// Whether the box `aabb` (world) reaches beyond the line of one of the
+    /// [`across`](Self::across) seams (a vertex inside it can be across that seam). False
+    /// without such seams.
+    pub fn beyond_across(&self, aabb: &Aabb) -> bool {
+        self.across != 0
+            && self.reach.iter().any(|&(e, _)| {
+                let (n, v) = (
+                    self.world_normals()[e as usize],
+                    self.world_vertices()[e as usize],
+                );
+                // The box's support along the seam's outward normal.
+                let far = Vec2::new(
+                    if n.x >= 0.0 { aabb.max.x } else { aabb.min.x },
+                    if n.y >= 0.0 { aabb.max.y } else { aabb.min.y },
+                );
+                n.dot(far - v) > 0.0
+            })
+    }
+
+    /// The edge range of edge `e` (m, edge coordinates, before any `ε_s`): `[0, L]`, extended
+    /// at an end where the edge meets an [`across`](Self::across) seam by that seam's reach
+    /// (the face continues into the covering piece under this one).
+    #[inline]
+    pub fn edge_range(&self, e: usize) -> (f64, f64) {
+        let len = self.local.lengths()[e];
+        if self.across == 0 {
+            return (0.0, len);
+        }
+        (
+            -self.reach(self.local.prev(e)),
+            len + self.reach(self.local.next(e)),
+        )
+    }
+
+    /// Whether world point `p` is outside this piece only across [`across`](Self::across) seams,
+    /// each within its reach (so inside the piece under it), and inside or on every other line:
+    /// `Some(d)` with `d` the largest of the other lines' distances, `None` otherwise.
+    pub fn across_seam(&self, p: Vec2) -> Option<f64> {
+        if self.across == 0 {
+            return None;
+        }
+        let (mut out, mut max_d) = (false, f64::NEG_INFINITY);
+        for e in 0..self.len() {
+            let d = self.edge_distance(e, p);
+            if self.is_seam(e) {
+                if d > 0.0 {
+                    if d > self.reach(e) {
+                        return None;
+                    }
+                    out = true;
+                }
+            } else {
+                max_d = max_d.max(d);
+            }
+        }
+        (out && max_d <= 0.0).then_some(max_d)
     }
 
     /// Number of vertices (= edges).

@@ -735,9 +735,16 @@ impl LocalStage {
             pair: (ia, ib),
             features: f,
         };
+        // A pair apart from a piece with `across` seams by less than their reach can have a
+        // vertex across one (in the piece under it), held by the piece's surfaces: scanned
+        // every sample.
+        let under = (a.across | b.across) != 0
+            && f.status == TrackStatus::Separated
+            && f.distance <= a.max_reach().max(b.max_reach())
+            && (a.beyond_across(&b.aabb) || b.beyond_across(&a.aabb));
         // A separated pair farther than δ_c may wait until its bodies have moved its gap.
         self.gaps[k] = match f.status {
-            TrackStatus::Separated if f.distance > delta_c + GAP_GUARD => Gap {
+            TrackStatus::Separated if f.distance > delta_c + GAP_GUARD && !under => Gap {
                 clear: f.distance - GAP_GUARD,
                 rel: now.rel,
                 angle_a: now.angle_a,
@@ -775,7 +782,17 @@ impl LocalStage {
             }
             TrackStatus::Separated if f.distance <= delta_c => {
                 ctx.closest_feature_candidates(a, b, &f, out);
+                if under {
+                    ctx.vertices_against(a, b, out, &mut Slack::new());
+                    ctx.vertices_against(b, a, out, &mut Slack::new());
+                }
                 false
+            }
+            TrackStatus::Separated if under => {
+                // Only vertices across a seam within its reach can be proposed here.
+                ctx.vertices_against(a, b, out, &mut Slack::new());
+                ctx.vertices_against(b, a, out, &mut Slack::new());
+                true
             }
             TrackStatus::Separated => false,
         }
@@ -1038,7 +1055,13 @@ impl Ctx {
         // A vertex farther than `δ_c + ε_s` outside B's box is farther than that from B: no
         // candidate (one needs an edge whose range holds it within `ε_s` and whose line is
         // within `δ_c`, which puts it within `δ_c + ε_s` of that edge) and not inside.
-        let reach = Vec2::new(self.delta_c + self.eps_s, self.delta_c + self.eps_s);
+        // A piece with `across` seams also holds vertices up to its seams' reach beyond them.
+        let across = b.c.across != 0;
+        let far = b.c.max_reach();
+        let reach = Vec2::new(
+            self.delta_c + self.eps_s + far,
+            self.delta_c + self.eps_s + far,
+        );
         let (lo, hi) = (b.c.aabb.min - reach, b.c.aabb.max + reach);
         // B's edges as (start, normal) pairs, read without bounds checks in the loop below.
         let (b_starts, b_normals) = (b.c.world_vertices(), b.c.world_normals());
@@ -1058,16 +1081,26 @@ impl Ctx {
             let mut near_lines = 0u32;
             // The nearest line of all, seams included: whether the vertex is inside B.
             let mut max_all = f64::NEG_INFINITY;
+            // The nearest seam line: whether the vertex is across a seam.
+            let mut max_seam = f64::NEG_INFINITY;
             for (e, (&e0, &n)) in b_starts.iter().zip(b_normals).enumerate() {
                 // = `b.c.edge_distance(e, p)`
                 let d = n.dot(p - e0);
                 if d > self.delta_c {
-                    // Farther than δ_c from B's half-plane, so from B.
-                    slack.decided(d - self.delta_c);
-                    continue 'vertex;
+                    // Across a seam within its reach: in the covering piece under B, where B's
+                    // surface lines hold it too (`Collider::across`).
+                    let r = if across { b.c.reach(e) } else { 0.0 };
+                    if d <= r {
+                        slack.decided((d - self.delta_c).min(r - d));
+                    } else {
+                        // Farther than δ_c from B's half-plane, so from B.
+                        slack.decided(d - self.delta_c);
+                        continue 'vertex;
+                    }
                 }
                 max_all = max_all.max(d);
                 if b.c.seams != 0 && b.c.is_seam(e) {
+                    max_seam = max_seam.max(d);
                     // A seam is no surface of B's body: never the vertex's contact normal.
                     slack.decided((self.delta_c - d).min((d + self.delta_c).abs()));
                     continue;
@@ -1089,18 +1122,30 @@ impl Ctx {
                     inside = Some(p);
                 }
             }
-            if max_d == f64::NEG_INFINITY || (max_all > max_d && max_all > 0.0) {
+            // Outside B only across seams that face a partly covered edge, within their reach:
+            // in the piece under B, at B's concave corner with it (`Collider::across_seam`).
+            let across_only =
+                across && max_seam > 0.0 && max_d <= 0.0 && b.c.across_seam(p).is_some();
+            if max_d == f64::NEG_INFINITY || (max_all > max_d && max_all > 0.0 && !across_only) {
                 // Every edge of B is a seam, or the vertex is outside B across a seam: the
                 // neighbouring pieces' surfaces hold it.
                 slack.decided(max_all.abs());
                 continue;
             }
+            if across {
+                // `across_only` is decided by the signs of `max_seam` and then `max_d` (the
+                // reach tests are recorded in the loop above).
+                slack.decided(max_seam.abs());
+                if max_seam > 0.0 {
+                    slack.decided(max_d.abs());
+                }
+            }
             // Nearest line first: its edge must hold the vertex (always so inside B, see above);
             // otherwise the vertex is in a corner region outside B and gets no candidate.
             let s = b.c.edge_coordinate(nearest, p);
-            let l = b.c.local.lengths()[nearest];
-            slack.decided((s + self.eps_s).abs().min((l + self.eps_s - s).abs()));
-            if s < -self.eps_s || s > l + self.eps_s {
+            let (r0, r1) = b.c.edge_range(nearest);
+            slack.decided((s - r0 + self.eps_s).abs().min((r1 + self.eps_s - s).abs()));
+            if s < r0 - self.eps_s || s > r1 + self.eps_s {
                 continue;
             }
             let mut e = nearest;
@@ -1216,8 +1261,10 @@ pub fn nearest_line(b: &Collider, p: Vec2) -> (usize, f64) {
             best = (e, d);
         }
     }
-    // Outside `b` across a seam: the point is that far from `b` (in the next piece).
-    if seam.1 > 0.0 && seam.1 > best.1 {
+    // Outside `b` across a seam: the point is that far from `b` (in the next piece), unless it
+    // is across seams that face a partly covered edge only, within their reach (in the piece
+    // under `b`, whose surface lines hold it too, `Collider::across_seam`).
+    if seam.1 > 0.0 && seam.1 > best.1 && !(best.1 <= 0.0 && b.across_seam(p).is_some()) {
         seam
     } else {
         best

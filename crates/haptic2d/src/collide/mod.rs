@@ -42,7 +42,7 @@ pub use local::{
     DEFAULT_EPS_S, NEAR_PARALLEL_ANGLE,
 };
 pub use overlap::{max_overlap, max_overlap_of_states, Overlap};
-pub use seam::{mark_seams, seam_mask, SEAM_ANGLE, SEAM_DISTANCE, SEAM_MAX_EDGES};
+pub use seam::{mark_seams, seam_mask, seam_reach, SEAM_ANGLE, SEAM_DISTANCE, SEAM_MAX_EDGES};
 pub use toi::{
     allowed_depth, radius as polygon_radius, speed_limit, swept_put_back,
     thickness as body_thickness, SweepScratch, SweptShape, TOI_MAX_SAMPLES,

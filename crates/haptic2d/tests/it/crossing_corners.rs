@@ -158,3 +158,84 @@ fn stack_5_polygons_overlap_is_seen_by_its_records_and_bounded_by_its_weight() {
     );
     assert!(worst <= 2.0 * weight / k, "overlap {worst} m beyond 2W/K");
 }
+
+/// Depth (m) of the plate's left end under the wall slab, and its top below the floor's top.
+const UNDER: f64 = 0.003;
+const PLATE_TOP: f64 = -0.0005;
+
+/// An L-shaped fixed body of two pieces (a floor slab, its top at `y = 0`, and a wall slab on its
+/// left end, its face at `x = 0`), and a thin plate (60 × 4 mm, 0.2 kg) sunk just under the
+/// floor's top with its left end `UNDER` under the wall slab, i.e. inside the floor slab where
+/// the floor's top edge is covered by the wall slab's bottom (a seam).
+fn joint_scene() -> String {
+    let (x0, x1) = (-UNDER, 0.06 - UNDER);
+    let (y0, y1) = (PLATE_TOP - 0.004, PLATE_TOP);
+    format!(
+        "name = \"slab-joint\"\n[world]\nrate = 1000\n[contact]\nimpacts = false\n\
+         [normal]\nmodel = \"paper\"\nkc = {KC}\nbc = 20.0\n[friction]\nmodel = \"none\"\n\
+         [[body]]\nname = \"walls\"\nkind = \"fixed\"\npieces = [\
+         [[-0.1, -0.1], [0.5, -0.1], [0.5, 0.0], [-0.1, 0.0]], \
+         [[-0.1, 0.0], [0.0, 0.0], [0.0, 0.3], [-0.1, 0.3]]]\n\
+         [[body]]\nname = \"plate\"\ndensity = {}\n\
+         polygon = [[{x0}, {y0}], [{x1}, {y0}], [{x1}, {y1}], [{x0}, {y1}]]\n\
+         [[load]]\nbody = \"*\"\nforce = [0.0, -9.81]\nper_mass = true\n",
+        0.2 / (0.06 * 0.004),
+    )
+}
+
+/// A corner inside the floor slab *under* the wall slab is at the body's concave corner: the
+/// body's surfaces there are the floor's exposed top (above it) and the wall slab's face (beside
+/// it, `UNDER` = 3 mm away), so it is held by both, and pushed out of the corner, not only up
+/// into the wall slab. The floor's top edge is only partly covered (a surface), the wall slab's
+/// bottom a whole seam that faces it (`Collider::across`, reach = the floor's 100 mm): the wall
+/// slab's face holds vertices across that seam within the reach (docs/MODELS.md §9.5a).
+///
+/// Derived: both left corners of the plate are `UNDER` behind the wall face's line `x = 0`
+/// (normal `+x`), inside the floor slab; so at `t = 0` each has a record on the wall slab's
+/// face with `n = (1, 0)` and `d = −UNDER`, which pushes the plate out from under the wall: within
+/// 0.2 s no part of it is left under the wall slab (`x ≥ 0`). Before, the wall slab gave the
+/// corners no candidate (they are outside it, across its bottom seam): the floor's top pushed
+/// them up, into the wall slab, where they arrived "found inside" (no stored depth) and stayed
+/// (the long passivity suite's seeds 11574, 10010 and 11996 hid 31.0, 12.1 and 10.6 mm beyond
+/// their allowance this way).
+#[test]
+fn corner_under_a_wall_slab_is_held_by_the_wall_face_and_pushed_out() {
+    let mut w = world(&joint_scene(), "slab-joint");
+    let wall = 1u32; // collider of the wall slab (second piece)
+    let plate = 2u32;
+    let face: Vec<_> = w
+        .contact_records()
+        .filter(|c| c.key.vertex_collider == plate && c.key.edge_collider == wall)
+        .map(|c| (c.key.vertex, c.n, c.d[0]))
+        .collect();
+    assert_eq!(
+        face.len(),
+        2,
+        "both left corners on the wall slab: {face:?}"
+    );
+    for &(v, n, d) in &face {
+        assert!(v == 0 || v == 3, "a left corner: {v}");
+        assert!(
+            (n.x - 1.0).abs() < 1e-12 && n.y.abs() < 1e-12,
+            "the face's normal: {n:?}"
+        );
+        assert!((d + UNDER).abs() < 1e-9, "depth UNDER: {d}");
+    }
+    for _ in 0..200 {
+        w.step();
+    }
+    let min_x = w.colliders[plate as usize]
+        .world_vertices()
+        .iter()
+        .map(|p| p.x)
+        .fold(f64::INFINITY, f64::min);
+    assert!(
+        min_x >= 0.0,
+        "the plate is out from under the wall: min x {min_x}"
+    );
+    assert!(
+        w.ledger().excess() < 1e-3,
+        "passive: {}",
+        w.ledger().excess()
+    );
+}

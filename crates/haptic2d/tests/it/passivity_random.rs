@@ -24,14 +24,10 @@ use std::fmt::Write as _;
 
 /// The passivity bound on the excess, per scene (J).
 const EXCESS_TOL: f64 = 1e-3;
-/// Bound on the largest overlap of two bodies in any scene (m, separating-axis depth,
-/// `World::max_overlap`). Measured over the 300 scenes: median 18.5 mm, largest 126.4 mm (main
-/// before issue 35: 126.9 mm, the same scenes): heavy bodies (made denser for the minimum-mass
-/// rule) resting on the softest laws sink by about `m·g/K` into the floor, and that depth is the
-/// records' own (seen, not hidden). So this is a regression bound (a body that sinks through the
-/// 100 mm floor, or tunnels, exceeds it), not a derived one; the geometry the suite derives is
-/// the hidden overlap below.
-const OVERLAP_BOUND: f64 = 0.15;
+/// The lowest a dynamic body's centre of mass can go while it has not passed through the floor
+/// (m): the floor slab's bottom (`−0.1`) less the largest circumradius (80 mm), see
+/// [`overlap_bound`].
+const Y_LOW: f64 = -0.18;
 /// The hidden overlap (issue 35 item 4, docs/MODELS.md §9.5b): at every sample, the world's
 /// largest overlap less its deepest contact record. Derived allowance: the clip contacts act
 /// when a pair's overlap exceeds its deepest record by `CLIP_MARGIN·δ_c` (1 mm), before the
@@ -186,6 +182,38 @@ fn scene(seed: u64, g: &Gen, heavier: i32) -> String {
     s
 }
 
+/// The derived bound (m) on the largest overlap of two bodies in a scene (separating-axis depth,
+/// `World::max_overlap`), from the scene alone (docs/MODELS.md §9.5b, "The suite's overlap
+/// bound"):
+///
+/// - energy: the run is passive (asserted: excess ≤ `EXCESS_TOL`), so the kinetic plus stored
+///   energy never exceeds `E = E_0 + Σ m_i·g·(y_i0 − Y_LOW) + EXCESS_TOL`, with `E_0` the ledger's
+///   initial energy (kinetic and contacts at `t = 0`) and the second term the most gravity can do
+///   while every centre of mass stays above `Y_LOW`;
+/// - depth: a record whose spring is pushed in by `x` (beyond its surface offset) stores at
+///   least `½·K·x²`, `K` the law's softest stiffness (`kc`, `k`; the hysteretic law's parallel
+///   spring `k0`, its blocks only add), so `x ≤ √(2·E/K)`;
+/// - hidden overlap: every sample the largest overlap is within `CLIP_MARGIN·δ_c` + one sample's
+///   motion + `HIDDEN_EXCESS` of the deepest record (asserted separately), and one sample's
+///   motion is at most `2·T·max_i(√(2E/m_i) + LEVER·√(2E/I_i))` (kinetic energy ≤ `E`).
+///
+/// The bound assumes records start at their surface (no offset); a record created "found inside"
+/// (`σ = δ`, §9.5a) is deeper than its spring by `σ`, and a scene where that matters exceeds it.
+fn overlap_bound(w: &haptic2d::world::World, gravity: bool) -> f64 {
+    let k = match &w.normal {
+        haptic2d::laws::normal::NormalModel::Hysteretic(l) => l.k0,
+        m => m.stiffness_damping().0,
+    };
+    let g = if gravity { 9.81 } else { 0.0 };
+    let dynamic = || w.bodies.iter().filter(|b| b.is_dynamic());
+    let drop: f64 = dynamic().map(|b| b.mass * g * (b.pose.pos.y - Y_LOW)).sum();
+    let e = w.ledger().initial + drop + EXCESS_TOL;
+    let speed = dynamic()
+        .map(|b| (2.0 * e / b.mass).sqrt() + LEVER * (2.0 * e / b.inertia).sqrt())
+        .fold(0.0, f64::max);
+    (2.0 * e / k).sqrt() + CLIP_MARGIN * DEFAULT_DELTA_C + 2.0 * w.params.dt * speed + HIDDEN_EXCESS
+}
+
 /// Scene `seed` and its world: a scene that `check` refuses only because a small body is too light
 /// for its contact law (the minimum-mass rule, §6.4) is made denser, 4× at a time, until accepted.
 fn world(seed: u64, g: &Gen) -> (String, haptic2d::world::World) {
@@ -209,6 +237,10 @@ struct Outcome {
     excess: f64,
     /// Largest overlap of two bodies over the run (m, separating-axis depth, `World::max_overlap`).
     overlap: f64,
+    /// The scene's derived bound on it (m, [`overlap_bound`]).
+    bound: f64,
+    /// Dynamic bodies whose centre of mass ended outside the walls' outer faces.
+    escaped: usize,
     /// Largest hidden overlap over the run (m): the world's largest overlap less its deepest
     /// contact record, at one sample.
     hidden: f64,
@@ -226,7 +258,9 @@ fn max_excess(seed: u64, g: &Gen) -> Outcome {
     let (normal, friction, impacts) =
         (w.normal.name(), w.friction.name(), w.params.contact.impacts);
     let bodies = w.bodies.len() - 1;
+    let gravity = !w.loads.is_empty();
     w.prime();
+    let bound = overlap_bound(&w, gravity);
     let mut worst = w.ledger().excess();
     let mut overlap = w.max_overlap().depth;
     let mut hidden = 0.0f64;
@@ -252,10 +286,22 @@ fn max_excess(seed: u64, g: &Gen) -> Outcome {
         beyond = beyond.max(o.depth - deepest - CLIP_MARGIN * DEFAULT_DELTA_C - motion);
     }
     assert!(worst.is_finite(), "scene {seed} diverged\n{text}");
+    // Bodies whose centre of mass left the box (through a wall, the floor or the ceiling).
+    let escaped = w
+        .bodies
+        .iter()
+        .filter(|b| b.is_dynamic())
+        .filter(|b| {
+            let p = b.pose.pos;
+            !(-0.1..=BOX + 0.1).contains(&p.x) || !(-0.1..=BOX + 0.1).contains(&p.y)
+        })
+        .count();
     Outcome {
         seed,
         excess: worst,
         overlap,
+        bound,
+        escaped,
         hidden,
         beyond,
         normal,
@@ -267,16 +313,32 @@ fn max_excess(seed: u64, g: &Gen) -> Outcome {
 
 /// Runs `scenes` scenes from `first_seed`, prints the summary line and asserts the bound.
 fn suite(first_seed: u64, scenes: u64, g: &Gen) {
-    let mut results: Vec<Outcome> = (first_seed..first_seed + scenes)
-        .map(|seed| max_excess(seed, g))
-        .collect();
+    suite_of((first_seed..first_seed + scenes).collect(), g)
+}
+
+/// [`suite`] over the listed seeds.
+fn suite_of(seeds: Vec<u64>, g: &Gen) {
+    let (first_seed, scenes) = (seeds[0], seeds.len() as u64);
+    let mut results: Vec<Outcome> = seeds.iter().map(|&seed| max_excess(seed, g)).collect();
     results.sort_by(|a, b| b.excess.total_cmp(&a.excess));
     let (worst_seed, worst) = (results[0].seed, results[0].excess);
     let over: Vec<_> = results.iter().filter(|r| r.excess > EXCESS_TOL).collect();
-    let deep: Vec<_> = results
+    let deep: Vec<_> = results.iter().filter(|r| r.overlap > r.bound).collect();
+    let escaped: Vec<(u64, usize, bool)> = results
         .iter()
-        .filter(|r| r.overlap > OVERLAP_BOUND)
+        .filter(|r| r.escaped > 0)
+        .map(|r| (r.seed, r.escaped, r.impacts))
         .collect();
+    println!(
+        "passivity_random: {} scenes end with a body outside the box (known failure, \
+         `random_polygon_scenes_keep_their_bodies_in_the_box`); first (seed, bodies, impacts): {:?}",
+        escaped.len(),
+        &escaped[..escaped.len().min(8)]
+    );
+    let tightest = results
+        .iter()
+        .map(|r| (r.overlap / r.bound, r.seed))
+        .fold((0.0, 0), |m, x| if x.0 > m.0 { x } else { m });
     let mut overlaps: Vec<f64> = results.iter().map(|r| r.overlap).collect();
     overlaps.sort_by(f64::total_cmp);
     let beyond_5mm = overlaps.iter().filter(|&&o| o > 0.005).count();
@@ -320,11 +382,12 @@ fn suite(first_seed: u64, scenes: u64, g: &Gen) {
         over.len()
     );
     println!(
-        "passivity_random: largest overlap of two bodies: median {:.2} mm, max {:.2} mm; {beyond_5mm} scenes above 5 mm, {} above the bound {} mm",
+        "passivity_random: largest overlap of two bodies: median {:.2} mm, max {:.2} mm; {beyond_5mm} scenes above 5 mm, {} above their derived bound (largest overlap/bound {:.3}, scene {})",
         overlaps[overlaps.len() / 2] * 1e3,
         overlaps[overlaps.len() - 1] * 1e3,
         deep.len(),
-        OVERLAP_BOUND * 1e3
+        tightest.0,
+        tightest.1,
     );
     assert!(
         hidden_over.is_empty(),
@@ -334,7 +397,7 @@ fn suite(first_seed: u64, scenes: u64, g: &Gen) {
     );
     assert!(
         deep.is_empty(),
-        "{} scenes overlapped more than {OVERLAP_BOUND} m: {deep:#?}",
+        "{} scenes overlapped more than their derived bound: {deep:#?}",
         deep.len()
     );
     assert!(
@@ -358,13 +421,12 @@ fn random_polygon_scenes_create_no_energy() {
 }
 
 #[test]
-/// Known failure (issue 35 item 4, open part): passive (worst excess 1.5e-8 J), but 3 of the 2000
-/// scenes hide an overlap more than `HIDDEN_EXCESS` beyond the allowance (seeds 11574: 31.0 mm,
-/// 10010: 12.1 mm, both impacts off; 11996: 10.6 mm, impacts on; 11669 and 11666 exceed the
-/// allowance by 7.2 and 5.2 mm); each of these scenes' largest overlap is with the multi-piece
-/// walls. Before the clip contacts 379 scenes hid more than 5 mm (up to 105 mm), now 14 (up to
-/// 60 mm).
-#[ignore = "long variant: 2000 scenes of up to 6 bodies, 2 s each (about a minute); fails its hidden-overlap assertion on 3 scenes (against the multi-piece walls, see the doc comment)"]
+/// Passes (5 December 2026, branch `s25-seam`): worst excess 1.5e-8 J; one scene hides an overlap
+/// beyond the allowance, by 7.1 mm (seed 11430, impacts on), within `HIDDEN_EXCESS`; 1 scene hides
+/// more than 5 mm in all (16.5 mm). Before the wall slabs held vertices across their seams
+/// (`collide/seam.rs`) 3 scenes failed (seeds 11574: 31.0 mm, 10010: 12.1 mm, 11996: 10.6 mm
+/// beyond), 14 hid more than 5 mm (up to 60 mm); before the clip contacts 379 (up to 105 mm).
+#[ignore = "long variant: 2000 scenes of up to 6 bodies, 2 s each (about 30 s in the test profile)"]
 fn random_polygon_scenes_create_no_energy_long() {
     suite(
         10_000,
@@ -373,5 +435,54 @@ fn random_polygon_scenes_create_no_energy_long() {
             max_bodies: 6,
             seconds: 2.0,
         },
+    );
+}
+
+/// The scenes of the long variant where corners slid into the floor slab *under* a wall slab (the
+/// floor's top is covered there by the wall slab's bottom seam): held only by the floor's top,
+/// they were pushed up into the wall slab and nothing stopped them sliding further under it; the
+/// scenes hid 31.0, 12.1 and 10.6 mm beyond the allowance (11574 and 10010 impacts off, 11996
+/// on; a 0.2 m/s triangle sunk 50 mm into the floor slid wholly under the left wall). Now the
+/// wall slab's faces hold vertices across its seam (`collide/seam.rs`): within the allowance.
+/// (Scene 11574 also loses a body through the floor early on, at about 1.4 s 7 m below the box:
+/// the known failure of `random_polygon_scenes_keep_their_bodies_in_the_box`.)
+#[test]
+fn corners_under_a_wall_slab_are_not_pushed_into_it() {
+    let seeds = vec![11574, 10010, 11996];
+    suite_of(
+        seeds,
+        &Gen {
+            max_bodies: 6,
+            seconds: 2.0,
+        },
+    );
+}
+
+/// Known failure (found 5 December 2026, branch `s25-seam`; the same on main): in 43 of the 300
+/// scenes (352 of the 2000 of the long variant), mostly with impacts off, a dynamic body
+/// ends outside the box, through the floor or a wall. Seed 6: a 45 kg polygon (made denser for
+/// the minimum-mass rule) on `minsky` with `k` = 3360 N/m has a static compression
+/// `m·g/k` ≈ 131 mm, more than the 100 mm floor slab: no spring of that law can hold it, and it
+/// sinks through the floor (75.7 mm overlap as it leaves at 2.55 m/s). A body that has left
+/// overlaps nothing, so the suite's overlap measures cannot see it, and [`overlap_bound`]'s
+/// premise (every centre of mass above `Y_LOW`) fails in those scenes. `check` warns per body when
+/// a spring cannot stop it within half a part's thickness (`scene::spring_stop_speed`); a static
+/// load beyond the thinnest part's thickness is not checked.
+#[test]
+#[ignore = "known failure: 43 of 300 scenes end with a body outside the box (see the doc comment)"]
+fn random_polygon_scenes_keep_their_bodies_in_the_box() {
+    let g = Gen {
+        max_bodies: 4,
+        seconds: 2.0,
+    };
+    let escaped: Vec<(u64, usize)> = (1..=300)
+        .map(|seed| max_excess(seed, &g))
+        .filter(|r| r.escaped > 0)
+        .map(|r| (r.seed, r.escaped))
+        .collect();
+    assert!(
+        escaped.is_empty(),
+        "{} scenes end with bodies outside the box (seed, bodies): {escaped:?}",
+        escaped.len()
     );
 }

@@ -3,7 +3,7 @@
 //! masses.
 
 use super::invariant::depth_ok;
-use super::sync::{geometry, new_entry, past_ds};
+use super::sync::{geometry, in_range, new_entry, past_ds};
 use super::ContactSet;
 use super::PastPoses;
 use crate::body::Body;
@@ -48,7 +48,7 @@ impl ContactSet {
             let touching = self.entries[g..h]
                 .iter()
                 .enumerate()
-                .filter(|(_, e)| e.d[0] <= p.delta_on && e.in_range(p.eps_s))
+                .filter(|(_, e)| e.d[0] <= p.delta_on && in_range(e, colliders, p.eps_s))
                 .max_by(|a, b| a.1.d[0].total_cmp(&b.1.d[0]))
                 .map(|(k, _)| g + k);
             let cos = self.cos_parallel;
@@ -160,7 +160,7 @@ impl ContactSet {
                                 && e.d[0] > 0.0
                                 && e.c0 < -p.v_c
                                 && e.d[0] + dt * e.c0 <= 0.0
-                                && e.in_range(p.eps_s)
+                                && in_range(e, colliders, p.eps_s)
                                 && !twin_has_record(entries, pending, e.key, colliders, cos)
                         })
                         .map(|k| g + k);
@@ -371,7 +371,12 @@ fn crossed_edge(
         if d_prev > 0.0 && d_now <= 0.0 {
             let lam = d_prev / (d_prev - d_now);
             let s_cross = crossing_coordinate(d_prev, d_now, s_prev, s_now);
-            if s_cross >= -eps_s && s_cross <= len + eps_s && best.is_none_or(|(l, _)| lam < l) {
+            let (r0, r1) = if cb.across == 0 {
+                (0.0, len)
+            } else {
+                cb.edge_range(e)
+            };
+            if s_cross >= r0 - eps_s && s_cross <= r1 + eps_s && best.is_none_or(|(l, _)| lam < l) {
                 best = Some((lam, e as u32));
             }
         }

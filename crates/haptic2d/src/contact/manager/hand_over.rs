@@ -52,8 +52,8 @@ impl ContactSet {
             // Never onto a seam (the vertex is then outside B, in the next piece).
             let holds = !cb.is_seam(j)
                 && max_d <= p.delta_off
-                && s_j >= -p.eps_s
-                && s_j <= cb.local.lengths()[j] + p.eps_s;
+                && s_j >= cb.edge_range(j).0 - p.eps_s
+                && s_j <= cb.edge_range(j).1 + p.eps_s;
             let e = &mut self.entries[idx];
             e.state = None;
             self.laws.release(e.law);

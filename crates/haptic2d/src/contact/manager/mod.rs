@@ -351,7 +351,7 @@ impl ContactSet {
         // Each of the next three stages is a pass over every record; the merge's pass has
         // already seen whether it would change anything (`StageWork`).
         if work.release {
-            self.release(tick);
+            self.release(tick, colliders);
         }
         if work.hand_over {
             self.hand_over(tick, colliders, bodies, past, normal, friction);

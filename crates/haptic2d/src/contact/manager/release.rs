@@ -1,18 +1,21 @@
 //! Stage 2 of the contact step: §8.2 rule 4 (release of a record that left its edge) and rule 5
 //! (re-collision, optional).
 
+use super::sync::in_range;
 use super::ContactSet;
+use crate::collide::Collider;
 use crate::contact::record::{ContactEvent, ContactState, EventKind, NO_LAW};
 
 impl ContactSet {
     /// §8.2 rule 4 (release) and rule 5 (re-collision, optional).
-    pub(super) fn release(&mut self, tick: u64) {
+    /// The edge range extends across the seams that face a partly covered edge (`in_range`).
+    pub(super) fn release(&mut self, tick: u64, colliders: &[Collider]) {
         let p = self.params;
         for e in self.entries.iter_mut() {
             if e.state != Some(ContactState::Continuous) {
                 continue;
             }
-            if e.d[0] > p.delta_off || !e.in_range(p.eps_s) {
+            if e.d[0] > p.delta_off || !in_range(e, colliders, p.eps_s) {
                 // A loaded record leaving its edge's range: its effective depth may go to its
                 // pair's clip records (crossing corners, `clip.rs`) in this sample.
                 if e.d[0] <= p.delta_off {

@@ -89,7 +89,7 @@ impl ContactSet {
             match e.state {
                 Some(ContactState::Continuous) => {
                     if e.d[0] > p.delta_off
-                        || !e.in_range(p.eps_s)
+                        || !in_range(e, colliders, p.eps_s)
                         || recollide.is_some_and(|v_re| e.c0 < -v_re)
                     {
                         work.release = true;
@@ -99,7 +99,7 @@ impl ContactSet {
                     }
                 }
                 Some(ContactState::Colliding) => {}
-                None => work.create |= e.d[0] <= p.delta_on && e.in_range(p.eps_s),
+                None => work.create |= e.d[0] <= p.delta_on && in_range(e, colliders, p.eps_s),
             }
         }
         let len = self.entries.len() as u32;
@@ -132,7 +132,7 @@ impl ContactSet {
         merge_in_place(&mut self.entries, &self.changes, |cand| {
             let j = cand as usize;
             let e = new_entry(tick, candidates[j], colliders, bodies, past);
-            work.create |= e.d[0] <= p.delta_on && e.in_range(p.eps_s);
+            work.create |= e.d[0] <= p.delta_on && in_range(&e, colliders, p.eps_s);
             VeContact {
                 nearest_edge: flags.is_some_and(|f| f[j]),
                 ..e
@@ -211,6 +211,21 @@ pub(super) fn merge_in_place<T: Copy>(
         }
     }
     v.truncate(new_len);
+}
+
+/// Whether record `e`'s vertex is within its edge's range `±ε_s` ([`VeContact::in_range`]), the
+/// range extended across the seams that face a partly covered edge
+/// ([`Collider::edge_range`]): a face of a wall slab continues into the floor slab under it.
+/// The edge's collider is read only for a vertex out of the plain range.
+#[inline(always)]
+pub(super) fn in_range(e: &VeContact, colliders: &[Collider], eps_s: f64) -> bool {
+    e.in_range(eps_s) || {
+        let cb = &colliders[e.key.edge_collider as usize];
+        cb.across != 0 && {
+            let (r0, r1) = cb.edge_range(e.key.edge as usize);
+            e.s >= r0 - eps_s && e.s <= r1 + eps_s
+        }
+    }
 }
 
 /// Re-measures an existing entry: shifts the histories and refreshes geometry and velocities from
