@@ -5,6 +5,7 @@ use super::device::device_from_table;
 use super::file::SceneFile;
 use super::laws::{friction_from, normal_from};
 use super::load_table::loads_from;
+use super::static_sink::static_sink_warnings;
 use super::world_table::{contact_params, world_params};
 use super::{SceneError, SceneErrors};
 use crate::body::Body;
@@ -109,6 +110,7 @@ pub(super) fn build(
         warnings.push(PULSE_NOT_PASSIVE_2D.to_string());
     }
     let loads = loads_from(&file.loads, &bodies, &mut errs);
+    warnings.extend(static_sink_warnings(&bodies, &shapes, &loads, &normal));
     if !bodies.iter().any(|b| b.is_dynamic()) && errs.is_empty() {
         warnings.push("the scene has no dynamic body: nothing will move".into());
     }

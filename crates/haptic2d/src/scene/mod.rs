@@ -13,6 +13,7 @@ mod error;
 mod file;
 mod laws;
 mod load_table;
+pub mod static_sink;
 pub mod overlap;
 mod world_table;
 
