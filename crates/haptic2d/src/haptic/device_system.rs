@@ -1,9 +1,11 @@
 //! [`DeviceSystem`]: the haptic system for either kind of device — the twin pantograph (4 joints,
 //! x, y, θ: [`HapticSystem`], MODELS §10–§11; the simulated device, a replay, the Haply twin) or a
 //! 2-DOF five-bar (2 joints, x and y of a grasp point: [`Planar2System`]; a Haply 2DIY, a UDP
-//! five-bar, the Inverse3). The one enum every front end drives (the rig of `haptic2d run`, the
-//! Haply closed loop of `haptic2d-devices`): the loop, the watchdog, the logs and the display see
-//! one interface; each method says what the 2-DOF form does differently.
+//! five-bar, the Inverse3). Both are [`Haptic`](super::Haptic) over their device coupling and run
+//! the same tick ([`Haptic::haptic_tick`](super::Haptic::haptic_tick)); the enum only routes the
+//! joint reading to the right device. The one enum every front end drives (the rig of `haptic2d
+//! run`, the Haply closed loop of `haptic2d-devices`): the loop, the watchdog, the logs and the
+//! display see one interface; each method says what the 2-DOF form does differently.
 
 use crate::control::passivity::PlanarPassivity;
 use crate::device::linalg::{V3, V4};
@@ -11,10 +13,11 @@ use crate::device::TwinKinematics;
 use crate::world::World;
 
 use super::config::ControllerKind;
-use super::planar2::{Planar2Output, Planar2System};
+use super::planar2::Planar2System;
 use super::record::TickRecord;
 use super::safety::SafetyTrip;
-use super::system::{HapticSystem, TickOutput};
+use super::system::HapticSystem;
+use super::tick::TickOutput;
 
 /// The system a device drives.
 #[derive(Clone, Debug)]
@@ -27,22 +30,6 @@ pub enum DeviceSystem {
     TwoDof(Planar2System),
 }
 
-/// A 2-DOF output in the twin's shape: torques `[τ1, τ2, 0, 0]`; no closure monitor on a five-bar.
-#[inline]
-fn widen(o: Planar2Output) -> TickOutput {
-    TickOutput {
-        torques: [o.torques[0], o.torques[1], 0.0, 0.0],
-        tripped: o.tripped,
-        margin: if o.record.margin.is_finite() {
-            o.record.margin
-        } else {
-            0.0
-        },
-        closure_fault: false,
-        record: o.record,
-    }
-}
-
 impl DeviceSystem {
     /// One tick on joint angles `q` (rad) taken `elapsed` s after the previous tick (the interval
     /// the device's signals are differentiated over; `None`: one period, a device paced by the
@@ -50,18 +37,19 @@ impl DeviceSystem {
     #[inline]
     pub fn tick(&mut self, q: &V4, elapsed: Option<f64>, paused: bool) -> TickOutput {
         match self {
-            DeviceSystem::Twin(s) => match (paused, elapsed) {
-                (true, _) => s.tick_paused(q),
-                (false, None) => s.tick(q),
-                (false, Some(e)) => s.tick_elapsed(q, e),
-            },
+            DeviceSystem::Twin(s) => {
+                let elapsed = elapsed.unwrap_or(s.dt());
+                match paused {
+                    true => s.haptic_tick_paused(q),
+                    false => s.haptic_tick(q, elapsed, f64::NAN),
+                }
+            }
             DeviceSystem::TwoDof(s) => {
-                let q2 = [q[0], q[1]];
-                widen(match (paused, elapsed) {
-                    (true, _) => s.tick_paused(&q2),
-                    (false, None) => s.tick(&q2),
-                    (false, Some(e)) => s.tick_elapsed(&q2, e),
-                })
+                let (q2, elapsed) = ([q[0], q[1]], elapsed.unwrap_or(s.dt()));
+                match paused {
+                    true => s.haptic_tick_paused(&q2),
+                    false => s.haptic_tick(&q2, elapsed, f64::NAN),
+                }
             }
         }
     }
@@ -72,8 +60,8 @@ impl DeviceSystem {
     #[inline]
     pub fn tick_timed(&mut self, q: &V4, elapsed: f64, device_wait: f64) -> TickOutput {
         match self {
-            DeviceSystem::Twin(s) => s.tick_timed(q, elapsed, device_wait),
-            DeviceSystem::TwoDof(s) => widen(s.tick_timed(&[q[0], q[1]], elapsed, device_wait)),
+            DeviceSystem::Twin(s) => s.haptic_tick(q, elapsed, device_wait),
+            DeviceSystem::TwoDof(s) => s.haptic_tick(&[q[0], q[1]], elapsed, device_wait),
         }
     }
 
