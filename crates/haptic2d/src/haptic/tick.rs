@@ -282,3 +282,82 @@ where
         self.dt
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::device::pantograph2::Pantograph2;
+    use crate::geom::Vec2;
+    use crate::haptic::planar2::{Planar2Config, Planar2System};
+    use crate::haptic::{ControllerKind, DeviceSystem, HapticConfig, HapticSystem, SafetyReason};
+    use crate::scene::builtin;
+
+    fn linkage() -> Pantograph2 {
+        Pantograph2::new(0.038, 0.07, 0.09).unwrap()
+    }
+
+    fn five_bar() -> DeviceSystem {
+        let world = builtin("box-in-walls", Some(1000.0))
+            .unwrap()
+            .unwrap()
+            .world;
+        let mut c = Planar2Config::new(linkage(), 0.123);
+        c.controller = ControllerKind::from_name("coupling").unwrap();
+        c.safety.ramp_time = 0.0;
+        DeviceSystem::TwoDof(Planar2System::new(world, c).unwrap())
+    }
+
+    fn twin() -> (DeviceSystem, [f64; 4]) {
+        let world = builtin("box-in-walls", Some(1000.0))
+            .unwrap()
+            .unwrap()
+            .world;
+        let sys = HapticSystem::new(world, &HapticConfig::default()).unwrap();
+        let q = sys.device().kin.ik(&sys.device_start()).unwrap();
+        (DeviceSystem::Twin(sys), q)
+    }
+
+    /// Joint angles of the five-bar's handle `dx` m from the gen 3 workspace centre along x.
+    fn q_at(dx: f64) -> [f64; 4] {
+        let q = linkage().ik(Vec2::new(0.019 + dx, 0.10)).unwrap();
+        [q[0], q[1], 0.0, 0.0]
+    }
+
+    /// The fault injection was the twin's alone while each device had its own tick; with one tick
+    /// the 2-DOF device's torques pass the same injection point and the same final gate.
+    #[test]
+    fn a_non_finite_torque_on_a_five_bar_is_zeroed_by_the_shared_gate_in_the_same_tick() {
+        let mut sys = five_bar();
+        sys.tick(&q_at(0.0), None, false);
+        let out = sys.tick(&q_at(0.004), None, false);
+        assert!(!out.tripped && out.torques[0].abs() > 0.0, "{out:?}");
+        let DeviceSystem::TwoDof(s) = &mut sys else {
+            unreachable!()
+        };
+        s.inject_torque_fault(1, f64::NAN);
+        let out = sys.tick(&q_at(0.004), None, false);
+        assert!(out.tripped);
+        assert_eq!(out.torques, [0.0; 4]);
+        let trip = sys.safety_trip().unwrap();
+        assert!(
+            matches!(trip.reason, SafetyReason::NonFiniteTorque { index: 1, .. }),
+            "{trip}"
+        );
+    }
+
+    /// The paused tick is written once: on either device it zeroes the torques, leaves the world's
+    /// time standing and still reads the device (the margin of a valid reading is reported).
+    #[test]
+    fn a_paused_tick_zeroes_torques_and_freezes_the_world_on_either_device() {
+        let (twin, q_twin) = twin();
+        for (mut sys, q) in [(twin, q_twin), (five_bar(), q_at(0.004))] {
+            sys.tick(&q, None, false);
+            let t = sys.world().time();
+            for _ in 0..3 {
+                let out = sys.tick(&q, None, true);
+                assert_eq!(out.torques, [0.0; 4]);
+                assert!(!out.tripped && out.margin > 0.0, "{out:?}");
+            }
+            assert_eq!(sys.world().time(), t, "the world stood still");
+        }
+    }
+}
