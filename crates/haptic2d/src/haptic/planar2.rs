@@ -116,13 +116,17 @@ pub struct Planar2Output {
 /// [`Haptic`] over a five-bar held at a grasp point.
 pub type Planar2System = Haptic<GraspCoupling>;
 
-/// A 2-DOF five-bar as the tick drives it (see the module doc): the device, the translation from
-/// the device to the world (anchored at the first reading), the grasp point and the twist target.
+/// A 2-DOF device as the tick drives it (see the module doc): the device `D` (the five-bar
+/// [`Pantograph2Device`], or the pass-through [`PointDevice`](crate::device::PointDevice)), the
+/// translation from the device to the world (anchored at the first reading), the grasp point, the
+/// twist target, and the system's settings `S` as given.
 #[derive(Clone, Debug)]
-pub struct GraspCoupling {
-    config: Planar2Config,
-    /// The five-bar at the Cartesian boundary: handle point, filtered velocity, `τ = Jᵀ·f`.
-    device: Pantograph2Device,
+pub struct GraspCoupling<D = Pantograph2Device, S = Planar2Config> {
+    pub(super) settings: S,
+    /// Grasp point in the slave's body frame (m).
+    grasp: [f64; 2],
+    /// The device at the Cartesian boundary: handle point, filtered velocity, `τ = Jᵀ·f`.
+    device: D,
     /// World point of the grasp at start (m): the first handle position maps here.
     world_origin: Vec2,
     device_origin: Option<Vec2>,
@@ -132,7 +136,7 @@ pub struct GraspCoupling {
     twist_gains: (f64, f64),
 }
 
-impl GraspCoupling {
+impl<D, S> GraspCoupling<D, S> {
     /// The handle point of reading `e` in world coordinates (m): `E − E_0 + G_0`, with `E_0` the
     /// anchored handle point (this one before the anchor) and `G_0` the grasp point at the anchor.
     fn handle_world(&self, e: &DeviceEstimate) -> Vec2 {
@@ -142,14 +146,14 @@ impl GraspCoupling {
     }
 }
 
-impl DeviceCoupling for GraspCoupling {
-    type Device = Pantograph2Device;
+impl<D: CartesianDevice<Joints = [f64; 2]>, S> DeviceCoupling for GraspCoupling<D, S> {
+    type Device = D;
     const MARGIN_AT_SENSE: bool = true;
 
-    fn device(&self) -> &Pantograph2Device {
+    fn device(&self) -> &D {
         &self.device
     }
-    fn device_mut(&mut self) -> &mut Pantograph2Device {
+    fn device_mut(&mut self) -> &mut D {
         &mut self.device
     }
 
@@ -165,7 +169,7 @@ impl DeviceCoupling for GraspCoupling {
 
     fn unalign(&mut self, world: &World, slave: usize) {
         self.device_origin = None;
-        self.world_origin = grasp_world(world, slave, self.config.grasp);
+        self.world_origin = grasp_world(world, slave, self.grasp);
     }
 
     /// The slave held at the grasp point: its position `c + R·r_g` and velocity `v + ω × R·r_g`.
@@ -173,7 +177,7 @@ impl DeviceCoupling for GraspCoupling {
         let mut s = SlaveState::at_centre(world, i);
         let body = &world.bodies[i];
         let (c, theta, omega) = (body.pose.pos, body.pose.angle, body.omega);
-        let r = rotate(theta, self.config.grasp);
+        let r = rotate(theta, self.grasp);
         let (pg, vg) = (c + r, body.vel + omega * perp(r));
         s.x_s = [pg.x, pg.y, theta];
         s.v_s = [vg.x, vg.y, omega];
@@ -252,10 +256,74 @@ impl DeviceCoupling for GraspCoupling {
     }
 }
 
+/// What every 2-DOF system is built from besides its device and settings (checked by
+/// [`grasp_system`]).
+pub(super) struct GraspParts {
+    pub controller: ControllerKind,
+    pub slave: Option<String>,
+    pub grasp: [f64; 2],
+    pub velocity_cutoff_hz: f64,
+    pub safety: SafetyConfig,
+    pub keep_slave_loads: bool,
+    pub workspace: WorkspaceSquare,
+    /// Trip below this singularity margin (the device's own measure).
+    pub min_margin: f64,
+    /// The final gate's limit (N·m, or N on a point device).
+    pub gate_limit: f64,
+}
+
+/// A 2-DOF system around `world` for the device `device(dt)` held at a grasp point; errors name the
+/// setting.
+pub(super) fn grasp_system<D, S>(
+    mut world: World,
+    device: impl FnOnce(f64) -> D,
+    settings: S,
+    p: GraspParts,
+) -> Result<Haptic<GraspCoupling<D, S>>, String>
+where
+    D: CartesianDevice<Joints = [f64; 2]>,
+{
+    let dt = world.params.dt;
+    if !p.grasp.iter().all(|v| v.is_finite()) {
+        return Err(format!("grasp = {:?} m: must be finite", p.grasp));
+    }
+    if !(p.velocity_cutoff_hz.is_finite() && p.velocity_cutoff_hz > 0.0) {
+        return Err("velocity_cutoff_hz must be > 0 Hz (default 50)".into());
+    }
+    p.safety.validate()?;
+    p.workspace.validate()?;
+    let slave = find_slave(&world, p.slave.as_deref())?;
+    let body = &world.bodies[slave];
+    let controller = Controller::build(p.controller, &world, slave, dt)?;
+    let world_origin = grasp_world(&world, slave, p.grasp);
+    let wn = 2.0 * std::f64::consts::PI * TWIST_TARGET_HZ;
+    let twist_gains = (body.inertia * wn * wn, 2.0 * body.inertia * wn);
+    if !p.keep_slave_loads {
+        world.loads.retain(|l| l.body != slave);
+    }
+    let safety = SafetyStage::new(
+        p.safety,
+        Safety::new(p.min_margin, p.gate_limit, p.safety.torque_trip_margin),
+        WorkspaceBound::of_square(&p.workspace, dt),
+        dt,
+    );
+    let coupling = GraspCoupling {
+        settings,
+        grasp: p.grasp,
+        device: device(dt),
+        world_origin,
+        device_origin: None,
+        twist_target: None,
+        twist_gains,
+    };
+    Ok(Haptic::assemble(
+        coupling, controller, None, world, slave, safety,
+    ))
+}
+
 impl Planar2System {
     /// Builds the system around `world` (its period is the tick period). Errors name the setting.
-    pub fn new(mut world: World, config: Planar2Config) -> Result<Self, String> {
-        let dt = world.params.dt;
+    pub fn new(world: World, config: Planar2Config) -> Result<Self, String> {
         for (i, t) in config.tau_max.iter().enumerate() {
             if !(t.is_finite() && *t > 0.0) {
                 return Err(format!(
@@ -263,54 +331,40 @@ impl Planar2System {
                 ));
             }
         }
-        if !config.grasp.iter().all(|v| v.is_finite()) {
-            return Err(format!("grasp = {:?} m: must be finite", config.grasp));
-        }
-        if !(config.velocity_cutoff_hz.is_finite() && config.velocity_cutoff_hz > 0.0) {
-            return Err("velocity_cutoff_hz must be > 0 Hz (default 50)".into());
-        }
-        config.safety.validate()?;
-        config.workspace.validate()?;
-        let slave = find_slave(&world, config.slave.as_deref())?;
-        let body = &world.bodies[slave];
-        let controller = Controller::build(config.controller, &world, slave, dt)?;
-        let world_origin = grasp_world(&world, slave, config.grasp);
-        let wn = 2.0 * std::f64::consts::PI * TWIST_TARGET_HZ;
-        let twist_gains = (body.inertia * wn * wn, 2.0 * body.inertia * wn);
-        if !config.keep_slave_loads {
-            world.loads.retain(|l| l.body != slave);
-        }
-        // The final gate clamps to the smaller motor limit (the saturation already scales each
-        // motor to its own) and trips above it by the default margin.
-        let safety = SafetyStage::new(
-            config.safety,
-            Safety::new(
-                config.min_singularity_margin,
-                config.tau_max[0].min(config.tau_max[1]),
-                config.safety.torque_trip_margin,
-            ),
-            WorkspaceBound::of_square(&config.workspace, dt),
-            dt,
-        );
-        let coupling = GraspCoupling {
-            device: Pantograph2Device::new(
-                config.linkage,
-                config.tau_max,
-                config.min_singularity_margin,
-                config.velocity_cutoff_hz,
-                dt,
-            ),
-            twist_target: None,
-            twist_gains,
-            config,
-            world_origin,
-            device_origin: None,
+        let parts = GraspParts {
+            controller: config.controller,
+            slave: config.slave.clone(),
+            grasp: config.grasp,
+            velocity_cutoff_hz: config.velocity_cutoff_hz,
+            safety: config.safety,
+            keep_slave_loads: config.keep_slave_loads,
+            workspace: config.workspace,
+            min_margin: config.min_singularity_margin,
+            // The final gate clamps to the smaller motor limit (the saturation already scales
+            // each motor to its own) and trips above it by the default margin.
+            gate_limit: config.tau_max[0].min(config.tau_max[1]),
         };
-        Ok(Haptic::assemble(
-            coupling, controller, None, world, slave, safety,
-        ))
+        let (linkage, tau_max) = (config.linkage, config.tau_max);
+        let (min_margin, cutoff) = (config.min_singularity_margin, config.velocity_cutoff_hz);
+        let device = |dt| Pantograph2Device::new(linkage, tau_max, min_margin, cutoff, dt);
+        grasp_system(world, device, config, parts)
     }
 
+    /// Switches the teleoperation controller to `kind` from its reset state; the gains are checked
+    /// against the slave's mass as in [`Self::new`], and on error the running controller is kept.
+    pub fn set_controller(&mut self, kind: ControllerKind) -> Result<(), String> {
+        self.controller = Controller::build(kind, &self.world, self.slave, self.dt)?;
+        self.coupling.settings.controller = kind;
+        Ok(())
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &Planar2Config {
+        &self.coupling.settings
+    }
+}
+
+impl<D: CartesianDevice<Joints = [f64; 2]>, S> Haptic<GraspCoupling<D, S>> {
     /// Sets the twist target `θ_t` (rad, unwrapped like the body's angle), or turns it off (`None`);
     /// a non-finite angle turns it off.
     pub fn set_twist_target(&mut self, theta: Option<f64>) {
@@ -364,18 +418,6 @@ impl Planar2System {
         narrow(self.haptic_tick_paused(q))
     }
 
-    /// Switches the teleoperation controller to `kind` from its reset state; the gains are checked
-    /// against the slave's mass as in [`Self::new`], and on error the running controller is kept.
-    pub fn set_controller(&mut self, kind: ControllerKind) -> Result<(), String> {
-        self.controller = Controller::build(kind, &self.world, self.slave, self.dt)?;
-        self.coupling.config.controller = kind;
-        Ok(())
-    }
-
-    /// The configuration.
-    pub fn config(&self) -> &Planar2Config {
-        &self.coupling.config
-    }
     /// Handle position (m, board frame) that maps to the slave's grasp point at start, once measured.
     pub fn device_origin(&self) -> Option<Vec2> {
         self.coupling.device_origin
