@@ -1,7 +1,7 @@
 //! [`HapticSystem`]: the twin pantograph's haptic system, `Haptic<TwinCoupling>` — the device
 //! (x, y, θ) behind a [`DeviceMap`] (scale, anchored at the first reading), the slave held at its
 //! centre, the optional passivity controller on the device port. The tick is the one of
-//! [`Haptic`](super::Haptic) (`tick.rs`); this file holds the twin's coupling and its API.
+//! [`Haptic`] (`tick.rs`); this file holds the twin's coupling and its API.
 
 use crate::control::four_channel::TeleopSignals;
 use crate::control::passivity::PlanarPassivity;
