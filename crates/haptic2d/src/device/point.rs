@@ -16,6 +16,7 @@ use super::cartesian::CartesianDevice;
 use super::fault::DeviceFault;
 use super::filter::VelocityFilter;
 use super::linalg::{M3, V3, V4};
+use super::pantograph2_device::planar_estimate;
 use super::twin_pantograph::{DeviceEstimate, TorqueCommand};
 
 /// A handle point read directly, with its force limit, velocity filter and last reading.
@@ -61,14 +62,7 @@ impl CartesianDevice for PointDevice {
             return Err(DeviceFault::NonFinite);
         }
         self.point = Some(*u);
-        let pose = [u[0], u[1], 0.0];
-        let v = self.filter.update_elapsed(&pose, elapsed);
-        Ok(DeviceEstimate {
-            pose,
-            velocity: [v[0], v[1], 0.0],
-            hand_wrench: [0.0; 3],
-            closure_error: 0.0,
-        })
+        Ok(planar_estimate(&mut self.filter, *u, elapsed))
     }
 
     /// `(f_x, f_y)` (N; the moment `f[2]` has no actuator), scaled by

@@ -30,7 +30,7 @@ pub use device_system::DeviceSystem;
 pub use experiment::DeviceInTheLoop;
 pub use limit_cycle::LimitCycleMonitor;
 pub use mapping::DeviceMap;
-pub use planar2::{GraspCoupling, Planar2System};
+pub use planar2::{GraspConfig, GraspCoupling, GraspSettings, Planar2System};
 pub use plausibility::JointPlausibility;
 pub use point::{PointConfig, PointSystem};
 pub use record::{TickRecord, TICK_COLUMNS};

@@ -256,29 +256,66 @@ impl<D: CartesianDevice<Joints = [f64; 2]>, S> DeviceCoupling for GraspCoupling<
     }
 }
 
-/// What every 2-DOF system is built from besides its device and settings (checked by
-/// [`grasp_system`]).
-pub(super) struct GraspParts {
+/// The settings every 2-DOF system shares, whatever its device: the controller, the slave and the
+/// grasp point, the velocity filter, the safety settings and the workspace square (the fields of
+/// [`Planar2Config`] of the same names).
+#[derive(Clone, Debug, PartialEq)]
+pub struct GraspConfig {
+    /// Teleoperation controller (§11), acting on x and y.
     pub controller: ControllerKind,
+    /// Name of the slave body; `None` = the first dynamic body.
     pub slave: Option<String>,
+    /// Grasp point in the slave's body frame (m). Default `(0, 0)`, the centre.
     pub grasp: [f64; 2],
+    /// Velocity low-pass cut-off (Hz), §10.7. Default 50.
     pub velocity_cutoff_hz: f64,
+    /// The shared safety settings ([`SafetyConfig`]): ramp, stall limit, trip margin.
     pub safety: SafetyConfig,
+    /// Keep the scene's loads on the slave body. Default false (the hand drives it).
     pub keep_slave_loads: bool,
+    /// The workspace square of the device file (device frame, m) with its wall and trip.
     pub workspace: WorkspaceSquare,
-    /// Trip below this singularity margin (the device's own measure).
-    pub min_margin: f64,
-    /// The final gate's limit (N·m, or N on a point device).
-    pub gate_limit: f64,
 }
 
-/// A 2-DOF system around `world` for the device `device(dt)` held at a grasp point; errors name the
+impl GraspConfig {
+    /// The defaults above around the workspace square `workspace`.
+    pub fn new(workspace: WorkspaceSquare) -> Self {
+        Self {
+            controller: ControllerKind::default(),
+            slave: None,
+            grasp: [0.0; 2],
+            velocity_cutoff_hz: 50.0,
+            safety: SafetyConfig::default(),
+            keep_slave_loads: false,
+            workspace,
+        }
+    }
+}
+
+impl From<&Planar2Config> for GraspConfig {
+    fn from(c: &Planar2Config) -> Self {
+        Self {
+            controller: c.controller,
+            slave: c.slave.clone(),
+            grasp: c.grasp,
+            velocity_cutoff_hz: c.velocity_cutoff_hz,
+            safety: c.safety,
+            keep_slave_loads: c.keep_slave_loads,
+            workspace: c.workspace,
+        }
+    }
+}
+
+/// A 2-DOF system around `world` for the device `device(dt)` held at a grasp point with the shared
+/// settings `p`, the singularity limit `min_margin` (the device's own measure) and the final gate's
+/// limit `gate_limit` (N·m, or N on a point device); `settings` is kept as given. Errors name the
 /// setting.
 pub(super) fn grasp_system<D, S>(
     mut world: World,
     device: impl FnOnce(f64) -> D,
     settings: S,
-    p: GraspParts,
+    p: &GraspConfig,
+    (min_margin, gate_limit): (f64, f64),
 ) -> Result<Haptic<GraspCoupling<D, S>>, String>
 where
     D: CartesianDevice<Joints = [f64; 2]>,
@@ -303,7 +340,7 @@ where
     }
     let safety = SafetyStage::new(
         p.safety,
-        Safety::new(p.min_margin, p.gate_limit, p.safety.torque_trip_margin),
+        Safety::new(min_margin, gate_limit, p.safety.torque_trip_margin),
         WorkspaceBound::of_square(&p.workspace, dt),
         dt,
     );
@@ -331,40 +368,43 @@ impl Planar2System {
                 ));
             }
         }
-        let parts = GraspParts {
-            controller: config.controller,
-            slave: config.slave.clone(),
-            grasp: config.grasp,
-            velocity_cutoff_hz: config.velocity_cutoff_hz,
-            safety: config.safety,
-            keep_slave_loads: config.keep_slave_loads,
-            workspace: config.workspace,
-            min_margin: config.min_singularity_margin,
-            // The final gate clamps to the smaller motor limit (the saturation already scales
-            // each motor to its own) and trips above it by the default margin.
-            gate_limit: config.tau_max[0].min(config.tau_max[1]),
-        };
+        // The final gate clamps to the smaller motor limit (the saturation already scales each
+        // motor to its own) and trips above it by the default margin.
+        let gate_limit = config.tau_max[0].min(config.tau_max[1]);
         let (linkage, tau_max) = (config.linkage, config.tau_max);
         let (min_margin, cutoff) = (config.min_singularity_margin, config.velocity_cutoff_hz);
         let device = |dt| Pantograph2Device::new(linkage, tau_max, min_margin, cutoff, dt);
-        grasp_system(world, device, config, parts)
+        let common = GraspConfig::from(&config);
+        grasp_system(world, device, config, &common, (min_margin, gate_limit))
     }
+}
 
+/// The settings a 2-DOF system keeps ([`Planar2Config`], [`PointConfig`](super::PointConfig)): the
+/// controller they name follows [`Haptic::set_controller`].
+pub trait GraspSettings {
+    /// The teleoperation controller of the settings.
+    fn controller_mut(&mut self) -> &mut ControllerKind;
+}
+
+impl GraspSettings for Planar2Config {
+    fn controller_mut(&mut self) -> &mut ControllerKind {
+        &mut self.controller
+    }
+}
+
+impl<D: CartesianDevice<Joints = [f64; 2]>, S: GraspSettings> Haptic<GraspCoupling<D, S>> {
     /// Switches the teleoperation controller to `kind` from its reset state; the gains are checked
-    /// against the slave's mass as in [`Self::new`], and on error the running controller is kept.
+    /// against the slave's mass as when built, and on error the running controller is kept.
     pub fn set_controller(&mut self, kind: ControllerKind) -> Result<(), String> {
         self.controller = Controller::build(kind, &self.world, self.slave, self.dt)?;
-        self.coupling.settings.controller = kind;
+        *self.coupling.settings.controller_mut() = kind;
         Ok(())
     }
 
     /// The configuration.
-    pub fn config(&self) -> &Planar2Config {
+    pub fn config(&self) -> &S {
         &self.coupling.settings
     }
-}
-
-impl<D: CartesianDevice<Joints = [f64; 2]>, S> Haptic<GraspCoupling<D, S>> {
     /// Sets the twist target `θ_t` (rad, unwrapped like the body's angle), or turns it off (`None`);
     /// a non-finite angle turns it off.
     pub fn set_twist_target(&mut self, theta: Option<f64>) {

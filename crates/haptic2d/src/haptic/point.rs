@@ -9,9 +9,7 @@ use crate::device::PointDevice;
 use crate::world::World;
 
 use super::config::ControllerKind;
-use super::controller::Controller;
-use super::planar2::{grasp_system, GraspCoupling, GraspParts};
-use super::safety::SafetyConfig;
+use super::planar2::{grasp_system, GraspConfig, GraspCoupling, GraspSettings};
 use super::tick::Haptic;
 use super::workspace::WorkspaceSquare;
 
@@ -23,35 +21,18 @@ pub type PointSystem = Haptic<GraspCoupling<PointDevice, PointConfig>>;
 pub struct PointConfig {
     /// Force limit on `|(f_x, f_y)|` (N), > 0: the device's own (the Inverse3's `limits.force_limit`).
     pub force_limit: f64,
-    /// Teleoperation controller (§11), acting on x and y.
-    pub controller: ControllerKind,
-    /// Name of the slave body; `None` = the first dynamic body.
-    pub slave: Option<String>,
-    /// Grasp point in the slave's body frame (m). Default `(0, 0)`, the centre.
-    pub grasp: [f64; 2],
-    /// Velocity low-pass cut-off (Hz), §10.7. Default 50.
-    pub velocity_cutoff_hz: f64,
-    /// The shared safety settings ([`SafetyConfig`]): ramp, stall limit, trip margin.
-    pub safety: SafetyConfig,
-    /// Keep the scene's loads on the slave body. Default false (the hand drives it).
-    pub keep_slave_loads: bool,
-    /// The workspace square of the device file (device frame, m) with its wall and trip.
-    pub workspace: WorkspaceSquare,
+    /// The settings every 2-DOF system shares (controller, slave, grasp point, filter, safety,
+    /// workspace square).
+    pub common: GraspConfig,
 }
 
 impl PointConfig {
     /// A configuration for a device with force limit `force_limit` (N) and workspace square
-    /// `workspace`, with the defaults above.
+    /// `workspace` (device frame, m), with [`GraspConfig::new`]'s defaults.
     pub fn new(force_limit: f64, workspace: WorkspaceSquare) -> Self {
         Self {
             force_limit,
-            controller: ControllerKind::default(),
-            slave: None,
-            grasp: [0.0; 2],
-            velocity_cutoff_hz: 50.0,
-            safety: SafetyConfig::default(),
-            keep_slave_loads: false,
-            workspace,
+            common: GraspConfig::new(workspace),
         }
     }
 }
@@ -63,33 +44,17 @@ impl PointSystem {
         if !(f.is_finite() && f > 0.0) {
             return Err(format!("force_limit = {f} N: must be a finite number > 0"));
         }
-        let parts = GraspParts {
-            controller: config.controller,
-            slave: config.slave.clone(),
-            grasp: config.grasp,
-            velocity_cutoff_hz: config.velocity_cutoff_hz,
-            safety: config.safety,
-            keep_slave_loads: config.keep_slave_loads,
-            workspace: config.workspace,
-            // No singularity: the margin is 1 at every reading.
-            min_margin: 0.0,
-            gate_limit: f,
-        };
-        let cutoff = config.velocity_cutoff_hz;
-        grasp_system(world, |dt| PointDevice::new(f, cutoff, dt), config, parts)
+        let cutoff = config.common.velocity_cutoff_hz;
+        let common = config.common.clone();
+        let device = |dt| PointDevice::new(f, cutoff, dt);
+        // No singularity: the margin is 1 at every reading.
+        grasp_system(world, device, config, &common, (0.0, f))
     }
+}
 
-    /// Switches the teleoperation controller to `kind` from its reset state; the gains are checked
-    /// against the slave's mass as in [`Self::new`], and on error the running controller is kept.
-    pub fn set_controller(&mut self, kind: ControllerKind) -> Result<(), String> {
-        self.controller = Controller::build(kind, &self.world, self.slave, self.dt)?;
-        self.coupling.settings.controller = kind;
-        Ok(())
-    }
-
-    /// The configuration.
-    pub fn config(&self) -> &PointConfig {
-        &self.coupling.settings
+impl GraspSettings for PointConfig {
+    fn controller_mut(&mut self) -> &mut ControllerKind {
+        &mut self.common.controller
     }
 }
 
@@ -98,8 +63,8 @@ mod tests {
     use super::*;
     use crate::control::coupling::CouplingGains;
     use crate::haptic::record::FLAG_SATURATED;
+    use crate::haptic::tick::tests::box_in_walls;
     use crate::haptic::{DeviceSystem, SafetyReason};
-    use crate::scene::builtin;
 
     /// The device's rest point (m, device frame) and the square around it.
     const U0: [f64; 2] = [0.01, -0.02];
@@ -107,16 +72,13 @@ mod tests {
     /// A point system on box-in-walls with a spring-only coupling (K = 500 N/m, no damping, so the
     /// force depends on the position error alone), no ramp and a 5 N force limit.
     fn point_system() -> DeviceSystem {
-        let world = builtin("box-in-walls", Some(1000.0))
-            .unwrap()
-            .unwrap()
-            .world;
+        let world = box_in_walls();
         let mut c = PointConfig::new(5.0, WorkspaceSquare::around(U0, 0.05));
-        c.controller = ControllerKind::Coupling(CouplingGains {
+        c.common.controller = ControllerKind::Coupling(CouplingGains {
             k: [500.0, 500.0, 1.0],
             b: [0.0; 3],
         });
-        c.safety.ramp_time = 0.0;
+        c.common.safety.ramp_time = 0.0;
         DeviceSystem::Point(PointSystem::new(world, c).unwrap())
     }
 
@@ -169,12 +131,8 @@ mod tests {
 
     #[test]
     fn a_force_limit_that_is_not_positive_is_refused_naming_the_field() {
-        let world = builtin("box-in-walls", Some(1000.0))
-            .unwrap()
-            .unwrap()
-            .world;
         let c = PointConfig::new(0.0, WorkspaceSquare::around(U0, 0.05));
-        let err = PointSystem::new(world, c).unwrap_err();
+        let err = PointSystem::new(box_in_walls(), c).unwrap_err();
         assert!(err.contains("force_limit"), "{err}");
     }
 }

@@ -284,49 +284,45 @@ where
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use crate::device::pantograph2::Pantograph2;
     use crate::geom::Vec2;
     use crate::haptic::planar2::{Planar2Config, Planar2System};
     use crate::haptic::{ControllerKind, DeviceSystem, HapticConfig, HapticSystem, SafetyReason};
-    use crate::scene::builtin;
+    use crate::world::World;
 
-    fn linkage() -> Pantograph2 {
-        Pantograph2::new(0.038, 0.07, 0.09).unwrap()
+    /// The box-in-walls scene at 1 kHz, the slave's world in these tests.
+    pub(in crate::haptic) fn box_in_walls() -> World {
+        let scene = crate::scene::builtin("box-in-walls", Some(1000.0));
+        scene.unwrap().unwrap().world
     }
 
-    fn five_bar() -> DeviceSystem {
-        let world = builtin("box-in-walls", Some(1000.0))
-            .unwrap()
-            .unwrap()
-            .world;
-        let mut c = Planar2Config::new(linkage(), 0.123);
+    /// A gen 3 2DIY linkage (m) with the coupling controller and no ramp, and the joint angles of
+    /// its handle `dx` m from the workspace centre along x.
+    fn five_bar() -> (DeviceSystem, impl Fn(f64) -> [f64; 4]) {
+        let linkage = Pantograph2::new(0.038, 0.07, 0.09).unwrap();
+        let mut c = Planar2Config::new(linkage, 0.123);
         c.controller = ControllerKind::from_name("coupling").unwrap();
         c.safety.ramp_time = 0.0;
-        DeviceSystem::TwoDof(Planar2System::new(world, c).unwrap())
+        let sys = Planar2System::new(box_in_walls(), c).unwrap();
+        let q_at = move |dx: f64| {
+            let q = linkage.ik(Vec2::new(0.019 + dx, 0.10)).unwrap();
+            [q[0], q[1], 0.0, 0.0]
+        };
+        (DeviceSystem::TwoDof(sys), q_at)
     }
 
     fn twin() -> (DeviceSystem, [f64; 4]) {
-        let world = builtin("box-in-walls", Some(1000.0))
-            .unwrap()
-            .unwrap()
-            .world;
-        let sys = HapticSystem::new(world, &HapticConfig::default()).unwrap();
+        let sys = HapticSystem::new(box_in_walls(), &HapticConfig::default()).unwrap();
         let q = sys.device().kin.ik(&sys.device_start()).unwrap();
         (DeviceSystem::Twin(sys), q)
-    }
-
-    /// Joint angles of the five-bar's handle `dx` m from the gen 3 workspace centre along x.
-    fn q_at(dx: f64) -> [f64; 4] {
-        let q = linkage().ik(Vec2::new(0.019 + dx, 0.10)).unwrap();
-        [q[0], q[1], 0.0, 0.0]
     }
 
     /// The fault injection was the twin's alone while each device had its own tick; with one tick
     /// the 2-DOF device's torques pass the same injection point and the same final gate.
     #[test]
     fn a_non_finite_torque_on_a_five_bar_is_zeroed_by_the_shared_gate_in_the_same_tick() {
-        let mut sys = five_bar();
+        let (mut sys, q_at) = five_bar();
         sys.tick(&q_at(0.0), None, false);
         let out = sys.tick(&q_at(0.004), None, false);
         assert!(!out.tripped && out.torques[0].abs() > 0.0, "{out:?}");
@@ -349,7 +345,8 @@ mod tests {
     #[test]
     fn a_paused_tick_zeroes_torques_and_freezes_the_world_on_either_device() {
         let (twin, q_twin) = twin();
-        for (mut sys, q) in [(twin, q_twin), (five_bar(), q_at(0.004))] {
+        let (five_bar, q_at) = five_bar();
+        for (mut sys, q) in [(twin, q_twin), (five_bar, q_at(0.004))] {
             sys.tick(&q, None, false);
             let t = sys.world().time();
             for _ in 0..3 {
