@@ -12,6 +12,23 @@ use super::linalg::{M3, V3, V4};
 use super::pantograph2::{jt_mul, Pantograph2, Pantograph2State};
 use super::twin_pantograph::{DeviceEstimate, TorqueCommand};
 
+/// The estimate of a 2-DOF handle point `p` (m, device frame) read `elapsed` s after the previous
+/// reading: pose `(x, y, 0)`, the velocity of `filter` (§10.7), no hand wrench, no closure error.
+pub(super) fn planar_estimate(
+    filter: &mut VelocityFilter,
+    p: [f64; 2],
+    elapsed: f64,
+) -> DeviceEstimate {
+    let pose = [p[0], p[1], 0.0];
+    let v = filter.update_elapsed(&pose, elapsed);
+    DeviceEstimate {
+        pose,
+        velocity: [v[0], v[1], 0.0],
+        hand_wrench: [0.0; 3],
+        closure_error: 0.0,
+    }
+}
+
 /// A five-bar with its motor limits, velocity filter and the state at the last reading.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Pantograph2Device {
@@ -70,14 +87,7 @@ impl CartesianDevice for Pantograph2Device {
             }
         };
         self.state = Some(s);
-        let pose = [s.e.x, s.e.y, 0.0];
-        let v = self.filter.update_elapsed(&pose, elapsed);
-        Ok(DeviceEstimate {
-            pose,
-            velocity: [v[0], v[1], 0.0],
-            hand_wrench: [0.0; 3],
-            closure_error: 0.0,
-        })
+        Ok(planar_estimate(&mut self.filter, [s.e.x, s.e.y], elapsed))
     }
 
     /// `τ = Jᵀ·(f_x, f_y)` (the moment `f[2]` has no motor), scaled by

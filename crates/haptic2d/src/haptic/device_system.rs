@@ -1,9 +1,12 @@
-//! [`DeviceSystem`]: the haptic system for either kind of device — the twin pantograph (4 joints,
-//! x, y, θ: [`HapticSystem`], MODELS §10–§11; the simulated device, a replay, the Haply twin) or a
+//! [`DeviceSystem`]: the haptic system for any kind of device — the twin pantograph (4 joints,
+//! x, y, θ: [`HapticSystem`], MODELS §10–§11; the simulated device, a replay, the Haply twin), a
 //! 2-DOF five-bar (2 joints, x and y of a grasp point: [`Planar2System`]; a Haply 2DIY, a UDP
-//! five-bar, the Inverse3). The one enum every front end drives (the rig of `haptic2d run`, the
-//! Haply closed loop of `haptic2d-devices`): the loop, the watchdog, the logs and the display see
-//! one interface; each method says what the 2-DOF form does differently.
+//! five-bar, the Inverse3 through its driver's virtual five-bar) or a Cartesian point device (the
+//! handle point in, a force out: [`PointSystem`]). All are [`Haptic`](super::Haptic) over their
+//! device coupling and run the same tick ([`Haptic::haptic_tick`](super::Haptic::haptic_tick)); the
+//! enum only routes the reading to the right device. The one enum every front end drives (the rig
+//! of `haptic2d run`, the Haply closed loop of `haptic2d-devices`): the loop, the watchdog, the logs
+//! and the display see one interface; each method says what the 2-DOF forms do differently.
 
 use crate::control::passivity::PlanarPassivity;
 use crate::device::linalg::{V3, V4};
@@ -11,10 +14,12 @@ use crate::device::TwinKinematics;
 use crate::world::World;
 
 use super::config::ControllerKind;
-use super::planar2::{Planar2Output, Planar2System};
+use super::planar2::Planar2System;
+use super::point::PointSystem;
 use super::record::TickRecord;
 use super::safety::SafetyTrip;
-use super::system::{HapticSystem, TickOutput};
+use super::system::HapticSystem;
+use super::tick::TickOutput;
 
 /// The system a device drives.
 #[derive(Clone, Debug)]
@@ -25,55 +30,62 @@ pub enum DeviceSystem {
     /// A 2-DOF five-bar holding the slave at a grasp point: x and y; the rotation is left to the
     /// world. Joints `q[0..2]`, torques `τ[0..2]` (`τ[2..4]` always zero).
     TwoDof(Planar2System),
+    /// A Cartesian point device holding the slave at a grasp point, as [`Self::TwoDof`]: the handle
+    /// point `q[0..2]` (m), the force `τ[0..2]` (N).
+    Point(PointSystem),
 }
 
-/// A 2-DOF output in the twin's shape: torques `[τ1, τ2, 0, 0]`; no closure monitor on a five-bar.
-#[inline]
-fn widen(o: Planar2Output) -> TickOutput {
-    TickOutput {
-        torques: [o.torques[0], o.torques[1], 0.0, 0.0],
-        tripped: o.tripped,
-        margin: if o.record.margin.is_finite() {
-            o.record.margin
-        } else {
-            0.0
-        },
-        closure_fault: false,
-        record: o.record,
-    }
+/// `$body` with `$s` bound to the system of whichever variant `$self` holds.
+macro_rules! each {
+    ($self:expr, $s:ident => $body:expr) => {
+        match $self {
+            DeviceSystem::Twin($s) => $body,
+            DeviceSystem::TwoDof($s) => $body,
+            DeviceSystem::Point($s) => $body,
+        }
+    };
 }
 
 impl DeviceSystem {
-    /// One tick on joint angles `q` (rad) taken `elapsed` s after the previous tick (the interval
-    /// the device's signals are differentiated over; `None`: one period, a device paced by the
-    /// ticks), or a paused tick. Never allocates.
+    /// One tick on joint readings `q` (rad; m on a point device) taken `elapsed` s after the
+    /// previous tick (the interval the device's signals are differentiated over; `None`: one period,
+    /// a device paced by the ticks), or a paused tick. Never allocates.
     #[inline]
     pub fn tick(&mut self, q: &V4, elapsed: Option<f64>, paused: bool) -> TickOutput {
         match self {
-            DeviceSystem::Twin(s) => match (paused, elapsed) {
-                (true, _) => s.tick_paused(q),
-                (false, None) => s.tick(q),
-                (false, Some(e)) => s.tick_elapsed(q, e),
-            },
+            DeviceSystem::Twin(s) => {
+                let elapsed = elapsed.unwrap_or(s.dt());
+                match paused {
+                    true => s.haptic_tick_paused(q),
+                    false => s.haptic_tick(q, elapsed, f64::NAN),
+                }
+            }
             DeviceSystem::TwoDof(s) => {
-                let q2 = [q[0], q[1]];
-                widen(match (paused, elapsed) {
-                    (true, _) => s.tick_paused(&q2),
-                    (false, None) => s.tick(&q2),
-                    (false, Some(e)) => s.tick_elapsed(&q2, e),
-                })
+                let (q2, elapsed) = ([q[0], q[1]], elapsed.unwrap_or(s.dt()));
+                match paused {
+                    true => s.haptic_tick_paused(&q2),
+                    false => s.haptic_tick(&q2, elapsed, f64::NAN),
+                }
+            }
+            DeviceSystem::Point(s) => {
+                let (u, elapsed) = ([q[0], q[1]], elapsed.unwrap_or(s.dt()));
+                match paused {
+                    true => s.haptic_tick_paused(&u),
+                    false => s.haptic_tick(&u, elapsed, f64::NAN),
+                }
             }
         }
     }
 
-    /// A running tick on joint angles `q` (rad) taken `elapsed` s after the previous one, of which
-    /// the loop waited `device_wait` s for the device (so that a stall says whether the host or the
-    /// device was late). Never allocates.
+    /// A running tick on joint readings `q` (rad; m on a point device) taken `elapsed` s after the
+    /// previous one, of which the loop waited `device_wait` s for the device (so that a stall says
+    /// whether the host or the device was late). Never allocates.
     #[inline]
     pub fn tick_timed(&mut self, q: &V4, elapsed: f64, device_wait: f64) -> TickOutput {
         match self {
-            DeviceSystem::Twin(s) => s.tick_timed(q, elapsed, device_wait),
-            DeviceSystem::TwoDof(s) => widen(s.tick_timed(&[q[0], q[1]], elapsed, device_wait)),
+            DeviceSystem::Twin(s) => s.haptic_tick(q, elapsed, device_wait),
+            DeviceSystem::TwoDof(s) => s.haptic_tick(&[q[0], q[1]], elapsed, device_wait),
+            DeviceSystem::Point(s) => s.haptic_tick(&[q[0], q[1]], elapsed, device_wait),
         }
     }
 
@@ -82,89 +94,66 @@ impl DeviceSystem {
     /// true when it tripped. Never allocates.
     #[inline]
     pub fn check_stall(&mut self, elapsed: f64, device_wait: f64) -> bool {
-        match self {
-            DeviceSystem::Twin(s) => s.check_stall(elapsed, device_wait),
-            DeviceSystem::TwoDof(s) => s.check_stall(elapsed, device_wait),
-        }
+        each!(self, s => s.check_stall(elapsed, device_wait))
     }
 
     /// The world.
     pub fn world(&self) -> &World {
-        match self {
-            DeviceSystem::Twin(s) => s.world(),
-            DeviceSystem::TwoDof(s) => s.world(),
-        }
+        each!(self, s => s.world())
     }
 
     /// Mutable access to the world (between ticks).
     pub fn world_mut(&mut self) -> &mut World {
-        match self {
-            DeviceSystem::Twin(s) => s.world_mut(),
-            DeviceSystem::TwoDof(s) => s.world_mut(),
-        }
+        each!(self, s => s.world_mut())
     }
 
     /// Index of the slave body.
     pub fn slave(&self) -> usize {
-        match self {
-            DeviceSystem::Twin(s) => s.slave(),
-            DeviceSystem::TwoDof(s) => s.slave(),
-        }
+        each!(self, s => s.slave())
     }
 
     /// The latched safety trip, if any.
     pub fn safety_trip(&self) -> Option<SafetyTrip> {
-        match self {
-            DeviceSystem::Twin(s) => s.safety_trip(),
-            DeviceSystem::TwoDof(s) => s.safety_trip(),
-        }
+        each!(self, s => s.safety_trip())
     }
 
     /// The record of the last tick (`x_m`: the twin's handle pose in the device frame; the 2-DOF
     /// handle point already in world coordinates).
     pub fn last_record(&self) -> &TickRecord {
-        match self {
-            DeviceSystem::Twin(s) => s.last_record(),
-            DeviceSystem::TwoDof(s) => s.last_record(),
-        }
+        each!(self, s => s.last_record())
     }
 
     /// Switches the controller (checked against the slave's mass; on error nothing changes).
     pub fn set_controller(&mut self, kind: ControllerKind) -> Result<(), String> {
-        match self {
-            DeviceSystem::Twin(s) => s.set_controller(kind),
-            DeviceSystem::TwoDof(s) => s.set_controller(kind),
-        }
+        each!(self, s => s.set_controller(kind))
     }
 
     /// The twin pantograph's kinematics (for the display's drawing of the linkage); `None` for a
     /// 2-DOF device.
     pub fn twin_kinematics(&self) -> Option<&TwinKinematics> {
-        match self {
-            DeviceSystem::Twin(s) => Some(&s.device().kin),
-            DeviceSystem::TwoDof(_) => None,
-        }
+        self.twin().map(|s| &s.device().kin)
     }
 
     /// The passivity controller, if the twin runs one (never on a 2-DOF device).
     pub fn passivity(&self) -> Option<&PlanarPassivity> {
-        match self {
-            DeviceSystem::Twin(s) => s.passivity(),
-            DeviceSystem::TwoDof(_) => None,
-        }
+        self.twin().and_then(|s| s.passivity())
     }
 
     /// The twin system, if this is one.
     pub fn twin(&self) -> Option<&HapticSystem> {
         match self {
             DeviceSystem::Twin(s) => Some(s),
-            DeviceSystem::TwoDof(_) => None,
+            _ => None,
         }
     }
 
     /// Translation from the device frame to the world frame (m): world = device + offset. The 2-DOF
     /// mapping is the translation anchored at the first handle reading (zero before it).
     pub fn device_to_world(&self) -> [f64; 2] {
+        let grasp = |d: Option<crate::geom::Vec2>, w: crate::geom::Vec2| match d {
+            Some(d) => [w.x - d.x, w.y - d.y],
+            None => [0.0; 2],
+        };
         match self {
             DeviceSystem::Twin(s) => {
                 let m = s.map();
@@ -173,13 +162,8 @@ impl DeviceSystem {
                     m.world_origin[1] - m.device_origin[1],
                 ]
             }
-            DeviceSystem::TwoDof(s) => match s.device_origin() {
-                Some(d) => {
-                    let w = s.world_origin();
-                    [w.x - d.x, w.y - d.y]
-                }
-                None => [0.0; 2],
-            },
+            DeviceSystem::TwoDof(s) => grasp(s.device_origin(), s.world_origin()),
+            DeviceSystem::Point(s) => grasp(s.device_origin(), s.world_origin()),
         }
     }
 
@@ -193,7 +177,7 @@ impl DeviceSystem {
     pub fn handle_world_of(&self, record: &TickRecord) -> V3 {
         match self {
             DeviceSystem::Twin(s) => s.map().pose_to_world(&record.x_m),
-            DeviceSystem::TwoDof(_) => record.x_m,
+            _ => record.x_m,
         }
     }
 }

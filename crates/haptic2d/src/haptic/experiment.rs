@@ -11,7 +11,8 @@ use crate::device::linalg::V3;
 use crate::device::{DeviceFault, HandModel, SimDevice};
 
 use super::record::TickRecord;
-use super::system::{HapticSystem, TickOutput};
+use super::system::HapticSystem;
+use super::tick::TickOutput;
 
 /// A haptic system, a simulated device plant and a hand, one tick at a time.
 #[derive(Clone, Debug)]

@@ -9,26 +9,33 @@
 
 pub mod config;
 mod controller;
+pub mod coupling;
 pub mod device_system;
 pub mod experiment;
 pub mod limit_cycle;
 pub mod mapping;
 pub mod planar2;
 pub mod plausibility;
+pub mod point;
 pub mod record;
 pub mod safety;
 pub mod safety_stage;
 pub mod system;
+pub mod tick;
 pub mod workspace;
 
 pub use config::{ControllerKind, HapticConfig};
+pub use coupling::{DeviceCoupling, SlaveState};
 pub use device_system::DeviceSystem;
 pub use experiment::DeviceInTheLoop;
 pub use limit_cycle::LimitCycleMonitor;
 pub use mapping::DeviceMap;
+pub use planar2::{GraspConfig, GraspCoupling, GraspSettings, Planar2System};
 pub use plausibility::JointPlausibility;
+pub use point::{PointConfig, PointSystem};
 pub use record::{TickRecord, TICK_COLUMNS};
 pub use safety::{Safety, SafetyConfig, SafetyReason, SafetyTrip};
 pub use safety_stage::SafetyStage;
-pub use system::{HapticSystem, TickOutput};
+pub use system::{HapticSystem, TwinCoupling};
+pub use tick::{Haptic, TickOutput};
 pub use workspace::{WorkspaceBound, WorkspaceSquare};

@@ -1,68 +1,119 @@
-//! [`HapticSystem`]: device + controller + passivity controller + world, and the per-sample
-//! [`HapticSystem::tick`] in the order of §0.5.
+//! [`HapticSystem`]: the twin pantograph's haptic system, `Haptic<TwinCoupling>` — the device
+//! (x, y, θ) behind a [`DeviceMap`] (scale, anchored at the first reading), the slave held at its
+//! centre, the optional passivity controller on the device port. The tick is the one of
+//! [`Haptic`] (`tick.rs`); this file holds the twin's coupling and its API.
 
+use crate::control::four_channel::TeleopSignals;
 use crate::control::passivity::PlanarPassivity;
-use crate::device::linalg::{V3, V4};
-use crate::device::TwinPantograph;
+use crate::device::linalg::{M3, V3, V4};
+use crate::device::{DeviceEstimate, TwinPantograph};
+use crate::geom::Vec2;
 use crate::world::World;
 
 use super::config::{find_slave, ControllerKind, HapticConfig};
 use super::controller::Controller;
+use super::coupling::{DeviceCoupling, SlaveState};
 use super::mapping::DeviceMap;
-use super::record::{TickRecord, FLAG_SAFETY};
-use super::safety::{Safety, SafetyConfig, SafetyTrip};
+use super::safety::{Safety, SafetyConfig};
 use super::safety_stage::SafetyStage;
+use super::tick::{Haptic, TickOutput};
 use super::workspace::WorkspaceBound;
 
-mod steps;
+/// The whole haptic system of DESIGN §1 for the twin pantograph: twin-pantograph estimator,
+/// teleoperation controller, optional passivity controller on the device port, and the virtual
+/// world with its slave body (see [`Haptic`] for the tick and its safety).
+pub type HapticSystem = Haptic<TwinCoupling>;
 
-use steps::PortOutput;
-
-/// What one tick hands back to the caller.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct TickOutput {
-    /// The four motor torques to write to the amplifiers now and hold for one period (N·m); all zero
-    /// when the safety latch is set.
-    pub torques: V4,
-    /// True when the safety latch is set (this tick or earlier).
-    pub tripped: bool,
-    /// The singularity margin at the measured pose (dimensionless, §10.4); 0 when the device could
-    /// not be read this tick. For a watchdog downstream.
-    pub margin: f64,
-    /// True when the kinematic consistency (closure) monitor of §10.3 failed this tick.
-    pub closure_fault: bool,
-    /// The tick's telemetry record.
-    pub record: TickRecord,
-}
-
-/// The whole haptic system of DESIGN §1: twin-pantograph estimator, teleoperation controller, optional
-/// passivity controller on the device port, and the virtual world with its slave body.
-///
-/// Safety (DESIGN §7) is part of the system, so every device gets it: the torques are exactly zero
-/// until the first valid device reading; at that reading the mapping is re-anchored so that the
-/// measured handle pose lands on the slave's pose (no coupling force on the first tick), and the
-/// torques ramp in over [`SafetyConfig::ramp_time`]; the workspace bound of the device file is a
-/// passive wall with a trip beyond it; a stall trips; the final gate clamps to `τ_max`.
+/// The twin pantograph as the tick drives it: the device, its [`DeviceMap`] to the world (anchored
+/// at the first reading), the preload of its redundancy resolution and the experiments' hand-wrench
+/// injection. The slave is held at its centre.
 #[derive(Clone, Debug)]
-pub struct HapticSystem {
+pub struct TwinCoupling {
     device: TwinPantograph,
-    controller: Controller,
-    passivity: Option<PlanarPassivity>,
-    world: World,
-    slave: usize,
     map: DeviceMap,
-    /// The shared safety steps: stall, plausibility, workspace bound, limit cycle, ramp, gate.
-    safety: SafetyStage,
     preload: f64,
-    dt: f64,
-    tau_prev: V4,
-    injected: Option<(usize, f64)>,
     /// A wrench added to the hand-wrench estimate before the controller (handle frame: N, N, N·m);
     /// zero except in experiments ([`HapticSystem::set_hand_estimate_injection`]).
     hand_injection: V3,
     /// False until the first valid reading after construction, a re-arm or a pause.
     aligned: bool,
-    record: TickRecord,
+}
+
+impl DeviceCoupling for TwinCoupling {
+    type Device = TwinPantograph;
+    const MARGIN_AT_SENSE: bool = false;
+
+    fn device(&self) -> &TwinPantograph {
+        &self.device
+    }
+    fn device_mut(&mut self) -> &mut TwinPantograph {
+        &mut self.device
+    }
+
+    /// Anchors the map: the measured handle pose maps onto the slave's current pose.
+    fn align(&mut self, e: &DeviceEstimate, world: &World, slave: usize) -> bool {
+        if self.aligned {
+            return false;
+        }
+        let body = &world.bodies[slave];
+        self.map.device_origin = e.pose;
+        self.map.world_origin = [body.pose.pos.x, body.pose.pos.y, body.pose.angle];
+        self.aligned = true;
+        true
+    }
+
+    fn unalign(&mut self, _world: &World, _slave: usize) {
+        self.aligned = false;
+    }
+
+    /// The estimates are stale after a fault (a stall, lost readings): restart the velocity filter
+    /// and the observer, keeping the θ unwrapping reference.
+    fn rearm(&mut self) {
+        let theta = self
+            .device
+            .pose()
+            .map_or(self.map.device_origin[2], |p| p[2]);
+        self.device.reset(theta);
+    }
+
+    fn slave_state(&self, world: &World, i: usize) -> SlaveState {
+        SlaveState::at_centre(world, i)
+    }
+
+    /// The handle through the map, the hand-wrench estimate plus the injection, and the master mass
+    /// in world coordinates: with the twist map `v_w = S·v_d` and the wrench map `f_d = S·f_w`
+    /// (`S = diag(s, s, 1)`), `f_d = M_d·a_d` gives `f_w = S⁻¹·M_d·S⁻¹·a_w`.
+    fn teleop_signals(&self, e: &DeviceEstimate, s: &SlaveState, m_dev: &M3) -> TeleopSignals {
+        let sc = [self.map.scale, self.map.scale, 1.0];
+        let master_mass: M3 =
+            std::array::from_fn(|i| std::array::from_fn(|j| m_dev[i][j] / (sc[i] * sc[j])));
+        TeleopSignals {
+            x_m: self.map.pose_to_world(&e.pose),
+            v_m: self.map.twist_to_world(&e.velocity),
+            f_h: self.map.wrench_to_world(&std::array::from_fn(|i| {
+                e.hand_wrench[i] + self.hand_injection[i]
+            })),
+            x_s: s.x_s,
+            v_s: s.v_s,
+            f_e: s.f_e,
+            master_mass,
+        }
+    }
+
+    fn wrench_to_device(&self, f: &V3) -> V3 {
+        self.map.wrench_to_device(f)
+    }
+    fn wrench_to_world(&self, f: &V3) -> V3 {
+        self.map.wrench_to_world(f)
+    }
+    fn preload(&self) -> f64 {
+        self.preload
+    }
+
+    /// The drive at the centre: force and torque as commanded.
+    fn drive(&self, f_cs: &V3, _s: &SlaveState, _latched: bool) -> (Vec2, f64) {
+        (Vec2::new(f_cs[0], f_cs[1]), f_cs[2])
+    }
 }
 
 impl HapticSystem {
@@ -121,31 +172,31 @@ impl HapticSystem {
             world.loads.retain(|l| l.body != slave);
         }
         device.reset(map.device_origin[2]);
-        Ok(Self {
+        let coupling = TwinCoupling {
             device,
-            controller,
-            passivity: config.passivity,
-            world,
-            slave,
             map,
-            safety: SafetyStage::new(
-                safety,
-                Safety::new(
-                    config.device.min_singularity_margin,
-                    tau_max,
-                    safety.torque_trip_margin,
-                ),
-                WorkspaceBound::new(&config.device, dt),
-                dt,
-            ),
             preload: config.preload,
-            dt,
-            tau_prev: [0.0; 4],
-            injected: None,
             hand_injection: [0.0; 3],
             aligned: false,
-            record: TickRecord::default(),
-        })
+        };
+        let safety = SafetyStage::new(
+            safety,
+            Safety::new(
+                config.device.min_singularity_margin,
+                tau_max,
+                safety.torque_trip_margin,
+            ),
+            WorkspaceBound::new(&config.device, dt),
+            dt,
+        );
+        Ok(Haptic::assemble(
+            coupling,
+            controller,
+            config.passivity,
+            world,
+            slave,
+            safety,
+        ))
     }
 
     /// One haptic sample taken on time (one period after the previous one): see
@@ -177,68 +228,12 @@ impl HapticSystem {
     /// reply, `device_wait` (s; NaN = unknown), so that a stall says whether the host or the device
     /// was late. Never allocates, locks, prints or does I/O.
     pub fn tick_timed(&mut self, q: &V4, elapsed: f64, device_wait: f64) -> TickOutput {
-        let t = self.world.time();
-        let mut flags = 0u32;
-        self.supervise_input(q, elapsed, device_wait); // 0
-        let (est, closure_fault) = self.sense(q, elapsed); // 1–2
-        self.align(est); // 1b
-        let slave = self.contact_stage(); // 3–6
-        let m_dev = self.device.mass_matrix(); // at the measured pose, for steps 7 and 8
-        let (f_cm, mut f_cs) = self.teleoperate(est, &slave, &m_dev); // 7
-        let port = self.port_passivity(est, &f_cm, &m_dev, &mut flags); // 8
-        let f_dev = self.workspace_wall(est, port.f_port); // 8b
-        let motor = self.motor_torques(&f_dev, &mut flags); // 9
-        if motor.gated {
-            f_cs = [0.0; 3];
-        }
-        self.book_port(&port.f_port, motor.applied); // 9b
-        self.integrate(&f_cs, motor.tau); // 10
-        let f_cm = self.map.wrench_to_world(&f_dev);
-        self.record_tick(t, est, &slave, (f_cm, f_cs), &port, motor.tau, flags); // 11
-        self.output(motor.tau, est.is_some(), closure_fault)
+        self.haptic_tick(q, elapsed, device_wait)
     }
 
-    /// A paused sample (the live display's pause): the device is still estimated from the encoder
-    /// angles `q` (rad; steps 1–2, so the pose unwrapping, the velocity filter and the hand-wrench
-    /// observer keep tracking the handle while the user moves it), but neither controller runs, the
-    /// world is not stepped (its time stands still) and the torques are zero. The record shows the
-    /// device, the frozen slave and zero commands. Never allocates, locks, prints or does I/O.
+    /// A paused sample: [`Haptic::haptic_tick_paused`]. Never allocates, locks, prints or does I/O.
     pub fn tick_paused(&mut self, q: &V4) -> TickOutput {
-        let t = self.world.time();
-        self.safety.supervise_paused((self.world.tick(), t), q);
-        let (est, closure_fault) = self.sense(q, self.dt); // 1–2
-        let mut tau = [0.0; 4];
-        let mut flags = 0u32;
-        if self.safety.gate((self.world.tick(), t), &mut tau, false) {
-            flags |= FLAG_SAFETY;
-        }
-        self.tau_prev = tau;
-        // The handle moves while the slave is frozen: the next running tick re-aligns and ramps in.
-        self.aligned = false;
-        self.safety.restart_clock();
-        if let Some(pc) = self.passivity.as_mut() {
-            pc.idle();
-        }
-        let slave = self.slave_state();
-        let port = PortOutput {
-            f_port: [0.0; 3],
-            po_energy: self.passivity.as_ref().map_or(0.0, |p| p.e_obs()),
-            alpha: [0.0; 3],
-        };
-        self.record_tick(t, est, &slave, ([0.0; 3], [0.0; 3]), &port, tau, flags); // 11
-        self.output(tau, est.is_some(), closure_fault)
-    }
-
-    /// The tick's output: the torques (N·m) written now, the latch, the singularity margin when the
-    /// device was read (`sensed`; 0 otherwise), the closure monitor's verdict and the record.
-    fn output(&self, torques: V4, sensed: bool, closure_fault: bool) -> TickOutput {
-        TickOutput {
-            torques,
-            tripped: self.safety.is_latched(),
-            margin: if sensed { self.device.margin() } else { 0.0 },
-            closure_fault,
-            record: self.record,
-        }
+        self.haptic_tick_paused(q)
     }
 
     /// Switches the teleoperation controller to `kind`, starting from its reset state (no integrator
@@ -249,104 +244,39 @@ impl HapticSystem {
         Ok(())
     }
 
-    /// Fault injection for safety tests and hardware commissioning: at the next tick, torque `index`
-    /// (0–3) is replaced by `value` just before the safety gate (e.g. NaN to check that a non-finite
-    /// torque is zeroed in the same tick). An out-of-range index is ignored.
-    pub fn inject_torque_fault(&mut self, index: usize, value: f64) {
-        if index < 4 {
-            self.injected = Some((index, value));
-        }
-    }
-
     /// Experiments only (issue 36, "the hand is replaced by a constant force" read as a force in the
     /// hand-force estimate): from the next tick on, `w` (handle frame: N, N, N·m) is added to the
     /// observer's hand-wrench estimate that the controller receives (`f_h` of §11.1). The recorded
     /// `w_h` stays the observer's own estimate. Non-finite values are ignored; zero turns it off.
     pub fn set_hand_estimate_injection(&mut self, w: V3) {
         if w.iter().all(|v| v.is_finite()) {
-            self.hand_injection = w;
+            self.coupling.hand_injection = w;
         }
     }
 
-    /// The world (bodies, contacts, ledger).
-    pub fn world(&self) -> &World {
-        &self.world
-    }
-    /// Mutable access to the world (e.g. to move a body between ticks).
-    pub fn world_mut(&mut self) -> &mut World {
-        &mut self.world
-    }
-    /// Index of the slave body in the world.
-    pub fn slave(&self) -> usize {
-        self.slave
-    }
     /// The device ↔ world mapping.
     pub fn map(&self) -> &DeviceMap {
-        &self.map
-    }
-    /// The workspace bound rendered from the device file.
-    pub fn workspace(&self) -> &WorkspaceBound {
-        self.safety.workspace()
+        &self.coupling.map
     }
     /// The device estimator.
     pub fn device(&self) -> &TwinPantograph {
-        &self.device
+        &self.coupling.device
     }
     /// The passivity controller, if enabled.
     pub fn passivity(&self) -> Option<&PlanarPassivity> {
         self.passivity.as_ref()
     }
-    /// The latched safety trip, if any.
-    pub fn safety_trip(&self) -> Option<SafetyTrip> {
-        self.safety.trip_info()
-    }
-    /// Re-arms the safety latch (an explicit user action). The next tick re-aligns the mapping to the
-    /// handle's measured pose and ramps the torques in again from zero, as at start-up.
-    pub fn reset_safety(&mut self) {
-        self.safety.rearm();
-        // The estimates are stale after a fault (a stall, lost readings): restart the velocity filter
-        // and the observer, keeping the θ unwrapping reference.
-        let theta = self
-            .device
-            .pose()
-            .map_or(self.map.device_origin[2], |p| p[2]);
-        self.device.reset(theta);
-        self.aligned = false;
-        self.safety.restart_clock();
-    }
-
-    /// The stall check of [`Self::tick_elapsed`] on its own, for a device paced by the ticks (the
-    /// simulated plant) whose signals are differentiated over one period but whose loop can still
-    /// stall: trips ([`SafetyReason::Stall`](super::safety::SafetyReason::Stall)) when `elapsed` (s since the previous tick; of which
-    /// `device_wait` s waiting for the device, NaN = unknown) exceeds the stall limit `max(max_stall_periods·T, min_stall_time)`; the
-    /// next tick's torques are then zero. Returns true when it tripped. Never allocates.
-    pub fn check_stall(&mut self, elapsed: f64, device_wait: f64) -> bool {
-        let at = (self.world.tick(), self.world.time());
-        self.safety.check_stall(at, elapsed, device_wait)
-    }
-    /// The safety settings (ramp, stall limit, torque trip margin).
-    pub fn safety_config(&self) -> &SafetyConfig {
-        self.safety.config()
-    }
     /// The start-up ramp factor the next tick applies (0 at the first valid reading, 1 once ramped in).
     pub fn ramp(&self) -> f64 {
-        if self.aligned {
+        if self.coupling.aligned {
             self.safety.ramp()
         } else {
             0.0
         }
     }
-    /// The record of the last tick.
-    pub fn last_record(&self) -> &TickRecord {
-        &self.record
-    }
-    /// The sample period `T` (s).
-    pub fn dt(&self) -> f64 {
-        self.dt
-    }
     /// The handle pose the device should start at (m, m, rad): the mapping's device origin (before
     /// the first tick; from then on, the handle pose the start-up alignment anchored).
     pub fn device_start(&self) -> V3 {
-        self.map.device_origin
+        self.coupling.map.device_origin
     }
 }

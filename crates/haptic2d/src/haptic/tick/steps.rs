@@ -1,29 +1,20 @@
-//! The named steps of one haptic tick ([`HapticSystem::tick_timed`] calls them in order; the
-//! numbers are DESIGN §1's). Each step reads and writes the system's state; none allocates, locks,
-//! prints or does I/O.
+//! The named steps of the one haptic tick ([`Haptic::haptic_tick`] calls them in order; the numbers
+//! are §0.5's). Each reads and writes the system's state through the device's
+//! [`DeviceCoupling`]; none allocates, locks, prints or does I/O.
 
-use super::HapticSystem;
-use crate::control::four_channel::TeleopSignals;
+use super::Haptic;
 use crate::control::passivity::explicit_damping_limit;
 use crate::device::linalg::{M3, V3, V4};
 use crate::device::{CartesianDevice, DeviceEstimate, DeviceFault};
-use crate::geom::Vec2;
+use crate::haptic::coupling::{DeviceCoupling, SlaveState};
 use crate::haptic::record::{
     TickRecord, FLAG_NEAR_SINGULAR, FLAG_PASSIVITY_ACTIVE, FLAG_SAFETY, FLAG_SATURATED,
 };
 use crate::haptic::safety::SafetyReason;
+use crate::haptic::safety_stage::TickClock;
 
-/// The slave body as the contact stage left it: pose and twist in world coordinates and the
-/// contact wrench it exerts on the world (`f_e`, N and N·m).
-#[derive(Clone, Copy, Debug)]
-pub(super) struct SlaveState {
-    pub x_s: V3,
-    pub v_s: V3,
-    pub f_e: V3,
-}
-
-/// The device port after the passivity controller: the wrench it asks of the device (handle
-/// coordinates), the observer's energy (J) and the damping per axis (N·s/m, N·m·s/rad).
+/// The device port after the passivity controller: the wrench it asks of the device (device
+/// frame, N, N, N·m), the observer's energy (J) and the damping per axis (N·s/m, N·m·s/rad).
 #[derive(Clone, Copy, Debug)]
 pub(super) struct PortOutput {
     pub f_port: V3,
@@ -40,21 +31,40 @@ pub(super) struct MotorOutput {
     pub applied: f64,
 }
 
-impl HapticSystem {
-    /// Step 0. Stall: the device held the previous torques for `elapsed` seconds, unsupervised.
-    /// Plausibility: a joint reading no hand can produce is a fault of the encoder or driver.
-    pub(super) fn supervise_input(&mut self, q: &V4, elapsed: f64, device_wait: f64) {
-        let at = (self.world.tick(), self.world.time());
-        self.safety.supervise_input(at, q, elapsed, device_wait);
+impl<C: DeviceCoupling> Haptic<C>
+where
+    <C::Device as CartesianDevice>::Joints: AsRef<[f64]>,
+{
+    /// The tick's place in time (index, s): the stamp of a trip.
+    pub(super) fn at(&self) -> TickClock {
+        (self.world.tick(), self.world.time())
     }
 
-    /// Steps 1–2. Device pose by forward kinematics (θ unwrapped, closure monitor), filtered
-    /// twist, and the hand-wrench estimate from the torques of the previous interval (§10.3,
-    /// §10.6, §10.7), both over the measured interval. A fault trips the latch; the flag says
-    /// whether it was the closure monitor.
-    pub(super) fn sense(&mut self, q: &V4, elapsed: f64) -> (Option<DeviceEstimate>, bool) {
-        let at = (self.world.tick(), self.world.time());
-        match self.device.sense(q, &self.tau_prev, elapsed) {
+    /// Step 0. Stall: the device held the previous torques for `elapsed` seconds, unsupervised.
+    /// Plausibility: a joint reading no hand can produce is a fault of the encoder or driver.
+    pub(super) fn supervise_input(
+        &mut self,
+        q: &<C::Device as CartesianDevice>::Joints,
+        elapsed: f64,
+        device_wait: f64,
+    ) {
+        let at = self.at();
+        self.safety
+            .supervise_input(at, q.as_ref(), elapsed, device_wait);
+    }
+
+    /// Steps 1–2. The device's handle pose (forward kinematics; the twin unwraps θ and runs its
+    /// closure monitor), filtered twist and hand-wrench estimate from the torques of the previous
+    /// interval (§10.3, §10.6, §10.7), over the measured interval. A fault trips the latch; the flag
+    /// says whether it was the closure monitor.
+    pub(super) fn sense(
+        &mut self,
+        q: &<C::Device as CartesianDevice>::Joints,
+        elapsed: f64,
+    ) -> (Option<DeviceEstimate>, bool) {
+        let at = self.at();
+        let tau_prev = self.tau_prev;
+        match self.coupling.device_mut().sense(q, &tau_prev, elapsed) {
             Ok(e) => (Some(e), false),
             Err(fault) => {
                 let closure = matches!(fault, DeviceFault::ClosureViolation { .. });
@@ -64,17 +74,33 @@ impl HapticSystem {
         }
     }
 
+    /// Step 2b. On a device whose singularity margin is known at the reading
+    /// ([`DeviceCoupling::MARGIN_AT_SENSE`], the five-bar), a margin below the latch's limit trips
+    /// now, before the controller runs. The twin's margin comes with its redundancy resolution
+    /// (step 9).
+    pub(super) fn guard_singularity(&mut self, sensed: bool, flags: &mut u32) {
+        if !(C::MARGIN_AT_SENSE && sensed) {
+            return;
+        }
+        let margin = self.coupling.device().margin();
+        let limit = self.safety.latch().min_margin;
+        if margin < limit {
+            *flags |= FLAG_NEAR_SINGULAR;
+            let at = self.at();
+            self.safety
+                .trip(at, SafetyReason::Singularity { margin, limit });
+        }
+    }
+
     /// Step 1b. Start-up alignment, at the first valid reading (and after a re-arm or a pause):
-    /// anchor the mapping so that the measured handle pose maps onto the slave's current pose. The
-    /// coupling then starts with zero pose error wherever the handle was, and the slave is not
-    /// moved (moving it could put it inside a wall). The torque ramp restarts here.
+    /// the coupling anchors its device → world map so that the handle lands on the slave's held
+    /// point. The coupling then starts with zero pose error wherever the handle was, and the slave
+    /// is not moved (moving it could put it inside a wall). The torque ramp restarts here.
     pub(super) fn align(&mut self, est: Option<DeviceEstimate>) {
-        if let (Some(e), false) = (est, self.aligned) {
-            let body = &self.world.bodies[self.slave];
-            self.map.device_origin = e.pose;
-            self.map.world_origin = [body.pose.pos.x, body.pose.pos.y, body.pose.angle];
-            self.aligned = true;
-            self.safety.restart_ramp();
+        if let Some(e) = est {
+            if self.coupling.align(&e, &self.world, self.slave) {
+                self.safety.restart_ramp();
+            }
         }
     }
 
@@ -83,25 +109,12 @@ impl HapticSystem {
     /// Returns the slave as the controller sees it.
     pub(super) fn contact_stage(&mut self) -> SlaveState {
         self.world.begin_step();
-        self.slave_state()
-    }
-
-    /// The slave body as the world holds it now: pose, twist and the contact wrench it exerts.
-    pub(super) fn slave_state(&self) -> SlaveState {
-        let body = &self.world.bodies[self.slave];
-        let cw = self.world.contact_wrench(self.slave);
-        SlaveState {
-            x_s: [body.pose.pos.x, body.pose.pos.y, body.pose.angle],
-            v_s: [body.vel.x, body.vel.y, body.omega],
-            f_e: [-cw.force.x, -cw.force.y, -cw.torque],
-        }
+        self.coupling.slave_state(&self.world, self.slave)
     }
 
     /// Step 7. Teleoperation: device command `f_cm` and slave drive `f_cs` (§11), in world
-    /// coordinates; both zero without a reading or while latched. The master-mass feed-forward
-    /// (off by default) gets the device's mass matrix at the measured pose, in world coordinates:
-    /// with the twist map `v_w = S·v_d` and the wrench map `f_d = S·f_w` (`S = diag(s, s, 1)`),
-    /// `f_d = M_d·a_d` gives `f_w = S⁻¹·M_d·S⁻¹·a_w`.
+    /// coordinates, on the axes the device renders; both zero without a reading or while latched.
+    /// `m_dev` is the device's mass matrix at the measured pose (master-mass feed-forward).
     pub(super) fn teleoperate(
         &mut self,
         est: Option<DeviceEstimate>,
@@ -114,24 +127,14 @@ impl HapticSystem {
         if self.safety.is_latched() {
             return ([0.0; 3], [0.0; 3]);
         }
-        let sc = [self.map.scale, self.map.scale, 1.0];
-        let master_mass: M3 =
-            std::array::from_fn(|i| std::array::from_fn(|j| m_dev[i][j] / (sc[i] * sc[j])));
-        let signals = TeleopSignals {
-            x_m: self.map.pose_to_world(&e.pose),
-            v_m: self.map.twist_to_world(&e.velocity),
-            f_h: self.map.wrench_to_world(&std::array::from_fn(|i| {
-                e.hand_wrench[i] + self.hand_injection[i]
-            })),
-            x_s: slave.x_s,
-            v_s: slave.v_s,
-            f_e: slave.f_e,
-            master_mass,
-        };
-        self.controller.step(&signals)
+        let signals = self.coupling.teleop_signals(&e, slave, m_dev);
+        let (mut f_cm, mut f_cs) = self.controller.step(&signals);
+        self.coupling.constrain(&mut f_cm);
+        self.coupling.constrain(&mut f_cs);
+        (f_cm, f_cs)
     }
 
-    /// Step 8. Passivity observer/controller on the device port (§12), in handle coordinates, with
+    /// Step 8. Passivity observer/controller on the device port (§12), in device coordinates, with
     /// α per axis capped at the explicit-damping limit `2·M_ii/T` of the device's inertia on that
     /// axis. It stops (α = 0, nothing booked but the zero applied) while latched.
     pub(super) fn port_passivity(
@@ -142,7 +145,7 @@ impl HapticSystem {
         flags: &mut u32,
     ) -> PortOutput {
         let mut out = PortOutput {
-            f_port: self.map.wrench_to_device(f_cm),
+            f_port: self.coupling.wrench_to_device(f_cm),
             po_energy: 0.0,
             alpha: [0.0; 3],
         };
@@ -165,9 +168,9 @@ impl HapticSystem {
     }
 
     /// Step 8b. Workspace bound (device file): a passive wall just past the edge of the workspace
-    /// square, and a trip beyond it. Returns the wrench for the motors (handle coordinates).
+    /// square, and a trip beyond it. Returns the wrench for the motors (device frame).
     pub(super) fn workspace_wall(&mut self, est: Option<DeviceEstimate>, f_port: V3) -> V3 {
-        let at = (self.world.tick(), self.world.time());
+        let at = self.at();
         let mut f_dev = f_port;
         if let Some(e) = est {
             self.safety
@@ -176,34 +179,38 @@ impl HapticSystem {
         f_dev
     }
 
-    /// Step 9. Redundancy resolution to four motor torques, saturation (§10.5), the limit-cycle
+    /// Step 9. The device's joint torques for the wrench (`τ = Jᵀ·f`; the twin's redundancy
+    /// resolution with its preload), saturation keeping the direction (§10.5), the limit-cycle
     /// monitor, the start-up ramp, and the final gate: a fault, a non-finite value, a singular pose
     /// or a request above τ_max by more than the margin zeroes the torques in this same tick; a
-    /// request just above τ_max is clamped to it.
-    pub(super) fn motor_torques(&mut self, f_dev: &V3, flags: &mut u32) -> MotorOutput {
-        let at = (self.world.tick(), self.world.time());
+    /// request just above τ_max is clamped to it. The ramp's clock advances only on a tick that
+    /// read the device (`sensed`).
+    pub(super) fn motor_torques(
+        &mut self,
+        f_dev: &V3,
+        sensed: bool,
+        flags: &mut u32,
+    ) -> MotorOutput {
+        let at = self.at();
         let mut tau = [0.0; 4];
         let mut wrench_scale = 0.0;
         if !self.safety.is_latched() {
-            match self.device.wrench_to_torques(f_dev, self.preload) {
+            let device = self.coupling.device();
+            match device.wrench_to_torques(f_dev, self.coupling.preload()) {
                 Ok(cmd) => {
                     tau = cmd.tau;
                     wrench_scale = cmd.wrench_scale;
                     if cmd.saturated {
                         *flags |= FLAG_SATURATED;
                     }
-                    let tau_max = self.device.tau_max();
+                    let tau_max = device.tau_max();
                     self.safety.observe_limit_cycle(at, &cmd.tau, &tau_max);
                     if cmd.near_singular {
                         *flags |= FLAG_NEAR_SINGULAR;
                         let limit = self.safety.latch().min_margin;
-                        self.safety.trip(
-                            at,
-                            SafetyReason::Singularity {
-                                margin: cmd.margin,
-                                limit,
-                            },
-                        );
+                        let margin = cmd.margin;
+                        self.safety
+                            .trip(at, SafetyReason::Singularity { margin, limit });
                     }
                 }
                 Err(fault) => self.safety.trip(at, SafetyReason::Torques(fault)),
@@ -215,7 +222,7 @@ impl HapticSystem {
             tau[i] = v;
         }
         let peak_before = tau.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        let gated = self.safety.gate(at, &mut tau, self.aligned);
+        let gated = self.safety.gate(at, &mut tau, sensed);
         let peak_after = tau.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         if gated {
             *flags |= FLAG_SAFETY;
@@ -244,17 +251,20 @@ impl HapticSystem {
         }
     }
 
-    /// Step 10. Slave drive `f_cs` held over the sample, then passive integration of every body
-    /// to k+1 (§6); the torques `tau` are the next tick's "previous interval" for the observer.
-    pub(super) fn integrate(&mut self, f_cs: &V3, tau: V4) {
-        self.world
-            .set_drive(self.slave, Vec2::new(f_cs[0], f_cs[1]), f_cs[2]);
+    /// Step 10. Slave drive `f_cs` held over the sample at the held point (the coupling turns it
+    /// into a force and a torque about the centre), then passive integration of every body to k+1
+    /// (§6); the torques `tau` are the next tick's "previous interval" for the observer.
+    pub(super) fn integrate(&mut self, f_cs: &V3, slave: &SlaveState, tau: V4) {
+        let latched = self.safety.is_latched();
+        let (force, torque) = self.coupling.drive(f_cs, slave, latched);
+        self.world.set_drive(self.slave, force, torque);
         self.world.finish_step();
         self.tau_prev = tau;
     }
 
     /// Step 11. Log: signals, energies and the contact count into the tick record; `t` (s) is the
-    /// tick's start time.
+    /// tick's start time; `(paused, gated)` say what kind of tick it was. The coupling then writes
+    /// its own conventions ([`DeviceCoupling::record`]).
     #[allow(clippy::too_many_arguments)]
     pub(super) fn record_tick(
         &mut self,
@@ -265,6 +275,7 @@ impl HapticSystem {
         port: &PortOutput,
         tau: V4,
         flags: u32,
+        (paused, gated): (bool, bool),
     ) {
         let ledger = self.world.ledger();
         let (x_m, v_m, w_h) = est.map_or(([0.0; 3], [0.0; 3], [0.0; 3]), |e| {
@@ -275,8 +286,8 @@ impl HapticSystem {
             x_m,
             v_m,
             w_h,
-            x_s: slave.x_s,
-            v_s: slave.v_s,
+            x_s: slave.centre,
+            v_s: slave.centre_twist,
             f_cm,
             f_cs,
             f_e: slave.f_e,
@@ -287,9 +298,12 @@ impl HapticSystem {
             applied_work: ledger.applied_work,
             po_energy: port.po_energy,
             alpha: port.alpha,
-            margin: self.device.margin(),
+            margin: self.coupling.device().margin(),
             closure_error: est.map_or(f64::NAN, |e| e.closure_error),
             flags,
         };
+        let (world, i) = (&self.world, self.slave);
+        self.coupling
+            .record(&mut self.record, est.as_ref(), world, i, paused, gated);
     }
 }
