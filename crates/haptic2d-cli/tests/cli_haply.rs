@@ -10,13 +10,12 @@
 //! take turns (one emulator at a time) to keep the load down.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
+use std::process::Command;
+use std::time::Duration;
 
 mod common;
 use common::{
-    cmd, column, emulate_haply, haply_file, interrupt, run, run_ok, signal, text, turn,
-    wait_for_log_rows,
+    cmd, column, cut_mid_run, emulate_haply, haply_file, interrupt, run, run_ok, signal, text, turn,
 };
 
 /// The gen 3 file with the test settings and `edit` applied, written into `dir`.
@@ -77,21 +76,9 @@ fn run_then_cut(cut: impl FnOnce(&mut common::Killed)) -> (String, Option<i32>, 
     let file = device_file(dir.path(), "gen3.toml", |t| t);
     let (mut emu, pty) = emulate_haply(&file, &[]);
     let log = dir.path().join("cut.csv");
-    let run = haply_run(&pty, &file, "20")
-        .arg("--log")
-        .arg(&log)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    wait_for_log_rows(&log);
-    cut(&mut emu);
-    let t0 = Instant::now();
-    let o = run.wait_with_output().unwrap();
-    let took = t0.elapsed();
-    let out = text(&o);
+    let (code, out, took) = cut_mid_run(haply_run(&pty, &file, "20"), &log, || cut(&mut emu));
     assert!(took < Duration::from_secs(5), "took {took:?}\n{out}");
-    (pty, o.status.code(), out)
+    (pty, code, out)
 }
 
 #[test]

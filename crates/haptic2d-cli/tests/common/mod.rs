@@ -118,6 +118,34 @@ pub fn wait_for_log_rows(log: &Path) {
     );
 }
 
+/// Spawns `run` (a `haptic2d run` command; its CSV log is set here, at `log`), waits until its log
+/// has rows (the loop is ticking: no fixed sleep), calls `cut` (silences or kills the device) and
+/// waits for the run. Its exit code, its stdout and stderr, and how long it took to end after the cut.
+pub fn cut_mid_run(
+    mut run: Command,
+    log: &Path,
+    cut: impl FnOnce(),
+) -> (Option<i32>, String, std::time::Duration) {
+    let child = run
+        .arg("--log")
+        .arg(log)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut child = child;
+    let ticking = std::panic::catch_unwind(|| wait_for_log_rows(log));
+    if let Err(e) = ticking {
+        let _ = child.kill();
+        let _ = child.wait();
+        std::panic::resume_unwind(e);
+    }
+    cut();
+    let t0 = std::time::Instant::now();
+    let o = child.wait_with_output().unwrap();
+    (o.status.code(), text(&o), t0.elapsed())
+}
+
 /// The column `name` of a CSV text with a header line, as numbers.
 pub fn column(csv: &str, name: &str) -> Vec<f64> {
     let mut lines = csv.lines();

@@ -48,6 +48,7 @@ mod repro_contacts;
 mod safety_gate;
 mod scene_bounds;
 mod scene_errors;
+mod shared;
 mod stack_corners;
 mod startup_ramp;
 mod tunnelling;
