@@ -146,6 +146,37 @@ pub fn cut_mid_run(
     (o.status.code(), text(&o), t0.elapsed())
 }
 
+/// Runs `haptic2d ARGS…` with piped output and waits at most `limit`: its exit code and stdout
+/// followed by stderr. Panics if it hung (it is killed) or died by a signal (an abort?).
+pub fn ends_within<S: AsRef<OsStr> + std::fmt::Debug>(
+    args: &[S],
+    limit: std::time::Duration,
+) -> (i32, String) {
+    let child = Command::new(BIN)
+        .args(args)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let Some((status, out)) = wait_with_limit(child, limit) else {
+        panic!("{args:?} hung (killed after {limit:?})");
+    };
+    let code = status.code().unwrap_or_else(|| {
+        panic!("{args:?} was killed by a signal (an abort?) ({status}):\n{out}")
+    });
+    (code, out)
+}
+
+/// The "N ticks" of a run's timing summary.
+pub fn summary_ticks(out: &str) -> u64 {
+    out.split_whitespace()
+        .collect::<Vec<_>>()
+        .windows(2)
+        .find(|w| w[1] == "ticks")
+        .and_then(|w| w[0].parse().ok())
+        .unwrap_or_else(|| panic!("no tick count in:\n{out}"))
+}
+
 /// The column `name` of a CSV text with a header line, as numbers.
 pub fn column(csv: &str, name: &str) -> Vec<f64> {
     let mut lines = csv.lines();
