@@ -96,23 +96,8 @@ fn run_against_the_emulated_service_for_3_s_drives_the_box_into_the_wall() {
     assert_eq!(o.status.code(), Some(0), "{out}");
     assert!(out.contains("planar: world x = device x"), "{out}");
     assert!(!out.contains("panicked"), "{out}");
-    let csv = std::fs::read_to_string(&log).unwrap();
-    let mut lines = csv.lines();
-    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let col = |n: &str| {
-        header
-            .iter()
-            .position(|h| *h == n)
-            .unwrap_or_else(|| panic!("no column {n} in {header:?}"))
-    };
+    let (col, rows) = common::csv_rows(&log);
     let (xs, contacts) = (col("slave.x"), col("contacts"));
-    let rows: Vec<Vec<f64>> = lines
-        .map(|l| {
-            l.split(',')
-                .map(|v| v.parse().unwrap_or(f64::NAN))
-                .collect()
-        })
-        .collect();
     assert!(rows.len() > 1500, "{} rows", rows.len());
     let last = &rows[rows.len() - 300..];
     assert!(

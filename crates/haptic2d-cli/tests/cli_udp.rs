@@ -287,23 +287,13 @@ fn a_pushed_handle_drives_the_box_into_the_wall_and_feels_it() {
         .unwrap();
     let out = text(&o);
     assert_eq!(o.status.code(), Some(0), "{out}");
-    let csv = std::fs::read_to_string(&log).unwrap();
-    let mut lines = csv.lines();
-    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let col = |n: &str| head.iter().position(|h| *h == n).unwrap();
+    let (col, rows) = common::csv_rows(&log);
     let (dx, sx, fx, c) = (
         col("device.x"),
         col("slave.x"),
         col("f_cm.x"),
         col("contacts"),
     );
-    let rows: Vec<Vec<f64>> = lines
-        .map(|l| {
-            l.split(',')
-                .map(|v| v.parse().unwrap_or(f64::NAN))
-                .collect()
-        })
-        .collect();
     assert!(
         rows.len() > 1000,
         "{} rows

@@ -6,6 +6,7 @@
 //! - [`process`]: children killed on drop, first-line and banner handshakes, bounded waits;
 //! - [`files`]: temp copies of the shipped device files with edits;
 //! - [`firmware`]: the native build of the board firmware, started on its pseudo-terminal;
+//! - [`udp_device`]: the UDP reference devices (Python, C) in processes of their own;
 //! - [`browser`]: the headless Chromium + playwright-core launcher of the browser tests.
 
 pub mod alloc;
@@ -13,6 +14,7 @@ pub mod browser;
 pub mod files;
 pub mod firmware;
 pub mod process;
+pub mod udp_device;
 pub mod wait;
 
 pub use wait::{holds_for, wait_for, wait_until};

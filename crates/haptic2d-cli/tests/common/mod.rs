@@ -177,6 +177,28 @@ pub fn summary_ticks(out: &str) -> u64 {
         .unwrap_or_else(|| panic!("no tick count in:\n{out}"))
 }
 
+/// A CSV log read whole: the column index of each name (panicking on a missing one) and the rows as
+/// numbers (a cell that is not a number is NaN).
+pub fn csv_rows(path: &Path) -> (impl Fn(&str) -> usize, Vec<Vec<f64>>) {
+    let csv = std::fs::read_to_string(path).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
+    let rows = lines
+        .map(|l| {
+            l.split(',')
+                .map(|v| v.parse().unwrap_or(f64::NAN))
+                .collect()
+        })
+        .collect();
+    let col = move |n: &str| {
+        header
+            .iter()
+            .position(|h| h == n)
+            .unwrap_or_else(|| panic!("no column {n} in {header:?}"))
+    };
+    (col, rows)
+}
+
 /// The column `name` of a CSV text with a header line, as numbers.
 pub fn column(csv: &str, name: &str) -> Vec<f64> {
     let mut lines = csv.lines();

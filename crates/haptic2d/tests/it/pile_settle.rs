@@ -183,17 +183,14 @@ fn pile_1000_comes_to_rest_within_5_s() {
 /// turns the damper off; the default is on.
 #[test]
 fn chain_damper_scene_fields_are_checked() {
-    let wall = "[[body]]\nname = \"wall\"\nkind = \"fixed\"\npolygon = [[-0.1, -0.2], [0.0, -0.2], [0.0, 0.2], [-0.1, 0.2]]\n";
+    let wall = crate::shared::WALL_TOML;
     for (world, field) in [
         ("chain_tau = -0.001", "world.chain_tau"),
         ("chain_tau = nan", "world.chain_tau"),
         ("chain_sweeps = 100000", "world.chain_sweeps"),
     ] {
         let text = format!("[world]\n{world}\n{wall}");
-        let e = match Scene::from_toml(&text, "t.toml", None) {
-            Ok(_) => panic!("expected an error for {world}"),
-            Err(e) => e,
-        };
+        let e = crate::shared::scene_errors(&text);
         assert!(
             e.errors
                 .iter()

@@ -8,12 +8,7 @@ use haptic2d::scene::bounds::{
 };
 use haptic2d::scene::{builtin, Scene};
 
-const WALL: &str = r#"
-[[body]]
-name = "wall"
-kind = "fixed"
-polygon = [[-0.1, -0.2], [0.0, -0.2], [0.0, 0.2], [-0.1, 0.2]]
-"#;
+use crate::shared::WALL_TOML as WALL;
 
 use crate::shared::assert_scene_error as assert_error;
 

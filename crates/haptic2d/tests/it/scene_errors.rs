@@ -2,12 +2,7 @@
 
 use haptic2d::scene::Scene;
 
-const GOOD_BOX: &str = r#"
-[[body]]
-name = "wall"
-kind = "fixed"
-polygon = [[-0.1, -0.2], [0.0, -0.2], [0.0, 0.2], [-0.1, 0.2]]
-"#;
+use crate::shared::WALL_TOML as GOOD_BOX;
 
 use crate::shared::{assert_scene_error, scene_errors as errors};
 

@@ -7,6 +7,9 @@ use haptic2d::haptic::ControllerKind;
 use haptic2d::scene::{builtin, Scene, SceneErrors};
 use haptic2d::world::World;
 
+/// A fixed wall filling x ∈ [−0.1, 0] m, y ∈ [−0.2, 0.2] m (scene TOML).
+pub const WALL_TOML: &str = "[[body]]\nname = \"wall\"\nkind = \"fixed\"\npolygon = [[-0.1, -0.2], [0.0, -0.2], [0.0, 0.2], [-0.1, 0.2]]\n";
+
 /// The world of the scene `text` (`name` in messages), primed (its contacts found) as a run does
 /// before its first step.
 pub fn primed_world(text: &str, name: &str) -> World {
