@@ -273,10 +273,9 @@ fn run_display_serves_frames_and_applies_commands() {
     // Pause: the world's time stands still; resume: it runs again.
     send(&mut ws, r#"{"type":"pause"}"#);
     let p1 = wait_for(&mut ws, "frame", 5.0, |f| f["paused"] == true);
-    std::thread::sleep(std::time::Duration::from_millis(200));
-    let p2 = wait_for(&mut ws, "frame", 5.0, |f| {
-        f["seq"].as_u64() > p1["seq"].as_u64()
-    });
+    // Frames go on while paused: the 12th after it (about 0.2 s at 60 frames a second).
+    let after = p1["seq"].as_u64().unwrap() + 12;
+    let p2 = wait_for(&mut ws, "frame", 5.0, |f| f["seq"].as_u64() >= Some(after));
     assert_eq!(p1["t"], p2["t"], "paused world does not advance");
     assert_eq!(p2["drive"], serde_json::json!([0.0, 0.0, 0.0]));
     send(&mut ws, r#"{"type":"resume"}"#);

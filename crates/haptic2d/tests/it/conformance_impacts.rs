@@ -2,6 +2,7 @@
 //! file → proximity → contacts → impulses → laws → integration) with `impact_friction = "coulomb"`,
 //! each citing the result it checks and where its tolerance comes from.
 
+use crate::shared::FLOOR_TOML;
 use haptic2d::geom::{cross, Vec2};
 use haptic2d::scene::Scene;
 use haptic2d::world::World;
@@ -39,10 +40,7 @@ v_c = 0.05
 {normal}
 [friction]
 {friction}
-[[body]]
-name = "floor"
-kind = "fixed"
-polygon = [[-20.0, -0.1], [20.0, -0.1], [20.0, 0.0], [-20.0, 0.0]]
+{FLOOR_TOML}
 {bodies}
 "#
     );

@@ -7,6 +7,7 @@
 //! paper's normal law, frictionless (`impact_friction = "none"`, friction model `none`), the
 //! defaults of `[contact]` otherwise (`impact_surface_offset = true` since issue 35).
 
+use crate::shared::FLOOR_TOML;
 use haptic2d::scene::Scene;
 use haptic2d::world::World;
 
@@ -37,10 +38,7 @@ kc = {kc}
 bc = {bc}
 [friction]
 model = "none"
-[[body]]
-name = "floor"
-kind = "fixed"
-polygon = [[-20.0, -0.1], [20.0, -0.1], [20.0, 0.0], [-20.0, 0.0]]
+{FLOOR_TOML}
 {bodies}
 "#
     );

@@ -6,6 +6,7 @@
 //! `pile_1000_comes_to_rest_within_5_s` is ignored (release build:
 //! `cargo test --release -p haptic2d --test it pile_settle:: -- --ignored`).
 
+use crate::shared::PAPER_NORMAL_TOML;
 use haptic2d::scene::{builtin, Scene};
 use haptic2d::world::World;
 
@@ -25,10 +26,7 @@ proximity_every = 10
 impacts = true
 restitution = 0.2
 v_c = 0.05
-[normal]
-model = "paper"
-kc = 1.0e5
-bc = 40.0
+{PAPER_NORMAL_TOML}
 [friction]
 model = "reset-integrator"
 kr = 5.0e4

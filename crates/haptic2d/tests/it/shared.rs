@@ -10,6 +10,13 @@ use haptic2d::world::World;
 /// A fixed wall filling x ∈ [−0.1, 0] m, y ∈ [−0.2, 0.2] m (scene TOML).
 pub const WALL_TOML: &str = "[[body]]\nname = \"wall\"\nkind = \"fixed\"\npolygon = [[-0.1, -0.2], [0.0, -0.2], [0.0, 0.2], [-0.1, 0.2]]\n";
 
+/// A fixed floor 40 m long with its top at y = 0 (scene TOML).
+pub const FLOOR_TOML: &str = "[[body]]\nname = \"floor\"\nkind = \"fixed\"\npolygon = [[-20.0, -0.1], [20.0, -0.1], [20.0, 0.0], [-20.0, 0.0]]";
+
+/// The paper's normal law (MODELS §5: per corner, `kc` = 1e5 N/m, `bc` = 40 N·s/m) as a scene's
+/// `[normal]` table.
+pub const PAPER_NORMAL_TOML: &str = "[normal]\nmodel = \"paper\"\nkc = 1.0e5\nbc = 40.0";
+
 /// The world of the scene `text` (`name` in messages), primed (its contacts found) as a run does
 /// before its first step.
 pub fn primed_world(text: &str, name: &str) -> World {
