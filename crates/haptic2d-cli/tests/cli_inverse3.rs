@@ -12,7 +12,7 @@
 // the refusal is tested in tests/cli_exit.rs.
 #![cfg(feature = "inverse3")]
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
 mod common;
@@ -35,9 +35,9 @@ fn emulator(extra: &[&str]) -> (Killed, String) {
     (child, url)
 }
 
-fn run(url: &str, file: &PathBuf, duration: &str) -> Command {
+fn run(url: &str, file: &Path, duration: &str) -> Command {
     let device = format!("inverse3:{url}");
-    let mut c = cmd("run --device {} --device-file {}", &[&device, file]);
+    let mut c = cmd("run --device {} --device-file {}", &[&device, &file]);
     c.args(["--headless", "--no-rt", "--duration", duration]);
     c
 }

@@ -8,7 +8,7 @@
 //! tests in haptic2d-devices). The tests take turns to keep the load down.
 
 use std::net::{SocketAddr, UdpSocket};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::Arc;
@@ -39,9 +39,9 @@ fn sim_device(extra: &[&str]) -> Option<Device> {
     Some(Device(child, addr.parse().unwrap()))
 }
 
-fn run(addr: SocketAddr, file: &PathBuf, duration: &str) -> Command {
+fn run(addr: SocketAddr, file: &Path, duration: &str) -> Command {
     let device = format!("udp:{addr}");
-    let mut c = cmd("run --device {} --device-file {}", &[&device, file]);
+    let mut c = cmd("run --device {} --device-file {}", &[&device, &file]);
     c.args(["--headless", "--no-rt", "--duration", duration]);
     c
 }
