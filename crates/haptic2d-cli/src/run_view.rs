@@ -304,44 +304,13 @@ mod tests {
     use crate::hand_arg::HandSpec;
     use crate::run_rig::DeviceChoice;
     use haptic2d::haptic::HapticConfig;
-    use std::alloc::{GlobalAlloc, Layout, System};
-    use std::cell::Cell;
-    use std::time::{Duration, Instant};
+    use haptic2d_test_support::alloc::allocations;
+    use std::time::Duration;
 
-    /// Counts the allocations of the current thread.
-    struct Counting;
-
-    thread_local! {
-        static ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
-    }
-
-    unsafe impl GlobalAlloc for Counting {
-        unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-            ALLOCATIONS.with(|a| a.set(a.get() + 1));
-            unsafe { System.alloc(layout) }
-        }
-        unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-            unsafe { System.dealloc(ptr, layout) }
-        }
-        unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-            ALLOCATIONS.with(|a| a.set(a.get() + 1));
-            unsafe { System.realloc(ptr, layout, new_size) }
-        }
-    }
-
-    #[global_allocator]
-    static GLOBAL: Counting = Counting;
-
-    fn allocations() -> u64 {
-        ALLOCATIONS.with(|a| a.get())
-    }
+    haptic2d_test_support::install_counting_allocator!();
 
     fn until(what: &str, cond: impl Fn() -> bool) {
-        let end = Instant::now() + Duration::from_secs(10);
-        while !cond() {
-            assert!(Instant::now() < end, "timed out waiting for {what}");
-            std::thread::sleep(Duration::from_millis(10));
-        }
+        haptic2d_test_support::wait_for(what, Duration::from_secs(10), cond);
     }
 
     /// The loop's side of the display — polling commands, the haptic tick, capturing and publishing

@@ -2,7 +2,7 @@
 
 mod common;
 
-use common::{haptic2d, text};
+use common::{haptic2d, run, text};
 
 #[test]
 fn simulate_twice_gives_byte_identical_csv() {
@@ -10,14 +10,7 @@ fn simulate_twice_gives_byte_identical_csv() {
     let a = dir.path().join("a.csv");
     let b = dir.path().join("b.csv");
     for p in [&a, &b] {
-        let o = haptic2d(&[
-            "simulate",
-            "box-in-walls-tilt",
-            "--duration",
-            "1.5",
-            "--out",
-            p.to_str().unwrap(),
-        ]);
+        let o = run("simulate box-in-walls-tilt --duration 1.5 --out {}", &[&p]);
         assert!(o.status.success(), "{}", text(&o));
     }
     let (x, y) = (std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
@@ -29,16 +22,10 @@ fn simulate_twice_gives_byte_identical_csv() {
 fn simulate_writes_the_documented_columns() {
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path().join("b.csv");
-    let o = haptic2d(&[
-        "simulate",
-        "box-in-walls",
-        "--duration",
-        "1",
-        "--every",
-        "10",
-        "--out",
-        p.to_str().unwrap(),
-    ]);
+    let o = run(
+        "simulate box-in-walls --duration 1 --every 10 --out {}",
+        &[&p],
+    );
     assert!(o.status.success(), "{}", text(&o));
     let csv = std::fs::read_to_string(&p).unwrap();
     let mut lines = csv.lines();

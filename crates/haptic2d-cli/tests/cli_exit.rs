@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{haptic2d, text};
+use common::{haptic2d, run, text};
 use std::process::Output;
 
 fn code(o: &Output) -> i32 {
@@ -77,15 +77,9 @@ fn run_rate_above_cap_is_rejected_before_allocating_the_ring() {
     // Today's `--rate 1e9` sized a 624 GB telemetry ring.
     let _turn = common::turn(); // one real-time loop at a time
     assert_exit(
-        &[
-            "run",
-            "--headless",
-            "--no-rt",
-            "--rate",
-            "1e9",
-            "--duration",
-            "1",
-        ],
+        &"run --headless --no-rt --rate 1e9 --duration 1"
+            .split(' ')
+            .collect::<Vec<_>>(),
         2,
         "--rate must be a positive number of Hz up to 1e5",
     );
@@ -288,15 +282,7 @@ fn clap_usage_errors_exit_2() {
 /// (0xb6, skipped by a reader) and cut halfway into its second Chunk record. Returns their paths.
 fn hostile_logs(dir: &tempfile::TempDir) -> (String, String) {
     let rec = dir.path().join("rec.mcap");
-    let o = haptic2d(&[
-        "run",
-        "--headless",
-        "--no-rt",
-        "--duration",
-        "1.5",
-        "--log",
-        rec.to_str().unwrap(),
-    ]);
+    let o = run("run --headless --no-rt --duration 1.5 --log {}", &[&rec]);
     // Any whole log will do: a run a loaded machine stalls (a safety stop, exit 3) still leaves
     // one, ending on a whole tick.
     assert!(matches!(code(&o), 0 | 3), "{}", text(&o));

@@ -13,15 +13,13 @@
 //! box of box-in-walls into the left wall: the coupling pulls the handle back with a steady torque
 //! (see [`HAND_MOVE`]).
 
-use std::io::{BufRead, BufReader};
-use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
+use std::path::Path;
 use std::time::{Duration, Instant};
 
 mod common;
-use common::patient_device_file;
+use common::{cmd, holds_for, patient_device_file, wait_for, Killed};
+use haptic2d_test_support::firmware::{compile_native_firmware, start_native_firmware};
 
-const BIN: &str = env!("CARGO_BIN_EXE_haptic2d");
 /// The firmware's default watchdog (µs).
 const WATCHDOG_US: u64 = 20_000;
 /// How late past its time the native watchdog may act on a loaded machine (µs).
@@ -37,44 +35,6 @@ const HAND_MOVE: &str = "300,700,636,-192,0,0";
 /// When the board must hold a steady torque: the hand is still 1 s after the first write, the
 /// 0.5 s ramp long over (µs after the first write).
 const PRESSING_AFTER_US: u64 = 1_200_000;
-
-/// Compiles the native firmware (M3: 4 ports) with `cc` into `dir`.
-fn compile_firmware(dir: &Path) -> PathBuf {
-    let fw = common::root().join("devices/firmware");
-    let src = fw.join("haptic2d_firmware/src");
-    let native = fw.join("native");
-    let exe = dir.join("h2df-native-m3");
-    let cc = std::env::var("CC").unwrap_or_else(|_| "cc".into());
-    let out = Command::new(&cc)
-        .args(["-std=c11", "-O2", "-Wall", "-Wextra", "-Werror"])
-        .args(["-DH2DF_NATIVE", "-DH2DF_BOARD_M3", "-I"])
-        .arg(&native)
-        .arg("-I")
-        .arg(&src)
-        .arg(src.join("h2df.c"))
-        .arg(src.join("board.c"))
-        .arg(native.join("arduino_stub.c"))
-        .arg("-o")
-        .arg(&exe)
-        .output()
-        .unwrap_or_else(|e| panic!("cannot run the C compiler `{cc}`: {e}"));
-    assert!(
-        out.status.success(),
-        "the native firmware does not compile:\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    exe
-}
-
-/// Kills a child on drop (the firmware, or a run that a failed assertion leaves behind).
-struct Killed(Child);
-
-impl Drop for Killed {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
 
 /// The motor log: motor changes `(t µs, torques N·m)` and write times (µs), in order.
 #[derive(Default)]
@@ -142,26 +102,10 @@ fn kill_9_of_run_against_our_firmware_zeroes_the_motors_within_the_watchdog_time
     let dir =
         Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("cli-firmware-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let exe = compile_firmware(&dir);
+    // M3: 4 ports.
+    let exe = compile_native_firmware("M3", &dir);
     let motor_log = dir.join("motors.txt");
-    let mut fw = Command::new(&exe)
-        .arg("--motor-log")
-        .arg(&motor_log)
-        .args(["--hand-move", HAND_MOVE])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    let mut line = String::new();
-    BufReader::new(fw.stdout.as_mut().unwrap())
-        .read_line(&mut line)
-        .unwrap();
-    let _fw = Killed(fw);
-    let pty = line
-        .trim()
-        .strip_prefix("pty: ")
-        .unwrap_or_else(|| panic!("first line `{line}` is not `pty: PATH`"))
-        .to_string();
+    let (_fw, pty) = start_native_firmware(&exe, &motor_log, &["--hand-move", HAND_MOVE]);
 
     let file = patient_device_file(
         "haply-2diy-gen3.toml",
@@ -172,9 +116,8 @@ fn kill_9_of_run_against_our_firmware_zeroes_the_motors_within_the_watchdog_time
     let run_out = dir.join("run.txt");
     let run_err = dir.join("run-err.txt");
     let start_run = || {
-        Command::new(BIN)
-            .args(["run", "--device", &format!("haply:{pty}"), "--device-file"])
-            .arg(&file)
+        let device = format!("haply:{pty}");
+        cmd("run --device {} --device-file {}", &[&device, &file])
             .args(["--headless", "--duration", "10", "--no-rt"])
             .stdout(std::fs::File::create(&run_out).unwrap())
             .stderr(std::fs::File::create(&run_err).unwrap())
@@ -226,20 +169,16 @@ fn kill_9_of_run_against_our_firmware_zeroes_the_motors_within_the_watchdog_time
     run.0.kill().unwrap();
     run.0.wait().unwrap();
 
-    let t_kill = Instant::now();
-    let log = loop {
-        let log = Log::read(&motor_log);
+    let zeroed = |log: &Log| {
         let &(i_w, _) = log.writes.last().unwrap();
-        if log.motors.iter().any(|m| m.0 > i_w && m.2 == [0.0; 4]) {
-            break log;
-        }
-        assert!(
-            t_kill.elapsed() < Duration::from_secs(3),
-            "the motors are still on 3 s after kill -9 of the run (the watchdog?):\n{}",
-            log.tail()
-        );
-        std::thread::sleep(Duration::from_millis(2));
+        log.motors.iter().any(|m| m.0 > i_w && m.2 == [0.0; 4])
     };
+    let mut log = Log::default();
+    let what = "the motors zero after kill -9 of the run (the watchdog?)";
+    wait_for(what, Duration::from_secs(3), || {
+        log = Log::read(&motor_log);
+        zeroed(&log)
+    });
     let &(i_w, t_w) = log.writes.last().unwrap();
     let held = log.at(i_w);
     assert!(
@@ -258,10 +197,13 @@ fn kill_9_of_run_against_our_firmware_zeroes_the_motors_within_the_watchdog_time
         "motors zero {dt} µs after the last write (watchdog {WATCHDOG_US} µs):\n{}",
         log.tail()
     );
-    // And they stay zero.
-    std::thread::sleep(Duration::from_millis(50));
-    let later = Log::read(&motor_log);
-    assert_eq!(later.motors.last().unwrap().2, [0.0; 4], "{}", later.tail());
+    // And they stay zero, throughout 50 ms.
+    let mut later = Log::default();
+    let stays_zero = holds_for(Duration::from_millis(50), || {
+        later = Log::read(&motor_log);
+        later.motors.last().unwrap().2 == [0.0; 4]
+    });
+    assert!(stays_zero, "{}", later.tail());
     eprintln!(
         "torques {held:?} N·m at the last write; all zero {:.1} ms later",
         dt as f64 / 1000.0

@@ -9,80 +9,31 @@
 //! deadline; the stall check itself is tested in `run_rig`'s unit tests on synthetic tick times). The tests
 //! take turns (one emulator at a time) to keep the load down.
 
-use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
-use std::time::{Duration, Instant};
+use std::process::Command;
+use std::time::Duration;
 
 mod common;
-use common::{column, text, turn};
+use common::{
+    cmd, column, cut_mid_run, emulate_haply, haply_file, interrupt, run, run_ok, signal, text, turn,
+};
 
-const BIN: &str = env!("CARGO_BIN_EXE_haptic2d");
-
-fn shipped_text(file: &str) -> String {
-    std::fs::read_to_string(format!(
-        "{}/../../devices/{file}",
-        env!("CARGO_MANIFEST_DIR")
-    ))
-    .unwrap()
-}
-
-/// The gen 3 file with `edit` applied, written into `dir`.
+/// The gen 3 file with the test settings and `edit` applied, written into `dir`.
 fn device_file(dir: &Path, name: &str, edit: impl Fn(String) -> String) -> PathBuf {
-    shipped_file(dir, "haply-2diy-gen3.toml", name, edit)
+    haply_file(dir, "haply-2diy-gen3.toml", name, edit)
 }
 
-/// The shipped device file `file` with the test settings and `edit` applied, written into `dir`.
-fn shipped_file(dir: &Path, file: &str, name: &str, edit: impl Fn(String) -> String) -> PathBuf {
-    let p = dir.join(name);
-    let text = shipped_text(file)
-        .replace("timeout_periods = 20 ", "timeout_periods = 100 ")
-        .replace("max_missed_deadlines = 10 ", "max_missed_deadlines = 0 ")
-        .replace("max_stall_periods = 5 ", "max_stall_periods = 1000 ");
-    std::fs::write(&p, edit(text)).unwrap();
-    p
-}
-
-/// Starts `haptic2d emulate haply ARGS…` and returns it with the pty path (its first stdout line).
-fn emulate(args: &[&str]) -> (Child, String) {
-    let mut child = Command::new(BIN)
-        .args(["emulate", "haply"])
-        .args(args)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    let mut line = String::new();
-    BufReader::new(child.stdout.as_mut().unwrap())
-        .read_line(&mut line)
-        .unwrap();
-    let path = line
-        .trim()
-        .strip_prefix("pty: ")
-        .unwrap_or_else(|| panic!("first line `{line}` is not `pty: PATH`"))
-        .to_string();
-    (child, path)
-}
-
-fn stop(mut child: Child) {
-    // SIGINT, as Ctrl-C.
-    unsafe_sigint(child.id());
-    let _ = child.wait();
-}
-
-fn unsafe_sigint(pid: u32) {
-    let _ = Command::new("kill")
-        .args(["-INT", &pid.to_string()])
-        .status();
+/// The twin's shipped file with the test settings, written into `dir` as `name`.
+fn twin_file(dir: &Path, name: &str, edit: impl Fn(String) -> String) -> PathBuf {
+    haply_file(dir, "haply-twin.toml", name, edit)
 }
 
 /// `haptic2d run` on the emulated board at `pty` with device file `file`, headless, normal
 /// scheduling, for `duration` seconds; callers add their own options.
 fn haply_run(pty: &str, file: &Path, duration: &str) -> Command {
-    let mut c = Command::new(BIN);
-    c.args(["run", "--device", &format!("haply:{pty}"), "--device-file"])
-        .arg(file)
-        .args(["--headless", "--duration", duration, "--no-rt"]);
+    let device = format!("haply:{pty}");
+    let mut c = cmd("run --device {} --device-file {}", &[&device, &file]);
+    c.args(["--headless", "--duration", duration, "--no-rt"]);
     c
 }
 
@@ -91,14 +42,14 @@ fn run_against_the_emulator_for_3_s_logs_and_exits_clean() {
     let _turn = turn();
     let dir = tempfile::tempdir().unwrap();
     let file = device_file(dir.path(), "gen3.toml", |t| t);
-    let (emu, pty) = emulate(&["--device-file", file.to_str().unwrap()]);
+    let (emu, pty) = emulate_haply(&file, &[]);
     let log = dir.path().join("x.csv");
     let o = haply_run(&pty, &file, "3")
         .arg("--log")
         .arg(&log)
         .output()
         .unwrap();
-    stop(emu);
+    interrupt(emu);
     let out = text(&o);
     assert!(o.status.success(), "{out}");
     assert!(
@@ -116,29 +67,27 @@ fn run_against_the_emulator_for_3_s_logs_and_exits_clean() {
     assert!(rows > 500, "only {rows} rows logged:\n{out}");
 }
 
-#[test]
-fn emulator_killed_mid_run_exits_4_naming_the_device() {
+/// A 20 s run against the emulated gen 3 board, cut once its loop is ticking (its log has rows):
+/// `cut` silences the emulator. The pty, the run's exit code and its output; the run ends within 5 s
+/// of the cut (asserted).
+fn run_then_cut(cut: impl FnOnce(&mut common::Killed)) -> (String, Option<i32>, String) {
     let _turn = turn();
     let dir = tempfile::tempdir().unwrap();
     let file = device_file(dir.path(), "gen3.toml", |t| t);
-    let (mut emu, pty) = emulate(&["--device-file", file.to_str().unwrap()]);
-    let run = haply_run(&pty, &file, "20")
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    std::thread::sleep(Duration::from_millis(1500));
-    emu.kill().unwrap();
-    let _ = emu.wait();
-    let t0 = Instant::now();
-    let o = run.wait_with_output().unwrap();
-    let out = text(&o);
-    assert_eq!(o.status.code(), Some(4), "{out}");
-    assert!(
-        t0.elapsed() < Duration::from_secs(5),
-        "took {:?}",
-        t0.elapsed()
-    );
+    let (mut emu, pty) = emulate_haply(&file, &[]);
+    let log = dir.path().join("cut.csv");
+    let (code, out, took) = cut_mid_run(haply_run(&pty, &file, "20"), &log, || cut(&mut emu));
+    assert!(took < Duration::from_secs(5), "took {took:?}\n{out}");
+    (pty, code, out)
+}
+
+#[test]
+fn emulator_killed_mid_run_exits_4_naming_the_device() {
+    let (pty, code, out) = run_then_cut(|emu| {
+        emu.kill().unwrap();
+        let _ = emu.wait();
+    });
+    assert_eq!(code, Some(4), "{out}");
     assert!(
         out.contains(&format!("haply:{pty}"))
             && out.contains("check")
@@ -152,18 +101,11 @@ fn emulator_killed_mid_run_exits_4_naming_the_device() {
 
 /// `device check FILE --pulse` against the emulator at `pty`: the exit code and the output.
 fn device_check(pty: &str, file: &Path) -> (Option<i32>, String) {
-    let o = Command::new(BIN)
-        .args([
-            "device",
-            "check",
-            "--device",
-            &format!("haply:{pty}"),
-            "--pulse",
-            "--device-file",
-        ])
-        .arg(file)
-        .output()
-        .unwrap();
+    let device = format!("haply:{pty}");
+    let o = run(
+        "device check --device {} --pulse --device-file {}",
+        &[&device, &file],
+    );
     (o.status.code(), text(&o))
 }
 
@@ -175,7 +117,7 @@ fn device_check_passes_on_a_correct_board_held_at_rest_and_finds_a_flipped_motor
     let _turn = turn();
     let dir = tempfile::tempdir().unwrap();
     let good = device_file(dir.path(), "gen3.toml", |t| t);
-    let (emu, pty) = emulate(&["--device-file", good.to_str().unwrap()]);
+    let (emu, pty) = emulate_haply(&good, &[]);
     let (code, out) = device_check(&pty, &good);
     assert_eq!(code, Some(0), "{out}");
     assert!(
@@ -198,7 +140,7 @@ fn device_check_passes_on_a_correct_board_held_at_rest_and_finds_a_flipped_motor
         )
     });
     let (code, out) = device_check(&pty, &flipped);
-    stop(emu);
+    interrupt(emu);
     assert_eq!(code, Some(2), "{out}");
     assert!(
         out.contains("fix: motor[0] turns its link clockwise")
@@ -218,9 +160,9 @@ fn device_check_tells_a_reversed_motor_and_encoder_from_a_correct_joint() {
     let board = device_file(dir.path(), "board.toml", |t| {
         t.replacen("direction = \"ccw\"", "direction = \"cw\"", 1)
     });
-    let (emu, pty) = emulate(&["--device-file", board.to_str().unwrap()]);
+    let (emu, pty) = emulate_haply(&board, &[]);
     let (code, out) = device_check(&pty, &good);
-    stop(emu);
+    interrupt(emu);
     assert_eq!(code, Some(2), "{out}");
     assert!(
         out.contains("motor[0]'s motor AND encoder are both reversed"),
@@ -236,17 +178,17 @@ fn device_check_tells_a_reversed_motor_and_encoder_from_a_correct_joint() {
 fn device_check_on_the_twin_finds_a_joint_with_motor_and_encoder_reversed() {
     let _turn = turn();
     let dir = tempfile::tempdir().unwrap();
-    let good = shipped_file(dir.path(), "haply-twin.toml", "twin.toml", |t| t);
-    let (emu, pty) = emulate(&["--device-file", good.to_str().unwrap()]);
+    let good = twin_file(dir.path(), "twin.toml", |t| t);
+    let (emu, pty) = emulate_haply(&good, &[]);
     let (code, out) = device_check(&pty, &good);
-    stop(emu);
+    interrupt(emu);
     assert_eq!(code, Some(0), "{out}");
-    let board = shipped_file(dir.path(), "haply-twin.toml", "board.toml", |t| {
+    let board = twin_file(dir.path(), "board.toml", |t| {
         t.replacen("direction = \"ccw\"", "direction = \"cw\"", 1)
     });
-    let (emu, pty) = emulate(&["--device-file", board.to_str().unwrap()]);
+    let (emu, pty) = emulate_haply(&board, &[]);
     let (code, out) = device_check(&pty, &good);
-    stop(emu);
+    interrupt(emu);
     assert_eq!(code, Some(2), "{out}");
     assert_eq!(out.matches("angle +").count(), 4, "{out}");
     assert!(
@@ -262,10 +204,10 @@ fn device_check_on_the_twin_finds_a_joint_with_motor_and_encoder_reversed() {
 fn twin_on_an_m0_board_is_refused_naming_the_port_count() {
     let _turn = turn();
     let dir = tempfile::tempdir().unwrap();
-    let file = shipped_file(dir.path(), "haply-twin.toml", "twin.toml", |t| t);
-    let (emu, pty) = emulate(&["--device-file", file.to_str().unwrap(), "--board", "m0"]);
+    let file = twin_file(dir.path(), "twin.toml", |t| t);
+    let (emu, pty) = emulate_haply(&file, &["--board", "m0"]);
     let o = haply_run(&pty, &file, "1").output().unwrap();
-    stop(emu);
+    interrupt(emu);
     let out = text(&o);
     assert_eq!(o.status.code(), Some(4), "{out}");
     assert!(
@@ -278,17 +220,10 @@ fn twin_on_an_m0_board_is_refused_naming_the_port_count() {
 
 #[test]
 fn missing_port_and_bad_device_file_are_clear_errors() {
-    let o = Command::new(BIN)
-        .args([
-            "run",
-            "--device",
-            "haply:/dev/no-such-board",
-            "--headless",
-            "--duration",
-            "1",
-        ])
-        .output()
-        .unwrap();
+    let o = run(
+        "run --device haply:/dev/no-such-board --headless --duration 1",
+        &[],
+    );
     let out = text(&o);
     assert!(
         !o.status.success() && out.contains("/dev/no-such-board") && out.contains("check"),
@@ -298,17 +233,10 @@ fn missing_port_and_bad_device_file_are_clear_errors() {
     let bad = device_file(dir.path(), "bad.toml", |t| {
         t.replace("torque_limit = 0.123", "torque_limit = 0.4")
     });
-    let o = Command::new(BIN)
-        .args([
-            "run",
-            "--device",
-            "haply:/dev/null",
-            "--headless",
-            "--device-file",
-        ])
-        .arg(&bad)
-        .output()
-        .unwrap();
+    let o = run(
+        "run --device haply:/dev/null --headless --device-file {}",
+        &[&bad],
+    );
     let out = text(&o);
     assert_eq!(o.status.code(), Some(2), "{out}");
     assert!(
@@ -320,7 +248,7 @@ fn missing_port_and_bad_device_file_are_clear_errors() {
 
 #[test]
 fn devices_lists_ports_without_failing() {
-    let o = Command::new(BIN).arg("devices").output().unwrap();
+    let o = run("devices", &[]);
     assert!(o.status.success(), "{}", text(&o));
 }
 
@@ -334,23 +262,24 @@ fn haply_run_is_the_normal_loop_torques_start_at_zero_ramp_in_and_stay_clamped()
     let _turn = turn();
     let dir = tempfile::tempdir().unwrap();
     let file = device_file(dir.path(), "gen3.toml", |t| t);
-    let (emu, pty) = emulate(&[
-        "--device-file",
-        file.to_str().unwrap(),
-        // The user holds the handle at the rest pose while the board is set up (docs/DEVICES.md
-        // §7) and through the 0.5 s ramp, then pushes 0.5 N along x: a push from t = 0 would move
-        // the handle during the setup (refused by the rest-pose check) or run the free handle past
-        // the workspace edge while the wall's torques are still ramping in (a safety stop).
-        "--hand",
-        "script:0.8,0.5,0,0,5",
-    ]);
+    let (emu, pty) = emulate_haply(
+        &file,
+        &[
+            // The user holds the handle at the rest pose while the board is set up (docs/DEVICES.md
+            // §7) and through the 0.5 s ramp, then pushes 0.5 N along x: a push from t = 0 would move
+            // the handle during the setup (refused by the rest-pose check) or run the free handle past
+            // the workspace edge while the wall's torques are still ramping in (a safety stop).
+            "--hand",
+            "script:0.8,0.5,0,0,5",
+        ],
+    );
     let log = dir.path().join("ramp.csv");
     let o = haply_run(&pty, &file, "1.5")
         .arg("--log")
         .arg(&log)
         .output()
         .unwrap();
-    stop(emu);
+    interrupt(emu);
     let out = text(&o);
     assert!(o.status.success(), "{out}");
     let csv = std::fs::read_to_string(&log).unwrap();
@@ -381,30 +310,11 @@ fn haply_run_is_the_normal_loop_torques_start_at_zero_ramp_in_and_stay_clamped()
 /// what to check — not a stall.
 #[test]
 fn a_silent_emulated_device_exits_4_with_the_reason() {
-    let _turn = turn();
-    let dir = tempfile::tempdir().unwrap();
-    let file = device_file(dir.path(), "gen3.toml", |t| t);
-    let (mut emu, pty) = emulate(&["--device-file", file.to_str().unwrap()]);
-    let run = haply_run(&pty, &file, "20")
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    std::thread::sleep(Duration::from_millis(1500));
-    let pid = emu.id().to_string();
-    let _ = Command::new("kill").args(["-STOP", &pid]).status();
-    let t0 = Instant::now();
-    let o = run.wait_with_output().unwrap();
-    let _ = Command::new("kill").args(["-CONT", &pid]).status();
-    let _ = emu.kill();
-    let _ = emu.wait();
-    let out = text(&o);
-    assert_eq!(o.status.code(), Some(4), "{out}");
-    assert!(
-        t0.elapsed() < Duration::from_secs(5),
-        "took {:?}",
-        t0.elapsed()
-    );
+    let (pty, code, out) = run_then_cut(|emu| {
+        // Stopped, then resumed and killed when the guard drops.
+        signal(emu.id(), "-STOP");
+    });
+    assert_eq!(code, Some(4), "{out}");
     assert!(
         out.contains(&format!("haply:{pty}"))
             && out.contains("emulator on a pseudo-terminal (no USB cable)")
@@ -423,20 +333,15 @@ fn a_silent_emulated_device_exits_4_with_the_reason() {
 fn twin_runs_through_the_normal_loop_against_the_emulator() {
     let _turn = turn();
     let dir = tempfile::tempdir().unwrap();
-    let file = shipped_file(dir.path(), "haply-twin.toml", "twin.toml", |t| t);
-    let (emu, pty) = emulate(&[
-        "--device-file",
-        file.to_str().unwrap(),
-        "--hand",
-        "script:0.8,0.3,0,0,100",
-    ]);
+    let file = twin_file(dir.path(), "twin.toml", |t| t);
+    let (emu, pty) = emulate_haply(&file, &["--hand", "script:0.8,0.3,0,0,100"]);
     let log = dir.path().join("twin.csv");
     let o = haply_run(&pty, &file, "1.5")
         .arg("--log")
         .arg(&log)
         .output()
         .unwrap();
-    stop(emu);
+    interrupt(emu);
     let out = text(&o);
     assert!(o.status.success(), "{out}");
     assert!(out.contains("twin pantograph"), "{out}");
@@ -462,25 +367,10 @@ fn twin_runs_through_the_normal_loop_against_the_emulator() {
 #[test]
 fn stability_of_the_2diy_is_per_axis_x_and_y() {
     let dir = tempfile::tempdir().unwrap();
-    let file = format!(
-        "{}/../../devices/haply-2diy-gen3.toml",
-        env!("CARGO_MANIFEST_DIR")
-    );
+    let file = common::root().join("devices/haply-2diy-gen3.toml");
     let run = |controller: &str| {
-        let o = Command::new(BIN)
-            .args([
-                "stability",
-                "--device-file",
-                &file,
-                "--controller",
-                controller,
-                "--out",
-            ])
-            .arg(dir.path())
-            .output()
-            .unwrap();
-        assert!(o.status.success(), "{}", text(&o));
-        text(&o)
+        let line = format!("stability --device-file {{}} --controller {controller} --out {{}}");
+        run_ok(&line, &[&file, &dir.path()])
     };
     let out = run("four-channel");
     assert!(
@@ -504,7 +394,7 @@ fn run_refuses_an_unstable_released_configuration_on_a_haply_board() {
     let _turn = turn();
     let dir = tempfile::tempdir().unwrap();
     let file = device_file(dir.path(), "gen3.toml", |t| t);
-    let (emu, pty) = emulate(&["--device-file", file.to_str().unwrap()]);
+    let (emu, pty) = emulate_haply(&file, &[]);
     let args = |extra: &[&str]| {
         haply_run(&pty, &file, "0.5")
             .args(["--controller", "four-channel-spec"])
@@ -520,7 +410,7 @@ fn run_refuses_an_unstable_released_configuration_on_a_haply_board() {
         "{out}"
     );
     let o = args(&["--allow-unstable"]);
-    stop(emu);
+    interrupt(emu);
     let out = text(&o);
     assert!(out.contains("running box-in-walls"), "{out}");
 }

@@ -7,73 +7,37 @@
 //! 10 %) is `haptic2d-devices/tests/identify_emulator.rs`; here the sample times are the host's wall
 //! clock on a shared machine, so the bound is 15 %.
 
-use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Output, Stdio};
+use std::process::Output;
 
 mod common;
-use common::{text, turn};
+use common::{cmd, emulate_haply, interrupt as stop, run, shipped_text, text, turn, write_in};
 
 use haptic2d_devices::haply::{HaplyDeviceFile, HaplyKind};
-
-const BIN: &str = env!("CARGO_BIN_EXE_haptic2d");
 
 /// The shipped gen 3 file with `edit` applied, in `dir`, and a reply timeout of 1000 periods: on a
 /// machine at load average 13 the emulator was once silent for 100 ms. A late reply only stretches
 /// a sample interval, which the fit takes from the host's clock.
 fn device_file(dir: &Path, name: &str, edit: impl Fn(String) -> String) -> PathBuf {
-    let p = dir.join(name);
-    let text = std::fs::read_to_string(format!(
-        "{}/../../devices/haply-2diy-gen3.toml",
-        env!("CARGO_MANIFEST_DIR")
-    ))
-    .unwrap()
-    .replace("timeout_periods = 20 ", "timeout_periods = 1000 ");
-    std::fs::write(&p, edit(text)).unwrap();
-    p
+    let text = shipped_text("haply-2diy-gen3.toml")
+        .replace("timeout_periods = 20 ", "timeout_periods = 1000 ");
+    write_in(dir, name, &edit(text))
 }
 
-/// `haptic2d emulate haply --device-file FILE ARGS…` and its pty path.
-fn emulate(file: &Path, args: &[&str]) -> (Child, String) {
-    let mut child = Command::new(BIN)
-        .args(["emulate", "haply", "--device-file"])
-        .arg(file)
-        .args(args)
-        .args(["--duration", "30"])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    let mut line = String::new();
-    BufReader::new(child.stdout.as_mut().unwrap())
-        .read_line(&mut line)
-        .unwrap();
-    let path = line.trim().strip_prefix("pty: ").unwrap().to_string();
-    (child, path)
-}
-
-fn stop(mut child: Child) {
-    let _ = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
-        .status();
-    let _ = child.wait();
+/// `haptic2d emulate haply --device-file FILE ARGS… --duration 30` and its pty path.
+fn emulate(file: &Path, args: &[&str]) -> (common::Killed, String) {
+    emulate_haply(file, &[args, &["--duration", "30"]].concat())
 }
 
 fn identify(pty: &str, file: &Path, extra: &[&str]) -> Output {
-    Command::new(BIN)
-        .args([
-            "device",
-            "identify",
-            "--device",
-            &format!("haply:{pty}"),
-            "--release-delay",
-            "0",
-            "--device-file",
-        ])
-        .arg(file)
-        .args(extra)
-        .output()
-        .unwrap()
+    let device = format!("haply:{pty}");
+    cmd(
+        "device identify --device {} --release-delay 0 --device-file {}",
+        &[&device, &file],
+    )
+    .args(extra)
+    .output()
+    .unwrap()
 }
 
 /// A released handle (no hand, no hand damping): the identified joint inertias and the lumped model
@@ -115,11 +79,7 @@ fn device_identify_writes_the_emulated_inertia_and_the_gate_uses_it() {
     }
     assert!(((id.end_mass - m_e) / m_e).abs() < 0.15, "{out}");
     // The stability gate's numbers come from the table now.
-    let o = Command::new(BIN)
-        .args(["stability", "--controller", "coupling", "--device-file"])
-        .arg(&file)
-        .output()
-        .unwrap();
+    let o = run("stability --controller coupling --device-file {}", &[&file]);
     let s = text(&o);
     assert!(
         s.contains("device dynamics:") && s.contains(&format!("identified {}", id.date)),
@@ -127,11 +87,10 @@ fn device_identify_writes_the_emulated_inertia_and_the_gate_uses_it() {
     );
     // Without the table it says the numbers are estimates.
     let plain = device_file(dir.path(), "plain.toml", |t| t);
-    let o = Command::new(BIN)
-        .args(["stability", "--controller", "coupling", "--device-file"])
-        .arg(&plain)
-        .output()
-        .unwrap();
+    let o = run(
+        "stability --controller coupling --device-file {}",
+        &[&plain],
+    );
     assert!(
         text(&o).contains("built-in estimates, not measured"),
         "{}",
@@ -209,29 +168,13 @@ fn device_identify_refuses_a_handle_that_is_not_still_at_the_rest_pose() {
 /// Bad options exit 2 before the device is opened: a pulse above the cap, --write on a built-in file.
 #[test]
 fn device_identify_refuses_bad_options_with_exit_2() {
-    let o = Command::new(BIN)
-        .args([
-            "device",
-            "identify",
-            "--device",
-            "haply:/nonexistent",
-            "--torque",
-            "0.1",
-        ])
-        .output()
-        .unwrap();
+    let o = run(
+        "device identify --device haply:/nonexistent --torque 0.1",
+        &[],
+    );
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     assert!(text(&o).contains("--torque 0.1"), "{}", text(&o));
-    let o = Command::new(BIN)
-        .args([
-            "device",
-            "identify",
-            "--device",
-            "haply:/nonexistent",
-            "--write",
-        ])
-        .output()
-        .unwrap();
+    let o = run("device identify --device haply:/nonexistent --write", &[]);
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     assert!(
         text(&o).contains("--write needs --device-file"),

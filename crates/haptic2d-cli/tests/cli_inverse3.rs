@@ -12,63 +12,33 @@
 // the refusal is tested in tests/cli_exit.rs.
 #![cfg(feature = "inverse3")]
 
-use std::io::{BufRead, BufReader};
-use std::path::PathBuf;
-use std::process::{Child, Command, Stdio};
-use std::thread;
-use std::time::Duration;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
 
 mod common;
-use common::{column, patient_device_file, text, turn};
-
-const BIN: &str = env!("CARGO_BIN_EXE_haptic2d");
+use common::{cmd, column, cut_mid_run, patient_device_file, spawn_announced, text, turn, Killed};
 
 /// The shipped file, patient about the machine's timing, in a temp dir.
 fn device_file(tag: &str) -> PathBuf {
     patient_device_file("inverse3.toml", ("20", "100"), tag, "inverse3.toml")
 }
 
-struct Emulator(Child, String);
-
-impl Drop for Emulator {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
-
-/// `haptic2d emulate inverse3` on an ephemeral loopback port; its service URL.
-fn emulator(extra: &[&str]) -> Emulator {
-    let mut child = Command::new(BIN)
-        .args(["emulate", "inverse3", "--bind", "127.0.0.1:0"])
-        .args(extra)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    let mut line = String::new();
-    BufReader::new(child.stdout.take().unwrap())
-        .read_line(&mut line)
-        .unwrap();
-    let url = line
-        .trim()
-        .strip_prefix("listening: ")
-        .unwrap_or_else(|| panic!("first line `{line}`"))
-        .to_string();
+/// `haptic2d emulate inverse3` on an ephemeral loopback port (killed on drop); its service URL.
+fn emulator(extra: &[&str]) -> (Killed, String) {
+    let (child, url) = spawn_announced(
+        cmd("emulate inverse3 --bind 127.0.0.1:0", &[])
+            .args(extra)
+            .stderr(Stdio::null()),
+        "listening: ",
+    );
     assert!(url.starts_with("http://127.0.0.1:"), "{url}");
-    Emulator(child, url)
+    (child, url)
 }
 
-fn run(url: &str, file: &PathBuf, duration: &str) -> Command {
-    let mut c = Command::new(BIN);
-    c.args([
-        "run",
-        "--device",
-        &format!("inverse3:{url}"),
-        "--device-file",
-    ])
-    .arg(file)
-    .args(["--headless", "--no-rt", "--duration", duration]);
+fn run(url: &str, file: &Path, duration: &str) -> Command {
+    let device = format!("inverse3:{url}");
+    let mut c = cmd("run --device {} --device-file {}", &[&device, &file]);
+    c.args(["--headless", "--no-rt", "--duration", duration]);
     c
 }
 
@@ -126,23 +96,8 @@ fn run_against_the_emulated_service_for_3_s_drives_the_box_into_the_wall() {
     assert_eq!(o.status.code(), Some(0), "{out}");
     assert!(out.contains("planar: world x = device x"), "{out}");
     assert!(!out.contains("panicked"), "{out}");
-    let csv = std::fs::read_to_string(&log).unwrap();
-    let mut lines = csv.lines();
-    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let col = |n: &str| {
-        header
-            .iter()
-            .position(|h| *h == n)
-            .unwrap_or_else(|| panic!("no column {n} in {header:?}"))
-    };
+    let (col, rows) = common::csv_rows(&log);
     let (xs, contacts) = (col("slave.x"), col("contacts"));
-    let rows: Vec<Vec<f64>> = lines
-        .map(|l| {
-            l.split(',')
-                .map(|v| v.parse().unwrap_or(f64::NAN))
-                .collect()
-        })
-        .collect();
     assert!(rows.len() > 1500, "{} rows", rows.len());
     let last = &rows[rows.len() - 300..];
     assert!(
@@ -159,16 +114,9 @@ fn service_killed_mid_run_exits_4_naming_the_device() {
     let _t = turn();
     let mut emu = emulator(&[]);
     let file = device_file("kill");
-    let child = run(&emu.1, &file, "10")
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    thread::sleep(Duration::from_millis(1500));
-    emu.0.kill().unwrap();
-    let o = child.wait_with_output().unwrap();
-    let out = text(&o);
-    assert_eq!(o.status.code(), Some(4), "{out}");
+    let log = file.with_file_name("kill.csv");
+    let (code, out, _) = cut_mid_run(run(&emu.1, &file, "10"), &log, || emu.0.kill().unwrap());
+    assert_eq!(code, Some(4), "{out}");
     assert!(out.contains(&format!("inverse3:{}", emu.1)), "{out}");
     assert!(
         out.contains("check:") && out.contains("Inverse Service"),
@@ -212,27 +160,17 @@ fn no_service_and_bad_urls_are_clear_errors() {
     assert_eq!(o.status.code(), Some(4), "{out}");
     assert!(out.contains("haptic2d emulate inverse3"), "{out}");
     assert!(!out.contains("panicked"), "{out}");
-    let o = Command::new(BIN)
-        .args([
-            "run",
-            "--device",
-            "inverse3:nonsense",
-            "--headless",
-            "--duration",
-            "1",
-        ])
-        .output()
-        .unwrap();
+    let o = common::run(
+        "run --device inverse3:nonsense --headless --duration 1",
+        &[],
+    );
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     assert!(
         text(&o).contains("inverse3:http://HOST:PORT"),
         "{}",
         text(&o)
     );
-    let o = Command::new(BIN)
-        .args(["emulate", "inverse3", "--bind", "nowhere"])
-        .output()
-        .unwrap();
+    let o = common::run("emulate inverse3 --bind nowhere", &[]);
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     assert!(text(&o).contains("--bind"), "{}", text(&o));
 }

@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{haptic2d, text, turn};
+use common::{haptic2d, run, text, turn};
 use std::process::Command;
 
 #[test]
@@ -13,14 +13,7 @@ fn run_headless_one_second_prints_the_summary_and_logs_every_tick() {
     let _turn = turn();
     let dir = tempfile::tempdir().unwrap();
     let log = dir.path().join("run.csv");
-    let o = haptic2d(&[
-        "run",
-        "--headless",
-        "--duration",
-        "1",
-        "--log",
-        log.to_str().unwrap(),
-    ]);
+    let o = run("run --headless --duration 1 --log {}", &[&log]);
     let out = text(&o);
     assert!(o.status.success(), "{out}");
     for needle in [
@@ -96,14 +89,7 @@ fn run_replays_recorded_encoders() {
     let log = dir.path().join("rec.csv");
     // Record 0.2 s of the simulated device, then replay its encoder angles.
     let rec = dir.path().join("q.csv");
-    let o = haptic2d(&[
-        "run",
-        "--headless",
-        "--duration",
-        "0.2",
-        "--log",
-        log.to_str().unwrap(),
-    ]);
+    let o = run("run --headless --duration 0.2 --log {}", &[&log]);
     assert!(o.status.success(), "{}", text(&o));
     // Build q1..q4 from the device pose with the same model the binary uses.
     let params = haptic2d::device::DeviceParams::default();
@@ -287,10 +273,9 @@ fn run_display_serves_frames_and_applies_commands() {
     // Pause: the world's time stands still; resume: it runs again.
     send(&mut ws, r#"{"type":"pause"}"#);
     let p1 = wait_for(&mut ws, "frame", 5.0, |f| f["paused"] == true);
-    std::thread::sleep(std::time::Duration::from_millis(200));
-    let p2 = wait_for(&mut ws, "frame", 5.0, |f| {
-        f["seq"].as_u64() > p1["seq"].as_u64()
-    });
+    // Frames go on while paused: the 12th after it (about 0.2 s at 60 frames a second).
+    let after = p1["seq"].as_u64().unwrap() + 12;
+    let p2 = wait_for(&mut ws, "frame", 5.0, |f| f["seq"].as_u64() >= Some(after));
     assert_eq!(p1["t"], p2["t"], "paused world does not advance");
     assert_eq!(p2["drive"], serde_json::json!([0.0, 0.0, 0.0]));
     send(&mut ws, r#"{"type":"resume"}"#);

@@ -63,12 +63,7 @@ fn assert_whole_rows(path: &Path) -> usize {
 
 /// The "N ticks" of the run summary.
 fn ticks_in(out: &str) -> usize {
-    out.split_whitespace()
-        .collect::<Vec<_>>()
-        .windows(2)
-        .find(|w| w[1] == "ticks")
-        .and_then(|w| w[0].parse().ok())
-        .unwrap_or_else(|| panic!("no tick count in:\n{out}"))
+    common::summary_ticks(out) as usize
 }
 
 fn run_log_then(sig: libc::c_int) {
@@ -254,12 +249,7 @@ fn log_convert_renames_its_complete_output_into_place() {
     let dir = tempfile::tempdir().unwrap();
     let csv = big_tick_csv(dir.path(), 1000);
     let out = dir.path().join("out.mcap");
-    let o = common::haptic2d(&[
-        "log",
-        "convert",
-        csv.to_str().unwrap(),
-        out.to_str().unwrap(),
-    ]);
+    let o = common::run("log convert {} {}", &[&csv, &out]);
     assert!(o.status.success(), "{}", common::text(&o));
     let mut names: Vec<String> = std::fs::read_dir(dir.path())
         .unwrap()
@@ -279,12 +269,7 @@ fn log_convert_into_a_named_pipe_writes_the_pipe_and_keeps_it() {
     let dir = tempfile::tempdir().unwrap();
     let csv = big_tick_csv(dir.path(), 100);
     let mcap = dir.path().join("x.mcap");
-    let o = common::haptic2d(&[
-        "log",
-        "convert",
-        csv.to_str().unwrap(),
-        mcap.to_str().unwrap(),
-    ]);
+    let o = common::run("log convert {} {}", &[&csv, &mcap]);
     assert!(o.status.success(), "{}", common::text(&o));
     let fifo = dir.path().join("pipe");
     let c = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
@@ -294,12 +279,7 @@ fn log_convert_into_a_named_pipe_writes_the_pipe_and_keeps_it() {
         let fifo = fifo.clone();
         std::thread::spawn(move || std::fs::read_to_string(fifo).unwrap())
     };
-    let o = common::haptic2d(&[
-        "log",
-        "convert",
-        mcap.to_str().unwrap(),
-        fifo.to_str().unwrap(),
-    ]);
+    let o = common::run("log convert {} {}", &[&mcap, &fifo]);
     assert!(o.status.success(), "{}", common::text(&o));
     // (Checked before joining the reader: had the pipe been renamed over, the reader would wait
     // for a writer forever.)

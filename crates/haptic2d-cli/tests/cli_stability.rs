@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{haptic2d, text};
+use common::{haptic2d, run, text};
 
 fn stability(args: &[&str], out: &std::path::Path) -> String {
     let mut a = vec!["stability"];
@@ -121,13 +121,10 @@ fn stability_refuses_a_bad_controller_file_naming_the_field() {
     ] {
         let f = dir.path().join("bad.toml");
         std::fs::write(&f, body).unwrap();
-        let o = haptic2d(&[
-            "stability",
-            "--controller-file",
-            f.to_str().unwrap(),
-            "--out",
-            dir.path().to_str().unwrap(),
-        ]);
+        let o = run(
+            "stability --controller-file {} --out {}",
+            &[&f, &dir.path()],
+        );
         assert!(!o.status.success(), "{body}");
         let t = text(&o);
         assert!(t.contains("bad.toml"), "{t}");
@@ -152,26 +149,17 @@ fn run_and_reproduce_accept_a_controller_file() {
     let dir = tempfile::tempdir().unwrap();
     let root = common::root();
     let soft = root.join("controllers/coupling-soft.toml");
-    let o = haptic2d(&[
-        "run",
-        "--headless",
-        "--no-rt",
-        "--duration",
-        "0.2",
-        "--controller-file",
-        soft.to_str().unwrap(),
-    ]);
+    let o = run(
+        "run --headless --no-rt --duration 0.2 --controller-file {}",
+        &[&soft],
+    );
     assert!(o.status.success(), "{}", text(&o));
     assert!(text(&o).contains("controller coupling"), "{}", text(&o));
     let out = dir.path().join("repro");
-    let o = haptic2d(&[
-        "reproduce",
-        "fig8",
-        "--out",
-        out.to_str().unwrap(),
-        "--controller-file",
-        soft.to_str().unwrap(),
-    ]);
+    let o = run(
+        "reproduce fig8 --out {} --controller-file {}",
+        &[&out, &soft],
+    );
     assert!(o.status.success(), "{}", text(&o));
     let report = std::fs::read_to_string(out.join("fig8/report.md")).unwrap();
     assert!(

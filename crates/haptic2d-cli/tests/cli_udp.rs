@@ -7,61 +7,42 @@
 //! protocol and the exit paths, not the timing (the timeout itself is exercised by the driver
 //! tests in haptic2d-devices). The tests take turns to keep the load down.
 
-use std::io::{BufRead, BufReader};
 use std::net::{SocketAddr, UdpSocket};
-use std::path::PathBuf;
-use std::process::{Child, Command, Stdio};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::Arc;
 use std::thread;
 use std::time::Duration;
 
 mod common;
-use common::{patient_device_file, root, text, turn};
-
-const BIN: &str = env!("CARGO_BIN_EXE_haptic2d");
+use common::{cmd, cut_mid_run, patient_device_file, root, spawn_announced, text, turn, Killed};
 
 /// The reference file with a patient timeout and no missed-deadline limit, in a temp dir.
 fn device_file(tag: &str) -> PathBuf {
     patient_device_file("udp-pantograph.toml", ("3", "50"), tag, "udp.toml")
 }
 
-struct Device(Child, SocketAddr);
-
-impl Drop for Device {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
+/// The reference device (killed on drop) and its address.
+struct Device(Killed, SocketAddr);
 
 /// devices/udp/sim_device.py on an ephemeral loopback port, or `None` without python3.
 fn sim_device(extra: &[&str]) -> Option<Device> {
-    let mut child = Command::new("python3")
-        .arg(root().join("devices/udp/sim_device.py"))
+    let mut python = Command::new("python3");
+    python.arg("--version").stdout(Stdio::null());
+    python.status().ok()?;
+    let mut c = Command::new("python3");
+    c.arg(root().join("devices/udp/sim_device.py"))
         .args(["--bind", "127.0.0.1:0"])
-        .args(extra)
-        .stdout(Stdio::piped())
-        .spawn()
-        .ok()?;
-    let mut line = String::new();
-    BufReader::new(child.stdout.take().unwrap())
-        .read_line(&mut line)
-        .unwrap();
-    let addr = line
-        .trim()
-        .strip_prefix("listening on ")
-        .unwrap_or_else(|| panic!("first line `{line}`"))
-        .parse()
-        .unwrap();
-    Some(Device(child, addr))
+        .args(extra);
+    let (child, addr) = spawn_announced(&mut c, "listening on ");
+    Some(Device(child, addr.parse().unwrap()))
 }
 
-fn run(addr: SocketAddr, file: &PathBuf, duration: &str) -> Command {
-    let mut c = Command::new(BIN);
-    c.args(["run", "--device", &format!("udp:{addr}"), "--device-file"])
-        .arg(file)
-        .args(["--headless", "--no-rt", "--duration", duration]);
+fn run(addr: SocketAddr, file: &Path, duration: &str) -> Command {
+    let device = format!("udp:{addr}");
+    let mut c = cmd("run --device {} --device-file {}", &[&device, &file]);
+    c.args(["--headless", "--no-rt", "--duration", duration]);
     c
 }
 
@@ -306,23 +287,13 @@ fn a_pushed_handle_drives_the_box_into_the_wall_and_feels_it() {
         .unwrap();
     let out = text(&o);
     assert_eq!(o.status.code(), Some(0), "{out}");
-    let csv = std::fs::read_to_string(&log).unwrap();
-    let mut lines = csv.lines();
-    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let col = |n: &str| head.iter().position(|h| *h == n).unwrap();
+    let (col, rows) = common::csv_rows(&log);
     let (dx, sx, fx, c) = (
         col("device.x"),
         col("slave.x"),
         col("f_cm.x"),
         col("contacts"),
     );
-    let rows: Vec<Vec<f64>> = lines
-        .map(|l| {
-            l.split(',')
-                .map(|v| v.parse().unwrap_or(f64::NAN))
-                .collect()
-        })
-        .collect();
     assert!(
         rows.len() > 1000,
         "{} rows
@@ -412,16 +383,9 @@ fn device_killed_mid_run_exits_4_naming_the_device() {
         );
     };
     let file = device_file("kill");
-    let child = run(dev.1, &file, "20")
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    thread::sleep(Duration::from_millis(1500));
-    dev.0.kill().unwrap();
-    let o = child.wait_with_output().unwrap();
-    let out = text(&o);
-    assert_eq!(o.status.code(), Some(4), "{out}");
+    let log = file.with_file_name("kill.csv");
+    let (code, out, _) = cut_mid_run(run(dev.1, &file, "20"), &log, || dev.0.kill().unwrap());
+    assert_eq!(code, Some(4), "{out}");
     assert!(out.contains(&format!("udp:{}", dev.1)), "{out}");
     assert!(
         out.contains("no state for") && out.contains("latched"),
@@ -447,17 +411,7 @@ fn no_device_and_bad_arguments_are_clear_errors() {
         out.contains("no state from the device") && out.contains("sim_device.py"),
         "{out}"
     );
-    let o = Command::new(BIN)
-        .args([
-            "run",
-            "--device",
-            "udp:nowhere",
-            "--headless",
-            "--duration",
-            "1",
-        ])
-        .output()
-        .unwrap();
+    let o = common::run("run --device udp:nowhere --headless --duration 1", &[]);
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     assert!(text(&o).contains("udp:ADDR:PORT"), "{}", text(&o));
     let bad = file.with_file_name("bad.toml");

@@ -6,8 +6,7 @@
 
 mod common;
 
-use common::{haptic2d, text, wait_with_limit};
-use std::process::{Command, Stdio};
+use common::{run, text};
 use std::time::Duration;
 
 /// xorshift64*: seeded, the same cases on every run.
@@ -55,34 +54,17 @@ fn mutate(seed: &[u8], rng: &mut Rng, lens: &[usize]) -> Vec<u8> {
 
 /// Runs `args` with a 30 s limit; returns (exit code, output), failing on a signal or a hang.
 fn ends(args: &[&str]) -> (i32, String) {
-    let child = Command::new(env!("CARGO_BIN_EXE_haptic2d"))
-        .args(args)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let Some((status, out)) = wait_with_limit(child, Duration::from_secs(30)) else {
-        panic!("{args:?} hung (killed after 30 s)");
-    };
-    let code = status
-        .code()
-        .unwrap_or_else(|| panic!("{args:?} was killed by a signal (an abort?):\n{out}"));
-    (code, out)
+    common::ends_within(args, Duration::from_secs(30))
 }
 
 #[test]
 fn mutated_logs_through_log_info_log_convert_and_replay_end_with_a_documented_code() {
     let dir = tempfile::tempdir().unwrap();
     let seed_path = dir.path().join("seed.mcap");
-    let o = haptic2d(&[
-        "run",
-        "--headless",
-        "--no-rt",
-        "--duration",
-        "0.05",
-        "--log",
-        seed_path.to_str().unwrap(),
-    ]);
+    let o = run(
+        "run --headless --no-rt --duration 0.05 --log {}",
+        &[&seed_path],
+    );
     assert!(o.status.success(), "{}", text(&o));
     let seed = std::fs::read(&seed_path).unwrap();
     let lens = record_lengths(&seed);
@@ -124,14 +106,9 @@ fn mutated_logs_through_log_info_log_convert_and_replay_end_with_a_documented_co
     eprintln!("{codes:?}");
     // The CSV tick log of the same kind, mutated, through `log info` and `replay:`.
     let csv = dir.path().join("seed.csv");
-    assert!(haptic2d(&[
-        "log",
-        "convert",
-        seed_path.to_str().unwrap(),
-        csv.to_str().unwrap()
-    ])
-    .status
-    .success());
+    assert!(run("log convert {} {}", &[&seed_path, &csv])
+        .status
+        .success());
     let text_seed = std::fs::read(&csv).unwrap();
     for i in 0..8 {
         let mut b = text_seed.clone();

@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{haptic2d, text};
+use common::{haptic2d, run, text};
 use haptic2d_rt::mcap::columns::{TickRow, Val, LOOP_COLUMN_COUNT, TICK_TABLE};
 use haptic2d_rt::mcap::reader::{read_file, read_info, read_ticks};
 use haptic2d_rt::mcap::schemas::*;
@@ -13,15 +13,7 @@ use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::Duration;
 
-/// "N ticks" of the timing summary.
-fn summary_ticks(out: &str) -> u64 {
-    out.split_whitespace()
-        .collect::<Vec<_>>()
-        .windows(2)
-        .find(|w| w[1] == "ticks")
-        .and_then(|w| w[0].parse().ok())
-        .unwrap_or_else(|| panic!("no tick count in:\n{out}"))
-}
+use common::summary_ticks;
 
 fn run_logged(log: &Path, extra: &[&str]) -> String {
     let mut args = vec![
@@ -323,14 +315,7 @@ fn replay_of_a_run_csv_log_reproduces_its_device_motion() {
 fn simulate_out_mcap_writes_every_sample_of_the_world() {
     let dir = tempfile::tempdir().unwrap();
     let m = dir.path().join("sim.mcap");
-    let o = haptic2d(&[
-        "simulate",
-        "box-in-walls",
-        "--duration",
-        "0.5",
-        "--out",
-        m.to_str().unwrap(),
-    ]);
+    let o = run("simulate box-in-walls --duration 0.5 --out {}", &[&m]);
     let out = text(&o);
     assert!(o.status.success(), "{out}");
     let samples: u64 = out
@@ -561,14 +546,7 @@ fn mcap_to_csv_writes_the_bodies_contacts_and_energy_channels_next_to_the_tick_c
 
     // A world recording of `simulate` (no tick channel) with resting contacts: the world CSVs only.
     let (w, wc) = (dir.path().join("pile.mcap"), dir.path().join("pile.csv"));
-    let o = haptic2d(&[
-        "simulate",
-        "pile",
-        "--duration",
-        "0.3",
-        "--out",
-        w.to_str().unwrap(),
-    ]);
+    let o = run("simulate pile --duration 0.3 --out {}", &[&w]);
     assert!(o.status.success(), "{}", text(&o));
     let r = haptic2d(&["log", "convert", w.to_str().unwrap(), wc.to_str().unwrap()]);
     assert!(r.status.success(), "{}", text(&r));
@@ -704,14 +682,7 @@ fn mcap_log_time_is_unix_epoch_ns_the_deadline_plus_the_recorded_offset() {
     // simulate: the start's Unix time + round(t · 1e9).
     let s = dir.path().join("sim.mcap");
     let before = unix_now_ns();
-    let o = haptic2d(&[
-        "simulate",
-        "box-in-walls",
-        "--duration",
-        "0.05",
-        "--out",
-        s.to_str().unwrap(),
-    ]);
+    let o = run("simulate box-in-walls --duration 0.05 --out {}", &[&s]);
     assert!(o.status.success(), "{}", text(&o));
     let bytes = read_file(&s).unwrap();
     let info = read_info(&bytes, "sim.mcap").unwrap();

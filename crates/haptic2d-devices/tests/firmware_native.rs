@@ -5,13 +5,15 @@
 //! Timing assertions allow a scheduling margin (the firmware runs as a normal process on a shared
 //! machine) and every wait polls against a deadline.
 
-use std::io::{BufRead, BufReader, Read, Write};
+use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
 use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
 use haptic2d_devices::haply::serial::{open_port, BoardPort};
+use haptic2d_test_support::firmware::{compile_native_firmware, start_native_firmware};
+use haptic2d_test_support::process::Killed;
+use haptic2d_test_support::{holds_for, wait_until};
 
 /// How late past its time the native watchdog may act on a loaded machine (µs).
 const SCHEDULING_MARGIN_US: u64 = 30_000;
@@ -35,46 +37,14 @@ fn firmware_exe(board: Board) -> PathBuf {
 }
 
 fn compile(board: Board) -> PathBuf {
-    let fw = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../devices/firmware");
-    let src = fw.join("haptic2d_firmware/src");
-    let native = fw.join("native");
     let dir =
         Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("fw-native-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let exe = dir.join(format!("h2df-native-{board:?}").to_lowercase());
-    let cc = std::env::var("CC").unwrap_or_else(|_| "cc".into());
-    let out = Command::new(&cc)
-        .args([
-            "-std=c11",
-            "-O2",
-            "-Wall",
-            "-Wextra",
-            "-Werror",
-            "-DH2DF_NATIVE",
-        ])
-        .arg(format!("-DH2DF_BOARD_{board:?}"))
-        .arg("-I")
-        .arg(&native)
-        .arg("-I")
-        .arg(&src)
-        .arg(src.join("h2df.c"))
-        .arg(src.join("board.c"))
-        .arg(native.join("arduino_stub.c"))
-        .arg("-o")
-        .arg(&exe)
-        .output()
-        .unwrap_or_else(|e| panic!("cannot run the C compiler `{cc}`: {e}"));
-    assert!(
-        out.status.success(),
-        "the native firmware does not compile:\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    exe
+    compile_native_firmware(&format!("{board:?}"), &dir)
 }
 
 /// A running native firmware: its pseudo-terminal and its motor log. Killed on drop.
 struct Firmware {
-    child: Child,
+    _child: Killed,
     pty: String,
     log: PathBuf,
 }
@@ -88,24 +58,12 @@ impl Firmware {
     fn start_with(board: Board, tag: &str, args: &[&str]) -> Self {
         let exe = firmware_exe(board);
         let log = exe.with_file_name(format!("motors-{tag}.txt"));
-        let mut child = Command::new(&exe)
-            .arg("--motor-log")
-            .arg(&log)
-            .args(args)
-            .stdout(Stdio::piped())
-            .stderr(Stdio::inherit())
-            .spawn()
-            .unwrap();
-        let mut line = String::new();
-        BufReader::new(child.stdout.as_mut().unwrap())
-            .read_line(&mut line)
-            .unwrap();
-        let pty = line
-            .trim()
-            .strip_prefix("pty: ")
-            .unwrap_or_else(|| panic!("first line `{line}` is not `pty: PATH`"))
-            .to_string();
-        Self { child, pty, log }
+        let (child, pty) = start_native_firmware(&exe, &log, args);
+        Self {
+            _child: child,
+            pty,
+            log,
+        }
     }
 
     fn port(&self) -> BoardPort {
@@ -118,26 +76,23 @@ impl Firmware {
 
     /// Polls the motor log until `done` holds (or panics after `limit`).
     fn wait_log(&self, limit: Duration, what: &str, done: impl Fn(&MotorLog) -> bool) -> MotorLog {
-        let t0 = Instant::now();
-        loop {
-            let log = self.log();
-            if done(&log) {
-                return log;
-            }
-            assert!(
-                t0.elapsed() < limit,
-                "{what}: not seen within {limit:?}; motor log:\n{}",
-                log.tail()
-            );
-            std::thread::sleep(Duration::from_millis(2));
-        }
+        let mut log = self.log();
+        let seen = wait_until(Instant::now() + limit, || {
+            log = self.log();
+            done(&log)
+        });
+        assert!(
+            seen,
+            "{what}: not seen within {limit:?}; motor log:\n{}",
+            log.tail()
+        );
+        log
     }
 }
 
 impl Drop for Firmware {
     fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
+        // The child is killed when `_child` drops, after this.
         if !std::thread::panicking() {
             let _ = std::fs::remove_file(&self.log);
         }
@@ -499,10 +454,13 @@ fn stop_writing_and_time_the_zero(fw: &Firmware, port: &mut BoardPort, for_ms: u
         log.tail()
     );
     let t_zero = log.zero_after(i).unwrap();
-    // Nothing turns them on again.
-    std::thread::sleep(Duration::from_millis(50));
-    let later = fw.log();
-    assert_eq!(later.now(), [0.0; 4], "{}", later.tail());
+    // Nothing turns them on again: zero throughout 50 ms.
+    let mut later = fw.log();
+    let stays_zero = holds_for(Duration::from_millis(50), || {
+        later = fw.log();
+        later.now() == [0.0; 4]
+    });
+    assert!(stays_zero, "{}", later.tail());
     t_zero - t_write
 }
 

@@ -8,9 +8,8 @@ use support::*;
 use haptic2d::device::HandModel;
 use haptic2d_rt::DeviceIo;
 
-#[path = "../../haptic2d/tests/support/counting_alloc.rs"]
-mod counting_alloc;
-use counting_alloc::allocations;
+haptic2d_test_support::install_counting_allocator!();
+use haptic2d_test_support::alloc::allocations;
 
 #[test]
 fn the_haply_exchange_allocates_nothing_once_open() {

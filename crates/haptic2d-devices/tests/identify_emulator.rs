@@ -8,49 +8,26 @@
 
 mod support;
 
-use std::sync::atomic::AtomicBool;
-use std::sync::Arc;
-
 use haptic2d::device::HandModel;
 use haptic2d_devices::haply::identify::{
     estimate, heavy_direction, joint_directions, lumped, record_pulses, PulsePlan, Timebase,
 };
-use haptic2d_devices::haply::serial::Pty;
-use haptic2d_devices::haply::{
-    emulator, serve, EmulatorClock, EmulatorConfig, HaplyDeviceFile, HaplyKind, Plant,
-};
-use support::{device_file, open_driver, Emu};
+use haptic2d_devices::haply::{HaplyDeviceFile, HaplyKind, Plant};
+use support::{device_file, open_driver, start_emulator_with, Emu};
 
 /// An emulated board wired as `truth`, its linkage's inertia (`I_j` and `m_e`) scaled by `scale`,
 /// hand released with damping `b_h` (N·s/m) at the end point.
 fn emulator_with(truth: &HaplyDeviceFile, scale: f64, b_h: f64) -> (Emu, [f64; 3]) {
-    let pty = Pty::new().unwrap();
-    let stop = Arc::new(AtomicBool::new(false));
-    let config = EmulatorConfig {
-        hand: HandModel::Free,
-        clock: EmulatorClock::PerWrite(0.001),
-        hand_damping: b_h,
-        ..EmulatorConfig::default()
-    };
-    let mut plant = emulator::plant_for(truth, None, &config).unwrap();
-    let Plant::TwoDiy(p) = &mut plant else {
-        panic!("2diy")
-    };
-    p.i_j *= scale;
-    p.m_e *= scale;
-    let numbers = [p.i_j, p.m_e, p.b];
-    let (s2, f2) = (stop.clone(), truth.clone());
-    let master = pty.master;
-    let handle = std::thread::spawn(move || serve(master, &f2, plant, &config, &s2));
-    (
-        Emu {
-            path: pty.path,
-            stop,
-            handle: Some(handle),
-            keep: Some(pty.keep),
-        },
-        numbers,
-    )
+    let mut numbers = [0.0; 3];
+    let emu = start_emulator_with(truth, HandModel::Free, 0.001, b_h, |plant| {
+        let Plant::TwoDiy(p) = plant else {
+            panic!("2diy")
+        };
+        p.i_j *= scale;
+        p.m_e *= scale;
+        numbers = [p.i_j, p.m_e, p.b];
+    });
+    (emu, numbers)
 }
 
 fn plan() -> PulsePlan {

@@ -11,9 +11,8 @@ use std::time::Instant;
 use haptic2d_devices::inverse3::{Emulator3Config, Hand3};
 use haptic2d_rt::io::Device2Io;
 
-#[path = "../../haptic2d/tests/support/counting_alloc.rs"]
-mod counting_alloc;
-use counting_alloc::allocations;
+haptic2d_test_support::install_counting_allocator!();
+use haptic2d_test_support::alloc::allocations;
 
 #[test]
 fn the_exchange_allocates_nothing_once_open() {

@@ -13,6 +13,7 @@ use std::time::{Duration, Instant};
 use haptic2d_devices::inverse3::{Emulator3Config, Hand3, Inverse3Device, Inverse3DeviceFile};
 use haptic2d_rt::io::Device2Io;
 use haptic2d_rt::DeviceError;
+use haptic2d_test_support::{holds_for, wait_for};
 
 fn norm(f: [f64; 3]) -> f64 {
     f.iter().map(|x| x * x).sum::<f64>().sqrt()
@@ -50,12 +51,11 @@ fn force_starts_at_zero_and_the_plane_spring_ramps_in() {
     });
     let file = file_for(&emu, NOT_THE_TIMEOUT_UNDER_TEST);
     let mut dev = open(&file);
-    // Opened, nothing written yet: the client has sent zero force only.
-    std::thread::sleep(Duration::from_millis(30));
-    assert_eq!(
-        emu.plant().f_cmd,
-        [0.0; 3],
-        "force before the first command"
+    // Opened, nothing written yet: the client has sent zero force only, throughout 30 ms.
+    assert!(
+        holds_for(Duration::from_millis(30), || emu.plant().f_cmd == [0.0; 3]),
+        "force before the first command: {:?}",
+        emu.plant().f_cmd
     );
     let t0 = Instant::now();
     let log = drive(&mut dev, &emu, [0.0; 2], 800);
@@ -109,8 +109,9 @@ fn every_force_is_clamped_to_the_file_limit() {
         Err(DeviceError::Io(m)) => assert!(m.contains("non-finite"), "{m}"),
         other => panic!("{other:?}"),
     }
-    std::thread::sleep(Duration::from_millis(30));
-    assert_eq!(emu.plant().f_cmd, [0.0; 3]);
+    wait_for("zero force at the emulator", Duration::from_secs(5), || {
+        emu.plant().f_cmd == [0.0; 3]
+    });
 }
 
 /// Regression: the command slot keeps only the newest command, so a zero command followed by a

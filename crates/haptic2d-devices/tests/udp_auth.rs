@@ -14,9 +14,14 @@ use std::time::{Duration, Instant};
 use haptic2d_devices::udp::auth::{
     session_of, UdpKey, COMMAND2_LEN, HELLO_LEN, KIND_HELLO, NONCE_LEN, STATE2_LEN,
 };
-use haptic2d_devices::udp::codec::{Command, State, COMMAND_LEN, KIND_COMMAND, STATE_LEN};
+use haptic2d_devices::udp::codec::{Command, COMMAND_LEN, KIND_COMMAND, STATE_LEN};
 use haptic2d_devices::udp::{UdpDevice, UdpDeviceFile};
 use haptic2d_rt::DeviceIo;
+
+#[path = "support/udp_echo.rs"]
+#[allow(dead_code)]
+mod udp_echo;
+use udp_echo::{answer, Encoded};
 
 const PERIOD: Duration = Duration::from_millis(1);
 /// The genuine joint angles (rad).
@@ -87,21 +92,7 @@ impl Device2 {
                 let c = Command::decode(&v1).unwrap();
                 commands += 1;
                 seq += 1;
-                let state = |seq: u32, q: [f32; 2]| {
-                    let mut s1 = [0u8; STATE_LEN];
-                    State {
-                        seq,
-                        echo_seq: c.seq,
-                        status: 0,
-                        device_time_ns: 0,
-                        echo_host_ns: c.host_time_ns,
-                        position: [q[0], q[1], 0.0],
-                        velocity: [0.0; 3],
-                        force: [0.0; 3],
-                    }
-                    .encode(&mut s1);
-                    s1
-                };
+                let state = |seq: u32, q: [f32; 2]| answer(&c, seq, [q[0], q[1], 0.0]).encoded();
                 let mut out = [0u8; STATE2_LEN];
                 let dev_seq = if attack == Attack::SeqJump && commands == 50 {
                     seq.wrapping_add(1 << 31)
@@ -239,16 +230,7 @@ fn version_1_is_not_locked_out_by_a_forged_state_2_pow_31_ahead() {
             };
             seq += 1;
             let mut out = [0u8; STATE_LEN];
-            let s = State {
-                seq,
-                echo_seq: c.seq,
-                status: 0,
-                device_time_ns: 0,
-                echo_host_ns: c.host_time_ns,
-                position: [Q[0], Q[1], 0.0],
-                velocity: [0.0; 3],
-                force: [0.0; 3],
-            };
+            let s = answer(&c, seq, [Q[0], Q[1], 0.0]);
             if seq == 50 {
                 // The forged one, ahead of the genuine answer to the same command.
                 let mut f = s;

@@ -6,10 +6,9 @@
 //! Only the genuine commands may act; after the host falls silent the device zeroes its output.
 //! Skipped (with a note) where `python3` or `cc` is missing.
 
-use std::io::BufRead;
 use std::net::{SocketAddr, UdpSocket};
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command as Process, Stdio};
+use std::process::Command as Process;
 use std::thread;
 use std::time::{Duration, Instant};
 
@@ -21,6 +20,9 @@ use haptic2d_devices::udp::codec::{
 };
 use haptic2d_devices::udp::{UdpDevice, UdpDeviceFile};
 use haptic2d_rt::DeviceIo;
+use haptic2d_test_support::process::Killed;
+use haptic2d_test_support::udp_device::{device_command, start_device, Which};
+use haptic2d_test_support::wait_until;
 
 const KEY_HEX: &str = "8f1c2a9e4b7d6035f2e1c0b9a8d7e6f5041322f1e0d9c8b7a6958473625140ff";
 
@@ -37,77 +39,19 @@ fn key_file(tag: &str, mode: u32) -> PathBuf {
     p
 }
 
-struct Proc(Child);
-
-impl Drop for Proc {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
-
-#[derive(Clone, Copy, Debug)]
-enum Which {
-    Python,
-    C,
-}
-
 /// The reference device's command line (`None` where its tool is missing).
 fn device_cmd(which: Which) -> Option<Process> {
-    match which {
-        Which::Python => {
-            let ok = Process::new("python3").arg("--version").output().is_ok();
-            ok.then(|| {
-                let mut p = Process::new("python3");
-                p.arg(concat!(
-                    env!("CARGO_MANIFEST_DIR"),
-                    "/../../devices/udp/sim_device.py"
-                ));
-                p
-            })
-        }
-        Which::C => {
-            // One executable per test thread: tests build it concurrently.
-            static N: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-            let n = N.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-            let exe = Path::new(env!("CARGO_TARGET_TMPDIR"))
-                .join(format!("udp_sim_device_auth_{}_{n}", std::process::id()));
-            let built = Process::new("cc")
-                .args(["-O2", "-Wall", "-Werror", "-o"])
-                .arg(&exe)
-                .arg(concat!(
-                    env!("CARGO_MANIFEST_DIR"),
-                    "/../../devices/udp/sim_device.c"
-                ))
-                .arg("-lm")
-                .status()
-                .ok()?;
-            assert!(built.success(), "sim_device.c does not build");
-            Some(Process::new(exe))
-        }
-    }
+    // One C executable per call: tests build it concurrently.
+    static N: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let n = N.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let exe = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("udp_sim_device_auth_{}_{n}", std::process::id()));
+    device_command(which, &exe)
 }
 
 /// Starts the device on a loopback port with `args`; its address.
-fn start(which: Which, args: &[&str]) -> Option<(Proc, SocketAddr)> {
-    let mut cmd = device_cmd(which)?;
-    let mut child = cmd
-        .args(["--bind", "127.0.0.1:0"])
-        .args(args)
-        .stdout(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut line = String::new();
-    std::io::BufReader::new(child.stdout.take().unwrap())
-        .read_line(&mut line)
-        .unwrap();
-    let addr = line
-        .trim()
-        .strip_prefix("listening on ")
-        .unwrap_or_else(|| panic!("{which:?}: first line `{line}`"))
-        .parse()
-        .unwrap();
-    Some((Proc(child), addr))
+fn start(which: Which, args: &[&str]) -> Option<(Killed, SocketAddr)> {
+    Some(start_device(device_cmd(which)?, args))
 }
 
 /// A version-2 command of `session`, seq `seq`, ENABLE, torques `tau`, sealed with `key`.
@@ -243,9 +187,12 @@ fn attack(which: Which) {
         exchange(&host, &k, session, &c, seq);
     }
 
-    // 5. Silence: the device's watchdog zeroes its output.
-    thread::sleep(Duration::from_millis(400));
-    let t = std::fs::read_to_string(&trace).unwrap();
+    // 5. Silence: the device's watchdog zeroes its output (its trace ends on the watchdog line).
+    let mut t = String::new();
+    wait_until(Instant::now() + Duration::from_secs(10), || {
+        t = std::fs::read_to_string(&trace).unwrap_or_default();
+        t.lines().last() == Some("watchdog 0 0")
+    });
     let lines: Vec<&str> = t.lines().collect();
     let applied = lines.iter().filter(|l| l.starts_with("applied")).count();
     assert_eq!(

@@ -3,7 +3,7 @@
 //! devices/udp/sim_device.py in another process (a missing `python3` fails the test with the install hint).
 
 use std::net::{SocketAddr, UdpSocket};
-use std::process::{Child, Command as Process, Stdio};
+use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::thread;
@@ -14,6 +14,8 @@ use haptic2d_devices::udp::codec::{
 };
 use haptic2d_devices::udp::{UdpDevice, UdpDeviceFile};
 use haptic2d_rt::{DeviceError, DeviceIo};
+use haptic2d_test_support::process::Killed;
+use haptic2d_test_support::udp_device::{start_reference_device, Which};
 
 const PERIOD: Duration = Duration::from_millis(1);
 
@@ -282,40 +284,9 @@ fn no_device_at_the_address_is_a_clear_error() {
     );
 }
 
-struct Python(Child);
-
-impl Drop for Python {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
-
 /// Starts devices/udp/sim_device.py on an ephemeral loopback port; `None` without python3.
-fn sim_device(extra: &[&str]) -> Option<(Python, SocketAddr)> {
-    let script = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../devices/udp/sim_device.py"
-    );
-    let mut child = Process::new("python3")
-        .arg(script)
-        .args(["--bind", "127.0.0.1:0"])
-        .args(extra)
-        .stdout(Stdio::piped())
-        .spawn()
-        .ok()?;
-    let mut line = String::new();
-    use std::io::BufRead;
-    std::io::BufReader::new(child.stdout.take().unwrap())
-        .read_line(&mut line)
-        .unwrap();
-    let addr = line
-        .trim()
-        .strip_prefix("listening on ")
-        .unwrap()
-        .parse()
-        .unwrap();
-    Some((Python(child), addr))
+fn sim_device(extra: &[&str]) -> Option<(Killed, SocketAddr)> {
+    start_reference_device(Which::Python, Path::new(""), extra)
 }
 
 #[test]
@@ -375,37 +346,9 @@ fn the_python_reference_device_in_pose_mode_gives_the_same_angles() {
 }
 
 /// devices/udp/sim_device.c, built with `cc` into the test's temp dir; `None` without `cc`.
-fn c_device() -> Option<(Python, SocketAddr)> {
-    let src = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../devices/udp/sim_device.c"
-    );
-    let exe = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("udp_sim_device");
-    let built = Process::new("cc")
-        .args(["-O2", "-Wall", "-Werror", "-o"])
-        .arg(&exe)
-        .arg(src)
-        .arg("-lm")
-        .status()
-        .ok()?;
-    assert!(built.success(), "sim_device.c does not build");
-    let mut child = Process::new(&exe)
-        .args(["--bind", "127.0.0.1:0"])
-        .stdout(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut line = String::new();
-    use std::io::BufRead;
-    std::io::BufReader::new(child.stdout.take().unwrap())
-        .read_line(&mut line)
-        .unwrap();
-    let addr = line
-        .trim()
-        .strip_prefix("listening on ")
-        .unwrap()
-        .parse()
-        .unwrap();
-    Some((Python(child), addr))
+fn c_device() -> Option<(Killed, SocketAddr)> {
+    let exe = Path::new(env!("CARGO_TARGET_TMPDIR")).join("udp_sim_device");
+    start_reference_device(Which::C, &exe, &[])
 }
 
 #[test]

@@ -11,9 +11,8 @@ use haptic2d_rt::DeviceIo;
 mod udp_echo;
 use udp_echo::{spawn_echo_device, spawn_echo_device_v2};
 
-#[path = "../../haptic2d/tests/support/counting_alloc.rs"]
-mod counting_alloc;
-use counting_alloc::allocations;
+haptic2d_test_support::install_counting_allocator!();
+use haptic2d_test_support::alloc::allocations;
 
 #[test]
 fn the_exchange_allocates_nothing_once_open() {

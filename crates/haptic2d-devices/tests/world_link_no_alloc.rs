@@ -11,9 +11,8 @@ use haptic2d_devices::world_link::{
     LinkEndpoint, PortMessage, KIND_TO_DEVICE, KIND_TO_WORLD, PORT_LEN,
 };
 
-#[path = "../../haptic2d/tests/support/counting_alloc.rs"]
-mod counting_alloc;
-use counting_alloc::allocations;
+haptic2d_test_support::install_counting_allocator!();
+use haptic2d_test_support::alloc::allocations;
 
 #[test]
 fn a_period_of_the_world_link_allocates_nothing_once_open() {

@@ -14,45 +14,13 @@ use haptic2d_rt::mcap::reader::{encoders_of, read_info, read_ticks};
 use haptic2d_rt::mcap::tick_csv::read_tick_csv_from;
 use haptic2d_rt::mcap::world_csv::read_world_tables;
 use haptic2d_rt::mcap::{McapSetup, McapSink, WorldSample};
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
 use std::collections::BTreeMap;
 use std::panic::AssertUnwindSafe;
 use std::time::{Duration, Instant};
 
-/// The system allocator, recording the largest single request of the current thread.
-struct Measuring;
-
-thread_local! {
-    static LARGEST: Cell<usize> = const { Cell::new(0) };
-}
-
-fn note(size: usize) {
-    let _ = LARGEST.try_with(|m| m.set(m.get().max(size)));
-}
-
-// SAFETY: every call is forwarded to `System` unchanged; the bookkeeping touches a const-initialised
-// thread-local `Cell` only (no allocation, no destructor).
-unsafe impl GlobalAlloc for Measuring {
-    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
-        note(l.size());
-        System.alloc(l)
-    }
-    unsafe fn alloc_zeroed(&self, l: Layout) -> *mut u8 {
-        note(l.size());
-        System.alloc_zeroed(l)
-    }
-    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
-        System.dealloc(p, l)
-    }
-    unsafe fn realloc(&self, p: *mut u8, l: Layout, size: usize) -> *mut u8 {
-        note(size);
-        System.realloc(p, l, size)
-    }
-}
-
-#[global_allocator]
-static ALLOC: Measuring = Measuring;
+// The counting allocator records the largest single request of each thread (haptic2d-test-support).
+haptic2d_test_support::install_counting_allocator!();
+use haptic2d_test_support::alloc::{largest, reset_largest};
 
 /// Largest single allocation the readers may make for a file of `len` bytes: the parsed rows are
 /// a few times the text (a tick row is 16 bytes a column, ~1 KB, for a ~1 KB JSON message; vectors
@@ -186,11 +154,11 @@ impl Tally {
 
     fn case(&mut self, what: &str, len: usize, f: impl FnOnce() -> Result<(), String>) {
         self.cases += 1;
-        LARGEST.with(|m| m.set(0));
+        reset_largest();
         let t = Instant::now();
         let r = std::panic::catch_unwind(AssertUnwindSafe(f));
         let dt = t.elapsed();
-        let largest = LARGEST.with(|m| m.get());
+        let largest = largest();
         match r {
             Ok(Ok(())) => self.ok += 1,
             Ok(Err(e)) => {
@@ -439,7 +407,7 @@ fn record_length_of_2_pow_64_minus_1_is_a_clear_error_not_a_panic() {
     // ../shared/repro/len-max.mcap (rebuilt by `len_max_log`): the Header's length field is 2⁶⁴ − 1; `log info`, `log
     // convert` and `replay:` panicked inside the mcap crate (exit 101).
     let b = len_max_log();
-    LARGEST.with(|m| m.set(0));
+    reset_largest();
     for r in [
         read_info(&b, "len-max.mcap").map(|_| ()),
         read_ticks(&b, "len-max.mcap").map(|_| ()),
@@ -452,7 +420,7 @@ fn record_length_of_2_pow_64_minus_1_is_a_clear_error_not_a_panic() {
             "{e}"
         );
     }
-    assert!(LARGEST.with(|m| m.get()) < 1 << 20);
+    assert!(largest() < 1 << 20);
 }
 
 #[test]

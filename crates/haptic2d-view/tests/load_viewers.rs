@@ -79,7 +79,7 @@ async fn phase(addr: &str, n: usize, secs: f64) -> Phase {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn five_viewers_keep_receiving_frames() {
-    let demo = common::Demo::start(&[]);
+    let demo = common::start_demo(&[]);
     let secs = 4.0;
     let one = phase(&demo.addr, 1, secs).await;
     let five = phase(&demo.addr, 5, secs).await;

@@ -6,36 +6,8 @@ use haptic2d::device::{DeviceParams, TwinKinematics};
 use haptic2d::geom::Vec2;
 use haptic2d::scene::builtin;
 use haptic2d_view::{Frame, FrameInputs, LiveTiming, ViewHub};
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
-
-/// Counts allocations made by the current thread.
-struct Counting;
-
-thread_local! {
-    static ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
-}
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.with(|a| a.set(a.get() + 1));
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        ALLOCATIONS.with(|a| a.set(a.get() + 1));
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
-
-#[global_allocator]
-static GLOBAL: Counting = Counting;
-
-fn allocations() -> u64 {
-    ALLOCATIONS.with(|a| a.get())
-}
+haptic2d_test_support::install_counting_allocator!();
+use haptic2d_test_support::alloc::allocations;
 
 /// The box is pushed into the left wall (contacts appear), a frame is published every tick (60×
 /// the real rate, the worst case), with the device linkage: after a first pass (the world's own

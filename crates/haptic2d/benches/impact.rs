@@ -17,8 +17,11 @@ use haptic2d::contact::impact::{ImpactRow, ImpactSolver};
 use haptic2d::contact::ImpactFriction;
 use haptic2d::geom::{Pose, Vec2};
 use haptic2d::scene::builtin;
+#[path = "support/windowed.rs"]
+mod windowed;
 use std::hint::black_box;
-use std::time::{Duration, Instant};
+use std::time::Duration;
+use windowed::windowed_steps;
 
 /// Steps timed from one copy of the warmed state.
 const WINDOW: u64 = 250;
@@ -113,21 +116,7 @@ fn pile_step(c: &mut Criterion) {
             }
             let w0 = w.clone();
             g.bench_function(format!("{mode}/pile:100/warm {warm} s"), |b| {
-                b.iter_custom(|iters| {
-                    let mut total = Duration::ZERO;
-                    let mut left = iters;
-                    while left > 0 {
-                        w.clone_from(&w0);
-                        let n = left.min(WINDOW);
-                        let t0 = Instant::now();
-                        for _ in 0..n {
-                            black_box(&mut w).step();
-                        }
-                        total += t0.elapsed();
-                        left -= n;
-                    }
-                    total
-                })
+                b.iter_custom(|iters| windowed_steps(&mut w, &w0, iters, WINDOW))
             });
         }
     }

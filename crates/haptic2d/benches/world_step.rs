@@ -9,8 +9,10 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use haptic2d::scene::builtin;
-use std::hint::black_box;
-use std::time::{Duration, Instant};
+#[path = "support/windowed.rs"]
+mod windowed;
+use std::time::Duration;
+use windowed::windowed_steps;
 
 /// Steps timed from one copy of the warmed state (a few simulated seconds; a multiple of every
 /// scene's proximity period, so each window sees the same share of global-stage steps).
@@ -45,21 +47,7 @@ fn world_step(c: &mut Criterion) {
         }
         let w0 = w.clone();
         g.bench_function(scene, |b| {
-            b.iter_custom(|iters| {
-                let mut total = Duration::ZERO;
-                let mut left = iters;
-                while left > 0 {
-                    w.clone_from(&w0);
-                    let n = left.min(WINDOW);
-                    let t0 = Instant::now();
-                    for _ in 0..n {
-                        black_box(&mut w).step();
-                    }
-                    total += t0.elapsed();
-                    left -= n;
-                }
-                total
-            })
+            b.iter_custom(|iters| windowed_steps(&mut w, &w0, iters, WINDOW))
         });
     }
     g.finish();

@@ -1,60 +1,53 @@
-//! Helpers shared by the CLI end-to-end tests (each test binary uses some of them).
-#![allow(dead_code)]
+//! Helpers shared by the CLI end-to-end tests (each test binary uses some of them); the
+//! crate-independent ones live in haptic2d-test-support.
+#![allow(dead_code, unused_imports)]
 
+pub use haptic2d_test_support::files::{repo_root as root, temp_dir, write_in};
+pub use haptic2d_test_support::process::{signal, spawn_announced, text, wait_with_limit, Killed};
+pub use haptic2d_test_support::{holds_for, wait_for, wait_until};
+
+use std::ffi::OsStr;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
+
+/// The `haptic2d` binary built for these tests.
+pub const BIN: &str = env!("CARGO_BIN_EXE_haptic2d");
 
 /// Runs the `haptic2d` binary built for these tests with `args` and waits for it.
 pub fn haptic2d(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_haptic2d"))
+    Command::new(BIN)
         .args(args)
         .output()
         .expect("the binary runs")
 }
 
-/// Standard output and standard error of a finished run, one after the other.
-pub fn text(o: &Output) -> String {
-    format!(
-        "{}\n{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
+/// A `haptic2d` command whose arguments are the words of `line`, each word `{}` replaced by the
+/// next of `paths` (whole, spaces and all): `cmd("simulate box-in-walls --out {}", &[&csv])`.
+pub fn cmd(line: &str, paths: &[&dyn AsRef<OsStr>]) -> Command {
+    let mut c = Command::new(BIN);
+    let mut next = paths.iter();
+    for word in line.split_whitespace() {
+        if word == "{}" {
+            c.arg(next.next().expect("a path for every {}").as_ref());
+        } else {
+            c.arg(word);
+        }
+    }
+    assert!(next.next().is_none(), "more paths than {{}} in `{line}`");
+    c
 }
 
-/// Waits for `child` (spawned with piped stdout and stderr) at most `limit`, reading both pipes on
-/// their own threads meanwhile (a child that fills a pipe nobody reads never exits). Returns the
-/// exit status and stdout followed by stderr, or `None` (the child killed) if it did not exit in
-/// time.
-pub fn wait_with_limit(
-    mut child: std::process::Child,
-    limit: std::time::Duration,
-) -> Option<(std::process::ExitStatus, String)> {
-    use std::io::Read;
-    fn drain(pipe: Option<impl Read + Send + 'static>) -> std::thread::JoinHandle<String> {
-        std::thread::spawn(move || {
-            let mut s = String::new();
-            if let Some(mut p) = pipe {
-                let mut bytes = Vec::new();
-                let _ = p.read_to_end(&mut bytes);
-                s = String::from_utf8_lossy(&bytes).into_owned();
-            }
-            s
-        })
-    }
-    let (out, err) = (drain(child.stdout.take()), drain(child.stderr.take()));
-    let t0 = std::time::Instant::now();
-    let status = loop {
-        if let Some(s) = child.try_wait().unwrap() {
-            break Some(s);
-        }
-        if t0.elapsed() > limit {
-            let _ = child.kill();
-            let _ = child.wait();
-            break None;
-        }
-        std::thread::sleep(std::time::Duration::from_millis(10));
-    };
-    let text = out.join().unwrap() + &err.join().unwrap();
-    status.map(|s| (s, text))
+/// [`cmd`] run to its end: the output.
+pub fn run(line: &str, paths: &[&dyn AsRef<OsStr>]) -> Output {
+    cmd(line, paths).output().expect("the binary runs")
+}
+
+/// [`run`], asserting it succeeded; stdout followed by stderr.
+pub fn run_ok(line: &str, paths: &[&dyn AsRef<OsStr>]) -> String {
+    let o = run(line, paths);
+    let out = text(&o);
+    assert!(o.status.success(), "`haptic2d {line}` failed:\n{out}");
+    out
 }
 
 /// Serialises the tests of one binary that start emulators or devices (keeps the load down).
@@ -63,39 +56,147 @@ pub fn turn() -> std::sync::MutexGuard<'static, ()> {
     ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner())
 }
 
-/// The repository's root.
-pub fn root() -> std::path::PathBuf {
-    std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
+/// The text of the shipped device file `devices/NAME`.
+pub fn shipped_text(name: &str) -> String {
+    haptic2d_test_support::files::shipped_device_text(name)
 }
 
 /// The shipped device file `devices/SHIPPED`, patient about a loaded machine's timing (its
 /// `timeout_periods = FROM` line set to `TO`, the missed-deadline check off, the stall limit at 1000
 /// periods: the CLI tests check protocols and exit paths, not timing), written as `NAME` into a
 /// temp dir of its own (`TAG` tells the tests of one binary apart).
-pub fn patient_device_file(
-    shipped: &str,
-    timeout: (&str, &str),
-    tag: &str,
-    name: &str,
-) -> std::path::PathBuf {
+pub fn patient_device_file(shipped: &str, timeout: (&str, &str), tag: &str, name: &str) -> PathBuf {
     let from = format!("timeout_periods = {} ", timeout.0);
     let to = format!("timeout_periods = {}", timeout.1);
-    let text = std::fs::read_to_string(root().join("devices").join(shipped))
-        .unwrap()
+    let text = shipped_text(shipped)
         .replace(&from, &to)
         .replace("max_missed_deadlines = 10 ", "max_missed_deadlines = 0  ")
         .replace("max_stall_periods = 5 ", "max_stall_periods = 1000");
     assert!(text.contains(&to) && text.contains("max_missed_deadlines = 0 "));
     assert!(text.contains("max_stall_periods = 1000"));
-    let dir = std::env::temp_dir().join(format!(
-        "haptic2d-cli-{}-{}-{tag}",
-        name.trim_end_matches(".toml"),
-        std::process::id()
-    ));
-    std::fs::create_dir_all(&dir).unwrap();
-    let p = dir.join(name);
-    std::fs::write(&p, text).unwrap();
-    p
+    let dir = temp_dir(&format!("cli-{}", name.trim_end_matches(".toml")), tag);
+    write_in(&dir, name, &text)
+}
+
+/// The shipped Haply device file `file` with the emulator tests' settings (a reply timeout of 100
+/// periods, the missed-deadline check off, a stall limit of 1000 periods) and `edit` applied,
+/// written as `dir/name`.
+pub fn haply_file(dir: &Path, file: &str, name: &str, edit: impl Fn(String) -> String) -> PathBuf {
+    let text = shipped_text(file)
+        .replace("timeout_periods = 20 ", "timeout_periods = 100 ")
+        .replace("max_missed_deadlines = 10 ", "max_missed_deadlines = 0 ")
+        .replace("max_stall_periods = 5 ", "max_stall_periods = 1000 ");
+    write_in(dir, name, &edit(text))
+}
+
+/// `haptic2d emulate haply --device-file FILE ARGS…`, killed on drop, and its pty path (its first
+/// stdout line, `pty: PATH`).
+pub fn emulate_haply(file: &Path, args: &[&str]) -> (Killed, String) {
+    spawn_announced(
+        Command::new(BIN)
+            .args(["emulate", "haply", "--device-file"])
+            .arg(file)
+            .args(args)
+            .stderr(std::process::Stdio::null()),
+        "pty: ",
+    )
+}
+
+/// Stops a child as Ctrl-C does (SIGINT) and reaps it.
+pub fn interrupt(mut child: Killed) {
+    signal(child.id(), "-INT");
+    let _ = child.wait();
+}
+
+/// Waits (at most 60 s) until the CSV log at `log` has its first rows on disk: the run's loop has
+/// been ticking for a while (the logger writes through a 64 KiB buffer, hundreds of rows).
+pub fn wait_for_log_rows(log: &Path) {
+    wait_for(
+        &format!("rows in {}", log.display()),
+        std::time::Duration::from_secs(60),
+        || std::fs::metadata(log).is_ok_and(|m| m.len() > 0),
+    );
+}
+
+/// Spawns `run` (a `haptic2d run` command; its CSV log is set here, at `log`), waits until its log
+/// has rows (the loop is ticking: no fixed sleep), calls `cut` (silences or kills the device) and
+/// waits for the run. Its exit code, its stdout and stderr, and how long it took to end after the cut.
+pub fn cut_mid_run(
+    mut run: Command,
+    log: &Path,
+    cut: impl FnOnce(),
+) -> (Option<i32>, String, std::time::Duration) {
+    let child = run
+        .arg("--log")
+        .arg(log)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut child = child;
+    let ticking = std::panic::catch_unwind(|| wait_for_log_rows(log));
+    if let Err(e) = ticking {
+        let _ = child.kill();
+        let _ = child.wait();
+        std::panic::resume_unwind(e);
+    }
+    cut();
+    let t0 = std::time::Instant::now();
+    let o = child.wait_with_output().unwrap();
+    (o.status.code(), text(&o), t0.elapsed())
+}
+
+/// Runs `haptic2d ARGS…` with piped output and waits at most `limit`: its exit code and stdout
+/// followed by stderr. Panics if it hung (it is killed) or died by a signal (an abort?).
+pub fn ends_within<S: AsRef<OsStr> + std::fmt::Debug>(
+    args: &[S],
+    limit: std::time::Duration,
+) -> (i32, String) {
+    let child = Command::new(BIN)
+        .args(args)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let Some((status, out)) = wait_with_limit(child, limit) else {
+        panic!("{args:?} hung (killed after {limit:?})");
+    };
+    let code = status.code().unwrap_or_else(|| {
+        panic!("{args:?} was killed by a signal (an abort?) ({status}):\n{out}")
+    });
+    (code, out)
+}
+
+/// The "N ticks" of a run's timing summary.
+pub fn summary_ticks(out: &str) -> u64 {
+    out.split_whitespace()
+        .collect::<Vec<_>>()
+        .windows(2)
+        .find(|w| w[1] == "ticks")
+        .and_then(|w| w[0].parse().ok())
+        .unwrap_or_else(|| panic!("no tick count in:\n{out}"))
+}
+
+/// A CSV log read whole: the column index of each name (panicking on a missing one) and the rows as
+/// numbers (a cell that is not a number is NaN).
+pub fn csv_rows(path: &Path) -> (impl Fn(&str) -> usize, Vec<Vec<f64>>) {
+    let csv = std::fs::read_to_string(path).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
+    let rows = lines
+        .map(|l| {
+            l.split(',')
+                .map(|v| v.parse().unwrap_or(f64::NAN))
+                .collect()
+        })
+        .collect();
+    let col = move |n: &str| {
+        header
+            .iter()
+            .position(|h| h == n)
+            .unwrap_or_else(|| panic!("no column {n} in {header:?}"))
+    };
+    (col, rows)
 }
 
 /// The column `name` of a CSV text with a header line, as numbers.

@@ -78,6 +78,17 @@ pub fn start_emulator(file: &HaplyDeviceFile, hand: HandModel, dt: f64) -> Emu {
 
 /// [`start_emulator`] with hand damping `b_h` (N·s/m).
 pub fn start_emulator_damped(file: &HaplyDeviceFile, hand: HandModel, dt: f64, b_h: f64) -> Emu {
+    start_emulator_with(file, hand, dt, b_h, |_| {})
+}
+
+/// [`start_emulator_damped`] with `edit` applied to the emulated plant first (e.g. its inertia).
+pub fn start_emulator_with(
+    file: &HaplyDeviceFile,
+    hand: HandModel,
+    dt: f64,
+    b_h: f64,
+    edit: impl FnOnce(&mut haptic2d_devices::haply::Plant),
+) -> Emu {
     let pty = Pty::new().unwrap();
     let stop = Arc::new(AtomicBool::new(false));
     let config = EmulatorConfig {
@@ -86,7 +97,8 @@ pub fn start_emulator_damped(file: &HaplyDeviceFile, hand: HandModel, dt: f64, b
         hand_damping: b_h,
         ..EmulatorConfig::default()
     };
-    let plant = emulator::plant_for(file, None, &config).unwrap();
+    let mut plant = emulator::plant_for(file, None, &config).unwrap();
+    edit(&mut plant);
     let (s2, f2) = (stop.clone(), file.clone());
     let master = pty.master;
     let handle = std::thread::spawn(move || serve(master, &f2, plant, &config, &s2));

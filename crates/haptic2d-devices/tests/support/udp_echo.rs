@@ -10,6 +10,35 @@ use haptic2d_devices::udp::codec::{Command, State, STATE_LEN};
 /// The joint angles every answer carries (rad).
 pub const ECHO_POSITION: [f32; 3] = [1.9, 1.2, 0.0];
 
+/// The state answering command `c`: device sequence number `seq`, the command's sequence number
+/// and host time echoed, joint angles `position` (rad), at rest, no force.
+pub fn answer(c: &Command, seq: u32, position: [f32; 3]) -> State {
+    State {
+        seq,
+        echo_seq: c.seq,
+        status: 0,
+        device_time_ns: 0,
+        echo_host_ns: c.host_time_ns,
+        position,
+        velocity: [0.0; 3],
+        force: [0.0; 3],
+    }
+}
+
+/// A state as its datagram.
+pub trait Encoded {
+    /// The `STATE_LEN` bytes of the state.
+    fn encoded(&self) -> [u8; STATE_LEN];
+}
+
+impl Encoded for State {
+    fn encoded(&self) -> [u8; STATE_LEN] {
+        let mut out = [0u8; STATE_LEN];
+        self.encode(&mut out);
+        out
+    }
+}
+
 /// Starts the device on a free loopback port, answering each command `delay` after it arrives, on
 /// its own thread (it ends with the test process). Returns its address.
 pub fn spawn_echo_device(delay: Duration) -> SocketAddr {
@@ -26,18 +55,7 @@ pub fn spawn_echo_device(delay: Duration) -> SocketAddr {
                 thread::sleep(delay);
             }
             seq += 1;
-            let mut out = [0u8; STATE_LEN];
-            State {
-                seq,
-                echo_seq: c.seq,
-                status: 0,
-                device_time_ns: 0,
-                echo_host_ns: c.host_time_ns,
-                position: ECHO_POSITION,
-                velocity: [0.0; 3],
-                force: [0.0; 3],
-            }
-            .encode(&mut out);
+            let out = answer(&c, seq, ECHO_POSITION).encoded();
             let _ = sock.send_to(&out, peer);
         }
     });
@@ -74,18 +92,7 @@ pub fn spawn_echo_device_v2(key: haptic2d_devices::udp::UdpKey) -> SocketAddr {
                 continue;
             };
             seq += 1;
-            let mut out = [0u8; STATE_LEN];
-            State {
-                seq,
-                echo_seq: c.seq,
-                status: 0,
-                device_time_ns: 0,
-                echo_host_ns: c.host_time_ns,
-                position: ECHO_POSITION,
-                velocity: [0.0; 3],
-                force: [0.0; 3],
-            }
-            .encode(&mut out);
+            let out = answer(&c, seq, ECHO_POSITION).encoded();
             let mut out2 = [0u8; STATE2_LEN];
             key.state2(session, &out, &mut out2);
             let _ = sock.send_to(&out2, peer);

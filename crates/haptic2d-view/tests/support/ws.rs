@@ -68,13 +68,8 @@ impl FakeLoop {
     /// never a fixed sleep: a loaded machine only makes it take longer).
     pub fn wait_for(&self, n: usize) -> Vec<Command> {
         let deadline = std::time::Instant::now() + Duration::from_secs(10);
-        loop {
-            let got = self.commands.lock().unwrap().clone();
-            if got.len() >= n || std::time::Instant::now() > deadline {
-                return got;
-            }
-            std::thread::sleep(Duration::from_millis(2));
-        }
+        haptic2d_test_support::wait_until(deadline, || self.commands.lock().unwrap().len() >= n);
+        self.commands.lock().unwrap().clone()
     }
 }
 

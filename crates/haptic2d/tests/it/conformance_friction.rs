@@ -7,6 +7,7 @@
 //! presliding spring `kr`), at 1 kHz. An incline of angle φ is the flat floor with gravity tilted by
 //! φ (the same equations of motion in the incline's frame).
 
+use crate::shared::{FLOOR_TOML, PAPER_NORMAL_TOML};
 use haptic2d::scene::Scene;
 use haptic2d::world::World;
 
@@ -48,16 +49,10 @@ integration = "semi-implicit"
 impacts = true
 restitution = 0.0
 v_c = 0.05
-[normal]
-model = "paper"
-kc = 1.0e5
-bc = 40.0
+{PAPER_NORMAL_TOML}
 [friction]
 {friction}
-[[body]]
-name = "floor"
-kind = "fixed"
-polygon = [[-20.0, -0.1], [20.0, -0.1], [20.0, 0.0], [-20.0, 0.0]]
+{FLOOR_TOML}
 [[body]]
 name = "block"
 mass = 1.0

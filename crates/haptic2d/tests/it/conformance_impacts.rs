@@ -2,7 +2,7 @@
 //! file → proximity → contacts → impulses → laws → integration) with `impact_friction = "coulomb"`,
 //! each citing the result it checks and where its tolerance comes from.
 
-use haptic2d::contact::{ContactState, EventKind};
+use crate::shared::FLOOR_TOML;
 use haptic2d::geom::{cross, Vec2};
 use haptic2d::scene::Scene;
 use haptic2d::world::World;
@@ -40,10 +40,7 @@ v_c = 0.05
 {normal}
 [friction]
 {friction}
-[[body]]
-name = "floor"
-kind = "fixed"
-polygon = [[-20.0, -0.1], [20.0, -0.1], [20.0, 0.0], [-20.0, 0.0]]
+{FLOOR_TOML}
 {bodies}
 "#
     );
@@ -54,15 +51,7 @@ polygon = [[-20.0, -0.1], [20.0, -0.1], [20.0, 0.0], [-20.0, 0.0]]
 
 const CLASSICAL: &str = "model = \"classical\"\nv_th = 0.001\nmu_s = 0.5\nmu_k = 0.5";
 
-/// True if the last step resolved a colliding contact.
-fn impacted(w: &World) -> bool {
-    w.contacts().events().iter().any(|e| {
-        matches!(
-            e.kind,
-            EventKind::Created(ContactState::Colliding) | EventKind::CreatedSimultaneous
-        )
-    })
-}
+use crate::shared::impacted;
 
 /// Drops a 0.1 m × 0.05 m, 1 kg box flat from rest with its base at `h` onto the floor (paper
 /// law, `kc = 1e5 N/m`, `bc = 40 N·s/m` per corner, restitution `e`) at `rate` Hz; returns the apex

@@ -7,7 +7,7 @@
 //! paper's normal law, frictionless (`impact_friction = "none"`, friction model `none`), the
 //! defaults of `[contact]` otherwise (`impact_surface_offset = true` since issue 35).
 
-use haptic2d::contact::{ContactState, EventKind};
+use crate::shared::FLOOR_TOML;
 use haptic2d::scene::Scene;
 use haptic2d::world::World;
 
@@ -38,10 +38,7 @@ kc = {kc}
 bc = {bc}
 [friction]
 model = "none"
-[[body]]
-name = "floor"
-kind = "fixed"
-polygon = [[-20.0, -0.1], [20.0, -0.1], [20.0, 0.0], [-20.0, 0.0]]
+{FLOOR_TOML}
 {bodies}
 "#
     );
@@ -61,15 +58,7 @@ fn a_box(name: &str, x: f64, y: f64, v: [f64; 2]) -> String {
 
 const GRAVITY: &str = "[[load]]\nbody = \"*\"\nforce = [0.0, -9.81]\nper_mass = true\n";
 
-/// True if the last step resolved a colliding contact.
-fn impacted(w: &World) -> bool {
-    w.contacts().events().iter().any(|e| {
-        matches!(
-            e.kind,
-            EventKind::Created(ContactState::Colliding) | EventKind::CreatedSimultaneous
-        )
-    })
-}
+use crate::shared::impacted;
 
 /// The sampled flight of semi-implicit Euler (§6.2) under gravity alone from height `y` with
 /// velocity `v` at the end of a sample: `y_j = y + j·T·v − g·T²·j(j − 1)/2`, its largest value

@@ -9,7 +9,6 @@
 use haptic2d::collide::{sat_depth, Collider};
 use haptic2d::geom::{ConvexPolygon, Pose, Vec2};
 use haptic2d::scene::{Scene, PULSE_NOT_PASSIVE_2D};
-use haptic2d::world::World;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -20,13 +19,7 @@ const PULSE: &str = include_str!("../repro/pulse-energy.toml");
 /// Passivity bound on the ledger excess (J), as issue 10's acceptance.
 const EXCESS_TOL: f64 = 1e-3;
 
-fn world(text: &str, name: &str) -> World {
-    let mut w = Scene::from_toml(text, name, None)
-        .unwrap_or_else(|e| panic!("{name} is a valid scene: {e}"))
-        .world;
-    w.prime();
-    w
-}
+use crate::shared::primed_world as world;
 
 /// Penetration depth of two convex vertex sets by brute force: the least translation along any
 /// of `n` equally spaced directions `u` that separates them, `max_A u·a − min_B u·b` (0 if some

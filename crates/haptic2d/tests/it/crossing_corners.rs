@@ -8,18 +8,10 @@
 //! into each other while every record stayed shallow.
 
 use haptic2d::collide::{CLIP_MARGIN, DEFAULT_DELTA_C};
-use haptic2d::scene::Scene;
-use haptic2d::world::World;
 
 const STACK: &str = include_str!("../repro/stack-5-polygons-interpenetrate.toml");
 
-fn world(text: &str, name: &str) -> World {
-    let mut w = Scene::from_toml(text, name, None)
-        .unwrap_or_else(|e| panic!("{name} is a valid scene: {e}"))
-        .world;
-    w.prime();
-    w
-}
+use crate::shared::primed_world as world;
 
 /// Contact stiffness (N/m) of the shelf scene (the paper's law, per corner).
 const KC: f64 = 20_000.0;

@@ -197,10 +197,7 @@ fn scene_device_errors_are_collected_with_the_others() {
     let text = format!(
         "{SCENE}\n[world]\nrate = 500\nproximity_every = 0\n[device]\nm_h = -1\nlinks = 2\n"
     );
-    let e = match Scene::from_toml(&text, "s.toml", None) {
-        Ok(_) => panic!("expected errors"),
-        Err(e) => e,
-    };
+    let e = crate::shared::scene_errors(&text);
     let shown = e.to_string();
     let fields: Vec<&str> = e.errors.iter().map(|x| x.field.as_str()).collect();
     assert!(fields.contains(&"world.proximity_every"), "{shown}");
@@ -214,10 +211,7 @@ fn scene_device_errors_are_collected_with_the_others() {
     );
     // The scene's rate bounds the observer gain.
     let text = format!("{SCENE}\n[world]\nrate = 100\n[device]\nobserver_gain = [200, 60, 60]\n");
-    let e = match Scene::from_toml(&text, "s.toml", None) {
-        Ok(_) => panic!("expected errors"),
-        Err(e) => e,
-    };
+    let e = crate::shared::scene_errors(&text);
     assert!(
         e.errors
             .iter()

@@ -117,13 +117,10 @@ fn the_budget_bounds_the_row_updates_of_an_impact() {
 fn impact_sweeps_scene_field_is_checked() {
     use haptic2d::contact::DEFAULT_IMPACT_SWEEPS;
     use haptic2d::scene::Scene;
-    let wall = "[[body]]\nname = \"wall\"\nkind = \"fixed\"\npolygon = [[-0.1, -0.2], [0.0, -0.2], [0.0, 0.2], [-0.1, 0.2]]\n";
+    let wall = crate::shared::WALL_TOML;
     for bad in [0, 201] {
         let text = format!("[contact]\nimpact_sweeps = {bad}\n{wall}");
-        let e = match Scene::from_toml(&text, "t.toml", None) {
-            Ok(_) => panic!("expected an error for impact_sweeps = {bad}"),
-            Err(e) => e,
-        };
+        let e = crate::shared::scene_errors(&text);
         assert!(
             e.errors
                 .iter()

@@ -3,8 +3,9 @@
 //! `cargo test -p haptic2d --test it MODULE::` (e.g. `passivity_random::`).
 //! `impact_memory.rs` stays its own binary: its allocator measures the peak of every thread.
 
-#[path = "../support/counting_alloc.rs"]
-mod counting_alloc;
+// The no-allocation modules count this thread's allocations (haptic2d-test-support).
+haptic2d_test_support::install_counting_allocator!();
+use haptic2d_test_support::alloc as counting_alloc;
 #[path = "../support/polygon.rs"]
 mod polygon_support;
 #[path = "../support/ve.rs"]
@@ -47,6 +48,7 @@ mod repro_contacts;
 mod safety_gate;
 mod scene_bounds;
 mod scene_errors;
+mod shared;
 mod stack_corners;
 mod startup_ramp;
 mod tunnelling;

@@ -6,6 +6,7 @@
 //! `pile_1000_comes_to_rest_within_5_s` is ignored (release build:
 //! `cargo test --release -p haptic2d --test it pile_settle:: -- --ignored`).
 
+use crate::shared::PAPER_NORMAL_TOML;
 use haptic2d::scene::{builtin, Scene};
 use haptic2d::world::World;
 
@@ -25,10 +26,7 @@ proximity_every = 10
 impacts = true
 restitution = 0.2
 v_c = 0.05
-[normal]
-model = "paper"
-kc = 1.0e5
-bc = 40.0
+{PAPER_NORMAL_TOML}
 [friction]
 model = "reset-integrator"
 kr = 5.0e4
@@ -183,17 +181,14 @@ fn pile_1000_comes_to_rest_within_5_s() {
 /// turns the damper off; the default is on.
 #[test]
 fn chain_damper_scene_fields_are_checked() {
-    let wall = "[[body]]\nname = \"wall\"\nkind = \"fixed\"\npolygon = [[-0.1, -0.2], [0.0, -0.2], [0.0, 0.2], [-0.1, 0.2]]\n";
+    let wall = crate::shared::WALL_TOML;
     for (world, field) in [
         ("chain_tau = -0.001", "world.chain_tau"),
         ("chain_tau = nan", "world.chain_tau"),
         ("chain_sweeps = 100000", "world.chain_sweeps"),
     ] {
         let text = format!("[world]\n{world}\n{wall}");
-        let e = match Scene::from_toml(&text, "t.toml", None) {
-            Ok(_) => panic!("expected an error for {world}"),
-            Err(e) => e,
-        };
+        let e = crate::shared::scene_errors(&text);
         assert!(
             e.errors
                 .iter()

@@ -3,29 +3,18 @@
 //! the stall trip within the tick with its reason, the final clamp, and a pause or re-arm that
 //! re-aligns and ramps in again from zero.
 
-use haptic2d::device::pantograph2::Pantograph2;
 use haptic2d::geom::Vec2;
 use haptic2d::haptic::planar2::{Planar2Config, Planar2System};
-use haptic2d::haptic::{ControllerKind, SafetyReason, WorkspaceSquare};
+use haptic2d::haptic::{SafetyReason, WorkspaceSquare};
 use haptic2d::scene::builtin;
 
 const T: f64 = 1e-3;
 
-fn linkage() -> Pantograph2 {
-    Pantograph2::new(0.038, 0.07, 0.09).unwrap()
-}
+use crate::shared::{gen3_linkage as linkage, planar2_system};
 
 fn system(ramp_time: f64) -> Planar2System {
-    let world = builtin("box-in-walls", Some(1000.0))
-        .unwrap()
-        .unwrap()
-        .world;
-    let mut c = Planar2Config::new(linkage(), 0.123);
-    c.controller = ControllerKind::from_name("coupling").unwrap();
-    c.safety.ramp_time = ramp_time;
     // The periods rule alone (the 20 ms floor has its own test in safety_gate.rs).
-    c.safety.min_stall_time = 0.0;
-    Planar2System::new(world, c).unwrap()
+    planar2_system(ramp_time, |c| c.safety.min_stall_time = 0.0)
 }
 
 /// Joint angles of the handle `dx` m from the gen 3 workspace centre along x.
@@ -123,17 +112,7 @@ fn planar2_past_the_edge_the_handle_feels_the_same_wall_as_the_twin() {
     // and the controller see the same handle, so the difference of their device commands is the
     // wall alone. The handle starts inside (the bound arms there), moves 2 mm past the +x edge and
     // is held there.
-    let make = |square: WorkspaceSquare| {
-        let world = builtin("box-in-walls", Some(1000.0))
-            .unwrap()
-            .unwrap()
-            .world;
-        let mut c = Planar2Config::new(linkage(), 0.123);
-        c.controller = ControllerKind::from_name("coupling").unwrap();
-        c.safety.ramp_time = 0.0;
-        c.workspace = square;
-        Planar2System::new(world, c).unwrap()
-    };
+    let make = |square: WorkspaceSquare| planar2_system(0.0, |c| c.workspace = square);
     let mut walled = make(WorkspaceSquare::around([0.019, 0.10], 0.03));
     // "Without": a square far past the linkage's reach (1 m), whose wall the handle never meets.
     let mut free = make(WorkspaceSquare::around([0.019, 0.10], 1.0));

@@ -2,25 +2,13 @@
 //! display (wheel / Q–E) through a twist target: a critically damped 5 Hz torsion spring-damper on the
 //! slave, world side only (the motors never see it).
 
-use haptic2d::device::pantograph2::Pantograph2;
 use haptic2d::geom::Vec2;
-use haptic2d::haptic::planar2::{Planar2Config, Planar2System, TWIST_TARGET_HZ};
-use haptic2d::haptic::ControllerKind;
-use haptic2d::scene::builtin;
+use haptic2d::haptic::planar2::{Planar2System, TWIST_TARGET_HZ};
 
-fn linkage() -> Pantograph2 {
-    Pantograph2::new(0.038, 0.07, 0.09).unwrap()
-}
+use crate::shared::gen3_linkage as linkage;
 
 fn system() -> Planar2System {
-    let world = builtin("box-in-walls", Some(1000.0))
-        .unwrap()
-        .unwrap()
-        .world;
-    let mut c = Planar2Config::new(linkage(), 0.123);
-    c.controller = ControllerKind::from_name("coupling").unwrap();
-    c.safety.ramp_time = 0.0;
-    Planar2System::new(world, c).unwrap()
+    crate::shared::planar2_system(0.0, |_| {})
 }
 
 /// The handle held still at the gen 3 workspace centre.

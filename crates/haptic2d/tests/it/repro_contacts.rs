@@ -13,13 +13,7 @@ const R8B: &str = include_str!("../repro/r8b-two-polygons-noimpacts-nofriction.t
 /// Passivity bound on the ledger excess (J), as the issue's acceptance: 1 mJ.
 const EXCESS_TOL: f64 = 1e-3;
 
-fn world(text: &str, name: &str) -> World {
-    let mut w = Scene::from_toml(text, name, None)
-        .unwrap_or_else(|e| panic!("{name} is a valid scene: {e}"))
-        .world;
-    w.prime();
-    w
-}
+use crate::shared::primed_world as world;
 
 /// What a run shows: the largest ledger excess, and the worst violation of the depth invariant over
 /// every record and sample (m, ≤ 0 when it holds). The invariant (`contact/manager/invariant.rs`,

@@ -6,34 +6,11 @@
 use haptic2d::scene::bounds::{
     MAX_BODIES, MAX_LENGTH_M, MAX_OMEGA_RAD_S, MAX_RATE_HZ, MAX_SPEED_M_S, MAX_VERTICES,
 };
-use haptic2d::scene::{builtin, Scene, SceneErrors};
+use haptic2d::scene::{builtin, Scene};
 
-const WALL: &str = r#"
-[[body]]
-name = "wall"
-kind = "fixed"
-polygon = [[-0.1, -0.2], [0.0, -0.2], [0.0, 0.2], [-0.1, 0.2]]
-"#;
+use crate::shared::WALL_TOML as WALL;
 
-fn errors(text: &str) -> SceneErrors {
-    match Scene::from_toml(text, "test.toml", None) {
-        Ok(_) => panic!("expected an error for:\n{text}"),
-        Err(e) => e,
-    }
-}
-
-/// Asserts that some error is on a field containing `field`, its message contains `what`, and it
-/// gives a fix.
-fn assert_error(text: &str, field: &str, what: &str) {
-    let e = errors(text);
-    let shown = e.to_string();
-    assert!(
-        e.errors
-            .iter()
-            .any(|x| x.field.contains(field) && x.message.contains(what) && !x.fix.is_empty()),
-        "no error on `{field}` containing `{what}`:\n{shown}"
-    );
-}
+use crate::shared::assert_scene_error as assert_error;
 
 /// A dynamic body `b` (a 4 cm box of 0.5 kg at x = 0.1 m) with extra keys.
 fn body(extra: &str) -> String {

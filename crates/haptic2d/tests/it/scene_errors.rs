@@ -1,32 +1,17 @@
 //! Bad scene input never panics: each case gives a message naming the field and the fix.
 
-use haptic2d::scene::{Scene, SceneErrors};
+use haptic2d::scene::Scene;
 
-const GOOD_BOX: &str = r#"
-[[body]]
-name = "wall"
-kind = "fixed"
-polygon = [[-0.1, -0.2], [0.0, -0.2], [0.0, 0.2], [-0.1, 0.2]]
-"#;
+use crate::shared::WALL_TOML as GOOD_BOX;
 
-fn errors(text: &str) -> SceneErrors {
-    match Scene::from_toml(text, "test.toml", None) {
-        Ok(_) => panic!("expected an error for:\n{text}"),
-        Err(e) => e,
-    }
-}
+use crate::shared::{assert_scene_error, scene_errors as errors};
 
-/// Asserts one error mentions `field` and its message contains `what`, and that it gives a fix.
+/// Asserts one error mentions `field` and its message contains `what`, and that it gives a fix; the
+/// message names the file.
 fn assert_error(text: &str, field: &str, what: &str) {
-    let e = errors(text);
-    let shown = e.to_string();
+    let shown = errors(text).to_string();
     assert!(shown.starts_with("test.toml"), "the file is named: {shown}");
-    assert!(
-        e.errors
-            .iter()
-            .any(|x| x.field.contains(field) && x.message.contains(what) && !x.fix.is_empty()),
-        "no error on `{field}` containing `{what}`:\n{shown}"
-    );
+    assert_scene_error(text, field, what);
 }
 
 fn with_body(body: &str) -> String {
