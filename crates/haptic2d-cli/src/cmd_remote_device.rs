@@ -441,21 +441,30 @@ pub fn run_from_run(a: &crate::cmd_run::RunArgs, world: &str) -> Result<Status, 
     })
 }
 
-fn run_device_side(p: &Plan) -> Result<Status, Failure> {
-    let a = p.side;
-    let key = a.link.key().map_err(Failure::from)?;
-    let addr = world_addr(p.world).map_err(Failure::from)?;
-    let hand = HandSpec::parse(p.hand).map_err(Failure::from)?;
-    if let Some(d) = p.duration {
+/// Checks `--duration` (s) and builds the safety settings with `--max-stall-periods`.
+fn check_run_settings(
+    duration: Option<f64>,
+    max_stall_periods: f64,
+) -> Result<SafetyConfig, Failure> {
+    if let Some(d) = duration {
         if !(d.is_finite() && d > 0.0 && d <= crate::cmd_run::MAX_RUN_DURATION_S) {
             return Err(Failure::from(format!("--duration must be > 0 s (got {d})")));
         }
     }
     let safety_config = SafetyConfig {
-        max_stall_periods: a.max_stall_periods,
+        max_stall_periods,
         ..SafetyConfig::default()
     };
     safety_config.validate().map_err(Failure::from)?;
+    Ok(safety_config)
+}
+
+fn run_device_side(p: &Plan) -> Result<Status, Failure> {
+    let a = p.side;
+    let key = a.link.key().map_err(Failure::from)?;
+    let addr = world_addr(p.world).map_err(Failure::from)?;
+    let hand = HandSpec::parse(p.hand).map_err(Failure::from)?;
+    let safety_config = check_run_settings(p.duration, a.max_stall_periods)?;
     let dt = 1.0 / p.rate;
     let params = DeviceParams::default();
     let origin = [params.workspace_center_x, params.workspace_center_y, 0.0];

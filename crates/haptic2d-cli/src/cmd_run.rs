@@ -162,12 +162,8 @@ enum LoopEnd {
 /// Runs the haptic loop: validate the options, build the rig, start the display and the logger,
 /// run the loop until the duration ends, a signal arrives or the tick stops it, then report.
 pub fn run(a: &RunArgs) -> Result<Status, Failure> {
-    match &a.world {
-        Some(w) => return crate::cmd_remote_device::run_from_run(a, w),
-        None if a.remote.any_given() => {
-            return Err("--key, --push, --link and the other options of a split loop need --world udp:HOST:PORT\n    fix: add --world udp:HOST:PORT (a `haptic2d serve-world`), or leave them out".into())
-        }
-        None => {}
+    if let Some(split) = split_loop(a) {
+        return split;
     }
     let opts = validate_options(a)?;
     let scene = scene_arg::load(&a.scene, Some(a.rate))?;
@@ -254,20 +250,7 @@ pub fn run(a: &RunArgs) -> Result<Status, Failure> {
     let live_setup = McapSetup::for_world(rig.system.world(), scene_meta.clone(), true);
     let (tx, logger, latest) = start_telemetry(a, rig.system.world(), scene_meta)?;
     let foxglove = match opts.foxglove {
-        Some(addr) => {
-            let f = FoxgloveServer::start(
-                addr,
-                latest,
-                live_setup,
-                a.foxglove_rate,
-                a.foxglove_allow_remote,
-            )?;
-            if let Some(w) = crate::foxglove_live::remote_warning(f.addr()) {
-                eprintln!("{w}");
-            }
-            crate::outln!("{}", f.banner());
-            Some(f)
-        }
+        Some(addr) => Some(start_foxglove(a, addr, latest, live_setup)?),
         None => None,
     };
     let watchdog = make_watchdog(&rig)?;
@@ -314,6 +297,38 @@ pub fn run(a: &RunArgs) -> Result<Status, Failure> {
         crate::outln!("{}", f.shutdown());
     }
     report(a, &rig, &summary, end, stop.load(Ordering::SeqCst), logger)
+}
+
+/// `run --world udp:HOST:PORT`: the device side of a split loop (`cmd_remote_device`); split-loop
+/// options without `--world` are refused. `None`: a local run.
+fn split_loop(a: &RunArgs) -> Option<Result<Status, Failure>> {
+    match &a.world {
+        Some(w) => Some(crate::cmd_remote_device::run_from_run(a, w)),
+        None if a.remote.any_given() => Some(Err("--key, --push, --link and the other options of a split loop need --world udp:HOST:PORT\n    fix: add --world udp:HOST:PORT (a `haptic2d serve-world`), or leave them out".into())),
+        None => None,
+    }
+}
+
+/// Starts the live Foxglove server on `addr` and prints its banner (and the warning of an address
+/// beyond loopback).
+fn start_foxglove(
+    a: &RunArgs,
+    addr: std::net::SocketAddr,
+    latest: SnapshotRx<LoggedTick>,
+    live_setup: McapSetup,
+) -> Result<FoxgloveServer, Failure> {
+    let f = FoxgloveServer::start(
+        addr,
+        latest,
+        live_setup,
+        a.foxglove_rate,
+        a.foxglove_allow_remote,
+    )?;
+    if let Some(w) = crate::foxglove_live::remote_warning(f.addr()) {
+        eprintln!("{w}");
+    }
+    crate::outln!("{}", f.banner());
+    Ok(f)
 }
 
 /// Step 1: checks every option before anything starts (errors are bad input).

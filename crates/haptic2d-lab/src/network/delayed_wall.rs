@@ -192,105 +192,134 @@ pub fn run_delayed_wall_traced(
     (r, trace)
 }
 
+/// The link and the two ports of a delayed-wall run.
+struct Net {
+    up: Link<ToWorld>,
+    down: Link<ToDevice>,
+    master: TdpaPort,
+    slave: TdpaPort,
+    wave_m: WaveMaster,
+    wave_s: WaveSlave,
+}
+
+/// One sample's exchange with wave variables: the handle force `f_m` and the body force `f_s` (N)
+/// from the states `(x_m, v_m, x_s, v_s)` (m, m/s).
+fn exchange_waves(cfg: &DelayedWall, net: &mut Net, k: u64, st: [f64; 4]) -> (f64, f64) {
+    let (dt, [x_m, v_m, x_s, v_s]) = (cfg.dt, st);
+    // Device side: the newest returning wave (once), the handle's force, the wave out.
+    let (f_m, out) = net
+        .wave_m
+        .step(x_m, v_m, net.down.deliver(k).map(|m| m.wave), dt);
+    net.master.observe(f_m, v_m, dt);
+    net.up.send(
+        k,
+        ToWorld {
+            x: x_m,
+            v: v_m,
+            e_in: 0.0,
+            wave: out,
+        },
+    );
+    // World side: the newest forward wave (once) drives x_d, which pulls the body.
+    let s = net.wave_s.step(
+        net.up.deliver(k).map(|m| m.wave),
+        x_s,
+        v_s,
+        cfg.k_coupling,
+        cfg.b_coupling,
+        dt,
+    );
+    net.slave.observe(s.force, s.v_d, dt);
+    net.down.send(
+        k,
+        ToDevice {
+            f: 0.0,
+            e_in: 0.0,
+            wave: s.msg,
+        },
+    );
+    (f_m, s.force)
+}
+
+/// One sample's exchange of forces and positions, with TDPA on both ports or neither: `(f_m, f_s)`
+/// (N) from the states `(x_m, v_m, x_s, v_s)`.
+fn exchange_forces(cfg: &DelayedWall, net: &mut Net, k: u64, st: [f64; 4]) -> (f64, f64) {
+    let (dt, [x_m, v_m, x_s, v_s]) = (cfg.dt, st);
+    let tdpa = cfg.mode == LinkMode::Tdpa;
+    let (alpha_m, alpha_s) = (2.0 * cfg.m_device / dt, 2.0 * cfg.m_body / dt);
+    // Device side: read the newest force, apply the master port's controller.
+    let (f_req, far_s) = net.down.receive(k).map_or((0.0, 0.0), |m| (m.f, m.e_in));
+    let f_m = if tdpa {
+        net.master.step(f_req, v_m, far_s, dt, alpha_m)
+    } else {
+        net.master.observe(f_req, v_m, dt);
+        f_req
+    };
+    net.up.send(
+        k,
+        ToWorld {
+            x: x_m,
+            v: v_m,
+            e_in: net.master.energy_in(),
+            wave: WaveMsg::default(),
+        },
+    );
+    // World side: the coupling on the newest handle state, the slave port's controller.
+    let (xm_r, vm_r, far_m) = net
+        .up
+        .receive(k)
+        .map_or((0.0, 0.0, 0.0), |m| (m.x, m.v, m.e_in));
+    let f_c = cfg.k_coupling * (xm_r - x_s) + cfg.b_coupling * (vm_r - v_s);
+    let f_s = if tdpa {
+        net.slave.step(f_c, v_s, far_m, dt, alpha_s)
+    } else {
+        net.slave.observe(f_c, v_s, dt);
+        f_c
+    };
+    net.down.send(
+        k,
+        ToDevice {
+            f: -f_s,
+            e_in: net.slave.energy_in(),
+            wave: WaveMsg::default(),
+        },
+    );
+    (f_m, f_s)
+}
+
 fn simulate(
     cfg: &DelayedWall,
     mut trace: Option<(&mut Vec<TracePoint>, u64)>,
 ) -> DelayedWallResult {
     let dt = cfg.dt;
     let n = (cfg.duration / dt).round() as u64;
-    let mut up: Link<ToWorld> = Link::new(cfg.link);
     let back_imp = Impairment {
         seed: cfg.link.seed.wrapping_add(1),
         ..cfg.link
     };
-    let mut down: Link<ToDevice> = Link::new(back_imp);
-    let (mut master, mut slave) = (TdpaPort::new(), TdpaPort::new());
-    let (mut x_m, mut v_m, mut x_s, mut v_s) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
-    let (mut max_f, mut max_v) = (0.0f64, 0.0f64);
-    let (mut err_sum, mut wall_sum, mut window) = (0.0, 0.0, 0u64);
-    let mut separation = f64::NAN;
-    let alpha_m = 2.0 * cfg.m_device / dt;
-    let alpha_s = 2.0 * cfg.m_body / dt;
     let wp = match cfg.mode {
         LinkMode::Wave(p) => p,
         _ => WaveParams::default(),
     };
-    let (mut wave_m, mut wave_s) = (WaveMaster::new(wp), WaveSlave::new(wp, 0.0));
+    let mut net = Net {
+        up: Link::new(cfg.link),
+        down: Link::new(back_imp),
+        master: TdpaPort::new(),
+        slave: TdpaPort::new(),
+        wave_m: WaveMaster::new(wp),
+        wave_s: WaveSlave::new(wp, 0.0),
+    };
+    let (mut x_m, mut v_m, mut x_s, mut v_s) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    let (mut max_f, mut max_v) = (0.0f64, 0.0f64);
+    let (mut err_sum, mut wall_sum, mut window) = (0.0, 0.0, 0u64);
+    let mut separation = f64::NAN;
     for k in 0..n {
         let t = k as f64 * dt;
-        let (f_m, f_s);
-        if let LinkMode::Wave(_) = cfg.mode {
-            // Device side: the newest returning wave (once), the handle's force, the wave out.
-            let (f, out) = wave_m.step(x_m, v_m, down.deliver(k).map(|m| m.wave), dt);
-            master.observe(f, v_m, dt);
-            f_m = f;
-            up.send(
-                k,
-                ToWorld {
-                    x: x_m,
-                    v: v_m,
-                    e_in: 0.0,
-                    wave: out,
-                },
-            );
-            // World side: the newest forward wave (once) drives x_d, which pulls the body.
-            let s = wave_s.step(
-                up.deliver(k).map(|m| m.wave),
-                x_s,
-                v_s,
-                cfg.k_coupling,
-                cfg.b_coupling,
-                dt,
-            );
-            slave.observe(s.force, s.v_d, dt);
-            f_s = s.force;
-            down.send(
-                k,
-                ToDevice {
-                    f: 0.0,
-                    e_in: 0.0,
-                    wave: s.msg,
-                },
-            );
-        } else {
-            let tdpa = cfg.mode == LinkMode::Tdpa;
-            // Device side: read the newest force, apply the master port's controller.
-            let (f_req, far_s) = down.receive(k).map_or((0.0, 0.0), |m| (m.f, m.e_in));
-            f_m = if tdpa {
-                master.step(f_req, v_m, far_s, dt, alpha_m)
-            } else {
-                master.observe(f_req, v_m, dt);
-                f_req
-            };
-            up.send(
-                k,
-                ToWorld {
-                    x: x_m,
-                    v: v_m,
-                    e_in: master.energy_in(),
-                    wave: WaveMsg::default(),
-                },
-            );
-            // World side: the coupling on the newest handle state, the slave port's controller.
-            let (xm_r, vm_r, far_m) = up
-                .receive(k)
-                .map_or((0.0, 0.0, 0.0), |m| (m.x, m.v, m.e_in));
-            let f_c = cfg.k_coupling * (xm_r - x_s) + cfg.b_coupling * (vm_r - v_s);
-            f_s = if tdpa {
-                slave.step(f_c, v_s, far_m, dt, alpha_s)
-            } else {
-                slave.observe(f_c, v_s, dt);
-                f_c
-            };
-            down.send(
-                k,
-                ToDevice {
-                    f: -f_s,
-                    e_in: slave.energy_in(),
-                    wave: WaveMsg::default(),
-                },
-            );
-        }
+        let st = [x_m, v_m, x_s, v_s];
+        let (f_m, f_s) = match cfg.mode {
+            LinkMode::Wave(_) => exchange_waves(cfg, &mut net, k, st),
+            _ => exchange_forces(cfg, &mut net, k, st),
+        };
         // The wall on the body, the hand on the handle.
         let f_wall = if x_s > cfg.x_wall {
             -cfg.k_wall * (x_s - cfg.x_wall)
@@ -324,7 +353,7 @@ fn simulate(
                     x_s,
                     f_m,
                     f_wall,
-                    created: NetworkEnergy::of(&master, &slave).created,
+                    created: NetworkEnergy::of(&net.master, &net.slave).created,
                 });
             }
         }
@@ -337,15 +366,15 @@ fn simulate(
     }
     let w = window.max(1) as f64;
     DelayedWallResult {
-        network: NetworkEnergy::of(&master, &slave),
-        dissipated: master.dissipated() + slave.dissipated(),
+        network: NetworkEnergy::of(&net.master, &net.slave),
+        dissipated: net.master.dissipated() + net.slave.dissipated(),
         max_handle_force: max_f,
         max_handle_speed: max_v,
         force_error: err_sum / w,
         wall_force: wall_sum / w,
         separation,
         drift: (x_m - x_s).abs(),
-        lost: up.lost + down.lost,
+        lost: net.up.lost + net.down.lost,
     }
 }
 

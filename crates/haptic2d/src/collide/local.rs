@@ -757,45 +757,7 @@ impl LocalStage {
         };
         self.gaps[k].penetrating = self.trackers[k].is_penetrating();
         // VE candidates (§9.4–9.5).
-        let (a, b) = (sa, sb);
-        match f.status {
-            TrackStatus::Penetrating => {
-                let mark = out.len();
-                let inside_a = ctx.vertices_against(a, b, out, &mut Slack::new());
-                let inside_b = ctx.vertices_against(b, a, out, &mut Slack::new());
-                // Crossing corners with no vertex inside (§9.5b).
-                let (pa, pb) = ((a.id, a.c), (b.id, b.c));
-                let none_inside = inside_a.is_none() && inside_b.is_none();
-                !(none_inside && clip_crossing_corners(pa, pb, ctx.eps_s, delta_c, mark, out))
-            }
-            // Closer than GJK's ε_abs, "apart" is not a certificate: two equal boxes stacked
-            // corner on corner overlap with every vertex of each exactly on a side line of the
-            // other (signed distance 0 or ±1e-19 m), so no vertex is strictly inside, GJK stops
-            // at |v| ≤ ε_abs and the walk certifies a vertex–side-edge pair at ~1e-20 m, which
-            // would propose one side-edge candidate and let the boxes sink through each other.
-            // The vertex scan (§9.4) proposes every touching vertex instead (at distance 0 it
-            // is exact for touching pairs as well).
-            TrackStatus::Separated if f.distance <= GJK_EPS_ABS => {
-                ctx.vertices_against(a, b, out, &mut Slack::new());
-                ctx.vertices_against(b, a, out, &mut Slack::new());
-                true
-            }
-            TrackStatus::Separated if f.distance <= delta_c => {
-                ctx.closest_feature_candidates(a, b, &f, out);
-                if under {
-                    ctx.vertices_against(a, b, out, &mut Slack::new());
-                    ctx.vertices_against(b, a, out, &mut Slack::new());
-                }
-                false
-            }
-            TrackStatus::Separated if under => {
-                // Only vertices across a seam within its reach can be proposed here.
-                ctx.vertices_against(a, b, out, &mut Slack::new());
-                ctx.vertices_against(b, a, out, &mut Slack::new());
-                true
-            }
-            TrackStatus::Separated => false,
-        }
+        ctx.candidates(sa, sb, &f, under, out)
     }
 }
 
@@ -914,6 +876,60 @@ impl Ctx {
             edge: e as u32,
         });
         true
+    }
+
+    /// The VE candidates of a tracked pair `a`, `b` with closest features `f` (§9.4–9.5), pushed
+    /// to `out`; `under`: the pair can have a vertex across a seam (`Collider::across`). Returns
+    /// whether they are the vertex scan's.
+    fn candidates(
+        &self,
+        a: Side,
+        b: Side,
+        f: &ClosestFeatures,
+        under: bool,
+        out: &mut Vec<VeCandidate>,
+    ) -> bool {
+        match f.status {
+            TrackStatus::Penetrating => {
+                let mark = out.len();
+                let inside_a = self.vertices_against(a, b, out, &mut Slack::new());
+                let inside_b = self.vertices_against(b, a, out, &mut Slack::new());
+                // Crossing corners with no vertex inside (§9.5b).
+                let (pa, pb) = ((a.id, a.c), (b.id, b.c));
+                let none_inside = inside_a.is_none() && inside_b.is_none();
+                !(none_inside && clip_crossing_corners(pa, pb, self.eps_s, self.delta_c, mark, out))
+            }
+            // Closer than GJK's ε_abs, "apart" is not a certificate: two equal boxes stacked
+            // corner on corner overlap with every vertex of each exactly on a side line of the
+            // other (signed distance 0 or ±1e-19 m), so no vertex is strictly inside, GJK stops
+            // at |v| ≤ ε_abs and the walk certifies a vertex–side-edge pair at ~1e-20 m, which
+            // would propose one side-edge candidate and let the boxes sink through each other.
+            // The vertex scan (§9.4) proposes every touching vertex instead (at distance 0 it
+            // is exact for touching pairs as well).
+            TrackStatus::Separated if f.distance <= GJK_EPS_ABS => {
+                self.vertices_of_both(a, b, out);
+                true
+            }
+            TrackStatus::Separated if f.distance <= self.delta_c => {
+                self.closest_feature_candidates(a, b, f, out);
+                if under {
+                    self.vertices_of_both(a, b, out);
+                }
+                false
+            }
+            TrackStatus::Separated if under => {
+                // Only vertices across a seam within its reach can be proposed here.
+                self.vertices_of_both(a, b, out);
+                true
+            }
+            TrackStatus::Separated => false,
+        }
+    }
+
+    /// The vertex scan of both polygons against each other (§9.4).
+    fn vertices_of_both(&self, a: Side, b: Side, out: &mut Vec<VeCandidate>) {
+        self.vertices_against(a, b, out, &mut Slack::new());
+        self.vertices_against(b, a, out, &mut Slack::new());
     }
 
     /// Separated pair with distance ≤ δ_c: candidates from the closest features (§9.5).
@@ -1041,7 +1057,7 @@ impl Ctx {
     /// The corner-on-corner rule may choose the neighbour of the nearest edge at the corner; it is
     /// limited to a neighbour whose line is within `δ_c` of the nearest one, so every candidate
     /// satisfies `d_e ≥ max_j d_j − δ_c` (the invariant the contact manager checks,
-    /// [`nearest_line`]).
+    /// [`nearest_line`](super::nearest_line)).
     ///
     /// Every comparison's distance from its threshold is recorded in `slack` (`reuse.rs`).
     fn vertices_against(
@@ -1236,73 +1252,6 @@ fn most_aligned_edge(c: &Collider, v: usize, p: Vec2) -> usize {
     } else {
         e_out
     }
-}
-
-/// The nearest edge line of `b` to the world point `p`: `(j*, d_{j*})` with `d_{j*} = max_j d_j`
-/// over `b`'s edge lines that are not seams (m, positive outside; `(0, −∞)` if every edge is a
-/// seam), or the seam line `p` is farthest outside of if it is outside `b` across a seam (then
-/// `j*` is a seam, never a contact edge). For `p` inside `b`, `−d_{j*}` is its depth (distance
-/// to the body's surface through `b`'s surface edges).
-///
-/// The invariant of every VE record `(V, e)` (issue 10): `d_e ≥ d_{j*} − δ_c`, so its stored
-/// energy `½·K_c·d_e²` never exceeds that of the vertex's real depth by more than the corner
-/// tolerance allows, or (issue 35) `−d_e ≤ sat_depth + δ_c`, the pair's overlap.
-#[inline]
-pub fn nearest_line(b: &Collider, p: Vec2) -> (usize, f64) {
-    let mut best = (0usize, f64::NEG_INFINITY);
-    let mut seam = (0usize, 0.0f64);
-    for e in 0..b.len() {
-        let d = b.edge_distance(e, p);
-        if b.is_seam(e) {
-            if d > seam.1 {
-                seam = (e, d);
-            }
-        } else if d > best.1 {
-            best = (e, d);
-        }
-    }
-    // Outside `b` across a seam: the point is that far from `b` (in the next piece), unless it
-    // is across seams that face a partly covered edge only, within their reach (in the piece
-    // under `b`, whose surface lines hold it too, `Collider::across_seam`).
-    if seam.1 > 0.0 && seam.1 > best.1 && !(best.1 <= 0.0 && b.across_seam(p).is_some()) {
-        seam
-    } else {
-        best
-    }
-}
-
-/// Penetration depth of two convex polygons by separating axes (m): the smallest overlap of their
-/// projections over the edge normals of both, `0` if some axis separates them. No vertex of one
-/// can be deeper in the other than this (translating by the minimum separating vector clears
-/// every vertex). Costs `O((n_a + n_b)²)`: for checks and reports, not the hot path.
-///
-/// **Seams** (`seam.rs`): a piece of a multi-piece body is cleared through the body's surface,
-/// never through a seam into the next piece. So a seam's normal is no axis, and neither is an
-/// axis whose separating motion (of `a` relative to `b`) has a component through a seam of `b`
-/// (or, reversed, of `a`): moving along it could clear the piece through the joint. Along an
-/// admissible axis `u` every vertex leaves the piece through a surface edge `f` (`n_f·u > 0`)
-/// after at least its depth `−d_f`, so the bound above still holds with depth measured to the
-/// nearest surface line ([`nearest_line`]). A piece with no admissible axis gets the least
-/// overlap over its surface normals.
-pub fn sat_depth(a: &Collider, b: &Collider) -> f64 {
-    sat_axis(a, b).0
-}
-
-/// [`sat_depth`] with its axis: `(depth, u)`, `u` the unit direction in which `a` moves
-/// (relative to `b`) to separate by `depth`; `u = 0` when the pair is apart.
-pub fn sat_axis(a: &Collider, b: &Collider) -> (f64, Vec2) {
-    super::clip::sat_face(a, b).map_or((0.0, Vec2::ZERO), |f| (f.depth, f.axis))
-}
-
-/// Whether moving a body relative to `c` along `u` has a component out through a seam of `c`
-/// (`n_s·u > 0` for a seam `s`, beyond round-off).
-#[inline]
-pub(crate) fn through_seam(c: &Collider, u: Vec2) -> bool {
-    c.seams != 0
-        && c.world_normals()
-            .iter()
-            .enumerate()
-            .any(|(e, n)| c.is_seam(e) && n.dot(u) > 1e-12)
 }
 
 #[cfg(test)]

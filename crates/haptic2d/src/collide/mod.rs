@@ -25,6 +25,7 @@ mod collider;
 mod gjk;
 mod local;
 mod overlap;
+mod queries;
 mod reuse;
 mod seam;
 mod toi;
@@ -38,10 +39,10 @@ pub use gjk::{
     GJK_MAX_ITERATIONS,
 };
 pub use local::{
-    corner_facing_edge, nearest_line, sat_axis, sat_depth, LocalStage, PairState, DEFAULT_DELTA_C,
-    DEFAULT_EPS_S, NEAR_PARALLEL_ANGLE,
+    corner_facing_edge, LocalStage, PairState, DEFAULT_DELTA_C, DEFAULT_EPS_S, NEAR_PARALLEL_ANGLE,
 };
 pub use overlap::{max_overlap, max_overlap_of_states, Overlap};
+pub use queries::{nearest_line, sat_axis, sat_depth};
 pub use seam::{mark_seams, seam_mask, seam_reach, SEAM_ANGLE, SEAM_DISTANCE, SEAM_MAX_EDGES};
 pub use toi::{
     allowed_depth, radius as polygon_radius, speed_limit, swept_put_back,

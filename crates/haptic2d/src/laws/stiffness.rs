@@ -27,9 +27,8 @@ impl NormalModel {
     pub fn static_depth(&self, f: f64) -> f64 {
         match self {
             NormalModel::Hysteretic(l) => {
-                let g = |d: f64| {
-                    l.k0 * d + l.elements.iter().map(|e| (e.k * d).min(e.f)).sum::<f64>()
-                };
+                let g =
+                    |d: f64| l.k0 * d + l.elements.iter().map(|e| (e.k * d).min(e.f)).sum::<f64>();
                 let mut hi = 1e-6;
                 while g(hi) < f {
                     hi *= 2.0;

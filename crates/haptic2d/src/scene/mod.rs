@@ -13,8 +13,8 @@ mod error;
 mod file;
 mod laws;
 mod load_table;
-pub mod static_sink;
 pub mod overlap;
+pub mod static_sink;
 mod world_table;
 
 pub use bounds::{divergence, Divergence, MAX_BODIES, MAX_FILE_BYTES, MAX_RATE_HZ, MAX_SAMPLES};

@@ -37,7 +37,14 @@ pub fn static_sink_warnings(
         let f: f64 = loads
             .iter()
             .filter(|l| l.body == i)
-            .map(|l| (if l.per_mass { l.force * b.mass } else { l.force }).length())
+            .map(|l| {
+                (if l.per_mass {
+                    l.force * b.mass
+                } else {
+                    l.force
+                })
+                .length()
+            })
             .sum();
         let Some((j, w)) = thick
             .iter()

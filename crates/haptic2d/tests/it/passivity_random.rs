@@ -358,7 +358,10 @@ fn suite_of(seeds: Vec<u64>, g: &Gen) {
         .filter(|r| r.escaped > 0 && !r.warned)
         .map(|r| (r.seed, r.escaped, r.impacts))
         .collect();
-    let warned_kept = results.iter().filter(|r| r.warned && r.escaped == 0).count();
+    let warned_kept = results
+        .iter()
+        .filter(|r| r.warned && r.escaped == 0)
+        .count();
     let sink_lost = results.iter().filter(|r| r.sinks && r.escaped > 0).count();
     let sink_kept = results.iter().filter(|r| r.sinks && r.escaped == 0).count();
     println!(
