@@ -13,15 +13,12 @@
 //! `bash crates/haptic2d-view/e2e/install.sh`). When they are missing the test FAILS with that
 //! hint: it is never reported as passed without running.
 
+use haptic2d_test_support::browser::{e2e_dir, require_prerequisites};
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
-
-fn e2e_dir() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../haptic2d-view/e2e")
-}
 
 fn study_file() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../studies/stiffness-walls.toml")
@@ -108,30 +105,6 @@ impl Drop for Session {
     }
 }
 
-fn missing_prerequisites(e2e: &Path) -> Vec<String> {
-    let mut missing = Vec::new();
-    let chromium = std::env::var("CHROMIUM_PATH").unwrap_or_else(|_| "/usr/bin/chromium".into());
-    if !Path::new(&chromium).exists() {
-        missing.push(format!("chromium ({chromium})"));
-    }
-    let node_ok = Command::new("node")
-        .arg("--version")
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .status()
-        .is_ok_and(|s| s.success());
-    if !node_ok {
-        missing.push("node".into());
-    }
-    if !e2e
-        .join("node_modules/playwright-core/package.json")
-        .exists()
-    {
-        missing.push("e2e/node_modules (npm ci)".into());
-    }
-    missing
-}
-
 /// Runs the page script; returns the answers it gave as (trial, choice).
 fn answer_on_the_page(url: &str, answers: u32, first: u32, end: &str) -> Vec<(u32, u8)> {
     let out = Command::new("node")
@@ -190,13 +163,7 @@ fn rows(tsv: &Path) -> (Vec<(u32, u8, f64)>, String) {
 
 #[test]
 fn browser_study_answers_trials_and_resumes_after_sigint_with_no_trial_lost_or_repeated() {
-    let missing = missing_prerequisites(&e2e_dir());
-    if !missing.is_empty() {
-        panic!(
-            "browser e2e prerequisites missing: {}. Run `bash crates/haptic2d-view/e2e/install.sh`",
-            missing.join(", ")
-        );
-    }
+    require_prerequisites(&e2e_dir());
     let dir = tempfile::tempdir().unwrap();
     let tsv = dir.path().join("sub-e2e01/ses-1/trials.tsv");
 

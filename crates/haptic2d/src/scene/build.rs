@@ -5,11 +5,11 @@ use super::device::device_from_table;
 use super::file::SceneFile;
 use super::laws::{friction_from, normal_from};
 use super::load_table::loads_from;
-use super::static_sink::static_sink_warnings;
+use super::static_sink::{static_sink_warnings, thicknesses, thinnest_other};
 use super::world_table::{contact_params, world_params};
 use super::{SceneError, SceneErrors};
 use crate::body::Body;
-use crate::collide::{body_thickness, speed_limit};
+use crate::collide::speed_limit;
 use crate::device::DeviceParams;
 use crate::geom::ConvexPolygon;
 use crate::integrate::min_mass;
@@ -202,22 +202,13 @@ fn spring_stop_warnings(
     limit: f64,
 ) -> Vec<String> {
     let (k, _) = normal.stiffness_damping();
-    let thick: Vec<f64> = shapes
-        .iter()
-        .map(|ps| ps.iter().map(body_thickness).fold(f64::INFINITY, f64::min))
-        .collect();
+    let thick = thicknesses(shapes);
     let mut out = Vec::new();
     for (i, b) in bodies.iter().enumerate() {
         if !b.is_dynamic() || k.is_nan() || k <= 0.0 {
             continue;
         }
-        let Some((j, w)) = thick
-            .iter()
-            .enumerate()
-            .filter(|&(j, _)| j != i)
-            .min_by(|a, b| a.1.total_cmp(b.1))
-            .map(|(j, &w)| (j, w))
-        else {
+        let Some((j, w)) = thinnest_other(&thick, i) else {
             continue;
         };
         let v = spring_stop_speed(b.mass, k, w);

@@ -16,6 +16,24 @@ use crate::geom::ConvexPolygon;
 use crate::laws::normal::NormalModel;
 use crate::load::Load;
 
+/// The thickness (m) of each body: its thinnest piece's.
+pub(super) fn thicknesses(shapes: &[Vec<ConvexPolygon>]) -> Vec<f64> {
+    shapes
+        .iter()
+        .map(|ps| ps.iter().map(body_thickness).fold(f64::INFINITY, f64::min))
+        .collect()
+}
+
+/// The thinnest body other than `i` and its thickness (m), of [`thicknesses`] `thick`.
+pub(super) fn thinnest_other(thick: &[f64], i: usize) -> Option<(usize, f64)> {
+    thick
+        .iter()
+        .enumerate()
+        .filter(|&(j, _)| j != i)
+        .min_by(|a, b| a.1.total_cmp(b.1))
+        .map(|(j, &w)| (j, w))
+}
+
 /// One warning per dynamic body whose loads compress its two resting corners through the thinnest
 /// part of another body (a box flat on a 40 mm slab on the paper law with `kc` = 2000 N/m: 16 kg
 /// and more, `δ` ≥ 39 mm, fall through; 14 kg rests).
@@ -25,10 +43,7 @@ pub fn static_sink_warnings(
     loads: &[Load],
     normal: &NormalModel,
 ) -> Vec<String> {
-    let thick: Vec<f64> = shapes
-        .iter()
-        .map(|ps| ps.iter().map(body_thickness).fold(f64::INFINITY, f64::min))
-        .collect();
+    let thick = thicknesses(shapes);
     let mut out = Vec::new();
     for (i, b) in bodies.iter().enumerate() {
         if !b.is_dynamic() {
@@ -46,13 +61,7 @@ pub fn static_sink_warnings(
                 .length()
             })
             .sum();
-        let Some((j, w)) = thick
-            .iter()
-            .enumerate()
-            .filter(|&(j, _)| j != i)
-            .min_by(|a, b| a.1.total_cmp(b.1))
-            .map(|(j, &w)| (j, w))
-        else {
+        let Some((j, w)) = thinnest_other(&thick, i) else {
             continue;
         };
         if f <= 0.0 {
