@@ -84,8 +84,8 @@ pub fn sat_face(a: &Collider, b: &Collider) -> Option<SatFace> {
                     ..cand
                 });
             }
-            let through = seams
-                && (super::queries::through_seam(b, u) || super::queries::through_seam(a, -u));
+            let through =
+                seams && (super::seam::through_seam(b, u) || super::seam::through_seam(a, -u));
             if !through && best.is_none_or(|f| -min_d < f.depth) {
                 best = Some(cand);
             }
@@ -99,7 +99,7 @@ pub fn sat_face(a: &Collider, b: &Collider) -> Option<SatFace> {
 /// `u` bound the pair's separating-axis depth from above.
 pub fn admissible_axis(a: &Collider, b: &Collider, u: Vec2) -> bool {
     (a.seams == 0 && b.seams == 0)
-        || !(super::queries::through_seam(b, u) || super::queries::through_seam(a, -u))
+        || !(super::seam::through_seam(b, u) || super::seam::through_seam(a, -u))
 }
 
 /// The edge of `i` whose outward normal is most antiparallel to `n` (the incident edge; the

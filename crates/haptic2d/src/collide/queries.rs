@@ -1,8 +1,7 @@
 //! Depth queries against a collider that respect its seams (`seam.rs`): the nearest surface line
 //! of a point ([`nearest_line`]), the separating-axis depth of two pieces ([`sat_depth`],
-//! [`sat_axis`]) and whether a motion leaves a piece through a seam ([`through_seam`]). Used by the
-//! local stage's candidate rules (`local.rs`), the clip contacts (`clip.rs`) and the depth
-//! invariant of the contact records.
+//! [`sat_axis`]). Used by the local stage's candidate rules (`local.rs`), the clip contacts
+//! (`clip.rs`) and the depth invariant of the contact records.
 
 use super::Collider;
 use crate::geom::Vec2;
@@ -61,15 +60,4 @@ pub fn sat_depth(a: &Collider, b: &Collider) -> f64 {
 /// (relative to `b`) to separate by `depth`; `u = 0` when the pair is apart.
 pub fn sat_axis(a: &Collider, b: &Collider) -> (f64, Vec2) {
     super::clip::sat_face(a, b).map_or((0.0, Vec2::ZERO), |f| (f.depth, f.axis))
-}
-
-/// Whether moving a body relative to `c` along `u` has a component out through a seam of `c`
-/// (`n_s·u > 0` for a seam `s`, beyond round-off).
-#[inline]
-pub(crate) fn through_seam(c: &Collider, u: Vec2) -> bool {
-    c.seams != 0
-        && c.world_normals()
-            .iter()
-            .enumerate()
-            .any(|(e, n)| c.is_seam(e) && n.dot(u) > 1e-12)
 }

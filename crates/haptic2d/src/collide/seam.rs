@@ -34,7 +34,7 @@
 //! 6.6 J.)
 
 use super::Collider;
-use crate::geom::ConvexPolygon;
+use crate::geom::{ConvexPolygon, Vec2};
 
 /// Largest angle (rad, from antiparallel) between two edges that join at a seam.
 pub const SEAM_ANGLE: f64 = 1e-6;
@@ -154,6 +154,17 @@ pub fn seam_reach(colliders: &[Collider], i: usize) -> Vec<(u32, f64)> {
         }
     }
     out
+}
+
+/// Whether moving a body relative to `c` along `u` has a component out through a seam of `c`
+/// (`n_s·u > 0` for a seam `s`, beyond round-off).
+#[inline]
+pub(crate) fn through_seam(c: &Collider, u: Vec2) -> bool {
+    c.seams != 0
+        && c.world_normals()
+            .iter()
+            .enumerate()
+            .any(|(e, n)| c.is_seam(e) && n.dot(u) > 1e-12)
 }
 
 #[cfg(test)]
