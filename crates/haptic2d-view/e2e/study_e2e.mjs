@@ -64,13 +64,18 @@ try {
       const v = await page.evaluate(() => window.__haptic2d.study);
       check(Date.now() - t0 < 30_000, `trial ${trial} reached the answer phase within 30 s (last ${JSON.stringify(v)})`);
       if (v.trial === trial && v.phase === "presenting") {
-        // Buttons are disabled while an interval is presented.
-        const disabled = await page.$$eval("#study-choices button", (bs) => bs.every((b) => b.disabled));
-        const prompt = await page.textContent("#study-prompt");
-        const now = await page.evaluate(() => window.__haptic2d.study);
-        if (now.phase === "presenting") {
-          check(disabled, "the answer buttons are disabled during a presentation");
-          check(/Interval [12] of 2/.test(prompt), `the prompt names the interval: ${prompt}`);
+        // Buttons are disabled while an interval is presented. The phase, the buttons and the
+        // prompt are read in one evaluation (one snapshot of the page: the frame handler updates
+        // them together), so a phase change between reads cannot pair a new phase with an old
+        // prompt.
+        const snap = await page.evaluate(() => ({
+          phase: window.__haptic2d.study.phase,
+          disabled: [...document.querySelectorAll("#study-choices button")].every((b) => b.disabled),
+          prompt: document.querySelector("#study-prompt").textContent,
+        }));
+        if (snap.phase === "presenting") {
+          check(snap.disabled, "the answer buttons are disabled during a presentation");
+          check(/Interval [12] of 2/.test(snap.prompt), `the prompt names the interval: ${snap.prompt}`);
         }
       }
       if (v.trial === trial && v.phase === "answer") break;
