@@ -6,6 +6,7 @@ use crate::device_arg;
 use crate::exit::{Failure, Status};
 use crate::foxglove_live::FoxgloveServer;
 use crate::hand_arg::HandSpec;
+use crate::loop_end::LoopEnd;
 use crate::run_log::{self, RunLogger};
 use crate::run_rig::{DeviceChoice, DeviceModel, RealOpenError, Rig};
 use crate::run_view::{self, LiveView, LoadedScene};
@@ -18,8 +19,8 @@ use haptic2d_rt::mcap::{LoggedTick, McapSetup};
 use haptic2d_rt::signal::install_stop_signals;
 use haptic2d_rt::telemetry::{ring_capacity, MAX_RING_BYTES};
 use haptic2d_rt::{
-    run_loop, telemetry_channel, DeviceError, FaultKind, LoopConfig, SnapshotRx, TelemetryTx,
-    TickControl, TickInfo, TimingSummary, Watchdog,
+    run_loop, telemetry_channel, DeviceError, LoopConfig, SnapshotRx, TelemetryTx, TickControl,
+    TickInfo, TimingSummary, Watchdog,
 };
 use std::collections::BTreeMap;
 use std::net::SocketAddr;
@@ -142,21 +143,6 @@ struct RunOptions {
     controller: ControllerKind,
     device: DeviceChoice,
     hand: HandSpec,
-}
-
-/// Why the loop stopped, when the tick stopped it (the loop also stops at the end of `--duration`
-/// or on a signal, with no reason recorded here).
-enum LoopEnd {
-    /// A replay's recorded data ended (a clean end).
-    ReplayEnded,
-    /// The device failed a read or a write, or the watchdog saw it lost.
-    DeviceLost(String),
-    /// The loop's watchdog tripped (other than a lost device).
-    Watchdog(String),
-    /// The haptic tick's own safety latch tripped (reported by `system.safety_trip()`).
-    SafetyLatch,
-    /// The world diverged (MODELS §0.5 step 12): its time (s) and why.
-    WorldDiverged(String),
 }
 
 /// Runs the haptic loop: validate the options, build the rig, start the display and the logger,
@@ -496,22 +482,14 @@ impl LoopState<'_> {
         let safety = self.rig.safety_input(info, &out, lost.is_some());
         let Rig { system, io, .. } = &mut *self.rig;
         let guard = self.watchdog.guard(&safety, &mut tau);
-        if let Some(e) = lost {
+        // A lost reading, or (MODELS §0.5 step 12) a world that diverged in this tick, stops the
+        // loop before its torques reach the device.
+        if let Some(end) = lost
+            .map(LoopEnd::read_failed)
+            .or_else(|| LoopEnd::diverged(system.world()))
+        {
             io.zero_torques();
-            self.end = Some(match e {
-                DeviceError::EndOfData => LoopEnd::ReplayEnded,
-                e => LoopEnd::DeviceLost(e.to_string()),
-            });
-            return TickControl::Stop;
-        }
-        // MODELS §0.5 step 12: a world that diverged in this tick stops the loop before its
-        // torques reach the device.
-        if let Some(d) = system.world().divergence() {
-            io.zero_torques();
-            let t = system.world().time();
-            self.end = Some(LoopEnd::WorldDiverged(format!(
-                "the world diverged at t = {t:.4} s: {d}\n    torques were set to zero and latched; fix: lower the contact stiffness or raise the rate (docs/SCENES.md)"
-            )));
+            self.end = Some(end);
             return TickControl::Stop;
         }
         if let Err(e) = io.write_torques(&tau) {
@@ -528,17 +506,9 @@ impl LoopState<'_> {
         } else {
             self.tx.set_latest(self.logged);
         }
-        if let Err(f) = guard {
+        if let Some(end) = LoopEnd::after_write(guard, out.tripped) {
             io.zero_torques();
-            self.end = Some(match f.kind {
-                FaultKind::DeviceLost => LoopEnd::DeviceLost(f.to_string()),
-                _ => LoopEnd::Watchdog(f.to_string()),
-            });
-            return TickControl::Stop;
-        }
-        if out.tripped {
-            io.zero_torques();
-            self.end = Some(LoopEnd::SafetyLatch);
+            self.end = Some(end);
             return TickControl::Stop;
         }
         if let Some(v) = self.view.as_mut() {

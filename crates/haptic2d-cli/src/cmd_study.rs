@@ -237,35 +237,7 @@ fn study_run(
         stop_after,
     )
     .map_err(Failure::error)?;
-    let quest = if s.slopes.is_empty() {
-        "QUEST"
-    } else {
-        "QUEST+"
-    };
-    for (c, est, (lo, hi)) in &s.quest {
-        println!("{quest} {c}: threshold {est:.4} [{lo:.4}, {hi:.4}] (posterior mean, 95 % credible interval)");
-    }
-    for (c, b) in &s.slopes {
-        println!("QUEST+ {c}: Weibull slope {b:.2} (posterior mean)");
-    }
-    println!(
-        "{}: {} trial(s) run{}; {}",
-        s.dir.display(),
-        s.ran,
-        if s.resumed > 0 {
-            format!(" after {} resumed from trials.tsv", s.resumed)
-        } else {
-            String::new()
-        },
-        if s.complete {
-            format!(
-                "session complete\nnext: haptic2d study analyse {}",
-                s.dir.display()
-            )
-        } else {
-            "session not complete: run the same command again to resume".into()
-        }
-    );
+    print!("{}", s.report("run the same command again to resume"));
     Ok(Status::Clean)
 }
 

@@ -25,6 +25,7 @@ mod foxglove_live;
 mod grip_twist;
 mod hand_arg;
 mod haply_arg;
+mod loop_end;
 mod pipe;
 mod run_log;
 mod run_rig;

@@ -16,6 +16,7 @@
 use crate::device_arg;
 use crate::exit::{Failure, Status};
 use crate::hand_arg::HandSpec;
+use crate::loop_end::LoopEnd;
 use crate::run_rig::{DeviceChoice, DeviceModel, RealOpenError, Rig};
 use crate::run_view::{self, LiveView, LoadedScene};
 use crate::study_present::{Event, Plan, Presenter, MAX_INTERVALS};
@@ -28,7 +29,7 @@ use haptic2d_lab::study::schedule::{Schedule, TrialSpec};
 use haptic2d_lab::study::{run as run_session, session_seed, stimulus, Study};
 use haptic2d_rt::clock::now_ns;
 use haptic2d_rt::signal::install_stop_signals;
-use haptic2d_rt::{run_loop, DeviceError, FaultKind, LoopConfig, TickControl, TickInfo, Watchdog};
+use haptic2d_rt::{run_loop, LoopConfig, TickControl, TickInfo, Watchdog};
 use std::collections::HashMap;
 use std::net::SocketAddr;
 use std::path::{Path, PathBuf};
@@ -57,14 +58,6 @@ pub struct BrowserOptions {
     pub allow_unstable: bool,
     /// `--allow-remote-device`.
     pub allow_remote_device: bool,
-}
-
-/// Why the loop stopped, when the tick stopped it.
-enum LoopEnd {
-    DeviceLost(String),
-    Watchdog(String),
-    SafetyLatch,
-    Diverged(String),
 }
 
 /// Why the session ended early (from the observer's side).
@@ -285,9 +278,14 @@ fn finish(
             Status::DeviceLost,
             format!("{m}\n    torques were set to zero and latched"),
         ),
+        // A study refuses a replay, so its data cannot end; were it to, the device is gone.
+        (Some(LoopEnd::ReplayEnded), _) => (
+            Status::DeviceLost,
+            "the device's data ended\n    torques were set to zero and latched".into(),
+        ),
         (Some(LoopEnd::Watchdog(m)), _) => (Status::SafetyStop, m),
         (Some(LoopEnd::SafetyLatch), _) => (Status::SafetyStop, "safety stop".into()),
-        (Some(LoopEnd::Diverged(m)), _) => (Status::Diverged, m),
+        (Some(LoopEnd::WorldDiverged(m)), _) => (Status::Diverged, m),
         (None, Some(EarlyEnd::Page)) => (Status::Clean, "stopped from the page".into()),
         (None, Some(EarlyEnd::Loop)) => (
             Status::Interrupted,
@@ -295,24 +293,7 @@ fn finish(
         ),
         (None, None) => match session_result {
             Ok(s) => {
-                crate::outln!(
-                    "{}: {} trial(s) run{}; {}",
-                    s.dir.display(),
-                    s.ran,
-                    if s.resumed > 0 {
-                        format!(" after {} resumed from trials.tsv", s.resumed)
-                    } else {
-                        String::new()
-                    },
-                    if s.complete {
-                        format!(
-                            "session complete\nnext: haptic2d study analyse {}",
-                            s.dir.display()
-                        )
-                    } else {
-                        format!("session not complete: {resume_hint}")
-                    }
-                );
+                crate::outln!("{}", s.report(resume_hint).trim_end());
                 return Ok(Status::Clean);
             }
             Err(e) => return Err(Failure::error(e)),
@@ -473,20 +454,14 @@ impl StudyLoop<'_> {
         let safety = self.rig.safety_input(info, &out, lost.is_some());
         let Rig { system, io, .. } = &mut *self.rig;
         let guard = self.watchdog.guard(&safety, &mut tau);
-        if let Some(e) = lost {
+        // A lost reading, or a world that diverged in this tick, stops the loop before its torques
+        // reach the device (as in `haptic2d run`).
+        if let Some(end) = lost
+            .map(LoopEnd::read_failed)
+            .or_else(|| LoopEnd::diverged(system.world()))
+        {
             io.zero_torques();
-            self.end = Some(LoopEnd::DeviceLost(match e {
-                DeviceError::EndOfData => "the device's data ended".into(),
-                e => e.to_string(),
-            }));
-            return TickControl::Stop;
-        }
-        if let Some(d) = system.world().divergence() {
-            io.zero_torques();
-            self.end = Some(LoopEnd::Diverged(format!(
-                "the world diverged at t = {:.4} s: {d}\n    torques were set to zero and latched",
-                system.world().time()
-            )));
+            self.end = Some(end);
             return TickControl::Stop;
         }
         if let Err(e) = io.write_torques(&tau) {
@@ -494,17 +469,9 @@ impl StudyLoop<'_> {
             self.end = Some(LoopEnd::DeviceLost(e.to_string()));
             return TickControl::Stop;
         }
-        if let Err(f) = guard {
+        if let Some(end) = LoopEnd::after_write(guard, out.tripped) {
             io.zero_torques();
-            self.end = Some(match f.kind {
-                FaultKind::DeviceLost => LoopEnd::DeviceLost(f.to_string()),
-                _ => LoopEnd::Watchdog(f.to_string()),
-            });
-            return TickControl::Stop;
-        }
-        if out.tripped {
-            io.zero_torques();
-            self.end = Some(LoopEnd::SafetyLatch);
+            self.end = Some(end);
             return TickControl::Stop;
         }
         self.view.set_study_view(Some(self.presenter.view()));

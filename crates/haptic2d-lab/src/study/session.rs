@@ -61,6 +61,46 @@ pub struct RunSummary {
     pub slopes: Vec<(String, f64)>,
 }
 
+impl RunSummary {
+    /// What a session run reports at its end (the simulated and the browser paths alike): each
+    /// condition's QUEST or QUEST+ estimate, then where the trials went and whether the session is
+    /// complete (`resume_hint` says how to go on when it is not).
+    pub fn report(&self, resume_hint: &str) -> String {
+        let s = self;
+        let mut out = String::new();
+        let quest = if s.slopes.is_empty() {
+            "QUEST"
+        } else {
+            "QUEST+"
+        };
+        for (c, est, (lo, hi)) in &s.quest {
+            out += &format!("{quest} {c}: threshold {est:.4} [{lo:.4}, {hi:.4}] (posterior mean, 95 % credible interval)\n");
+        }
+        for (c, b) in &s.slopes {
+            out += &format!("QUEST+ {c}: Weibull slope {b:.2} (posterior mean)\n");
+        }
+        let resumed = if s.resumed > 0 {
+            format!(" after {} resumed from trials.tsv", s.resumed)
+        } else {
+            String::new()
+        };
+        let state = if s.complete {
+            format!(
+                "session complete\nnext: haptic2d study analyse {}",
+                s.dir.display()
+            )
+        } else {
+            format!("session not complete: {resume_hint}")
+        };
+        out += &format!(
+            "{}: {} trial(s) run{resumed}; {state}\n",
+            s.dir.display(),
+            s.ran
+        );
+        out
+    }
+}
+
 /// The answer names the comparison (or, same–different: says "different", 1, exactly when the
 /// comparison was presented).
 pub fn answer_correct(study: &Study, spec: &TrialSpec, response: u8) -> bool {
