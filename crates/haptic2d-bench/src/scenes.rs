@@ -21,13 +21,13 @@ pub struct Case {
     pub rapier_restitution: f64,
 }
 
-/// The sliding scene: `n` boxes of 0.05 m and 2 kg resting on a floor, launched along +x at 1–2 m/s,
-/// 0.2 m apart so they never touch each other; reset-integrator friction μ_s = 0.5, μ_k = 0.45
-/// (they slide for ≈ 0.25–0.45 s, then stick).
-pub fn sliding_toml(n: usize) -> String {
-    let mut s = String::from(
-        r#"name = "sliding"
-description = "boxes sliding on a floor with reset-integrator friction"
+/// The head of a bench scene on a floor from x = −1 m to `floor_end` (m), 0.1 m thick, under
+/// gravity, with the pile's contact laws: 1 kHz, paper normal law (`Kc = 1e5 N/m`, `Bc = 40
+/// N·s/m`), reset-integrator friction (μ_s = 0.5, μ_k = 0.45), impacts with restitution 0.2.
+fn floor_scene_head(name: &str, description: &str, floor_end: f64) -> String {
+    format!(
+        r#"name = "{name}"
+description = "{description}"
 
 [world]
 rate = 1000
@@ -54,13 +54,24 @@ beta = 20.0
 [[body]]
 name = "floor"
 kind = "fixed"
-pieces = [[[-1.0, -0.1], [8.0, -0.1], [8.0, 0.0], [-1.0, 0.0]]]
+pieces = [[[-1.0, -0.1], [{floor_end:.1}, -0.1], [{floor_end:.1}, 0.0], [-1.0, 0.0]]]
 
 [[load]]
 body = "*"
 force = [0.0, -9.81]
 per_mass = true
-"#,
+"#
+    )
+}
+
+/// The sliding scene: `n` boxes of 0.05 m and 2 kg resting on a floor, launched along +x at 1–2 m/s,
+/// 0.2 m apart so they never touch each other; reset-integrator friction μ_s = 0.5, μ_k = 0.45
+/// (they slide for ≈ 0.25–0.45 s, then stick).
+pub fn sliding_toml(n: usize) -> String {
+    let mut s = floor_scene_head(
+        "sliding",
+        "boxes sliding on a floor with reset-integrator friction",
+        8.0,
     );
     for k in 0..n {
         let v = 1.0 + k as f64 / n.max(1) as f64;
@@ -76,43 +87,7 @@ per_mass = true
 /// boxes, 1 mm apart, each row resting on the one below: 210 boxes for 20 rows) on a floor, with the
 /// pile's contact laws; it starts at rest and should stay so.
 pub fn pyramid_toml(rows: usize) -> String {
-    let mut s = String::from(
-        r#"name = "pyramid"
-description = "a pyramid of boxes resting on the ground"
-
-[world]
-rate = 1000
-proximity_every = 10
-integration = "semi-implicit"
-
-[contact]
-impacts = true
-restitution = 0.2
-v_c = 0.05
-
-[normal]
-model = "paper"
-kc = 1.0e5
-bc = 40.0
-
-[friction]
-model = "reset-integrator"
-kr = 5.0e4
-mu_s = 0.5
-mu_k = 0.45
-beta = 20.0
-
-[[body]]
-name = "floor"
-kind = "fixed"
-pieces = [[[-1.0, -0.1], [3.0, -0.1], [3.0, 0.0], [-1.0, 0.0]]]
-
-[[load]]
-body = "*"
-force = [0.0, -9.81]
-per_mass = true
-"#,
-    );
+    let mut s = floor_scene_head("pyramid", "a pyramid of boxes resting on the ground", 3.0);
     let pitch = 0.051; // box width + 1 mm gap
     for r in 0..rows {
         for k in 0..rows - r {
@@ -165,31 +140,27 @@ pub fn cases(pile_sizes: &[usize], filter: &[String]) -> Result<Vec<Case>, Strin
             rapier_restitution: 0.5,
         });
     }
-    if keep("sliding") {
-        let n = 10;
-        out.push(Case {
-            scene: "sliding",
+    // The generated floor scenes carry the pile's laws (rapier2d: μ 0.5, e 0.2).
+    let floor_case = |label: &'static str, n: usize, toml: String| -> Result<Case, String> {
+        Ok(Case {
+            scene: label,
             n,
-            haptic: scene(
-                "sliding",
-                Some(Scene::from_toml(&sliding_toml(n), "sliding", rate)),
-            )?,
+            haptic: scene(label, Some(Scene::from_toml(&toml, label, rate)))?,
             rapier_friction: 0.5,
             rapier_restitution: 0.2,
-        });
+        })
+    };
+    if keep("sliding") {
+        let n = 10;
+        out.push(floor_case("sliding", n, sliding_toml(n))?);
     }
     if keep("pyramid") {
         let rows = 20;
-        out.push(Case {
-            scene: "pyramid",
-            n: rows * (rows + 1) / 2,
-            haptic: scene(
-                "pyramid",
-                Some(Scene::from_toml(&pyramid_toml(rows), "pyramid", rate)),
-            )?,
-            rapier_friction: 0.5,
-            rapier_restitution: 0.2,
-        });
+        out.push(floor_case(
+            "pyramid",
+            rows * (rows + 1) / 2,
+            pyramid_toml(rows),
+        )?);
     }
     Ok(out)
 }

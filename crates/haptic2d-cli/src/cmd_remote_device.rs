@@ -1,12 +1,15 @@
 //! `haptic2d run --world udp:HOST:PORT --key FILE` (alias: `haptic2d remote-device --world …`): the
 //! device side of the haptic loop split at a network (issue 41, docs/TELEOP.md). It runs the device (the simulated twin
 //! pantograph and its simulated hand) with its local safety, and renders the force the world side
-//! sends through the master port's TDPA passivity controller. Every period:
+//! sends through the master port's TDPA passivity controller — or, with `--link wave`, the force
+//! of the lab's wave master ([`WaveMaster`], one per axis) from the returning waves, under their
+//! energy budget. Every period:
 //!
 //! ```text
 //! encoders → pose, twist (TwinPantograph::estimate)          stall, joint plausibility (SafetyStage)
 //! newest world message (authenticated, by sequence number)    lost link: none for --link-timeout-ms → latch
 //! force · ramp → TDPA master port (energy in from the world)  workspace bound (trip past it)
+//!   (wave: F = −(b·v − √(2b)·w), w the newest wave within the world's wave energy sent)
 //! → torques (redundancy, saturation) → limit cycle, gate → motors   book the force really applied
 //!
 //! The safety steps are the shared `SafetyStage`, the same as every device's in `run`.
@@ -29,10 +32,11 @@ use haptic2d::device::{DeviceParams, ObserverKind, TwinPantograph};
 use haptic2d::haptic::safety::{Safety, SafetyConfig, SafetyReason};
 use haptic2d::haptic::workspace::WorkspaceBound;
 use haptic2d::haptic::SafetyStage;
-use haptic2d_devices::world_link::message::{FLAG_BYE, FLAG_LATCHED, FLAG_TDPA};
+use haptic2d_devices::world_link::message::{FLAG_BYE, FLAG_LATCHED, FLAG_TDPA, FLAG_WAVE};
 use haptic2d_devices::world_link::{
     LinkEndpoint, PortMessage, KIND_TO_DEVICE, KIND_TO_WORLD, PORT_LEN,
 };
+use haptic2d_lab::network::wave::{WaveMaster, WaveMsg};
 use haptic2d_rt::clock::now_ns;
 use haptic2d_rt::{
     run_loop, DeviceIo, LoopConfig, SharedTarget, SimIo, TickControl, TickInfo, TickInterval,
@@ -133,6 +137,8 @@ enum Latch {
     LostLink { silent: f64, limit: f64 },
     /// The world side closed the session.
     WorldClosed,
+    /// The world side runs the other kind of link (waves against forces): `true` if it runs waves.
+    Mismatch { world_waves: bool },
     /// The simulated device failed.
     DeviceIo,
 }
@@ -194,6 +200,14 @@ struct DeviceSide {
     safety: SafetyStage,
     origin: V3,
     tdpa: bool,
+    /// The wave master per axis with `--link wave`, and what it sent last.
+    wave: Option<[WaveMaster; 3]>,
+    wave_out: [WaveMsg; 3],
+    /// With waves: the measured pose at the start of the period just ended, and the force
+    /// really applied over it (booked one period late, on the measured displacement).
+    prev_pose_for_books: Option<V3>,
+    prev_applied: V3,
+
     ports: PlanarTdpa,
     /// The port's energy as the plant really received it: the applied force times the simulated
     /// plant's true displacement over the period.
@@ -234,28 +248,10 @@ impl DeviceSide {
         };
         let at = (k, t);
         self.safety.supervise_input(at, &q, elapsed, f64::NAN);
-        // The world's newest message, and the lost-link check.
-        if let Some(m) = self.ep.poll(KIND_TO_DEVICE) {
-            let now = now_ns();
-            self.stats.arrived(now, m.echo_time_ns, m.echo_age_ns);
-            (self.last, self.last_k, self.last_arrival_ns) = (Some(m), k, now);
-            if m.flags & FLAG_BYE != 0 {
-                return self.stop(t, Latch::WorldClosed);
-            }
-        }
-        let silent = k.saturating_sub(self.last_k);
-        let limit = if self.last.is_some() {
-            self.timeout_periods
-        } else {
-            self.first_timeout_periods
+        let fresh = match self.receive(k, t, dt) {
+            Ok(m) => m,
+            Err(stop) => return stop,
         };
-        if silent > limit {
-            let lost = Latch::LostLink {
-                silent: silent as f64 * dt,
-                limit: limit as f64 * dt,
-            };
-            return self.stop(t, lost);
-        }
         // The world's force, ramped in, through the master port's passivity controller. (Unlike
         // the lab's teleop, the port keeps the filtered velocity: measured over the split loop,
         // the plants' true ledger showed no gain from the unfiltered rate; docs/TELEOP.md.)
@@ -264,7 +260,33 @@ impl DeviceSide {
         let (f_req, far) = self.last.map_or(([0.0; 3], [0.0; 3]), |m| {
             (m.force.map(|f| f * ramp), m.energy_in)
         });
-        let f_net = if self.tdpa {
+        let moved: Option<V3> = self
+            .prev_pose_for_books
+            .map(|p| std::array::from_fn(|i| (x[i] - p[i]) / dt));
+        self.prev_pose_for_books = Some(x);
+        let f_net = if let Some(wm) = &mut self.wave {
+            // Waves. First the period just ended, as the plant received it: the force really
+            // applied over it and the measured displacement (the waves sent are those, one period
+            // late; the wave drawn beyond what the budget granted is a debt).
+            if let Some(mv) = moved {
+                for i in 0..3 {
+                    self.wave_out[i] =
+                        wm[i].book(x[i] - self.origin[i], mv[i], self.prev_applied[i], dt);
+                }
+                self.ports.observe(&self.prev_applied, &mv, dt);
+            }
+            // Then this period's force: the newest returning wave (once), within the world's
+            // wave energy sent, and the damping b·v on the filtered velocity (as the TDPA port's;
+            // the unfiltered rate of the pose gave the same plants' ledger and a larger debt).
+            std::array::from_fn(|i| {
+                let msg = fresh.map(|m| WaveMsg {
+                    wave: m.wave[i],
+                    energy: m.wave_energy[i],
+                    x: m.wave_x[i],
+                });
+                wm[i].force(v[i], msg, dt) * ramp
+            })
+        } else if self.tdpa {
             let m = self.dev.mass_matrix();
             let alpha_max = [0, 1, 2].map(|i| 2.0 * m[i][i].abs() / dt);
             self.ports.control(&f_req, &v, &far, dt, &alpha_max)
@@ -292,7 +314,10 @@ impl DeviceSide {
             scale = 0.0;
         }
         let applied = f_net.map(|f| f * scale);
-        if self.tdpa {
+        self.prev_applied = applied;
+        if self.wave.is_some() {
+            // Booked at the next period, on the displacement measured over this one.
+        } else if self.tdpa {
             self.ports.book(&applied, &v, dt);
         } else {
             self.ports.observe(&applied, &v, dt);
@@ -315,12 +340,49 @@ impl DeviceSide {
         }
     }
 
+    /// The world's newest message this period, if one arrived, and the lost-link check: `Err`
+    /// holds the stop (the world closed the link, runs the other link kind, or fell silent).
+    fn receive(&mut self, k: u64, t: f64, dt: f64) -> Result<Option<PortMessage>, TickControl> {
+        let fresh = self.ep.poll(KIND_TO_DEVICE);
+        if let Some(m) = fresh {
+            let now = now_ns();
+            self.stats.arrived(now, m.echo_time_ns, m.echo_age_ns);
+            (self.last, self.last_k, self.last_arrival_ns) = (Some(m), k, now);
+            if m.flags & FLAG_BYE != 0 {
+                return Err(self.stop(t, Latch::WorldClosed));
+            }
+            let world_waves = m.flags & FLAG_WAVE != 0;
+            if world_waves != self.wave.is_some() {
+                return Err(self.stop(t, Latch::Mismatch { world_waves }));
+            }
+        }
+        let silent = k.saturating_sub(self.last_k);
+        let limit = if self.last.is_some() {
+            self.timeout_periods
+        } else {
+            self.first_timeout_periods
+        };
+        if silent > limit {
+            let lost = Latch::LostLink {
+                silent: silent as f64 * dt,
+                limit: limit as f64 * dt,
+            };
+            return Err(self.stop(t, lost));
+        }
+        Ok(fresh)
+    }
+
     fn send(&mut self, k: u64, x: &V3, v: &V3, force: &V3, flags: u32) {
         self.seq = self.seq.wrapping_add(1);
         let now = now_ns();
+        let (w, we, wx) = (
+            self.wave_out.map(|o| o.wave),
+            self.wave_out.map(|o| o.energy),
+            self.wave_out.map(|o| o.x),
+        );
         let msg = PortMessage {
             seq: self.seq,
-            flags: flags | if self.tdpa { FLAG_TDPA } else { 0 },
+            flags: flags | self.method_flags(),
             time_ns: now,
             echo_time_ns: self.last.map_or(0, |m| m.time_ns),
             echo_age_ns: u32::try_from(now.saturating_sub(self.last_arrival_ns))
@@ -331,6 +393,9 @@ impl DeviceSide {
             force: *force,
             energy_in: self.ports.energy_in(),
             energy_out: self.ports.energy_out(),
+            wave: w,
+            wave_energy: we,
+            wave_x: wx,
         };
         msg.seal(
             self.ep.key(),
@@ -339,6 +404,17 @@ impl DeviceSide {
             &mut self.buf,
         );
         self.outbox.send(&mut self.ep, k, &self.buf);
+    }
+
+    /// `FLAG_TDPA` or `FLAG_WAVE` as this end runs.
+    fn method_flags(&self) -> u32 {
+        if self.tdpa {
+            FLAG_TDPA
+        } else if self.wave.is_some() {
+            FLAG_WAVE
+        } else {
+            0
+        }
     }
 
     /// Latches zero torques, says so to the world, and stops the loop.
@@ -354,9 +430,7 @@ impl DeviceSide {
     /// Tells the world side the session is over (three times, past the impairment: a lost BYE
     /// only makes the world wait for its silence timeout).
     fn bye(&mut self, latched: bool) {
-        let flags = FLAG_BYE
-            | if latched { FLAG_LATCHED } else { 0 }
-            | if self.tdpa { FLAG_TDPA } else { 0 };
+        let flags = FLAG_BYE | if latched { FLAG_LATCHED } else { 0 } | self.method_flags();
         for _ in 0..3 {
             self.seq = self.seq.wrapping_add(1);
             let msg = PortMessage {
@@ -365,6 +439,7 @@ impl DeviceSide {
                 time_ns: now_ns(),
                 energy_in: self.ports.energy_in(),
                 energy_out: self.ports.energy_out(),
+                wave_energy: self.wave_out.map(|o| o.energy),
                 ..PortMessage::default()
             };
             msg.seal(
@@ -501,12 +576,12 @@ fn run_device_side(p: &Plan) -> Result<Status, Failure> {
     )
     .map_err(Failure::error)?;
     outln!(
-        "device side: session {:016x} with the world at {}, simulated twin pantograph, hand {}, {} Hz, TDPA {}, impairment: {}; no display (the world is on the world side)",
+        "device side: session {:016x} with the world at {}, simulated twin pantograph, hand {}, {} Hz, link {}, impairment: {}; no display (the world is on the world side)",
         ep.session(),
         ep.peer(),
         p.hand,
         p.rate,
-        if a.link.tdpa() { "on" } else { "off" },
+        a.link.method(),
         a.link.describe(p.rate)
     );
     let timeout_periods = (a.link.link_timeout_ms * 1e-3 * p.rate).ceil() as u64;
@@ -526,6 +601,10 @@ fn run_device_side(p: &Plan) -> Result<Status, Failure> {
         ),
         origin,
         tdpa: a.link.tdpa(),
+        wave: a.link.wave().map(|w| w.map(WaveMaster::new)),
+        wave_out: [WaveMsg::default(); 3],
+        prev_pose_for_books: None,
+        prev_applied: [0.0; 3],
         ports: PlanarTdpa::default(),
         plant_ledger: PlanarTdpa::default(),
         outbox: a.link.outbox(p.rate),
@@ -585,11 +664,21 @@ fn report(
     outln!("{summary}");
     let mine = side.ports.totals();
     outln!("master port (device): {}", energies(mine));
+
     let plant = side.plant_ledger.totals();
     outln!(
         "master port (plant, true displacement): energy in {:.6} J, out {:.6} J",
         plant.0,
         plant.1
+    );
+    let per_axis = |p: &PlanarTdpa| -> [f64; 3] {
+        let (i, o) = (p.energy_in(), p.energy_out());
+        std::array::from_fn(|k| o[k] - i[k])
+    };
+    let (b, pl) = (per_axis(&side.ports), per_axis(&side.plant_ledger));
+    outln!(
+        "master port, out − in per axis (x, y, θ): books {:.6}, {:.6}, {:.6} J; plant {:.6}, {:.6}, {:.6} J",
+        b[0], b[1], b[2], pl[0], pl[1], pl[2]
     );
     if let Some(m) = side.last {
         let (i, o) = (
@@ -603,7 +692,23 @@ fn report(
             bal.created
         );
     }
+    if let Some(wm) = &side.wave {
+        let (used, cut) = wm.iter().fold((0.0, 0.0), |(u, c), m| {
+            (u + m.budget().used(), c + m.budget().cut())
+        });
+        let sent: f64 = side.wave_out.iter().map(|o| o.energy).sum();
+        let got: f64 = side.last.map_or(0.0, |m| m.wave_energy.iter().sum::<f64>());
+        outln!(
+            "waves: sent {sent:.6} J; returning waves: the world sent {got:.6} J (as last received), used {used:.6} J, {cut:.6} J cut by the budget"
+        );
+    }
     let c = side.ep.counters;
+    if c.old_version > 0 {
+        outln!(
+            "link: {} authentic port messages of the older world-link message version 1 refused: the world side is an older build (update both ends)",
+            c.old_version
+        );
+    }
     outln!(
         "link: {} received, {} stale, {} bad MAC, {} wrong session, {} malformed, {} send errors, {} dropped by the test impairment; largest force on the handle {:.3} N",
         c.received,
@@ -638,6 +743,11 @@ fn report(
                     limit * 1e3
                 ),
                 Latch::WorldClosed => "safety stop: the world side closed the session".into(),
+                Latch::Mismatch { world_waves } => format!(
+                    "safety stop: link mismatch: the world side runs {}, this side {} (both ends need the same --link)",
+                    if world_waves { "wave variables" } else { "force/velocity (tdpa or none)" },
+                    if world_waves { "force/velocity (tdpa or none)" } else { "wave variables" },
+                ),
                 Latch::DeviceIo => "safety stop: the simulated device failed".into(),
             };
             outln!("stopped: {what} at t = {t:.3} s; torques set to zero and latched");

@@ -8,9 +8,10 @@ use crate::foxglove_live::FoxgloveServer;
 use crate::hand_arg::HandSpec;
 use crate::loop_end::LoopEnd;
 use crate::run_log::{self, RunLogger};
-use crate::run_rig::{DeviceChoice, DeviceModel, RealOpenError, Rig};
+use crate::run_rig::{DeviceChoice, RealOpenError, Rig};
 use crate::run_view::{self, LiveView, LoadedScene};
 use crate::scene_arg;
+use crate::worst_step::WorstStep;
 use haptic2d::control::passivity::PlanarPassivity;
 use haptic2d::device::DeviceFault;
 use haptic2d::haptic::{ControllerKind, HapticConfig, SafetyReason};
@@ -163,10 +164,7 @@ pub fn run(a: &RunArgs) -> Result<Status, Failure> {
         .load_real(a.device_file.as_deref(), a.allow_remote_device)?;
     let device_setting = match &real {
         Some(r) => device_arg::DeviceSetting {
-            params: match &r.model {
-                DeviceModel::Twin(p) => *p,
-                DeviceModel::FiveBar { .. } => haptic2d::device::DeviceParams::default(),
-            },
+            params: r.model.twin_params(),
             origin: r.summary.clone(),
         },
         None => device_arg::resolve(a.device_file.as_deref(), &scene, 1.0 / a.rate)?,
@@ -242,10 +240,43 @@ pub fn run(a: &RunArgs) -> Result<Status, Failure> {
     let watchdog = make_watchdog(&rig)?;
     let stop = install_stop()?;
     let loop_config = make_loop_config(a)?;
+    print_banner(a, &rig, &scene_name, &device_setting.origin, &hand_name);
+
+    let mut state = LoopState {
+        rig: &mut rig,
+        view,
+        watchdog,
+        logging: logger.is_some(),
+        capture_world: logger.as_ref().is_some_and(RunLogger::captures_world) || foxglove.is_some(),
+        logged: LoggedTick::default(),
+        tx,
+        end: None,
+        worst: WorstStep::default(),
+    };
+    let summary = run_on_rt_thread(&loop_config, &stop, &mut state);
+    // Zero torques before anything else (Ctrl-C, the end of --duration, a failure alike); the port
+    // closes when the rig is dropped, after the report.
+    state.rig.io.zero_torques();
+    let summary = summary?;
+    let end = state.end.take();
+    let worst = state.worst;
+    drop(state);
+    if let Some(s) = server {
+        s.shutdown();
+    }
+    if let Some(f) = foxglove {
+        crate::outln!("{}", f.shutdown());
+    }
+    let interrupted = stop.load(Ordering::SeqCst);
+    report(a, &rig, &summary, worst, end, interrupted, logger)
+}
+
+/// The line that starts a run: scene, device and where its parameters came from, controller,
+/// hand, rate and duration.
+fn print_banner(a: &RunArgs, rig: &Rig, scene_name: &str, origin: &str, hand_name: &str) {
     crate::outln!(
-        "running {scene_name}: device {} (parameters: {}), controller {}{}, hand {hand_name}, {} Hz{}; Ctrl-C stops",
+        "running {scene_name}: device {} (parameters: {origin}), controller {}{}, hand {hand_name}, {} Hz{}; Ctrl-C stops",
         rig.io.name(),
-        device_setting.origin,
         rig.config.controller.name(),
         if a.passivity {
             " + passivity controller"
@@ -258,31 +289,6 @@ pub fn run(a: &RunArgs) -> Result<Status, Failure> {
             None => String::new(),
         }
     );
-
-    let mut state = LoopState {
-        rig: &mut rig,
-        view,
-        watchdog,
-        logging: logger.is_some(),
-        capture_world: logger.as_ref().is_some_and(RunLogger::captures_world) || foxglove.is_some(),
-        logged: LoggedTick::default(),
-        tx,
-        end: None,
-    };
-    let summary = run_on_rt_thread(&loop_config, &stop, &mut state);
-    // Zero torques before anything else (Ctrl-C, the end of --duration, a failure alike); the port
-    // closes when the rig is dropped, after the report.
-    state.rig.io.zero_torques();
-    let summary = summary?;
-    let end = state.end.take();
-    drop(state);
-    if let Some(s) = server {
-        s.shutdown();
-    }
-    if let Some(f) = foxglove {
-        crate::outln!("{}", f.shutdown());
-    }
-    report(a, &rig, &summary, end, stop.load(Ordering::SeqCst), logger)
 }
 
 /// `run --world udp:HOST:PORT`: the device side of a split loop (`cmd_remote_device`); split-loop
@@ -455,12 +461,24 @@ struct LoopState<'r> {
     logged: LoggedTick,
     /// Why the tick stopped the loop, if it did.
     end: Option<LoopEnd>,
+    /// The slowest world step so far and its stages.
+    worst: WorstStep,
 }
 
 impl LoopState<'_> {
+    /// One tick, timed: the slowest one keeps its world step's stage times ([`WorstStep`]).
+    fn tick(&mut self, info: &TickInfo) -> TickControl {
+        let start = std::time::Instant::now();
+        let control = self.tick_untimed(info);
+        let took = start.elapsed();
+        self.worst
+            .observe(self.rig.system.world(), took, info.index, info.t_s);
+        control
+    }
+
     /// One haptic tick: the page's commands, device read, system tick, watchdog, device write,
     /// telemetry, then the display. Allocation-free in steady state.
-    fn tick(&mut self, info: &TickInfo) -> TickControl {
+    fn tick_untimed(&mut self, info: &TickInfo) -> TickControl {
         // The page's commands, between ticks.
         if let Some(v) = self.view.as_mut() {
             v.apply_commands(self.rig);
@@ -564,6 +582,7 @@ fn report(
     a: &RunArgs,
     rig: &Rig,
     summary: &TimingSummary,
+    worst: WorstStep,
     end: Option<LoopEnd>,
     interrupted: bool,
     logger: Option<RunLogger>,
@@ -572,6 +591,9 @@ fn report(
         eprintln!("{w}");
     }
     crate::outln!("{summary}");
+    if let Some(line) = worst.line() {
+        crate::outln!("  {line}");
+    }
     crate::outln!(
         "on time: {:.3} % of {} deadlines ({} ticks, {} skipped, {} overruns)",
         summary.on_time_fraction * 100.0,
@@ -661,6 +683,7 @@ mod tests {
             capture_world: false,
             logged: LoggedTick::default(),
             end: None,
+            worst: WorstStep::default(),
         }
     }
 

@@ -4,7 +4,11 @@
 //! drives the slave body through a virtual coupling to it, with the slave port's TDPA passivity
 //! controller (energy in from the device side received with every message), steps the world and
 //! sends the coupling's reaction back (as computed, before this port's controller) with its
-//! port's energies. It runs at normal priority (it
+//! port's energies. With `--link wave` the lab's wave slave ([`WaveSlave`], one per axis) takes
+//! the place of the coupling to the received handle: the newest forward wave, within the wave
+//! energy the device side sent (and with the budgeted drift compensation to the handle's received
+//! position), drives a commanded point that pulls the slave through the coupling; the returning
+//! wave goes back. It runs at normal priority (it
 //! drives no motor) and ends when the device side says goodbye or falls silent.
 
 use std::net::UdpSocket;
@@ -14,10 +18,11 @@ use std::time::Duration;
 use haptic2d::control::tdpa::PlanarTdpa;
 use haptic2d::geom::Vec2;
 use haptic2d::world::World;
-use haptic2d_devices::world_link::message::{FLAG_BYE, FLAG_TDPA};
+use haptic2d_devices::world_link::message::{FLAG_BYE, FLAG_TDPA, FLAG_WAVE};
 use haptic2d_devices::world_link::{
     LinkEndpoint, PortMessage, KIND_TO_DEVICE, KIND_TO_WORLD, PORT_LEN,
 };
+use haptic2d_lab::network::wave::{WaveMsg, WaveSlave};
 use haptic2d_rt::clock::now_ns;
 use haptic2d_rt::{run_loop, LoopConfig, TickControl, TickInfo};
 
@@ -80,6 +85,9 @@ struct WorldSide {
     k: [f64; 3],
     b: [f64; 3],
     tdpa: bool,
+    /// The wave slave per axis with `--link wave`, and what it sent last.
+    wave: Option<[WaveSlave; 3]>,
+    wave_out: [WaveMsg; 3],
     ports: PlanarTdpa,
     /// The port's energy as the slave body really received it: the applied force times its
     /// displacement over the world step.
@@ -101,6 +109,8 @@ struct WorldSide {
     contact: (u64, f64, f64, f64),
     /// The device side's TDPA flag, as last received.
     peer_tdpa: Option<bool>,
+    /// The device side's wave flag, as last received.
+    peer_wave: Option<bool>,
     end: Option<&'static str>,
 }
 
@@ -117,23 +127,50 @@ impl WorldSide {
         )
     }
 
-    fn tick(&mut self, info: &TickInfo) -> TickControl {
-        let (k, dt) = (info.deadline_index, info.period_s);
-        if let Some(m) = self.ep.poll(KIND_TO_WORLD) {
+    /// The device side's newest message this period, if one arrived: kept as the last, with the
+    /// link's statistics and the peer's link kind; a goodbye or a link mismatch ends the session.
+    fn receive(&mut self, k: u64) -> Option<PortMessage> {
+        let fresh = self.ep.poll(KIND_TO_WORLD);
+        if let Some(m) = fresh {
             let now = now_ns();
             self.stats.arrived(now, m.echo_time_ns, m.echo_age_ns);
             (self.last, self.last_k, self.last_arrival_ns) = (Some(m), k, now);
             self.peer_tdpa = Some(m.flags & FLAG_TDPA != 0);
+            let peer_wave = m.flags & FLAG_WAVE != 0;
+            self.peer_wave = Some(peer_wave);
             if m.flags & FLAG_BYE != 0 {
                 self.end = Some("the device side closed the session");
+            } else if peer_wave != self.wave.is_some() {
+                self.end = Some("link mismatch: one end runs wave variables, the other forces (both ends need the same --link)");
             }
         }
+        fresh
+    }
+
+    fn tick(&mut self, info: &TickInfo) -> TickControl {
+        let (k, dt) = (info.deadline_index, info.period_s);
+        let fresh = self.receive(k);
         let silent = k.saturating_sub(self.last_k);
         let (x_s, v_s) = self.slave_state();
-        let live = self.last.is_some() && silent <= self.timeout_periods;
+        let live = self.last.is_some() && silent <= self.timeout_periods && self.end.is_none();
         let (mut f_s, mut f_c) = ([0.0; 3], [0.0; 3]);
         let far = self.last.map_or([0.0; 3], |m| m.energy_in);
-        if let (true, Some(m)) = (live, self.last) {
+        if let (true, Some(ws)) = (live, &mut self.wave) {
+            // Waves: the newest forward wave (once) drives the commanded point x_d, which pulls
+            // the body through the coupling.
+            for i in 0..3 {
+                let msg = fresh.map(|m| WaveMsg {
+                    wave: m.wave[i],
+                    energy: m.wave_energy[i],
+                    x: m.wave_x[i],
+                });
+                let st = ws[i].step(msg, x_s[i], v_s[i], self.k[i], self.b[i], dt);
+                (f_s[i], self.wave_out[i]) = (st.force, st.msg);
+            }
+            f_c = f_s;
+            self.live_ticks += 1;
+            self.max_force = self.max_force.max(f_s[0].hypot(f_s[1]));
+        } else if let (true, Some(m)) = (live, self.last) {
             f_c = std::array::from_fn(|i| {
                 self.k[i] * (m.pose[i] - x_s[i]) + self.b[i] * (m.twist[i] - v_s[i])
             });
@@ -162,16 +199,26 @@ impl WorldSide {
                 c.3 + (wall - coupling).abs(),
             );
         }
+        // The port books what the body really received: the force held over the world step
+        // times the body's displacement over it (the world knows it at once). Booked on the
+        // velocity at the start of the step instead, the controller's damping near its cap
+        // `2m/T` counted as dissipated what the body did not lose (docs/TELEOP.md).
         if self.tdpa {
-            self.ports.book(&f_s, &v_s, dt);
+            self.ports.book(&f_s, &moved, dt);
         } else {
-            self.ports.observe(&f_s, &v_s, dt);
+            self.ports.observe(&f_s, &moved, dt);
         }
         self.seq = self.seq.wrapping_add(1);
         let now = now_ns();
         let msg = PortMessage {
             seq: self.seq,
-            flags: if self.tdpa { FLAG_TDPA } else { 0 },
+            flags: if self.tdpa {
+                FLAG_TDPA
+            } else if self.wave.is_some() {
+                FLAG_WAVE
+            } else {
+                0
+            },
             time_ns: now,
             echo_time_ns: self.last.map_or(0, |m| m.time_ns),
             echo_age_ns: u32::try_from(now.saturating_sub(self.last_arrival_ns))
@@ -185,6 +232,9 @@ impl WorldSide {
             force: f_c.map(|f| -f),
             energy_in: self.ports.energy_in(),
             energy_out: self.ports.energy_out(),
+            wave: self.wave_out.map(|o| o.wave),
+            wave_energy: self.wave_out.map(|o| o.energy),
+            wave_x: self.wave_out.map(|o| o.x),
         };
         msg.seal(
             self.ep.key(),
@@ -264,13 +314,13 @@ pub fn run(a: &ServeWorldArgs) -> Result<Status, Failure> {
         .local_addr()
         .map_err(|e| Failure::error(e.to_string()))?;
     outln!(
-        "serve-world: {} ({}), slave `{}` ({} kg), {} Hz, TDPA {}, impairment: {}",
+        "serve-world: {} ({}), slave `{}` ({} kg), {} Hz, link {}, impairment: {}",
         scene.name,
         scene.source,
         body.name,
         body.mass,
         a.rate,
-        if a.link.tdpa() { "on" } else { "off" },
+        a.link.method(),
         a.link.describe(a.rate)
     );
     outln!("serve-world: listening on {local}");
@@ -295,6 +345,8 @@ pub fn run(a: &ServeWorldArgs) -> Result<Status, Failure> {
         k,
         b,
         tdpa: a.link.tdpa(),
+        wave: a.link.wave().map(|w| w.map(|p| WaveSlave::new(p, 0.0))),
+        wave_out: [WaveMsg::default(); 3],
         ports: PlanarTdpa::default(),
         plant_ledger: PlanarTdpa::default(),
         outbox: a.link.outbox(a.rate),
@@ -310,6 +362,7 @@ pub fn run(a: &ServeWorldArgs) -> Result<Status, Failure> {
         max_force: 0.0,
         contact: (0, 0.0, 0.0, 0.0),
         peer_tdpa: None,
+        peer_wave: None,
         end: None,
     };
     let config = LoopConfig {
@@ -338,7 +391,23 @@ fn report(side: &mut WorldSide, summary: &haptic2d_rt::TimingSummary) {
         plant.0,
         plant.1
     );
+    if let Some(ws) = &side.wave {
+        let (used, cut) = ws.iter().fold((0.0, 0.0), |(u, c), s| {
+            (u + s.budget().used(), c + s.budget().cut())
+        });
+        let sent: f64 = side.wave_out.iter().map(|o| o.energy).sum();
+        let got: f64 = side.last.map_or(0.0, |m| m.wave_energy.iter().sum::<f64>());
+        outln!(
+            "waves: sent {sent:.6} J; forward waves: the device side sent {got:.6} J (as last received), used {used:.6} J (drift compensation included), {cut:.6} J cut by the budget"
+        );
+    }
     let c = side.ep.counters;
+    if c.old_version > 0 {
+        outln!(
+            "link: {} authentic port messages of the older world-link message version 1 refused: the device side is an older build (update both ends)",
+            c.old_version
+        );
+    }
     outln!(
         "link: {} received, {} stale, {} bad MAC, {} wrong session, {} malformed, {} send errors, {} dropped by the test impairment; {} periods live; largest coupling force {:.3} N",
         c.received,

@@ -14,7 +14,8 @@ use haptic2d_devices::haply::identified::Identified;
 use haptic2d_devices::haply::{HaplyDeviceFile, HaplyKind, Plant2};
 use haptic2d_devices::registry::DeviceModel;
 use haptic2d_lab::stability::planar2::{
-    analyse_planar2, check_released_stability_planar2, FiveBarDynamics,
+    analyse_planar2, check_released_stability_planar2, check_released_stability_point,
+    FiveBarDynamics,
 };
 use haptic2d_lab::stability::{analyse_config, plot::write_pole_plot};
 use std::path::PathBuf;
@@ -139,7 +140,7 @@ pub fn run(a: &StabilityArgs) -> Result<(), Failure> {
 
 /// The gate `haptic2d run` applies before driving the real device of model `model`: the
 /// configuration `config` must be stable with the hand released on every axis of the device
-/// (x, y, θ for a twin pantograph; x and y for a 2-DOF device). The error names the axis and the fix
+/// (x, y, θ for a twin pantograph; x and y for a 2-DOF or point device). The error names the axis and the fix
 /// (`--allow-unstable` overrides).
 pub fn check_real_device(
     model: &DeviceModel,
@@ -157,6 +158,12 @@ pub fn check_real_device(
             linkage,
             &five_bar_dynamics(linkage, *center, identified.as_ref())?.0,
             Vec2::new(center[0], center[1]),
+            &config.controller,
+            world,
+        ),
+        DeviceModel::Point { gate_dynamics, .. } => check_released_stability_point(
+            gate_dynamics.mass,
+            gate_dynamics.damping,
             &config.controller,
             world,
         ),

@@ -32,9 +32,11 @@ mod run_rig;
 mod run_view;
 mod scene_arg;
 mod study_browser;
+mod study_mcap;
 mod study_present;
 mod world_link_arg;
 mod world_mcap;
+mod worst_step;
 
 use clap::{Parser, Subcommand};
 use exit::{Failure, Status};

@@ -4,7 +4,9 @@
 //!
 //! The real devices (`--device haply:…`, `udp:…`, `inverse3…`) come from the device registry of
 //! `haptic2d-devices` ([`haptic2d_devices::registry`], re-exported here): the device choice, the
-//! model the system is built for, and the closure that opens the device.
+//! model the system is built for (a twin: [`HapticSystem`]; a five-bar: [`Planar2System`]; a
+//! Cartesian point device such as the Inverse3: [`PointSystem`]), and the closure that opens the
+//! device.
 //!
 //! The rig does the rest: the stability gate with the hand released (`--allow-unstable`), zero
 //! torques until the first valid reading and the start-up ramp of the shared safety layer, the
@@ -14,9 +16,10 @@ use crate::grip_twist::GripTwist;
 use crate::hand_arg::HandSpec;
 use haptic2d::device::linalg::{V3, V4};
 use haptic2d::device::DeviceParams;
-use haptic2d::haptic::planar2::{Planar2Config, Planar2System};
+use haptic2d::haptic::planar2::{GraspConfig, Planar2Config, Planar2System};
 use haptic2d::haptic::{
-    ControllerKind, DeviceSystem, HapticConfig, HapticSystem, SafetyConfig, TickOutput,
+    ControllerKind, DeviceSystem, HapticConfig, HapticSystem, PointConfig, PointSystem,
+    SafetyConfig, TickOutput,
 };
 use haptic2d::world::World;
 use haptic2d_devices::device_safety::DeviceSafety;
@@ -228,6 +231,26 @@ impl Rig {
                 c.workspace = *workspace;
                 DeviceSystem::TwoDof(Planar2System::new(world, c)?)
             }
+            DeviceModel::Point {
+                force_limit,
+                workspace,
+                ..
+            } => {
+                if config.passivity.is_some() {
+                    return Err("--passivity is not available on a point device (its port has no hand-wrench observer); leave it out".into());
+                }
+                let mut common = GraspConfig::new(*workspace);
+                common.controller = config.controller;
+                common.slave = config.slave.clone();
+                common.safety = safety;
+                DeviceSystem::Point(PointSystem::new(
+                    world,
+                    PointConfig {
+                        force_limit: *force_limit,
+                        common,
+                    },
+                )?)
+            }
         })
     }
 
@@ -244,9 +267,10 @@ impl Rig {
         };
         WatchdogConfig {
             min_singularity_margin: match &self.real {
-                // The 2-DOF system trips on its own margin (a five-bar's margin is another measure).
+                // The 2-DOF system trips on its own margin (a five-bar's margin is another measure;
+                // a point device has none).
                 Some(RealLimits {
-                    model: DeviceModel::FiveBar { .. },
+                    model: DeviceModel::FiveBar { .. } | DeviceModel::Point { .. },
                     ..
                 }) => 0.0,
                 _ => self.config.device.min_singularity_margin,
@@ -295,10 +319,11 @@ impl Rig {
     pub fn tick_system(&mut self, q: &V4, info: &TickInfo, paused: bool) -> TickOutput {
         let elapsed_ns = self.interval.update(info);
         let wait_ns = std::mem::replace(&mut self.prev_read_wait_ns, self.read_wait_ns);
-        // A sensed handle orientation turns the slave's twist target (2-DOF devices).
-        if let (Some(a), DeviceSystem::TwoDof(s)) = (self.io.handle_angle(), &mut self.system) {
-            let slave_angle = s.world().bodies[s.slave()].pose.angle;
-            s.set_twist_target(self.grip.target(a, slave_angle));
+        // A sensed handle orientation turns the slave's twist target (2-DOF and point devices).
+        if let (Some(a), None) = (self.io.handle_angle(), self.system.twin()) {
+            let slave_angle = self.system.world().bodies[self.system.slave()].pose.angle;
+            self.system
+                .set_twist_target(self.grip.target(a, slave_angle));
         }
         if paused {
             self.elapsed_periods = 1.0;
@@ -401,8 +426,7 @@ impl Rig {
     /// no hand follows a target. On a 2-DOF device (the real hand moves x and y) only the angle is
     /// used: it becomes the twist target of the slave's virtual torsion spring (the wheel / Q–E).
     pub fn set_hand_target(&mut self, world: V3) -> Option<V3> {
-        if let DeviceSystem::TwoDof(s) = &mut self.system {
-            s.set_twist_target(Some(world[2]));
+        if self.system.set_twist_target(Some(world[2])) {
             return Some(self.hand_target_world());
         }
         let t = self.target.as_ref()?;
@@ -421,10 +445,11 @@ impl Rig {
     pub fn hand_target_world(&self) -> V3 {
         match (&self.target, &self.system) {
             (Some(t), DeviceSystem::Twin(s)) => s.map().pose_to_world(&t.get()),
-            // 2-DOF: the handle's x and y, and the twist target (else the slave's angle).
-            (_, DeviceSystem::TwoDof(s)) => {
+            // 2-DOF and point devices: the handle's x and y, and the twist target (else the
+            // slave's angle).
+            (_, DeviceSystem::TwoDof(_) | DeviceSystem::Point(_)) => {
                 let h = self.system.handle_world();
-                [h[0], h[1], s.twist_target().unwrap_or(h[2])]
+                [h[0], h[1], self.system.twist_target().unwrap_or(h[2])]
             }
             _ => self.system.handle_world(),
         }
@@ -480,16 +505,16 @@ pub enum RealOpenError {
     Open(String),
 }
 
+/// Rigs and ticks the CLI's unit tests share.
 #[cfg(test)]
-mod tests {
+pub(crate) mod test_rig {
     use super::*;
-    use haptic2d::device::pantograph2::Pantograph2;
-    use haptic2d::haptic::WorkspaceSquare;
-    use haptic2d::scene::builtin;
-    use haptic2d_rt::Watchdog;
 
-    fn rig() -> Rig {
-        let scene = builtin("box-in-walls", Some(1000.0)).unwrap().unwrap();
+    /// The simulated twin on `box-in-walls` at 1 kHz, the hand following its target.
+    pub(crate) fn sim_rig() -> Rig {
+        let scene = haptic2d::scene::builtin("box-in-walls", Some(1000.0))
+            .unwrap()
+            .unwrap();
         Rig::new(
             scene.world,
             "box-in-walls",
@@ -500,7 +525,8 @@ mod tests {
         .unwrap()
     }
 
-    fn info(k: u64) -> TickInfo {
+    /// Tick `k` of a 1 kHz loop that is always on time (deadline `k` ms).
+    pub(crate) fn tick_info(k: u64) -> TickInfo {
         TickInfo {
             index: k,
             deadline_index: k,
@@ -512,6 +538,16 @@ mod tests {
             deadline_ns: k * 1_000_000,
         }
     }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::test_rig::{sim_rig as rig, tick_info as info};
+    use super::*;
+    use haptic2d::device::pantograph2::Pantograph2;
+    use haptic2d::haptic::WorkspaceSquare;
+    use haptic2d::scene::builtin;
+    use haptic2d_rt::Watchdog;
 
     /// Issue 11: `run` gave the watchdog a nominal singularity margin (1) and no closure fault.
     #[test]
@@ -659,7 +695,8 @@ mod tests {
         .unwrap()
     }
 
-    /// A 2-DOF device whose joint 0 turns `step` rad per read from its workspace centre.
+    /// A 2-DOF device whose joint 0 turns `step` rad per read from its workspace centre (or, a point
+    /// device, whose x moves `step` m per read).
     struct MovingBoard {
         q: [f64; 2],
         step: f64,
@@ -695,19 +732,23 @@ mod tests {
         p
     }
 
-    /// Ticks the real device `real` (its I/O replaced by a board turning joint 0 at 10 rad/s, far
-    /// below the default bound of 1000 rad/s) for 20 ms; returns the trip, if any.
-    fn run_at_10_rad_per_s(real: RealDevice) -> Option<haptic2d::haptic::SafetyTrip> {
+    /// Ticks the real device `real` (its I/O replaced by a board turning joint 0 at 10 rad/s, or a
+    /// point device moving at 10 m/s, far below the default bound of 1000 rad/s or m/s) for 20 ms;
+    /// returns the trip, if any. The point starts 0.1 m left of its square's centre, so that its
+    /// 0.2 m stay inside the square.
+    fn run_at_10_per_s(real: RealDevice) -> Option<haptic2d::haptic::SafetyTrip> {
         let mut real = real;
-        let DeviceModel::FiveBar {
-            linkage, center, ..
-        } = &real.model
-        else {
-            panic!("a 2-DOF device")
+        let q = match &real.model {
+            DeviceModel::FiveBar {
+                linkage, center, ..
+            } => linkage
+                .ik(haptic2d::geom::Vec2::new(center[0], center[1]))
+                .unwrap(),
+            DeviceModel::Point { workspace, .. } => {
+                [workspace.centre[0] - 0.1, workspace.centre[1]]
+            }
+            DeviceModel::Twin(_) => panic!("a 2-DOF or point device"),
         };
-        let q = linkage
-            .ik(haptic2d::geom::Vec2::new(center[0], center[1]))
-            .unwrap();
         real.open = Box::new(move |_| Ok(Box::new(MovingBoard { q, step: 0.01 }) as _));
         let scene = builtin("box-in-walls", Some(1000.0)).unwrap().unwrap();
         let mut rig = Rig::with_real(
@@ -726,22 +767,29 @@ mod tests {
     }
 
     /// Issue 38 item 6, issue 34: the device file's `[safety] max_velocity` reaches the system of
-    /// every device kind. 10 rad/s passes the default bound and trips a file's 5 rad/s, which the
-    /// trip names; the file's `stall_floor` sets the watchdog's floor.
+    /// every device kind. 10 rad/s (m/s on a point device) passes the default bound and trips a
+    /// file's 5, which the trip names; the file's `stall_floor` sets the watchdog's floor.
     fn a_file_velocity_bound_is_honoured(
         load: impl Fn(&std::path::Path) -> RealDevice,
         shipped: &str,
     ) {
         let dir = tempfile::tempdir().unwrap();
         let plain = safety_file(dir.path(), shipped, |t| t);
-        assert_eq!(run_at_10_rad_per_s(load(&plain)), None, "{shipped}");
+        assert_eq!(run_at_10_per_s(load(&plain)), None, "{shipped}");
+        // Whatever bound the shipped file sets (rad/s on a linkage, m/s on the Inverse3), 5.
         let tight = safety_file(dir.path(), shipped, |t| {
-            t.replace("max_velocity = 1000.0", "max_velocity = 5.0")
+            t.lines()
+                .map(|l| match l.split_once('=') {
+                    Some((k, _)) if k.trim() == "max_velocity" => "max_velocity = 5.0".to_string(),
+                    _ => l.to_string(),
+                })
+                .collect::<Vec<_>>()
+                .join("\n")
                 .replace("stall_floor = 0.02 ", "stall_floor = 0.1 ")
         });
         let real = load(&tight);
         assert_eq!(real.safety.stall_floor, 0.1);
-        let trip = run_at_10_rad_per_s(real).expect("a trip");
+        let trip = run_at_10_per_s(real).expect("a trip");
         match trip.reason {
             haptic2d::haptic::SafetyReason::JointSpeed { index, limit, .. } => {
                 assert_eq!((index, limit), (0, 5.0), "{trip}")
@@ -886,6 +934,183 @@ mod tests {
         rig.rebuild(world).unwrap();
         assert!(matches!(rig.system, DeviceSystem::TwoDof(_)));
         assert_eq!(rig.io.name(), "fake-board");
+    }
+
+    /// What a fake point device reports: the handle point (m) and the grip angle (rad), and the
+    /// force (N) the rig last wrote.
+    #[derive(Default)]
+    struct PointState {
+        point: [f64; 2],
+        angle: Option<f64>,
+        force: [f64; 4],
+    }
+
+    /// A Cartesian point device (an Inverse3 in planar mode, faked): `q = [x, y, 0, 0]` (m).
+    struct FakePoint(Arc<std::sync::Mutex<PointState>>);
+
+    impl DeviceIo for FakePoint {
+        fn read_encoders(&mut self) -> Result<[f64; 4], DeviceError> {
+            let p = self.0.lock().unwrap().point;
+            Ok([p[0], p[1], 0.0, 0.0])
+        }
+        fn write_torques(&mut self, tau: &[f64; 4]) -> Result<(), DeviceError> {
+            self.0.lock().unwrap().force = *tau;
+            Ok(())
+        }
+        fn zero_torques(&mut self) {
+            self.0.lock().unwrap().force = [0.0; 4];
+        }
+        fn name(&self) -> &str {
+            "fake-point"
+        }
+        fn handle_angle(&self) -> Option<f64> {
+            self.0.lock().unwrap().angle
+        }
+    }
+
+    /// A rig on a fake point device (force limit 5 N, square (0, 0) ± 0.15 m, the Inverse3's gate
+    /// dynamics) resting at (0.01, −0.02) m, with the coupling controller and no start-up ramp.
+    fn point_rig() -> (Rig, Arc<std::sync::Mutex<PointState>>) {
+        let state = Arc::new(std::sync::Mutex::new(PointState {
+            point: [0.01, -0.02],
+            ..PointState::default()
+        }));
+        let shared = state.clone();
+        let real = RealDevice {
+            name: "fake-point".into(),
+            model: DeviceModel::Point {
+                force_limit: 5.0,
+                workspace: WorkspaceSquare::around([0.0, 0.0], 0.15),
+                gate_dynamics: haptic2d_devices::registry::inverse3::GATE_DYNAMICS,
+            },
+            summary: "a fake point device".into(),
+            wait_periods: 20.0,
+            max_missed_run: None,
+            max_stall_periods: 5.0,
+            safety: DeviceSafety::default(),
+            match_controller: None,
+            open: Box::new(move |_| Ok(Box::new(FakePoint(shared)) as Box<dyn DeviceIo + Send>)),
+        };
+        let scene = builtin("box-in-walls", Some(1000.0)).unwrap().unwrap();
+        let config = HapticConfig {
+            controller: ControllerKind::from_name("coupling").unwrap(),
+            ..HapticConfig::default()
+        };
+        let rig = Rig::with_real(
+            scene.world,
+            "box-in-walls",
+            config,
+            DeviceChoice::Inverse3(None),
+            real,
+        )
+        .unwrap();
+        (rig, state)
+    }
+
+    /// Issue 37 item 1: a point device (the Inverse3) runs on the point system, not through a
+    /// virtual linkage: the first tick's force is zero, the force then follows the handle (the
+    /// coupling pulls it back towards the slave it anchored to) within the 5 N limit, and a
+    /// rebuild (the page's reset) keeps the point system.
+    #[test]
+    fn a_real_point_rig_drives_a_point_system_from_zero_force() {
+        let (mut rig, state) = point_rig();
+        assert!(matches!(rig.system, DeviceSystem::Point(_)));
+        assert!(rig.twin_params().is_none() && rig.system.twin_kinematics().is_none());
+        assert_eq!(rig.watchdog_config().min_singularity_margin, 0.0);
+        let q = rig.read().unwrap();
+        assert_eq!(q, [0.01, -0.02, 0.0, 0.0]);
+        let out = rig.tick_system(&q, &info(0), false);
+        assert_eq!(out.torques, [0.0; 4], "anchored at the first reading");
+        // The handle 5 mm to the right of where it anchored, the slave at rest: the coupling pulls
+        // it back (−x), the ramp (0.5 s by default) growing.
+        state.lock().unwrap().point = [0.015, -0.02];
+        let mut last = 0.0;
+        for k in 1..400 {
+            let q = rig.read().unwrap();
+            let out = rig.tick_system(&q, &info(k), false);
+            assert!(!out.tripped, "{:?}", rig.system.safety_trip());
+            assert!(out.torques[0].hypot(out.torques[1]) <= 5.0 + 1e-12);
+            assert_eq!(out.torques[2..], [0.0; 2]);
+            last = out.torques[0];
+        }
+        assert!(last < -0.1, "pulled back: {last} N");
+        let world = builtin("box-in-walls", Some(1000.0))
+            .unwrap()
+            .unwrap()
+            .world;
+        rig.rebuild(world).unwrap();
+        assert!(matches!(rig.system, DeviceSystem::Point(_)));
+        assert_eq!(rig.io.name(), "fake-point");
+    }
+
+    /// The VerseGrip's angle turns the slave's twist target on a point device as on a 2DIY
+    /// (anchored at the first reading), and the page's wheel sets it too.
+    #[test]
+    fn a_point_devices_grip_angle_turns_the_slave() {
+        let (mut rig, state) = point_rig();
+        let theta0 = rig.system.world().bodies[rig.system.slave()].pose.angle;
+        state.lock().unwrap().angle = Some(0.2);
+        let q = rig.read().unwrap();
+        rig.tick_system(&q, &info(0), false);
+        assert_eq!(rig.system.twist_target(), Some(theta0));
+        state.lock().unwrap().angle = Some(0.5);
+        rig.tick_system(&q, &info(1), false);
+        let t = rig.system.twist_target().unwrap();
+        assert!((t - (theta0 + 0.3)).abs() < 1e-12, "{t}");
+        let set = rig.set_hand_target([9.0, 9.0, -0.4]).unwrap();
+        assert_eq!(set[2], -0.4);
+        assert_ne!(set[0], 9.0, "x and y stay the handle's");
+    }
+
+    /// The workspace bound of the device file reaches a point device in the rig: a handle carried
+    /// past the square's trip distance latches zero force within the tick, with its reason.
+    #[test]
+    fn a_point_device_past_its_square_latches_zero_force_in_the_rig() {
+        let (mut rig, state) = point_rig();
+        let q = rig.read().unwrap();
+        rig.tick_system(&q, &info(0), false);
+        // 0.15 m half-width, 10 mm trip distance: 0.17 m is past it. Walk there at 1 m/s (below
+        // the speed bound) so that only the square can trip.
+        let mut tripped = None;
+        for k in 1..200u64 {
+            let x = (0.01 + 0.001 * k as f64).min(0.17);
+            state.lock().unwrap().point = [x, -0.02];
+            let q = rig.read().unwrap();
+            let out = rig.tick_system(&q, &info(k), false);
+            if out.tripped {
+                assert_eq!(out.torques, [0.0; 4]);
+                tripped = Some(x);
+                break;
+            }
+        }
+        let x = tripped.expect("the square trips");
+        // The first reading at the trip distance (0.16 m, up to rounding) or past it, not before.
+        assert!(x > 0.16 - 1e-9 && x < 0.1615, "tripped at {x} m");
+        let trip = rig.system.safety_trip().unwrap();
+        assert!(
+            matches!(
+                trip.reason,
+                haptic2d::haptic::SafetyReason::Workspace { axis: 0, .. }
+            ),
+            "{trip}"
+        );
+    }
+
+    /// The released-handle stability gate applies to a point device, linearised with the
+    /// Inverse3's gate dynamics: the spec's four-channel gains are refused, the default passes.
+    #[test]
+    fn display_controller_switch_on_a_point_device_passes_the_released_stability_gate() {
+        let (mut rig, _) = point_rig();
+        rig.enforce_released_stability();
+        let spec = ControllerKind::from_name("four-channel-spec").unwrap();
+        let e = rig
+            .set_controller(spec)
+            .expect_err("the gate refuses the switch");
+        assert!(
+            e.contains("axis x") && e.contains("--allow-unstable"),
+            "{e}"
+        );
+        rig.set_controller(ControllerKind::default()).unwrap();
     }
 
     /// Issue 11 (noticed in session 5): the display's controller switch skipped the released-handle

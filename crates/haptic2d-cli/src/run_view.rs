@@ -119,6 +119,10 @@ pub fn start(
 pub struct StudyInbox {
     /// The last answer `(trial, choice)` not yet taken.
     pub answer: Option<(u32, u8)>,
+    /// The last magnitude estimate `(trial, value)` not yet taken.
+    pub magnitude: Option<(u32, f64)>,
+    /// The last "continue after the break" `trial` not yet taken.
+    pub cont: Option<u32>,
     /// The page asked to stop the session.
     pub stop: bool,
 }
@@ -263,6 +267,16 @@ impl LiveView {
                 }
                 inbox.answer = Some((trial, choice));
             }
+            Command::Magnitude { trial, value } => {
+                let inbox = self.study.as_mut().ok_or(NO_STUDY)?;
+                if inbox.magnitude.is_some() {
+                    return Err("one answer per tick: refused".into());
+                }
+                inbox.magnitude = Some((trial, value));
+            }
+            Command::ContinueStudy { trial } => {
+                self.study.as_mut().ok_or(NO_STUDY)?.cont = Some(trial);
+            }
             Command::StopStudy => self.study.as_mut().ok_or(NO_STUDY)?.stop = true,
         }
         Ok(())
@@ -301,9 +315,6 @@ impl LiveView {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::hand_arg::HandSpec;
-    use crate::run_rig::DeviceChoice;
-    use haptic2d::haptic::HapticConfig;
     use haptic2d_test_support::alloc::allocations;
     use std::time::Duration;
 
@@ -325,14 +336,7 @@ mod tests {
             description: scene.description.clone(),
             world: scene.world.clone(),
         };
-        let mut rig = Rig::new(
-            scene.world,
-            "box-in-walls",
-            HapticConfig::default(),
-            DeviceChoice::Sim,
-            HandSpec::Follow,
-        )
-        .unwrap();
+        let mut rig = crate::run_rig::test_rig::sim_rig();
         let (server, mut view) =
             start("127.0.0.1:0".parse().unwrap(), &rig, loaded, 1000.0, false).unwrap();
         let addr = server.local_addr();
@@ -403,14 +407,7 @@ mod tests {
             description: scene.description.clone(),
             world: scene.world.clone(),
         };
-        let mut rig = Rig::new(
-            scene.world,
-            "box-in-walls",
-            HapticConfig::default(),
-            DeviceChoice::Sim,
-            HandSpec::Follow,
-        )
-        .unwrap();
+        let mut rig = crate::run_rig::test_rig::sim_rig();
         let (server, mut view) =
             start("127.0.0.1:0".parse().unwrap(), &rig, loaded, 1000.0, false).unwrap();
         let addr = server.local_addr();

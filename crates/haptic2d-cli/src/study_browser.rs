@@ -17,8 +17,9 @@ use crate::device_arg;
 use crate::exit::{Failure, Status};
 use crate::hand_arg::HandSpec;
 use crate::loop_end::LoopEnd;
-use crate::run_rig::{DeviceChoice, DeviceModel, RealOpenError, Rig};
+use crate::run_rig::{DeviceChoice, RealOpenError, Rig};
 use crate::run_view::{self, LiveView, LoadedScene};
+use crate::study_mcap::{self, TrialLogger, TrialTap};
 use crate::study_present::{Event, Plan, Presenter, MAX_INTERVALS};
 use haptic2d::haptic::HapticConfig;
 use haptic2d::laws::friction::FrictionModel;
@@ -26,6 +27,7 @@ use haptic2d::laws::normal::NormalModel;
 use haptic2d::scene::Scene;
 use haptic2d_lab::study::observer::{Answer, Observer};
 use haptic2d_lab::study::schedule::{Schedule, TrialSpec};
+use haptic2d_lab::study::session::session_dir;
 use haptic2d_lab::study::{run as run_session, session_seed, stimulus, Study};
 use haptic2d_rt::clock::now_ns;
 use haptic2d_rt::signal::install_stop_signals;
@@ -98,6 +100,8 @@ pub fn run(
         ..LoopConfig::default()
     };
     loop_config.validate()?;
+    let (tap, trial_log) =
+        start_trial_log(&study, &text, &rig, out, participant, session, o, rate)?;
     let (plan_tx, plan_rx) = rtrb::RingBuffer::<Plan>::new(2);
     let (event_tx, event_rx) = rtrb::RingBuffer::<Event>::new(16);
     eprintln!(
@@ -114,9 +118,10 @@ pub fn run(
         rig: &mut rig,
         view,
         watchdog,
-        presenter: Presenter::new(study.task, o.interval_s),
+        presenter: Presenter::new(study.task, o.interval_s).with_modulus(study.modulus),
         plans: plan_rx,
         events: event_tx,
+        tap,
         end: None,
     };
     let mut observer = BrowserObserver {
@@ -125,6 +130,7 @@ pub fn run(
         ended: &ended,
         planned,
         laws: HashMap::new(),
+        rest_next: false,
         early: None,
     };
     let (session_result, timing) = std::thread::scope(|s| {
@@ -167,6 +173,10 @@ pub fn run(
     let end = state.end.take();
     drop(state);
     server.shutdown();
+    match trial_log.finish() {
+        Ok(r) => crate::outln!("{r}"),
+        Err(e) => crate::outln!("warning: {e}"),
+    }
     if let Some(Ok(t)) = &timing {
         crate::outln!(
             "on time: {:.3} % of {} deadlines ({} overruns)",
@@ -203,9 +213,6 @@ fn check_options(o: &BrowserOptions) -> Result<SocketAddr, Failure> {
 /// run` does, gated by the released-stability check for a real device. Returns the rig, the scene
 /// for the display and the loop rate (Hz).
 fn build_rig(study: &Study, o: &BrowserOptions) -> Result<(Rig, LoadedScene, f64), Failure> {
-    if study.task == haptic2d_lab::study::file::Task::Magnitude {
-        return Err("this study is magnitude estimation, and the browser page has no number entry yet\n    fix: run it with --observer simulated, or use a 2AFC, 3AFC or same-different task with people".into());
-    }
     let first = &study.conditions[0].reference;
     let scene_text = stimulus::scene_text(study, first, None).map_err(scene_errors)?;
     let scene = Scene::from_toml(&scene_text, &study.scene_source, study.rate)
@@ -218,10 +225,7 @@ fn build_rig(study: &Study, o: &BrowserOptions) -> Result<(Rig, LoadedScene, f64
     }
     let real = device.load_real(o.device_file.as_deref(), o.allow_remote_device)?;
     let device_params = match &real {
-        Some(r) => match &r.model {
-            DeviceModel::Twin(p) => *p,
-            DeviceModel::FiveBar { .. } => haptic2d::device::DeviceParams::default(),
-        },
+        Some(r) => r.model.twin_params(),
         None => device_arg::resolve(o.device_file.as_deref(), &scene, dt)?.params,
     };
     let mut config = HapticConfig {
@@ -264,6 +268,35 @@ fn build_rig(study: &Study, o: &BrowserOptions) -> Result<(Rig, LoadedScene, f64
         .into());
     }
     Ok((rig, loaded, rate))
+}
+
+/// Starts the per-trial MCAP logs (`study_mcap.rs`) in the session's directory.
+#[allow(clippy::too_many_arguments)]
+fn start_trial_log(
+    study: &Study,
+    text: &str,
+    rig: &Rig,
+    out: &Path,
+    participant: &str,
+    session: u32,
+    o: &BrowserOptions,
+    rate: f64,
+) -> Result<(TrialTap, TrialLogger), Failure> {
+    let scene = crate::run_log::scene_strings(
+        &study.scene_source,
+        &study.name,
+        o.device_file.as_deref(),
+        &[
+            ("rate_hz", rate.to_string()),
+            ("command", "study run --observer browser".into()),
+            ("device", o.device.clone()),
+            ("study_toml", text.to_string()),
+            ("participant", participant.to_string()),
+            ("session", session.to_string()),
+        ],
+    );
+    let dir = session_dir(out, participant, session);
+    Ok(study_mcap::start(&dir, rig.system.world(), scene, rate)?)
 }
 
 /// Reports how the session ended and returns the exit status.
@@ -320,6 +353,8 @@ struct BrowserObserver<'a> {
     planned: u32,
     /// The laws of a stimulus: (condition, comparison, delta bits) → (normal, friction).
     laws: HashMap<(usize, bool, u64), (NormalModel, FrictionModel)>,
+    /// The next trial starts with a rest break (`Observer::rest` was called).
+    rest_next: bool,
     early: Option<EarlyEnd>,
 }
 
@@ -370,6 +405,7 @@ impl Observer for BrowserObserver<'_> {
             planned: self.planned,
             intervals: n as u8,
             laws,
+            rest: std::mem::take(&mut self.rest_next),
         };
         self.plans
             .push(plan)
@@ -381,11 +417,12 @@ impl Observer for BrowserObserver<'_> {
                         trial,
                         choice,
                         rt_s,
+                        magnitude,
                     } if trial == spec.trial => {
                         return Ok(Answer {
                             response: choice,
                             rt: rt_s,
-                            magnitude: None,
+                            magnitude,
                         })
                     }
                     Event::Answered { .. } => {}
@@ -406,6 +443,18 @@ impl Observer for BrowserObserver<'_> {
     fn describe(&self) -> String {
         "browser (a participant answering on the page)".into()
     }
+
+    /// The break is shown by the loop when the next trial's plan arrives (`Plan::rest`).
+    fn rest(&mut self, _study: &Study, _next: &TrialSpec) -> Result<(), String> {
+        self.rest_next = true;
+        Ok(())
+    }
+}
+
+/// True when the tick holds the world with zero force: the page's pause, or a rest break (the
+/// torques then ramp in from zero, as after a pause).
+fn held(paused: bool, presenter: &Presenter) -> bool {
+    paused || presenter.on_break()
 }
 
 /// Everything one tick touches, owned by the loop thread while it runs.
@@ -416,6 +465,8 @@ struct StudyLoop<'r> {
     presenter: Presenter,
     plans: rtrb::Consumer<Plan>,
     events: rtrb::Producer<Event>,
+    /// The open trial's ticks and the trial marks, for the per-trial MCAP logs.
+    tap: TrialTap,
     end: Option<LoopEnd>,
 }
 
@@ -439,12 +490,24 @@ impl StudyLoop<'_> {
             paused,
             watched,
             now_ns(),
-            inbox.answer,
-            inbox.stop,
+            inbox,
         ) {
+            if let Event::Answered {
+                trial,
+                choice,
+                rt_s,
+                ..
+            } = ev
+            {
+                self.tap.end(trial, choice, rt_s);
+            }
             // The ring holds 16 events and the main thread drains it every 2 ms.
             let _ = self.events.push(ev);
         }
+        if let Some(trial) = self.presenter.take_started() {
+            self.tap.start(trial);
+        }
+        let paused = held(paused, &self.presenter);
         let (q, lost) = match self.rig.read() {
             Ok(q) => (q, None),
             Err(e) => ([f64::NAN; 4], Some(e)),
@@ -469,6 +532,9 @@ impl StudyLoop<'_> {
             self.end = Some(LoopEnd::DeviceLost(e.to_string()));
             return TickControl::Stop;
         }
+        let mut rec = out.record;
+        rec.tau = tau;
+        self.tap.tick(info, &q, &rec, system.world());
         if let Some(end) = LoopEnd::after_write(guard, out.tripped) {
             io.zero_torques();
             self.end = Some(end);
@@ -483,8 +549,8 @@ impl StudyLoop<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::run_rig::test_rig::{sim_rig, tick_info};
     use crate::study_present::{in_free_space, Phase};
-    use haptic2d::scene::builtin;
     use haptic2d_lab::study::file::Task;
 
     /// One tick of the simulated rig with the presenter in it (as `StudyLoop::tick`, without the
@@ -498,8 +564,7 @@ mod tests {
             false,
             true,
             0,
-            None,
-            false,
+            Default::default(),
         );
         let q = rig.io.read_encoders().unwrap();
         let out = rig.system.tick(&q, None, false);
@@ -514,15 +579,7 @@ mod tests {
     /// switch: no step in the force the participant feels.
     #[test]
     fn stimulus_switch_waits_for_free_space_so_the_felt_force_never_steps() {
-        let scene = builtin("box-in-walls", Some(1000.0)).unwrap().unwrap();
-        let mut rig = Rig::new(
-            scene.world,
-            "box-in-walls",
-            HapticConfig::default(),
-            DeviceChoice::Sim,
-            HandSpec::Follow,
-        )
-        .unwrap();
+        let mut rig = sim_rig();
         let home = rig.hand_target_world();
         let before = rig.system.world().normal;
         let minsky = NormalModel::from_name("minsky", true).unwrap();
@@ -547,6 +604,7 @@ mod tests {
             planned: 1,
             intervals: 2,
             laws: [(minsky, f); MAX_INTERVALS],
+            rest: false,
         }));
         for _ in 0..500 {
             step(&mut rig, &mut p);
@@ -570,5 +628,92 @@ mod tests {
             last_force = f_after;
         }
         panic!("the box never left the wall");
+    }
+
+    /// One tick as `StudyLoop::tick` does it (presenter, hold, the rig's system tick at tick `k`
+    /// of 1 ms, torques written); returns the torques sent.
+    fn loop_tick(
+        rig: &mut Rig,
+        p: &mut Presenter,
+        k: u64,
+        inbox: crate::run_view::StudyInbox,
+    ) -> [f64; 4] {
+        let slave = rig.system.slave();
+        p.tick(rig.system.world_mut(), slave, 1e-3, false, true, 0, inbox);
+        let info = tick_info(k);
+        let q = rig.read().unwrap();
+        let out = rig.tick_system(&q, &info, held(false, p));
+        rig.io.write_torques(&out.torques).unwrap();
+        out.torques
+    }
+
+    fn norm(t: [f64; 4]) -> f64 {
+        t.iter().map(|x| x * x).sum::<f64>().sqrt()
+    }
+
+    /// A rest break commands zero torque from its first tick while the hand presses the wall, for
+    /// as long as it lasts; after the page continues, the torque ramps in from zero (no jolt): its
+    /// mean over the first 50 ms stays under a fifth of where it settles.
+    #[test]
+    fn a_break_commands_zero_torque_and_the_torque_ramps_in_after_it() {
+        let mut rig = sim_rig();
+        let mut p = Presenter::new(Task::TwoAfc, 0.5);
+        let idle = crate::run_view::StudyInbox::default();
+        rig.set_hand_target([-0.01, 0.0, 0.0]);
+        let mut k = 0;
+        let mut pressing = 0.0;
+        for _ in 0..3000 {
+            pressing = norm(loop_tick(&mut rig, &mut p, k, idle));
+            k += 1;
+        }
+        assert!(
+            pressing > 1e-3,
+            "the hand presses the wall: |τ| = {pressing} N·m"
+        );
+        let f = rig.system.world().friction;
+        let n = rig.system.world().normal;
+        assert!(p.start(Plan {
+            trial: 3,
+            done: 2,
+            planned: 10,
+            intervals: 2,
+            laws: [(n, f); MAX_INTERVALS],
+            rest: true,
+        }));
+        for _ in 0..500 {
+            assert_eq!(
+                loop_tick(&mut rig, &mut p, k, idle),
+                [0.0; 4],
+                "no force on a break"
+            );
+            k += 1;
+        }
+        let cont = crate::run_view::StudyInbox {
+            cont: Some(3),
+            ..idle
+        };
+        let first = norm(loop_tick(&mut rig, &mut p, k, cont));
+        k += 1;
+        assert!(!p.on_break());
+        assert!(
+            first < 0.05 * pressing,
+            "the torque ramps in from zero: {first} after the break, {pressing} before"
+        );
+        // The ramp: over the first 50 ms the torque stays far below where it settles (0.5–0.6 s).
+        let (mut early, mut settled) = (first, 0.0);
+        for i in 1..600 {
+            let t = norm(loop_tick(&mut rig, &mut p, k, idle));
+            if i < 50 {
+                early += t;
+            } else if i >= 500 {
+                settled += t;
+            }
+            k += 1;
+        }
+        let (early, settled) = (early / 50.0, settled / 100.0);
+        assert!(
+            settled > 1e-3 && early < 0.2 * settled,
+            "the torque ramps in: mean {early} N·m over the first 50 ticks, {settled} at 0.5–0.6 s"
+        );
     }
 }

@@ -4,6 +4,10 @@
 //!
 //! Per trial (a [`Plan`], built on the main thread with each interval's laws already made):
 //!
+//! 0. **break** (only before a trial the study's `[breaks]` rest before): the page shows "Take a
+//!    break"; the loop holds the world frozen with zero force commanded (as a pause: no stimulus,
+//!    the handle free) until the page's `continue_study` for this trial, then the torques ramp in
+//!    from zero again as after a pause.
 //! 1. **free space**: the interval's stimulus (wall law and friction model, with the trial's
 //!    parameters) is installed in the world at the first tick in which the slave body has **no
 //!    contact record**. Its contact force is then zero before and after the switch, so the switch
@@ -11,7 +15,8 @@
 //!    the wall, the previous stimulus stays (the page asks the participant to lift the handle off).
 //! 2. **presenting**: the participant explores for `interval_s` of loop time (paused ticks do not
 //!    count), then the next interval starts at 1.
-//! 3. **answer**: after the last interval the page shows the answer buttons; the response time is
+//! 3. **answer**: after the last interval the page shows the answer buttons (magnitude estimation:
+//!    a number entry, the number finite and > 0); the response time is
 //!    the monotonic time from entering this phase (the prompt) to the tick that takes the answer.
 //!    Only an answer naming the current trial with a choice the task offers is taken; any other is
 //!    counted as refused and changes nothing.
@@ -19,6 +24,7 @@
 //! The device's own safety (torques ramped in from zero at the start, clamped, latched to zero on a
 //! stall or a lost device) is the loop's, unchanged.
 
+use crate::run_view::StudyInbox;
 use haptic2d::laws::friction::FrictionModel;
 use haptic2d::laws::normal::NormalModel;
 use haptic2d::world::World;
@@ -41,6 +47,8 @@ pub struct Plan {
     pub intervals: u8,
     /// Each interval's wall law and friction model (the first `intervals` are used).
     pub laws: [(NormalModel, FrictionModel); MAX_INTERVALS],
+    /// A rest break comes before this trial (the study's `[breaks]`).
+    pub rest: bool,
 }
 
 /// What the presenter reports to the main thread.
@@ -54,6 +62,8 @@ pub enum Event {
         choice: u8,
         /// Response time (s, monotonic clock, from the prompt to the tick that took the answer).
         rt_s: f64,
+        /// Magnitude estimation: the number given (`choice` is then 0).
+        magnitude: Option<f64>,
     },
     /// The page asked to stop the session.
     Stop,
@@ -64,6 +74,8 @@ pub enum Event {
 pub enum Phase {
     /// No trial: waiting for the next plan.
     Idle,
+    /// The rest break before the trial: the world is held (no force) until the page continues.
+    Break,
     /// Interval `k` (from 0) is installed once the slave leaves every contact.
     FreeSpace(u8),
     /// Interval `k` is presented; `left_s` seconds remain.
@@ -85,6 +97,8 @@ pub struct Presenter {
     last_saved: u32,
     done: u32,
     planned: u32,
+    started: Option<u32>,
+    modulus: f64,
 }
 
 /// The choices `task` offers.
@@ -93,9 +107,15 @@ pub fn valid_choice(task: Task, choice: u8) -> bool {
         Task::TwoAfc => (1..=2).contains(&choice),
         Task::ThreeAfc => (1..=3).contains(&choice),
         Task::SameDifferent => choice <= 1,
-        // A number, not a choice: refused before the session starts (`study_browser::build_rig`).
+        // A number, not a choice (`valid_magnitude`).
         Task::Magnitude => false,
     }
+}
+
+/// A magnitude estimate the loop takes: finite, > 0 and at most
+/// [`MAX_MAGNITUDE`](haptic2d_view::command::MAX_MAGNITUDE) (as the server checks it).
+pub fn valid_magnitude(v: f64) -> bool {
+    v.is_finite() && v > 0.0 && v <= haptic2d_view::command::MAX_MAGNITUDE
 }
 
 /// The task's name on the page.
@@ -127,7 +147,15 @@ impl Presenter {
             last_saved: 0,
             done: 0,
             planned: 0,
+            started: None,
+            modulus: 0.0,
         }
+    }
+
+    /// The number the reference stands for in a magnitude-estimation study (shown on the page).
+    pub fn with_modulus(mut self, modulus: f64) -> Self {
+        self.modulus = modulus;
+        self
     }
 
     /// The phase now.
@@ -150,15 +178,31 @@ impl Presenter {
         self.done = plan.done;
         self.planned = plan.planned;
         self.plan = Some(plan);
-        self.phase = Phase::FreeSpace(0);
+        if plan.rest {
+            self.phase = Phase::Break;
+        } else {
+            self.phase = Phase::FreeSpace(0);
+            self.started = Some(plan.trial);
+        }
         true
     }
 
+    /// The trial whose presentation started since the last call (its break over, if it had one):
+    /// the per-trial log opens here.
+    pub fn take_started(&mut self) -> Option<u32> {
+        self.started.take()
+    }
+
+    /// True during a rest break: the loop holds the world with zero force.
+    pub fn on_break(&self) -> bool {
+        self.phase == Phase::Break
+    }
+
     /// One tick: `dt` seconds of loop time (s) not `paused`, at monotonic time `now_ns`, with the
-    /// page's `answer` and `stop` request since the last tick; a trial's first interval starts
-    /// only while `watched` (a page is connected: nobody is presented a stimulus without the page
-    /// that names the interval). Installs an interval's laws in `world` (only with `slave` in free
-    /// space). Returns what the main thread must know. Allocation-free.
+    /// page's study commands since the last tick (`inbox`: answer, magnitude, continue, stop); a
+    /// trial's first interval starts only while `watched` (a page is connected: nobody is presented
+    /// a stimulus without the page that names the interval). Installs an interval's laws in `world`
+    /// (only with `slave` in free space). Returns what the main thread must know. Allocation-free.
     #[allow(clippy::too_many_arguments)]
     pub fn tick(
         &mut self,
@@ -168,16 +212,26 @@ impl Presenter {
         paused: bool,
         watched: bool,
         now_ns: u64,
-        answer: Option<(u32, u8)>,
-        stop: bool,
+        inbox: StudyInbox,
     ) -> Option<Event> {
         if self.phase == Phase::Stopping {
             return None;
         }
-        if stop {
+        if inbox.stop {
             self.phase = Phase::Stopping;
             return Some(Event::Stop);
         }
+        if let Some(trial) = inbox.cont {
+            match (self.phase, self.plan) {
+                (Phase::Break, Some(plan)) if trial == plan.trial && watched => {
+                    self.phase = Phase::FreeSpace(0);
+                    self.started = Some(trial);
+                }
+                // Not this break (another trial, no break, a double press): refused.
+                _ => self.refused += 1,
+            }
+        }
+        let answer = inbox.answer;
         let mut event = None;
         match (self.phase, self.plan) {
             (Phase::FreeSpace(k), Some(plan))
@@ -199,26 +253,36 @@ impl Presenter {
                 };
             }
             (Phase::Answer(prompt), Some(plan)) => {
-                if let Some((trial, choice)) = answer {
-                    if trial == plan.trial && valid_choice(self.task, choice) {
-                        event = Some(Event::Answered {
-                            trial,
-                            choice,
-                            rt_s: now_ns.saturating_sub(prompt) as f64 * 1e-9,
-                        });
-                        self.last_saved = trial;
-                        self.done = plan.done + 1;
-                        self.plan = None;
-                        self.phase = Phase::Idle;
-                        return event;
+                let taken = match (self.task, answer, inbox.magnitude) {
+                    (Task::Magnitude, _, Some((t, v))) if t == plan.trial && valid_magnitude(v) => {
+                        Some((0, Some(v)))
                     }
+                    (_, Some((t, c)), _) if t == plan.trial && valid_choice(self.task, c) => {
+                        Some((c, None))
+                    }
+                    _ => None,
+                };
+                if let Some((choice, magnitude)) = taken {
+                    event = Some(Event::Answered {
+                        trial: plan.trial,
+                        choice,
+                        rt_s: now_ns.saturating_sub(prompt) as f64 * 1e-9,
+                        magnitude,
+                    });
+                    self.last_saved = plan.trial;
+                    self.done = plan.done + 1;
+                    self.plan = None;
+                    self.phase = Phase::Idle;
+                    return event;
+                }
+                if answer.is_some() || inbox.magnitude.is_some() {
                     self.refused += 1;
                 }
                 return None;
             }
             _ => {}
         }
-        if answer.is_some() {
+        if answer.is_some() || inbox.magnitude.is_some() {
             // Not the answer phase: an early or late answer (a double click) is refused.
             self.refused += 1;
         }
@@ -229,6 +293,7 @@ impl Presenter {
     pub fn view(&self) -> StudyView {
         let (interval, phase, remaining_s) = match self.phase {
             Phase::Idle => (0, "starting", 0.0),
+            Phase::Break => (0, "break", 0.0),
             Phase::FreeSpace(k) => (k + 1, "free_space", self.interval_s),
             Phase::Presenting(k, left) => (k + 1, "presenting", left.max(0.0)),
             Phase::Answer(_) => (0, "answer", 0.0),
@@ -245,6 +310,11 @@ impl Presenter {
             task: task_name(self.task),
             refused: self.refused,
             last_saved: self.last_saved,
+            modulus: if self.task == Task::Magnitude {
+                self.modulus
+            } else {
+                0.0
+            },
         }
     }
 
@@ -273,6 +343,15 @@ mod tests {
             planned: 10,
             intervals: 2,
             laws: two_laws(),
+            rest: false,
+        }
+    }
+
+    /// The page's answer `choice` to `trial`.
+    fn ans(trial: u32, choice: u8) -> StudyInbox {
+        StudyInbox {
+            answer: Some((trial, choice)),
+            ..StudyInbox::default()
         }
     }
 
@@ -285,34 +364,22 @@ mod tests {
         assert!(p.start(plan(&w, 3)));
         assert!(!p.start(plan(&w, 4)), "one trial at a time");
         // An answer while presenting is refused.
-        assert_eq!(
-            p.tick(&mut w, slave, 1e-3, false, true, 0, Some((3, 1)), false),
-            None
-        );
+        assert_eq!(p.tick(&mut w, slave, 1e-3, false, true, 0, ans(3, 1)), None);
         assert_eq!(p.refused(), 1);
         let mut t = 0;
         while !matches!(p.phase(), Phase::Answer(_)) {
             t += 1_000_000;
             assert_eq!(
-                p.tick(&mut w, slave, 1e-3, false, true, t, None, false),
+                p.tick(&mut w, slave, 1e-3, false, true, t, StudyInbox::default()),
                 None
             );
             assert!(t < 100_000_000, "the intervals end");
         }
         let prompt = t;
         // Another trial, an impossible choice: refused, still waiting.
-        assert_eq!(
-            p.tick(&mut w, slave, 1e-3, false, true, t, Some((2, 1)), false),
-            None
-        );
-        assert_eq!(
-            p.tick(&mut w, slave, 1e-3, false, true, t, Some((3, 3)), false),
-            None
-        );
-        assert_eq!(
-            p.tick(&mut w, slave, 1e-3, false, true, t, Some((3, 0)), false),
-            None
-        );
+        assert_eq!(p.tick(&mut w, slave, 1e-3, false, true, t, ans(2, 1)), None);
+        assert_eq!(p.tick(&mut w, slave, 1e-3, false, true, t, ans(3, 3)), None);
+        assert_eq!(p.tick(&mut w, slave, 1e-3, false, true, t, ans(3, 0)), None);
         assert_eq!(p.refused(), 4);
         assert!(matches!(p.phase(), Phase::Answer(_)));
         let ev = p.tick(
@@ -322,23 +389,20 @@ mod tests {
             false,
             true,
             prompt + 640_000_000,
-            Some((3, 2)),
-            false,
+            ans(3, 2),
         );
         assert_eq!(
             ev,
             Some(Event::Answered {
                 trial: 3,
                 choice: 2,
-                rt_s: 0.64
+                rt_s: 0.64,
+                magnitude: None
             })
         );
         assert_eq!(p.phase(), Phase::Idle);
         // A second click on the same answer: refused.
-        assert_eq!(
-            p.tick(&mut w, slave, 1e-3, false, true, t, Some((3, 2)), false),
-            None
-        );
+        assert_eq!(p.tick(&mut w, slave, 1e-3, false, true, t, ans(3, 2)), None);
         assert_eq!(p.refused(), 5);
         assert_eq!(p.view().last_saved, 3);
         assert_eq!(p.view().done, 3);
@@ -351,14 +415,14 @@ mod tests {
         let slave = w.body_index("box").unwrap();
         let mut p = Presenter::new(Task::TwoAfc, 0.005);
         p.start(plan(&w, 1));
-        p.tick(&mut w, slave, 1e-3, false, true, 0, None, false);
+        p.tick(&mut w, slave, 1e-3, false, true, 0, StudyInbox::default());
         assert_eq!(p.phase(), Phase::Presenting(0, 0.005));
         for _ in 0..100 {
-            p.tick(&mut w, slave, 1e-3, true, true, 0, None, false);
+            p.tick(&mut w, slave, 1e-3, true, true, 0, StudyInbox::default());
         }
         assert_eq!(p.phase(), Phase::Presenting(0, 0.005));
         for _ in 0..5 {
-            p.tick(&mut w, slave, 1e-3, false, true, 0, None, false);
+            p.tick(&mut w, slave, 1e-3, false, true, 0, StudyInbox::default());
         }
         assert_eq!(p.phase(), Phase::FreeSpace(1));
     }
@@ -369,5 +433,123 @@ mod tests {
         assert!(!valid_choice(Task::SameDifferent, 2));
         assert!(!valid_choice(Task::TwoAfc, 0) && !valid_choice(Task::TwoAfc, 3));
         assert!(valid_choice(Task::ThreeAfc, 3) && !valid_choice(Task::ThreeAfc, 0));
+    }
+
+    fn inbox_cont(trial: u32) -> StudyInbox {
+        StudyInbox {
+            cont: Some(trial),
+            ..StudyInbox::default()
+        }
+    }
+
+    fn inbox_magnitude(trial: u32, value: f64) -> StudyInbox {
+        StudyInbox {
+            magnitude: Some((trial, value)),
+            ..StudyInbox::default()
+        }
+    }
+
+    /// A trial with a rest break before it: the loop holds (`on_break`, no law installed, no
+    /// trial log opened) until the page continues this trial, with a page connected; a continue for
+    /// another trial, or a second one, is refused and changes nothing.
+    #[test]
+    fn a_break_holds_the_trial_until_the_page_continues_it() {
+        let scene = builtin("box-in-walls", Some(1000.0)).unwrap().unwrap();
+        let mut w = scene.world;
+        let slave = w.body_index("box").unwrap();
+        let before = w.normal;
+        let mut p = Presenter::new(Task::TwoAfc, 0.005);
+        assert!(p.start(Plan {
+            rest: true,
+            ..plan(&w, 5)
+        }));
+        assert_eq!((p.phase(), p.view().phase), (Phase::Break, "break"));
+        let idle = StudyInbox::default();
+        for _ in 0..1000 {
+            assert_eq!(p.tick(&mut w, slave, 1e-3, false, true, 0, idle), None);
+        }
+        assert!(p.on_break() && p.take_started().is_none());
+        assert_eq!(w.normal, before, "no stimulus during the break");
+        // An answer, a continue for another trial, a continue with no page: refused or held.
+        p.tick(&mut w, slave, 1e-3, false, true, 0, ans(5, 1));
+        p.tick(&mut w, slave, 1e-3, false, true, 0, inbox_cont(4));
+        assert_eq!(p.refused(), 2);
+        p.tick(&mut w, slave, 1e-3, false, false, 0, inbox_cont(5));
+        assert!(p.on_break(), "nobody continues without the page");
+        assert_eq!(p.refused(), 3);
+        p.tick(&mut w, slave, 1e-3, false, true, 0, inbox_cont(5));
+        // The box is in free space: the first interval is installed in the same tick.
+        assert_eq!(p.phase(), Phase::Presenting(0, 0.005));
+        assert_eq!(
+            p.take_started(),
+            Some(5),
+            "the trial (and its log) starts now"
+        );
+        assert_eq!(p.take_started(), None);
+        p.tick(&mut w, slave, 1e-3, false, true, 0, inbox_cont(5));
+        assert_eq!(p.refused(), 4, "a second continue is refused");
+        assert_eq!(w.normal, two_laws()[0].0, "the first interval is presented");
+        // Without a break the trial starts at once.
+        let mut q = Presenter::new(Task::TwoAfc, 0.005);
+        q.start(plan(&w, 1));
+        assert_eq!(q.take_started(), Some(1));
+    }
+
+    /// Magnitude estimation takes a finite number above 0 for the trial presented (its `choice`
+    /// is 0, as the simulated path's) and refuses interval choices and bad numbers.
+    #[test]
+    fn magnitude_takes_a_positive_number_for_its_trial_and_refuses_choices() {
+        let scene = builtin("box-in-walls", Some(1000.0)).unwrap().unwrap();
+        let mut w = scene.world;
+        let slave = w.body_index("box").unwrap();
+        let mut p = Presenter::new(Task::Magnitude, 0.005);
+        assert_eq!(p.view().task, "magnitude");
+        p.start(plan(&w, 2));
+        let mut t = 0;
+        while !matches!(p.phase(), Phase::Answer(_)) {
+            t += 1_000_000;
+            p.tick(&mut w, slave, 1e-3, false, true, t, StudyInbox::default());
+            assert!(t < 100_000_000, "the intervals end");
+        }
+        for bad in [
+            ans(2, 1),
+            inbox_magnitude(1, 50.0),
+            inbox_magnitude(2, 0.0),
+            inbox_magnitude(2, -3.0),
+            inbox_magnitude(2, f64::NAN),
+            inbox_magnitude(2, f64::INFINITY),
+        ] {
+            assert_eq!(p.tick(&mut w, slave, 1e-3, false, true, t, bad), None);
+        }
+        assert_eq!(p.refused(), 6);
+        let ev = p.tick(
+            &mut w,
+            slave,
+            1e-3,
+            false,
+            true,
+            t + 2_000_000_000,
+            inbox_magnitude(2, 137.5),
+        );
+        assert_eq!(
+            ev,
+            Some(Event::Answered {
+                trial: 2,
+                choice: 0,
+                rt_s: 2.0,
+                magnitude: Some(137.5)
+            })
+        );
+        // A magnitude in a 2AFC study is refused.
+        let mut q = Presenter::new(Task::TwoAfc, 0.005);
+        q.start(plan(&w, 1));
+        while !matches!(q.phase(), Phase::Answer(_)) {
+            q.tick(&mut w, slave, 1e-3, false, true, 0, StudyInbox::default());
+        }
+        assert_eq!(
+            q.tick(&mut w, slave, 1e-3, false, true, 0, inbox_magnitude(1, 5.0)),
+            None
+        );
+        assert_eq!(q.refused(), 1);
     }
 }

@@ -1,11 +1,18 @@
 //! What `serve-world` and the device side (`run --world`, alias `remote-device`) share (issue 41,
-//! docs/TELEOP.md): the key, the TDPA switch, the link timeout, the impairment in front of the socket, and the link's statistics.
+//! docs/TELEOP.md): the key, what keeps the link passive (TDPA, wave variables, or nothing), the
+//! link timeout, the impairment in front of the socket, and the link's statistics.
 
 use std::path::PathBuf;
 
 use haptic2d_devices::udp::UdpKey;
 use haptic2d_devices::world_link::{LinkEndpoint, PORT_LEN};
+use haptic2d_lab::network::wave::WaveParams;
 use haptic2d_lab::network::{Impairment, Link};
+
+/// The default wave impedances (N·s/m, N·s/m, N·m·s/rad): the lab's 20 N·s/m
+/// ([`WaveParams::default`]) on the two translations; on the rotation, the same ratio to the
+/// coupling's default damping (5 N·s/m, 0.01 N·m·s/rad) as on the translations.
+pub const WAVE_B: [f64; 3] = [20.0, 20.0, 0.04];
 
 /// Options of both ends of the world link.
 #[derive(clap::Args, Debug, Clone)]
@@ -18,11 +25,18 @@ pub struct LinkArgs {
     /// what the link does without it. Never on a real device.
     #[arg(long)]
     pub no_tdpa: bool,
-    /// What keeps the link passive: `tdpa` (time-domain passivity on both ports), or `none` (the
-    /// ports only observe; the same as --no-tdpa). `wave` (wave variables) runs in the lab
-    /// (`haptic2d teleop --figures`) and is refused here: not built across the two processes yet.
+    /// What keeps the link passive: `tdpa` (time-domain passivity on both ports), `wave` (wave
+    /// variables with an energy budget per wave and the budgeted drift compensation), or `none`
+    /// (the ports only observe; the same as --no-tdpa). Both ends need the same.
     #[arg(long, value_name = "tdpa|wave|none", default_value = "tdpa")]
     pub link: String,
+    /// With --link wave: the wave impedance per axis (N·s/m, N·s/m, N·m·s/rad); both ends need
+    /// the same.
+    #[arg(long, value_delimiter = ',', num_args = 3, default_values_t = WAVE_B, value_name = "BX,BY,BTHETA")]
+    pub wave_b: Vec<f64>,
+    /// With --link wave: the drift compensation's gain (1/s) on the world side; 0 turns it off.
+    #[arg(long, default_value_t = 5.0, value_name = "PER_S")]
+    pub drift_gain: f64,
     /// No authentic datagram from the other end for this long (ms) counts as a lost link: the
     /// device side latches zero torques and says why; the world side stops driving the slave.
     #[arg(long, default_value_t = 100.0, value_name = "MS")]
@@ -61,8 +75,21 @@ impl LinkArgs {
         }
         match self.link.as_str() {
             "tdpa" | "none" => {}
-            "wave" => return Err("--link wave: wave variables run in the lab's simulated link (haptic2d teleop --figures DIR, docs/TELEOP.md) but not yet across the two processes\n    fix: --link tdpa".into()),
+            "wave" if self.no_tdpa => return Err("--link wave --no-tdpa: --no-tdpa means --link none\n    fix: one of --link wave, --link none".into()),
+            "wave" => {}
             other => return Err(format!("--link {other}: expected tdpa, wave or none\n    fix: --link tdpa")),
+        }
+        if self.wave_b.len() != 3 || !self.wave_b.iter().all(|b| b.is_finite() && *b > 0.0) {
+            return Err(format!(
+                "--wave-b needs three finite impedances > 0 (x, y, θ), got {:?}\n    fix: e.g. --wave-b 20,20,0.04",
+                self.wave_b
+            ));
+        }
+        if !(self.drift_gain.is_finite() && self.drift_gain >= 0.0) {
+            return Err(format!(
+                "--drift-gain must be finite and ≥ 0 (1/s), got {}",
+                self.drift_gain
+            ));
         }
         match &self.key {
             Some(k) => UdpKey::from_file(k),
@@ -75,6 +102,8 @@ impl LinkArgs {
         self.key.is_some()
             || self.no_tdpa
             || self.link != "tdpa"
+            || self.wave_b != WAVE_B
+            || self.drift_gain != 5.0
             || self.link_timeout_ms != 100.0
             || self.delay_ms != 0.0
             || self.loss != 0.0
@@ -84,6 +113,28 @@ impl LinkArgs {
     /// True when this end runs its TDPA passivity controller (`--link tdpa` without --no-tdpa).
     pub fn tdpa(&self) -> bool {
         !self.no_tdpa && self.link == "tdpa"
+    }
+
+    /// The wave settings per axis when this end runs wave variables (`--link wave`).
+    pub fn wave(&self) -> Option<[WaveParams; 3]> {
+        (self.link == "wave").then(|| {
+            std::array::from_fn(|i| WaveParams {
+                b: self.wave_b.get(i).copied().unwrap_or(WAVE_B[i]),
+                drift_gain: self.drift_gain,
+            })
+        })
+    }
+
+    /// The link's passivity method, in words: `tdpa`, `wave (b …)` or `none`.
+    pub fn method(&self) -> String {
+        match (self.tdpa(), self.wave()) {
+            (true, _) => "tdpa".into(),
+            (false, Some(w)) => format!(
+                "wave (b {}, {}, {}; drift gain {} /s)",
+                w[0].b, w[1].b, w[2].b, w[0].drift_gain
+            ),
+            _ => "none".into(),
+        }
     }
 
     /// The impairment in periods of `rate_hz`, `None` when there is none.

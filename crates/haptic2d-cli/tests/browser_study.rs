@@ -13,6 +13,7 @@
 //! `bash crates/haptic2d-view/e2e/install.sh`). When they are missing the test FAILS with that
 //! hint: it is never reported as passed without running.
 
+use haptic2d_rt::mcap::reader::{read_file, read_info};
 use haptic2d_test_support::browser::{e2e_dir, require_prerequisites};
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
@@ -33,9 +34,13 @@ struct Session {
 
 impl Session {
     fn start(out_dir: &Path) -> Session {
+        Self::start_with(&study_file(), out_dir)
+    }
+
+    fn start_with(study: &Path, out_dir: &Path) -> Session {
         let mut child = Command::new(env!("CARGO_BIN_EXE_haptic2d"))
             .args(["study", "run"])
-            .arg(study_file())
+            .arg(study)
             .args([
                 "--observer",
                 "browser",
@@ -105,11 +110,11 @@ impl Drop for Session {
     }
 }
 
-/// Runs the page script; returns the answers it gave as (trial, choice).
-fn answer_on_the_page(url: &str, answers: u32, first: u32, end: &str) -> Vec<(u32, u8)> {
+/// Runs the page script `script` with `args`; returns its JSON result line.
+fn run_page_script(script: &str, args: &[&str]) -> serde_json::Value {
     let out = Command::new("node")
-        .arg(e2e_dir().join("study_e2e.mjs"))
-        .args([url, &answers.to_string(), &first.to_string(), end])
+        .arg(e2e_dir().join(script))
+        .args(args)
         .current_dir(e2e_dir())
         .output()
         .expect("node runs");
@@ -128,6 +133,15 @@ fn answer_on_the_page(url: &str, answers: u32, first: u32, end: &str) -> Vec<(u3
         .expect("a JSON line");
     let v: serde_json::Value = serde_json::from_str(line).expect("JSON");
     assert_eq!(v["ok"], true, "{line}");
+    v
+}
+
+/// Runs the page script; returns the answers it gave as (trial, choice).
+fn answer_on_the_page(url: &str, answers: u32, first: u32, end: &str) -> Vec<(u32, u8)> {
+    let v = run_page_script(
+        "study_e2e.mjs",
+        &[url, &answers.to_string(), &first.to_string(), end],
+    );
     v["answers"]
         .as_array()
         .expect("answers")
@@ -139,6 +153,50 @@ fn answer_on_the_page(url: &str, answers: u32, first: u32, end: &str) -> Vec<(u3
             )
         })
         .collect()
+}
+
+/// The per-trial MCAP log of `trial` in `trials/`: complete, answered with `response`, holding
+/// ticks whose log times span the trial: at least the two presented intervals (2 × 0.4 s of loop
+/// time) plus the response time from trials.tsv. `haptic2d log info` reads it.
+fn check_trial_log(trials: &Path, trial: u32, response: u8, rt_s: f64) {
+    let path = trials.join(format!("trial-{trial:04}.mcap"));
+    let info = read_info(&read_file(&path).expect("the trial's MCAP"), "trial").unwrap();
+    assert!(info.complete, "{} is finished", path.display());
+    let m = info.metadata("haptic2d.trial").expect("haptic2d.trial");
+    assert_eq!(m["trial"], trial.to_string());
+    assert_eq!(m["outcome"], "answered");
+    assert_eq!(m["response"], response.to_string());
+    let ticks = info.count("/haptic2d/tick");
+    assert_eq!(m["ticks"], ticks.to_string());
+    assert_eq!(
+        info.count("/haptic2d/contacts"),
+        ticks,
+        "the world rides along"
+    );
+    let (t0, t1) = info.time_range_ns.expect("messages");
+    let span = (t1 - t0) as f64 * 1e-9;
+    assert!(
+        span >= 0.8 + rt_s - 0.01 && span < 60.0,
+        "trial {trial}: ticks span {span} s, the intervals and the answer took at least {} s",
+        0.8 + rt_s
+    );
+    let rate: f64 = info.metadata("haptic2d.scene").unwrap()["rate_hz"]
+        .parse()
+        .unwrap();
+    assert!(
+        ticks as f64 >= 0.8 * rate - 1.0,
+        "{ticks} ticks at {rate} Hz cover the two intervals"
+    );
+    let out = Command::new(env!("CARGO_BIN_EXE_haptic2d"))
+        .args(["log", "info"])
+        .arg(&path)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success() && text.contains("/haptic2d/tick"),
+        "{text}"
+    );
 }
 
 /// The rows of trials.tsv as (trial, response, rt_s), and the file's text.
@@ -184,9 +242,13 @@ fn browser_study_answers_trials_and_resumes_after_sigint_with_no_trial_lost_or_r
         first,
         "trials.tsv holds exactly the page's answers, in order"
     );
+    let trials = dir.path().join("sub-e2e01/ses-1/trials");
     for r in &r1 {
         assert!(r.2 > 0.0 && r.2 < 30.0, "response time {} s", r.2);
+        check_trial_log(&trials, r.0, r.1, r.2);
     }
+    // Trial 4 had started when SIGINT came: its log is finished, marked interrupted.
+    let interrupted = trials.join("trial-0004.mcap").exists();
 
     // The same command resumes at trial 4; the page answers it and stops with Esc.
     let mut s = Session::start(dir.path());
@@ -211,4 +273,100 @@ fn browser_study_answers_trials_and_resumes_after_sigint_with_no_trial_lost_or_r
         all,
         "every answered trial once, in order"
     );
+    // One MCAP per answered trial; the interrupted presentation of trial 4 kept aside.
+    for r in &r2 {
+        check_trial_log(&trials, r.0, r.1, r.2);
+    }
+    let mut names: Vec<String> = std::fs::read_dir(&trials)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    let mut want: Vec<String> = (1..=4).map(|t| format!("trial-{t:04}.mcap")).collect();
+    if interrupted {
+        want.push("trial-0004-interrupted-1.mcap".into());
+    }
+    // Trial 5 may have started before the page's stop: its log is then marked interrupted.
+    if names.iter().any(|n| n == "trial-0005.mcap") {
+        want.push("trial-0005.mcap".into());
+    }
+    want.sort();
+    for n in names
+        .iter()
+        .filter(|n| n.contains("interrupted") || n.contains("0005"))
+    {
+        let info = read_info(&read_file(&trials.join(n)).unwrap(), n).unwrap();
+        assert!(info.complete, "{n} is finished");
+        assert_eq!(
+            info.metadata("haptic2d.trial").unwrap()["outcome"],
+            "interrupted"
+        );
+    }
+    assert_eq!(names, want);
+}
+
+/// The rows of a magnitude session's trials.tsv as (trial, response, magnitude, rt_s).
+fn magnitude_rows(tsv: &Path) -> Vec<(u32, u8, f64, f64)> {
+    let text = std::fs::read_to_string(tsv).expect("trials.tsv");
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().expect("header").split('\t').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let (t, r, m, rt) = (col("trial"), col("response"), col("magnitude"), col("rt_s"));
+    lines
+        .map(|l| {
+            let f: Vec<&str> = l.split('\t').collect();
+            (
+                f[t].parse().unwrap(),
+                f[r].parse().unwrap(),
+                f[m].parse().unwrap(),
+                f[rt].parse().unwrap(),
+            )
+        })
+        .collect()
+}
+
+/// A magnitude-estimation study with a rest break every 2 trials, on the page: the page shows a
+/// number entry (words, negative numbers and 0 refused on the page; the loop refuses a second
+/// number), the numbers typed land in trials.tsv's `magnitude` column (`response` 0, as the
+/// simulated path writes them), the full-page break screen holds the session before trial 3 until
+/// Space (a continue naming another trial refused), and each answered trial has its MCAP.
+#[test]
+fn browser_magnitude_study_takes_typed_numbers_and_holds_at_the_break_screen() {
+    require_prerequisites(&e2e_dir());
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../studies/stiffness-magnitude.toml"),
+    )
+    .unwrap();
+    let study = dir.path().join("magnitude-breaks.toml");
+    std::fs::write(&study, format!("{text}\n[breaks]\nevery = 2\n")).unwrap();
+    let out = dir.path().join("data");
+    let mut s = Session::start_with(&study, &out);
+    let v = run_page_script("study_break_magnitude_e2e.mjs", &[&s.url, "3", "3"]);
+    let (code, stdout) = s.wait();
+    assert_eq!(code, Some(0), "the page's stop ends the session:\n{stdout}");
+    assert_eq!(v["breakSeen"], true);
+    let sent: Vec<(u32, f64)> = v["answers"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|a| {
+            (
+                a["trial"].as_u64().unwrap() as u32,
+                a["magnitude"].as_f64().unwrap(),
+            )
+        })
+        .collect();
+    assert_eq!(sent.len(), 3);
+    let session = out.join("sub-e2e01/ses-1");
+    let rows = magnitude_rows(&session.join("trials.tsv"));
+    assert_eq!(
+        rows.iter().map(|r| (r.0, r.2)).collect::<Vec<_>>(),
+        sent,
+        "trials.tsv holds the numbers typed, in order"
+    );
+    for r in &rows {
+        assert_eq!(r.1, 0, "response 0 in magnitude estimation");
+        check_trial_log(&session.join("trials"), r.0, 0, r.3);
+    }
 }

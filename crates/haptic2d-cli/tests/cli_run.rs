@@ -23,6 +23,8 @@ fn run_headless_one_second_prints_the_summary_and_logs_every_tick() {
         "compute  µs: p50",
         "overruns",
         "on time:",
+        // Issue 42: the stages of the slowest world step (the default build times them).
+        "slowest tick: tick",
     ] {
         assert!(out.contains(needle), "missing `{needle}` in:\n{out}");
     }

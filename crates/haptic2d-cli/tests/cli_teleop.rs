@@ -206,9 +206,15 @@ struct Pushed {
 /// holds still for 0.6 s (the ramp), then its target moves 15 mm to the left at 50 mm/s: the box,
 /// 3 mm from the wall, is pushed into it, with about 2.3 N at rest (hand and coupling springs in
 /// series against the wall); 3 s in all.
-fn pushed_into_the_wall(tdpa: bool, tag: &str) -> Pushed {
+fn pushed_into_the_wall(link: &str, tag: &str) -> Pushed {
+    pushed_into_the_wall_as(link, link, tag)
+}
+
+/// As [`pushed_into_the_wall`], the world side with `--link world_link`, the device side with
+/// `--link device_link` (`tdpa`, `wave`, or `none`: the same as --no-tdpa).
+fn pushed_into_the_wall_as(world_link: &str, device_link: &str, tag: &str) -> Pushed {
     let key = key_file(tag, 0x5a);
-    let mut common = vec![
+    let common = vec![
         "--delay-ms",
         "25",
         "--loss",
@@ -216,14 +222,12 @@ fn pushed_into_the_wall(tdpa: bool, tag: &str) -> Pushed {
         "--link-timeout-ms",
         "300",
     ];
-    if !tdpa {
-        // `--link none` (the same as --no-tdpa) on both ends.
-        common.extend(["--link", "none"]);
-    }
     let mut w_args = common.clone();
+    w_args.extend(["--link", world_link]);
     w_args.extend(["--seed", "2"]);
     let world = World::start(&key, &w_args);
     let mut d_args = common;
+    d_args.extend(["--link", device_link]);
     d_args.extend([
         "--seed",
         "3",
@@ -236,6 +240,15 @@ fn pushed_into_the_wall(tdpa: bool, tag: &str) -> Pushed {
     ]);
     let (status, device) = device(&world, &key, &d_args);
     let world = world.finish(Duration::from_secs(10));
+    if world_link != device_link {
+        return Pushed {
+            status,
+            created: f64::NAN,
+            plants_created: f64::NAN,
+            device,
+            world,
+        };
+    }
     let (mi, mo) = port(&device, "master port (device):");
     let (si, so) = port(&world, "world port (slave):");
     let (pi, po) = port(&device, "master port (plant, true displacement):");
@@ -250,9 +263,10 @@ fn pushed_into_the_wall(tdpa: bool, tag: &str) -> Pushed {
 }
 
 #[test]
-fn with_tdpa_a_50_ms_round_trip_with_5_percent_loss_creates_no_energy_pushing_into_a_wall() {
+fn with_tdpa_a_50_ms_round_trip_with_5_percent_loss_creates_no_energy_pushing_into_a_wall_and_the_world_books_the_body(
+) {
     let _t = turn();
-    let r = pushed_into_the_wall(true, "tdpa");
+    let r = pushed_into_the_wall("tdpa", "tdpa");
     let all = format!("{}\n{}", r.device, r.world);
     assert_eq!(r.status, 0, "{all}");
     assert!(r.device.contains("no safety stop"), "{all}");
@@ -263,6 +277,13 @@ fn with_tdpa_a_50_ms_round_trip_with_5_percent_loss_creates_no_energy_pushing_in
         r.plants_created <= 1e-3,
         "plants: created {} J\n{all}",
         r.plants_created
+    );
+    // The world port books what the body really received (the force held over the world step ×
+    // the body's displacement over it): its books are the body's ledger.
+    assert_eq!(
+        port(&r.world, "world port (slave):"),
+        port(&r.world, "world port (body, true displacement):"),
+        "{all}"
     );
     // The run did what it claims: the delay and the loss were there, the wall was felt.
     let rtt = number(&r.device, "link: round trip", "p50 ");
@@ -291,13 +312,68 @@ fn with_tdpa_a_50_ms_round_trip_with_5_percent_loss_creates_no_energy_pushing_in
 #[test]
 fn without_tdpa_the_same_run_creates_energy() {
     let _t = turn();
-    let r = pushed_into_the_wall(false, "none");
+    let r = pushed_into_the_wall("none", "none");
     let all = format!("{}\n{}", r.device, r.world);
     assert!(
         r.created > 0.02 && r.plants_created > 0.02,
         "created {} J (books), {} J (plants): the delayed link should create energy without TDPA\n{all}",
         r.created,
         r.plants_created
+    );
+}
+
+/// Issue 41, wave variables across the two processes: the same acceptance run with `--link wave`
+/// on both ends (the waves, the wave energy each sender has put on the link, and the handle's
+/// position for the drift compensation cross in the authenticated message). No energy created —
+/// by the plants' ledger (applied forces × true displacements) and by the ports' books — and no
+/// safety stop. Measured (docs/TELEOP.md): plants −7.5 mJ, books −6.3 mJ, wall 1.6 N.
+#[test]
+fn with_waves_a_50_ms_round_trip_with_5_percent_loss_creates_no_energy_pushing_into_a_wall() {
+    let _t = turn();
+    let r = pushed_into_the_wall("wave", "wave");
+    let all = format!("{}\n{}", r.device, r.world);
+    assert_eq!(r.status, 0, "{all}");
+    assert!(r.device.contains("no safety stop"), "{all}");
+    assert!(r.device.contains("link wave (b 20, 20, 0.04"), "{all}");
+    assert!(
+        r.plants_created <= 1e-3,
+        "plants: created {} J\n{all}",
+        r.plants_created
+    );
+    assert!(r.created <= 1e-3, "books: created {} J\n{all}", r.created);
+    let rtt = number(&r.device, "link: round trip", "p50 ");
+    assert!(
+        (49.0..80.0).contains(&rtt),
+        "round trip p50 {rtt} ms\n{all}"
+    );
+    assert!(number(&r.device, "link: ", "send errors, ") > 20.0, "{all}");
+    // The waves did the work: each end used wave energy the other sent, and the wall is felt.
+    let used = number(&r.world, "waves: ", "used ");
+    assert!(used > 0.01, "{all}");
+    let wall = number(&r.world, "contact: ", "mean wall force ");
+    assert!(wall > 1.0, "the wall was not felt: {wall} N\n{all}");
+    assert!(
+        r.world.contains("the device side closed the session"),
+        "{all}"
+    );
+}
+
+/// A device side running waves against a world side running TDPA latches zero torques at the
+/// first message and says why (the two ends would read each other's fields wrongly).
+#[test]
+fn a_wave_device_side_against_a_tdpa_world_latches_and_says_link_mismatch() {
+    let _t = turn();
+    let r = pushed_into_the_wall_as("tdpa", "wave", "mismatch");
+    let all = format!("{}\n{}", r.device, r.world);
+    assert_eq!(r.status, 3, "{all}");
+    assert!(
+        r.device
+            .contains("link mismatch: the world side runs force/velocity"),
+        "{all}"
+    );
+    assert!(
+        r.device.contains("torques set to zero and latched"),
+        "{all}"
     );
 }
 
@@ -391,8 +467,9 @@ fn run_refuses_split_loop_options_without_world_and_local_world_options_with_it(
                 k,
                 "--link",
                 "wave",
+                "--no-tdpa",
             ],
-            "not yet across the two processes",
+            "--no-tdpa means --link none",
         ),
         (
             &["serve-world", "box-in-walls", "--key", k, "--link", "waves"],

@@ -217,7 +217,8 @@ fn shipped_text(name: &str) -> String {
 }
 
 /// Issue 38 item 6: every shipped device file carries the `[safety]` table with the shared
-/// defaults (4π rad, 1000 rad/s, 20 ms), so the shipped behaviour is unchanged.
+/// defaults (4π rad, 1000 rad/s, 20 ms), so the shipped behaviour is unchanged; the Inverse3's,
+/// whose readings are a point, bounds it at 1 m and 50 m/s.
 #[test]
 fn shipped_safety_tables_are_the_shared_defaults() {
     use haptic2d_devices::device_safety::DeviceSafety;
@@ -244,7 +245,13 @@ fn shipped_safety_tables_are_the_shared_defaults() {
             "inverse3",
         )
         .unwrap();
-        assert_eq!(i3.safety, d);
+        // The Inverse3's readings are the plane point: its bounds are in m and m/s.
+        let point = DeviceSafety {
+            max_angle: 1.0,
+            max_velocity: 50.0,
+            ..d
+        };
+        assert_eq!(i3.safety, point);
     }
 }
 
@@ -301,7 +308,12 @@ fn bad_safety_values_name_the_field_in_every_device_file() {
         assert!(e.contains(field), "udp {to}: {e}");
         #[cfg(feature = "inverse3")]
         {
-            let i3 = shipped_text("inverse3.toml").replace(from, to);
+            // The same field, from the Inverse3's own bounds (m, m/s).
+            let from3 = from
+                .replace("1000.0", "50.0")
+                .replace("12.566370614359172", "1.0");
+            let i3 = shipped_text("inverse3.toml").replace(&from3, to);
+            assert_ne!(i3, shipped_text("inverse3.toml"), "{from3}");
             let e = haptic2d_devices::inverse3::Inverse3DeviceFile::from_toml(&i3, "t")
                 .unwrap_err()
                 .to_string();

@@ -1,6 +1,6 @@
 //! The Inverse3 driver closed-loop against the Inverse Service emulator, in real time at 1 kHz
-//! (issue 15): the 2-DOF system on the driver's virtual five-bar drives the box of box-in-walls into
-//! the left wall; the emulated cursor is pushed back and settles where the rendered stiffness says;
+//! (issue 15): the point system (`PointSystem`: the plane point in, the plane force out, no linkage)
+//! drives the box of box-in-walls into the left wall; the emulated cursor is pushed back and settles where the rendered stiffness says;
 //! the third axis is held by the virtual plane.
 //!
 //! Expected values. The virtual coupling (K_c = 500 N/m) in series with the wall (k_c = 1000 N/m
@@ -19,11 +19,8 @@ use inverse3_support::*;
 
 use std::time::Instant;
 
-use haptic2d::haptic::planar2::{Planar2Config, Planar2System};
-use haptic2d::haptic::{ControllerKind, WorkspaceSquare};
-use haptic2d_devices::inverse3::planar::{virtual_center, virtual_linkage, virtual_torque_limit};
+use haptic2d::haptic::{ControllerKind, PointConfig, PointSystem, WorkspaceSquare};
 use haptic2d_devices::inverse3::{Emulator3Config, Hand3};
-use haptic2d_rt::io::Device2Io;
 
 const PUSH: f64 = 0.8; // N, towards the left wall (−x)
 const PRESS: f64 = 0.4; // N, into the plane (+z)
@@ -55,25 +52,25 @@ fn the_box_hits_the_wall_and_the_emulated_cursor_is_pushed_back() {
     let mut world = scene.world;
     let i = world.body_index("box").unwrap();
     world.bodies[i].pose.pos.x = 0.04;
-    let mut c = Planar2Config::new(virtual_linkage(), virtual_torque_limit(file.force_limit));
-    c.controller = ControllerKind::from_name("coupling").unwrap();
-    // The square `haptic2d run` gives the Inverse3: the device file's, around the virtual centre.
-    c.workspace = WorkspaceSquare::around(virtual_center(), file.half_width);
-    let mut system = Planar2System::new(world, c).unwrap();
+    // The system `haptic2d run` gives the Inverse3: the file's force limit and square.
+    let mut c = PointConfig::new(
+        file.force_limit,
+        WorkspaceSquare::around(file.center, file.half_width),
+    );
+    c.common.controller = ControllerKind::from_name("coupling").unwrap();
+    let mut system = PointSystem::new(world, c).unwrap();
     let t0 = Instant::now();
     let mut tail: Vec<Sample> = Vec::new();
     let n = 4000;
     for k in 0..n {
-        let q = dev
-            .read_joints()
-            .unwrap_or_else(|e| panic!("tick {k}: {e}"));
+        let q = dev.read_point().unwrap_or_else(|e| panic!("tick {k}: {e}"));
         let out = system.tick(&q);
         assert!(
             !out.tripped,
             "safety trip at tick {k}: {:?}",
             system.safety_trip()
         );
-        dev.write_joint_torques(&out.torques).unwrap();
+        dev.write_force(&out.torques).unwrap();
         if k >= n - 1000 {
             let p = emu.plant();
             tail.push((

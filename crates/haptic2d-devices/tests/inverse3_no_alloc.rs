@@ -1,4 +1,5 @@
-//! The Inverse3 driver's exchange on the tick allocates nothing once open (issue 15): the shared
+//! The Inverse3 driver's exchange on the tick — the loop's `DeviceIo` calls, the plane point read
+//! and the plane force written — allocates nothing once open (issue 15): the shared
 //! counting allocator counts per thread, so the client thread and the emulator allocate freely, off
 //! the tick.
 #![cfg(feature = "inverse3")]
@@ -9,7 +10,7 @@ use inverse3_support::*;
 use std::time::Instant;
 
 use haptic2d_devices::inverse3::{Emulator3Config, Hand3};
-use haptic2d_rt::io::Device2Io;
+use haptic2d_rt::DeviceIo;
 
 haptic2d_test_support::install_counting_allocator!();
 use haptic2d_test_support::alloc::allocations;
@@ -24,16 +25,16 @@ fn the_exchange_allocates_nothing_once_open() {
     let mut dev = open(&file);
     let t0 = Instant::now();
     for k in 0..50 {
-        dev.read_joints().unwrap();
-        dev.write_joint_torques(&[0.01, -0.01]).unwrap();
+        dev.read_encoders().unwrap();
+        dev.write_torques(&[0.01, -0.01, 0.0, 0.0]).unwrap();
         wait_tick(t0, k + 1);
     }
     let mut reads = 0;
     let mut allocs = 0;
     for k in 50..550 {
         let before = allocations();
-        let q = dev.read_joints();
-        let w = dev.write_joint_torques(&[0.01, -0.01]);
+        let q = dev.read_encoders();
+        let w = dev.write_torques(&[0.01, -0.01, 0.0, 0.0]);
         allocs += allocations() - before;
         q.unwrap();
         w.unwrap();

@@ -1,6 +1,6 @@
 //! Safety of the Inverse3 driver against the Inverse Service emulator (issue 15): zero force before
 //! the first command and a ramp of the virtual plane from zero; every force clamped to the file's
-//! limit; the held axis held by the plane's spring; a non-finite torque sends zero; a latch holds;
+//! limit; the held axis held by the plane's spring; a non-finite force sends zero; a latch holds;
 //! the service killed mid-run is a lost device (no panic, zero force latched, a message naming the
 //! device and what to check); no service is a clear error at open.
 #![cfg(feature = "inverse3")]
@@ -11,27 +11,26 @@ use inverse3_support::*;
 use std::time::{Duration, Instant};
 
 use haptic2d_devices::inverse3::{Emulator3Config, Hand3, Inverse3Device, Inverse3DeviceFile};
-use haptic2d_rt::io::Device2Io;
-use haptic2d_rt::DeviceError;
+use haptic2d_rt::{DeviceError, DeviceIo};
 use haptic2d_test_support::{holds_for, wait_for};
 
 fn norm(f: [f64; 3]) -> f64 {
     f.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
 
-/// Drives `dev` for `ms` ticks with joint torques `tau`; returns the emulator's applied force and
-/// the plant after each tick.
+/// Drives `dev` for `ms` ticks with the plane force `force` (N); returns the emulator's applied
+/// force and the plant after each tick.
 fn drive(
     dev: &mut Inverse3Device,
     emu: &haptic2d_devices::inverse3::Inverse3Emulator,
-    tau: [f64; 2],
+    force: [f64; 2],
     ms: u64,
 ) -> Vec<([f64; 3], [f64; 3], [f64; 3])> {
     let t0 = Instant::now();
     let mut out = Vec::new();
     for k in 0..ms {
-        dev.read_joints().unwrap();
-        dev.write_joint_torques(&tau).unwrap();
+        dev.read_point().unwrap();
+        dev.write_force(&force).unwrap();
         let p = emu.plant();
         out.push((p.f_cmd, p.p, p.v));
         wait_tick(t0, k + 1);
@@ -96,7 +95,7 @@ fn every_force_is_clamped_to_the_file_limit() {
     let file = file_for(&emu, NOT_THE_TIMEOUT_UNDER_TEST);
     assert_eq!(file.force_limit, 5.0);
     let mut dev = open(&file);
-    // 100 N·m on a 0.5 m virtual link asks hundreds of newtons.
+    // |(100, −100)| = 141 N asked, 28 times the limit.
     let log = drive(&mut dev, &emu, [100.0, -100.0], 700);
     let sent = dev.last_sent();
     assert!((sent[0].hypot(sent[1]) - 5.0).abs() < 1e-9, "{sent:?}");
@@ -104,8 +103,8 @@ fn every_force_is_clamped_to_the_file_limit() {
     // The f32 wire rounds; the emulated device's own limit is 10 N.
     assert!(max <= 5.0 + 1e-5, "applied {max} N");
     assert!(max > 4.9, "the clamp, not zero: {max} N");
-    // A non-finite torque: an error, and zero force.
-    match dev.write_joint_torques(&[f64::NAN, 0.0]) {
+    // A non-finite force: an error, and zero force.
+    match dev.write_force(&[f64::NAN, 0.0]) {
         Err(DeviceError::Io(m)) => assert!(m.contains("non-finite"), "{m}"),
         other => panic!("{other:?}"),
     }
@@ -151,9 +150,9 @@ fn the_service_killed_mid_run_is_a_lost_device_with_its_reason() {
     emu.stop();
     let t0 = Instant::now();
     let err = loop {
-        match dev.read_joints() {
+        match dev.read_point() {
             Ok(_) => {
-                let _ = dev.write_joint_torques(&[0.1, 0.0]);
+                let _ = dev.write_force(&[0.1, 0.0]);
             }
             Err(e) => break e,
         }
@@ -171,9 +170,9 @@ fn the_service_killed_mid_run_is_a_lost_device_with_its_reason() {
     );
     // The timeout is 20 ms; a closed connection may be noticed sooner.
     assert!(lost_after < Duration::from_millis(500), "{lost_after:?}");
-    assert!(matches!(dev.read_joints(), Err(DeviceError::Lost(_))));
+    assert!(matches!(dev.read_point(), Err(DeviceError::Lost(_))));
     assert!(matches!(
-        dev.write_joint_torques(&[0.1, 0.0]),
+        dev.write_force(&[0.1, 0.0]),
         Err(DeviceError::Lost(_))
     ));
     dev.zero_torques();

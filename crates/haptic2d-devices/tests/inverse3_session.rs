@@ -17,7 +17,6 @@ use std::time::{Duration, Instant};
 use haply::device_model::{Command, Force, ServiceData, ServiceMsg, ServiceState};
 use haptic2d_devices::inverse3::emulator::EMULATED_ID;
 use haptic2d_devices::inverse3::{Emulator3Config, Hand3};
-use haptic2d_rt::io::Device2Io;
 use haptic2d_rt::DeviceError;
 use tungstenite::Message;
 
@@ -175,7 +174,7 @@ fn a_state_without_a_cursor_position_is_a_lost_device_not_the_origin() {
     let t0 = Instant::now();
     let mut k = 0;
     let err = loop {
-        match dev.read_joints() {
+        match dev.read_point() {
             Ok(_) => {
                 let p = dev.sample().position;
                 assert!(
@@ -187,7 +186,7 @@ fn a_state_without_a_cursor_position_is_a_lost_device_not_the_origin() {
             }
             Err(e) => break e,
         }
-        dev.write_joint_torques(&[0.001, -0.001]).unwrap();
+        dev.write_force(&[0.001, -0.001]).unwrap();
         k += 1;
         wait_tick(t0, k);
         assert!(t0.elapsed() < Duration::from_secs(5), "never lost");
@@ -200,7 +199,7 @@ fn a_state_without_a_cursor_position_is_a_lost_device_not_the_origin() {
         "{m}"
     );
     assert!(k >= 100, "lost only once positions went missing (tick {k})");
-    assert!(dev.read_joints().is_err(), "stays lost");
+    assert!(dev.read_point().is_err(), "stays lost");
     wait_for("zero force sent", Duration::from_secs(5), || {
         emu.plant().f_cmd == [0.0; 3]
     });

@@ -224,14 +224,7 @@ pub fn sweep_walls(
     show_progress: bool,
 ) -> Result<SweepSummary, String> {
     cfg.validate()?;
-    if out.exists() && !out.is_dir() {
-        return Err(format!(
-            "--out: `{}` exists and is not a folder",
-            out.display()
-        ));
-    }
-    std::fs::create_dir_all(out)
-        .map_err(|e| format!("--out: cannot create `{}`: {e}", out.display()))?;
+    crate::figures::create_out_dir(out)?;
     let dt = 1.0 / cfg.rate_hz;
     let ks = log_space(cfg.k_range.0, cfg.k_range.1, cfg.points);
     let bs = log_space(cfg.b_range.0, cfg.b_range.1, cfg.points);

@@ -3,6 +3,7 @@
 //! this module runs every loop in Rust with the GIL released.
 
 mod columns;
+mod devices;
 mod errors;
 mod haptic;
 mod harness;
@@ -26,6 +27,7 @@ fn _haptic2d(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(lab::sweep_models, m)?)?;
     m.add_function(wrap_pyfunction!(lab::reproduce, m)?)?;
     m.add_function(wrap_pyfunction!(study::study_present, m)?)?;
+    m.add_function(wrap_pyfunction!(devices::devices, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -8,6 +8,10 @@
 //! A 2-joint device (a 2-DOF five-bar such as a Haply 2DIY) implements [`Device2Io`] (two motor
 //! angles in, two motor torques out) and enters the loop through [`Joints2`], which is a
 //! [`DeviceIo`] that fills `q[0..2]`, leaves `q[2..4]` zero and drops `τ[2..4]`.
+//!
+//! A Cartesian point device (the Inverse3, a `PointSystem` in the loop) uses the same four slots
+//! with other units: `read_encoders` gives `[x, y, 0, 0]`, the handle's plane point (m), and
+//! `write_torques` takes the plane force in `τ[0..2]` (N), ignoring the rest.
 
 use std::fmt;
 use std::path::Path;
@@ -40,11 +44,12 @@ impl std::error::Error for DeviceError {}
 /// real-time thread, once per tick at most, and must not block longer than
 /// the device's own transfer time.
 pub trait DeviceIo {
-    /// Reads the four joint angles `[q11, q12, q21, q22]`, radians.
+    /// Reads the four joint angles `[q11, q12, q21, q22]`, radians (a point device: `[x, y, 0, 0]`,
+    /// m; module docs).
     fn read_encoders(&mut self) -> Result<[f64; 4], DeviceError>;
 
     /// Commands the four joint torques `[τ11, τ12, τ21, τ22]`, N·m (already
-    /// saturated by the caller).
+    /// saturated by the caller; a point device: the plane force `[f_x, f_y, ·, ·]`, N).
     fn write_torques(&mut self, tau: &[f64; 4]) -> Result<(), DeviceError>;
 
     /// Commands zero torque on every motor. Must not fail (best effort on a

@@ -21,6 +21,10 @@ pub const MAX_TARGET_COORDINATE: f64 = 1000.0;
 /// Largest trial number an answer may name.
 pub const MAX_TRIAL: u64 = 1_000_000;
 
+/// Largest number a magnitude estimate may give (above any modulus a study file accepts times a
+/// sensible ratio; the page refuses larger ones too).
+pub const MAX_MAGNITUDE: f64 = 1e9;
+
 /// The controllers the page can select: the named configurations of `haptic2d run --controller`
 /// ([`haptic2d::haptic::ControllerKind::from_name`]), with the same names.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -115,6 +119,11 @@ impl ControllerKind {
 ///   waits for the answer, and only a choice the study's task offers; any other answer (an old
 ///   trial, a double click, a choice the task has not) is refused with a message and changes
 ///   nothing. Without a running study it is refused.
+/// - [`Magnitude`](Command::Magnitude): the participant's magnitude estimate for trial `trial`
+///   (a magnitude-estimation study only; finite, > 0 and at most [`MAX_MAGNITUDE`]). Taken like an
+///   answer: for the trial presented, in its answer phase.
+/// - [`ContinueStudy`](Command::ContinueStudy): the participant ends the rest break before trial
+///   `trial` (the study's `[breaks]`). Taken only during that break; any other is refused.
 /// - [`StopStudy`](Command::StopStudy): end the study session after the current trial's answer is
 ///   saved (an unanswered trial is not written: the session resumes at it). Torques go to zero as
 ///   the loop stops. Without a running study it is refused.
@@ -168,6 +177,18 @@ pub enum Command {
         /// 0 = "same" and 1 = "different".
         choice: u8,
     },
+    /// A magnitude estimate (`haptic2d study run --observer browser`, magnitude estimation).
+    Magnitude {
+        /// The trial answered (from 1).
+        trial: u32,
+        /// The number given to the comparison (finite, > 0).
+        value: f64,
+    },
+    /// End the rest break before `trial`.
+    ContinueStudy {
+        /// The trial the break comes before (from 1).
+        trial: u32,
+    },
     /// End the study session (it resumes at its next unanswered trial).
     StopStudy,
 }
@@ -186,6 +207,8 @@ impl Command {
             Command::Resume => "resume",
             Command::Reset => "reset",
             Command::Answer { .. } => "answer",
+            Command::Magnitude { .. } => "magnitude",
+            Command::ContinueStudy { .. } => "continue_study",
             Command::StopStudy => "stop_study",
         }
     }
@@ -207,6 +230,8 @@ enum Incoming {
     Resume {},
     Reset {},
     Answer { trial: u64, choice: u64 },
+    Magnitude { trial: u64, value: f64 },
+    ContinueStudy { trial: u64 },
     StopStudy {},
 }
 
@@ -233,6 +258,17 @@ fn static_name(kind: &str, name: &str, valid: &[&'static str]) -> Result<&'stati
 /// The names of the built-in scenes the page may switch to.
 pub fn scene_names() -> Vec<&'static str> {
     BUILTIN.iter().map(|b| b.0).collect()
+}
+
+/// A trial number a study message names: 1 to [`MAX_TRIAL`].
+fn check_trial(kind: &str, trial: u64) -> Result<u32, String> {
+    if (1..=MAX_TRIAL).contains(&trial) {
+        Ok(trial as u32)
+    } else {
+        Err(format!(
+            "{kind}.trial = {trial} is out of range (1 to {MAX_TRIAL})"
+        ))
+    }
 }
 
 /// Parses and checks one text message. Errors are one-line messages for the client and the log.
@@ -279,21 +315,29 @@ pub fn parse_client_message(text: &str) -> Result<ClientMessage, String> {
         Incoming::Resume {} => Command::Resume,
         Incoming::Reset {} => Command::Reset,
         Incoming::Answer { trial, choice } => {
-            if !(1..=MAX_TRIAL).contains(&trial) {
-                return Err(format!(
-                    "answer.trial = {trial} is out of range (1 to {MAX_TRIAL})"
-                ));
-            }
+            let trial = check_trial("answer", trial)?;
             if choice > 3 {
                 return Err(format!(
                     "answer.choice = {choice} is out of range (1 to 3 = the interval named; same–different: 0 = same, 1 = different)"
                 ));
             }
             Command::Answer {
-                trial: trial as u32,
+                trial,
                 choice: choice as u8,
             }
         }
+        Incoming::Magnitude { trial, value } => {
+            let trial = check_trial("magnitude", trial)?;
+            if !(value.is_finite() && value > 0.0 && value <= MAX_MAGNITUDE) {
+                return Err(format!(
+                    "magnitude.value = {value} is not a number above 0 (at most {MAX_MAGNITUDE:e})"
+                ));
+            }
+            Command::Magnitude { trial, value }
+        }
+        Incoming::ContinueStudy { trial } => Command::ContinueStudy {
+            trial: check_trial("continue_study", trial)?,
+        },
         Incoming::StopStudy {} => Command::StopStudy,
     };
     Ok(ClientMessage::Command(cmd))
@@ -364,6 +408,24 @@ mod tests {
         );
         assert_eq!(ok(r#"{"type":"stop_study"}"#), Command::StopStudy);
         assert_eq!(
+            ok(r#"{"type":"magnitude","trial":4,"value":125.5}"#),
+            Command::Magnitude {
+                trial: 4,
+                value: 125.5
+            }
+        );
+        assert_eq!(
+            ok(r#"{"type":"magnitude","trial":4,"value":3}"#),
+            Command::Magnitude {
+                trial: 4,
+                value: 3.0
+            }
+        );
+        assert_eq!(
+            ok(r#"{"type":"continue_study","trial":9}"#),
+            Command::ContinueStudy { trial: 9 }
+        );
+        assert_eq!(
             parse_client_message(r#"{"type":"hello","token":"abc"}"#),
             Ok(ClientMessage::Hello {
                 token: "abc".into()
@@ -419,6 +481,31 @@ mod tests {
             ),
             (r#"{"type":"answer","trial":"3","choice":1}"#, "malformed"),
             (r#"{"type":"stop_study","now":true}"#, "malformed"),
+            (r#"{"type":"magnitude","trial":4,"value":0}"#, "above 0"),
+            (r#"{"type":"magnitude","trial":4,"value":-2.5}"#, "above 0"),
+            (r#"{"type":"magnitude","trial":4,"value":1e300}"#, "above 0"),
+            (
+                r#"{"type":"magnitude","trial":4,"value":1e400}"#,
+                "malformed",
+            ),
+            (
+                r#"{"type":"magnitude","trial":4,"value":"NaN"}"#,
+                "malformed",
+            ),
+            (
+                r#"{"type":"magnitude","trial":4,"value":null}"#,
+                "malformed",
+            ),
+            (r#"{"type":"magnitude","trial":0,"value":5}"#, "trial"),
+            (r#"{"type":"magnitude","trial":4}"#, "malformed"),
+            (
+                r#"{"type":"magnitude","trial":4,"value":5,"choice":1}"#,
+                "malformed",
+            ),
+            (r#"{"type":"continue_study"}"#, "malformed"),
+            (r#"{"type":"continue_study","trial":0}"#, "trial"),
+            (r#"{"type":"continue_study","trial":2000000}"#, "trial"),
+            (r#"{"type":"continue_study","trial":3,"x":1}"#, "malformed"),
         ] {
             let e = parse_client_message(msg).expect_err(msg);
             assert!(e.contains(needle), "{msg}: {e}");

@@ -211,18 +211,23 @@ pub struct StudyView {
     pub interval: u8,
     /// Intervals per trial (2 or 3).
     pub intervals: u8,
-    /// `"starting"` (waiting for the next trial), `"free_space"` (the next interval's stimulus is
+    /// `"starting"` (waiting for the next trial), `"break"` (a rest break before the trial: the
+    /// world is held with zero force until the page's `continue_study`), `"free_space"` (the next interval's stimulus is
     /// installed once the handle leaves the wall), `"presenting"`, `"answer"` (waiting for the
     /// answer), `"stopping"` (the session ends).
     pub phase: &'static str,
     /// Seconds left in the interval presented (s).
     pub remaining_s: f64,
-    /// The task: `"2afc"`, `"3afc"` or `"same-different"` (which buttons the page shows).
+    /// The task: `"2afc"`, `"3afc"`, `"same-different"` (which buttons the page shows) or
+    /// `"magnitude"` (a number entry).
     pub task: &'static str,
     /// Answers refused so far (an old trial, a choice the task has not, outside the answer phase).
     pub refused: u32,
     /// The session's last answer was saved for this trial (0: none yet).
     pub last_saved: u32,
+    /// Magnitude estimation: the number the first interval (the reference) stands for (0 in the
+    /// other tasks).
+    pub modulus: f64,
 }
 
 impl Clone for Frame {

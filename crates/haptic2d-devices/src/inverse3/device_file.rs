@@ -331,8 +331,9 @@ impl Inverse3DeviceFile {
     }
 }
 
-/// The largest `workspace.half_width` (m): the virtual linkage the planar mode runs on reaches
-/// this far from its centre with a singularity margin above 0.5 (see `planar.rs`).
+/// The largest `workspace.half_width` (m): a plausibility bound on the file (a 0.4 m square is
+/// larger than a desk-top device's reach; a slip such as `2` for `0.2` is refused). The square is
+/// the workspace bound of the loop's point system, in plane coordinates.
 pub const MAX_HALF_WIDTH: f64 = 0.2;
 
 #[cfg(test)]

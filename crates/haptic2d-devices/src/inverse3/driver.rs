@@ -1,32 +1,34 @@
-//! [`Inverse3Device`]: a Haply Inverse3 through its Inverse Service, in planar mode, behind
-//! `haptic2d-rt`'s [`Device2Io`] (the virtual five-bar's joints, see [`planar`](super::planar)).
+//! [`Inverse3Device`]: a Haply Inverse3 through its Inverse Service, in planar mode, as a Cartesian
+//! point device: it reports the plane point (m) and takes the plane force (N), behind
+//! `haptic2d-rt`'s [`DeviceIo`] with the point-device convention of
+//! [`DeviceSystem::Point`](haptic2d::haptic::DeviceSystem::Point): `q = [x, y, 0, 0]` (m),
+//! `τ = [f_x, f_y, ·, ·]` (N; `τ[2..4]` have no actuator and are ignored). No linkage stands in
+//! between: the loop's [`PointSystem`](haptic2d::haptic::PointSystem) renders the force itself.
 //!
-//! The exchange on the tick is two slot operations: [`read_joints`](Device2Io::read_joints) takes
-//! the newest state from the client thread's slot, maps its cursor to the plane and the virtual
-//! linkage's joints; [`write_joint_torques`](Device2Io::write_joint_torques) turns the joint torques
-//! into the plane force `f = J⁻ᵀ·τ`, clamps it to the force limit and puts it in the command slot.
-//! Nothing there blocks, allocates or locks (the error paths format their messages).
+//! The exchange on the tick is two slot operations: [`read_point`](Inverse3Device::read_point)
+//! takes the newest state from the client thread's slot and maps its cursor to the plane;
+//! [`write_force`](Inverse3Device::write_force) clamps the plane force to the force limit and puts
+//! it in the command slot. Nothing there blocks, allocates or locks (the error paths format their
+//! messages).
 //!
 //! Safety in the driver itself: force is zero until the first valid state and ramps in (the loop's
 //! start-up ramp for the plane force, the client's for the virtual plane); every force is clamped
 //! to `limits.force_limit` here and once more, with the plane's force, in the client; a
-//! non-finite torque sends zero and fails; a state older than `service.timeout_periods` periods, or
-//! a client that closed, is a lost device (zero force latched); [`zero_torques`](Device2Io::zero_torques)
-//! latches zero force (the run loop calls it only on its way out: every later command is zero) and
-//! `Drop` stops the client (zero force, then the connection closes).
+//! non-finite force sends zero and fails; a state older than `service.timeout_periods` periods, or
+//! a client that closed, is a lost device (zero force latched); [`zero_force`](Inverse3Device::zero_force)
+//! ([`DeviceIo::zero_torques`]) latches zero force (the run loop calls it only on its way out: every
+//! later command is zero) and `Drop` stops the client (zero force, then the connection closes).
 
 use std::sync::atomic::Ordering;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use haptic2d::device::pantograph2::Pantograph2;
 use haptic2d_rt::clock::now_ns;
-use haptic2d_rt::io::Device2Io;
-use haptic2d_rt::DeviceError;
+use haptic2d_rt::{DeviceError, DeviceIo};
 
 use super::client::{self, ClientConfig, ClientEnds, OPEN_TIMEOUT};
 use super::device_file::Inverse3DeviceFile;
-use super::planar::{clamp_norm, virtual_linkage, wrench_of, PlaneMap};
+use super::planar::{clamp_norm, PlaneMap};
 use super::slots::{ClientStatus, ForceCommand, Inverse3Sample};
 
 /// A Haply Inverse3 in planar mode.
@@ -36,10 +38,9 @@ pub struct Inverse3Device {
     status: Arc<ClientStatus>,
     thread: Option<std::thread::JoinHandle<()>>,
     map: PlaneMap,
-    linkage: Pantograph2,
     timeout_ns: u64,
     timeout: Duration,
-    q: [f64; 2],
+    point: [f64; 2],
     sample: Inverse3Sample,
     valid: bool,
     lost: bool,
@@ -96,10 +97,9 @@ impl Inverse3Device {
             status,
             thread: Some(thread),
             map,
-            linkage: virtual_linkage(),
             timeout_ns: timeout.as_nanos() as u64,
             timeout,
-            q: [0.0; 2],
+            point: [0.0; 2],
             sample: Inverse3Sample::default(),
             valid: false,
             lost: false,
@@ -129,7 +129,7 @@ impl Inverse3Device {
         Ok(dev)
     }
 
-    /// The newest state: the joints of its plane point, or the error that ends the run.
+    /// The newest state and its plane point, or the error that ends the run.
     #[inline]
     fn take(&mut self) -> Result<(), DeviceError> {
         let s = *self.state.read();
@@ -148,20 +148,17 @@ impl Inverse3Device {
         }
         self.sample = s;
         let u = self.map.planar(&s.position);
-        match self.linkage.ik(self.map.to_virtual(u)) {
-            Ok(q) => {
-                self.q = q;
-                self.valid = true;
-                Ok(())
-            }
-            Err(f) => {
-                self.valid = false;
-                Err(DeviceError::Io(format!(
-                    "Inverse3 {}: the cursor's plane point ({:.4}, {:.4}) m is out of the planar mode's reach ({f}); check [workspace] center and half_width",
-                    self.name, u[0], u[1]
-                )))
-            }
+        if !(u[0].is_finite() && u[1].is_finite()) {
+            // No force follows a reading that is not a point (`write_force` sends zero).
+            self.valid = false;
+            return Err(DeviceError::Io(format!(
+                "Inverse3 {}: the cursor's plane point ({}, {}) m is not finite",
+                self.name, u[0], u[1]
+            )));
         }
+        self.point = u;
+        self.valid = true;
+        Ok(())
     }
 
     fn lose(&mut self, why: std::fmt::Arguments<'_>) -> DeviceError {
@@ -219,9 +216,12 @@ pub fn handle_angle(map: &PlaneMap, q: [f64; 4]) -> Option<f64> {
     (p[0].hypot(p[1]) > 1e-9).then(|| p[1].atan2(p[0]))
 }
 
-impl Device2Io for Inverse3Device {
+impl Inverse3Device {
+    /// The cursor's plane point `(x, y)` (m, the plane's axes in the device frame: see
+    /// [`PlaneMap::planar`]) from the newest state. A stale state, a closed client or a device
+    /// already lost is [`DeviceError::Lost`] (zero force latched). Never allocates on success.
     #[inline]
-    fn read_joints(&mut self) -> Result<[f64; 2], DeviceError> {
+    pub fn read_point(&mut self) -> Result<[f64; 2], DeviceError> {
         if self.lost {
             return Err(DeviceError::Lost(format!(
                 "Inverse3 {}: already lost",
@@ -229,41 +229,38 @@ impl Device2Io for Inverse3Device {
             )));
         }
         self.take()?;
-        Ok(self.q)
+        Ok(self.point)
     }
 
+    /// Commands the plane force `f = (f_x, f_y)` (N): clamped to `limits.force_limit` keeping its
+    /// direction, then put in the command slot with the virtual plane enabled. A non-finite
+    /// component sends zero and fails; before a valid state, zero is sent; after a zero command
+    /// ([`Self::zero_force`]) every command is zero. Never allocates on success.
     #[inline]
-    fn write_joint_torques(&mut self, tau: &[f64; 2]) -> Result<(), DeviceError> {
+    pub fn write_force(&mut self, f: &[f64; 2]) -> Result<(), DeviceError> {
         if self.lost {
             return Err(DeviceError::Lost(format!(
                 "Inverse3 {}: already lost",
                 self.name
             )));
         }
-        if let Some(j) = (0..2).find(|&j| !tau[j].is_finite()) {
+        if let Some(j) = (0..2).find(|&j| !f[j].is_finite()) {
             self.put([0.0; 2], false);
             return Err(DeviceError::Io(format!(
-                "Inverse3 {}: non-finite torque τ[{j}] = {}; zero force sent",
-                self.name, tau[j]
+                "Inverse3 {}: non-finite force f[{j}] = {} N; zero force sent",
+                self.name, f[j]
             )));
         }
         if !self.valid {
             self.put([0.0; 2], false);
             return Ok(());
         }
-        let f = self
-            .linkage
-            .state(self.q)
-            .ok()
-            .and_then(|s| wrench_of(&s.j, *tau));
-        match f {
-            Some(f) => self.put(clamp_norm(f, self.map.force_limit()), true),
-            None => self.put([0.0; 2], false),
-        }
+        self.put(clamp_norm(*f, self.map.force_limit()), true);
         Ok(())
     }
 
-    fn zero_torques(&mut self) {
+    /// Latches zero force: this and every later command is zero, with the virtual plane off.
+    pub fn zero_force(&mut self) {
         self.sent = [0.0; 2];
         self.latched = true;
         self.command.write(ForceCommand {
@@ -271,6 +268,27 @@ impl Device2Io for Inverse3Device {
             enable: false,
             latched: true,
         });
+    }
+}
+
+/// The loop's device interface with the point-device convention (see the module doc).
+impl DeviceIo for Inverse3Device {
+    /// `[x, y, 0, 0]`: the plane point (m), [`Inverse3Device::read_point`].
+    #[inline]
+    fn read_encoders(&mut self) -> Result<[f64; 4], DeviceError> {
+        let [x, y] = self.read_point()?;
+        Ok([x, y, 0.0, 0.0])
+    }
+
+    /// `τ[0..2]` is the plane force (N), [`Inverse3Device::write_force`]; `τ[2..4]` is ignored (no
+    /// actuator: the point system's are always zero).
+    #[inline]
+    fn write_torques(&mut self, tau: &[f64; 4]) -> Result<(), DeviceError> {
+        self.write_force(&[tau[0], tau[1]])
+    }
+
+    fn zero_torques(&mut self) {
+        self.zero_force();
     }
 
     fn name(&self) -> &str {
@@ -300,7 +318,7 @@ impl Inverse3Device {
 
 impl Drop for Inverse3Device {
     fn drop(&mut self) {
-        self.zero_torques();
+        self.zero_force();
         self.status.stop.store(true, Ordering::Release);
         if let Some(t) = self.thread.take() {
             let _ = t.join();

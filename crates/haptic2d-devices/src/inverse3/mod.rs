@@ -3,11 +3,12 @@
 //! is held by a stiff, damped virtual plane rendered on the device.
 //!
 //! - [`device_file`] — `devices/inverse3.toml`;
-//! - [`planar`] — the plane mapping, the virtual plane, the force clamp, the virtual five-bar through
-//!   which the planar point enters the run loop's 2-DOF system;
+//! - [`planar`] — the plane mapping, the virtual plane, the force clamp;
 //! - [`slots`] — the wait-free exchange with the client thread;
 //! - [`client`] — the `haply::HaplyDevice` client on its own thread and tokio runtime;
-//! - [`driver`] — [`Inverse3Device`], the [`Device2Io`](haptic2d_rt::io::Device2Io) of the loop;
+//! - [`driver`] — [`Inverse3Device`], a Cartesian point device (the plane point in m, the plane
+//!   force in N) behind the loop's [`DeviceIo`](haptic2d_rt::DeviceIo), driven by a
+//!   [`PointSystem`](haptic2d::haptic::PointSystem);
 //! - [`emulator`] — a stand-in for the Inverse Service on loopback (`haptic2d emulate inverse3`).
 
 pub mod client;

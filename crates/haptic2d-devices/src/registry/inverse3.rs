@@ -3,8 +3,10 @@
 //! [`super`]), in planar mode. `URL` is the service's address, `http://HOST:PORT` (the WebSocket
 //! is `ws://HOST:PORT/`); without it the device file's `[service]` (default
 //! `http://localhost:10001`, `ws://localhost:10001/`). The device file (default the shipped
-//! devices/inverse3.toml) maps two device axes to the world plane and holds the third; the system is
-//! the 2-DOF system on the driver's virtual five-bar (see `crate::inverse3::planar`).
+//! devices/inverse3.toml) maps two device axes to the world plane and holds the third; the model is
+//! a point model ([`super::DeviceModel::Point`]): the driver reports the plane point (m) and
+//! takes the plane force (N), and the loop's system is the Cartesian
+//! [`PointSystem`](haptic2d::haptic::PointSystem) (no linkage in between).
 //!
 //! The driver is behind the `inverse3` feature of haptic2d-devices (haptic2d-cli's `inverse3`
 //! turns it on; off by default: it brings Haply's client with its HTTP/TLS stack); without it `--device inverse3` is refused as bad input with the
@@ -12,13 +14,10 @@
 
 #[cfg(feature = "inverse3")]
 use super::DeviceModel;
+use super::PointDynamics;
 use super::RealDevice;
 #[cfg(feature = "inverse3")]
-use crate::inverse3::planar::{virtual_center, virtual_linkage, virtual_torque_limit};
-#[cfg(feature = "inverse3")]
 use crate::inverse3::{Inverse3Device, Inverse3DeviceFile};
-#[cfg(feature = "inverse3")]
-use haptic2d_rt::io::Joints2;
 #[cfg(feature = "inverse3")]
 use haptic2d_rt::DeviceIo;
 use std::path::Path;
@@ -26,6 +25,19 @@ use std::path::Path;
 /// Why `--device inverse3` and `emulate inverse3` are refused by a build without the `inverse3`
 /// feature, and how to get them.
 pub const NOT_BUILT: &str = "the Haply Inverse3 driver is not in this build (the `inverse3` feature is off by default: it needs Haply's client with its HTTP/TLS stack and OpenSSL headers)\n    fix: cargo install --path crates/haptic2d-cli --features inverse3   (or cargo run --release --features inverse3 -- run --device inverse3)";
+
+/// The handle dynamics the stability gate of `run` linearises an Inverse3 with: 0.03 kg, no
+/// damping. Not a measurement of an Inverse3 (nobody here has one): the lightest of the project's
+/// estimates (the 2DIY emulator's end-point mass, the one the gate used before, through the
+/// virtual five-bar that this point model replaced; the Inverse3 emulator moves 0.2 kg with
+/// 1 N·s/m). The gate errs towards refusing: over the named controllers and virtual couplings of
+/// rising damping it refuses every released axis for this handle that it refuses for the
+/// emulator's, and more (haptic2d-lab `stability::planar2` test
+/// `the_gate_refuses_for_a_light_undamped_point_handle_whatever_it_refuses_for_a_heavy_one`).
+pub const GATE_DYNAMICS: PointDynamics = PointDynamics {
+    mass: 0.03,
+    damping: 0.0,
+};
 
 /// Without the `inverse3` feature: the URL is checked, then the device refused ([`NOT_BUILT`]).
 #[cfg(not(feature = "inverse3"))]
@@ -91,13 +103,11 @@ pub fn real_device(url: Option<&str>, device_file: Option<&Path>) -> Result<Real
     let open_name = name.clone();
     Ok(RealDevice {
         name,
-        model: DeviceModel::FiveBar {
-            linkage: virtual_linkage(),
-            tau_max: virtual_torque_limit(file.force_limit),
-            center: virtual_center(),
-            // The plane's square, moved with the plane point to the virtual linkage's centre.
-            workspace: haptic2d::haptic::WorkspaceSquare::around(virtual_center(), file.half_width),
-            identified: None,
+        model: DeviceModel::Point {
+            force_limit: file.force_limit,
+            // The file's square, in the plane coordinates the driver reports.
+            workspace: haptic2d::haptic::WorkspaceSquare::around(file.center, file.half_width),
+            gate_dynamics: GATE_DYNAMICS,
         },
         summary,
         wait_periods: file.timeout_periods,
@@ -108,7 +118,7 @@ pub fn real_device(url: Option<&str>, device_file: Option<&Path>) -> Result<Real
         // Connect and wait for the first state before the first deadline.
         open: Box::new(move |period| {
             let dev = Inverse3Device::open(&file, period, &open_name)?;
-            Ok(Box::new(Joints2(dev)) as Box<dyn DeviceIo + Send>)
+            Ok(Box::new(dev) as Box<dyn DeviceIo + Send>)
         }),
     })
 }
@@ -161,11 +171,17 @@ mod tests {
 
     #[test]
     #[cfg(feature = "inverse3")]
-    fn the_shipped_file_is_a_virtual_five_bar_with_the_file_limits() {
+    fn the_shipped_file_is_a_point_device_with_the_file_limits() {
         let r = real_device(Some("http://127.0.0.1:1234"), None).unwrap();
         assert_eq!(r.name, "inverse3:http://127.0.0.1:1234");
-        assert!(
-            matches!(r.model, DeviceModel::FiveBar { tau_max, .. } if tau_max == virtual_torque_limit(5.0))
+        let file = Inverse3DeviceFile::shipped();
+        assert_eq!(
+            r.model,
+            DeviceModel::Point {
+                force_limit: 5.0,
+                workspace: haptic2d::haptic::WorkspaceSquare::around(file.center, 0.15),
+                gate_dynamics: GATE_DYNAMICS,
+            }
         );
         assert_eq!(r.wait_periods, 20.0);
         assert_eq!(r.max_missed_run, Some(10));

@@ -10,9 +10,12 @@
 //! 2. its arm in [`DeviceChoice::load_real`], calling a glue function in its own file
 //!    ([`haply::real_device`], [`udp::real_device`], …) that reads and checks the device file
 //!    **without opening anything** and returns a [`RealDevice`]:
-//!    - its [`DeviceModel`]: [`DeviceModel::Twin`] (4 joints, MODELS §10, a [`DeviceParams`]) or
+//!    - its [`DeviceModel`]: [`DeviceModel::Twin`] (4 joints, MODELS §10, a [`DeviceParams`]),
 //!      [`DeviceModel::FiveBar`] (2 joints: the linkage and the motor torque limit; the system is the
-//!      2-DOF [`Planar2System`](haptic2d::haptic::planar2::Planar2System));
+//!      2-DOF [`Planar2System`](haptic2d::haptic::planar2::Planar2System)) or
+//!      [`DeviceModel::Point`] (a Cartesian device whose driver does its own kinematics: the
+//!      handle point in, a force out; the system is the
+//!      [`PointSystem`](haptic2d::haptic::PointSystem));
 //!    - the device's own reply timeout (`wait_periods`, periods: a silent device is its driver's
 //!      [`DeviceError::Lost`](haptic2d_rt::DeviceError::Lost) → exit 4), the watchdog's
 //!      missed-deadline limit and the stall limit on the loop's own time;
@@ -20,7 +23,8 @@
 //!    - an `open` closure that opens and hand-shakes the device at the control period and returns
 //!      it as a [`DeviceIo`]; a 2-joint driver implements
 //!      [`Device2Io`](haptic2d_rt::io::Device2Io) and is wrapped in
-//!      [`Joints2`](haptic2d_rt::io::Joints2).
+//!      [`Joints2`](haptic2d_rt::io::Joints2); a point driver implements [`DeviceIo`] with the
+//!      point convention (`q = [x, y, 0, 0]` in m, `τ[0..2]` the force in N).
 //!
 //! The rig of `haptic2d run` does the rest: the stability gate with the hand released, zero torques
 //! until the first valid reading and the start-up ramp of the shared safety stage, the stall check
@@ -28,6 +32,7 @@
 
 pub mod haply;
 pub mod inverse3;
+pub mod kinds;
 pub mod udp;
 
 use crate::device_safety::DeviceSafety;
@@ -133,6 +138,39 @@ pub enum DeviceModel {
         /// used by the stability gate in place of the built-in estimates; `None`: not measured.
         identified: Option<crate::haply::identified::Identified>,
     },
+    /// A Cartesian point device (the handle point `(x, y)` in `q[0..2]`, m; the force `(f_x, f_y)`
+    /// in `τ[0..2]`, N): no linkage to model, `J = I` (the Haply Inverse3 in planar mode).
+    Point {
+        /// Force limit on `|(f_x, f_y)|` (N).
+        force_limit: f64,
+        /// The workspace square of the device file (m, the device's plane coordinates) with its
+        /// wall and trip: the bound the point system applies.
+        workspace: WorkspaceSquare,
+        /// The handle's apparent mass (kg) and viscous damping (N·s/m) per axis that the stability
+        /// gate linearises with (estimates unless the device file says otherwise).
+        gate_dynamics: PointDynamics,
+    },
+}
+
+impl DeviceModel {
+    /// The twin's parameters; the defaults for a five-bar or a point device (whose systems do not
+    /// use them: the run's `HapticConfig::device` then only carries the defaults).
+    pub fn twin_params(&self) -> DeviceParams {
+        match self {
+            DeviceModel::Twin(p) => *p,
+            DeviceModel::FiveBar { .. } | DeviceModel::Point { .. } => DeviceParams::default(),
+        }
+    }
+}
+
+/// The lumped dynamics of a point device's handle along each plane axis, as the stability gate of
+/// `haptic2d run` sees them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PointDynamics {
+    /// Apparent moving mass (kg), > 0.
+    pub mass: f64,
+    /// Viscous damping (N·s/m), ≥ 0.
+    pub damping: f64,
 }
 
 /// Opens a real device at the control period: handshake done, ready for the first tick.

@@ -72,6 +72,21 @@ pub fn real_device(
     device_file: Option<&Path>,
     allow_remote: bool,
 ) -> Result<RealDevice, String> {
+    let (real, warnings) = real_device_and_warnings(addr, device_file, allow_remote)?;
+    for w in warnings {
+        eprintln!("{w}");
+    }
+    Ok(real)
+}
+
+/// [`real_device`] with its warnings (unauthenticated protocol, beyond loopback) returned instead of
+/// printed: for a listing of the registry, which prints nothing.
+pub fn real_device_and_warnings(
+    addr: &str,
+    device_file: Option<&Path>,
+    allow_remote: bool,
+) -> Result<(RealDevice, Vec<String>), String> {
+    let mut warnings = Vec::new();
     let addr = address_of(addr)?;
     let warning = check_address(addr, allow_remote)?;
     let file = match device_file {
@@ -85,14 +100,12 @@ pub fn real_device(
                 file.source
             ));
         }
-        eprintln!(
+        warnings.push(format!(
             "warning: udp:{addr} speaks protocol version 1 (no protocol.key_file in {}): datagrams are not authenticated, any local process could send states; set protocol.key_file for version 2",
             file.source
-        );
+        ));
     }
-    if let Some(w) = warning {
-        eprintln!("{w}");
-    }
+    warnings.extend(warning);
     let name = format!("udp:{addr}");
     let summary = format!(
         "{}, 2-DOF pantograph, {} in, {} out, torque limit {} N·m, protocol version {}",
@@ -107,7 +120,7 @@ pub fn real_device(
         if file.key.is_some() { 2 } else { 1 }
     );
     let open_name = name.clone();
-    Ok(RealDevice {
+    let real = RealDevice {
         name,
         model: DeviceModel::FiveBar {
             linkage: file.linkage,
@@ -127,7 +140,8 @@ pub fn real_device(
             let dev = UdpDevice::open(addr, &file, period, &open_name)?;
             Ok(Box::new(Counted(dev)) as Box<dyn DeviceIo + Send>)
         }),
-    })
+    };
+    Ok((real, warnings))
 }
 
 /// Where the stability gate linearises a UDP pantograph (m, device frame): on the symmetry axis

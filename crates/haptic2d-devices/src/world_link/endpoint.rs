@@ -11,7 +11,7 @@
 use std::net::{SocketAddr, ToSocketAddrs, UdpSocket};
 use std::time::{Duration, Instant};
 
-use super::message::{PortMessage, PORT_LEN};
+use super::message::{PortMessage, Refused, PORT_LEN};
 use crate::udp::auth::{
     nonce, Drop2, UdpKey, HEADER2_LEN, HELLO_LEN, KIND_HELLO, NONCE_LEN, VERSION2, WELCOME_LEN,
 };
@@ -30,6 +30,9 @@ pub struct LinkCounters {
     pub wrong_session: u64,
     /// Datagrams of the wrong size, framing or kind, or with a non-finite number.
     pub malformed: u64,
+    /// Authentic port messages of this session in the older message version 1 (the other end is
+    /// an older build): refused.
+    pub old_version: u64,
     /// Sends that failed (the other end gone: loopback answers with "connection refused").
     pub send_errors: u64,
 }
@@ -220,16 +223,17 @@ impl LinkEndpoint {
                     }
                 }
             }
-            match PortMessage::open(&self.key, b, kind, self.session) {
+            match PortMessage::open_versioned(&self.key, b, kind, self.session) {
                 Ok(m) if m.seq > self.newest_seq => {
                     self.newest_seq = m.seq;
                     self.counters.received += 1;
                     newest = Some(m);
                 }
                 Ok(_) => self.counters.stale += 1,
-                Err(Drop2::BadMac) => self.counters.bad_mac += 1,
-                Err(Drop2::WrongSession) => self.counters.wrong_session += 1,
-                Err(Drop2::Malformed) => self.counters.malformed += 1,
+                Err(Refused::OldVersion) => self.counters.old_version += 1,
+                Err(Refused::Drop(Drop2::BadMac)) => self.counters.bad_mac += 1,
+                Err(Refused::Drop(Drop2::WrongSession)) => self.counters.wrong_session += 1,
+                Err(Refused::Drop(Drop2::Malformed)) => self.counters.malformed += 1,
             }
         }
         newest

@@ -8,4 +8,4 @@ pub mod endpoint;
 pub mod message;
 
 pub use endpoint::{LinkCounters, LinkEndpoint};
-pub use message::{PortMessage, KIND_TO_DEVICE, KIND_TO_WORLD, PORT_LEN};
+pub use message::{PortMessage, Refused, KIND_TO_DEVICE, KIND_TO_WORLD, PORT_LEN};

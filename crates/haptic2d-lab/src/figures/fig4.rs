@@ -14,7 +14,7 @@
 //! `|ω| < 1e-9 rad/s` for the paper method (see [`checks_2d`]).
 
 use crate::csv::write_columns;
-use crate::figures::{Figure, FigureContext, FigureReport};
+use crate::figures::{par_jobs, Figure, FigureContext, FigureReport};
 use crate::harness::wall::{run_wall, EntryImpulse, WallConfig};
 use crate::plot::{write_panels, Panel, Series, Stroke};
 use crate::schema::{CaseMetrics, Check, Dimension, Fig4Measured, FigureMetrics, Measured};
@@ -25,7 +25,6 @@ use haptic2d::laws::friction::FrictionModel;
 use haptic2d::laws::normal::{colgate_margin, NormalModel};
 use haptic2d::metrics::{BounceMetrics, BounceSample};
 use haptic2d::world::World;
-use rayon::prelude::*;
 use std::fmt::Write as _;
 
 /// Duration of every Fig. 4 run (s).
@@ -594,23 +593,19 @@ impl Figure for Fig4 {
         let jobs: Vec<(usize, Dimension)> = (0..CASES.len())
             .flat_map(|i| [(i, Dimension::OneD), (i, Dimension::TwoD)])
             .collect();
-        let done: Vec<Done> = jobs
-            .par_iter()
-            .map(|&(i, dim)| {
-                let r = match dim {
-                    Dimension::OneD => run_1d(&CASES[i]),
-                    Dimension::TwoD => run_2d(&CASES[i]),
-                };
-                ctx.progress.inc(1);
-                r.map(|(trace, measured)| Done {
-                    case: i,
-                    dim,
-                    trace,
-                    measured,
-                })
-                .map_err(|e| format!("fig4 {} {}: {e}", CASES[i].name, dim.as_str()))
+        let done: Vec<Done> = par_jobs(ctx.progress, &jobs, |&(i, dim)| {
+            let r = match dim {
+                Dimension::OneD => run_1d(&CASES[i]),
+                Dimension::TwoD => run_2d(&CASES[i]),
+            };
+            r.map(|(trace, measured)| Done {
+                case: i,
+                dim,
+                trace,
+                measured,
             })
-            .collect::<Result<_, _>>()?;
+            .map_err(|e| format!("fig4 {} {}: {e}", CASES[i].name, dim.as_str()))
+        })?;
         let get = |i: usize, d: Dimension| {
             done.iter()
                 .find(|x| x.case == i && x.dim == d)
@@ -728,16 +723,7 @@ impl Figure for Fig4 {
             1,
             (1000, 620),
         )?);
-        let metrics = FigureMetrics {
-            figure: "fig4".into(),
-            cases,
-        };
-        let markdown = report(&metrics);
-        Ok(FigureReport {
-            metrics,
-            markdown,
-            files,
-        })
+        Ok(FigureReport::new("fig4", cases, files, report))
     }
 }
 

@@ -19,14 +19,15 @@
 //!   the second impact < 0.15·v1, no separation in the last 2 s;
 //! - hysteretic (Fig. 6, "stable soon"): the first three contact ratios < 0.85 and ≤ 6 separations.
 
-use crate::csv::write_columns;
 use crate::figures::fig5_sweep;
-use crate::figures::{Figure, FigureContext, FigureReport};
-use crate::plot::{write_panels, Panel, Series, Stroke};
+use crate::figures::{
+    case_panels, device_case, run_configurations, write_tick_csv, Figure, FigureContext,
+    FigureReport,
+};
+use crate::plot::{write_panels, Series, Stroke};
 use crate::scenarios::walls_with_device::{check, run_case, Fig5Case, Fig5Params, FIG5_CASES};
-use crate::scenarios::{with_capstan_friction, Protocol};
+use crate::scenarios::{with_capstan_friction, ControllerRuns, Protocol};
 use crate::schema::{CaseMetrics, Dimension, Fig4Measured, FigureMetrics, Measured};
-use rayon::prelude::*;
 use std::fmt::Write as _;
 
 /// The runs: `(name, parameters)`: the default controller on the §10.2 device, the §11.1 table on
@@ -46,15 +47,9 @@ fn controllers(ctx: Option<&FigureContext>) -> Result<Vec<(String, Fig5Params)>,
         ("coupling".to_string(), Fig5Params::coupling()),
         (
             "former-default".to_string(),
-            Fig5Params {
-                haptic: haptic2d::haptic::HapticConfig {
-                    controller: haptic2d::haptic::ControllerKind::FourChannel(
-                        haptic2d::control::four_channel::FourChannelGains::master_force_feedback(),
-                    ),
-                    ..haptic2d::haptic::HapticConfig::default()
-                },
-                ..Fig5Params::default()
-            },
+            Fig5Params::with_controller(haptic2d::haptic::ControllerKind::FourChannel(
+                haptic2d::control::four_channel::FourChannelGains::master_force_feedback(),
+            )),
         ),
     ];
     // Issue 36 item 4: every carrier (the default, the §11.1 table, the former default) also with
@@ -160,19 +155,10 @@ impl Figure for Fig5 {
     }
     fn run(&self, ctx: &FigureContext) -> Result<FigureReport, String> {
         let ctrl = controllers(Some(ctx))?;
-        let jobs: Vec<(usize, usize)> = (0..ctrl.len())
-            .flat_map(|i| (0..FIG5_CASES.len()).map(move |j| (i, j)))
-            .collect();
-        let done: Vec<(usize, usize, Fig5Case)> = jobs
-            .par_iter()
-            .map(|&(i, j)| {
-                let (name, normal, e) = FIG5_CASES[j];
-                let r = run_case(&ctrl[i].1, name, normal, e)
-                    .map_err(|e| format!("fig5 {}: {e}", ctrl[i].0));
-                ctx.progress.inc(1);
-                r.map(|c| (i, j, c))
-            })
-            .collect::<Result<_, _>>()?;
+        let done = run_configurations(ctx, "fig5", &ctrl, FIG5_CASES.len(), |p, j| {
+            let (name, normal, e) = FIG5_CASES[j];
+            run_case(p, name, normal, e)
+        })?;
         let mut files = Vec::new();
         let mut cases = Vec::new();
         for (i, j, c) in &done {
@@ -184,79 +170,41 @@ impl Figure for Fig5 {
                 &crate::scenarios::walls_with_device::wall_world(normal, p.rate)?,
                 p.rate,
             );
-            let mut case = CaseMetrics::new(
-                &model,
-                Dimension::TwoD,
-                Measured::Fig4(measured(c)),
-                vec![check(c)],
-            )
-            .with_comparison(carrier(*i, wall).is_none())
-            .with_stability(stability);
-            if let Some(why) = carrier(*i, wall) {
-                case = case.with_carrier(format!("{}: {why}", ctrl[*i].0));
-            }
+            let case = device_case(
+                CaseMetrics::new(
+                    &model,
+                    Dimension::TwoD,
+                    Measured::Fig4(measured(c)),
+                    vec![check(c)],
+                ),
+                &ctrl[*i].0,
+                carrier(*i, wall),
+                stability,
+            );
             cases.push(case);
-            let r = &c.records;
-            let col = |f: &dyn Fn(usize) -> f64| (0..r.len()).map(f).collect::<Vec<f64>>();
-            let x0 = (r[0].x_s[0], r[0].x_m[0]);
-            let scale = ctrl[*i].1.haptic.scale;
             let path = ctx.dir.join(format!("{}_{}.csv", ctrl[*i].0, c.name));
-            write_columns(
-                &path,
-                &[
-                    "t_s",
-                    "box_x_m",
-                    "box_y_m",
-                    "box_theta_rad",
-                    "gap_m",
-                    "box_vx_m_s",
-                    "device_x_world_m",
-                    "f_e_x_n",
-                    "contacts",
-                ],
-                &[
-                    &col(&|k| r[k].t),
-                    &col(&|k| r[k].x_s[0]),
-                    &col(&|k| r[k].x_s[1]),
-                    &col(&|k| r[k].x_s[2]),
-                    &c.gap,
-                    &col(&|k| r[k].v_s[0]),
-                    &col(&|k| x0.0 + scale * (r[k].x_m[0] - x0.1)),
-                    &col(&|k| r[k].f_e[0]),
-                    &col(&|k| r[k].contacts as f64),
-                ],
-            )?;
+            let scale = ctrl[*i].1.haptic.scale;
+            write_tick_csv(&path, &c.records, scale, "box", &[(4, "gap_m", &c.gap)])?;
             files.push(path);
         }
-        let panels: Vec<Panel> = FIG5_CASES
-            .iter()
-            .enumerate()
-            .map(|(j, (wall, _, _))| Panel {
-                title: label(wall).to_string(),
-                x_label: "time (s)".into(),
-                y_label: "box gap to the wall (mm)".into(),
-                series: done
-                    .iter()
-                    .filter(|d| d.1 == j)
-                    .map(|(i, _, c)| {
-                        let pts = c
-                            .records
-                            .iter()
-                            .zip(&c.gap)
-                            .map(|(r, g)| (r.t, g * 1e3))
-                            .collect();
-                        let stroke = if *i == 0 {
-                            Stroke::Solid
-                        } else {
-                            Stroke::Dashed
-                        };
-                        Series::new(&ctrl[*i].0, pts, *i, stroke)
-                    })
-                    .collect(),
-                h_lines: vec![0.0],
-                ..Panel::default()
-            })
-            .collect();
+        let titles: Vec<&str> = FIG5_CASES.iter().map(|(wall, _, _)| label(wall)).collect();
+        let mut panels = case_panels(&titles, "box gap to the wall (mm)", &done, |i, c| {
+            let pts = c
+                .records
+                .iter()
+                .zip(&c.gap)
+                .map(|(r, g)| (r.t, g * 1e3))
+                .collect();
+            let stroke = if i == 0 {
+                Stroke::Solid
+            } else {
+                Stroke::Dashed
+            };
+            Series::new(&ctrl[i].0, pts, i, stroke)
+        });
+        for p in &mut panels {
+            p.h_lines = vec![0.0];
+        }
         files.extend(write_panels(
             &ctx.dir.join("positions"),
             "Figs. 5–6 with the device in the loop: box gap to the wall (push 2 N after 0.5 s)",
@@ -270,19 +218,10 @@ impl Figure for Fig5 {
             ctx.progress,
         )?;
         files.extend(fig5_sweep::write(&ctx.dir, &sweep)?);
-        let metrics = FigureMetrics {
-            figure: "fig5".into(),
-            cases,
-        };
-        let markdown = report(
-            &metrics,
-            &fig5_sweep::markdown(&sweep, &fig5_sweep::MARGINS),
-        );
-        Ok(FigureReport {
-            metrics,
-            markdown,
-            files,
-        })
+        let sweep_md = fig5_sweep::markdown(&sweep, &fig5_sweep::MARGINS);
+        Ok(FigureReport::new("fig5", cases, files, |m| {
+            report(m, &sweep_md)
+        }))
     }
 }
 

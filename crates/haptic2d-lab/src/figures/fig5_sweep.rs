@@ -9,7 +9,6 @@ use crate::csv::write_columns;
 use crate::plot::{write_panels, Panel, Series, Stroke};
 use crate::scenarios::walls_with_device::{run_case, Fig5Params, FIG5_CASES};
 use indicatif::ProgressBar;
-use rayon::prelude::*;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -47,26 +46,23 @@ pub fn run(
         .iter()
         .flat_map(|&m| (0..FIG5_CASES.len()).map(move |j| (m, j)))
         .collect();
-    jobs.par_iter()
-        .map(|&(margin, j)| {
-            let (name, normal, e) = FIG5_CASES[j];
-            let p = base.with_margin(margin);
-            let f_v = p.haptic_config()?.device.f_v;
-            let c = run_case(&p, name, normal, e)
-                .map_err(|e| format!("fig5 sweep, margin {margin}: {e}"))?;
-            progress.inc(1);
-            let b = &c.metrics.bounce;
-            Ok(SweepPoint {
-                margin,
-                f_v,
-                wall: name,
-                separations: b.separations(),
-                late_separations: c.metrics.late_separations,
-                first_ratio: b.contact_ratios.first().copied(),
-                pass: c.metrics.pass,
-            })
+    crate::figures::par_jobs(progress, &jobs, |&(margin, j)| {
+        let (name, normal, e) = FIG5_CASES[j];
+        let p = base.with_margin(margin);
+        let f_v = p.haptic_config()?.device.f_v;
+        let c = run_case(&p, name, normal, e)
+            .map_err(|e| format!("fig5 sweep, margin {margin}: {e}"))?;
+        let b = &c.metrics.bounce;
+        Ok(SweepPoint {
+            margin,
+            f_v,
+            wall: name,
+            separations: b.separations(),
+            late_separations: c.metrics.late_separations,
+            first_ratio: b.contact_ratios.first().copied(),
+            pass: c.metrics.pass,
         })
-        .collect()
+    })
 }
 
 /// Writes `sweep.csv` (one row per margin and wall) and the `sweep` SVG/PNG chart into `dir`.

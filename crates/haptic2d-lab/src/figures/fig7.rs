@@ -16,14 +16,13 @@
 //! against the same F7-5 bound.
 
 use crate::csv::write_columns;
-use crate::figures::{Figure, FigureContext, FigureReport};
+use crate::figures::{par_jobs, Figure, FigureContext, FigureReport};
 use crate::harness::peg::{PegHarness, PegPush, PegResult};
 use crate::plot::{write_panels, Panel, Series, Stroke};
 use crate::schema::{CaseMetrics, Check, Dimension, Fig7Measured, FigureMetrics, Measured};
 use crate::world2d::{body, load_builtin, rebuild};
 use haptic2d::geom::Vec2;
 use haptic2d::laws::friction::FrictionModel;
-use rayon::prelude::*;
 use std::fmt::Write as _;
 
 /// The five models of Fig. 7: `(case name, friction model name, label)`.
@@ -380,31 +379,27 @@ impl Figure for Fig7 {
                 }
             }
         }
-        let done: Vec<Done> = jobs
-            .par_iter()
-            .map(|&(i, p, dim)| {
-                let (case, f_pk) = (MODELS[i].0, PEAKS[p]);
-                let r = match dim {
-                    Dimension::OneD => run_1d(case, f_pk).map(|r| {
-                        let m = measured(&r, f_pk, 0.0, 0.0);
-                        (r, m)
-                    }),
-                    Dimension::TwoD => run_2d(case, f_pk, None).map(|r| {
-                        let m = measured(&r.result, f_pk, r.max_abs_theta, r.max_abs_y);
-                        (r.result, m)
-                    }),
-                };
-                ctx.progress.inc(1);
-                r.map(|(result, measured)| Done {
-                    model: i,
-                    peak: p,
-                    dim,
-                    result,
-                    measured,
-                })
-                .map_err(|e| format!("fig7 {case} {f_pk} N {}: {e}", dim.as_str()))
+        let done: Vec<Done> = par_jobs(ctx.progress, &jobs, |&(i, p, dim)| {
+            let (case, f_pk) = (MODELS[i].0, PEAKS[p]);
+            let r = match dim {
+                Dimension::OneD => run_1d(case, f_pk).map(|r| {
+                    let m = measured(&r, f_pk, 0.0, 0.0);
+                    (r, m)
+                }),
+                Dimension::TwoD => run_2d(case, f_pk, None).map(|r| {
+                    let m = measured(&r.result, f_pk, r.max_abs_theta, r.max_abs_y);
+                    (r.result, m)
+                }),
+            };
+            r.map(|(result, measured)| Done {
+                model: i,
+                peak: p,
+                dim,
+                result,
+                measured,
             })
-            .collect::<Result<_, _>>()?;
+            .map_err(|e| format!("fig7 {case} {f_pk} N {}: {e}", dim.as_str()))
+        })?;
         let get = |i: usize, p: usize, d: Dimension| {
             done.iter()
                 .find(|x| x.model == i && x.peak == p && x.dim == d)
@@ -550,16 +545,7 @@ impl Figure for Fig7 {
             2,
             (640, 460),
         )?);
-        let metrics = FigureMetrics {
-            figure: "fig7".into(),
-            cases,
-        };
-        let markdown = report(&metrics);
-        Ok(FigureReport {
-            metrics,
-            markdown,
-            files,
-        })
+        Ok(FigureReport::new("fig7", cases, files, report))
     }
 }
 

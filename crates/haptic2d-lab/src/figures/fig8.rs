@@ -16,13 +16,14 @@
 //! (the device's friction and quantisation make the staircase vary by ~1e-3 m per cycle; the device
 //! is an energy port the ledger does not close).
 
-use crate::csv::write_columns;
-use crate::figures::{Figure, FigureContext, FigureReport};
-use crate::plot::{write_panels, Panel, Series, Stroke};
+use crate::figures::{
+    case_panels, device_case, run_configurations, write_tick_csv, Figure, FigureContext,
+    FigureReport,
+};
+use crate::plot::{write_panels, Series, Stroke};
 use crate::scenarios::peg_with_device::{run_case, Fig8Case, Fig8Params, FIG8_CASES};
-use crate::scenarios::{with_capstan_friction, Protocol};
+use crate::scenarios::{with_capstan_friction, ControllerRuns, Protocol};
 use crate::schema::{CaseMetrics, Check, Dimension, Fig7Measured, FigureMetrics, Measured};
-use rayon::prelude::*;
 use std::fmt::Write as _;
 
 /// The controllers compared: `(name, parameters, comparison)`. The four-channel controller with its
@@ -53,11 +54,9 @@ fn controllers(ctx: Option<&FigureContext>) -> Result<Vec<(String, Fig8Params)>,
             Fig8Params {
                 rate: 500.0,
                 scale: 1.0,
-                haptic: haptic2d::haptic::HapticConfig {
-                    controller: haptic2d::haptic::ControllerKind::Coupling(PAPER_RATE_COUPLING),
-                    ..haptic2d::haptic::HapticConfig::default()
-                },
-                ..Fig8Params::default()
+                ..Fig8Params::with_controller(haptic2d::haptic::ControllerKind::Coupling(
+                    PAPER_RATE_COUPLING,
+                ))
             },
         ),
     ];
@@ -200,19 +199,10 @@ impl Figure for Fig8 {
     }
     fn run(&self, ctx: &FigureContext) -> Result<FigureReport, String> {
         let ctrl = controllers(Some(ctx))?;
-        let jobs: Vec<(usize, usize)> = (0..ctrl.len())
-            .flat_map(|i| (0..FIG8_CASES.len()).map(move |j| (i, j)))
-            .collect();
-        let done: Vec<(usize, usize, Fig8Case)> = jobs
-            .par_iter()
-            .map(|&(i, j)| {
-                let (name, model, drift) = FIG8_CASES[j];
-                let r = run_case(&ctrl[i].1, name, model, drift)
-                    .map_err(|e| format!("fig8 {}: {e}", ctrl[i].0));
-                ctx.progress.inc(1);
-                r.map(|c| (i, j, c))
-            })
-            .collect::<Result<_, _>>()?;
+        let done = run_configurations(ctx, "fig8", &ctrl, FIG8_CASES.len(), |p, j| {
+            let (name, model, drift) = FIG8_CASES[j];
+            run_case(p, name, model, drift)
+        })?;
         let mut files = Vec::new();
         let mut cases = Vec::new();
         for (i, j, c) in &done {
@@ -220,75 +210,35 @@ impl Figure for Fig8 {
             let model = format!("{}/{}", ctrl[*i].0, c.name);
             let (world, haptic) =
                 crate::scenarios::peg_with_device::case_world(p, FIG8_CASES[*j].1)?;
-            let mut case = CaseMetrics::new(
-                &model,
-                Dimension::TwoD,
-                Measured::Fig7(measured(p, c)),
-                checks(c),
-            )
-            .with_comparison(carrier(*i).is_none())
-            .with_stability(crate::design::verdict_line(&haptic, &world, p.rate));
-            if let Some(why) = carrier(*i) {
-                case = case.with_carrier(format!("{}: {why}", ctrl[*i].0));
-            }
+            let case = device_case(
+                CaseMetrics::new(
+                    &model,
+                    Dimension::TwoD,
+                    Measured::Fig7(measured(p, c)),
+                    checks(c),
+                ),
+                &ctrl[*i].0,
+                carrier(*i),
+                crate::design::verdict_line(&haptic, &world, p.rate),
+            );
             cases.push(case);
-            let r = &c.records;
-            let col = |f: &dyn Fn(usize) -> f64| (0..r.len()).map(f).collect::<Vec<f64>>();
-            let x0 = (r[0].x_s[0], r[0].x_m[0]);
             let path = ctx.dir.join(format!("{}_{}.csv", ctrl[*i].0, c.name));
-            write_columns(
-                &path,
-                &[
-                    "t_s",
-                    "peg_x_m",
-                    "peg_y_m",
-                    "peg_theta_rad",
-                    "peg_vx_m_s",
-                    "device_x_world_m",
-                    "push_n",
-                    "f_e_x_n",
-                    "contacts",
-                ],
-                &[
-                    &col(&|k| r[k].t),
-                    &col(&|k| r[k].x_s[0]),
-                    &col(&|k| r[k].x_s[1]),
-                    &col(&|k| r[k].x_s[2]),
-                    &col(&|k| r[k].v_s[0]),
-                    &col(&|k| x0.0 + p.scale * (r[k].x_m[0] - x0.1)),
-                    &c.push,
-                    &col(&|k| r[k].f_e[0]),
-                    &col(&|k| r[k].contacts as f64),
-                ],
-            )?;
+            write_tick_csv(&path, &c.records, p.scale, "peg", &[(6, "push_n", &c.push)])?;
             files.push(path);
         }
-        let panels: Vec<Panel> = FIG8_CASES
-            .iter()
-            .enumerate()
-            .map(|(j, (name, _, _))| Panel {
-                title: label(name).to_string(),
-                x_label: "time (s)".into(),
-                y_label: "peg position x (mm)".into(),
-                series: done
-                    .iter()
-                    .filter(|d| d.1 == j)
-                    .map(|(i, _, c)| {
-                        let pts = c.records.iter().map(|r| (r.t, r.x_s[0] * 1e3)).collect();
-                        let (stroke, lbl) = match (*i, &c.stopped) {
-                            (0, _) => (Stroke::Solid, ctrl[*i].0.clone()),
-                            (_, Some(_)) => {
-                                (Stroke::Dashed, format!("{} (safety stop)", ctrl[*i].0))
-                            }
-                            _ => (Stroke::Dashed, ctrl[*i].0.clone()),
-                        };
-                        Series::new(lbl, pts, *i, stroke)
-                    })
-                    .collect(),
-                y_range: Some((-5.0, 120.0)),
-                ..Panel::default()
-            })
-            .collect();
+        let titles: Vec<&str> = FIG8_CASES.iter().map(|(name, _, _)| label(name)).collect();
+        let mut panels = case_panels(&titles, "peg position x (mm)", &done, |i, c| {
+            let pts = c.records.iter().map(|r| (r.t, r.x_s[0] * 1e3)).collect();
+            let (stroke, lbl) = match (i, &c.stopped) {
+                (0, _) => (Stroke::Solid, ctrl[i].0.clone()),
+                (_, Some(_)) => (Stroke::Dashed, format!("{} (safety stop)", ctrl[i].0)),
+                _ => (Stroke::Dashed, ctrl[i].0.clone()),
+            };
+            Series::new(lbl, pts, i, stroke)
+        });
+        for p in &mut panels {
+            p.y_range = Some((-5.0, 120.0));
+        }
         files.extend(write_panels(
             &ctx.dir.join("positions"),
             "Figs. 8–11 with the device in the loop: peg position, push 2.1 N (1 − cos 2πt)/2 from t = 1 s",
@@ -296,16 +246,7 @@ impl Figure for Fig8 {
             2,
             (620, 320),
         )?);
-        let metrics = FigureMetrics {
-            figure: "fig8".into(),
-            cases,
-        };
-        let markdown = report(&metrics);
-        Ok(FigureReport {
-            metrics,
-            markdown,
-            files,
-        })
+        Ok(FigureReport::new("fig8", cases, files, report))
     }
 }
 

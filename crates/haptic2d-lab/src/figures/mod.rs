@@ -11,9 +11,12 @@ pub mod fig5_sweep;
 pub mod fig7;
 pub mod fig8;
 
-use crate::schema::FigureMetrics;
-use haptic2d::haptic::ControllerKind;
+use crate::csv::write_columns;
+use crate::plot::{Panel, Series};
+use crate::schema::{CaseMetrics, FigureMetrics};
+use haptic2d::haptic::{ControllerKind, TickRecord};
 use indicatif::{ProgressBar, ProgressStyle};
+use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -38,6 +41,153 @@ pub struct FigureReport {
     pub markdown: String,
     /// Files written into the figure folder (CSV, SVG, PNG).
     pub files: Vec<PathBuf>,
+}
+
+impl FigureReport {
+    /// The report of figure `figure`: its `cases` as the metrics, `report` of those metrics as its
+    /// section of `REPORT.md`, and the `files` it wrote.
+    pub fn new(
+        figure: &str,
+        cases: Vec<CaseMetrics>,
+        files: Vec<PathBuf>,
+        report: impl FnOnce(&FigureMetrics) -> String,
+    ) -> Self {
+        let metrics = FigureMetrics {
+            figure: figure.into(),
+            cases,
+        };
+        let markdown = report(&metrics);
+        FigureReport {
+            metrics,
+            markdown,
+            files,
+        }
+    }
+}
+
+/// Runs `job` on every element of `jobs` in parallel (rayon), advancing `progress` by one per
+/// finished job: the results in the order of `jobs`, or the first error.
+pub fn par_jobs<J: Sync, T: Send>(
+    progress: &ProgressBar,
+    jobs: &[J],
+    job: impl Fn(&J) -> Result<T, String> + Sync + Send,
+) -> Result<Vec<T>, String> {
+    jobs.par_iter()
+        .map(|j| {
+            let r = job(j);
+            progress.inc(1);
+            r
+        })
+        .collect()
+}
+
+/// A device-in-the-loop figure's runs: `case(parameters, j)` for every configuration `(label,
+/// parameters)` of `ctrl` and every case `j < cases`, in parallel (see [`par_jobs`]). Each result
+/// comes with its configuration's index `i` and its case `j`; an error names the figure and the
+/// configuration.
+pub fn run_configurations<P: Sync, C: Send>(
+    ctx: &FigureContext,
+    figure: &str,
+    ctrl: &[(String, P)],
+    cases: usize,
+    case: impl Fn(&P, usize) -> Result<C, String> + Sync + Send,
+) -> Result<Vec<(usize, usize, C)>, String> {
+    let jobs: Vec<(usize, usize)> = (0..ctrl.len())
+        .flat_map(|i| (0..cases).map(move |j| (i, j)))
+        .collect();
+    par_jobs(ctx.progress, &jobs, |&(i, j)| {
+        case(&ctrl[i].1, j)
+            .map(|c| (i, j, c))
+            .map_err(|e| format!("{figure} {}: {e}", ctrl[i].0))
+    })
+}
+
+/// A case of a device-in-the-loop figure: a claim case when `carrier` (why configuration `label`
+/// carries the claim) is given, a comparison run otherwise; `stability` is `haptic2d stability`'s
+/// verdict for the configuration on the case's scene.
+pub fn device_case(
+    case: CaseMetrics,
+    label: &str,
+    carrier: Option<&str>,
+    stability: String,
+) -> CaseMetrics {
+    let case = case
+        .with_comparison(carrier.is_none())
+        .with_stability(stability);
+    match carrier {
+        Some(why) => case.with_carrier(format!("{label}: {why}")),
+        None => case,
+    }
+}
+
+/// Writes the CSV of a device-in-the-loop run from its tick `records`: `t_s`, the slave body's
+/// pose and x velocity (`{body}_x_m`, `{body}_y_m`, `{body}_theta_rad`, `{body}_vx_m_s`), the
+/// device handle's x mapped to the world at mapping `scale` from the slave's start
+/// (`device_x_world_m`), `f_e_x_n` and `contacts`; each of the figure's own columns `(index, name,
+/// values)` stands at its index among them.
+pub fn write_tick_csv(
+    path: &Path,
+    records: &[TickRecord],
+    scale: f64,
+    body: &str,
+    own: &[(usize, &str, &[f64])],
+) -> Result<(), String> {
+    let r = records;
+    let col = |f: &dyn Fn(usize) -> f64| (0..r.len()).map(f).collect::<Vec<f64>>();
+    let x0 = (r[0].x_s[0], r[0].x_m[0]);
+    let columns = [
+        col(&|k| r[k].t),
+        col(&|k| r[k].x_s[0]),
+        col(&|k| r[k].x_s[1]),
+        col(&|k| r[k].x_s[2]),
+        col(&|k| r[k].v_s[0]),
+        col(&|k| x0.0 + scale * (r[k].x_m[0] - x0.1)),
+        col(&|k| r[k].f_e[0]),
+        col(&|k| r[k].contacts as f64),
+    ];
+    let mut names = vec![
+        "t_s".to_string(),
+        format!("{body}_x_m"),
+        format!("{body}_y_m"),
+        format!("{body}_theta_rad"),
+        format!("{body}_vx_m_s"),
+        "device_x_world_m".to_string(),
+        "f_e_x_n".to_string(),
+        "contacts".to_string(),
+    ];
+    let mut values: Vec<&[f64]> = columns.iter().map(|c| c.as_slice()).collect();
+    for &(at, name, v) in own {
+        names.insert(at, name.to_string());
+        values.insert(at, v);
+    }
+    let names: Vec<&str> = names.iter().map(|n| n.as_str()).collect();
+    write_columns(path, &names, &values)
+}
+
+/// A device-in-the-loop figure's position panels: one panel per case (titled `titles[j]`), with
+/// one series per configuration, `series(i, run)` for run `(i, j, run)` of `done` (see
+/// [`run_configurations`]); time on x, `y_label` on y.
+pub fn case_panels<C>(
+    titles: &[&str],
+    y_label: &str,
+    done: &[(usize, usize, C)],
+    series: impl Fn(usize, &C) -> Series,
+) -> Vec<Panel> {
+    titles
+        .iter()
+        .enumerate()
+        .map(|(j, title)| Panel {
+            title: title.to_string(),
+            x_label: "time (s)".into(),
+            y_label: y_label.into(),
+            series: done
+                .iter()
+                .filter(|d| d.1 == j)
+                .map(|(i, _, c)| series(*i, c))
+                .collect(),
+            ..Panel::default()
+        })
+        .collect()
 }
 
 /// A reproducible experiment of the paper.
@@ -133,14 +283,7 @@ pub fn reproduce_with(
     if out.as_os_str().is_empty() {
         return Err("--out: the output folder must not be empty".to_string());
     }
-    if out.exists() && !out.is_dir() {
-        return Err(format!(
-            "--out: `{}` exists and is not a folder",
-            out.display()
-        ));
-    }
-    std::fs::create_dir_all(out)
-        .map_err(|e| format!("--out: cannot create `{}`: {e}", out.display()))?;
+    create_out_dir(out)?;
 
     let total: u64 = selected.iter().map(|f| f.jobs()).sum();
     let bar = if show_progress {
@@ -194,6 +337,19 @@ pub fn reproduce_with(
         report,
         seconds: start.elapsed().as_secs_f64(),
     })
+}
+
+/// Creates the output folder `out` (`--out`) with its parents; an error if `out` is a file or
+/// cannot be created.
+pub fn create_out_dir(out: &Path) -> Result<(), String> {
+    if out.exists() && !out.is_dir() {
+        return Err(format!(
+            "--out: `{}` exists and is not a folder",
+            out.display()
+        ));
+    }
+    std::fs::create_dir_all(out)
+        .map_err(|e| format!("--out: cannot create `{}`: {e}", out.display()))
 }
 
 fn write(path: &Path, text: &str) -> Result<(), String> {

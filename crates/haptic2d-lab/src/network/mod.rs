@@ -6,6 +6,7 @@
 
 pub mod delayed_wall;
 pub mod figures;
+pub mod held;
 pub mod link;
 pub mod teleop;
 pub mod wave;

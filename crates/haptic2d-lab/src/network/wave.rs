@@ -107,6 +107,16 @@ impl WaveBudget {
         w
     }
 
+    /// Corrects the last [`Self::spend`]: the port really drew the wave `drawn` where `spent` was
+    /// granted (a force that saturated, was ramped or gated); books the difference of their
+    /// energies over `dt` (s). More drawn than granted is a debt: the room left shrinks, and
+    /// the next samples get less until the sender has sent more.
+    pub fn rebook(&mut self, spent: f64, drawn: f64, dt: f64) {
+        if spent.is_finite() && drawn.is_finite() && dt > 0.0 {
+            self.used += 0.5 * (drawn * drawn - spent * spent) * dt;
+        }
+    }
+
     /// Wave energy used so far (J).
     pub fn used(&self) -> f64 {
         self.used
@@ -126,6 +136,8 @@ pub struct WaveMaster {
     sent: f64,
     /// The newest returning wave and the slave's wave energy sent, as received.
     last: WaveMsg,
+    /// The returning wave granted by the budget in the last [`WaveMaster::force`] (√W).
+    w: f64,
 }
 
 impl WaveMaster {
@@ -141,23 +153,45 @@ impl WaveMaster {
     /// newest wave if one arrived this sample. Returns the force on the handle (N, `−F_m`) and the
     /// message to send.
     pub fn step(&mut self, x: f64, v: f64, msg: Option<WaveMsg>, dt: f64) -> (f64, WaveMsg) {
+        let f = self.force(v, msg, dt);
+        (f, self.book(x, v, f, dt))
+    }
+
+    /// The force alone, for a caller that may apply less than it returns (a device whose torques
+    /// saturate, a start-up ramp, a safety gate): the force on the handle (N, `−F_m`) from the
+    /// newest returning wave within its budget, with the handle moving at `v` (m/s). Then book
+    /// what was really applied with [`Self::book`].
+    pub fn force(&mut self, v: f64, msg: Option<WaveMsg>, dt: f64) -> f64 {
         let b = self.p.b;
         if let Some(m) = msg.filter(|m| m.wave.is_finite() && m.energy.is_finite()) {
             self.last = m;
         }
-        let w = self.budget.spend(self.last.wave, self.last.energy, dt);
+        self.w = self.budget.spend(self.last.wave, self.last.energy, dt);
         let v = if v.is_finite() { v } else { 0.0 };
-        let f_m = b * v - (2.0 * b).sqrt() * w;
-        let u = (2.0 * b).sqrt() * v - w;
+        -(b * v - (2.0 * b).sqrt() * self.w)
+    }
+
+    /// Books the sample in which `applied` (N) really acted on the handle at `x` (m) moving at `v`
+    /// (m/s) — the force of [`Self::force`], or less — and returns the message to send. The wave
+    /// sent and the returning wave drawn are those of the force really applied,
+    /// `u = (b·v − applied)/√(2b)`, `w = (b·v + applied)/√(2b)`, so that the port's power is
+    /// exactly `½u² − ½w²`; a drawn wave larger than the budget granted is booked as a debt
+    /// ([`WaveBudget::rebook`]).
+    pub fn book(&mut self, x: f64, v: f64, applied: f64, dt: f64) -> WaveMsg {
+        let b = self.p.b;
+        let (v, applied) = (
+            if v.is_finite() { v } else { 0.0 },
+            if applied.is_finite() { applied } else { 0.0 },
+        );
+        let u = (b * v - applied) / (2.0 * b).sqrt();
+        let drawn = (b * v + applied) / (2.0 * b).sqrt();
+        self.budget.rebook(self.w, drawn, dt);
         self.sent += 0.5 * u * u * dt;
-        (
-            -f_m,
-            WaveMsg {
-                wave: u,
-                energy: self.sent,
-                x,
-            },
-        )
+        WaveMsg {
+            wave: u,
+            energy: self.sent,
+            x,
+        }
     }
 
     /// The returning waves' budget (energy used and cut).
@@ -313,6 +347,35 @@ mod tests {
         assert_eq!(b.spend(-3.0, 1e-3, dt), 0.0);
         assert!((b.used() - 1e-3).abs() < 1e-12);
         assert!(b.spend(f64::NAN, 1.0, dt) == 0.0);
+    }
+
+    #[test]
+    fn a_master_whose_force_is_cut_sends_and_draws_the_waves_of_the_force_applied() {
+        let p = WaveParams::default();
+        let dt = 1e-3;
+        let back = WaveMsg {
+            wave: 2.0,
+            energy: 1.0,
+            x: 0.0,
+        };
+        let (v, b) = (0.05, p.b);
+        // Uncut, force + book is the step: u = √(2b)·v − w.
+        let mut m = WaveMaster::new(p);
+        let (f, out) = m.step(0.0, v, Some(back), dt);
+        assert!((f - (-(b * v) + (2.0 * b).sqrt() * 2.0)).abs() < 1e-12);
+        assert!((out.wave - ((2.0 * b).sqrt() * v - 2.0)).abs() < 1e-12);
+        // The actuators apply half of it: the port's power v·(−applied) is ½u² − ½w² exactly,
+        // with u sent and w drawn (booked in the budget) those of the half force.
+        let mut m = WaveMaster::new(p);
+        let f = m.force(v, Some(back), dt);
+        let out = m.book(0.0, v, 0.5 * f, dt);
+        let drawn = m.budget().used() / (0.5 * dt);
+        let power = v * -(0.5 * f);
+        assert!(
+            (power - (0.5 * out.wave * out.wave - 0.5 * drawn)).abs() < 1e-9,
+            "{power} {out:?} {drawn}"
+        );
+        assert!((out.energy - 0.5 * out.wave * out.wave * dt).abs() < 1e-15);
     }
 
     #[test]

@@ -10,6 +10,37 @@
 pub mod peg_with_device;
 pub mod walls_with_device;
 
+use haptic2d::control::coupling::CouplingGains;
+use haptic2d::control::four_channel::FourChannelGains;
+use haptic2d::haptic::{ControllerKind, HapticConfig};
+
+/// The parameters of a device-in-the-loop scenario ([`walls_with_device::Fig5Params`],
+/// [`peg_with_device::Fig8Params`]) and the controller comparison runs made from its defaults.
+pub trait ControllerRuns: Default {
+    /// The haptic configuration the scenario runs.
+    fn haptic_mut(&mut self) -> &mut HapticConfig;
+
+    /// The defaults with `controller` in place of the default controller.
+    fn with_controller(controller: ControllerKind) -> Self {
+        let mut p = Self::default();
+        p.haptic_mut().controller = controller;
+        p
+    }
+
+    /// The defaults with the virtual-coupling controller (§11.2) instead of the four-channel one
+    /// (same device). A comparison run.
+    fn coupling() -> Self {
+        Self::with_controller(ControllerKind::Coupling(CouplingGains::default()))
+    }
+
+    /// The defaults with the paper's four-channel gains (the §11.1 table,
+    /// `FourChannelGains::spec`) on the spec's device as given: unstable with the hand released
+    /// (§11.4). A comparison run.
+    fn paper_controller() -> Self {
+        Self::with_controller(ControllerKind::FourChannel(FourChannelGains::spec()))
+    }
+}
+
 /// How "the hand is replaced by a constant force" (Figs. 5–6; the sinusoidal force of Figs. 8–11)
 /// is read (issue 36 item 4). The paper's force information is observer-based, so the force could
 /// have acted on the handle or been fed to the controller as the hand's force.
@@ -35,6 +66,43 @@ impl Protocol {
             Protocol::HandleForce => "handle-force",
             Protocol::EstimateInjection => "estimate-injection",
         }
+    }
+}
+
+/// The text of the built-in scene `scene` with its table from the line `table` up to (not
+/// including) the line `next` replaced by `replacement`: how a device-in-the-loop case swaps the
+/// wall law or friction model of the paper's scene.
+pub fn builtin_with_table(
+    scene: &str,
+    table: &str,
+    next: &str,
+    replacement: &str,
+) -> Result<String, String> {
+    let text = haptic2d::scene::BUILTIN
+        .iter()
+        .find(|b| b.0 == scene)
+        .ok_or(format!("built-in scene {scene} missing"))?
+        .2;
+    let start = text.find(table).ok_or(format!("{scene} has no {table}"))?;
+    let end = text[start..]
+        .find(next)
+        .map(|i| start + i)
+        .ok_or(format!("{scene} has no {next}"))?;
+    Ok(format!("{}{replacement}{}", &text[..start], &text[end..]))
+}
+
+/// The hand holding the handle at pose `start` ([`HandModel::grip`](haptic2d::device::HandModel::grip)),
+/// with the grip's stiffness (N/m, N/m, N·m/rad) and damping (N·s/m, N·s/m, N·m·s/rad) per axis,
+/// which the pushes after the release keep along the axes they do not drive.
+pub fn hold_at(
+    start: [f64; 3],
+) -> Result<(haptic2d::device::HandModel, [f64; 3], [f64; 3]), String> {
+    let hold = haptic2d::device::HandModel::grip(start);
+    match hold {
+        haptic2d::device::HandModel::SpringDamper {
+            stiffness, damping, ..
+        } => Ok((hold, stiffness, damping)),
+        _ => Err("grip hand is a spring-damper".into()),
     }
 }
 

@@ -14,7 +14,7 @@
 //! **Which runs carry the claims (issue 36).** The default controller
 //! (`FourChannelGains::local_force_feedback`: `C6 = −1`, slave-side local force feedback `C5 = 2`,
 //! master damping injection 1 N·s/m) — [`Fig8Params::default`]. Comparison runs: the virtual
-//! coupling ([`Fig8Params::coupling`]) and the §11.1 table ([`Fig8Params::paper_controller`]).
+//! coupling ([`Fig8Params::coupling`](crate::scenarios::ControllerRuns::coupling)) and the §11.1 table ([`Fig8Params::paper_controller`](crate::scenarios::ControllerRuns::paper_controller)).
 //!
 //! **The mechanism.** After the release nothing holds the handle: with the §11.1 table (`C2 = 1`) the
 //! released loop of handle, peg and the squeezed corner springs is unstable in continuous time — for
@@ -38,13 +38,11 @@
 //! cycle differences < 1e-5 m) is not required: the device's joint friction, encoder quantisation and
 //! coupling make the staircase vary by about 1e-3 m per cycle.
 
-use haptic2d::control::coupling::CouplingGains;
-use haptic2d::control::four_channel::FourChannelGains;
 use haptic2d::device::HandModel;
 use haptic2d::laws::friction::FrictionModel;
-use haptic2d::scene::{Scene, BUILTIN};
+use haptic2d::scene::Scene;
 
-use haptic2d::haptic::config::{ControllerKind, HapticConfig};
+use haptic2d::haptic::config::HapticConfig;
 use haptic2d::haptic::experiment::DeviceInTheLoop;
 use haptic2d::haptic::record::TickRecord;
 use haptic2d::haptic::system::HapticSystem;
@@ -115,28 +113,11 @@ impl Fig8Params {
     pub fn four_channel() -> Self {
         Self::default()
     }
+}
 
-    /// The defaults with the virtual-coupling controller (§11.2). A comparison run.
-    pub fn coupling() -> Self {
-        Self {
-            haptic: HapticConfig {
-                controller: ControllerKind::Coupling(CouplingGains::default()),
-                ..HapticConfig::default()
-            },
-            ..Self::default()
-        }
-    }
-
-    /// The defaults with the §11.1 table (`FourChannelGains::spec`): unstable with the hand released
-    /// (§11.4). A comparison run.
-    pub fn paper_controller() -> Self {
-        Self {
-            haptic: HapticConfig {
-                controller: ControllerKind::FourChannel(FourChannelGains::spec()),
-                ..HapticConfig::default()
-            },
-            ..Self::default()
-        }
+impl super::ControllerRuns for Fig8Params {
+    fn haptic_mut(&mut self) -> &mut HapticConfig {
+        &mut self.haptic
     }
 }
 
@@ -186,23 +167,12 @@ pub struct Fig8Case {
 
 fn peg_toml(friction: &str) -> Result<String, String> {
     FrictionModel::from_name(friction, true)?;
-    let text = BUILTIN
-        .iter()
-        .find(|b| b.0 == "peg-in-hole")
-        .ok_or("built-in scene peg-in-hole missing")?
-        .2;
-    let start = text
-        .find("[friction]")
-        .ok_or("peg-in-hole has no [friction]")?;
-    let end = text[start..]
-        .find("[[body]]")
-        .map(|i| start + i)
-        .ok_or("peg-in-hole has no [[body]]")?;
-    Ok(format!(
-        "{}[friction]\nmodel = \"{friction}\"\n\n{}",
-        &text[..start],
-        &text[end..]
-    ))
+    super::builtin_with_table(
+        "peg-in-hole",
+        "[friction]",
+        "[[body]]",
+        &format!("[friction]\nmodel = \"{friction}\"\n\n"),
+    )
 }
 
 /// The peg-in-hole world with friction model `friction` at `rate` (Hz), and the haptic settings a
@@ -228,27 +198,12 @@ pub fn run_case(
     friction: &str,
     expect_drift: bool,
 ) -> Result<Fig8Case, String> {
-    let world = Scene::from_toml(&peg_toml(friction)?, "fig8", Some(p.rate))
-        .map_err(|e| e.to_string())?
-        .world;
-    let mut cfg = p.haptic.clone();
-    cfg.device_origin = Some([p.start_x, cfg.device.workspace_center_y, 0.0]);
-    cfg.scale = p.scale;
+    let (world, cfg) = case_world(p, friction)?;
     let system = HapticSystem::new(world, &cfg)?;
     let s = p.scale;
     let mut l = DeviceInTheLoop::new(system, HandModel::Free, 10, true)?;
     let start = l.plant.pose();
-    let HandModel::SpringDamper {
-        stiffness, damping, ..
-    } = HandModel::grip(start)
-    else {
-        return Err("grip hand is a spring-damper".into());
-    };
-    let hold = HandModel::SpringDamper {
-        target: start,
-        stiffness,
-        damping,
-    };
+    let (hold, stiffness, damping) = super::hold_at(start)?;
     // The push in: a 1 N/m spring stretched by s·F metres (constant to ±1 % over the travel), y and θ
     // still gripped.
     let pushing = HandModel::SpringDamper {

@@ -27,10 +27,10 @@
 //! states beside `haptic2d stability`'s verdict (see `crate::figures::fig5`): the hysteretic wall by the
 //! default controller ([`Fig5Params::default`]: `FourChannelGains::local_force_feedback`, `C6 = −1`,
 //! `C5 = 2`), the pulse wall by the former default (`C6 = −1`, `C5 = 0`, `D_m = 2`), and the SEH and
-//! ZOH bouncing by the paper's §11.1 table ([`Fig5Params::paper_controller`]), which is unstable
+//! ZOH bouncing by the paper's §11.1 table ([`Fig5Params::paper_controller`](crate::scenarios::ControllerRuns::paper_controller)), which is unstable
 //! released against these walls and refused on a real device. Comparison runs: the §11.1 table on a
 //! device damped at twice Colgate's bound ([`Fig5Params::calibrated_damping`]) and the virtual
-//! coupling ([`Fig5Params::coupling`]).
+//! coupling ([`Fig5Params::coupling`](crate::scenarios::ControllerRuns::coupling)).
 //!
 //! **The mechanism.** After the release the hand is a constant force: the handle is *released* in the
 //! sense of §11.4 (no hand impedance). With the §11.1 table (`C2 = 1`) the released loop of handle,
@@ -49,16 +49,15 @@
 //! the study of issue 36 (`tests/design_search.rs`, 700+ candidates, MODELS.md §11.4) has both.
 
 use crate::schema::Check;
-use haptic2d::control::coupling::CouplingGains;
-use haptic2d::control::four_channel::FourChannelGains;
 use haptic2d::device::dynamics::LumpedDynamics;
 use haptic2d::device::HandModel;
 use haptic2d::device::TwinPantograph;
 use haptic2d::laws::normal::{BrakingPulseLaw, NormalModel};
 use haptic2d::metrics::{BounceMetrics, BounceSample};
-use haptic2d::scene::{Scene, BUILTIN};
+use haptic2d::scene::Scene;
 
-use haptic2d::haptic::config::{ControllerKind, HapticConfig};
+use super::ControllerRuns as _;
+use haptic2d::haptic::config::HapticConfig;
 use haptic2d::haptic::experiment::DeviceInTheLoop;
 use haptic2d::haptic::record::TickRecord;
 use haptic2d::haptic::safety::SafetyConfig;
@@ -104,32 +103,14 @@ pub struct Fig5Params {
     pub protocol: super::Protocol,
 }
 
+impl super::ControllerRuns for Fig5Params {
+    fn haptic_mut(&mut self) -> &mut HapticConfig {
+        &mut self.haptic
+    }
+}
+
 impl Fig5Params {
-    /// The defaults with the virtual-coupling controller (§11.2) instead of the four-channel one
-    /// (same spec device). A comparison run.
-    pub fn coupling() -> Self {
-        Self {
-            haptic: HapticConfig {
-                controller: ControllerKind::Coupling(CouplingGains::default()),
-                ..HapticConfig::default()
-            },
-            ..Self::default()
-        }
-    }
-
-    /// The paper's four-channel gains (the §11.1 table, `FourChannelGains::spec`) on the spec's
-    /// device as given: unstable with the hand released (§11.4). A comparison run.
-    pub fn paper_controller() -> Self {
-        Self {
-            haptic: HapticConfig {
-                controller: ControllerKind::FourChannel(FourChannelGains::spec()),
-                ..HapticConfig::default()
-            },
-            ..Self::default()
-        }
-    }
-
-    /// Same as [`Fig5Params::paper_controller`] (the §11.1 table on the undamped §10.2 device).
+    /// Same as [`Fig5Params::paper_controller`](crate::scenarios::ControllerRuns::paper_controller) (the §11.1 table on the undamped §10.2 device).
     pub fn spec_device() -> Self {
         Self::paper_controller()
     }
@@ -285,22 +266,12 @@ fn box_gap(x: &[f64; 3], half: [f64; 2]) -> f64 {
 /// The box-in-walls scene with the wall law `normal` (per-contact defaults) and impacts off.
 fn walls_toml(normal: &str, extra: &str) -> Result<String, String> {
     NormalModel::from_name(normal, true)?;
-    let text = BUILTIN
-        .iter()
-        .find(|b| b.0 == "box-in-walls")
-        .ok_or("built-in scene box-in-walls missing")?
-        .2;
-    let start = text
-        .find("[normal]")
-        .ok_or("box-in-walls has no [normal]")?;
-    let end = text[start..]
-        .find("[friction]")
-        .map(|i| start + i)
-        .ok_or("box-in-walls has no [friction]")?;
-    let mut out = String::with_capacity(text.len());
-    out.push_str(&text[..start]);
-    out.push_str(&format!("[normal]\nmodel = \"{normal}\"\n{extra}\n"));
-    out.push_str(&text[end..]);
+    let out = super::builtin_with_table(
+        "box-in-walls",
+        "[normal]",
+        "[friction]",
+        &format!("[normal]\nmodel = \"{normal}\"\n{extra}\n"),
+    )?;
     if !out.contains("impacts = true") {
         return Err("box-in-walls: `impacts = true` not found".into());
     }
@@ -349,17 +320,7 @@ pub fn run_case(
     let system = HapticSystem::with_safety(world, &haptic, p.safety)?;
     let mut l = DeviceInTheLoop::new(system, HandModel::Free, 10, p.quantize)?;
     let start = l.plant.pose();
-    let HandModel::SpringDamper {
-        stiffness, damping, ..
-    } = HandModel::grip(start)
-    else {
-        return Err("grip hand is a spring-damper".into());
-    };
-    let hold = HandModel::SpringDamper {
-        target: start,
-        stiffness,
-        damping,
-    };
+    let (hold, stiffness, damping) = super::hold_at(start)?;
     // After the release: a constant push along −x. With the guide, a spring of 1 N/m stretched by
     // 2 m gives F·(1 ± 1 %) over the few centimetres of travel, with no damping along x, while y and θ
     // keep the grip's spring–damper.

@@ -324,7 +324,7 @@ pub trait Observer {
     /// A short description for the session record (`simulated W=0.15 λ=0.02`).
     fn describe(&self) -> String;
     /// A rest break before `next` (the study's `[breaks]`, `order.rs`). The default (the simulated
-    /// observer, and the browser page for now) does nothing.
+    /// observer) does nothing; the browser session shows its break screen before `next`.
     fn rest(&mut self, _study: &Study, _next: &TrialSpec) -> Result<(), String> {
         Ok(())
     }

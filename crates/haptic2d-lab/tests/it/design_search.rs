@@ -32,10 +32,8 @@ use std::fmt::Write as _;
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Params {
     FourChannel {
-        c6: f64,
-        c5: f64,
-        d_m: f64,
-        d_s: f64,
+        /// `[C6, C5, D_m, D_s]` on x and y (D_m, D_s in N·s/m).
+        g: [f64; 4],
         /// θ gains `[K_s, B_s, K_m, B_m, D_m]` (N·m/rad, N·m·s/rad).
         th: [f64; 5],
     },
@@ -50,13 +48,8 @@ enum Params {
 impl Params {
     fn kind(&self) -> ControllerKind {
         match *self {
-            Params::FourChannel {
-                c6,
-                c5,
-                d_m,
-                d_s,
-                th,
-            } => {
+            Params::FourChannel { g, th } => {
+                let [c6, c5, d_m, d_s] = g;
                 let spec = FourChannelGains::spec();
                 ControllerKind::FourChannel(FourChannelGains {
                     c6: [c6, c6, -1.0],
@@ -78,64 +71,67 @@ impl Params {
     }
     fn key(&self) -> String {
         match *self {
-            Params::FourChannel {
-                c6,
-                c5,
-                d_m,
-                d_s,
-                th,
-            } => format!("4ch c6={c6:.3} c5={c5:.3} dm={d_m:.3} ds={d_s:.3} th={th:?}"),
+            Params::FourChannel { g, th } => {
+                let [c6, c5, d_m, d_s] = g;
+                format!("4ch c6={c6:.3} c5={c5:.3} dm={d_m:.3} ds={d_s:.3} th={th:?}")
+            }
             Params::Coupling { k, b, th } => format!("vc k={k:.1} b={b:.2} th={th:?}"),
         }
     }
-    /// Half-step neighbours.
+    /// Half-step neighbours (four-channel: those with C6 ≤ −0.5 and C5, D_m, D_s ≥ 0).
     fn neighbours(&self) -> Vec<Params> {
-        let mut v = Vec::new();
+        let near = |x: f64, d: f64| [x + -d, x + 0.0, x + d];
+        let by = |x: f64| [x * 0.8, x * 1.0, x * 1.25];
         match *self {
-            Params::FourChannel {
-                c6,
-                c5,
-                d_m,
-                d_s,
+            Params::FourChannel { g, th } => grid(
+                [
+                    &near(g[0], 0.05),
+                    &near(g[1], 0.25),
+                    &near(g[2], 0.25),
+                    &near(g[3], 2.5),
+                ],
                 th,
-            } => {
-                for dc6 in [-0.05, 0.0, 0.05] {
-                    for dc5 in [-0.25, 0.0, 0.25] {
-                        for ddm in [-0.25, 0.0, 0.25] {
-                            for dds in [-2.5, 0.0, 2.5] {
-                                let p = Params::FourChannel {
-                                    c6: c6 + dc6,
-                                    c5: c5 + dc5,
-                                    d_m: d_m + ddm,
-                                    d_s: d_s + dds,
-                                    th,
-                                };
-                                if (c6 + dc6) <= -0.5
-                                    && c5 + dc5 >= 0.0
-                                    && d_m + ddm >= 0.0
-                                    && d_s + dds >= 0.0
-                                {
-                                    v.push(p);
-                                }
-                            }
-                        }
-                    }
-                }
-            }
-            Params::Coupling { k, b, th } => {
-                for fk in [0.8, 1.0, 1.25] {
-                    for fb in [0.8, 1.0, 1.25] {
-                        v.push(Params::Coupling {
-                            k: k * fk,
-                            b: b * fb,
-                            th,
-                        });
-                    }
-                }
-            }
+                [&[], &[]],
+                [0.0; 2],
+            )
+            .into_iter()
+            .filter(|p| {
+                matches!(*p, Params::FourChannel { g: [c6, c5, d_m, d_s], .. }
+                    if c6 <= -0.5 && c5 >= 0.0 && d_m >= 0.0 && d_s >= 0.0)
+            })
+            .collect(),
+            Params::Coupling { k, b, th } => grid([&[]; 4], [0.0; 5], [&by(k), &by(b)], th),
         }
-        v
     }
+}
+
+/// The design study's cases, and the model the transparency ("feel") is scored on: x of the
+/// box in the walls at 1 kHz.
+fn study_cases_and_feel() -> (Vec<StudyCase>, haptic2d_lab::stability::AxisModel) {
+    let cases = design::study_cases().expect("cases");
+    let feel_model = cases
+        .iter()
+        .find(|c| c.label == "box-in-walls@1" && c.rate == 1000.0)
+        .expect("box-in-walls")
+        .model
+        .axes[0];
+    (cases, feel_model)
+}
+
+/// Each claim with its verdict and detail, `; `-separated.
+fn claims_line(claims: &[ClaimOutcome]) -> String {
+    claims
+        .iter()
+        .map(|o| {
+            format!(
+                "{} {} ({})",
+                o.claim,
+                if o.pass { "PASS" } else { "fail" },
+                o.detail
+            )
+        })
+        .collect::<Vec<_>>()
+        .join("; ")
 }
 
 /// A scored candidate.
@@ -155,29 +151,43 @@ impl Point {
     }
 }
 
-fn coarse(th: [f64; 5], th_c: [f64; 2]) -> Vec<Params> {
+/// The four-channel designs at every `(C6, C5, D_m, D_s)` of the values `four` (in that nesting
+/// order) with the transparency gains `th`, then the couplings at every `(K, B)` of `coupling` with
+/// the θ gains `th_c`.
+fn grid(four: [&[f64]; 4], th: [f64; 5], coupling: [&[f64]; 2], th_c: [f64; 2]) -> Vec<Params> {
     let mut v = Vec::new();
-    for c6 in [-1.1, -1.0, -0.9, -0.8] {
-        for c5 in [0.0, 0.5, 1.0, 1.5, 2.0, 3.0] {
-            for d_m in [0.0, 0.5, 1.0, 2.0, 4.0] {
-                for d_s in [0.0, 5.0, 15.0] {
+    for &c6 in four[0] {
+        for &c5 in four[1] {
+            for &d_m in four[2] {
+                for &d_s in four[3] {
                     v.push(Params::FourChannel {
-                        c6,
-                        c5,
-                        d_m,
-                        d_s,
+                        g: [c6, c5, d_m, d_s],
                         th,
                     });
                 }
             }
         }
     }
-    for k in [250.0, 500.0, 1000.0, 2000.0] {
-        for b in [2.0, 5.0, 10.0, 20.0] {
+    for &k in coupling[0] {
+        for &b in coupling[1] {
             v.push(Params::Coupling { k, b, th: th_c });
         }
     }
     v
+}
+
+fn coarse(th: [f64; 5], th_c: [f64; 2]) -> Vec<Params> {
+    grid(
+        [
+            &[-1.1, -1.0, -0.9, -0.8],
+            &[0.0, 0.5, 1.0, 1.5, 2.0, 3.0],
+            &[0.0, 0.5, 1.0, 2.0, 4.0],
+            &[0.0, 5.0, 15.0],
+        ],
+        th,
+        [&[250.0, 500.0, 1000.0, 2000.0], &[2.0, 5.0, 10.0, 20.0]],
+        th_c,
+    )
 }
 
 /// The margin, or a failed analysis recorded as unstable (−∞) with the reason.
@@ -224,17 +234,11 @@ fn csv(points: &BTreeMap<String, Point>) -> String {
     s.push('\n');
     for p in points.values() {
         let (arch, cols) = match p.params {
-            Params::FourChannel {
-                c6,
-                c5,
-                d_m,
-                d_s,
-                th,
-            } => (
+            Params::FourChannel { g, th } => (
                 "four-channel",
                 format!(
-                    "{c6},{c5},{d_m},{d_s},{},{},{},{},{},,",
-                    th[0], th[1], th[2], th[3], th[4]
+                    "{},{},{},{},{},{},{},{},{},,",
+                    g[0], g[1], g[2], g[3], th[0], th[1], th[2], th[3], th[4]
                 ),
             ),
             Params::Coupling { k, b, th } => {
@@ -272,13 +276,7 @@ fn csv(points: &BTreeMap<String, Point>) -> String {
 #[test]
 #[ignore = "long: the design study (hundreds of stability analyses, ~100 x 9 device-in-the-loop runs); run with --release"]
 fn design_study_frontier() {
-    let cases = design::study_cases().expect("cases");
-    let feel_model = cases
-        .iter()
-        .find(|c| c.label == "box-in-walls@1" && c.rate == 1000.0)
-        .expect("box-in-walls")
-        .model
-        .axes[0];
+    let (cases, feel_model) = study_cases_and_feel();
     // The θ gains first, by stability alone (the claims are on x): the §11.1 table's θ slave PD
     // (4, 0.03) is refused on the peg at 500 Hz (§6.4: its 3.3e-5 kg·m² is below 1.5 x min_mass)
     // and grows there against the friction-stick spring. Grid over the θ gains on issue 36's
@@ -299,10 +297,7 @@ fn design_study_frontier() {
         .par_iter()
         .map(|th| {
             let p = Params::FourChannel {
-                c6: -1.0,
-                c5: 1.5,
-                d_m: 1.0,
-                d_s: 0.0,
+                g: [-1.0, 1.5, 1.0, 0.0],
                 th: *th,
             };
             (*th, margin_or_failed(&p.kind(), &cases))
@@ -596,30 +591,20 @@ fn claims_at_the_paper_rate_and_with_joint_friction() {
 #[test]
 #[ignore = "long: the paper-rate study (run with --release, about 2 min on 2 cores)"]
 fn paper_rate_study() {
-    let th = [1.0, 0.003, 0.5, 0.002, 0.004];
-    let th_c = [0.125, 0.005];
-    let mut grid = Vec::new();
-    for c6 in [-1.1, -1.0, -0.9] {
-        for c5 in [1.0, 1.5, 2.0, 2.5, 3.0, 4.0] {
-            for d_m in [0.0, 0.5, 1.0, 2.0] {
-                for d_s in [0.0, 5.0] {
-                    grid.push(Params::FourChannel {
-                        c6,
-                        c5,
-                        d_m,
-                        d_s,
-                        th,
-                    });
-                }
-            }
-        }
-    }
-    for k in [160.0, 250.0, 390.625, 500.0, 1000.0] {
-        for b in [2.0, 5.0, 7.8125, 15.0] {
-            grid.push(Params::Coupling { k, b, th: th_c });
-        }
-    }
-    paper_rate_grid(grid);
+    paper_rate_grid(grid(
+        [
+            &[-1.1, -1.0, -0.9],
+            &[1.0, 1.5, 2.0, 2.5, 3.0, 4.0],
+            &[0.0, 0.5, 1.0, 2.0],
+            &[0.0, 5.0],
+        ],
+        [1.0, 0.003, 0.5, 0.002, 0.004],
+        [
+            &[160.0, 250.0, 390.625, 500.0, 1000.0],
+            &[2.0, 5.0, 7.8125, 15.0],
+        ],
+        [0.125, 0.005],
+    ));
 }
 
 /// The four-channel family refined where the paper-rate study found its best (C6 −1.2…−0.95, C5
@@ -627,48 +612,28 @@ fn paper_rate_study() {
 #[test]
 #[ignore = "long: refinement of the paper-rate study (run with --release, a few minutes)"]
 fn paper_rate_study_refined() {
-    let th = [1.0, 0.003, 0.5, 0.002, 0.004];
-    let mut grid = Vec::new();
-    for c6 in [-1.2, -1.1, -1.05, -1.0, -0.95] {
-        for c5 in [1.25, 1.5, 1.75, 2.0, 2.25, 2.5] {
-            for d_m in [0.0, 0.5, 1.0] {
-                for d_s in [0.0, 2.5, 10.0] {
-                    grid.push(Params::FourChannel {
-                        c6,
-                        c5,
-                        d_m,
-                        d_s,
-                        th,
-                    });
-                }
-            }
-        }
-    }
-    for k in [100.0, 130.0, 160.0, 200.0, 250.0] {
-        for b in [3.0, 5.0, 7.8125, 10.0] {
-            grid.push(Params::Coupling {
-                k,
-                b,
-                th: [0.125, 0.005],
-            });
-        }
-    }
-    paper_rate_grid(grid);
+    paper_rate_grid(grid(
+        [
+            &[-1.2, -1.1, -1.05, -1.0, -0.95],
+            &[1.25, 1.5, 1.75, 2.0, 2.25, 2.5],
+            &[0.0, 0.5, 1.0],
+            &[0.0, 2.5, 10.0],
+        ],
+        [1.0, 0.003, 0.5, 0.002, 0.004],
+        [
+            &[100.0, 130.0, 160.0, 200.0, 250.0],
+            &[3.0, 5.0, 7.8125, 10.0],
+        ],
+        [0.125, 0.005],
+    ));
 }
 
 /// Scores `grid` as described at [`paper_rate_study`].
 fn paper_rate_grid(grid: Vec<Params>) {
-    use haptic2d::haptic::HapticConfig;
     use haptic2d_lab::scenarios::peg_with_device::Fig8Params;
     use haptic2d_lab::scenarios::walls_with_device::Fig5Params;
-    use haptic2d_lab::scenarios::Protocol;
-    let cases = design::study_cases().expect("cases");
-    let feel_model = cases
-        .iter()
-        .find(|c| c.label == "box-in-walls@1" && c.rate == 1000.0)
-        .expect("box-in-walls")
-        .model
-        .axes[0];
+    use haptic2d_lab::scenarios::{ControllerRuns, Protocol};
+    let (cases, feel_model) = study_cases_and_feel();
     let t0 = std::time::Instant::now();
     let margins: Vec<(Params, Margin)> = grid
         .par_iter()
@@ -689,11 +654,7 @@ fn paper_rate_grid(grid: Vec<Params>) {
         rate: 500.0,
         scale: 1.0,
         protocol,
-        haptic: HapticConfig {
-            controller: kind,
-            ..HapticConfig::default()
-        },
-        ..Fig8Params::default()
+        ..Fig8Params::with_controller(kind)
     };
     let mut scored: Vec<(Params, Margin, Protocol, Vec<ClaimOutcome>)> = stable
         .par_iter()
@@ -735,15 +696,7 @@ fn paper_rate_grid(grid: Vec<Params>) {
             m.released,
             feel.drag,
             feel.wall,
-            c.iter()
-                .map(|o| format!(
-                    "{} {} ({})",
-                    o.claim,
-                    if o.pass { "PASS" } else { "fail" },
-                    o.detail
-                ))
-                .collect::<Vec<_>>()
-                .join("; ")
+            claims_line(c)
         );
     }
     // Figs. 5–6 (already at 500 Hz, scale 1) for the designs with at least 4 of 5 there.
@@ -754,11 +707,7 @@ fn paper_rate_grid(grid: Vec<Params>) {
         .map(|(p, _, pr, c8)| {
             let c5 = design::fig5_claims(&Fig5Params {
                 protocol: *pr,
-                haptic: HapticConfig {
-                    controller: p.kind(),
-                    ..HapticConfig::default()
-                },
-                ..Fig5Params::default()
+                ..Fig5Params::with_controller(p.kind())
             });
             (
                 format!(
@@ -815,16 +764,7 @@ fn friction_compensation_settings() {
             format!(
                 "compensation {c}, deadband {d} rad/s: {}/5 — {}",
                 claims.iter().filter(|o| o.pass).count(),
-                claims
-                    .iter()
-                    .map(|o| format!(
-                        "{} {} ({})",
-                        o.claim,
-                        if o.pass { "PASS" } else { "fail" },
-                        o.detail
-                    ))
-                    .collect::<Vec<_>>()
-                    .join("; ")
+                claims_line(&claims)
             )
         })
         .collect();

@@ -27,6 +27,7 @@
 
 use haptic2d::haptic::safety::SafetyConfig;
 use haptic2d_lab::scenarios::walls_with_device::{run_case, Fig5Case, Fig5Expectation, Fig5Params};
+use haptic2d_lab::scenarios::ControllerRuns as _;
 
 fn pulse(p: &Fig5Params) -> Fig5Case {
     run_case(p, "pulse", "pulse", Fig5Expectation::SettlesAtFirstImpact).expect("run")

@@ -14,6 +14,7 @@
 //! - Virtual coupling on the damped device: dissipative, every wall settles.
 
 use haptic2d_lab::scenarios::walls_with_device::{run, Fig5Case, Fig5Params};
+use haptic2d_lab::scenarios::ControllerRuns as _;
 
 fn case<'a>(cases: &'a [Fig5Case], name: &str) -> &'a Fig5Case {
     cases.iter().find(|c| c.name == name).expect("case")

@@ -17,6 +17,7 @@
 //!   workspace bound.
 
 use haptic2d_lab::scenarios::peg_with_device::{run, Fig8Case, Fig8Params};
+use haptic2d_lab::scenarios::ControllerRuns as _;
 
 fn report(label: &str, cases: &[Fig8Case]) {
     for c in cases {

@@ -16,5 +16,6 @@ mod stability;
 mod study_methods;
 mod study_pse;
 mod study_simulated;
+mod study_support;
 mod walls_w1_w9;
 mod world_f7;

@@ -4,22 +4,8 @@
 use haptic2d_lab::study::analyse::{analyse_dir, AnalyseOptions};
 use haptic2d_lab::study::numeric::norm_cdf;
 use haptic2d_lab::study::{run, session_seed, SimulatedObserver, Study};
-use std::path::Path;
 
-fn load(name: &str) -> (Study, String) {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../studies")
-        .join(name);
-    (
-        Study::load(&p).unwrap(),
-        std::fs::read_to_string(&p).unwrap(),
-    )
-}
-
-fn run_one(study: &Study, text: &str, out: &Path, id: &str) -> haptic2d_lab::study::RunSummary {
-    let mut obs = SimulatedObserver::new(study.observer, session_seed(study.seed, id, 1));
-    run(study, text, out, id, 1, &mut obs, &mut |_, _| {}, None).unwrap()
-}
+use super::study_support::{analyse, load, run_one};
 
 /// QUEST (`studies/stiffness-walls-quest.toml`, 80 trials per condition, prior centred at 300 N/m)
 /// on six simulated participants. The observer's threshold in QUEST's sense (the delta where the
@@ -134,14 +120,7 @@ fn three_afc_recovers_the_models_two_thirds_correct_point_within_its_interval() 
     let dir = tempfile::tempdir().unwrap();
     let s = run_one(&study, &text, dir.path(), "sim01");
     assert!(s.complete);
-    let (res, _) = analyse_dir(
-        dir.path(),
-        &AnalyseOptions {
-            bootstrap: 200,
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let res = analyse(dir.path(), 200);
     let r = &res[0];
     eprintln!(
         "3AFC JND {:.1} [{:.1}, {:.1}], model {truth:.1}",
@@ -175,14 +154,7 @@ fn same_different_recovers_the_models_jnd_and_criterion_within_their_intervals()
     let dir = tempfile::tempdir().unwrap();
     let s = run_one(&study, &text, dir.path(), "sim01");
     assert!(s.complete);
-    let (res, _) = analyse_dir(
-        dir.path(),
-        &AnalyseOptions {
-            bootstrap: 200,
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let res = analyse(dir.path(), 200);
     let r = &res[0];
     let sd = r.sd.as_ref().expect("a same–different analysis");
     let truth = study.observer.weber_fraction * study.conditions[0].reference_value;

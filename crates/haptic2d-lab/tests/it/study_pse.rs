@@ -11,24 +11,11 @@
 //! the physical PSE: the comparison value whose felt stiffness equals the reference's, found by
 //! bisection on the exploration alone, without the psychophysics.
 
-use haptic2d_lab::study::analyse::{analyse_dir, AnalyseOptions, ConditionResult, Pse};
+use haptic2d_lab::study::analyse::{ConditionResult, Pse};
 use haptic2d_lab::study::observer::explore;
-use haptic2d_lab::study::{run, session_seed, stimulus, SimulatedObserver, Study};
-use std::path::{Path, PathBuf};
+use haptic2d_lab::study::{stimulus, Study};
 
-fn file(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../studies")
-        .join(name)
-}
-
-fn load(name: &str) -> (Study, String) {
-    let p = file(name);
-    (
-        Study::load(&p).unwrap(),
-        std::fs::read_to_string(&p).unwrap(),
-    )
-}
+use super::study_support::{analyse, load, run_one};
 
 /// The felt stiffness of condition `c`'s reference (`None`) or comparison at `delta`.
 fn felt(study: &Study, c: usize, delta: Option<f64>) -> f64 {
@@ -73,28 +60,9 @@ fn run_for(study: &Study, text: &str, ids: &[&str], bootstrap: u32) -> Vec<Vec<C
     let dir = tempfile::tempdir().unwrap();
     ids.iter()
         .map(|id| {
-            let mut obs = SimulatedObserver::new(study.observer, session_seed(study.seed, id, 1));
-            let s = run(
-                study,
-                text,
-                dir.path(),
-                id,
-                1,
-                &mut obs,
-                &mut |_, _| {},
-                None,
-            )
-            .unwrap();
+            let s = run_one(study, text, dir.path(), id);
             assert!(s.complete);
-            analyse_dir(
-                &s.dir,
-                &AnalyseOptions {
-                    bootstrap,
-                    ..Default::default()
-                },
-            )
-            .unwrap()
-            .0
+            analyse(&s.dir, bootstrap)
         })
         .collect()
 }

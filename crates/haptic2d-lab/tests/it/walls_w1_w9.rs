@@ -26,6 +26,17 @@ fn first_ratios(r: &WallRun, n: usize) -> Vec<f64> {
     ratios[..n].to_vec()
 }
 
+/// Asserts that each of the first `n` contact ratios of `r` lies in `range`.
+fn assert_first_ratios_in(r: &WallRun, n: usize, range: std::ops::RangeInclusive<f64>) {
+    for (i, ratio) in first_ratios(r, n).into_iter().enumerate() {
+        assert!(
+            range.contains(&ratio),
+            "contact {}: ratio {ratio} outside {range:?}",
+            i + 1
+        );
+    }
+}
+
 fn mean(v: &[f64]) -> f64 {
     v.iter().sum::<f64>() / v.len() as f64
 }
@@ -33,13 +44,7 @@ fn mean(v: &[f64]) -> f64 {
 #[test]
 fn w1_zoh_wall_is_active() {
     let r = run("zoh", WallConfig::fig4());
-    for (i, ratio) in first_ratios(&r, 5).into_iter().enumerate() {
-        assert!(
-            (1.04..=1.20).contains(&ratio),
-            "contact {}: ratio {ratio}",
-            i + 1
-        );
-    }
+    assert_first_ratios_in(&r, 5, 1.04..=1.20);
     let entries = r.metrics.entry_speeds();
     assert!(entries.len() >= 5);
     assert!(
@@ -51,13 +56,7 @@ fn w1_zoh_wall_is_active() {
 #[test]
 fn w2_seh_wall_bounces_at_constant_amplitude() {
     let r = run("seh", WallConfig::fig4());
-    for (i, ratio) in first_ratios(&r, 5).into_iter().enumerate() {
-        assert!(
-            (0.95..=1.00).contains(&ratio),
-            "contact {}: ratio {ratio}",
-            i + 1
-        );
-    }
+    assert_first_ratios_in(&r, 5, 0.95..=1.00);
     let entries = r.metrics.entry_speeds();
     assert!(entries.len() >= 20, "only {} contacts", entries.len());
     let v20 = entries[19];

@@ -11,6 +11,7 @@ API in SI units and hands results back as NumPy arrays.
 - :func:`reproduce`: the paper's figures, as ``haptic2d reproduce`` writes them.
 - :func:`present`: one stimulus of a study file, explored by the simulated hand (for PsychoPy loops).
 - :func:`read_log`: a CSV written by ``haptic2d simulate --out`` or ``haptic2d run --log``.
+- :func:`devices`: the real devices ``haptic2d run --device`` can drive (the shared registry).
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from ._world import World, CONTACT_DTYPE
 from ._haptic import HapticSystem
 from ._lab import sweep_walls, reproduce, read_log, SWEEP_CLASSES
 from ._study import present
+from ._devices import devices
 from . import harness
 
 __all__ = [
@@ -31,6 +33,7 @@ __all__ = [
     "reproduce",
     "read_log",
     "present",
+    "devices",
     "SWEEP_CLASSES",
     "harness",
     "__version__",

@@ -17,6 +17,7 @@ __all__ = [
     "reproduce",
     "read_log",
     "present",
+    "devices",
     "SWEEP_CLASSES",
     "harness",
     "__version__",
@@ -111,3 +112,5 @@ def sweep_walls(
 def reproduce(figure: str = ..., out: _Path = ...) -> Dict[str, Any]: ...
 def read_log(path: _Path) -> Dict[str, np.ndarray]: ...
 def present(study: _Path, condition: str, delta: Optional[float] = ...) -> Dict[str, Any]: ...
+
+def devices() -> List[Dict[str, Any]]: ...

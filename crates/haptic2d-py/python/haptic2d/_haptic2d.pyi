@@ -16,6 +16,7 @@ __all__ = [
     "sweep_models",
     "reproduce",
     "study_present",
+    "devices",
     "__version__",
 ]
 
@@ -133,3 +134,5 @@ def reproduce(
 def study_present(
     study: Union[str, "os.PathLike[str]"], condition: str, delta: Optional[float] = None
 ) -> Tuple[float, List[float], float, str]: ...
+
+def devices() -> List[Dict[str, Any]]: ...

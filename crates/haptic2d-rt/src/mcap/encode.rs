@@ -49,19 +49,25 @@ pub fn encode_bodies(b: &mut Vec<u8>, names: &[String], s: &WorldSample) -> std:
             Some(n) => write!(b, "{{\"name\":{n}")?,
             None => write!(b, "{{\"name\":\"body{i}\"")?,
         }
-        for (k, v) in ["x", "y", "theta"].iter().zip(body.pose) {
-            b.push(b',');
-            write_key(b, k)?;
-            write_json_f64(b, v)?;
-        }
-        for (k, v) in ["vx", "vy", "omega"].iter().zip(body.twist) {
-            b.push(b',');
-            write_key(b, k)?;
-            write_json_f64(b, v)?;
-        }
+        write_fields(b, ["x", "y", "theta"].into_iter().zip(body.pose))?;
+        write_fields(b, ["vx", "vy", "omega"].into_iter().zip(body.twist))?;
         b.push(b'}');
     }
     b.extend_from_slice(b"]}");
+    Ok(())
+}
+
+/// Writes `,"key":value` for each `(key, value)` of `fields` (values as [`write_json_f64`]
+/// writes them).
+fn write_fields<'a>(
+    b: &mut Vec<u8>,
+    fields: impl IntoIterator<Item = (&'a str, f64)>,
+) -> std::io::Result<()> {
+    for (k, v) in fields {
+        b.push(b',');
+        write_key(b, k)?;
+        write_json_f64(b, v)?;
+    }
     Ok(())
 }
 
@@ -91,20 +97,19 @@ pub fn encode_contacts(b: &mut Vec<u8>, names: &[String], s: &WorldSample) -> st
                 "continuous"
             }
         )?;
-        for (k, v) in [
-            ("x", c.point[0]),
-            ("y", c.point[1]),
-            ("nx", c.normal[0]),
-            ("ny", c.normal[1]),
-            ("penetration", c.penetration),
-            ("f_n", c.f_n),
-            ("f_t", c.f_t),
-            ("slip", c.slip),
-        ] {
-            b.push(b',');
-            write_key(b, k)?;
-            write_json_f64(b, v)?;
-        }
+        write_fields(
+            b,
+            [
+                ("x", c.point[0]),
+                ("y", c.point[1]),
+                ("nx", c.normal[0]),
+                ("ny", c.normal[1]),
+                ("penetration", c.penetration),
+                ("f_n", c.f_n),
+                ("f_t", c.f_t),
+                ("slip", c.slip),
+            ],
+        )?;
         b.push(b'}');
     }
     b.extend_from_slice(b"]}");
@@ -116,18 +121,17 @@ pub fn encode_energy(b: &mut Vec<u8>, s: &WorldSample) -> std::io::Result<()> {
     let l = &s.ledger;
     b.extend_from_slice(b"{\"t\":");
     write_json_f64(b, s.t)?;
-    for (k, v) in [
-        ("kinetic", l.kinetic),
-        ("stored", l.stored),
-        ("applied_work", l.applied_work),
-        ("initial", l.initial),
-        ("impact_loss", l.impact_loss),
-        ("excess", l.excess()),
-    ] {
-        b.push(b',');
-        write_key(b, k)?;
-        write_json_f64(b, v)?;
-    }
+    write_fields(
+        b,
+        [
+            ("kinetic", l.kinetic),
+            ("stored", l.stored),
+            ("applied_work", l.applied_work),
+            ("initial", l.initial),
+            ("impact_loss", l.impact_loss),
+            ("excess", l.excess()),
+        ],
+    )?;
     b.push(b'}');
     Ok(())
 }
@@ -178,16 +182,7 @@ pub fn encode_scene_update<B: Write>(
             b.write_all(b",\"w\":")?;
             write_json_f64(b, qw)?;
             b.write_all(b"}},\"thickness\":0.002,\"scale_invariant\":false,\"points\":[")?;
-            for (j, p) in outline.iter().enumerate() {
-                if j > 0 {
-                    b.write_all(b",")?;
-                }
-                b.write_all(b"{\"x\":")?;
-                write_json_f64(b, p[0])?;
-                b.write_all(b",\"y\":")?;
-                write_json_f64(b, p[1])?;
-                b.write_all(b",\"z\":0}")?;
-            }
+            write_points(b, outline.iter().copied())?;
             write!(b, "],\"color\":{color},\"colors\":[],\"indices\":[]}}")?;
         }
         b.write_all(b"]}")?;
@@ -199,29 +194,38 @@ pub fn encode_scene_update<B: Write>(
         b,
         "{{\"timestamp\":{{\"sec\":{sec},\"nsec\":{nsec}}},\"frame_id\":\"world\",\"id\":\"contacts\",\"lifetime\":{{\"sec\":0,\"nsec\":0}},\"frame_locked\":false,\"metadata\":[],{empty},\"lines\":[{{\"type\":2,\"pose\":{{\"position\":{{\"x\":0,\"y\":0,\"z\":0}},\"orientation\":{{\"x\":0,\"y\":0,\"z\":0,\"w\":1}}}},\"thickness\":0.002,\"scale_invariant\":false,\"points\":["
     )?;
-    for (j, c) in s.contacts().iter().enumerate() {
-        if j > 0 {
-            b.write_all(b",")?;
-        }
-        let len = c.f_n * FORCE_LINE_M_PER_N;
-        let tip = [
-            c.point[0] + c.normal[0] * len,
-            c.point[1] + c.normal[1] * len,
-        ];
-        for (k, p) in [c.point, tip].iter().enumerate() {
-            if k > 0 {
-                b.write_all(b",")?;
-            }
-            b.write_all(b"{\"x\":")?;
-            write_json_f64(b, p[0])?;
-            b.write_all(b",\"y\":")?;
-            write_json_f64(b, p[1])?;
-            b.write_all(b",\"z\":0}")?;
-        }
-    }
+    write_points(
+        b,
+        s.contacts().iter().flat_map(|c| {
+            let len = c.f_n * FORCE_LINE_M_PER_N;
+            let tip = [
+                c.point[0] + c.normal[0] * len,
+                c.point[1] + c.normal[1] * len,
+            ];
+            [c.point, tip]
+        }),
+    )?;
     b.write_all(
         b"],\"color\":{\"r\":0.9,\"g\":0.2,\"b\":0.2,\"a\":1},\"colors\":[],\"indices\":[]}]}]}",
     )?;
+    Ok(())
+}
+
+/// Writes `points` as comma-separated Foxglove `Point3`s in the plane, `{"x":…,"y":…,"z":0}`.
+fn write_points<B: Write>(
+    b: &mut B,
+    points: impl IntoIterator<Item = [f64; 2]>,
+) -> std::io::Result<()> {
+    for (j, p) in points.into_iter().enumerate() {
+        if j > 0 {
+            b.write_all(b",")?;
+        }
+        b.write_all(b"{\"x\":")?;
+        write_json_f64(b, p[0])?;
+        b.write_all(b",\"y\":")?;
+        write_json_f64(b, p[1])?;
+        b.write_all(b",\"z\":0}")?;
+    }
     Ok(())
 }
 

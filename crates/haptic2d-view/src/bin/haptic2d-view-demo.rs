@@ -247,7 +247,10 @@ impl Demo {
                 self.paused = false;
                 Ok(None)
             }
-            Command::Answer { .. } | Command::StopStudy => {
+            Command::Answer { .. }
+            | Command::Magnitude { .. }
+            | Command::ContinueStudy { .. }
+            | Command::StopStudy => {
                 Err("no study is running (haptic2d study run --observer browser)".to_string())
             }
         };

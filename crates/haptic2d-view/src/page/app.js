@@ -174,7 +174,11 @@
     "2afc": { q: "Which interval was stiffer?", c: [[1, "First", "1"], [2, "Second", "2"]] },
     "3afc": { q: "Which interval was stiffest?", c: [[1, "First", "1"], [2, "Second", "2"], [3, "Third", "3"]] },
     "same-different": { q: "Were the two intervals the same or different?", c: [[0, "Same", "S"], [1, "Different", "D"]] },
+    // Magnitude estimation: a number entry instead of buttons (no choice keys).
+    "magnitude": { q: "How stiff was the second interval? The first is MODULUS: type a number above 0, then Enter.", c: [] },
   };
+  // The largest number the server takes (haptic2d_view::command::MAX_MAGNITUDE).
+  const MAX_MAGNITUDE = 1e9;
   const study = { view: null, built: "", answeredTrial: 0, sent: [], transitions: [] };
   function updateStudy(v) {
     const last = study.transitions[study.transitions.length - 1];
@@ -201,8 +205,14 @@
         sp.textContent = `interval ${i + 1}`;
         return sp;
       }));
-      $("study-keys").textContent = `keys: ${spec.c.map((c) => c[2]).join(" / ")} answer · Space pause · Esc stop`;
+      $("study-keys").textContent = spec.c.length
+        ? `keys: ${spec.c.map((c) => c[2]).join(" / ")} answer · Space pause · Esc stop`
+        : "Enter answers · Esc stop";
+      $("study-magnitude").classList.toggle("on", v.task === "magnitude");
     }
+    const onBreak = v.phase === "break";
+    document.body.classList.toggle("study-break", onBreak);
+    if (onBreak) $("study-break-progress").textContent = `${v.done} of at most ${v.planned} answered`;
     $("study-progress").textContent = v.trial
       ? `Trial ${v.trial} of at most ${v.planned} · ${v.done} answered`
       : `${v.done} of at most ${v.planned} answered`;
@@ -212,7 +222,8 @@
     switch (v.phase) {
       case "presenting": prompt = `Interval ${v.interval} of ${v.intervals}: explore the wall (${v.remaining_s.toFixed(1)} s)`; break;
       case "free_space": prompt = `Lift the handle off the wall: interval ${v.interval} starts in free space`; break;
-      case "answer": prompt = waiting ? spec.q : "Saving the answer…"; break;
+      case "answer": prompt = waiting ? spec.q.replace("MODULUS", String(v.modulus)) : "Saving the answer…"; break;
+      case "break": prompt = "Take a break: press Continue (Space) when ready"; break;
       case "stopping": prompt = "Session stopped: the torques are off. It resumes at this trial."; break;
       default: prompt = "Next trial…";
     }
@@ -220,6 +231,13 @@
     $("study-prompt").textContent = prompt;
     [...$("study-intervals").children].forEach((sp, i) => sp.classList.toggle("now", v.phase === "presenting" && v.interval === i + 1));
     [...$("study-choices").children].forEach((b) => { b.disabled = !waiting || paused; });
+    const numberOpen = v.task === "magnitude" && waiting && !paused;
+    const input = $("study-magnitude-input");
+    if (input.disabled === numberOpen) {
+      input.disabled = !numberOpen;
+      $("study-magnitude-ok").disabled = !numberOpen;
+      if (numberOpen) { input.value = ""; $("study-magnitude-error").textContent = ""; input.focus(); }
+    }
     $("study-pause").textContent = paused ? "Resume (Space)" : "Pause (Space)";
   }
   function answer(choice) {
@@ -233,13 +251,47 @@
     $("study-prompt").textContent = "Saving the answer…";
     return true;
   }
+  // A magnitude estimate: a finite number above 0 (the server checks it again).
+  function parseMagnitude(text) {
+    const t = String(text).trim().replace(",", ".");
+    if (!/^[0-9]*\.?[0-9]+(e[+-]?[0-9]+)?$/i.test(t)) return null;
+    const x = Number(t);
+    return Number.isFinite(x) && x > 0 && x <= MAX_MAGNITUDE ? x : null;
+  }
+  function answerMagnitude(text) {
+    const v = study.view;
+    if (!v || v.task !== "magnitude" || v.phase !== "answer" || study.answeredTrial === v.trial) return false;
+    if (state.lastFrame && state.lastFrame.paused) return false;
+    const value = parseMagnitude(text);
+    if (value === null) {
+      $("study-magnitude-error").textContent = `"${String(text).slice(0, 20)}" is not a number above 0: type e.g. 120`;
+      return false;
+    }
+    if (!send({ type: "magnitude", trial: v.trial, value })) return false;
+    study.answeredTrial = v.trial;
+    study.sent.push({ trial: v.trial, magnitude: value });
+    $("study-magnitude-input").disabled = true;
+    $("study-magnitude-ok").disabled = true;
+    $("study-magnitude-error").textContent = "";
+    $("study-prompt").textContent = "Saving the answer…";
+    return true;
+  }
+  $("study-magnitude").onsubmit = (ev) => { ev.preventDefault(); answerMagnitude($("study-magnitude-input").value); };
+  function continueStudy() {
+    const v = study.view;
+    if (!v || v.phase !== "break") return false;
+    return send({ type: "continue_study", trial: v.trial });
+  }
+  $("study-continue").onclick = () => continueStudy();
   $("study-pause").onclick = () => send({ type: state.lastFrame && state.lastFrame.paused ? "resume" : "pause" });
   $("study-stop").onclick = () => send({ type: "stop_study" });
   window.addEventListener("keydown", (ev) => {
     const v = study.view;
     if (!v || ev.repeat) return;
-    if (ev.target && (ev.target.tagName === "SELECT" || ev.target.tagName === "INPUT")) return;
+    // Esc stops the session from anywhere, the number entry included.
     if (ev.key === "Escape") { send({ type: "stop_study" }); ev.preventDefault(); return; }
+    if (ev.target && (ev.target.tagName === "SELECT" || ev.target.tagName === "INPUT")) return;
+    if (ev.key === " " && v.phase === "break") { continueStudy(); ev.preventDefault(); return; }
     if (ev.key === " ") { $("study-pause").click(); ev.preventDefault(); return; }
     const spec = CHOICES[v.task] || CHOICES["2afc"];
     const hit = spec.c.find((c) => c[2].toLowerCase() === ev.key.toLowerCase());

@@ -49,6 +49,16 @@ pub struct SatFace {
     pub admissible: bool,
 }
 
+/// The signed distance (m) of `q`'s deepest vertex from `p`'s edge line `e`: minus the overlap
+/// along `n_e` when negative (`+∞` for a `q` without vertices).
+#[inline]
+fn deepest_behind(p: &Collider, e: usize, q: &Collider) -> f64 {
+    q.world_vertices()
+        .iter()
+        .map(|&v| p.edge_distance(e, v))
+        .fold(f64::INFINITY, f64::min)
+}
+
 /// The separating-axis depth of `a` and `b` with its reference face; `None` if some axis
 /// separates them (or one has no edge). The same search, order and ties as
 /// [`sat_depth`](super::sat_depth), which calls it.
@@ -58,12 +68,7 @@ pub fn sat_face(a: &Collider, b: &Collider) -> Option<SatFace> {
     let mut fallback: Option<SatFace> = None;
     for (p, q, sign, first) in [(a, b, -1.0, true), (b, a, 1.0, false)] {
         for e in 0..p.len() {
-            // Overlap along n_e: how far q's deepest vertex is behind p's edge line e.
-            let min_d = q
-                .world_vertices()
-                .iter()
-                .map(|&v| p.edge_distance(e, v))
-                .fold(f64::INFINITY, f64::min);
+            let min_d = deepest_behind(p, e, q);
             if min_d >= 0.0 {
                 return None;
             }
@@ -94,12 +99,42 @@ pub fn sat_face(a: &Collider, b: &Collider) -> Option<SatFace> {
     best.or(fallback)
 }
 
+/// The separating-axis depth of `a` and `b` when it exceeds `floor` (m), else `None`: the same
+/// value as [`sat_depth`](super::sat_depth) where it is returned. The search stops at the first
+/// admissible axis (no seam, no motion out through one) whose overlap is at most `floor`: the
+/// depth, the least overlap over the admissible axes, cannot exceed it. That is how
+/// [`max_overlap`](super::overlap::max_overlap) skips most of a pile's shallow contacts.
+pub fn sat_depth_above(a: &Collider, b: &Collider, floor: f64) -> Option<f64> {
+    let seams = a.seams != 0 || b.seams != 0;
+    for (p, q, sign) in [(a, b, -1.0), (b, a, 1.0)] {
+        for e in 0..p.len() {
+            let min_d = deepest_behind(p, e, q);
+            if min_d >= 0.0 {
+                return None;
+            }
+            if -min_d <= floor
+                && (!seams || (!p.is_seam(e) && admissible_axis(a, b, p.world_normals()[e] * sign)))
+            {
+                return None;
+            }
+        }
+    }
+    sat_face(a, b).map(|f| f.depth).filter(|&d| d > floor)
+}
+
 /// Whether `u` is an admissible separating axis for moving `a` relative to `b` (no component out
 /// through a seam of either, see [`sat_depth`](super::sat_depth)): only then does the overlap along
-/// `u` bound the pair's separating-axis depth from above.
+/// `u` bound the pair's separating-axis depth from above. Inlined: the clip stage asks it of every
+/// record each sample, and almost every pair has no seam.
+#[inline]
 pub fn admissible_axis(a: &Collider, b: &Collider, u: Vec2) -> bool {
-    (a.seams == 0 && b.seams == 0)
-        || !(super::seam::through_seam(b, u) || super::seam::through_seam(a, -u))
+    (a.seams == 0 && b.seams == 0) || admissible_across_seams(a, b, u)
+}
+
+/// [`admissible_axis`] for a pair with a seam: `u` moves neither out through a seam.
+#[inline(never)]
+fn admissible_across_seams(a: &Collider, b: &Collider, u: Vec2) -> bool {
+    !(super::seam::through_seam(b, u) || super::seam::through_seam(a, -u))
 }
 
 /// The edge of `i` whose outward normal is most antiparallel to `n` (the incident edge; the

@@ -20,6 +20,7 @@
 //! ```
 
 mod broad;
+mod candidates;
 mod clip;
 mod collider;
 mod gjk;
@@ -32,15 +33,14 @@ mod toi;
 mod tracker;
 
 pub use broad::{required_delta_prox, BroadPhase, BroadStats, DEFAULT_DELTA_PROX};
+pub use candidates::corner_facing_edge;
 pub use clip::{admissible_axis, clip_pairs, incident_edge, sat_face, SatFace, CLIP_MARGIN};
 pub use collider::Collider;
 pub use gjk::{
     gjk_distance, support_hill_climb, GjkCache, GjkOutput, GJK_EPS_ABS, GJK_EPS_REL,
     GJK_MAX_ITERATIONS,
 };
-pub use local::{
-    corner_facing_edge, LocalStage, PairState, DEFAULT_DELTA_C, DEFAULT_EPS_S, NEAR_PARALLEL_ANGLE,
-};
+pub use local::{LocalStage, PairState, DEFAULT_DELTA_C, DEFAULT_EPS_S, NEAR_PARALLEL_ANGLE};
 pub use overlap::{max_overlap, max_overlap_of_states, Overlap};
 pub use queries::{nearest_line, sat_axis, sat_depth};
 pub use seam::{mark_seams, seam_mask, seam_reach, SEAM_ANGLE, SEAM_DISTANCE, SEAM_MAX_EDGES};

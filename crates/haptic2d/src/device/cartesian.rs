@@ -13,7 +13,8 @@
 //!
 //! Implemented by the twin pantograph ([`TwinPantograph`]: 4 joints, x, y
 //! and θ, redundant) and the 2-DOF five-bar ([`Pantograph2Device`](super::pantograph2_device::Pantograph2Device):
-//! 2 joints, x and y; a Haply 2DIY, a UDP five-bar, the Inverse3 through its virtual five-bar).
+//! 2 joints, x and y; a Haply 2DIY, a UDP five-bar) and the Cartesian pass-through
+//! ([`PointDevice`](super::PointDevice): the handle point in, a force out; the Inverse3).
 
 use super::fault::DeviceFault;
 use super::linalg::{M3, V3, V4};

@@ -1,5 +1,5 @@
 //! [`Pantograph2Device`]: a 2-DOF five-bar ([`Pantograph2`]) behind the [`CartesianDevice`]
-//! boundary — a Haply 2DIY, a UDP five-bar, and the Inverse3 through its virtual five-bar. The
+//! boundary — a Haply 2DIY and a UDP five-bar (the Inverse3 is a [`PointDevice`](super::PointDevice)). The
 //! handle point and its Jacobian come from the linkage; the twist is the §10.7 velocity filter on
 //! the handle point (device frame); there is no hand-wrench observer (no dynamic model of a 2DIY),
 //! so the estimate is zero; `τ = Jᵀ·f` is scaled down as a whole when a motor would exceed its

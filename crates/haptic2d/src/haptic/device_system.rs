@@ -1,8 +1,8 @@
 //! [`DeviceSystem`]: the haptic system for any kind of device — the twin pantograph (4 joints,
 //! x, y, θ: [`HapticSystem`], MODELS §10–§11; the simulated device, a replay, the Haply twin), a
 //! 2-DOF five-bar (2 joints, x and y of a grasp point: [`Planar2System`]; a Haply 2DIY, a UDP
-//! five-bar, the Inverse3 through its driver's virtual five-bar) or a Cartesian point device (the
-//! handle point in, a force out: [`PointSystem`]). All are [`Haptic`](super::Haptic) over their
+//! five-bar) or a Cartesian point device (the handle point in, a force out: [`PointSystem`]; the
+//! Haply Inverse3 in planar mode). All are [`Haptic`](super::Haptic) over their
 //! device coupling and run the same tick ([`Haptic::haptic_tick`](super::Haptic::haptic_tick)); the
 //! enum only routes the reading to the right device. The one enum every front end drives (the rig
 //! of `haptic2d run`, the Haply closed loop of `haptic2d-devices`): the loop, the watchdog, the logs
@@ -137,6 +137,27 @@ impl DeviceSystem {
     /// The passivity controller, if the twin runs one (never on a 2-DOF device).
     pub fn passivity(&self) -> Option<&PlanarPassivity> {
         self.twin().and_then(|s| s.passivity())
+    }
+
+    /// Sets the twist target `θ_t` (rad; `None`: off) of a system holding the slave at a grasp point
+    /// (a five-bar or a point device: the virtual torsion spring that turns the slave). Returns
+    /// false, and does nothing, on the twin (its handle carries θ itself).
+    pub fn set_twist_target(&mut self, theta: Option<f64>) -> bool {
+        match self {
+            DeviceSystem::Twin(_) => return false,
+            DeviceSystem::TwoDof(s) => s.set_twist_target(theta),
+            DeviceSystem::Point(s) => s.set_twist_target(theta),
+        }
+        true
+    }
+
+    /// The twist target (rad) of a grasp-point system; `None` when off or on the twin.
+    pub fn twist_target(&self) -> Option<f64> {
+        match self {
+            DeviceSystem::Twin(_) => None,
+            DeviceSystem::TwoDof(s) => s.twist_target(),
+            DeviceSystem::Point(s) => s.twist_target(),
+        }
     }
 
     /// The twin system, if this is one.

@@ -1,7 +1,8 @@
 //! [`SafetyStage`]: the tick's safety code, written once for every device (DESIGN §7). The one tick,
 //! [`Haptic::haptic_tick`](super::Haptic::haptic_tick) — run by the twin pantograph's
-//! [`HapticSystem`](super::HapticSystem) and the 2-DOF
-//! [`Planar2System`](super::planar2::Planar2System) (a 2DIY, a UDP five-bar, the Inverse3) alike —
+//! [`HapticSystem`](super::HapticSystem), the 2-DOF
+//! [`Planar2System`](super::planar2::Planar2System) (a 2DIY, a UDP five-bar) and the
+//! [`PointSystem`](super::PointSystem) (the Inverse3) alike —
 //! owns one and calls it at these points of §0.5:
 //!
 //! ```text

@@ -96,22 +96,10 @@ velocity = [0.0, -2.0]
 #[test]
 fn i5_invalid_impact_goes_straight_to_continuous() {
     // The box moves slower than v_c into the wall: a new contact is Continuous and no impulse acts.
-    let mut w = scene(
-        r#"
-[world]
-rate = 500
-[[body]]
-name = "wall"
-kind = "fixed"
-polygon = [[-0.1, -0.2], [0.0, -0.2], [0.0, 0.2], [-0.1, 0.2]]
-[[body]]
-name = "box"
-mass = 0.5
-box = [0.04, 0.02]
-position = [0.0205, 0.0]
-velocity = [-0.01, 0.0]
-"#,
-    );
+    let mut w = scene(&format!(
+        "[world]\nrate = 500\n{}position = [0.0205, 0.0]\nvelocity = [-0.01, 0.0]\n",
+        crate::shared::WALL_AND_BOX_TOML
+    ));
     let mut created = 0;
     for _ in 0..200 {
         let before = w.bodies[1].vel;

@@ -159,24 +159,19 @@ fn stray_keys_next_to_the_device_table_and_bad_toml_are_errors() {
     assert_field_error(&e, "line 2", "");
 }
 
-const SCENE: &str = r#"
-name = "with-device"
-[[body]]
-name = "wall"
-kind = "fixed"
-polygon = [[-0.1, -0.2], [0.0, -0.2], [0.0, 0.2], [-0.1, 0.2]]
-[[body]]
-name = "box"
-mass = 0.5
-box = [0.04, 0.02]
-position = [0.04, 0.0]
-"#;
+/// A scene with no `[device]` table: the wall and the box 0.04 m from it.
+fn scene_text() -> String {
+    format!(
+        "name = \"with-device\"\n{}position = [0.04, 0.0]\n",
+        crate::shared::WALL_AND_BOX_TOML
+    )
+}
 
 #[test]
 fn scene_device_table_overrides_the_defaults() {
-    let plain = Scene::from_toml(SCENE, "s.toml", None).unwrap();
+    let plain = Scene::from_toml(&scene_text(), "s.toml", None).unwrap();
     assert_eq!(plain.device, None, "no [device] table: None");
-    let text = format!("{SCENE}\n[device]\nm_h = 0.12\nf_c = 0.01\n");
+    let text = format!("{}\n[device]\nm_h = 0.12\nf_c = 0.01\n", scene_text());
     let s = Scene::from_toml(&text, "s.toml", None).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(
         s.device,
@@ -187,7 +182,7 @@ fn scene_device_table_overrides_the_defaults() {
         })
     );
     // The whole template, pasted into a scene, is the defaults.
-    let s = Scene::from_toml(&format!("{SCENE}\n{}", template()), "s.toml", None)
+    let s = Scene::from_toml(&format!("{}\n{}", scene_text(), template()), "s.toml", None)
         .unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(s.device, Some(DeviceParams::default()));
 }
@@ -195,7 +190,8 @@ fn scene_device_table_overrides_the_defaults() {
 #[test]
 fn scene_device_errors_are_collected_with_the_others() {
     let text = format!(
-        "{SCENE}\n[world]\nrate = 500\nproximity_every = 0\n[device]\nm_h = -1\nlinks = 2\n"
+        "{}\n[world]\nrate = 500\nproximity_every = 0\n[device]\nm_h = -1\nlinks = 2\n",
+        scene_text()
     );
     let e = crate::shared::scene_errors(&text);
     let shown = e.to_string();
@@ -210,7 +206,10 @@ fn scene_device_errors_are_collected_with_the_others() {
         "{shown}"
     );
     // The scene's rate bounds the observer gain.
-    let text = format!("{SCENE}\n[world]\nrate = 100\n[device]\nobserver_gain = [200, 60, 60]\n");
+    let text = format!(
+        "{}\n[world]\nrate = 100\n[device]\nobserver_gain = [200, 60, 60]\n",
+        scene_text()
+    );
     let e = crate::shared::scene_errors(&text);
     assert!(
         e.errors

@@ -136,6 +136,12 @@ impl Rod {
 
     /// Runs the engine's frictional impact on this rod with COM velocity `v` and spin `w`.
     fn engine(&self, v: Vec2, w: f64, e: f64, mu: f64) -> (Vec2, f64) {
+        self.impact(v, w, e, Some(mu))
+    }
+
+    /// The rod's impact with COM velocity `v`, spin `w` and restitution `e`, solved by the engine
+    /// with Coulomb friction `mu`, or with the frictionless default when `mu` is `None`.
+    fn impact(&self, v: Vec2, w: f64, e: f64, mu: Option<f64>) -> (Vec2, f64) {
         let mut bodies = vec![
             Body::fixed("ground", Pose::IDENTITY),
             Body::dynamic("rod", self.m, self.i, Pose::new(0.0, 0.0, 0.0)),
@@ -151,7 +157,9 @@ impl Rod {
             restitution: e,
         };
         let mut s = ImpactSolver::new();
-        s.set_friction(ImpactFriction::Coulomb, mu);
+        if let Some(mu) = mu {
+            s.set_friction(ImpactFriction::Coulomb, mu);
+        }
         s.solve(&[row], &mut bodies);
         (bodies[1].vel, bodies[1].omega)
     }
@@ -270,27 +278,7 @@ fn routh_slip_reversal_rod_end() {
 fn none_and_zero_mu_are_the_frictionless_solver() {
     let rod = Rod::new(45.0);
     let v = Vec2::new(3.0, -1.0);
-    let run = |mode: Option<f64>| {
-        let mut bodies = vec![
-            Body::fixed("ground", Pose::IDENTITY),
-            Body::dynamic("rod", rod.m, rod.i, Pose::new(0.0, 0.0, 0.0)),
-        ];
-        bodies[1].vel = v;
-        let row = ImpactRow {
-            body_a: 1,
-            body_b: 0,
-            n: Vec2::new(0.0, 1.0),
-            r_a: rod.r,
-            r_b: rod.r,
-            restitution: 0.5,
-        };
-        let mut s = ImpactSolver::new();
-        if let Some(mu) = mode {
-            s.set_friction(ImpactFriction::Coulomb, mu);
-        }
-        s.solve(&[row], &mut bodies);
-        (bodies[1].vel, bodies[1].omega)
-    };
+    let run = |mode: Option<f64>| rod.impact(v, 0.0, 0.5, mode);
     let a = run(None);
     let b = run(Some(0.0));
     assert_eq!(a.0.x.to_bits(), b.0.x.to_bits());
@@ -307,7 +295,7 @@ fn none_and_zero_mu_are_the_frictionless_solver() {
 #[test]
 fn scene_impact_friction_fields_are_checked() {
     use haptic2d::scene::Scene;
-    let base = "[[body]]\nname = \"wall\"\nkind = \"fixed\"\npolygon = [[-0.1, -0.2], [0.0, -0.2], [0.0, 0.2], [-0.1, 0.2]]\n";
+    let base = crate::shared::WALL_TOML;
     let err = |contact: &str| {
         let text = format!("[contact]\n{contact}\n{base}");
         crate::shared::scene_errors(&text)

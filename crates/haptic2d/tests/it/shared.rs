@@ -10,6 +10,10 @@ use haptic2d::world::World;
 /// A fixed wall filling x ∈ [−0.1, 0] m, y ∈ [−0.2, 0.2] m (scene TOML).
 pub const WALL_TOML: &str = "[[body]]\nname = \"wall\"\nkind = \"fixed\"\npolygon = [[-0.1, -0.2], [0.0, -0.2], [0.0, 0.2], [-0.1, 0.2]]\n";
 
+/// [`WALL_TOML`] and a 0.04 m × 0.02 m box of 0.5 kg, whose `position` (and any other field)
+/// follows (scene TOML).
+pub const WALL_AND_BOX_TOML: &str = "[[body]]\nname = \"wall\"\nkind = \"fixed\"\npolygon = [[-0.1, -0.2], [0.0, -0.2], [0.0, 0.2], [-0.1, 0.2]]\n[[body]]\nname = \"box\"\nmass = 0.5\nbox = [0.04, 0.02]\n";
+
 /// A fixed floor 40 m long with its top at y = 0 (scene TOML).
 pub const FLOOR_TOML: &str = "[[body]]\nname = \"floor\"\nkind = \"fixed\"\npolygon = [[-20.0, -0.1], [20.0, -0.1], [20.0, 0.0], [-20.0, 0.0]]";
 

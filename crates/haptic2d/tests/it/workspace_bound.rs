@@ -158,13 +158,9 @@ fn device_file_workspace_fields_are_checked() {
     }
 }
 
-/// The closed loop: a hand pushes the handle with 1.5 N toward +x after a 0.6 s grip, through the
-/// virtual coupling, with the box free to follow for 0.24 m. The handle arrives at the edge at speed,
-/// overshoots by a few mm (less than the 10 mm trip distance) and comes to rest about F/K = 0.75 mm past
-/// the edge, with no trip.
-#[test]
-fn a_pushing_hand_is_held_at_the_edge() {
-    let p = DeviceParams::default();
+/// The box in the walls on the twin with device `p` through the virtual coupling, the hand gripping
+/// the handle at its start pose (encoder quantisation on or off).
+fn gripped_box_in_walls(p: DeviceParams, quantize: bool) -> DeviceInTheLoop {
     let world = builtin("box-in-walls", Some(RATE)).unwrap().unwrap().world;
     let config = HapticConfig {
         device: p,
@@ -172,8 +168,19 @@ fn a_pushing_hand_is_held_at_the_edge() {
         ..HapticConfig::default()
     };
     let sys = HapticSystem::new(world, &config).unwrap();
-    let mut l = DeviceInTheLoop::new(sys, HandModel::Free, 4, true).unwrap();
+    let mut l = DeviceInTheLoop::new(sys, HandModel::Free, 4, quantize).unwrap();
     l.hand = HandModel::grip(l.plant.pose());
+    l
+}
+
+/// The closed loop: a hand pushes the handle with 1.5 N toward +x after a 0.6 s grip, through the
+/// virtual coupling, with the box free to follow for 0.24 m. The handle arrives at the edge at speed,
+/// overshoots by a few mm (less than the 10 mm trip distance) and comes to rest about F/K = 0.75 mm past
+/// the edge, with no trip.
+#[test]
+fn a_pushing_hand_is_held_at_the_edge() {
+    let p = DeviceParams::default();
+    let mut l = gripped_box_in_walls(p, true);
     let edge = p.workspace_center_x + p.workspace_half_width;
     let mut max_x = f64::NEG_INFINITY;
     for k in 0..(3.0 * RATE) as usize {
@@ -207,15 +214,7 @@ fn a_pushing_hand_is_held_at_the_edge() {
 #[test]
 fn a_push_that_overpowers_the_wall_trips_at_the_trip_distance() {
     let p = DeviceParams::default();
-    let world = builtin("box-in-walls", Some(RATE)).unwrap().unwrap().world;
-    let config = HapticConfig {
-        device: p,
-        controller: ControllerKind::Coupling(CouplingGains::default()),
-        ..HapticConfig::default()
-    };
-    let sys = HapticSystem::new(world, &config).unwrap();
-    let mut l = DeviceInTheLoop::new(sys, HandModel::Free, 4, false).unwrap();
-    l.hand = HandModel::grip(l.plant.pose());
+    let mut l = gripped_box_in_walls(p, false);
     let edge = p.workspace_center_x + p.workspace_half_width;
     let mut prev = l.plant_pose()[0];
     for k in 0..(3.0 * RATE) as usize {

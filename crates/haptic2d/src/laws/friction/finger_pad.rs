@@ -10,7 +10,8 @@
 //!
 //! The static/kinetic gap is a hysteretic threshold on one spring, not a stiffness boost as in §1.
 
-use super::{FrictionInput, FrictionLaw, FrictionMode};
+use super::shell::{engage, friction_law, LoadedFriction};
+use super::{FrictionInput, FrictionMode};
 
 crate::law_params! { FingerPad, "friction model 'nahvi'";
     k_p0 (self.k_p0) [] "N/m" Positive "pad stiffness at zero load",
@@ -81,32 +82,23 @@ impl FingerPad {
     }
 }
 
-impl FrictionLaw for FingerPad {
-    fn reset(&mut self) {
+friction_law!(FingerPad);
+
+impl LoadedFriction for FingerPad {
+    fn forget(&mut self) {
         self.engaged = false;
-        self.mode = FrictionMode::Stick;
         self.u = 0.0;
     }
 
     /// Anchors the pad at the god-object's entry point, so `u ≈ 0` at first contact.
-    fn begin(&mut self, s_entry: f64) {
-        self.reset();
-        self.s_a = s_entry;
-        self.engaged = true;
+    fn start(&mut self, s_entry: f64) {
+        engage(&mut self.s_a, &mut self.engaged, &mut self.mode, s_entry);
     }
 
     #[inline(always)]
-    fn update(&mut self, i: &FrictionInput) -> f64 {
-        if i.fn_ <= 0.0 {
-            self.reset(); // delete state
-            return 0.0;
-        }
-        if !self.engaged {
-            // Loaded again after a release (or never begun): anchor where the vertex is now.
-            self.s_a = i.s;
-            self.engaged = true;
-            self.mode = FrictionMode::Stick;
-        }
+    fn loaded(&mut self, i: &FrictionInput) -> f64 {
+        // Loaded again after a release (or never begun): anchor where the vertex is now.
+        engage(&mut self.s_a, &mut self.engaged, &mut self.mode, i.s);
         let k = self.k_pad(i.fn_);
         self.k_used = k;
         let mut u = i.s - self.s_a;
@@ -128,16 +120,12 @@ impl FrictionLaw for FingerPad {
     }
 
     /// `½·k_pad·u²` (J), the U_f of §13.2 F7-5.
-    fn stored_energy(&self) -> f64 {
+    fn spring_energy(&self) -> f64 {
         0.5 * self.k_used * self.u * self.u
     }
 
     /// The pad anchor `s_a` (§8.3), once engaged.
-    fn anchor(&self, _s: f64) -> Option<f64> {
+    fn stick_point(&self, _s: f64) -> Option<f64> {
         self.engaged.then_some(self.s_a)
-    }
-
-    fn mode(&self) -> FrictionMode {
-        self.mode
     }
 }

@@ -12,7 +12,8 @@
 //! `|z| ≤ z_stick`, rises as a half sine from 0 at `z_stick` to 1 at `z_max`, and is 1 beyond. Because the
 //! adhesion point does not move in the elastic zone, oscillating loads below `k·z_stick` cause no drift.
 
-use super::{FrictionInput, FrictionLaw, FrictionMode};
+use super::shell::{friction_law, LoadedFriction};
+use super::{FrictionInput, FrictionMode};
 
 crate::law_params! { @impl HaywardArmstrong, |s: &HaywardArmstrong| if s.is_dahl() { "friction model 'dahl'" } else { "friction model 'hayward-armstrong'" };
     k (self.k) [] "N/m" Positive "bristle stiffness",
@@ -127,18 +128,15 @@ impl HaywardArmstrong {
     }
 }
 
-impl FrictionLaw for HaywardArmstrong {
-    fn reset(&mut self) {
+friction_law!(HaywardArmstrong);
+
+impl LoadedFriction for HaywardArmstrong {
+    fn forget(&mut self) {
         self.z = 0.0;
-        self.mode = FrictionMode::Stick;
     }
 
     #[inline(always)]
-    fn update(&mut self, i: &FrictionInput) -> f64 {
-        if i.fn_ <= 0.0 {
-            self.reset();
-            return 0.0;
-        }
+    fn loaded(&mut self, i: &FrictionInput) -> f64 {
         let z_max = self.mu_k * i.fn_ / self.k;
         self.z = self.z.clamp(-z_max, z_max); // reset if the load dropped
         let z_prev = self.z;
@@ -154,17 +152,12 @@ impl FrictionLaw for HaywardArmstrong {
     }
 
     /// `½·k·z²` (J), the U_f of §13.2 F7-5.
-    fn stored_energy(&self) -> f64 {
+    fn spring_energy(&self) -> f64 {
         0.5 * self.k * self.z * self.z
     }
 
     /// The adhesion point `s − z` (§8.3).
-    fn anchor(&self, s: f64) -> Option<f64> {
+    fn stick_point(&self, s: f64) -> Option<f64> {
         Some(s - self.z)
-    }
-
-    /// `Slip` when the adhesion point moved at the last update (plastic flow or sliding).
-    fn mode(&self) -> FrictionMode {
-        self.mode
     }
 }

@@ -5,7 +5,8 @@
 //! `μk·F_n` opposes the slip velocity. The velocity is not reset on sticking, so a residual
 //! `|S0| < v_th` persists below stiction: the creep that this model is shown to have (Fig. 7).
 
-use super::{FrictionInput, FrictionLaw, FrictionMode};
+use super::shell::{friction_law, LoadedFriction};
+use super::{FrictionInput, FrictionMode};
 
 crate::law_params! { Karnopp, "friction model 'classical'";
     v_th (self.v_th) [] "m/s" Positive "stick velocity band",
@@ -50,17 +51,11 @@ impl Karnopp {
     }
 }
 
-impl FrictionLaw for Karnopp {
-    fn reset(&mut self) {
-        self.mode = FrictionMode::Stick;
-    }
+friction_law!(Karnopp);
 
+impl LoadedFriction for Karnopp {
     #[inline(always)]
-    fn update(&mut self, i: &FrictionInput) -> f64 {
-        if i.fn_ <= 0.0 {
-            self.reset();
-            return 0.0;
-        }
+    fn loaded(&mut self, i: &FrictionInput) -> f64 {
         if i.s0.abs() > self.v_th {
             // slip: kinetic Coulomb friction against the slip velocity
             self.mode = FrictionMode::Slip;
@@ -74,16 +69,12 @@ impl FrictionLaw for Karnopp {
     }
 
     /// No spring: 0 J.
-    fn stored_energy(&self) -> f64 {
+    fn spring_energy(&self) -> f64 {
         0.0
     }
 
     /// No anchor: the god-object tracks the projection (§8.3, frictionless tracking).
-    fn anchor(&self, _s: f64) -> Option<f64> {
+    fn stick_point(&self, _s: f64) -> Option<f64> {
         None
-    }
-
-    fn mode(&self) -> FrictionMode {
-        self.mode
     }
 }

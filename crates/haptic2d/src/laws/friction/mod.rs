@@ -6,6 +6,7 @@ mod hayward_armstrong;
 mod karnopp;
 mod reset_integrator;
 mod salcudean_vlaar;
+mod shell;
 
 use crate::laws::params::{ParamSpec, Params, TableRow};
 pub use finger_pad::FingerPad;
@@ -77,6 +78,20 @@ pub enum FrictionModel {
     Karnopp(Karnopp),
     /// Salcudean–Vlaar modified Karnopp model (§4.2).
     SalcudeanVlaar(SalcudeanVlaar),
+}
+
+/// `$e` on the model of whichever variant `$self` holds, bound as `$m`; `$n` for no friction.
+macro_rules! dispatch {
+    ($self:ident, $m:ident => $e:expr, none => $n:expr) => {
+        match $self {
+            FrictionModel::None => $n,
+            FrictionModel::ResetIntegrator($m) => $e,
+            FrictionModel::HaywardArmstrong($m) => $e,
+            FrictionModel::FingerPad($m) => $e,
+            FrictionModel::Karnopp($m) => $e,
+            FrictionModel::SalcudeanVlaar($m) => $e,
+        }
+    };
 }
 
 impl FrictionModel {
@@ -160,38 +175,17 @@ impl FrictionModel {
     /// The model behind this variant as its parameter declarations, to set a value (`None` for
     /// the frictionless model, which has none).
     fn params_mut(&mut self) -> Option<&mut dyn Params> {
-        Some(match self {
-            FrictionModel::None => return None,
-            FrictionModel::ResetIntegrator(m) => m,
-            FrictionModel::HaywardArmstrong(m) => m,
-            FrictionModel::FingerPad(m) => m,
-            FrictionModel::Karnopp(m) => m,
-            FrictionModel::SalcudeanVlaar(m) => m,
-        })
+        dispatch!(self, m => Some(m), none => None)
     }
 
     /// The model behind this variant as its parameter declarations: [`Params::get`] reads a value.
     pub fn params(&self) -> &dyn Params {
-        match self {
-            FrictionModel::None => &Frictionless,
-            FrictionModel::ResetIntegrator(m) => m,
-            FrictionModel::HaywardArmstrong(m) => m,
-            FrictionModel::FingerPad(m) => m,
-            FrictionModel::Karnopp(m) => m,
-            FrictionModel::SalcudeanVlaar(m) => m,
-        }
+        dispatch!(self, m => m, none => &Frictionless)
     }
 
     /// This model's parameters, declared once ([`crate::laws::params`]).
     pub fn specs(&self) -> &'static [ParamSpec] {
-        match self {
-            FrictionModel::None => &[],
-            FrictionModel::ResetIntegrator(_) => ResetIntegrator::SPECS,
-            FrictionModel::HaywardArmstrong(_) => HaywardArmstrong::SPECS,
-            FrictionModel::FingerPad(_) => FingerPad::SPECS,
-            FrictionModel::Karnopp(_) => Karnopp::SPECS,
-            FrictionModel::SalcudeanVlaar(_) => SalcudeanVlaar::SPECS,
-        }
+        self.params().specs()
     }
 
     /// Sets one parameter by its scene-file key ([`Self::specs`]; docs/MODELS.md Part I lists them
@@ -251,20 +245,6 @@ impl FrictionModel {
     pub fn uses_external_force(&self) -> bool {
         matches!(self, FrictionModel::Karnopp(_))
     }
-}
-
-/// Forwards a `FrictionLaw` method to the selected model.
-macro_rules! dispatch {
-    ($self:ident, $m:ident => $e:expr, none => $n:expr) => {
-        match $self {
-            FrictionModel::None => $n,
-            FrictionModel::ResetIntegrator($m) => $e,
-            FrictionModel::HaywardArmstrong($m) => $e,
-            FrictionModel::FingerPad($m) => $e,
-            FrictionModel::Karnopp($m) => $e,
-            FrictionModel::SalcudeanVlaar($m) => $e,
-        }
-    };
 }
 
 // Every law's `update`, and its dispatch here, are `#[inline(always)]`. The contact set's force

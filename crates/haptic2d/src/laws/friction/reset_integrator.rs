@@ -1,6 +1,7 @@
 //! Haessig–Friedland reset-integrator friction (§1), per VE contact: the paper's model (eq. 2).
 
-use super::{FrictionInput, FrictionLaw, FrictionMode};
+use super::shell::{friction_law, LoadedFriction};
+use super::{FrictionInput, FrictionMode};
 
 crate::law_params! { ResetIntegrator, "friction model 'reset-integrator'";
     kr (self.kr) [] "N/m" Positive "stick stiffness Kr",
@@ -139,18 +140,15 @@ impl ResetIntegrator {
     }
 }
 
-impl FrictionLaw for ResetIntegrator {
-    fn reset(&mut self) {
+friction_law!(ResetIntegrator);
+
+impl LoadedFriction for ResetIntegrator {
+    fn forget(&mut self) {
         self.p = 0.0;
-        self.mode = FrictionMode::Stick;
     }
 
     #[inline(always)]
-    fn update(&mut self, i: &FrictionInput) -> f64 {
-        if i.fn_ <= 0.0 {
-            self.reset();
-            return 0.0;
-        }
+    fn loaded(&mut self, i: &FrictionInput) -> f64 {
         // Load scaling: either the strain limit or the stiffness follows μk·F_n.
         let (kr, p0) = match self.scaling {
             LoadScaling::Limit => (self.kr, self.mu_k * i.fn_ / self.kr),
@@ -178,7 +176,7 @@ impl FrictionLaw for ResetIntegrator {
     }
 
     /// `½(1 + a)·Kr·p²` in stick, `½Kr·p²` in slip (J): the U_f of §13.2 F7-5.
-    fn stored_energy(&self) -> f64 {
+    fn spring_energy(&self) -> f64 {
         let k = match self.mode {
             FrictionMode::Stick => (1.0 + self.a()) * self.k_used,
             FrictionMode::Slip => self.k_used,
@@ -187,11 +185,7 @@ impl FrictionLaw for ResetIntegrator {
     }
 
     /// The stick point `s − p` (§8.3).
-    fn anchor(&self, s: f64) -> Option<f64> {
+    fn stick_point(&self, s: f64) -> Option<f64> {
         Some(s - self.p)
-    }
-
-    fn mode(&self) -> FrictionMode {
-        self.mode
     }
 }

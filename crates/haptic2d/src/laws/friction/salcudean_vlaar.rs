@@ -5,7 +5,8 @@
 //! it re-sticks (with a new stick point at the current `s`) as soon as `|S0| < v_th`. In slip the force
 //! is Coulomb plus viscous: `F_t = −μk·F_n·sgn(S0) − b_v·S0`.
 
-use super::{FrictionInput, FrictionLaw, FrictionMode};
+use super::shell::{engage, friction_law, LoadedFriction};
+use super::{FrictionInput, FrictionMode};
 
 crate::law_params! { SalcudeanVlaar, "friction model 'salcudean-vlaar'";
     k_p (self.k_p) [] "N/m" Positive "stick PD stiffness",
@@ -68,32 +69,23 @@ impl SalcudeanVlaar {
     }
 }
 
-impl FrictionLaw for SalcudeanVlaar {
-    fn reset(&mut self) {
+friction_law!(SalcudeanVlaar);
+
+impl LoadedFriction for SalcudeanVlaar {
+    fn forget(&mut self) {
         self.engaged = false;
-        self.mode = FrictionMode::Stick;
         self.offset = 0.0;
     }
 
     /// Sticks at the god-object's entry point.
-    fn begin(&mut self, s_entry: f64) {
-        self.reset();
-        self.s_a = s_entry;
-        self.engaged = true;
+    fn start(&mut self, s_entry: f64) {
+        engage(&mut self.s_a, &mut self.engaged, &mut self.mode, s_entry);
     }
 
     #[inline(always)]
-    fn update(&mut self, i: &FrictionInput) -> f64 {
-        if i.fn_ <= 0.0 {
-            self.reset();
-            return 0.0;
-        }
-        if !self.engaged {
-            // Loaded again after a release (or never begun): stick where the vertex is now.
-            self.s_a = i.s;
-            self.engaged = true;
-            self.mode = FrictionMode::Stick;
-        }
+    fn loaded(&mut self, i: &FrictionInput) -> f64 {
+        // Loaded again after a release (or never begun): anchor where the vertex is now.
+        engage(&mut self.s_a, &mut self.engaged, &mut self.mode, i.s);
         if self.mode == FrictionMode::Stick {
             let offset = i.s - self.s_a;
             let f = -self.k_p * offset - self.k_d * i.s0;
@@ -115,16 +107,12 @@ impl FrictionLaw for SalcudeanVlaar {
     }
 
     /// `½·K_p·(s − s_a)²` in stick, 0 in slip (J): the U_f of §13.2 F7-5.
-    fn stored_energy(&self) -> f64 {
+    fn spring_energy(&self) -> f64 {
         0.5 * self.k_p * self.offset * self.offset
     }
 
     /// The stick point `s_a` (§8.3), once engaged.
-    fn anchor(&self, _s: f64) -> Option<f64> {
+    fn stick_point(&self, _s: f64) -> Option<f64> {
         self.engaged.then_some(self.s_a)
-    }
-
-    fn mode(&self) -> FrictionMode {
-        self.mode
     }
 }

@@ -1,6 +1,7 @@
 //! Colgate & Schenkel (1997) wall and passivity condition (§5.4).
 
-use super::{NormalInput, NormalLaw};
+use super::spring_wall::{spring_wall, SpringWall};
+use super::NormalInput;
 
 crate::law_params! { ColgateLaw, "colgate";
     k (self.k) [] "N/m" NonNegative "wall stiffness",
@@ -45,25 +46,16 @@ impl ColgateLaw {
     }
 }
 
-impl NormalLaw for ColgateLaw {
-    fn reset(&mut self) {
-        self.stored = 0.0;
-    }
+spring_wall!(ColgateLaw, k);
+
+impl SpringWall for ColgateLaw {
     #[inline(always)]
-    fn force(&mut self, input: &NormalInput) -> f64 {
-        let delta = input.depth();
-        self.stored = 0.5 * self.k * delta * delta;
-        if delta <= 0.0 {
-            return 0.0;
-        }
+    fn wall_force(&mut self, delta: f64, input: &NormalInput) -> f64 {
         let delta_prev = if input.hist >= 2 {
             (-input.d[1]).max(0.0)
         } else {
             delta
         };
         (self.k * delta + self.b * (delta - delta_prev) / input.dt).max(0.0)
-    }
-    fn stored_energy(&self) -> f64 {
-        self.stored
     }
 }

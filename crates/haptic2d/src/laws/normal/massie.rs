@@ -1,6 +1,7 @@
 //! Massie PI wall (PHANToM rendering, §5.6, [REC] form).
 
-use super::{NormalInput, NormalLaw};
+use super::spring_wall::{spring_wall, SpringWall};
+use super::NormalInput;
 
 crate::law_params! { MassiePiLaw, "pi";
     k (self.k) [] "N/m" NonNegative "proportional stiffness",
@@ -52,23 +53,15 @@ impl MassiePiLaw {
     }
 }
 
-impl NormalLaw for MassiePiLaw {
-    fn reset(&mut self) {
+spring_wall!(MassiePiLaw, k);
+
+impl SpringWall for MassiePiLaw {
+    fn forget(&mut self) {
         self.integral = 0.0;
-        self.stored = 0.0;
     }
     #[inline(always)]
-    fn force(&mut self, input: &NormalInput) -> f64 {
-        let delta = input.depth();
-        self.stored = 0.5 * self.k * delta * delta;
-        if delta <= 0.0 {
-            self.integral = 0.0;
-            return 0.0;
-        }
+    fn wall_force(&mut self, delta: f64, input: &NormalInput) -> f64 {
         self.integral = (self.integral + input.dt * delta).clamp(0.0, self.i_max);
         (self.k * delta + self.k_i * self.integral).max(0.0)
-    }
-    fn stored_energy(&self) -> f64 {
-        self.stored
     }
 }

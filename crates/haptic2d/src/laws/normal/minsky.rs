@@ -1,6 +1,7 @@
 //! Minsky et al. (1990): stabilise the wall by adding damping (§5.3, [REC] form).
 
-use super::{NormalInput, NormalLaw};
+use super::spring_wall::{spring_wall, SpringWall};
+use super::NormalInput;
 
 crate::law_params! { MinskyLaw, "minsky";
     k (self.k) [] "N/m" NonNegative "wall stiffness",
@@ -39,21 +40,12 @@ impl MinskyLaw {
     }
 }
 
-impl NormalLaw for MinskyLaw {
-    fn reset(&mut self) {
-        self.stored = 0.0;
-    }
+spring_wall!(MinskyLaw, k);
+
+impl SpringWall for MinskyLaw {
     #[inline(always)]
-    fn force(&mut self, input: &NormalInput) -> f64 {
-        let delta = input.depth();
-        self.stored = 0.5 * self.k * delta * delta;
-        if delta <= 0.0 {
-            return 0.0;
-        }
+    fn wall_force(&mut self, delta: f64, input: &NormalInput) -> f64 {
         let v_in = -input.c0;
         (self.k * delta + self.b_m * v_in).max(0.0)
-    }
-    fn stored_energy(&self) -> f64 {
-        self.stored
     }
 }

@@ -21,6 +21,7 @@ mod minsky;
 mod paper;
 mod pulse;
 mod seh;
+mod spring_wall;
 mod zoh;
 
 use crate::laws::params::{ParamSpec, Params, TableRow};
@@ -219,16 +220,7 @@ impl NormalModel {
 
     /// This model's parameters, declared once ([`crate::laws::params`]).
     pub fn specs(&self) -> &'static [ParamSpec] {
-        match self {
-            NormalModel::Paper(_) => PaperLaw::SPECS,
-            NormalModel::Zoh(_) => ZohLaw::SPECS,
-            NormalModel::Minsky(_) => MinskyLaw::SPECS,
-            NormalModel::Colgate(_) => ColgateLaw::SPECS,
-            NormalModel::Seh(_) => SehLaw::SPECS,
-            NormalModel::MassiePi(_) => MassiePiLaw::SPECS,
-            NormalModel::BrakingPulse(_) => BrakingPulseLaw::SPECS,
-            NormalModel::Hysteretic(_) => HystereticLaw::SPECS,
-        }
+        self.params().specs()
     }
 }
 

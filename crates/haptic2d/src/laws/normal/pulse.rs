@@ -1,6 +1,7 @@
 //! Salcudean–Vlaar braking pulse on wall entry (§5.7, [REC] sizing).
 
-use super::{NormalInput, NormalLaw};
+use super::spring_wall::{spring_wall, SpringWall};
+use super::NormalInput;
 
 crate::law_params! { BrakingPulseLaw, "pulse";
     k (self.k) [] "N/m" NonNegative "wall stiffness",
@@ -56,22 +57,20 @@ impl BrakingPulseLaw {
     }
 }
 
-impl NormalLaw for BrakingPulseLaw {
-    fn reset(&mut self) {
+spring_wall!(BrakingPulseLaw, k);
+
+impl SpringWall for BrakingPulseLaw {
+    fn forget(&mut self) {
+        self.outside();
+        self.pulse = 0.0;
+    }
+    /// Leaving the wall re-arms the pulse (the latched `F_b` is replaced at the next entry).
+    fn outside(&mut self) {
         self.inside = false;
         self.count = 0;
-        self.pulse = 0.0;
-        self.stored = 0.0;
     }
     #[inline(always)]
-    fn force(&mut self, input: &NormalInput) -> f64 {
-        let delta = input.depth();
-        self.stored = 0.5 * self.k * delta * delta;
-        if delta <= 0.0 {
-            self.inside = false;
-            self.count = 0;
-            return 0.0;
-        }
+    fn wall_force(&mut self, delta: f64, input: &NormalInput) -> f64 {
         if !self.inside {
             // First sample inside: latch the entry speed and size the pulse.
             self.inside = true;
@@ -86,8 +85,5 @@ impl NormalLaw for BrakingPulseLaw {
             self.count += 1;
         }
         f.max(0.0)
-    }
-    fn stored_energy(&self) -> f64 {
-        self.stored
     }
 }

@@ -1,6 +1,7 @@
 //! Ellis et al. (1997) sample–estimate–hold wall, with the optional predictor–corrector (§5.5).
 
-use super::{NormalInput, NormalLaw};
+use super::spring_wall::{spring_wall, SpringWall};
+use super::NormalInput;
 
 crate::law_params! { SehLaw, "seh";
     k (self.k) [] "N/m" NonNegative "wall stiffness",
@@ -54,19 +55,14 @@ impl SehLaw {
     }
 }
 
-impl NormalLaw for SehLaw {
-    fn reset(&mut self) {
+spring_wall!(SehLaw, k);
+
+impl SpringWall for SehLaw {
+    fn forget(&mut self) {
         self.used_prev = 0.0;
-        self.stored = 0.0;
     }
     #[inline(always)]
-    fn force(&mut self, input: &NormalInput) -> f64 {
-        let delta = input.depth();
-        self.stored = 0.5 * self.k * delta * delta;
-        if delta <= 0.0 {
-            self.used_prev = 0.0;
-            return 0.0;
-        }
+    fn wall_force(&mut self, delta: f64, input: &NormalInput) -> f64 {
         // Predictor: extrapolated signed penetration over the coming interval.
         let mut estimate = -input.seh_distance();
         // Corrector: add the error of the previous interval's held estimate.
@@ -79,14 +75,12 @@ impl NormalLaw for SehLaw {
         self.used_prev = if self.k > 0.0 { f / self.k } else { 0.0 };
         f
     }
-    fn stored_energy(&self) -> f64 {
-        self.stored
-    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::laws::normal::NormalLaw;
 
     fn input(d: [f64; 3]) -> NormalInput {
         NormalInput {

@@ -1,6 +1,7 @@
 //! ZOH pure stiffness, the "active" wall (§5.2).
 
-use super::{NormalInput, NormalLaw};
+use super::spring_wall::{spring_wall, SpringWall};
+use super::NormalInput;
 
 crate::law_params! { ZohLaw, "zoh";
     k (self.k) [] "N/m" NonNegative "wall stiffness",
@@ -34,17 +35,11 @@ impl ZohLaw {
     }
 }
 
-impl NormalLaw for ZohLaw {
-    fn reset(&mut self) {
-        self.stored = 0.0;
-    }
+spring_wall!(ZohLaw, k);
+
+impl SpringWall for ZohLaw {
     #[inline(always)]
-    fn force(&mut self, input: &NormalInput) -> f64 {
-        let delta = input.depth();
-        self.stored = 0.5 * self.k * delta * delta;
+    fn wall_force(&mut self, delta: f64, _input: &NormalInput) -> f64 {
         (self.k * delta).max(0.0)
-    }
-    fn stored_energy(&self) -> f64 {
-        self.stored
     }
 }
