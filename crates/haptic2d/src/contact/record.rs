@@ -111,6 +111,10 @@ pub struct VeContact {
     pub since: u64,
     /// The pair's geometry in the bodies' own frames (fixed for the life of the entry).
     pub local: LocalGeom,
+    /// The crossing-corner stage's own-axis test, remembered (`contact/manager/clip.rs`): the
+    /// relative angle `θ_A − θ_B` (rad) at which it was last computed, and the excess (m) it found
+    /// there (the overlap along the record's normal less the record's own depth). NaN: not yet.
+    pub own_axis: (f64, f64),
 }
 
 /// Body-frame geometry of a VE pair: the vertex in A's frame, the edge's start, normal and tangent

@@ -50,6 +50,53 @@ use crate::contact::record::{ContactEvent, ContactState, EventKind, VeContact, N
 use crate::laws::friction::FrictionModel;
 use crate::laws::normal::NormalModel;
 
+/// The own-axis test of a record (module docs): the overlap of the two polygons along the
+/// record's normal is within `margin` (m) of the record's own depth, on an admissible axis (a
+/// seam's piece is cleared through its surface only, `sat_depth`); then the pair's overlap is too.
+///
+/// The excess `max_v n·(V_rec − v)` over the vertices `v` of A depends on the relative angle
+/// `φ = θ_A − θ_B` only (`n` is B's edge normal and `V_rec − v` a vector of A's, so the dot
+/// product is `R(−φ)·n_B · (V_rec − v)_A`), and it changes by at most `|Δφ|·|V_rec − v| ≤
+/// |Δφ|·2·r_A` (`r_A` A's vertex radius) when `φ` does. For a pair without seams the test is
+/// remembered (`VeContact::own_axis`) and recomputed only once that bound, plus rounding
+/// allowances far above the computation's own (1e-9 m per metre of position, 1e-15 rad per radian
+/// of angle), could reach the margin: the answer is the one the full test gives. (The colliders'
+/// world features are those of the bodies' poses here: both are updated at step 3a, and nothing
+/// in the contact stage moves a body.)
+#[inline]
+fn own_axis_clears(
+    e: &mut VeContact,
+    colliders: &[Collider],
+    bodies: &[Body],
+    margin: f64,
+) -> bool {
+    let ca = &colliders[e.key.vertex_collider as usize];
+    let cb = &colliders[e.key.edge_collider as usize];
+    let plain = ca.seams == 0 && cb.seams == 0;
+    let (pa, pb) = (&bodies[ca.body].pose, &bodies[cb.body].pose);
+    let phi = pa.angle - pb.angle;
+    if plain {
+        let (phi0, excess0) = e.own_axis;
+        let rounding =
+            1e-9 * (1.0 + pa.pos.x.abs() + pa.pos.y.abs() + pb.pos.x.abs() + pb.pos.y.abs());
+        let turned = (phi - phi0).abs() + 1e-15 * (pa.angle.abs() + pb.angle.abs() + phi0.abs());
+        // NaN (not yet computed) fails the comparison.
+        if excess0 + turned * 2.0 * ca.local.radius() + rounding <= margin {
+            return true;
+        }
+    }
+    let edge = e.key.edge as usize;
+    let along = ca
+        .world_vertices()
+        .iter()
+        .map(|&v| -cb.edge_distance(edge, v))
+        .fold(f64::NEG_INFINITY, f64::max);
+    if plain {
+        e.own_axis = (phi, along + e.d[0]);
+    }
+    along <= -e.d[0] + margin && !cb.is_seam(edge) && admissible_axis(ca, cb, e.n)
+}
+
 impl ContactSet {
     /// Holds every pair whose overlap exceeds its deepest record's depth by more than
     /// `CLIP_MARGIN·δ_c` on its reference face (module docs). Runs after `create`, before the
@@ -64,20 +111,7 @@ impl ContactSet {
         friction: &FrictionModel,
     ) {
         let margin = CLIP_MARGIN * self.delta_c;
-        // The own-axis test of a record: the overlap along its normal is within the margin of
-        // its depth, on an admissible axis (a seam's piece is cleared through its surface only,
-        // `sat_depth`); then the pair's overlap is too.
-        let clears = |e: &VeContact| {
-            let ca = &colliders[e.key.vertex_collider as usize];
-            let cb = &colliders[e.key.edge_collider as usize];
-            let edge = e.key.edge as usize;
-            let along = ca
-                .world_vertices()
-                .iter()
-                .map(|&v| -cb.edge_distance(edge, v))
-                .fold(f64::NEG_INFINITY, f64::max);
-            along <= -e.d[0] + margin && !cb.is_seam(edge) && admissible_axis(ca, cb, e.n)
-        };
+        let clears = |e: &mut VeContact| own_axis_clears(e, colliders, bodies, margin);
         let pair_of = |key: &VeCandidate| {
             let (a, b) = (key.vertex_collider, key.edge_collider);
             (a.min(b), a.max(b))
@@ -85,7 +119,7 @@ impl ContactSet {
         // Pairs (a < b) with a record whose own-axis test fails, and those that lost a loaded
         // record out of its edge range this sample (`release`).
         self.crossing.clear();
-        for e in self.entries.iter().filter(|e| e.is_contact()) {
+        for e in self.entries.iter_mut().filter(|e| e.is_contact()) {
             if !clears(e) {
                 self.crossing.push(pair_of(&e.key));
             }
@@ -102,7 +136,7 @@ impl ContactSet {
         self.crossing_info.clear();
         self.crossing_info
             .resize(self.crossing.len(), (0.0, false, false));
-        for e in self.entries.iter().filter(|e| e.is_contact()) {
+        for e in self.entries.iter_mut().filter(|e| e.is_contact()) {
             if let Ok(k) = self.crossing.binary_search(&pair_of(&e.key)) {
                 let info = &mut self.crossing_info[k];
                 info.0 = info.0.max(-e.d[0]);
@@ -260,5 +294,94 @@ impl ContactSet {
             key,
             kind: EventKind::Created(ContactState::Continuous),
         });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::own_axis_clears;
+    use crate::body::Body;
+    use crate::collide::{Collider, VeCandidate};
+    use crate::contact::manager::sync::new_entry;
+    use crate::contact::manager::PastPoses;
+    use crate::geom::{ConvexPolygon, Pose};
+
+    /// A 0.1 m box rocking and sliding on a floor, its bottom-right corner on the floor's top
+    /// edge: over 20 000 seeded random motions (some in place) the remembered own-axis test answers
+    /// exactly as the full test on a record that remembers nothing; both answers occur, and the
+    /// remembered one is used after the box has turned.
+    #[test]
+    fn remembered_own_axis_test_answers_as_the_full_test() {
+        let floor_pose = Pose::new(0.3, -0.1, 0.0);
+        let mut bodies = vec![
+            Body::dynamic("box", 1.0, 1e-3, Pose::new(0.0, 0.048, 0.0)),
+            Body::fixed("floor", floor_pose),
+        ];
+        let mut colliders = vec![
+            Collider::new(
+                0,
+                true,
+                ConvexPolygon::rectangle(0.1, 0.1).unwrap(),
+                &bodies[0].pose,
+            ),
+            Collider::new(
+                1,
+                false,
+                ConvexPolygon::rectangle(2.0, 0.2).unwrap(),
+                &floor_pose,
+            ),
+        ];
+        let key = VeCandidate {
+            vertex_collider: 0,
+            vertex: 1,
+            edge_collider: 1,
+            edge: 2,
+        };
+        let past = PastPoses {
+            prev: &[],
+            prev2: &[],
+        };
+        let margin = 1e-3;
+        let mut remembered = new_entry(0, key, &colliders, &bodies, &past);
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut uniform = move || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            ((state >> 11) as f64) / ((1u64 << 53) as f64) * 2.0 - 1.0
+        };
+        let (mut cleared, mut failed, mut reused) = (0, 0, 0);
+        for _ in 0..20_000 {
+            let pose = &mut bodies[0].pose;
+            if uniform() > -0.5 {
+                pose.angle = (pose.angle + 2e-3 * uniform()).clamp(-0.04, 0.04);
+                pose.pos.x += 1e-3 * uniform();
+                pose.pos.y = 0.048 + 1e-3 * uniform();
+            }
+            let pose = bodies[0].pose;
+            colliders[0].update(&pose);
+            let fresh = new_entry(0, key, &colliders, &bodies, &past);
+            remembered.d = fresh.d;
+            let full = own_axis_clears(&mut fresh.clone(), &colliders, &bodies, margin);
+            let answer = own_axis_clears(&mut remembered, &colliders, &bodies, margin);
+            assert_eq!(answer, full, "at {pose:?}");
+            if full {
+                cleared += 1;
+            } else {
+                failed += 1;
+            }
+            // Not recomputed here: what it remembers is from another angle.
+            if remembered.own_axis.0.to_bits() != (pose.angle - floor_pose.angle).to_bits() {
+                reused += 1;
+            }
+        }
+        assert!(
+            cleared > 1000 && failed > 1000,
+            "{cleared} cleared, {failed} failed"
+        );
+        assert!(
+            reused > 1000,
+            "the remembered answer was used {reused} times"
+        );
     }
 }
