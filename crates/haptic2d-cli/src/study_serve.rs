@@ -18,11 +18,12 @@ use crate::exit::{Failure, Status};
 use crate::hand_arg::HandSpec;
 use crate::loop_end::LoopEnd;
 use crate::run_rig::{DeviceChoice, Rig};
-use crate::run_view::{self, LiveView};
+use crate::run_view::{self, LiveView, LoadedScene};
 use crate::serve_conn::{Action, Protocol, MAX_LINE};
 use crate::serve_present::{FromLoop, ServePresenter, ToLoop};
 use crate::study_browser::{self, BrowserOptions};
-use crate::study_mcap::{self, TrialTap};
+use crate::study_mcap::{self, TrialLogger, TrialTap};
+use haptic2d_view::ViewHandle;
 use haptic2d_lab::study::Study;
 use haptic2d_rt::signal::install_stop_signals;
 use haptic2d_rt::{run_loop, TickControl, TickInfo, Watchdog};
@@ -89,6 +90,53 @@ fn hand(o: &ServeOptions) -> Result<HandSpec, Failure> {
     }
 }
 
+/// The display page (unless `--headless`), the study owning the stimulus: the page cannot switch
+/// the scene or the laws.
+fn start_view(
+    o: &ServeOptions,
+    rig: &Rig,
+    loaded: LoadedScene,
+    rate: f64,
+) -> Result<(Option<ViewHandle>, Option<LiveView>), Failure> {
+    if o.headless {
+        return Ok((None, None));
+    }
+    let bind = o.rig.bind.parse::<SocketAddr>().map_err(|e| {
+        Failure::from(format!(
+            "--bind `{}`: {e}\n    fix: e.g. --bind 127.0.0.1:8080",
+            o.rig.bind
+        ))
+    })?;
+    let (server, mut view) = run_view::start(bind, rig, loaded, rate, o.rig.require_token)?;
+    crate::outln!("{}", server.banner());
+    view.enable_study();
+    Ok((Some(server), Some(view)))
+}
+
+/// The per-presentation MCAP logs in `out/trials/` (`--out`), each naming the study and the device.
+fn start_logs(
+    out: &Path,
+    study: &Study,
+    text: &str,
+    rig: &Rig,
+    o: &ServeOptions,
+    rate: f64,
+) -> Result<(TrialTap, TrialLogger), Failure> {
+    check_out(out)?;
+    let scene = crate::run_log::scene_strings(
+        &study.scene_source,
+        &study.name,
+        o.rig.device_file.as_deref(),
+        &[
+            ("rate_hz", rate.to_string()),
+            ("command", "study serve".into()),
+            ("device", o.rig.device.clone()),
+            ("study_toml", text.to_string()),
+        ],
+    );
+    Ok(study_mcap::start(out, rig.system.world(), scene, rate)?)
+}
+
 /// Runs the server until the client's `stop`, a signal, the page's stop or the loop's end.
 pub fn run(file: &Path, o: &ServeOptions) -> Result<Status, Failure> {
     let listen = check_listen(&o.listen)?;
@@ -99,41 +147,13 @@ pub fn run(file: &Path, o: &ServeOptions) -> Result<Status, Failure> {
         .and_then(|l| l.set_nonblocking(true).map(|_| l))
         .map_err(|e| Failure::from(format!("cannot listen on {listen}: {e}")))?;
     let local = listener.local_addr().map_err(|e| e.to_string())?;
-    let (server, mut view) = if o.headless {
-        (None, None)
-    } else {
-        let bind = o.rig.bind.parse::<SocketAddr>().map_err(|e| {
-            Failure::from(format!(
-                "--bind `{}`: {e}\n    fix: e.g. --bind 127.0.0.1:8080",
-                o.rig.bind
-            ))
-        })?;
-        let (server, view) = run_view::start(bind, &rig, loaded, rate, o.rig.require_token)?;
-        crate::outln!("{}", server.banner());
-        (Some(server), Some(view))
-    };
-    if let Some(v) = view.as_mut() {
-        // The study owns the stimulus: the page cannot switch the scene or the laws.
-        v.enable_study();
-    }
+    let (server, view) = start_view(o, &rig, loaded, rate)?;
     let stop = install_stop_signals()?;
     let watchdog = Watchdog::new(rig.watchdog_config())?;
     let loop_config = study_browser::study_loop_config(rate, o.rig.no_rt)?;
     let (tap, logger, trials_dir) = match &o.out {
         Some(out) => {
-            check_out(out)?;
-            let scene = crate::run_log::scene_strings(
-                &study.scene_source,
-                &study.name,
-                o.rig.device_file.as_deref(),
-                &[
-                    ("rate_hz", rate.to_string()),
-                    ("command", "study serve".into()),
-                    ("device", o.rig.device.clone()),
-                    ("study_toml", text.clone()),
-                ],
-            );
-            let (tap, logger) = study_mcap::start(out, rig.system.world(), scene, rate)?;
+            let (tap, logger) = start_logs(out, &study, &text, &rig, o, rate)?;
             (Some(tap), Some(logger), Some(out.join("trials")))
         }
         None => (None, None, None),
