@@ -239,7 +239,7 @@ impl<'a> Protocol<'a> {
     }
 
     /// Turns a report of the loop into the reply it completes, if any.
-    pub fn from_loop(&mut self, ev: FromLoop) -> Option<Value> {
+    pub fn on_report(&mut self, ev: FromLoop) -> Option<Value> {
         match ev {
             FromLoop::Started { id, t_s } => {
                 if let Some(p) = self.pending.as_mut().filter(|p| p.id == id) {

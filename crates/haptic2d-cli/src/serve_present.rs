@@ -42,6 +42,8 @@ pub struct Request {
 }
 
 /// What the main thread sends the loop.
+// Every slot of the ring is the size of a request anyway; boxing it would allocate per request.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Copy, Debug)]
 pub enum ToLoop {
     /// Present a stimulus.

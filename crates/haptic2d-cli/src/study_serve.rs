@@ -23,10 +23,10 @@ use crate::serve_conn::{Action, Protocol, MAX_LINE};
 use crate::serve_present::{FromLoop, ServePresenter, ToLoop};
 use crate::study_browser::{self, BrowserOptions};
 use crate::study_mcap::{self, TrialLogger, TrialTap};
-use haptic2d_view::ViewHandle;
 use haptic2d_lab::study::Study;
 use haptic2d_rt::signal::install_stop_signals;
 use haptic2d_rt::{run_loop, TickControl, TickInfo, Watchdog};
+use haptic2d_view::ViewHandle;
 use serde_json::Value;
 use std::io::{ErrorKind, Read, Write};
 use std::net::{SocketAddr, TcpListener, TcpStream};
@@ -362,7 +362,7 @@ impl Link {
                 }
             }
             while let Ok(ev) = self.reports.pop() {
-                if let Some(reply) = proto.from_loop(ev) {
+                if let Some(reply) = proto.on_report(ev) {
                     self.send_all(&[reply]);
                 }
             }
@@ -444,7 +444,7 @@ impl Link {
     fn farewell(&mut self, proto: &mut Protocol, reason: &str, client_stopped: bool) {
         // Reports that arrived since the last poll (a presentation that ended just before).
         while let Ok(ev) = self.reports.pop() {
-            if let Some(reply) = proto.from_loop(ev) {
+            if let Some(reply) = proto.on_report(ev) {
                 self.send_all(&[reply]);
             }
         }
