@@ -32,7 +32,7 @@ class StudyServer:
     exits) when the server was started by :func:`serve`, and closes the connection otherwise.
     """
 
-    def __init__(self, sock: socket.socket, process: Optional[subprocess.Popen] = None) -> None:
+    def __init__(self, sock: socket.socket, process: Optional["subprocess.Popen[str]"] = None) -> None:
         self._sock = sock
         self._file = sock.makefile("r", encoding="utf-8", newline="\n")
         self._process = process
@@ -57,7 +57,7 @@ class StudyServer:
                 raise StudyServerError(f"the study server is gone ({e})") from e
             if not line:
                 raise StudyServerError(f"the study server closed the connection{self._exit_note()}")
-            reply = json.loads(line)
+            reply: Dict[str, Any] = json.loads(line)
             if not reply.get("ok", False):
                 raise StudyServerError(str(reply.get("error", reply)))
             if reply.get("cmd") == cmd:
@@ -146,7 +146,7 @@ class StudyServer:
             self._sock.close()
 
     @property
-    def process(self) -> Optional[subprocess.Popen]:
+    def process(self) -> Optional["subprocess.Popen[str]"]:
         """The server process started by :func:`serve`, else None."""
         return self._process
 
