@@ -219,6 +219,11 @@ pub fn run(file: &Path, o: &ServeOptions) -> Result<Status, Failure> {
             "interrupted by a signal (SIGINT or SIGTERM)".into(),
         ),
     };
+    // The client hears why the latch tripped, not just that it did.
+    let why = match (status, rig.system.safety_trip()) {
+        (Status::SafetyStop, Some(trip)) => format!("{why}: {trip}"),
+        _ => why,
+    };
     let reason = format!("{why}; torques were set to zero");
     link.farewell(&mut proto, &reason, status == Status::Clean && client_stop);
     if let Some(l) = logger {
@@ -234,9 +239,6 @@ pub fn run(file: &Path, o: &ServeOptions) -> Result<Status, Failure> {
             t.deadlines,
             t.overruns
         );
-    }
-    if let Some(trip) = rig.system.safety_trip() {
-        crate::outln!("{trip}");
     }
     crate::outln!("stopped: {reason}");
     Ok(status)

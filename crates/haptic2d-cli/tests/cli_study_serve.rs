@@ -1,9 +1,9 @@
 //! `haptic2d study serve` end to end (issue 40 item 7): the real binary on the simulated device,
 //! driven over TCP on loopback with JSON lines as a Python/PsychoPy client drives it. A present
 //! runs on the real-time loop and comes back with the loop's measures; bad requests are answered
-//! with their reasons and change nothing; `stop` exits 0; SIGINT ends the server with 130, answering
-//! the pending presentation with the reason and zeroing the torques; non-loopback addresses are
-//! refused before anything starts.
+//! with their reasons and change nothing; `stop` exits 0; SIGINT ends the server with 130 and a
+//! safety stop with 3, each answering the pending presentation with the reason and zeroing the
+//! torques; non-loopback addresses are refused before anything starts.
 
 mod common;
 
@@ -214,6 +214,27 @@ fn sigint_answers_the_pending_presentation_zeroes_the_torques_and_exits_130() {
     assert_eq!(code, Some(130), "{out}");
     assert!(out.contains("1 interrupted trial(s)"), "{out}");
     assert!(out_dir.join("trials/trial-0001.mcap").is_file());
+}
+
+/// A safety stop (here a scripted 50 N push, after 3 s of holding, drives the handle past the
+/// workspace edge: the latch trips) ends the server with exit 3; the pending presentation is
+/// answered with the trip's reason, and a last line says why the server ended.
+#[test]
+fn a_safety_stop_answers_the_pending_presentation_with_the_trip_and_exits_3() {
+    let mut s = Served::start("script:3.0,-50,0,0,10", &[]);
+    let r = s.ask(json!({"cmd": "present", "condition": "spring-1000", "duration_s": 20}));
+    let e = error_of(&r);
+    assert_eq!(r["cmd"], json!("present"));
+    assert!(
+        e.contains("safety stop")
+            && e.contains("past the workspace edge")
+            && e.contains("torques were set to zero"),
+        "{e}"
+    );
+    let last = s.reply();
+    assert_eq!(last["cmd"], json!("server"), "{last}");
+    let (code, out) = s.exit();
+    assert_eq!(code, Some(3), "{out}");
 }
 
 /// The server has no key: any address beyond loopback is refused before the device is opened.
