@@ -216,6 +216,45 @@ fn sigint_answers_the_pending_presentation_zeroes_the_torques_and_exits_130() {
     assert!(out_dir.join("trials/trial-0001.mcap").is_file());
 }
 
+/// One client at a time: a second connection is told so and closed. A client that goes away ends
+/// its open-ended presentation, and the server serves the next client.
+#[test]
+fn a_second_client_is_refused_and_a_lost_clients_presentation_is_ended() {
+    let mut s = Served::start("follow", &[]);
+    let addr = s.conn.get_ref().peer_addr().unwrap();
+    let a = s.ask(json!({"cmd": "present", "condition": "spring-1000"}));
+    assert_eq!(a["until"], json!("end"), "{a}");
+    let mut second = BufReader::new(TcpStream::connect(addr).unwrap());
+    let mut line = String::new();
+    second.read_line(&mut line).unwrap();
+    assert!(line.contains("another client is connected"), "{line}");
+    line.clear();
+    assert_eq!(second.read_line(&mut line).unwrap(), 0, "then closed");
+    // The first client goes away mid-presentation; the next one finds it ended.
+    let Served { child, conn } = s;
+    drop(conn);
+    let stream = TcpStream::connect(addr).unwrap();
+    stream
+        .set_read_timeout(Some(Duration::from_secs(60)))
+        .unwrap();
+    let mut s = Served {
+        child,
+        conn: BufReader::new(stream),
+    };
+    let t0 = std::time::Instant::now();
+    loop {
+        let st = s.ask(json!({"cmd": "status"}));
+        if st["state"] == json!("idle") {
+            assert_eq!(st["presented"], json!(1), "{st}");
+            break;
+        }
+        assert!(t0.elapsed() < Duration::from_secs(30), "still {st}");
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    assert_eq!(s.ask(json!({"cmd": "stop"}))["ok"], json!(true));
+    assert_eq!(s.exit().0, Some(0));
+}
+
 /// A safety stop (here a scripted 50 N push, after 3 s of holding, drives the handle past the
 /// workspace edge: the latch trips) ends the server with exit 3; the pending presentation is
 /// answered with the trip's reason, and a last line says why the server ended.
