@@ -12,6 +12,10 @@
 //! A SIGINT or SIGTERM, the page's stop button, a lost device or a safety stop end the loop (torques
 //! zeroed and latched as in `haptic2d run`); the trial in progress is not written, so running the
 //! same command again resumes at it.
+//!
+//! The rig ([`build_rig`]), the loop's settings, the haptic step ([`haptic_step`]), the stimulus
+//! laws ([`stimulus_laws`]) and the end reasons ([`loop_end_status`]) are shared with `haptic2d
+//! study serve` (`study_serve.rs`), which presents stimuli on the same loop to a Python client.
 
 use crate::device_arg;
 use crate::exit::{Failure, Status};
