@@ -62,9 +62,12 @@ def test_two_walls_presented_on_the_loop_are_pressed_as_their_stiffness_says(bin
         # which also count deadlines a late loop skipped).
         assert m["ticks"] == round(PERIOD_S * 500) and m["end_s"] - m["start_s"] > PERIOD_S - 1e-9, m
         assert m["contact_s"] > 0.5 * PERIOD_S, m
+        # The press is not perfectly static (the box re-touches the wall near each trough at a small
+        # speed): measured peaks 1.97-2.11 N and depths within -1 %..+7 % of the derivation in
+        # December 2026 runs; the bounds leave room for that and still tell 1000 from 2000 N/m.
         assert abs(m["peak_force_n"] - PEAK_N) < 0.1 * PEAK_N, m
         expected_depth = PEAK_N / (2 * kc)
-        assert abs(m["deepest_m"] - expected_depth) < 0.1 * expected_depth, (m, expected_depth)
+        assert abs(m["deepest_m"] - expected_depth) < 0.15 * expected_depth, (m, expected_depth)
         expected_mean = PEAK_N * PERIOD_S / 2 / m["contact_s"]
         assert abs(m["mean_force_n"] - expected_mean) < 0.05 * expected_mean, (m, expected_mean)
         assert os.path.isfile(m["mcap"]), m
