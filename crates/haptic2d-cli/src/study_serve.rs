@@ -350,12 +350,11 @@ impl Link {
                 return false;
             }
             let t_s = f64::from_bits(t_bits.load(Ordering::Relaxed));
-            self.accept();
+            // Read before accepting: a client that closed and reconnected at once is seen gone
+            // first, so that its new connection is taken, not refused as a second client. The
+            // requests it sent before closing are served (a `stop` too); then whatever presentation
+            // it left running is ended.
             let (lines, gone) = self.read_lines();
-            if gone {
-                // A lost client ends the presentation it asked for; the next client may connect.
-                proto.drop_client();
-            }
             for line in lines {
                 let (replies, action) = proto.request(&line, t_s);
                 self.send_all(&replies);
@@ -363,6 +362,10 @@ impl Link {
                     return true;
                 }
             }
+            if gone {
+                proto.drop_client();
+            }
+            self.accept();
             while let Ok(ev) = self.reports.pop() {
                 if let Some(reply) = proto.on_report(ev) {
                     self.send_all(&[reply]);

@@ -2,7 +2,7 @@
 //! driven over TCP on loopback with JSON lines as a Python/PsychoPy client drives it. A present
 //! runs on the real-time loop and comes back with the loop's measures; bad requests are answered
 //! with their reasons and change nothing; `stop` exits 0; SIGINT ends the server with 130 and a
-//! safety stop with 3, each answering the pending presentation with the reason and zeroing the
+//! safety stop with 3 and a lost device with 4, each answering the pending presentation with the reason and zeroing the
 //! torques; non-loopback addresses are refused before anything starts.
 
 mod common;
@@ -29,11 +29,18 @@ impl Served {
     /// `haptic2d study serve studies/stiffness-walls.toml --device sim --hand HAND --headless` on a
     /// free loopback port, connected.
     fn start(hand: &str, extra: &[&str]) -> Served {
+        let mut args = vec!["--hand", hand];
+        args.extend_from_slice(extra);
+        Self::start_on("sim", &args)
+    }
+
+    /// The same on `device` with the options `extra`.
+    fn start_on(device: &str, extra: &[&str]) -> Served {
         let (child, addr) = spawn_announced(
             Command::new(BIN)
                 .args(["study", "serve"])
                 .arg(study())
-                .args(["--device", "sim", "--hand", hand, "--listen", "127.0.0.1:0"])
+                .args(["--device", device, "--listen", "127.0.0.1:0"])
                 .args(["--headless", "--no-rt"])
                 .args(extra),
             "study server: listening on ",
@@ -274,6 +281,31 @@ fn a_safety_stop_answers_the_pending_presentation_with_the_trip_and_exits_3() {
     assert_eq!(last["cmd"], json!("server"), "{last}");
     let (code, out) = s.exit();
     assert_eq!(code, Some(3), "{out}");
+}
+
+/// A lost device (the UDP reference device, devices/udp/sim_device.py, killed mid-presentation)
+/// ends the server as `haptic2d run`: exit 4, the pending presentation answered with the reason.
+#[test]
+fn a_lost_device_answers_the_pending_presentation_and_exits_4() {
+    let (mut dev, dev_addr) = spawn_announced(
+        Command::new("python3")
+            .arg(common::root().join("devices/udp/sim_device.py"))
+            .args(["--bind", "127.0.0.1:0"]),
+        "listening on ",
+    );
+    let file = common::patient_device_file("udp-pantograph.toml", ("3", "50"), "serve", "udp.toml");
+    let device = format!("udp:{dev_addr}");
+    let file_arg = file.display().to_string();
+    let mut s = Served::start_on(&device, &["--device-file", &file_arg]);
+    let a = s.ask(json!({"cmd": "present", "condition": "spring-1000"}));
+    assert_eq!(a["ok"], json!(true), "{a}");
+    std::thread::sleep(Duration::from_millis(300));
+    dev.kill().unwrap();
+    let r = s.reply();
+    let e = error_of(&r);
+    assert!(e.contains("torques were set to zero"), "{e}");
+    let (code, out) = s.exit();
+    assert_eq!(code, Some(4), "{out}");
 }
 
 /// The server has no key: any address beyond loopback is refused before the device is opened.
