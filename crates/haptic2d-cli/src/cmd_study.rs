@@ -1,10 +1,12 @@
 //! `haptic2d study`: perceptual studies (docs/STUDIES.md). `study run FILE --observer simulated`
 //! runs (or resumes) a session headless on the simulated observer; `--observer browser` runs it on
-//! the real-time haptic loop with answers from the browser page (`study_browser.rs`); `study analyse DIR` fits the
+//! the real-time haptic loop with answers from the browser page (`study_browser.rs`); `study serve
+//! FILE` presents stimuli on that loop to a local client (`study_serve.rs`); `study analyse DIR` fits the
 //! psychometric functions and draws them; `study check FILE` validates a study file.
 
 use crate::exit::{Failure, Status};
 use crate::study_browser::BrowserOptions;
+use crate::study_serve::ServeOptions;
 use haptic2d_lab::study::analyse::{analyse_dir, AnalyseOptions};
 use haptic2d_lab::study::fit::Shape;
 use haptic2d_lab::study::method::Method;
@@ -63,6 +65,51 @@ pub enum StudyCmd {
         /// Stop after this many new trials (the session resumes on the next run).
         #[arg(long)]
         stop_after: Option<u32>,
+    },
+    /// Serve the study's stimuli on the real-time haptic loop to one local client (a Python or
+    /// PsychoPy script: `haptic2d.StudyServer`), JSON lines over TCP on loopback: `present`
+    /// {condition, delta, duration_s}, `end`, `status`, `stop` (docs/STUDIES.md, "Driving trials
+    /// from Python or PsychoPy on the device"). The client keeps the trials and the answers.
+    Serve {
+        /// The study file (its scene, probe and stimuli; its method and [observer] are unused).
+        file: PathBuf,
+        /// The device, as `haptic2d run --device` (sim, haply:…, udp:…, inverse3[:URL]).
+        #[arg(long, default_value = "sim")]
+        device: String,
+        /// The device file, as `haptic2d run --device-file`.
+        #[arg(long, value_name = "FILE.toml")]
+        device_file: Option<PathBuf>,
+        /// The simulated device's hand, as `haptic2d run --hand` (follow, free, constant:…,
+        /// sine:…, script:…); refused for a real device.
+        #[arg(long)]
+        hand: Option<String>,
+        /// The clients' address: loopback only (the server has no key), port 0 picks a free one
+        /// (printed as `study server: listening on ADDRESS`).
+        #[arg(long, default_value = "127.0.0.1:7341")]
+        listen: String,
+        /// Address of the display page.
+        #[arg(long, default_value = "127.0.0.1:8080")]
+        bind: String,
+        /// No display page.
+        #[arg(long)]
+        headless: bool,
+        /// Write one MCAP log per presentation into OUT/trials/trial-NNNN.mcap (NNNN = the
+        /// presentation's id).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Normal scheduling instead of real-time.
+        #[arg(long)]
+        no_rt: bool,
+        /// The page's commands need the token on loopback too.
+        #[arg(long)]
+        require_token: bool,
+        /// Drive a real device even if `haptic2d stability` finds it unstable with the hand
+        /// released.
+        #[arg(long)]
+        allow_unstable: bool,
+        /// Let --device udp:ADDR:PORT be beyond loopback.
+        #[arg(long)]
+        allow_remote_device: bool,
     },
     /// Fit psychometric functions per condition (maximum likelihood, guess rate 0.5, fitted lapse
     /// rate, parametric-bootstrap 95 % intervals), report JNDs and Weber fractions, and write
@@ -132,6 +179,38 @@ pub fn run(cmd: &StudyCmd) -> Result<Status, Failure> {
             stop_after,
             ..
         } => study_run(file, observer, out, participant, *session, *stop_after),
+        StudyCmd::Serve {
+            file,
+            device,
+            device_file,
+            hand,
+            listen,
+            bind,
+            headless,
+            out,
+            no_rt,
+            require_token,
+            allow_unstable,
+            allow_remote_device,
+        } => crate::study_serve::run(
+            file,
+            &ServeOptions {
+                rig: BrowserOptions {
+                    device: device.clone(),
+                    device_file: device_file.clone(),
+                    bind: bind.clone(),
+                    interval_s: 0.0,
+                    no_rt: *no_rt,
+                    require_token: *require_token,
+                    allow_unstable: *allow_unstable,
+                    allow_remote_device: *allow_remote_device,
+                },
+                hand: hand.clone(),
+                listen: listen.clone(),
+                out: out.clone(),
+                headless: *headless,
+            },
+        ),
         StudyCmd::Analyse {
             dir,
             shape,

@@ -12,6 +12,10 @@
 //! A SIGINT or SIGTERM, the page's stop button, a lost device or a safety stop end the loop (torques
 //! zeroed and latched as in `haptic2d run`); the trial in progress is not written, so running the
 //! same command again resumes at it.
+//!
+//! The rig ([`build_rig`]), the loop's settings, the haptic step ([`haptic_step`]), the stimulus
+//! laws ([`stimulus_laws`]) and the end reasons ([`loop_end_status`]) are shared with `haptic2d
+//! study serve` (`study_serve.rs`), which presents stimuli on the same loop to a Python client.
 
 use crate::device_arg;
 use crate::exit::{Failure, Status};
@@ -83,7 +87,7 @@ pub fn run(
     let bind = check_options(o)?;
     haptic2d_lab::study::session::check_participant(participant)?;
     let (study, text) = Study::read(file).map_err(Failure::from)?;
-    let (mut rig, loaded, rate) = build_rig(&study, o)?;
+    let (mut rig, loaded, rate) = build_rig(&study, o, HandSpec::Follow)?;
     let seed = session_seed(study.seed, participant, session);
     let planned = Schedule::new(&study, seed).planned();
 
@@ -92,14 +96,7 @@ pub fn run(
     crate::outln!("{}", server.banner());
     let stop = install_stop_signals()?;
     let watchdog = Watchdog::new(rig.watchdog_config())?;
-    let loop_config = LoopConfig {
-        rate_hz: rate,
-        duration: None,
-        rt: !o.no_rt,
-        spin_us: (0.4e6 / rate).min(400.0),
-        ..LoopConfig::default()
-    };
-    loop_config.validate()?;
+    let loop_config = study_loop_config(rate, o.no_rt)?;
     let (tap, trial_log) =
         start_trial_log(&study, &text, &rig, out, participant, session, o, rate)?;
     let (plan_tx, plan_rx) = rtrb::RingBuffer::<Plan>::new(2);
@@ -209,10 +206,29 @@ fn check_options(o: &BrowserOptions) -> Result<SocketAddr, Failure> {
     })
 }
 
+/// The loop of a study on the device (the browser study, the study server): `rate` Hz, no end of
+/// its own, real-time scheduling unless `no_rt`.
+pub(crate) fn study_loop_config(rate: f64, no_rt: bool) -> Result<LoopConfig, Failure> {
+    let loop_config = LoopConfig {
+        rate_hz: rate,
+        duration: None,
+        rt: !no_rt,
+        spin_us: (0.4e6 / rate).min(400.0),
+        ..LoopConfig::default()
+    };
+    loop_config.validate()?;
+    Ok(loop_config)
+}
+
 /// Builds the rig (device, system, the study's first reference stimulus in the world) as `haptic2d
-/// run` does, gated by the released-stability check for a real device. Returns the rig, the scene
-/// for the display and the loop rate (Hz).
-fn build_rig(study: &Study, o: &BrowserOptions) -> Result<(Rig, LoadedScene, f64), Failure> {
+/// run` does, gated by the released-stability check for a real device; `hand` drives the simulated
+/// device (the browser study's is `follow`). Returns the rig, the scene for the display and the
+/// loop rate (Hz).
+pub(crate) fn build_rig(
+    study: &Study,
+    o: &BrowserOptions,
+    hand: HandSpec,
+) -> Result<(Rig, LoadedScene, f64), Failure> {
     let first = &study.conditions[0].reference;
     let scene_text = stimulus::scene_text(study, first, None).map_err(scene_errors)?;
     let scene = Scene::from_toml(&scene_text, &study.scene_source, study.rate)
@@ -244,7 +260,7 @@ fn build_rig(study: &Study, o: &BrowserOptions) -> Result<(Rig, LoadedScene, f64
         world: scene.world.clone(),
     };
     let mut rig = match real {
-        None => Rig::new(scene.world, &scene.source, config, device, HandSpec::Follow)?,
+        None => Rig::new(scene.world, &scene.source, config, device, hand)?,
         Some(r) => {
             Rig::with_real(scene.world, &scene.source, config, device, r).map_err(|e| match e {
                 RealOpenError::Config(m) => Failure::from(m),
@@ -299,6 +315,24 @@ fn start_trial_log(
     Ok(study_mcap::start(&dir, rig.system.world(), scene, rate)?)
 }
 
+/// The exit status of a study loop the tick stopped, and why (for the terminal).
+pub(crate) fn loop_end_status(end: LoopEnd) -> (Status, String) {
+    match end {
+        LoopEnd::DeviceLost(m) => (
+            Status::DeviceLost,
+            format!("{m}\n    torques were set to zero and latched"),
+        ),
+        // A study refuses a replay, so its data cannot end; were it to, the device is gone.
+        LoopEnd::ReplayEnded => (
+            Status::DeviceLost,
+            "the device's data ended\n    torques were set to zero and latched".into(),
+        ),
+        LoopEnd::Watchdog(m) => (Status::SafetyStop, m),
+        LoopEnd::SafetyLatch => (Status::SafetyStop, "safety stop".into()),
+        LoopEnd::WorldDiverged(m) => (Status::Diverged, m),
+    }
+}
+
 /// Reports how the session ended and returns the exit status.
 fn finish(
     end: Option<LoopEnd>,
@@ -307,18 +341,7 @@ fn finish(
 ) -> Result<Status, Failure> {
     let resume_hint = "run the same command again to resume at the next unanswered trial";
     let (status, why) = match (end, early) {
-        (Some(LoopEnd::DeviceLost(m)), _) => (
-            Status::DeviceLost,
-            format!("{m}\n    torques were set to zero and latched"),
-        ),
-        // A study refuses a replay, so its data cannot end; were it to, the device is gone.
-        (Some(LoopEnd::ReplayEnded), _) => (
-            Status::DeviceLost,
-            "the device's data ended\n    torques were set to zero and latched".into(),
-        ),
-        (Some(LoopEnd::Watchdog(m)), _) => (Status::SafetyStop, m),
-        (Some(LoopEnd::SafetyLatch), _) => (Status::SafetyStop, "safety stop".into()),
-        (Some(LoopEnd::WorldDiverged(m)), _) => (Status::Diverged, m),
+        (Some(end), _) => loop_end_status(end),
         (None, Some(EarlyEnd::Page)) => (Status::Clean, "stopped from the page".into()),
         (None, Some(EarlyEnd::Loop)) => (
             Status::Interrupted,
@@ -370,22 +393,34 @@ impl BrowserObserver<'_> {
         if let Some(l) = self.laws.get(&key) {
             return Ok(*l);
         }
-        let cond = &study.conditions[c];
-        let (name, vary) = if comparison {
-            (&cond.comparison, Some((&cond.vary, delta)))
-        } else {
-            (&cond.reference, None)
-        };
-        let w = stimulus::world(study, name, vary).map_err(|e| {
-            e.iter()
-                .map(|s| s.to_string())
-                .collect::<Vec<_>>()
-                .join("; ")
-        })?;
-        let l = (w.normal, w.friction);
+        let l = stimulus_laws(study, c, comparison, delta)?;
         self.laws.insert(key, l);
         Ok(l)
     }
+}
+
+/// The wall law and friction model of condition `c`'s reference, or of its comparison with the
+/// varied parameter raised by `delta` (its unit), built from the study's scene (allocates: call
+/// it off the loop thread). The error names the problem (an invalid parameter value).
+pub(crate) fn stimulus_laws(
+    study: &Study,
+    c: usize,
+    comparison: bool,
+    delta: f64,
+) -> Result<(NormalModel, FrictionModel), String> {
+    let cond = &study.conditions[c];
+    let (name, vary) = if comparison {
+        (&cond.comparison, Some((&cond.vary, delta)))
+    } else {
+        (&cond.reference, None)
+    };
+    let w = stimulus::world(study, name, vary).map_err(|e| {
+        e.iter()
+            .map(|s| s.to_string())
+            .collect::<Vec<_>>()
+            .join("; ")
+    })?;
+    Ok((w.normal, w.friction))
 }
 
 impl Observer for BrowserObserver<'_> {
@@ -508,35 +543,13 @@ impl StudyLoop<'_> {
             self.tap.start(trial);
         }
         let paused = held(paused, &self.presenter);
-        let (q, lost) = match self.rig.read() {
-            Ok(q) => (q, None),
-            Err(e) => ([f64::NAN; 4], Some(e)),
-        };
-        let out = self.rig.tick_system(&q, info, paused);
-        let mut tau = out.torques;
-        let safety = self.rig.safety_input(info, &out, lost.is_some());
-        let Rig { system, io, .. } = &mut *self.rig;
-        let guard = self.watchdog.guard(&safety, &mut tau);
-        // A lost reading, or a world that diverged in this tick, stops the loop before its torques
-        // reach the device (as in `haptic2d run`).
-        if let Some(end) = lost
-            .map(LoopEnd::read_failed)
-            .or_else(|| LoopEnd::diverged(system.world()))
-        {
-            io.zero_torques();
-            self.end = Some(end);
-            return TickControl::Stop;
-        }
-        if let Err(e) = io.write_torques(&tau) {
-            io.zero_torques();
-            self.end = Some(LoopEnd::DeviceLost(e.to_string()));
-            return TickControl::Stop;
-        }
-        let mut rec = out.record;
-        rec.tau = tau;
-        self.tap.tick(info, &q, &rec, system.world());
-        if let Some(end) = LoopEnd::after_write(guard, out.tripped) {
-            io.zero_torques();
+        if let Err(end) = haptic_step(
+            self.rig,
+            &mut self.watchdog,
+            Some(&mut self.tap),
+            info,
+            paused,
+        ) {
             self.end = Some(end);
             return TickControl::Stop;
         }
@@ -544,6 +557,52 @@ impl StudyLoop<'_> {
         self.view.after_tick(info, self.rig);
         TickControl::Continue
     }
+}
+
+/// The haptic tick of `haptic2d run` inside a study loop (the browser study, the study server):
+/// device read, system tick (`paused`: the world held, zero force), watchdog, device write, the
+/// tick logged to `tap` (a trial's MCAP, when one is open). `Err` is why the loop must stop; the
+/// torques are then zeroed already. Allocation-free (a reason allocates its message, on the tick
+/// that stops).
+pub(crate) fn haptic_step(
+    rig: &mut Rig,
+    watchdog: &mut Watchdog,
+    tap: Option<&mut TrialTap>,
+    info: &TickInfo,
+    paused: bool,
+) -> Result<(), LoopEnd> {
+    let (q, lost) = match rig.read() {
+        Ok(q) => (q, None),
+        Err(e) => ([f64::NAN; 4], Some(e)),
+    };
+    let out = rig.tick_system(&q, info, paused);
+    let mut tau = out.torques;
+    let safety = rig.safety_input(info, &out, lost.is_some());
+    let Rig { system, io, .. } = rig;
+    let guard = watchdog.guard(&safety, &mut tau);
+    // A lost reading, or a world that diverged in this tick, stops the loop before its torques
+    // reach the device (as in `haptic2d run`).
+    if let Some(end) = lost
+        .map(LoopEnd::read_failed)
+        .or_else(|| LoopEnd::diverged(system.world()))
+    {
+        io.zero_torques();
+        return Err(end);
+    }
+    if let Err(e) = io.write_torques(&tau) {
+        io.zero_torques();
+        return Err(LoopEnd::DeviceLost(e.to_string()));
+    }
+    if let Some(tap) = tap {
+        let mut rec = out.record;
+        rec.tau = tau;
+        tap.tick(info, &q, &rec, system.world());
+    }
+    if let Some(end) = LoopEnd::after_write(guard, out.tripped) {
+        io.zero_torques();
+        return Err(end);
+    }
+    Ok(())
 }
 
 #[cfg(test)]

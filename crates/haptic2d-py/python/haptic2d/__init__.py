@@ -10,6 +10,8 @@ API in SI units and hands results back as NumPy arrays.
 - :func:`sweep_walls`: stiffness x damping sweeps of the wall laws on any executor.
 - :func:`reproduce`: the paper's figures, as ``haptic2d reproduce`` writes them.
 - :func:`present`: one stimulus of a study file, explored by the simulated hand (for PsychoPy loops).
+- :func:`connect`, :func:`serve`, :class:`StudyServer`: present a study's stimuli on the real-time
+  loop and a device through ``haptic2d study serve`` (for PsychoPy loops with people).
 - :func:`read_log`: a CSV written by ``haptic2d simulate --out`` or ``haptic2d run --log``.
 - :func:`devices`: the real devices ``haptic2d run --device`` can drive (the shared registry).
 """
@@ -21,6 +23,7 @@ from ._world import World, CONTACT_DTYPE
 from ._haptic import HapticSystem
 from ._lab import sweep_walls, reproduce, read_log, SWEEP_CLASSES
 from ._study import present
+from ._server import StudyServer, StudyServerError, connect, serve
 from ._devices import devices
 from . import harness
 
@@ -33,6 +36,10 @@ __all__ = [
     "reproduce",
     "read_log",
     "present",
+    "StudyServer",
+    "StudyServerError",
+    "connect",
+    "serve",
     "devices",
     "SWEEP_CLASSES",
     "harness",
