@@ -32,6 +32,7 @@ mod run_rig;
 mod run_view;
 mod scene_arg;
 mod study_browser;
+mod study_buttons;
 mod study_mcap;
 mod study_present;
 mod world_link_arg;
