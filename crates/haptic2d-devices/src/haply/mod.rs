@@ -17,7 +17,10 @@ pub use buttons::{ButtonReader, ButtonSpec};
 pub use codec::{BoardSetup, CodecError, FirmwareIdentity, Reply, Rotation};
 pub use device_file::{HaplyDeviceFile, HaplyKind, MotorSpec};
 pub use driver::{check_rest, HaplyDevice, NO_WATCHDOG_WARNING};
-pub use emulator::{serve, serve_with_analog, AnalogInputs, BoardKind, EmulatorClock, EmulatorConfig, EmulatorReport, Firmware};
+pub use emulator::{
+    serve, serve_with_analog, AnalogInputs, BoardKind, EmulatorClock, EmulatorConfig,
+    EmulatorReport, Firmware,
+};
 pub use plant::{Plant, Plant2};
 pub use system::{HaplySystem, HaplyTick};
 pub use transport::{HaplyError, Transport};
