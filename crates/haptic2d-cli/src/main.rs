@@ -34,6 +34,7 @@ mod scene_arg;
 mod serve_conn;
 mod serve_present;
 mod study_browser;
+mod study_buttons;
 mod study_mcap;
 mod study_present;
 mod study_serve;

@@ -518,6 +518,7 @@ impl StudyLoop<'_> {
         }
         let slave = self.rig.system.slave();
         let watched = self.view.viewers() > 0;
+        self.presenter.set_buttons(self.rig.io.buttons());
         if let Some(ev) = self.presenter.tick(
             self.rig.system.world_mut(),
             slave,

@@ -19,12 +19,15 @@
 //!    a number entry, the number finite and > 0); the response time is
 //!    the monotonic time from entering this phase (the prompt) to the tick that takes the answer.
 //!    Only an answer naming the current trial with a choice the task offers is taken; any other is
-//!    counted as refused and changes nothing.
+//!    counted as refused and changes nothing. A press of a device button answers too, timed the
+//!    same way ([`crate::study_buttons`]: the mapping, and why a button held through the last
+//!    interval does not answer).
 //!
 //! The device's own safety (torques ramped in from zero at the start, clamped, latched to zero on a
 //! stall or a lost device) is the loop's, unchanged.
 
 use crate::run_view::StudyInbox;
+use crate::study_buttons::ButtonAnswers;
 use haptic2d::laws::friction::FrictionModel;
 use haptic2d::laws::normal::NormalModel;
 use haptic2d::world::World;
@@ -99,6 +102,9 @@ pub struct Presenter {
     planned: u32,
     started: Option<u32>,
     modulus: f64,
+    /// The device's buttons now ([`set_buttons`](Self::set_buttons)) and their edge logic.
+    buttons: u8,
+    device: ButtonAnswers,
 }
 
 /// The choices `task` offers.
@@ -149,7 +155,15 @@ impl Presenter {
             planned: 0,
             started: None,
             modulus: 0.0,
+            buttons: 0,
+            device: ButtonAnswers::default(),
         }
+    }
+
+    /// The device's buttons as read in the last exchange (bit `i` = button `i`), for the next
+    /// [`tick`](Self::tick); a device without buttons gives 0.
+    pub fn set_buttons(&mut self, buttons: u8) {
+        self.buttons = buttons;
     }
 
     /// The number the reference stands for in a magnitude-estimation study (shown on the page).
@@ -232,6 +246,8 @@ impl Presenter {
             }
         }
         let answer = inbox.answer;
+        let answering = matches!(self.phase, Phase::Answer(_));
+        let pressed = self.device.tick(self.task, answering, self.buttons);
         let mut event = None;
         match (self.phase, self.plan) {
             (Phase::FreeSpace(k), Some(plan))
@@ -260,7 +276,7 @@ impl Presenter {
                     (_, Some((t, c)), _) if t == plan.trial && valid_choice(self.task, c) => {
                         Some((c, None))
                     }
-                    _ => None,
+                    _ => pressed.map(|c| (c, None)),
                 };
                 if let Some((choice, magnitude)) = taken {
                     event = Some(Event::Answered {

@@ -29,3 +29,37 @@ fn the_haply_exchange_allocates_nothing_once_open() {
     let allocs = allocations() - before;
     assert_eq!(allocs, 0, "allocations on the exchange");
 }
+
+/// With buttons on analog pins (longer replies, the button reader), the exchange and `buttons()`
+/// still allocate nothing.
+#[test]
+fn the_haply_exchange_with_buttons_allocates_nothing_once_open() {
+    let mut file = device_file("haply-2diy-gen3.toml");
+    file.buttons = vec![
+        haptic2d_devices::haply::ButtonSpec {
+            pin: 61,
+            pressed_above: 512.0,
+        },
+        haptic2d_devices::haply::ButtonSpec {
+            pin: 56,
+            pressed_above: 512.0,
+        },
+    ];
+    let start = file.rest_pose().unwrap();
+    let emu = start_emulator(&file, HandModel::grip(start), 0.001);
+    let mut dev = open_driver(&emu, &file, 0.001);
+    for _ in 0..20 {
+        dev.read_encoders().unwrap();
+        dev.write_torques(&[0.01, -0.01, 0.0, 0.0]).unwrap();
+    }
+    let before = allocations();
+    let mut pressed = 0;
+    for _ in 0..500 {
+        dev.read_encoders().unwrap();
+        pressed |= dev.buttons();
+        dev.write_torques(&[0.01, -0.01, 0.0, 0.0]).unwrap();
+    }
+    let allocs = allocations() - before;
+    assert_eq!(allocs, 0, "allocations on the exchange");
+    assert_eq!(pressed, 0, "the emulator's pins read 0: nothing pressed");
+}

@@ -33,6 +33,8 @@ enum Fault {
     SilentAfter(u64),
     /// Report a fault (status bit 5) from this many commands on.
     ReportsFaultAfter(u64),
+    /// Report these buttons (status bits 8–15) from this many commands on.
+    PressesAfter(u64, u8),
 }
 
 struct FakeDevice {
@@ -75,6 +77,11 @@ impl FakeDevice {
                 };
                 if matches!(fault, Fault::ReportsFaultAfter(k) if n > k) {
                     status |= STATUS_FAULT;
+                }
+                if let Fault::PressesAfter(k, b) = fault {
+                    if n > k {
+                        status |= u32::from(b) << 8;
+                    }
                 }
                 let mut out = [0u8; STATE_LEN];
                 State {
@@ -268,6 +275,22 @@ fn a_device_fault_is_a_lost_device() {
     let err = run(&mut dev, 200, 0.01).unwrap_err();
     fake.finish();
     assert!(err.to_string().contains("reports a fault"), "{err}");
+}
+
+/// Status bits 8–15 reach `DeviceIo::buttons` with the state that carries them; before, a device
+/// sending 0 there (every version-1/2 device so far) has no button pressed.
+#[test]
+fn the_buttons_of_status_bits_8_to_15_reach_the_driver() {
+    let fake = FakeDevice::start(Fault::PressesAfter(20, 0b0000_0110));
+    let mut dev = open_patient(fake.addr);
+    run(&mut dev, 10, 0.0).unwrap();
+    assert_eq!(dev.buttons(), 0);
+    // Each read waits for the answer to the previous command: by tick 30 the device's 21st answer
+    // (the first with buttons) has been used.
+    run(&mut dev, 30, 0.0).unwrap();
+    assert_eq!(dev.buttons(), 0b0000_0110);
+    assert_eq!(dev.counters().malformed, 0, "{}", dev.counters());
+    fake.finish();
 }
 
 #[test]

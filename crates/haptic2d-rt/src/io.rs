@@ -74,6 +74,13 @@ pub trait DeviceIo {
     fn paced_by_ticks(&self) -> bool {
         false
     }
+
+    /// The device's buttons as read in the last exchange: bit `i` set = button `i` pressed (at
+    /// most 8 buttons, `0..=7`). `0` (the default) for a device without buttons, and before the
+    /// first reading. Read after `read_encoders`; never allocates or blocks (a field read).
+    fn buttons(&self) -> u8 {
+        0
+    }
 }
 
 /// The device interface of a 2-joint device (a 2-DOF five-bar: motor 1, motor 2), with the same
@@ -96,6 +103,12 @@ pub trait Device2Io {
     /// The handle's sensed orientation (rad), as [`DeviceIo::handle_angle`]; `None` by default.
     fn handle_angle(&self) -> Option<f64> {
         None
+    }
+
+    /// The device's buttons as read in the last exchange, as [`DeviceIo::buttons`] (bit `i` =
+    /// button `i` pressed); `0` by default (no buttons).
+    fn buttons(&self) -> u8 {
+        0
     }
 }
 
@@ -126,6 +139,10 @@ impl<D: Device2Io> DeviceIo for Joints2<D> {
 
     fn handle_angle(&self) -> Option<f64> {
         self.0.handle_angle()
+    }
+
+    fn buttons(&self) -> u8 {
+        self.0.buttons()
     }
 }
 
@@ -347,6 +364,38 @@ impl DeviceIo for ReplayDevice {
 
     fn paced_by_ticks(&self) -> bool {
         true
+    }
+}
+
+#[cfg(test)]
+mod buttons_tests {
+    use super::*;
+
+    /// A 2-joint device whose buttons a test sets.
+    struct Pressed(u8);
+
+    impl Device2Io for Pressed {
+        fn read_joints(&mut self) -> Result<[f64; 2], DeviceError> {
+            Ok([0.0; 2])
+        }
+        fn write_joint_torques(&mut self, _: &[f64; 2]) -> Result<(), DeviceError> {
+            Ok(())
+        }
+        fn zero_torques(&mut self) {}
+        fn name(&self) -> &str {
+            "pressed"
+        }
+        fn buttons(&self) -> u8 {
+            self.0
+        }
+    }
+
+    #[test]
+    fn a_device_without_buttons_reports_none_and_joints2_forwards_a_2_joint_devices_buttons() {
+        let replay = ReplayDevice::from_samples(vec![[0.0; 4]], ReplayEnd::Hold).unwrap();
+        assert_eq!(replay.buttons(), 0);
+        let d = Joints2(Pressed(0b101));
+        assert_eq!(DeviceIo::buttons(&d), 0b101);
     }
 }
 

@@ -28,6 +28,9 @@
 //! [safety]                      # optional (crate::device_safety): plausibility bounds, stall floor
 //! max_velocity = 1000.0         # rad/s
 //! [identified]                  # 2diy only, optional: written by `haptic2d device identify`
+//! [[buttons]]                   # optional, at most 8 (super::buttons): button 0, 1, … in order
+//! pin = "A2"                    # analog pin A0–A11 (or 54–65)
+//! pressed_above = 512.0         # the analog reading (board's ADC units) above which it is pressed
 //! ```
 
 use haptic2d::device::pantograph2::Pantograph2;
@@ -37,6 +40,7 @@ use haptic2d::haptic::ControllerKind;
 use haptic2d::scene::{device_params_from_toml, SceneError, SceneErrors};
 use serde::Deserialize;
 
+use super::buttons::{ButtonSpec, RawButton};
 use super::codec::{BoardSetup, Rotation, FIRMWARE_TORQUE_LIMIT, PORTS};
 use super::identified::{Identified, RawIdentified};
 use crate::device_safety::{DeviceSafety, RawSafety};
@@ -108,6 +112,8 @@ pub struct HaplyDeviceFile {
     pub safety: DeviceSafety,
     /// The `[identified]` table of a 2DIY: the dynamics `haptic2d device identify` measured.
     pub identified: Option<Identified>,
+    /// The `[[buttons]]` on analog pins, button `i` = the `i`-th table (none when absent).
+    pub buttons: Vec<ButtonSpec>,
 }
 
 #[derive(Deserialize)]
@@ -131,6 +137,8 @@ struct RawFile {
     safety: Option<RawSafety>,
     #[serde(default)]
     identified: Option<RawIdentified>,
+    #[serde(default)]
+    buttons: Vec<RawButton>,
 }
 
 #[derive(Deserialize)]
@@ -229,6 +237,22 @@ fn usb_id(s: &str) -> Option<(u16, u16)> {
     ))
 }
 
+/// The `board.usb_ids` as `(vendor, product)`, an error for each that is not `VENDOR:PRODUCT` in hex.
+fn usb_ids(raw: &[String], errs: &mut Vec<SceneError>) -> Vec<(u16, u16)> {
+    let mut ids = Vec::new();
+    for (i, s) in raw.iter().enumerate() {
+        match usb_id(s) {
+            Some(id) => ids.push(id),
+            None => errs.push(SceneError::new(
+                format!("board.usb_ids[{i}]"),
+                format!("`{s}` is not VENDOR:PRODUCT in hex"),
+                "write e.g. \"2341:804d\" (see `haptic2d devices` for the ids of your board)",
+            )),
+        }
+    }
+    ids
+}
+
 impl HaplyDeviceFile {
     /// Reads and parses the file at `path`.
     pub fn from_path(path: &std::path::Path) -> Result<Self, String> {
@@ -252,17 +276,7 @@ impl HaplyDeviceFile {
                 "use a number 0–255 (1 unless you changed the board's id)",
             ));
         }
-        let mut usb_ids = Vec::new();
-        for (i, s) in b.usb_ids.iter().enumerate() {
-            match usb_id(s) {
-                Some(id) => usb_ids.push(id),
-                None => errs.push(SceneError::new(
-                    format!("board.usb_ids[{i}]"),
-                    format!("`{s}` is not VENDOR:PRODUCT in hex"),
-                    "write e.g. \"2341:804d\" (see `haptic2d devices` for the ids of your board)",
-                )),
-            }
-        }
+        let usb_ids = usb_ids(&b.usb_ids, &mut errs);
         if !(b.torque_limit.is_finite()
             && b.torque_limit > 0.0
             && b.torque_limit <= FIRMWARE_TORQUE_LIMIT as f64)
@@ -439,6 +453,7 @@ impl HaplyDeviceFile {
             check_rest_pose(k, &motors, raw.rest.as_ref(), &mut errs);
         }
         let safety = RawSafety::check(raw.safety.as_ref(), &mut errs);
+        let buttons = super::buttons::check(&raw.buttons, &mut errs);
         let identified = match (&raw.identified, raw.kind.as_str()) {
             (None, _) => None,
             (Some(i), "2diy") => i.check(&mut errs),
@@ -468,13 +483,14 @@ impl HaplyDeviceFile {
                 kind,
                 safety,
                 identified,
+                buttons,
             }),
             _ => Err(fail(errs)),
         }
     }
 
-    /// The board set-up this file asks for: motors and encoders on the motor ports, no sensors, no
-    /// PWM outputs.
+    /// The board set-up this file asks for: motors and encoders on the motor ports, the buttons'
+    /// analog pins as sensors (in file order), no PWM outputs.
     pub fn board_setup(&self) -> BoardSetup {
         let mut s = BoardSetup::empty(self.id);
         for m in &self.motors {
@@ -486,6 +502,7 @@ impl HaplyDeviceFile {
             s.enc_offset_deg[p] = m.offset_deg as f32;
             s.enc_resolution[p] = m.counts_per_turn as f32;
         }
+        super::buttons::add_to_setup(&self.buttons, &mut s);
         s
     }
 

@@ -21,6 +21,10 @@
 //! board latches zero torques** (an all-zero write at once, if the port still takes bytes) and every
 //! later call fails: the setup is never re-sent (it would re-zero the encoders wherever the handle
 //! is); [`zero_torques`](DeviceIo::zero_torques) and `Drop` send a zero write before the port closes.
+//!
+//! Buttons: the device file's `[[buttons]]` pins are the set-up's analog sensors; every reply's
+//! analog values go through a [`ButtonReader`] (by pin rank, debounced over two samples) and
+//! [`buttons`](DeviceIo::buttons) returns its state. A lost board reports no button pressed.
 
 use std::io::{Read, Write};
 use std::time::Duration;
@@ -28,6 +32,7 @@ use std::time::Duration;
 use haptic2d::device::TwinKinematics;
 use haptic2d_rt::{DeviceError, DeviceIo};
 
+use super::buttons::ButtonReader;
 use super::codec::{CodecError, FirmwareIdentity, PORTS};
 use super::device_file::{HaplyDeviceFile, HaplyKind};
 use super::transport::{HaplyError, Transport};
@@ -82,6 +87,8 @@ pub struct HaplyDevice<S: Read + Write> {
     firmware: Option<FirmwareIdentity>,
     /// The port is a pseudo-terminal (an emulator): no USB cable to check.
     pty: bool,
+    /// The device file's buttons, from the replies' analog values.
+    buttons: ButtonReader,
 }
 
 impl<S: Read + Write> HaplyDevice<S> {
@@ -158,7 +165,10 @@ impl<S: Read + Write> HaplyDevice<S> {
             lost: false,
             firmware,
             pty,
+            buttons: ButtonReader::new(&file.buttons),
         };
+        let n = usize::from(dev.transport.setup().n_sensors);
+        dev.buttons.update(&reply.analog[..n]);
         dev.take_angles(&reply.angles_deg);
         check_rest(file, &dev.q).map_err(|e| format!("{name}: {e}"))?;
         Ok(dev)
@@ -220,6 +230,7 @@ impl<S: Read + Write> HaplyDevice<S> {
     /// Latches the loss: an all-zero write at once (no wait for its reply), then the error.
     fn lost_error(&mut self, e: HaplyError) -> DeviceError {
         self.lost = true;
+        self.buttons.clear();
         let n = self.transport.setup().n_motors();
         let zeroed = self.transport.send_write(&[0.0; PORTS][..n]).is_ok();
         self.sent = [0.0; PORTS];
@@ -306,6 +317,8 @@ impl<S: Read + Write> DeviceIo for HaplyDevice<S> {
         match self.transport.read_reply() {
             Ok(r) => {
                 self.take_angles(&r.angles_deg);
+                let n = usize::from(self.transport.setup().n_sensors);
+                self.buttons.update(&r.analog[..n]);
                 Ok(self.q)
             }
             Err(e) => Err(self.lost_error(e)),
@@ -356,6 +369,10 @@ impl<S: Read + Write> DeviceIo for HaplyDevice<S> {
 
     fn name(&self) -> &str {
         &self.name
+    }
+
+    fn buttons(&self) -> u8 {
+        self.buttons.state()
     }
 }
 

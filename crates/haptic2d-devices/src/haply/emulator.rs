@@ -20,6 +20,8 @@
 //!   (a 4-encoder setup: 1 of 17 bytes), and the torque bytes of the host's longer writes are read
 //!   as commands;
 //! - analog inputs ([`Firmware::analog_in`]) reported in **ascending pin order**;
+//!   [`serve_with_analog`] takes their values from an [`AnalogInputs`], which another thread (a test
+//!   pressing a button) may set at any time ([`serve`]: all pins read 0);
 //! - unknown command bytes discarded **one byte at a time** (a lone `0x03`, haptic2d's identify
 //!   query, is ignored: the stock firmware has no identify);
 //! - the direction-byte quirk (see [`decode_host_frame`]);
@@ -27,7 +29,8 @@
 //!   wrong direction byte sees that motor push the wrong way and that encoder count backwards.
 
 use std::io::{ErrorKind, Read, Write};
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use haptic2d::device::HandModel;
@@ -317,6 +320,33 @@ impl Firmware {
     }
 }
 
+/// The voltages on the emulated board's analog pins A0–A11, as the values its ADC reports (the
+/// board's units, e.g. counts 0–1023), shared with whoever sets them (a test pressing a button wired
+/// to a pin). A clone shares the same pins. Lock-free: f32 bits in atomics.
+#[derive(Clone, Debug, Default)]
+pub struct AnalogInputs(Arc<[AtomicU32; MAX_SENSORS]>);
+
+impl AnalogInputs {
+    /// Sets the reading of analog pin `pin` (54–65 = A0–A11; other pins are ignored) to `value`.
+    pub fn set(&self, pin: u8, value: f32) {
+        if let Some(a) = pin
+            .checked_sub(ANALOG_PIN_MIN)
+            .and_then(|i| self.0.get(usize::from(i)))
+        {
+            a.store(value.to_bits(), Ordering::Relaxed);
+        }
+    }
+
+    /// The readings of A0–A11.
+    pub fn values(&self) -> [f32; MAX_SENSORS] {
+        let mut v = [0.0; MAX_SENSORS];
+        for (o, a) in v.iter_mut().zip(self.0.iter()) {
+            *o = f32::from_bits(a.load(Ordering::Relaxed));
+        }
+        v
+    }
+}
+
 /// Settings of [`serve`].
 #[derive(Clone, Debug)]
 pub struct EmulatorConfig {
@@ -391,13 +421,27 @@ pub fn plant_for(
 }
 
 /// Runs the emulated board of `file` on `stream` until `stop` is set or the stream fails, moving
-/// `plant`. The stream's read timeout should be short (≤ 1 ms): it paces the loop while idle.
+/// `plant`. The stream's read timeout should be short (≤ 1 ms): it paces the loop while idle. Every
+/// analog pin reads 0 ([`serve_with_analog`] sets them).
 pub fn serve<S: Read + Write>(
+    stream: S,
+    file: &HaplyDeviceFile,
+    plant: Plant,
+    config: &EmulatorConfig,
+    stop: &AtomicBool,
+) -> EmulatorReport {
+    serve_with_analog(stream, file, plant, config, stop, &AnalogInputs::default())
+}
+
+/// [`serve`] with the analog pins reading `analog`, sampled at every serviced write (as the board
+/// samples its encoders).
+pub fn serve_with_analog<S: Read + Write>(
     mut stream: S,
     file: &HaplyDeviceFile,
     mut plant: Plant,
     config: &EmulatorConfig,
     stop: &AtomicBool,
+    analog: &AnalogInputs,
 ) -> EmulatorReport {
     let mut fw = Firmware::with_board(file, config.board);
     let power_up_q = match config.power_up {
@@ -468,8 +512,9 @@ pub fn serve<S: Read + Write>(
                     break 'outer;
                 }
             }
-            // The board samples its encoders when it services the frame.
+            // The board samples its encoders (and analog pins) when it services the frame.
             let q = plant.joint_angles();
+            fw.analog_in = analog.values();
             let Some(n) = fw.service(&q, &mut out) else {
                 break;
             };

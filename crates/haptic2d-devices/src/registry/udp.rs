@@ -175,6 +175,10 @@ impl DeviceIo for Counted {
     fn name(&self) -> &str {
         self.0.name()
     }
+
+    fn buttons(&self) -> u8 {
+        self.0.buttons()
+    }
 }
 
 impl Drop for Counted {

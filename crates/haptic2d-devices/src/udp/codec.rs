@@ -59,9 +59,19 @@ pub const STATUS_LIMITED: u32 = 1 << 4;
 /// Status bit: the device has a fault of its own (e.g. its watchdog zeroed the motors); the host
 /// treats it as lost.
 pub const STATUS_FAULT: u32 = 1 << 5;
-/// Status bits a version-1 device may set; any other bit is malformed.
-pub const STATUS_BITS: u32 =
-    STATUS_POSE | STATUS_VELOCITY | STATUS_FORCE | STATUS_ENABLED | STATUS_LIMITED | STATUS_FAULT;
+/// Status bits 8–15: the device's buttons 0–7 (bit `8 + i` set = button `i` pressed when the
+/// state was sampled). A device without buttons sends 0 there, as every device before them did.
+pub const STATUS_BUTTONS: u32 = 0xff << STATUS_BUTTONS_SHIFT;
+/// The position of button 0 in `status`.
+pub const STATUS_BUTTONS_SHIFT: u32 = 8;
+/// Status bits a device may set; any other bit is malformed.
+pub const STATUS_BITS: u32 = STATUS_POSE
+    | STATUS_VELOCITY
+    | STATUS_FORCE
+    | STATUS_ENABLED
+    | STATUS_LIMITED
+    | STATUS_FAULT
+    | STATUS_BUTTONS;
 
 /// A host → device datagram.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -254,6 +264,11 @@ impl State {
     pub fn is_pose(&self) -> bool {
         self.status & STATUS_POSE != 0
     }
+
+    /// The buttons of `status` bits 8–15: bit `i` = button `i` pressed.
+    pub fn buttons(&self) -> u8 {
+        ((self.status & STATUS_BUTTONS) >> STATUS_BUTTONS_SHIFT) as u8
+    }
 }
 
 #[cfg(test)]
@@ -357,6 +372,26 @@ mod tests {
             Command::decode(&b[..COMMAND_LEN]),
             Err(CodecError::Kind(KIND_STATE))
         );
+    }
+
+    /// Status bits 8–15 (byte 13 of the datagram, the u32 at 12 being little-endian) are buttons
+    /// 0–7; an old device's 0 there is no button; bits 16–31 stay malformed.
+    #[test]
+    fn status_byte_13_carries_the_buttons_and_higher_bits_stay_reserved() {
+        let mut b = [0u8; STATE_LEN];
+        example_state().encode(&mut b);
+        assert_eq!(State::decode(&b).unwrap().buttons(), 0);
+        let mut c = b;
+        c[13] = 0b1000_0101;
+        let s = State::decode(&c).expect("button bits are valid");
+        assert_eq!(s.buttons(), 0b1000_0101);
+        assert_eq!(s.status & 0xff, 0x0a, "the low status bits are untouched");
+        let mut e = [0u8; STATE_LEN];
+        s.encode(&mut e);
+        assert_eq!(e, c, "round trip");
+        let mut c = b;
+        c[14] = 0x01;
+        assert_eq!(State::decode(&c), Err(CodecError::ReservedBits));
     }
 
     #[test]

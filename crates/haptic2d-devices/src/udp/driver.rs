@@ -15,6 +15,9 @@
 //! [`FLAG_BYE`]. Nothing allocates on the exchange, the MAC check included (only the error paths
 //! format messages).
 //!
+//! Buttons: [`buttons`](DeviceIo::buttons) is `status` bits 8–15 of the newest state used (bit `i`
+//! = button `i`, as the device sampled it; the device debounces); a lost device reports none.
+//!
 //! Authentication: with a key (`protocol.key_file`) the driver speaks version 2 — a session
 //! handshake before the first poll, a MAC on every datagram, every drop counted by reason. Without
 //! one it speaks version 1, which [`UdpDevice::open`] allows only towards a loopback address.
@@ -43,6 +46,8 @@ pub struct UdpDevice {
     lost: bool,
     /// The device listens on this machine (a program, e.g. a reference device), not on a network.
     loopback: bool,
+    /// The buttons of the newest state used (status bits 8–15).
+    buttons: u8,
 }
 
 /// The silence after a command that means the device is lost: the device file's
@@ -98,6 +103,7 @@ impl UdpDevice {
             name: name.to_string(),
             lost: false,
             loopback: addr.ip().is_loopback(),
+            buttons: 0,
         };
         let start = Instant::now();
         let io = |e: std::io::Error| format!("{name}: UDP error: {e}");
@@ -156,6 +162,7 @@ impl UdpDevice {
         if s.status & STATUS_FAULT != 0 {
             self.lost = true;
             self.valid = false;
+            self.buttons = 0;
             return Err(DeviceError::Lost(format!(
                 "UDP device {}: the device reports a fault (status bit 5); check the device's own log or display",
                 self.name
@@ -181,6 +188,7 @@ impl UdpDevice {
             self.q[0] = p[0] as f64;
             self.q[1] = p[1] as f64;
         }
+        self.buttons = s.buttons();
         self.valid = true;
         Ok(())
     }
@@ -257,6 +265,7 @@ impl DeviceIo for UdpDevice {
         if silent_for > self.timeout {
             self.lost = true;
             self.valid = false;
+            self.buttons = 0;
             return Err(DeviceError::Lost(format!(
                 "UDP device {}: no state for {:.1} ms after a command (timeout {:.1} ms = protocol.timeout_periods); {}\n    check: {}",
                 self.name,
@@ -314,6 +323,10 @@ impl DeviceIo for UdpDevice {
 
     fn name(&self) -> &str {
         &self.name
+    }
+
+    fn buttons(&self) -> u8 {
+        self.buttons
     }
 }
 
