@@ -303,4 +303,54 @@ mod tests {
             }
         }
     }
+
+    /// The analysis against the nonlinear simulation (`network::onset`, position–force, no TDPA,
+    /// no loss). Expected: the analysis's margin `T*` for the default run; checked: the onset the
+    /// bisection finds in the simulated run, round trips `2·d` ms. The tolerance, from the
+    /// model differences: the simulation's round trip moves in steps of 2 ms, and its sampling
+    /// adds lag the continuous model does not have — the hold of each actuator's force (half a
+    /// period each) and the backward-difference velocity (half a period) — so its onset lies
+    /// *below* `T*` by up to 2 ms + 2 ms; Coulomb friction, saturation and contact loss only
+    /// dissipate or bound, and cannot bring the onset below that. So: `0 ≤ T* − 2·d_unstable ≤ 4 ms`.
+    #[test]
+    fn the_position_force_margin_lies_within_4_ms_above_the_simulated_onset() {
+        let cfg = Teleop::new(Impairment::NONE, false);
+        let t = DelayedLoop::of_teleop(&cfg)
+            .unwrap()
+            .margin()
+            .unwrap()
+            .round_trip;
+        assert!(t.is_finite() && t > 0.0, "{t}");
+        let onset = crate::network::onset::simulated_onset(&cfg, 25)
+            .unwrap()
+            .unwrap();
+        let sim = 2.0 * onset.first_unstable as f64 * cfg.dt;
+        assert!(
+            (0.0..=4e-3).contains(&(t - sim)),
+            "analysis {t} s, simulation {onset:?}"
+        );
+    }
+
+    /// Lawrence's four channels with the default gains, hand and wall: `|A(jω)| > |B(jω)|` at
+    /// every frequency, so no round trip destabilises the loop in contact (the analysis), and the
+    /// simulated run without TDPA does not oscillate at 10, 50 or 200 ms (the check).
+    #[test]
+    fn four_channels_in_contact_are_stable_at_every_round_trip_in_the_analysis_and_the_simulation()
+    {
+        let base = Teleop::new(Impairment::NONE, false);
+        let cfg = Teleop {
+            architecture: Architecture::FourChannel(FourChannel::lawrence(base.k, base.b)),
+            ..base
+        };
+        let d = DelayedLoop::of_teleop(&cfg).unwrap().margin().unwrap();
+        assert!(d.round_trip.is_infinite(), "{d:?}");
+        for delay in [5, 25, 100] {
+            assert!(
+                !crate::network::onset::oscillates(&cfg, delay).unwrap(),
+                "{delay}"
+            );
+        }
+        // The same check sees position–force oscillate at 50 ms.
+        assert!(crate::network::onset::oscillates(&base, 25).unwrap());
+    }
 }
