@@ -26,7 +26,7 @@
 //! default 500 N/m, 5 N·s/m), `C2 = C3 = 1`, `C5 = C6 = 0`. The device impedance `Z = m·s + b`
 //! inside `C1` and `C4` is left out: its inertial part needs the far device's acceleration (a
 //! second difference of 4 000-count encoders at 1 kHz, noise of tens of m/s²) and its viscous
-//! part (`f_v·(JᵀJ)_xx`, about 0.04 N·s/m along x at the centre) is below 1 % of `B`. So the
+//! part (`f_v·(JᵀJ)_xx`, 0.028 N·s/m along x at the centre) is below 1 % of `B`. So the
 //! conditions hold up to the devices' own impedance: in steady contact the law gives
 //! `f_h = −f_e` and `x_m = x_s` exactly (add the two equilibria), and in motion the hand feels
 //! both devices' inertia, as with position–force. [`FourChannel::c5`]/[`FourChannel::c6`] allow

@@ -16,12 +16,16 @@ pub fn stiffnesses() -> Vec<f64> {
         .collect()
 }
 
-/// Writes `<dir>/teleop-margin.svg` and `.png`. Margins that are infinite (stable at every
-/// delay) or zero (unstable without delay) are left out of the curve.
+/// Round trip at which the stiffnesses stable at every round trip are drawn (ms).
+pub const EVERY_DELAY_MS: f64 = 1000.0;
+
+/// Writes `<dir>/teleop-margin.svg` and `.png`. A finite margin is a line (broken where the
+/// margin is not finite); a loop stable at every round trip is a square at
+/// [`EVERY_DELAY_MS`]; one unstable without delay is left out.
 pub fn write_margin_plot(cfg: &Teleop, dir: &Path) -> Result<Vec<PathBuf>, String> {
     let mut series = Vec::new();
     for (i, name) in ["position-force", "four-channel"].iter().enumerate() {
-        let mut pts = Vec::new();
+        let (mut seg, mut every) = (Vec::new(), Vec::new());
         for k in stiffnesses() {
             let mut c = *cfg;
             (c.k[0], c.k[1]) = (k, k);
@@ -32,10 +36,38 @@ pub fn write_margin_plot(cfg: &Teleop, dir: &Path) -> Result<Vec<PathBuf>, Strin
             };
             let d = DelayedLoop::of_teleop(&c)?.margin()?;
             if d.round_trip.is_finite() && d.round_trip > 0.0 {
-                pts.push((k, d.round_trip * 1e3));
+                seg.push((k, d.round_trip * 1e3));
+                continue;
+            }
+            if d.round_trip.is_infinite() {
+                every.push((k, EVERY_DELAY_MS));
+            }
+            if !seg.is_empty() {
+                let label = if series.iter().any(|x: &Series| x.color == i) {
+                    ""
+                } else {
+                    *name
+                };
+                series.push(Series::new(
+                    label,
+                    std::mem::take(&mut seg),
+                    i,
+                    Stroke::LineMarkers,
+                ));
             }
         }
-        series.push(Series::new(*name, pts, i, Stroke::Solid));
+        if !seg.is_empty() {
+            let label = if series.iter().any(|x: &Series| x.color == i) {
+                ""
+            } else {
+                *name
+            };
+            series.push(Series::new(label, seg, i, Stroke::LineMarkers));
+        }
+        if !every.is_empty() {
+            let label = format!("{name}: stable at every round trip (drawn at 1 s)");
+            series.push(Series::new(label, every, i, Stroke::Squares));
+        }
     }
     let panel = Panel {
         title: format!(
