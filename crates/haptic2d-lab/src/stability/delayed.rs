@@ -31,7 +31,8 @@
 //! needs a high order at 50 ms delays) and over Llewellyn's criterion (which certifies absolute
 //! stability against *every* passive hand and wall, a sufficient condition, not the margin of this
 //! hand and wall). `|A|² − |B|²` is scanned on a logarithmic grid of `ω` and each sign change
-//! refined by bisection.
+//! refined by bisection, together with the positive real roots in `ω²` of the polynomial
+//! `|A(jω)|² − |B(jω)|²` (so that two crossings closer than the grid are not missed).
 
 use haptic2d::device::dynamics::LumpedDynamics;
 use haptic2d::device::linalg::inv3;
@@ -102,6 +103,49 @@ fn at_jw(p: &[f64], w: f64) -> Complex {
         pw = (-pw.1 * w, pw.0 * w);
     }
     (re, im)
+}
+
+/// `|p(jω)|²` as a polynomial in ω (lowest power first): `Re² + Im²` with
+/// `Re = Σ_even (−1)^{k/2}·p_k·ω^k`, `Im = Σ_odd (−1)^{(k−1)/2}·p_k·ω^k`.
+fn abs2_jw(p: &[f64]) -> Poly {
+    let sign = |k: usize| if (k / 2).is_multiple_of(2) { 1.0 } else { -1.0 };
+    let re: Poly = (0..p.len())
+        .map(|k| {
+            if k.is_multiple_of(2) {
+                sign(k) * p[k]
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let im: Poly = (0..p.len())
+        .map(|k| {
+            if k.is_multiple_of(2) {
+                0.0
+            } else {
+                sign(k) * p[k]
+            }
+        })
+        .collect();
+    add(&mul(&re, &re), &mul(&im, &im))
+}
+
+/// The positive real roots `u = ω²` of `|A(jω)|² − |B(jω)|²` (an even polynomial in ω).
+fn squared_gap_roots(a: &[f64], b: &[f64]) -> Result<Vec<f64>, String> {
+    let r = add(&abs2_jw(a), &scale(&abs2_jw(b), -1.0));
+    let mut hi_first: Poly = r.iter().step_by(2).copied().collect();
+    while hi_first.last() == Some(&0.0) {
+        hi_first.pop();
+    }
+    hi_first.reverse();
+    if hi_first.len() < 2 {
+        return Ok(Vec::new());
+    }
+    Ok(poly_roots(&hi_first)?
+        .into_iter()
+        .filter(|z| z.0 > 0.0 && z.1.abs() <= 1e-9 * z.0)
+        .map(|z| z.0)
+        .collect())
 }
 
 impl DelayedLoop {
@@ -180,9 +224,12 @@ pub fn delay_margin(a: &[f64], b: &[f64]) -> Result<DelayMargin, String> {
         let (pa, pb) = (at_jw(a, w), at_jw(b, w));
         (pa.0 * pa.0 + pa.1 * pa.1).sqrt() - (pb.0 * pb.0 + pb.1 * pb.1).sqrt()
     };
-    let mut best = (f64::INFINITY, 0.0);
-    // ω from 0.01 to 1e6 rad/s, 200 points a decade.
+    // Candidate crossing frequencies: sign changes of |A| − |B| on a logarithmic grid (ω from
+    // 0.01 to 1e6 rad/s, 200 points a decade), refined by bisection, and, so that a crossing
+    // pair closer than the grid is not missed, the positive real roots of the polynomial
+    // |A(jω)|² − |B(jω)|² in ω² that satisfy |A| = |B| to 1e-6.
     let grid = |i: usize| 10f64.powf(-2.0 + i as f64 / 200.0);
+    let mut candidates = Vec::new();
     for i in 0..1600 {
         let (mut lo, mut hi) = (grid(i), grid(i + 1));
         if gap(lo).signum() == gap(hi).signum() {
@@ -196,7 +243,17 @@ pub fn delay_margin(a: &[f64], b: &[f64]) -> Result<DelayMargin, String> {
                 hi = mid;
             }
         }
-        let wc = 0.5 * (lo + hi);
+        candidates.push(0.5 * (lo + hi));
+    }
+    for u in squared_gap_roots(a, b)? {
+        let w = u.sqrt();
+        let scale = at_jw(a, w).0.hypot(at_jw(a, w).1);
+        if gap(w).abs() <= 1e-6 * scale {
+            candidates.push(w);
+        }
+    }
+    let mut best = (f64::INFINITY, 0.0);
+    for wc in candidates {
         let (pa, pb) = (at_jw(a, wc), at_jw(b, wc));
         // −A/B = e^{−jωT}: T = −arg(−A/B)/ω modulo 2π/ω, the smallest T ≥ 0.
         let arg = (-pa.1).atan2(-pa.0) - pb.1.atan2(pb.0);
@@ -227,6 +284,30 @@ mod tests {
         let w = 3f64.sqrt();
         assert!((d.omega - w).abs() < 1e-9, "{d:?}");
         assert!((d.round_trip - (-0.5f64).acos() / w).abs() < 1e-9, "{d:?}");
+    }
+
+    /// A crossing band far narrower than the grid: `A = s² + 0.02·s + 10⁴` (|A(jω)| has its
+    /// minimum 2 at ω = 100 rad/s) against `B = c = 2.0001` leaves `|A| < |B|` only for
+    /// `|ω² − 10⁴| < 0.02`, about 1e-4 rad/s wide against the grid's 1.2 rad/s there. Expected,
+    /// in closed form: the crossings `u = ω²` solve `(10⁴ − u)² + 4·10⁻⁴·u = c²` (the quadratic
+    /// formula), and at each `T = (−arg(−A(jω)/c) mod 2π)/ω`; the margin is the smaller (close to
+    /// `(π/2)/100 s`, where `−A/c ≈ −j`).
+    #[test]
+    fn a_crossing_band_narrower_than_the_grid_is_found() {
+        let c = 2.0001f64;
+        let d = delay_margin(&[1e4, 0.02, 1.0], &[c]).unwrap();
+        let (p, q) = (-2e4 + 4e-4, 1e8 - c * c);
+        let disc = (p * p / 4.0 - q).sqrt();
+        let t = [-p / 2.0 - disc, -p / 2.0 + disc]
+            .map(|u: f64| {
+                let w = u.sqrt();
+                let arg = (0.02 * w / -c).atan2((1e4 - u) / -c);
+                (-arg).rem_euclid(std::f64::consts::TAU) / w
+            })
+            .into_iter()
+            .fold(f64::INFINITY, f64::min);
+        assert!((d.omega - 100.0).abs() < 1e-3, "{d:?}");
+        assert!((d.round_trip - t).abs() < 1e-6 * t, "{d:?} vs {t}");
     }
 
     /// `|b| < a`: `|jω + a| > |b|` for every ω, no crossing: stable for every delay.
