@@ -4,13 +4,14 @@
 //! wall; the coupling's reaction comes back, so the contact is felt at the master. Simulated time
 //! (`haptic2d_lab::network::teleop`): deterministic, as fast as the machine goes.
 
-use haptic2d_lab::network::{run_teleop, Impairment, Teleop};
+use haptic2d_lab::network::{run_teleop, Architecture, FourChannel, Impairment, Teleop};
+use haptic2d_lab::stability::DelayedLoop;
 
 use crate::exit::{Failure, Status};
 use crate::outln;
 
 /// `teleop`'s options.
-#[derive(clap::Args, Debug)]
+#[derive(clap::Args, Clone, Debug)]
 pub struct TeleopArgs {
     /// The master device: `sim` (the simulated twin pantograph, pushed by a simulated grip).
     #[arg(long, default_value = "sim")]
@@ -43,6 +44,108 @@ pub struct TeleopArgs {
     /// unfiltered rate of the pose: reproduces the 10 ms chatter (docs/TELEOP.md).
     #[arg(long)]
     pub filtered_velocity: bool,
+    /// The teleoperation architecture: `position-force` (the slave follows through the coupling,
+    /// its reaction comes back) or `four-channel` (Lawrence's: positions, velocities and the
+    /// measured hand and wall forces both ways; docs/TELEOP.md).
+    #[arg(long, value_enum, default_value = "position-force")]
+    pub architecture: ArchitectureArg,
+    /// Coupling stiffness along x and y (N/m): position–force's `K`, four-channel's `K_m = K_s`.
+    #[arg(long, default_value_t = 500.0)]
+    pub stiffness: f64,
+    /// Coupling damping along x and y (N·s/m): position–force's `B`, four-channel's `B_m = B_s`.
+    #[arg(long, default_value_t = 5.0)]
+    pub damping: f64,
+    /// Instead of a run: print the delay margin of the linear model of the loop (x axis, no
+    /// TDPA) for the chosen architecture and gains, both architectures for comparison
+    /// (docs/TELEOP.md, "The delayed loop's stability").
+    #[arg(long)]
+    pub stability: bool,
+    /// With `--stability`: write the margin against the coupling stiffness, both architectures,
+    /// into DIR (teleop-margin.svg, .png; created if missing).
+    #[arg(long, value_name = "DIR", requires = "stability")]
+    pub stability_plot: Option<std::path::PathBuf>,
+}
+
+/// `--architecture`'s values.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ArchitectureArg {
+    /// Position–force: a virtual coupling at the slave, its reaction sent back.
+    PositionForce,
+    /// Lawrence's four channels with `C2 = C3 = 1`, `C5 = C6 = 0`.
+    FourChannel,
+}
+
+/// The run's settings from the options (the link, TDPA, velocities, architecture, gains).
+fn config(a: &TeleopArgs, link: Impairment) -> Teleop {
+    let base = Teleop::new(link, !a.no_tdpa);
+    let mut k = base.k;
+    let mut b = base.b;
+    (k[0], k[1], b[0], b[1]) = (a.stiffness, a.stiffness, a.damping, a.damping);
+    let architecture = match a.architecture {
+        ArchitectureArg::PositionForce => Architecture::PositionForce,
+        ArchitectureArg::FourChannel => Architecture::FourChannel(FourChannel::lawrence(k, b)),
+    };
+    Teleop {
+        duration: a.duration,
+        filtered_velocity: a.filtered_velocity,
+        k,
+        b,
+        architecture,
+        ..base
+    }
+}
+
+/// `--stability`: the delay margins of the linear model, and the plot if asked.
+fn stability(a: &TeleopArgs, cfg: &Teleop) -> Result<Status, Failure> {
+    let chosen = DelayedLoop::of_teleop(cfg).map_err(Failure::error)?;
+    outln!(
+        "delayed-loop stability (linear model of the x axis, no TDPA; docs/TELEOP.md): devices {:.4} kg, {:.4} N·s/m each; hand {} N/m, {} N·s/m; wall {} N/m, {} N·s/m; coupling {} N/m, {} N·s/m",
+        chosen.m, chosen.b, chosen.hand.0, chosen.hand.1, chosen.wall.0, chosen.wall.1, a.stiffness, a.damping
+    );
+    for (name, arch) in [
+        ("position-force", ArchitectureArg::PositionForce),
+        ("four-channel", ArchitectureArg::FourChannel),
+    ] {
+        let c = config(
+            &TeleopArgs {
+                architecture: arch,
+                ..a.clone()
+            },
+            cfg.link,
+        );
+        let d = DelayedLoop::of_teleop(&c)
+            .and_then(|l| l.margin())
+            .map_err(Failure::error)?;
+        let mark = if arch == a.architecture {
+            " (chosen)"
+        } else {
+            ""
+        };
+        let verdict = if d.round_trip == 0.0 {
+            format!(
+                "unstable without delay (right-most root {:+.2} ± {:.1}j /s)",
+                d.undelayed.0,
+                d.undelayed.1.abs()
+            )
+        } else if d.round_trip.is_infinite() {
+            "stable at every round trip".to_string()
+        } else {
+            format!(
+                "stable up to a round trip of {:.2} ms (crossing at {:.1} Hz)",
+                d.round_trip * 1e3,
+                d.omega / std::f64::consts::TAU
+            )
+        };
+        outln!("{name}{mark}: {verdict}");
+    }
+    if let Some(dir) = &a.stability_plot {
+        let files = haptic2d_lab::stability::delayed_plot::write_margin_plot(cfg, dir)
+            .map_err(Failure::error)?;
+        for f in files {
+            outln!("wrote {}", f.display());
+        }
+    }
+    Ok(Status::Clean)
 }
 
 /// Runs `teleop`.
@@ -82,14 +185,24 @@ pub fn run(a: &TeleopArgs) -> Result<Status, Failure> {
         )));
     }
     let link = Impairment::delay_loss(a.delay_ms.round() as u32, a.loss, a.seed);
-    let cfg = Teleop {
-        duration: a.duration,
-        filtered_velocity: a.filtered_velocity,
-        ..Teleop::new(link, !a.no_tdpa)
-    };
+    if !(a.stiffness.is_finite() && a.stiffness > 0.0 && a.damping.is_finite() && a.damping >= 0.0)
+    {
+        return Err(Failure::from(format!(
+            "--stiffness must be > 0 and --damping ≥ 0 (got {}, {})",
+            a.stiffness, a.damping
+        )));
+    }
+    let cfg = config(a, link);
+    if a.stability {
+        return stability(a, &cfg);
+    }
     let r = run_teleop(&cfg).map_err(Failure::error)?;
     outln!(
-        "teleop: master sim, slave sim, {:.1} s at 1 kHz, round trip {} ms, loss {:.1} % each way, TDPA {}, velocities {}",
+        "teleop: master sim, slave sim, {}{:.1} s at 1 kHz, round trip {} ms, loss {:.1} % each way, TDPA {}, velocities {}",
+        match a.architecture {
+            ArchitectureArg::PositionForce => "",
+            ArchitectureArg::FourChannel => "four-channel (C2 = C3 = 1, C5 = C6 = 0), ",
+        },
         a.duration,
         2 * link.delay,
         a.loss * 100.0,

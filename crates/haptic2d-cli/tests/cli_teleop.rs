@@ -519,6 +519,62 @@ fn teleop_of_two_simulated_devices_reproduces_the_wall_contact_at_the_master() {
     assert_eq!(o.status.code(), Some(2), "{}", common::text(&o));
 }
 
+/// `haptic2d teleop --architecture four-channel`: the four channels hold master and slave
+/// together, so the hand spring (300 N/m) meets the wall (2 000 N/m) with no coupling between:
+/// `(15 − 5) mm / (1/300 + 1/2000) m/N = 2.61 N` (±0.35 N for joint friction), felt at the master,
+/// with a separation well under the position–force coupling's 3.5 mm; stable without TDPA at a
+/// 50 ms round trip, where position–force runs away (docs/TELEOP.md).
+#[test]
+fn teleop_four_channel_feels_the_wall_with_master_and_slave_together_even_at_50_ms_without_tdpa() {
+    let o = common::haptic2d(&[
+        "teleop",
+        "--architecture",
+        "four-channel",
+        "--delay-ms",
+        "25",
+        "--no-tdpa",
+    ]);
+    let t = common::text(&o);
+    assert!(o.status.success(), "{t}");
+    assert!(t.contains("four-channel"), "{t}");
+    let wall = number(&t, "contact (last second):", "wall force on the slave ");
+    let felt = number(
+        &t,
+        "contact (last second):",
+        "force of the master on the hand ",
+    );
+    assert!((2.26..2.96).contains(&wall), "{t}");
+    assert!((felt - wall).abs() < 0.1 * wall, "{t}");
+    assert!(
+        number(&t, "largest master force", "separation at the end ") < 1.0,
+        "{t}"
+    );
+    assert!(number(&t, "plants:", "created ") < 1e-2, "{t}");
+}
+
+/// `haptic2d teleop --stability` prints a finite delay margin for position–force between 10 and
+/// 50 ms (the runs of this page: stable at 10 ms, running away at 50 ms without TDPA) and
+/// writes the margin plot where asked.
+#[test]
+fn teleop_stability_prints_the_delay_margin_and_writes_the_plot() {
+    let dir = key_file("margin", 0x02).with_file_name("margin");
+    let o = common::haptic2d(&[
+        "teleop",
+        "--stability",
+        "--stability-plot",
+        dir.to_str().unwrap(),
+    ]);
+    let t = common::text(&o);
+    assert!(o.status.success(), "{t}");
+    let ms = number(&t, "position-force (chosen):", "round trip of ");
+    assert!((10.0..50.0).contains(&ms), "{t}");
+    assert!(
+        t.contains("four-channel: stable at every round trip"),
+        "{t}"
+    );
+    assert!(dir.join("teleop-margin.svg").exists(), "{t}");
+}
+
 /// `haptic2d teleop --figures DIR` writes the delay table (Markdown, CSV) and one plot per round
 /// trip into the directory the user gives, and prints the table (docs/TELEOP.md).
 #[test]

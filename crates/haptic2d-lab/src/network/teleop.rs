@@ -16,6 +16,7 @@
 //! true pose, held over each period. The torques go through each device's redundancy resolution
 //! and saturation; each port books the force its device really applied.
 
+use super::four_channel::Architecture;
 use super::link::{Impairment, Link};
 use haptic2d::control::tdpa::{planar_balance, NetworkEnergy, PlanarTdpa};
 use haptic2d::device::linalg::V3;
@@ -56,6 +57,8 @@ pub struct Teleop {
     /// default). The filtered velocity makes the contact chatter at 8–12 ms round trips and hides
     /// the energy from the ports' observers (docs/TELEOP.md, "The 10 ms chatter").
     pub filtered_velocity: bool,
+    /// Position–force (the default) or four-channel (docs/TELEOP.md).
+    pub architecture: Architecture,
 }
 
 impl Teleop {
@@ -77,6 +80,7 @@ impl Teleop {
             b_wall: 2.0,
             device: DeviceParams::default(),
             filtered_velocity: false,
+            architecture: Architecture::PositionForce,
         }
     }
 }
@@ -110,21 +114,49 @@ pub struct TeleopResult {
     /// the *estimated* (filtered) velocities the ports see; the two differ when the filter's lag
     /// matters (docs/TELEOP.md, "The 10 ms chatter").
     pub plant_created: f64,
+    /// Peak-to-peak of the master–slave separation along x, `x_m − x_s`, over the last second
+    /// (m): quantisation-small in steady contact, millimetres when the loop oscillates.
+    pub swing: f64,
 }
 
-/// Master → slave: pose, twist, energy in.
+/// Master → slave: pose, twist, energy in, the hand's force on the handle (four-channel only).
 #[derive(Clone, Copy, Debug)]
 struct Up {
     x: V3,
     v: V3,
     e_in: V3,
+    f_h: V3,
 }
 
-/// Slave → master: force for the master, energy in.
+/// Slave → master: force for the master (position–force), energy in; the slave's pose, twist and
+/// force on the environment (four-channel).
 #[derive(Clone, Copy, Debug)]
 struct Down {
     f: V3,
     e_in: V3,
+    x: V3,
+    v: V3,
+    f_e: V3,
+}
+
+/// The hand and the wall at time `t`: the grip's target (m, m, rad), the wall's force on the
+/// slave (N, along x, pushing only) and the slave's penetration (m).
+fn environment(cfg: &Teleop, o: &V3, t: f64, slave: &SimDevice) -> (V3, f64, f64) {
+    let len = cfg.push[0].hypot(cfg.push[1]);
+    let frac = if len > 0.0 {
+        ((t - cfg.push_at).max(0.0) * cfg.push_speed / len).min(1.0)
+    } else {
+        0.0
+    };
+    let target = [o[0] + frac * cfg.push[0], o[1] + frac * cfg.push[1], o[2]];
+    let sx = slave.pose()[0] - o[0];
+    let pen = cfg.wall_x - sx;
+    let f_wall = if pen > 0.0 {
+        (cfg.k_wall * pen - cfg.b_wall * slave.velocity()[0]).max(0.0)
+    } else {
+        0.0
+    };
+    (target, f_wall, pen)
 }
 
 /// One device: plant, estimator, port, last torques.
@@ -195,6 +227,41 @@ impl Side {
     }
 }
 
+/// Sums over the last second of a run.
+struct Tail {
+    wall: f64,
+    master: f64,
+    error: f64,
+    n: u64,
+    /// Extremes of the separation along x (m).
+    lo: f64,
+    hi: f64,
+}
+
+impl Default for Tail {
+    fn default() -> Self {
+        Self {
+            wall: 0.0,
+            master: 0.0,
+            error: 0.0,
+            n: 0,
+            lo: f64::INFINITY,
+            hi: f64::NEG_INFINITY,
+        }
+    }
+}
+
+impl Tail {
+    /// Adds a sample: wall force (N), master force along x (N), separation along x (m).
+    fn add(&mut self, f_wall: f64, f_m: f64, sep: f64) {
+        self.wall += f_wall;
+        self.master += f_m;
+        self.error += (f_m.abs() - f_wall).abs();
+        self.n += 1;
+        (self.lo, self.hi) = (self.lo.min(sep), self.hi.max(sep));
+    }
+}
+
 /// Runs `cfg`. Errors only for a device that cannot be built.
 pub fn run_teleop(cfg: &Teleop) -> Result<TeleopResult, String> {
     let p = cfg.device;
@@ -207,8 +274,7 @@ pub fn run_teleop(cfg: &Teleop) -> Result<TeleopResult, String> {
         ..cfg.link
     });
     let n = (cfg.duration / dt).round() as u64;
-    let len = cfg.push[0].hypot(cfg.push[1]);
-    let (mut wall_sum, mut mf_sum, mut err_sum, mut window) = (0.0, 0.0, 0.0, 0u64);
+    let mut tail = Tail::default();
     let (mut max_f, mut max_pen, mut separation) = (0.0f64, 0.0f64, 0.0);
     let mut fault = None;
     // The plants' true ledger (see `TeleopResult::plant_created`).
@@ -224,29 +290,43 @@ pub fn run_teleop(cfg: &Teleop) -> Result<TeleopResult, String> {
                 break;
             }
         };
-        // Master: the newest force from the slave through its port.
-        let (f_req, far_s) = down
-            .receive(k)
-            .map_or(([0.0; 3], [0.0; 3]), |d| (d.f, d.e_in));
+        // The environments at this sample (true poses): the hand on the master, the wall on
+        // the slave; the four-channel law reads their forces as ideal sensors would.
+        let (target, f_wall, pen) = environment(cfg, &o, t, &s.plant);
+        let hand = HandModel::grip(target);
+        let f_h = hand.wrench(&m.plant.pose(), &m.plant.velocity(), t);
+        let f_e = [-f_wall, 0.0, 0.0];
+        let rel = |x: &V3| -> V3 { std::array::from_fn(|i| x[i] - o[i]) };
+        // Master: the newest message from the slave, the law, its port.
+        let (f_req, far_s) = down.receive(k).map_or(([0.0; 3], [0.0; 3]), |d| {
+            let f = match &cfg.architecture {
+                Architecture::PositionForce => d.f,
+                Architecture::FourChannel(g) => g.master(&rel(&xm), &vm, &f_h, &d.x, &d.v, &d.f_e),
+            };
+            (f, d.e_in)
+        });
         let Ok(f_m) = m.drive(&f_req, &vm, &far_s, cfg.tdpa, dt) else {
             fault = Some("master torques");
             break;
         };
-        let rel = |x: &V3| -> V3 { std::array::from_fn(|i| x[i] - o[i]) };
         up.send(
             k,
             Up {
                 x: rel(&xm),
                 v: vm,
                 e_in: m.port.energy_in(),
+                f_h,
             },
         );
-        // Slave: the coupling to the newest master state, through its port.
+        // Slave: the newest master state, the law, its port.
         let (f_c, far_m) = up.receive(k).map_or(([0.0; 3], [0.0; 3]), |u| {
             let xs_r = rel(&xs);
-            let f: V3 = std::array::from_fn(|i| {
-                cfg.k[i] * (u.x[i] - xs_r[i]) + cfg.b[i] * (u.v[i] - vs[i])
-            });
+            let f: V3 = match &cfg.architecture {
+                Architecture::PositionForce => std::array::from_fn(|i| {
+                    cfg.k[i] * (u.x[i] - xs_r[i]) + cfg.b[i] * (u.v[i] - vs[i])
+                }),
+                Architecture::FourChannel(g) => g.slave(&xs_r, &vs, &f_e, &u.x, &u.v, &u.f_h),
+            };
             (f, u.e_in)
         });
         let Ok(f_s) = s.drive(&f_c, &vs, &far_m, cfg.tdpa, dt) else {
@@ -259,37 +339,21 @@ pub fn run_teleop(cfg: &Teleop) -> Result<TeleopResult, String> {
             Down {
                 f: f_c.map(|f| -f),
                 e_in: s.port.energy_in(),
+                x: rel(&xs),
+                v: vs,
+                f_e,
             },
         );
-        // The environments: the hand on the master, the wall on the slave (true poses).
-        let frac = if len > 0.0 {
-            ((t - cfg.push_at).max(0.0) * cfg.push_speed / len).min(1.0)
-        } else {
-            0.0
-        };
-        let target = [o[0] + frac * cfg.push[0], o[1] + frac * cfg.push[1], o[2]];
-        let sx = s.plant.pose()[0] - o[0];
-        let pen = cfg.wall_x - sx;
-        let f_wall = if pen > 0.0 {
-            (cfg.k_wall * pen - cfg.b_wall * s.plant.velocity()[0]).max(0.0)
-        } else {
-            0.0
-        };
         max_pen = max_pen.max(pen);
         max_f = max_f.max(f_m[0].hypot(f_m[1]));
         if t >= cfg.duration - 1.0 {
-            wall_sum += f_wall;
-            mf_sum += f_m[0];
-            err_sum += (f_m[0].abs() - f_wall).abs();
-            window += 1;
+            tail.add(f_wall, f_m[0], xm[0] - xs[0]);
         }
         separation = (xm[0] - xs[0]).hypot(xm[1] - xs[1]);
         let wall = HandModel::Constant {
             wrench: [f_wall, 0.0, 0.0],
         };
-        if m.plant.step(&m.tau, &HandModel::grip(target), dt).is_err()
-            || s.plant.step(&s.tau, &wall, dt).is_err()
-        {
+        if m.plant.step(&m.tau, &hand, dt).is_err() || s.plant.step(&s.tau, &wall, dt).is_err() {
             fault = Some("plant");
             break;
         }
@@ -298,21 +362,22 @@ pub fn run_teleop(cfg: &Teleop) -> Result<TeleopResult, String> {
         true_s.observe(&f_s, &rate(&ps0, &s.plant.pose()), dt);
         k += 1;
     }
-    let w = window.max(1) as f64;
+    let w = tail.n.max(1) as f64;
     let (mt, st) = (m.port.totals(), s.port.totals());
     let (tm, ts) = (true_m.totals(), true_s.totals());
     Ok(TeleopResult {
         network: planar_balance((mt.0, mt.1), (st.0, st.1)),
         dissipated: mt.2 + st.2,
-        wall_force: wall_sum / w,
-        master_force: mf_sum / w,
-        force_error: err_sum / w,
+        wall_force: tail.wall / w,
+        master_force: tail.master / w,
+        force_error: tail.error / w,
         max_master_force: max_f,
         max_penetration: max_pen,
         separation,
         samples: k,
         fault,
         plant_created: planar_balance((tm.0, tm.1), (ts.0, ts.1)).created,
+        swing: (tail.hi - tail.lo).max(0.0),
     })
 }
 
@@ -413,6 +478,33 @@ mod tests {
             let r = run(rt, loss, true);
             assert!(r.plant_created < 0.01, "{rt} ms: {r:?}");
             assert!(r.force_error < 0.05 * r.wall_force, "{rt} ms: {r:?}");
+        }
+    }
+
+    fn four_channel(round_trip_ms: u32, tdpa: bool) -> TeleopResult {
+        let link = Impairment::delay_loss(round_trip_ms / 2, 0.0, 5);
+        let base = Teleop::new(link, tdpa);
+        let g = super::super::FourChannel::lawrence(base.k, base.b);
+        run_teleop(&Teleop {
+            architecture: Architecture::FourChannel(g),
+            ..base
+        })
+        .unwrap()
+    }
+
+    /// Four channels are transparent in statics (`network::four_channel`): master and slave
+    /// coincide, so the hand spring (300 N/m) meets the wall (2 000 N/m) directly and the static
+    /// force is `(15 − 5) mm / (1/300 + 1/2000) m/N = 2.61 N`, against position–force's 1.76 N
+    /// through the coupling; the separation is friction's, not the coupling's 1.76 N / 500 N/m =
+    /// 3.5 mm. The band ±0.35 N is the position–force test's allowance for joint friction.
+    #[test]
+    fn four_channel_holds_master_and_slave_together_and_feels_the_wall_through_no_coupling() {
+        for tdpa in [false, true] {
+            let r = four_channel(0, tdpa);
+            assert_eq!(r.fault, None, "{r:?}");
+            assert!((2.26..2.96).contains(&r.wall_force), "{tdpa}: {r:?}");
+            assert!(r.force_error < 0.1 * r.wall_force, "{tdpa}: {r:?}");
+            assert!(r.separation < 1e-3, "{tdpa}: {r:?}");
         }
     }
 }

@@ -25,6 +25,8 @@
 //! [`check_released_stability`] is the gate `haptic2d run` applies before driving a real device.
 
 pub mod axis;
+pub mod delayed;
+pub mod delayed_plot;
 pub mod dense;
 pub mod eig;
 pub mod loop_model;
@@ -33,6 +35,7 @@ pub mod plot;
 pub mod report;
 
 pub use axis::{AxisController, AxisModel};
+pub use delayed::{delay_margin, DelayMargin, DelayedLoop};
 pub use loop_model::{
     AxisReport, Environment, LoopModel, LoopPoles, Verdict, AXES, MIN_DECAY_RATE,
 };
