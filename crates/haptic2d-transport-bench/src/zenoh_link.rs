@@ -112,7 +112,7 @@ pub fn echo_side(
             let now = now_ns();
             let mut out = [0u8; PORT_LEN];
             if e2.answer(&sample.payload().to_bytes(), now, &mut out) {
-                let _ = publisher.put(&out).wait();
+                let _ = publisher.put(out).wait();
             }
         })
         .wait()
