@@ -107,3 +107,21 @@ def test_refusals_raise_with_the_servers_reason_and_sigint_ends_it(binary) -> No
 def test_a_missing_binary_is_a_clear_error(tmp_path) -> None:
     with pytest.raises(FileNotFoundError, match="cargo build -p haptic2d-cli"):
         haptic2d.serve(STUDY, binary=tmp_path / "no-such-haptic2d")
+
+
+def test_server_staircase_example_runs_on_the_loop_without_a_display(binary) -> None:
+    # The worked example of docs/STUDIES.md, shortened: two trials of two 1 s intervals each, on the
+    # simulated device with the scripted push, the model observer answering from what the loop measured.
+    import subprocess
+    import sys
+
+    example = REPO / "examples" / "python" / "study_server_staircase.py"
+    env = {k: v for k, v in os.environ.items() if k != "DISPLAY"}
+    out = subprocess.run(
+        [sys.executable, str(example), "--trials", "2", "--interval", "1.0", "--binary", binary],
+        capture_output=True, text=True, env=env, timeout=180,
+    )
+    assert out.returncode == 0, out.stdout + out.stderr
+    assert "server: " in out.stdout
+    for n in (1, 2):
+        assert f"trial {n:3d}: delta" in out.stdout, out.stdout

@@ -37,9 +37,12 @@
 //! own normal (`O(n)`, the deepest vertex of the vertex polygon behind its edge line): the pair's
 //! overlap is no more than that, so a record for which it is within the margin of the record's
 //! own depth clears its pair, and the separating-axis test runs only for the pairs none of whose
-//! records clears it. (On a piece with seams the record's normal clears the pair only if it is an
-//! admissible axis: a body sunk into the joint of a floor and a wall slab has its one record on
-//! the slab's corner, whose normal would move the body out through the joint.)
+//! records clears it. The own-axis test depends on the two bodies' relative angle only, so it is
+//! remembered per record and recomputed only when the angle has turned enough that the answer
+//! could change (`own_axis_clears`): on a pile at rest, almost never. (On a piece with seams the
+//! record's normal clears the pair only if it is an admissible axis: a body sunk into the joint of
+//! a floor and a wall slab has its one record on the slab's corner, whose normal would move the
+//! body out through the joint; such pairs recompute every sample.)
 
 use super::sync::new_entry;
 use super::ContactSet;
