@@ -6,12 +6,7 @@
 # Usage: scripts/check_foxglove.sh [PATH/TO/haptic2d]
 set -euo pipefail
 cd "$(dirname "$0")/.."
-BIN="${1:-target/debug/haptic2d}"
-[ -x "$BIN" ] || cargo build -q -p haptic2d-cli
+source scripts/checker_venv.sh
 VENV=target/foxglove-venv
-if [ ! -x "$VENV/bin/python" ]; then
-  python3 -m venv "$VENV"
-fi
-"$VENV/bin/python" -c 'import websockets.sync.client, jsonschema' 2>/dev/null ||
-  "$VENV/bin/pip" install -q --disable-pip-version-check 'websockets>=13' 'jsonschema>=4'
+checker_venv "$VENV" "websockets.sync.client, jsonschema" 'websockets>=13' 'jsonschema>=4'
 "$VENV/bin/python" scripts/foxglove_client_check.py "$BIN"

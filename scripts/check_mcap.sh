@@ -4,13 +4,9 @@
 # runs scripts/read_mcap.py on them. Usage: scripts/check_mcap.sh [PATH/TO/haptic2d]
 set -euo pipefail
 cd "$(dirname "$0")/.."
-BIN="${1:-target/debug/haptic2d}"
-[ -x "$BIN" ] || cargo build -q -p haptic2d-cli
+source scripts/checker_venv.sh
 VENV=target/mcap-venv
-if [ ! -x "$VENV/bin/python" ]; then
-  python3 -m venv "$VENV"
-fi
-"$VENV/bin/python" -c 'import mcap' 2>/dev/null || "$VENV/bin/pip" install -q 'mcap>=1.2'
+checker_venv "$VENV" mcap 'mcap>=1.2'
 OUT=$(mktemp -d target/mcap-check.XXXXXX)
 trap 'rm -rf "$OUT"' EXIT
 "$BIN" run --headless --no-rt --duration 2 --log "$OUT/run.mcap" >/dev/null

@@ -35,6 +35,7 @@ mod state;
 mod timing;
 
 use clap::Parser;
+use haptic2d::world::World;
 use std::path::PathBuf;
 
 /// Command-line options.
@@ -164,10 +165,7 @@ fn run(args: &Args) -> Result<(), String> {
             return Err("--settle and --every must be positive durations in s".into());
         }
         for case in cases {
-            let label = format!("{} n={}", case.scene, case.n);
-            let mut h = case.haptic.world;
-            h.params.proximity_spread = !args.no_spread;
-            settle::apply(&mut h, &args.set).map_err(|e| format!("{label}: {e}"))?;
+            let (label, mut h) = haptic_world(args, case.scene, case.n, case.haptic.world)?;
             settle::run(
                 &label,
                 &mut h,
@@ -185,17 +183,9 @@ fn run(args: &Args) -> Result<(), String> {
             return Err("--rest-time must be a positive duration in s".into());
         }
         for case in cases {
-            let label = format!("{} n={}", case.scene, case.n);
-            let mut h = case.haptic.world;
-            h.params.proximity_spread = !args.no_spread;
-            settle::apply(&mut h, &args.set).map_err(|e| format!("{label}: {e}"))?;
-            let (mu, e) = (case.rapier_friction, case.rapier_restitution);
-            let mut r =
-                rapier_world::twin(&h, scenes::DT, mu, e).map_err(|x| format!("{label}: {x}"))?;
-            let mut b4 =
-                box2d_world::twin(&h, scenes::DT, 4, mu, e).map_err(|x| format!("{label}: {x}"))?;
-            let mut b1 =
-                box2d_world::twin(&h, scenes::DT, 1, mu, e).map_err(|x| format!("{label}: {x}"))?;
+            let (label, mut h) = haptic_world(args, case.scene, case.n, case.haptic.world)?;
+            let (mut r, mut b4, mut b1) =
+                peers(&h, &label, case.rapier_friction, case.rapier_restitution)?;
             let dynamic: Vec<bool> = h.bodies.iter().map(|b| b.is_dynamic()).collect();
             let dt = scenes::DT;
             let res = {
@@ -241,36 +231,12 @@ fn run(args: &Args) -> Result<(), String> {
     let mut rows = Vec::new();
     let mut step_csv = String::from("scene,n,engine,step,sample,us\n");
     for case in cases {
-        let label = format!("{} n={}", case.scene, case.n);
-        let mut h = case.haptic.world;
-        h.params.proximity_spread = !args.no_spread;
-        settle::apply(&mut h, &args.set).map_err(|e| format!("{label}: {e}"))?;
+        let (label, mut h) = haptic_world(args, case.scene, case.n, case.haptic.world)?;
         if !args.set.is_empty() {
             eprintln!("{label}: haptic2d with {}", args.set.join(", "));
         }
-        let mut r = rapier_world::twin(
-            &h,
-            scenes::DT,
-            case.rapier_friction,
-            case.rapier_restitution,
-        )
-        .map_err(|e| format!("{label}: {e}"))?;
-        let mut b4 = box2d_world::twin(
-            &h,
-            scenes::DT,
-            4,
-            case.rapier_friction,
-            case.rapier_restitution,
-        )
-        .map_err(|e| format!("{label}: {e}"))?;
-        let mut b1 = box2d_world::twin(
-            &h,
-            scenes::DT,
-            1,
-            case.rapier_friction,
-            case.rapier_restitution,
-        )
-        .map_err(|e| format!("{label}: {e}"))?;
+        let (mut r, mut b4, mut b1) =
+            peers(&h, &label, case.rapier_friction, case.rapier_restitution)?;
         eprintln!(
             "{label}: {} warm-up + {} timed steps per engine (4 engines, box2d build {}, {:?} clock) ...",
             args.warmup,
@@ -397,6 +363,43 @@ fn run(args: &Args) -> Result<(), String> {
         );
     }
     Ok(())
+}
+
+/// The label of a case ("pile n=100") and its haptic2d world `h` with `--no-spread` and `--set`
+/// applied.
+fn haptic_world(
+    args: &Args,
+    scene: &str,
+    n: usize,
+    mut h: World,
+) -> Result<(String, World), String> {
+    let label = format!("{scene} n={n}");
+    h.params.proximity_spread = !args.no_spread;
+    settle::apply(&mut h, &args.set).map_err(|e| format!("{label}: {e}"))?;
+    Ok((label, h))
+}
+
+/// The peers' twins of `h` at the benchmark's period, with friction `mu` and restitution `e`:
+/// Rapier, Box2D with 4 substeps (its default) and Box2D with 1.
+fn peers(
+    h: &World,
+    label: &str,
+    mu: f64,
+    e: f64,
+) -> Result<
+    (
+        rapier_world::RapierTwin,
+        box2d_world::Box2dTwin,
+        box2d_world::Box2dTwin,
+    ),
+    String,
+> {
+    let err = |x: String| format!("{label}: {x}");
+    Ok((
+        rapier_world::twin(h, scenes::DT, mu, e).map_err(err)?,
+        box2d_world::twin(h, scenes::DT, 4, mu, e).map_err(err)?,
+        box2d_world::twin(h, scenes::DT, 1, mu, e).map_err(err)?,
+    ))
 }
 
 fn main() {

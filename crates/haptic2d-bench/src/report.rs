@@ -81,6 +81,32 @@ pub fn step_rows(
     }
 }
 
+/// One line of [`table`]: an engine's times (µs) on row `r` and its two ratio columns, as text.
+/// The times are `[median, p99, p99 warm, chunk start]`.
+fn row(
+    s: &mut String,
+    r: &Row,
+    engine: &str,
+    [median_us, p99_us, p99_warm_us, chunk_start_us]: [f64; 4],
+    (ratio, ratio_p99): (String, String),
+) {
+    let _ = writeln!(
+        s,
+        "{:<13} {:>5} | {:<15} {:>10.2} {:>10.2} {:>7.2} {:>8.2} {:>9.2} {:>+10.2} | {:>7} {:>7}",
+        r.scene,
+        r.n,
+        engine,
+        median_us,
+        p99_us,
+        p99_us / median_us,
+        p99_warm_us / median_us,
+        chunk_start_us / median_us,
+        chunk_start_us - median_us,
+        ratio,
+        ratio_p99
+    );
+}
+
 /// The tables printed to stdout: step times with ratios (haptic2d / engine, median and p99), then the
 /// settle state after the run.
 pub fn table(rows: &[Row]) -> String {
@@ -103,38 +129,17 @@ pub fn table(rows: &[Row]) -> String {
     let _ = writeln!(s, "{}", "-".repeat(116));
     for r in rows {
         for (k, e) in r.engines.iter().enumerate() {
-            let _ = writeln!(
-                s,
-                "{:<13} {:>5} | {:<15} {:>10.2} {:>10.2} {:>7.2} {:>8.2} {:>9.2} {:>+10.2} | {:>7.3} {:>7.3}",
-                r.scene,
-                r.n,
-                e.key,
-                e.median_us,
-                e.p99_us,
-                e.p99_us / e.median_us,
-                e.p99_warm_us / e.median_us,
-                e.chunk_start_us / e.median_us,
-                e.chunk_start_us - e.median_us,
-                r.ratio(k),
-                r.ratio_p99(k)
+            let ratios = (
+                format!("{:.3}", r.ratio(k)),
+                format!("{:.3}", r.ratio_p99(k)),
             );
+            let times = [e.median_us, e.p99_us, e.p99_warm_us, e.chunk_start_us];
+            row(&mut s, r, &e.key, times, ratios);
         }
         let e = &r.reference;
-        let _ = writeln!(
-            s,
-            "{:<13} {:>5} | {:<15} {:>10.2} {:>10.2} {:>7.2} {:>8.2} {:>9.2} {:>+10.2} | {:>7} {:>7}",
-            r.scene,
-            r.n,
-            REFERENCE,
-            e.median_us,
-            e.p99_us,
-            e.p99_us / e.median_us,
-            e.p99_warm_us / e.median_us,
-            e.chunk_start_us / e.median_us,
-            e.chunk_start_us - e.median_us,
-            "—",
-            "—"
-        );
+        let dash = ("—".to_string(), "—".to_string());
+        let times = [e.median_us, e.p99_us, e.p99_warm_us, e.chunk_start_us];
+        row(&mut s, r, REFERENCE, times, dash);
     }
     let _ = writeln!(
         s,

@@ -13,10 +13,7 @@
 // lasts (1 s watched), a continue for another trial is refused by the loop, and Space continues.
 // Prints one JSON line {"ok":true,"answers":[{trial,magnitude}],…}; exit code 0 on success.
 
-import { chromium } from "playwright-core";
-import { mkdtempSync, rmSync } from "node:fs";
-import { tmpdir } from "node:os";
-import { join } from "node:path";
+import { check, runInBrowser } from "./browser.mjs";
 
 const [url, answersArg, breakArg] = process.argv.slice(2);
 if (!url || !answersArg || !breakArg) {
@@ -25,30 +22,8 @@ if (!url || !answersArg || !breakArg) {
 }
 const nAnswers = Number(answersArg);
 const breakBefore = Number(breakArg);
-const executablePath = process.env.CHROMIUM_PATH || "/usr/bin/chromium";
-const watchdog = setTimeout(() => {
-  console.error("FAIL: the e2e script did not finish within 100 s");
-  process.exit(1);
-}, 100_000);
 
-function check(cond, what) {
-  if (!cond) throw new Error(what);
-}
-
-const userDataDir = mkdtempSync(join(tmpdir(), "haptic2d-study-e2e-"));
-let context;
-const result = { answers: [], breakSeen: false };
-try {
-  context = await chromium.launchPersistentContext(userDataDir, {
-    executablePath,
-    headless: true,
-    viewport: { width: 1400, height: 900 },
-    args: ["--headless", "--no-sandbox", "--disable-gpu", "--no-first-run",
-      "--disable-background-networking", "--disable-component-update", "--disable-sync"],
-  });
-  const page = context.pages()[0] || (await context.newPage());
-  const pageErrors = [];
-  page.on("pageerror", (e) => pageErrors.push(String(e)));
+await runInBrowser({ name: "study_break_magnitude_e2e.mjs", limitMs: 100_000, result: { answers: [], breakSeen: false } }, async (page, result) => {
   await page.goto(url, { waitUntil: "load" });
   await page.waitForFunction(() => window.__haptic2d && window.__haptic2d.study, null, { timeout: 30_000 });
   const view = () => page.evaluate(() => window.__haptic2d.study);
@@ -109,15 +84,4 @@ try {
   await page.waitForFunction(() => window.__haptic2d.study && window.__haptic2d.study.phase === "stopping"
     || !window.__haptic2d.connected, null, { timeout: 10_000 });
   check(result.breakSeen || breakBefore > nAnswers, "the break was seen");
-  check(pageErrors.length === 0, `page errors: ${pageErrors.join("; ")}`);
-  result.ok = true;
-  console.log(JSON.stringify(result));
-} catch (e) {
-  console.error(`FAIL: ${e.message}`);
-  console.log(JSON.stringify({ ok: false, error: e.message, ...result }));
-  process.exitCode = 1;
-} finally {
-  clearTimeout(watchdog);
-  if (context) await context.close();
-  rmSync(userDataDir, { recursive: true, force: true });
-}
+});

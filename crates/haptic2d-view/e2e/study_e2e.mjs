@@ -14,10 +14,7 @@
 // old trial and a second answer for the same trial are refused by the loop. Prints one JSON line
 // {"ok":true,"answers":[{trial,choice},…],…}; exit code 0 on success.
 
-import { chromium } from "playwright-core";
-import { mkdtempSync, rmSync } from "node:fs";
-import { tmpdir } from "node:os";
-import { join } from "node:path";
+import { check, runInBrowser } from "./browser.mjs";
 
 const [url, answersArg, firstArg, end] = process.argv.slice(2);
 if (!url || !answersArg || !firstArg || !end) {
@@ -26,32 +23,8 @@ if (!url || !answersArg || !firstArg || !end) {
 }
 const nAnswers = Number(answersArg);
 const firstTrial = Number(firstArg);
-const executablePath = process.env.CHROMIUM_PATH || "/usr/bin/chromium";
 
-const watchdog = setTimeout(() => {
-  console.error("FAIL: the study e2e script did not finish within 100 s");
-  process.exit(1);
-}, 100_000);
-
-function check(cond, what) {
-  if (!cond) throw new Error(what);
-}
-
-const userDataDir = mkdtempSync(join(tmpdir(), "haptic2d-study-e2e-"));
-let context;
-const result = { answers: [], intervalsSeen: [] };
-try {
-  context = await chromium.launchPersistentContext(userDataDir, {
-    executablePath,
-    headless: true,
-    viewport: { width: 1400, height: 900 },
-    args: ["--headless", "--no-sandbox", "--disable-gpu", "--no-first-run",
-      "--disable-background-networking", "--disable-component-update", "--disable-sync"],
-  });
-  const page = context.pages()[0] || (await context.newPage());
-  const pageErrors = [];
-  page.on("pageerror", (e) => pageErrors.push(String(e)));
-
+await runInBrowser({ name: "study_e2e.mjs", limitMs: 100_000, result: { answers: [], intervalsSeen: [] } }, async (page, result) => {
   await page.goto(url, { waitUntil: "load" });
   await page.waitForFunction(() => window.__haptic2d && window.__haptic2d.study, null, { timeout: 30_000 });
   check(await page.evaluate(() => document.body.classList.contains("study-mode")), "the page is in study mode");
@@ -112,15 +85,4 @@ try {
     await page.waitForFunction(() => window.__haptic2d.study && window.__haptic2d.study.phase === "stopping"
       || !window.__haptic2d.connected, null, { timeout: 10_000 });
   }
-  check(pageErrors.length === 0, `page errors: ${pageErrors.join("; ")}`);
-  result.ok = true;
-  console.log(JSON.stringify(result));
-} catch (e) {
-  console.error(`FAIL: ${e.message}`);
-  console.log(JSON.stringify({ ok: false, error: e.message, ...result }));
-  process.exitCode = 1;
-} finally {
-  clearTimeout(watchdog);
-  if (context) await context.close();
-  rmSync(userDataDir, { recursive: true, force: true });
-}
+});

@@ -16,58 +16,24 @@
 // errors and no error frames on the page. Prints one JSON line with the measurements; exit code 0
 // on success.
 
-import { chromium } from "playwright-core";
-import { mkdtempSync, rmSync } from "node:fs";
-import { tmpdir } from "node:os";
-import { join } from "node:path";
+import { check, runInBrowser } from "./browser.mjs";
 
 const url = process.argv[2];
 if (!url) {
   console.error("usage: node view_e2e.mjs URL");
   process.exit(2);
 }
-const executablePath = process.env.CHROMIUM_PATH || "/usr/bin/chromium";
 const screenshotPath = process.env.HAPTIC2D_VIEW_SCREENSHOT;
 
-const watchdog = setTimeout(() => {
-  console.error("FAIL: the e2e script did not finish within 90 s");
-  process.exit(1);
-}, 90_000);
+const extraArgs = [
+  "--disable-quic",
+  // Recent Chromium blocks a public page's requests to loopback itself (Local Network Access)
+  // unless the user grants a permission; other browsers, older ones and a granted permission do
+  // not. Step 6 tests the display's own defence, so the browser's is turned off.
+  "--disable-features=LocalNetworkAccessChecks,LocalNetworkAccessChecksWebSockets,BlockInsecurePrivateNetworkRequests,PrivateNetworkAccessSendPreflights,PrivateNetworkAccessRespectPreflightResults",
+];
 
-function check(cond, what) {
-  if (!cond) throw new Error(what);
-}
-
-const userDataDir = mkdtempSync(join(tmpdir(), "haptic2d-e2e-"));
-let context;
-const result = {};
-try {
-  context = await chromium.launchPersistentContext(userDataDir, {
-    executablePath,
-    headless: true,
-    viewport: { width: 1400, height: 900 },
-    args: [
-      "--headless",
-      "--no-sandbox",
-      "--disable-gpu",
-      "--disable-quic",
-      "--no-first-run",
-      "--disable-background-networking",
-      "--disable-component-update",
-      "--disable-sync",
-      // Recent Chromium blocks a public page's requests to loopback itself (Local Network Access)
-      // unless the user grants a permission; other browsers, older ones and a granted permission do
-      // not. Step 6 tests the display's own defence, so the browser's is turned off.
-      "--disable-features=LocalNetworkAccessChecks,LocalNetworkAccessChecksWebSockets,BlockInsecurePrivateNetworkRequests,PrivateNetworkAccessSendPreflights,PrivateNetworkAccessRespectPreflightResults",
-    ],
-  });
-  const page = context.pages()[0] || (await context.newPage());
-  const pageErrors = [];
-  page.on("pageerror", (e) => pageErrors.push(String(e)));
-  page.on("console", (m) => {
-    if (m.type() === "error") pageErrors.push(m.text());
-  });
-
+await runInBrowser({ name: "view_e2e.mjs", limitMs: 90_000, extraArgs, consoleErrors: true }, async (page, result, context) => {
   // 1. The page loads, connects, gets the scene and frames.
   await page.goto(url, { waitUntil: "load" });
   await page.waitForFunction(
@@ -272,7 +238,6 @@ try {
   // 7. Nothing went wrong on the way.
   const errors = await page.evaluate(() => window.__haptic2d.errors);
   check(errors.length === 0, `error frames: ${JSON.stringify(errors)}`);
-  check(pageErrors.length === 0, `page errors: ${JSON.stringify(pageErrors)}`);
   // Acknowledgements read as information, not as errors: not in the error colour. (Setting the
   // wall law it already has is acknowledged and changes nothing.)
   const law = await page.evaluate(() => window.__haptic2d.lastFrame.wall_law);
@@ -289,15 +254,4 @@ try {
     await page.screenshot({ path: screenshotPath });
     result.screenshot = screenshotPath;
   }
-  console.log(JSON.stringify({ ok: true, ...result }));
-  await context.close();
-  clearTimeout(watchdog);
-  rmSync(userDataDir, { recursive: true, force: true });
-  process.exit(0);
-} catch (e) {
-  console.log(JSON.stringify({ ok: false, error: String(e && e.message ? e.message : e), ...result }));
-  console.error(`FAIL: ${e && e.stack ? e.stack : e}`);
-  if (context) await context.close().catch(() => {});
-  rmSync(userDataDir, { recursive: true, force: true });
-  process.exit(1);
-}
+});

@@ -241,6 +241,26 @@ fn exchange_waves(cfg: &DelayedWall, net: &mut Net, k: u64, st: [f64; 4]) -> (f6
     (f_m, s.force)
 }
 
+/// The force (N) `port` lets through for the requested `f` at velocity `v` (m/s): with `tdpa` its
+/// passivity controller's output (the far port's energy-in `far_e_in` (J), damping cap `alpha`
+/// (N·s/m)); without, `f` itself, booked by the port's observer.
+fn through_port(
+    port: &mut TdpaPort,
+    tdpa: bool,
+    f: f64,
+    v: f64,
+    far_e_in: f64,
+    dt: f64,
+    alpha: f64,
+) -> f64 {
+    if tdpa {
+        port.step(f, v, far_e_in, dt, alpha)
+    } else {
+        port.observe(f, v, dt);
+        f
+    }
+}
+
 /// One sample's exchange of forces and positions, with TDPA on both ports or neither: `(f_m, f_s)`
 /// (N) from the states `(x_m, v_m, x_s, v_s)`.
 fn exchange_forces(cfg: &DelayedWall, net: &mut Net, k: u64, st: [f64; 4]) -> (f64, f64) {
@@ -249,12 +269,7 @@ fn exchange_forces(cfg: &DelayedWall, net: &mut Net, k: u64, st: [f64; 4]) -> (f
     let (alpha_m, alpha_s) = (2.0 * cfg.m_device / dt, 2.0 * cfg.m_body / dt);
     // Device side: read the newest force, apply the master port's controller.
     let (f_req, far_s) = net.down.receive(k).map_or((0.0, 0.0), |m| (m.f, m.e_in));
-    let f_m = if tdpa {
-        net.master.step(f_req, v_m, far_s, dt, alpha_m)
-    } else {
-        net.master.observe(f_req, v_m, dt);
-        f_req
-    };
+    let f_m = through_port(&mut net.master, tdpa, f_req, v_m, far_s, dt, alpha_m);
     net.up.send(
         k,
         ToWorld {
@@ -270,12 +285,7 @@ fn exchange_forces(cfg: &DelayedWall, net: &mut Net, k: u64, st: [f64; 4]) -> (f
         .receive(k)
         .map_or((0.0, 0.0, 0.0), |m| (m.x, m.v, m.e_in));
     let f_c = cfg.k_coupling * (xm_r - x_s) + cfg.b_coupling * (vm_r - v_s);
-    let f_s = if tdpa {
-        net.slave.step(f_c, v_s, far_m, dt, alpha_s)
-    } else {
-        net.slave.observe(f_c, v_s, dt);
-        f_c
-    };
+    let f_s = through_port(&mut net.slave, tdpa, f_c, v_s, far_m, dt, alpha_s);
     net.down.send(
         k,
         ToDevice {

@@ -216,20 +216,8 @@ impl LoopModel {
         for i in 0..3 {
             let mut worst: Option<AxisReport> = None;
             for (name, axes) in &self.cases {
-                let a = &axes[i];
-                let r = AxisReport {
-                    axis: AXES[i],
-                    contact: name,
-                    model: *a,
-                    held: LoopPoles::of(a, self.dt, self.delay)?,
-                    released: LoopPoles::of(&a.released(), self.dt, self.delay)?,
-                };
-                let worse = worst.as_ref().is_none_or(|w| {
-                    r.released.growth.max(r.held.growth) > w.released.growth.max(w.held.growth)
-                });
-                if worse {
-                    worst = Some(r);
-                }
+                let r = AxisReport::analyse(AXES[i], name, axes[i], self.dt, self.delay)?;
+                r.keep_if_worse(&mut worst);
             }
             out.extend(worst);
         }
@@ -313,6 +301,33 @@ pub struct AxisReport {
 }
 
 impl AxisReport {
+    /// The loop poles of `model` on axis `axis` against the spring `contact`, held and released, at
+    /// period `dt` (s) with `delay` extra output samples.
+    pub fn analyse(
+        axis: &'static str,
+        contact: &'static str,
+        model: AxisModel,
+        dt: f64,
+        delay: usize,
+    ) -> Result<Self, String> {
+        Ok(AxisReport {
+            axis,
+            contact,
+            model,
+            held: LoopPoles::of(&model, dt, delay)?,
+            released: LoopPoles::of(&model.released(), dt, delay)?,
+        })
+    }
+
+    /// Puts `self` in `worst` when `worst` is empty or grows slower (held or released, 1/s) than
+    /// `self`: the per-axis reports keep the worse spring.
+    pub fn keep_if_worse(self, worst: &mut Option<AxisReport>) {
+        let growth = |r: &AxisReport| r.released.growth.max(r.held.growth);
+        if worst.as_ref().is_none_or(|w| growth(&self) > growth(w)) {
+            *worst = Some(self);
+        }
+    }
+
     /// The verdict from the sampled-data growth rates.
     pub fn verdict(&self) -> Verdict {
         if self.released.growth >= 0.0 {

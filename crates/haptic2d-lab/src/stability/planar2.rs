@@ -19,8 +19,7 @@ use haptic2d::world::World;
 
 use super::axis::AxisModel;
 use super::loop_model::{
-    axis_controller, AxisReport, Environment, LoopPoles, Verdict, AXES, GRIP_DAMPING,
-    GRIP_STIFFNESS,
+    axis_controller, AxisReport, Environment, Verdict, AXES, GRIP_DAMPING, GRIP_STIFFNESS,
 };
 
 /// Gain of the model's (decoupled, unused) hand-wrench observer (1/s).
@@ -153,19 +152,7 @@ fn analyse_axes(
                 k_o: DECOUPLED_OBSERVER_GAIN,
                 velocity_cutoff_hz: 50.0,
             };
-            let r = AxisReport {
-                axis: AXES[i],
-                contact: name,
-                model: m,
-                held: LoopPoles::of(&m, dt, delay)?,
-                released: LoopPoles::of(&m.released(), dt, delay)?,
-            };
-            let worse = worst.as_ref().is_none_or(|w| {
-                r.released.growth.max(r.held.growth) > w.released.growth.max(w.held.growth)
-            });
-            if worse {
-                worst = Some(r);
-            }
+            AxisReport::analyse(AXES[i], name, m, dt, delay)?.keep_if_worse(&mut worst);
         }
         out.extend(worst);
     }

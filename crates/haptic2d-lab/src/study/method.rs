@@ -181,6 +181,18 @@ fn positive(x: f64) -> bool {
     x.is_finite() && x > 0.0
 }
 
+/// A count of trials (per delta, staircase or condition) in 1 to [`MAX_TRIALS_PER_CONDITION`].
+fn trial_count(n: u32) -> bool {
+    n != 0 && n <= MAX_TRIALS_PER_CONDITION
+}
+
+/// Reports `field` (its `value`, and the `fix`) unless `ok`.
+fn require(e: &mut Report, ok: bool, field: &str, value: impl std::fmt::Display, fix: &str) {
+    if !ok {
+        e(field, value.to_string(), fix);
+    }
+}
+
 /// `[method]` of kind `"constant"`.
 fn constant_from(m: &MethodSection, own_deltas: bool, e: &mut Report) -> Method {
     let deltas = m.deltas.clone().unwrap_or_default();
@@ -201,13 +213,14 @@ fn constant_from(m: &MethodSection, own_deltas: bool, e: &mut Report) -> Method 
         );
     }
     let repeats = m.repeats.unwrap_or(0);
-    if repeats == 0 || repeats > MAX_TRIALS_PER_CONDITION {
-        e(
-            "repeats",
-            format!("{repeats} repeats"),
-            "give 1 to 100000 presentations per delta, e.g. repeats = 20",
-        );
-    }
+    let fix = "give 1 to 100000 presentations per delta, e.g. repeats = 20";
+    require(
+        e,
+        trial_count(repeats),
+        "repeats",
+        format!("{repeats} repeats"),
+        fix,
+    );
     let staircase_settings = [
         ("rule", m.rule.is_some()),
         ("starts", m.starts.is_some()),
@@ -253,30 +266,30 @@ fn staircase_from(m: &MethodSection, e: &mut Report) -> StaircaseSpec {
         e("starts", format!("{starts:?}"), "give 1 to 8 positive starting deltas, one per interleaved staircase, e.g. starts = [400.0, 50.0]");
     }
     let step = m.step_factor.unwrap_or(0.0);
-    if !(step.is_finite() && step > 1.0 && step <= 10.0) {
-        e(
-            "step_factor",
-            format!("{step}"),
-            "give a factor in (1, 10], e.g. step_factor = 1.25",
-        );
-    }
+    require(
+        e,
+        step.is_finite() && step > 1.0 && step <= 10.0,
+        "step_factor",
+        step,
+        "give a factor in (1, 10], e.g. step_factor = 1.25",
+    );
     let initial = m.initial_step_factor.unwrap_or(step);
-    if !(initial.is_finite() && initial > 1.0 && initial <= 10.0) {
-        e(
-            "initial_step_factor",
-            format!("{initial}"),
-            "give a factor in (1, 10], e.g. 2.0, or remove it",
-        );
-    }
+    require(
+        e,
+        initial.is_finite() && initial > 1.0 && initial <= 10.0,
+        "initial_step_factor",
+        initial,
+        "give a factor in (1, 10], e.g. 2.0, or remove it",
+    );
     let max_trials = m.max_trials.unwrap_or(0);
     let max_reversals = m.max_reversals.unwrap_or(u32::MAX);
-    if max_trials == 0 || max_trials > MAX_TRIALS_PER_CONDITION {
-        e(
-            "max_trials",
-            format!("{max_trials}"),
-            "give the stopping rule: 1 to 100000 trials per staircase, e.g. max_trials = 60",
-        );
-    }
+    require(
+        e,
+        trial_count(max_trials),
+        "max_trials",
+        max_trials,
+        "give the stopping rule: 1 to 100000 trials per staircase, e.g. max_trials = 60",
+    );
     if max_reversals == 0 {
         e(
             "max_reversals",
@@ -288,20 +301,20 @@ fn staircase_from(m: &MethodSection, e: &mut Report) -> StaircaseSpec {
     let hi = starts.iter().copied().fold(0.0, f64::max);
     let min_delta = m.min_delta.unwrap_or(lo / 64.0);
     let max_delta = m.max_delta.unwrap_or(4.0 * hi);
-    if !(positive(min_delta) && min_delta <= lo) {
-        e(
-            "min_delta",
-            format!("{min_delta}"),
-            "give a positive delta no larger than the smallest start",
-        );
-    }
-    if !(max_delta.is_finite() && max_delta >= hi) {
-        e(
-            "max_delta",
-            format!("{max_delta}"),
-            "give a delta at least the largest start",
-        );
-    }
+    require(
+        e,
+        positive(min_delta) && min_delta <= lo,
+        "min_delta",
+        min_delta,
+        "give a positive delta no larger than the smallest start",
+    );
+    require(
+        e,
+        max_delta.is_finite() && max_delta >= hi,
+        "max_delta",
+        max_delta,
+        "give a delta at least the largest start",
+    );
     if m.deltas.is_some() || m.repeats.is_some() {
         e(
             "deltas",
@@ -383,33 +396,31 @@ fn quest_from(m: &MethodSection, e: &mut Report) -> QuestSpec {
         );
     }
     let prior_sd = m.prior_sd.unwrap_or(0.5);
-    if !(prior_sd.is_finite() && prior_sd > 0.0 && prior_sd <= 3.0) {
-        e(
-            "prior_sd",
-            format!("{prior_sd}"),
-            "give the prior's sd of log10(threshold) in (0, 3], e.g. 0.5",
-        );
-    }
+    require(
+        e,
+        prior_sd.is_finite() && prior_sd > 0.0 && prior_sd <= 3.0,
+        "prior_sd",
+        prior_sd,
+        "give the prior's sd of log10(threshold) in (0, 3], e.g. 0.5",
+    );
     let beta = m.beta.unwrap_or(3.5);
-    if !(beta.is_finite() && (0.2..=20.0).contains(&beta)) {
-        e("beta", format!("{beta}"), "give the Weibull slope in [0.2, 20], e.g. 3.5 (Watson & Pelli) or the slope a pilot fit gave");
-    }
+    require(e, beta.is_finite() && (0.2..=20.0).contains(&beta), "beta", beta, "give the Weibull slope in [0.2, 20], e.g. 3.5 (Watson & Pelli) or the slope a pilot fit gave");
     let lapse = m.lapse.unwrap_or(0.01);
-    if !(lapse.is_finite() && (0.0..=0.2).contains(&lapse)) {
-        e(
-            "lapse",
-            format!("{lapse}"),
-            "give the assumed lapse rate in [0, 0.2], e.g. 0.01",
-        );
-    }
+    require(
+        e,
+        lapse.is_finite() && (0.0..=0.2).contains(&lapse),
+        "lapse",
+        lapse,
+        "give the assumed lapse rate in [0, 0.2], e.g. 0.01",
+    );
     let max_trials = m.max_trials.unwrap_or(0);
-    if max_trials == 0 || max_trials > MAX_TRIALS_PER_CONDITION {
-        e(
-            "max_trials",
-            format!("{max_trials}"),
-            "give the stopping rule: 1 to 100000 trials per condition, e.g. max_trials = 80",
-        );
-    }
+    require(
+        e,
+        trial_count(max_trials),
+        "max_trials",
+        max_trials,
+        "give the stopping rule: 1 to 100000 trials per condition, e.g. max_trials = 80",
+    );
     let min_delta = m.min_delta.unwrap_or(start / 100.0);
     let max_delta = m.max_delta.unwrap_or(start * 100.0);
     if !(positive(min_delta) && min_delta < start && max_delta.is_finite() && start < max_delta) {
