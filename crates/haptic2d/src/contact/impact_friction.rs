@@ -656,7 +656,11 @@ fn stacked_row<'a>(
     jt: &'a [[f64; 6]],
     i: usize,
 ) -> (&'a ImpactRow, &'a [f64; 6]) {
-    let j = if i % 2 == 0 { &jn[i / 2] } else { &jt[i / 2] };
+    let j = if i.is_multiple_of(2) {
+        &jn[i / 2]
+    } else {
+        &jt[i / 2]
+    };
     (&rows[i / 2], j)
 }
 
