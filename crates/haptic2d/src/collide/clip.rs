@@ -263,18 +263,9 @@ fn replace_scanned(out: &mut Vec<VeCandidate>, mark: usize, scanned: usize) {
 
 #[cfg(test)]
 mod tests {
+    use super::super::test_rect as rect;
     use super::*;
     use crate::geom::{ConvexPolygon, Pose};
-
-    fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> ConvexPolygon {
-        ConvexPolygon::new(vec![
-            Vec2::new(x0, y0),
-            Vec2::new(x1, y0),
-            Vec2::new(x1, y1),
-            Vec2::new(x0, y1),
-        ])
-        .unwrap()
-    }
 
     /// A diamond whose lowest corner went through a thin shelf (no vertex of either inside the
     /// other): the shelf's top is the reference face, the depth is the corner's depth below it,

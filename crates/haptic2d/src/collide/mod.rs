@@ -68,3 +68,15 @@ pub struct VeCandidate {
     /// Edge index in that collider (edge `i` runs from vertex `i` to `i+1`).
     pub edge: u32,
 }
+
+/// An axis-aligned rectangle from corner `(x0, y0)` to corner `(x1, y1)` (m), for the tests.
+#[cfg(test)]
+fn test_rect(x0: f64, y0: f64, x1: f64, y1: f64) -> crate::geom::ConvexPolygon {
+    crate::geom::ConvexPolygon::new(vec![
+        crate::geom::Vec2::new(x0, y0),
+        crate::geom::Vec2::new(x1, y0),
+        crate::geom::Vec2::new(x1, y1),
+        crate::geom::Vec2::new(x0, y1),
+    ])
+    .unwrap()
+}

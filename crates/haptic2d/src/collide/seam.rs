@@ -169,23 +169,13 @@ pub(crate) fn through_seam(c: &Collider, u: Vec2) -> bool {
 
 #[cfg(test)]
 mod tests {
+    use super::super::test_rect as rect;
     use super::*;
     use crate::geom::{Pose, Vec2};
 
-    fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> ConvexPolygon {
-        ConvexPolygon::new(vec![
-            Vec2::new(x0, y0),
-            Vec2::new(x1, y0),
-            Vec2::new(x1, y1),
-            Vec2::new(x0, y1),
-        ])
-        .unwrap()
-    }
-
-    /// The container of `corner-seam-tunnel.toml`: each wall slab's edge on the floor (or
-    /// ceiling) slab is a seam; the floor's top edge, covered only at its ends, is a surface.
-    #[test]
-    fn container_joints_are_seams_and_exposed_faces_are_not() {
+    /// The container of `corner-seam-tunnel.toml` (floor, left wall, right wall, ceiling; edges
+    /// run from vertex i to i + 1: bottom, right, top, left), its seams marked.
+    fn container() -> Vec<Collider> {
         let pieces = [
             rect(-0.1, -0.1, 0.5, 0.0),
             rect(-0.1, 0.0, 0.0, 0.4),
@@ -194,9 +184,17 @@ mod tests {
         ];
         let mut cols: Vec<Collider> = pieces
             .iter()
-            .map(|p| Collider::new(0, false, p.clone(), &Pose::new(0.0, 0.0, 0.0)))
+            .map(|p| Collider::new(0, false, p.clone(), &Pose::default()))
             .collect();
         mark_seams(&mut cols);
+        cols
+    }
+
+    /// The container of `corner-seam-tunnel.toml`: each wall slab's edge on the floor (or
+    /// ceiling) slab is a seam; the floor's top edge, covered only at its ends, is a surface.
+    #[test]
+    fn container_joints_are_seams_and_exposed_faces_are_not() {
+        let cols = container();
         // Edges run from vertex i to i + 1: bottom, right, top, left.
         assert_eq!(cols[0].seams, 0, "the floor's top edge is partly exposed");
         assert_eq!(
@@ -216,17 +214,7 @@ mod tests {
     /// face the ceiling. The floor and ceiling have no seam, so nothing to reach across.
     #[test]
     fn wall_seams_on_a_partly_covered_floor_reach_across_it() {
-        let pieces = [
-            rect(-0.1, -0.1, 0.5, 0.0),
-            rect(-0.1, 0.0, 0.0, 0.4),
-            rect(0.4, 0.0, 0.5, 0.4),
-            rect(-0.1, 0.4, 0.5, 0.5),
-        ];
-        let mut cols: Vec<Collider> = pieces
-            .iter()
-            .map(|p| Collider::new(0, false, p.clone(), &Pose::default()))
-            .collect();
-        mark_seams(&mut cols);
+        let cols = container();
         assert_eq!((cols[0].across, cols[3].across), (0, 0));
         for c in &cols[1..3] {
             assert_eq!(c.across, 0b0101);

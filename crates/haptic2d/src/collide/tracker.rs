@@ -271,6 +271,36 @@ fn most_violated(c: &Collider, f: Feature, p: Vec2) -> Option<Across> {
     across
 }
 
+/// What one test of the walk found: the feature stays, it moved, or the point is inside the
+/// polygon (deeper than `VORONOI_TOL` below every edge).
+enum Walk {
+    Stay,
+    Moved,
+    Inside,
+}
+
+/// Tests the other polygon's closest point `p` against the Voronoi region of feature `f` of `c`:
+/// moves `f` across the most violated boundary (to the nearest edge when `p` is in the interior)
+/// or leaves it where it is; `f` is untouched when `p` is inside `c`.
+#[inline(always)]
+fn walk_voronoi(c: &Collider, f: &mut Feature, p: Vec2) -> Walk {
+    match most_violated(c, *f, p) {
+        Some(Across::Feature(g)) => {
+            *f = g;
+            Walk::Moved
+        }
+        Some(Across::Interior) => {
+            let (e, d) = max_edge_distance(c, p);
+            if d < -VORONOI_TOL {
+                return Walk::Inside;
+            }
+            *f = Feature::Edge(e as u32);
+            Walk::Moved
+        }
+        None => Walk::Stay,
+    }
+}
+
 /// The edge of `c` with the largest signed distance of `p`, and that distance (m).
 fn max_edge_distance(c: &Collider, p: Vec2) -> (usize, f64) {
     let mut best = (0, f64::NEG_INFINITY);
@@ -428,37 +458,15 @@ impl FeatureTracker {
                     continue;
                 }
             };
-            // p_B against Vor(f_A).
-            match most_violated(a, fa, pb) {
-                Some(Across::Feature(f)) => {
-                    fa = f;
-                    continue;
-                }
-                Some(Across::Interior) => {
-                    let (e, d) = max_edge_distance(a, pb);
-                    if d < -VORONOI_TOL {
-                        return self.finish_penetrating(fa, fb, pa, pb, it);
-                    }
-                    fa = Feature::Edge(e as u32);
-                    continue;
-                }
-                None => {}
-            }
-            // p_A against Vor(f_B).
-            match most_violated(b, fb, pa) {
-                Some(Across::Feature(f)) => {
-                    fb = f;
-                    continue;
-                }
-                Some(Across::Interior) => {
-                    let (e, d) = max_edge_distance(b, pa);
-                    if d < -VORONOI_TOL {
-                        return self.finish_penetrating(fa, fb, pa, pb, it);
-                    }
-                    fb = Feature::Edge(e as u32);
-                    continue;
-                }
-                None => {}
+            // p_B against Vor(f_A), then p_A against Vor(f_B).
+            let walk = match walk_voronoi(a, &mut fa, pb) {
+                Walk::Stay => walk_voronoi(b, &mut fb, pa),
+                moved_or_inside => moved_or_inside,
+            };
+            match walk {
+                Walk::Moved => continue,
+                Walk::Inside => return self.finish_penetrating(fa, fb, pa, pb, it),
+                Walk::Stay => {}
             }
             self.feature_a = Some(fa);
             self.feature_b = Some(fb);

@@ -8,6 +8,7 @@
 //! ([`super::impact_friction`]).
 
 use super::impact_friction::{FrictionalImpactSolver, ImpactFriction, PhaseMethod};
+use super::last_solve::last_solve_views;
 use super::lcp::{LcpReport, LcpSolver};
 use crate::body::Body;
 use crate::geom::{cross, select_max, Vec2};
@@ -43,6 +44,27 @@ pub struct ImpactRow {
 }
 
 impl ImpactRow {
+    /// The row of a contact at world point `p` (m) between `bodies[body_a]` (the vertex's) and
+    /// `bodies[body_b]` (the edge's), with unit normal `n` out of B and restitution `restitution`:
+    /// the lever arms are `p` less each body's position (m).
+    pub fn at_point(
+        bodies: &[Body],
+        body_a: usize,
+        body_b: usize,
+        n: Vec2,
+        p: Vec2,
+        restitution: f64,
+    ) -> Self {
+        ImpactRow {
+            body_a,
+            body_b,
+            n,
+            r_a: p - bodies[body_a].pose.pos,
+            r_b: p - bodies[body_b].pose.pos,
+            restitution,
+        }
+    }
+
     /// The Jacobian row `G_i` as two blocks `(n, r_A × n)` for A and `(−n, −(r_B × n))` for B (§7.1).
     /// A fixed body's block is zero.
     pub(super) fn jacobian(&self, bodies: &[Body]) -> [f64; 6] {
@@ -171,6 +193,22 @@ impl Default for ImpactSolver {
     }
 }
 
+last_solve_views! { ImpactSolver, "rows";
+    /// Pre-impact normal velocities `b⁻ = G u⁻` of the last solve (m/s).
+    pre_velocities => b_pre,
+    /// Normal velocities after restitution and before the plastic correction (m/s).
+    restitution_velocities => b_mid,
+    /// Final post-impact normal velocities `b⁺ = G u⁺` of the last solve (m/s).
+    post_velocities => b_post,
+    /// Compression impulses `λ_i` of the last solve (N·s).
+    compression_impulses => lambda,
+    /// Plastic-correction impulses `λ'_i` of the last solve (N·s); all zero if it did not run.
+    correction_impulses => correction,
+    /// Total impulse per row applied by the last solve, `(1 + e_i)·λ_i + λ'_i` (N·s), along `n_i` on
+    /// the vertex body A (and opposite on B).
+    impulses => impulse,
+}
+
 impl ImpactSolver {
     /// A solver preallocated for impact sets of up to 8 rows.
     pub fn new() -> Self {
@@ -293,16 +331,6 @@ impl ImpactSolver {
         self.cap = rows;
     }
 
-    /// Number of rows of the last solve.
-    pub fn len(&self) -> usize {
-        self.n
-    }
-
-    /// True if the last solve had no rows.
-    pub fn is_empty(&self) -> bool {
-        self.n == 0
-    }
-
     /// The Delassus matrix `A = G M⁻¹ Gᵀ` of the last solve, row-major `n × n` (1/kg: (m/s) per N·s);
     /// empty when the last set took the sparse path (`n > DENSE_MAX_ROWS`: no matrix is built).
     pub fn delassus(&self) -> &[f64] {
@@ -310,37 +338,6 @@ impl ImpactSolver {
             return &[];
         }
         &self.a[..self.n * self.n]
-    }
-
-    /// Pre-impact normal velocities `b⁻ = G u⁻` of the last solve (m/s).
-    pub fn pre_velocities(&self) -> &[f64] {
-        &self.b_pre[..self.n]
-    }
-
-    /// Normal velocities after restitution and before the plastic correction (m/s).
-    pub fn restitution_velocities(&self) -> &[f64] {
-        &self.b_mid[..self.n]
-    }
-
-    /// Final post-impact normal velocities `b⁺ = G u⁺` of the last solve (m/s).
-    pub fn post_velocities(&self) -> &[f64] {
-        &self.b_post[..self.n]
-    }
-
-    /// Compression impulses `λ_i` of the last solve (N·s).
-    pub fn compression_impulses(&self) -> &[f64] {
-        &self.lambda[..self.n]
-    }
-
-    /// Plastic-correction impulses `λ'_i` of the last solve (N·s); all zero if it did not run.
-    pub fn correction_impulses(&self) -> &[f64] {
-        &self.correction[..self.n]
-    }
-
-    /// Total impulse per row applied by the last solve, `(1 + e_i)·λ_i + λ'_i` (N·s), along `n_i` on
-    /// the vertex body A (and opposite on B).
-    pub fn impulses(&self) -> &[f64] {
-        &self.impulse[..self.n]
     }
 
     /// Resolves the impact set `rows` (in the given order) on `bodies` (§7.2) and applies the velocity
@@ -894,14 +891,9 @@ mod tests {
                 let lower = if k == 0 { 0 } else { upper - 1 };
                 for dx in [-0.025, 0.025] {
                     let p = Vec2::new(x0 + dx, 0.05 * k as f64);
-                    rows.push(ImpactRow {
-                        body_a: upper,
-                        body_b: lower,
-                        n: Vec2::new(0.0, 1.0),
-                        r_a: p - bodies[upper].pose.pos,
-                        r_b: p - bodies[lower].pose.pos,
-                        restitution: if k % 2 == 0 { 0.5 } else { 0.0 },
-                    });
+                    let e = if k % 2 == 0 { 0.5 } else { 0.0 };
+                    let n = Vec2::new(0.0, 1.0);
+                    rows.push(ImpactRow::at_point(&bodies, upper, lower, n, p, e));
                 }
             }
         }

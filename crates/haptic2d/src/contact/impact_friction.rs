@@ -24,6 +24,7 @@
 
 use super::impact::ImpactRow;
 use super::impact_mlcp::{ImpactPhase, MixedLcp, MLCP_ENUMERATION_MAX};
+use super::last_solve::last_solve_views;
 use crate::body::Body;
 use crate::geom::{cross, perp};
 use crate::laws::friction::FrictionModel;
@@ -161,6 +162,15 @@ pub struct FrictionalImpactSolver {
     jump_fallbacks: u64,
 }
 
+last_solve_views! { FrictionalImpactSolver, "contacts";
+    /// Total normal impulses `p_n,i` of the last solve (N·s, along `n_i` on body A).
+    normal_impulses => pn,
+    /// Total tangential impulses `p_t,i` of the last solve (N·s, along `t_i = perp(n_i)` on body A).
+    tangential_impulses => pt,
+    /// Compression normal impulses of the last solve (N·s).
+    compression_impulses => pc,
+}
+
 impl FrictionalImpactSolver {
     /// A solver preallocated for `rows` contacts.
     pub fn with_capacity(rows: usize) -> Self {
@@ -199,31 +209,6 @@ impl FrictionalImpactSolver {
         self.u0.resize(bodies, [0.0; 3]);
         self.uc.resize(bodies, [0.0; 3]);
         self.cap = rows;
-    }
-
-    /// Number of contacts of the last solve.
-    pub fn len(&self) -> usize {
-        self.n
-    }
-
-    /// True if the last solve had no contacts.
-    pub fn is_empty(&self) -> bool {
-        self.n == 0
-    }
-
-    /// Total normal impulses `p_n,i` of the last solve (N·s, along `n_i` on body A).
-    pub fn normal_impulses(&self) -> &[f64] {
-        &self.pn[..self.n]
-    }
-
-    /// Total tangential impulses `p_t,i` of the last solve (N·s, along `t_i = perp(n_i)` on body A).
-    pub fn tangential_impulses(&self) -> &[f64] {
-        &self.pt[..self.n]
-    }
-
-    /// Compression normal impulses of the last solve (N·s).
-    pub fn compression_impulses(&self) -> &[f64] {
-        &self.pc[..self.n]
     }
 
     /// Energy fallbacks so far: `(restitution scaled, whole jump scaled)`.
@@ -567,24 +552,10 @@ impl FrictionalImpactSolver {
         let k = 2 * n;
         // Dense Delassus matrix over the stacked rows (n_0, t_0, n_1, t_1, …) and start velocities.
         for i in 0..k {
-            let (ri, ji) = (
-                &rows[i / 2],
-                if i % 2 == 0 {
-                    &self.jn[i / 2]
-                } else {
-                    &self.jt[i / 2]
-                },
-            );
+            let (ri, ji) = stacked_row(rows, &self.jn, &self.jt, i);
             self.b[i] = row_velocity(ji, ri, bodies);
             for j in 0..k {
-                let (rj, jj) = (
-                    &rows[j / 2],
-                    if j % 2 == 0 {
-                        &self.jn[j / 2]
-                    } else {
-                        &self.jt[j / 2]
-                    },
-                );
+                let (rj, jj) = stacked_row(rows, &self.jn, &self.jt, j);
                 let mut s = 0.0;
                 for (pi, bi) in [(0usize, ri.body_a), (3, ri.body_b)] {
                     let body = &bodies[bi];
@@ -674,6 +645,23 @@ impl FrictionalImpactSolver {
 /// `(v_x, v_y, ω)` of a body.
 fn twist(b: &Body) -> [f64; 3] {
     [b.vel.x, b.vel.y, b.omega]
+}
+
+/// Row `i` of the stacked frictional set (`n_0, t_0, n_1, t_1, …`): its impact row and its normal
+/// (even `i`) or tangential (odd `i`) Jacobian `[ax, ay, aω, bx, by, bω]`.
+#[inline(always)]
+fn stacked_row<'a>(
+    rows: &'a [ImpactRow],
+    jn: &'a [[f64; 6]],
+    jt: &'a [[f64; 6]],
+    i: usize,
+) -> (&'a ImpactRow, &'a [f64; 6]) {
+    let j = if i.is_multiple_of(2) {
+        &jn[i / 2]
+    } else {
+        &jt[i / 2]
+    };
+    (&rows[i / 2], j)
 }
 
 /// `J·u` for one 6-entry Jacobian row of `row`'s two bodies (m/s).

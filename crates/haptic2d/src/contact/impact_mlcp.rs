@@ -209,43 +209,35 @@ impl MixedLcp {
 mod tests {
     use super::*;
 
+    /// The solution `(p_n, p_t)` (N·s) for a particle of 1 kg on the ground (`A = I`) with start
+    /// velocities `b` (m/s), friction `mu` and, in restitution, the prescribed normal impulse.
+    fn particle(b: [f64; 2], mu: f64, phase: ImpactPhase, target: &[f64]) -> [f64; 2] {
+        let a = [1.0, 0.0, 0.0, 1.0];
+        let mut s = MixedLcp::with_capacity(1);
+        assert!(s.solve(&a, &b, mu, phase, target).is_some());
+        let x = s.solution(1);
+        [x[0], x[1]]
+    }
+
     /// A particle (m = 1 kg) on the ground: A = I. Approaching at (v_n, v_t) = (−1, 0.3) with μ = 0.5:
     /// sliding would need |p_t| = 0.5 ≥ 0.3, so it sticks: p = (1, −0.3).
     #[test]
     fn particle_sticks_when_the_cone_holds_it() {
-        let a = [1.0, 0.0, 0.0, 1.0];
-        let b = [-1.0, 0.3];
-        let mut s = MixedLcp::with_capacity(1);
-        assert!(s
-            .solve(&a, &b, 0.5, ImpactPhase::Compression, &[])
-            .is_some());
-        let x = s.solution(1);
+        let x = particle([-1.0, 0.3], 0.5, ImpactPhase::Compression, &[]);
         assert!((x[0] - 1.0).abs() < 1e-12 && (x[1] + 0.3).abs() < 1e-12);
     }
 
     /// Same particle, v_t = 2: it slides, p = (1, −0.5), and keeps v_t = 1.5.
     #[test]
     fn particle_slides_outside_the_cone() {
-        let a = [1.0, 0.0, 0.0, 1.0];
-        let b = [-1.0, 2.0];
-        let mut s = MixedLcp::with_capacity(1);
-        assert!(s
-            .solve(&a, &b, 0.5, ImpactPhase::Compression, &[])
-            .is_some());
-        let x = s.solution(1);
+        let x = particle([-1.0, 2.0], 0.5, ImpactPhase::Compression, &[]);
         assert!((x[0] - 1.0).abs() < 1e-12 && (x[1] + 0.5).abs() < 1e-12);
     }
 
     /// Restitution with a prescribed P = 0.5 and v_t = 0.1: sticking needs 0.1 ≤ μ·P = 0.25.
     #[test]
     fn restitution_keeps_the_prescribed_normal_impulse() {
-        let a = [1.0, 0.0, 0.0, 1.0];
-        let b = [0.0, 0.1];
-        let mut s = MixedLcp::with_capacity(1);
-        assert!(s
-            .solve(&a, &b, 0.5, ImpactPhase::Restitution, &[0.5])
-            .is_some());
-        let x = s.solution(1);
+        let x = particle([0.0, 0.1], 0.5, ImpactPhase::Restitution, &[0.5]);
         assert!((x[0] - 0.5).abs() < 1e-12 && (x[1] + 0.1).abs() < 1e-12);
     }
 }

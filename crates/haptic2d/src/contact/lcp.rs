@@ -62,6 +62,23 @@ pub struct LcpReport {
     pub pgs_failed: bool,
 }
 
+impl LcpReport {
+    /// The report a solve of size `n` by `method` starts from: [`LcpMethod::Empty`] when `n = 0`,
+    /// no active set, no iterations, converged, no fallback.
+    #[inline]
+    fn start(n: usize, method: LcpMethod) -> Self {
+        LcpReport {
+            n,
+            method: if n == 0 { LcpMethod::Empty } else { method },
+            active_mask: 0,
+            iterations: 0,
+            converged: true,
+            enumeration_failed: false,
+            pgs_failed: false,
+        }
+    }
+}
+
 /// Errors of [`LcpSolver::solve`]: inconsistent input sizes.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum LcpError {
@@ -276,19 +293,7 @@ impl LcpSolver {
             return Err(LcpError::TooLargeForEnumeration { n: b.len() });
         }
         let n = self.prepare(a, b)?;
-        let mut report = LcpReport {
-            n,
-            method: if n == 0 {
-                LcpMethod::Empty
-            } else {
-                LcpMethod::Enumeration
-            },
-            active_mask: 0,
-            iterations: 0,
-            converged: true,
-            enumeration_failed: false,
-            pgs_failed: false,
-        };
+        let mut report = LcpReport::start(n, LcpMethod::Enumeration);
         if n == 0 {
             return Ok(report);
         }
@@ -373,19 +378,7 @@ impl LcpSolver {
     /// Rows with `A_ii ≈ 0` keep `λ_i = 0`.
     pub fn solve_pgs(&mut self, a: &[f64], b: &[f64]) -> Result<LcpReport, LcpError> {
         let n = self.prepare(a, b)?;
-        let mut report = LcpReport {
-            n,
-            method: if n == 0 {
-                LcpMethod::Empty
-            } else {
-                LcpMethod::Pgs
-            },
-            active_mask: 0,
-            iterations: 0,
-            converged: true,
-            enumeration_failed: false,
-            pgs_failed: false,
-        };
+        let mut report = LcpReport::start(n, LcpMethod::Pgs);
         let lam = &mut self.lambda[..n];
         lam.fill(0.0);
         if n > 0 {

@@ -5,6 +5,7 @@ mod god_object;
 pub mod impact;
 pub mod impact_friction;
 pub mod impact_mlcp;
+mod last_solve;
 mod law_pool;
 pub mod lcp;
 mod lean_law;

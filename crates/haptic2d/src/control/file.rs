@@ -150,17 +150,9 @@ fn unknown_key(key: &str, valid: &[&str], architecture: &str) -> SceneError {
 /// Parses a controller file (`text`; `source` names it in messages). Every problem is reported with
 /// the field and the fix.
 pub fn controller_from_toml(text: &str, source: &str) -> Result<ControllerFile, SceneErrors> {
-    let fail = |errors| SceneErrors {
-        source: source.to_string(),
-        errors,
-    };
-    let table: toml::Table = toml::from_str(text).map_err(|e| {
-        fail(vec![SceneError::from_toml(
-            text,
-            &e,
-            format!("check the TOML syntax against {CONTROLLER_EXAMPLES}"),
-        )])
-    })?;
+    let fail = |errors| SceneErrors::new(source, errors);
+    let fix = format!("check the TOML syntax against {CONTROLLER_EXAMPLES}");
+    let table: toml::Table = SceneErrors::parse(text, source, fix)?;
     let mut errs = Vec::new();
     let description = match table.get("description") {
         None => None,

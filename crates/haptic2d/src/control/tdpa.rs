@@ -103,12 +103,7 @@ impl TdpaPort {
             return;
         }
         self.dissipated += self.alpha * v * v * dt;
-        let p = force * v;
-        if p > 0.0 {
-            self.e_out += p * dt;
-        } else {
-            self.e_in -= p * dt;
-        }
+        self.book_power(force * v, dt);
     }
 
     /// One sample of length `dt` (s): the network asks to apply `force` to a body moving at `v`;
@@ -133,13 +128,19 @@ impl TdpaPort {
                 self.dissipated += self.alpha * v * v * dt;
             }
         }
-        let p = f * v;
+        self.book_power(f * v, dt);
+        f
+    }
+
+    /// Books the power `p = F·v` (W) over `dt` (s): into `E_out` when the port outputs (`p > 0`),
+    /// into `E_in` otherwise.
+    #[inline]
+    fn book_power(&mut self, p: f64, dt: f64) {
         if p > 0.0 {
             self.e_out += p * dt;
         } else {
             self.e_in -= p * dt;
         }
-        f
     }
 
     /// Books one sample without a controller: the network applied `force` to a body moving at `v`
@@ -148,12 +149,7 @@ impl TdpaPort {
         if !(force.is_finite() && v.is_finite()) {
             return;
         }
-        let p = force * v;
-        if p > 0.0 {
-            self.e_out += p * dt;
-        } else {
-            self.e_in -= p * dt;
-        }
+        self.book_power(force * v, dt);
         self.alpha = 0.0;
     }
 }

@@ -95,13 +95,7 @@ impl CartesianDevice for Pantograph2Device {
     fn wrench_to_torques(&self, f: &V3, _preload: f64) -> Result<TorqueCommand, DeviceFault> {
         let s = self.state.ok_or(DeviceFault::NoPose)?;
         if s.margin < self.min_margin {
-            return Ok(TorqueCommand {
-                tau: [0.0; 4],
-                wrench_scale: 0.0,
-                saturated: false,
-                near_singular: true,
-                margin: s.margin,
-            });
+            return Ok(TorqueCommand::near_singular(s.margin));
         }
         let tau = jt_mul(&s.j, [f[0], f[1]]);
         let mut scale: f64 = 1.0;

@@ -27,6 +27,21 @@ pub struct TorqueCommand {
     pub margin: f64,
 }
 
+impl TorqueCommand {
+    /// The command at a pose whose singularity margin `margin` (dimensionless) is below the
+    /// device's minimum: all torques zero, the wrench scaled to nothing.
+    #[inline]
+    pub fn near_singular(margin: f64) -> Self {
+        TorqueCommand {
+            tau: [0.0; 4],
+            wrench_scale: 0.0,
+            saturated: false,
+            near_singular: true,
+            margin,
+        }
+    }
+}
+
 /// What one tick of sensing produces.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DeviceEstimate {
@@ -152,13 +167,7 @@ impl TwinPantograph {
             return Err(DeviceFault::NonFinite);
         }
         if self.margin < self.params.min_singularity_margin {
-            return Ok(TorqueCommand {
-                tau: [0.0; 4],
-                wrench_scale: 0.0,
-                saturated: false,
-                near_singular: true,
-                margin: self.margin,
-            });
+            return Ok(TorqueCommand::near_singular(self.margin));
         }
         let mut tau_w = min_norm_torques(&self.jac, w)?;
         if self.params.friction_compensation > 0.0 {

@@ -63,7 +63,7 @@ mod tests {
     use super::*;
     use crate::control::coupling::CouplingGains;
     use crate::haptic::record::FLAG_SATURATED;
-    use crate::haptic::tick::tests::box_in_walls;
+    use crate::haptic::tick::tests::{box_in_walls, tripped};
     use crate::haptic::{DeviceSystem, SafetyReason};
 
     /// The device's rest point (m, device frame) and the square around it.
@@ -120,9 +120,7 @@ mod tests {
         let mut sys = point_system();
         sys.tick(&at(0.0), None, false);
         let out = sys.tick(&at(0.08), None, false);
-        assert!(out.tripped);
-        assert_eq!(out.torques, [0.0; 4]);
-        let trip = sys.safety_trip().unwrap();
+        let trip = tripped(&sys, &out);
         assert!(
             matches!(trip.reason, SafetyReason::Workspace { axis: 0, .. }),
             "{trip}"

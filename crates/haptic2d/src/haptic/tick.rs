@@ -288,8 +288,19 @@ pub(super) mod tests {
     use crate::device::pantograph2::Pantograph2;
     use crate::geom::Vec2;
     use crate::haptic::planar2::{Planar2Config, Planar2System};
-    use crate::haptic::{ControllerKind, DeviceSystem, HapticConfig, HapticSystem, SafetyReason};
+    use crate::haptic::{
+        ControllerKind, DeviceSystem, HapticConfig, HapticSystem, SafetyReason, SafetyTrip,
+        TickOutput,
+    };
     use crate::world::World;
+
+    /// Asserts that `out`, a tick of `sys`, tripped with zero torques, and returns the latched trip
+    /// (its reason is the caller's to check).
+    pub(crate) fn tripped(sys: &DeviceSystem, out: &TickOutput) -> SafetyTrip {
+        assert!(out.tripped);
+        assert_eq!(out.torques, [0.0; 4]);
+        sys.safety_trip().unwrap()
+    }
 
     /// The box-in-walls scene at 1 kHz, the slave's world in these tests.
     pub(in crate::haptic) fn box_in_walls() -> World {
@@ -331,9 +342,7 @@ pub(super) mod tests {
         };
         s.inject_torque_fault(1, f64::NAN);
         let out = sys.tick(&q_at(0.004), None, false);
-        assert!(out.tripped);
-        assert_eq!(out.torques, [0.0; 4]);
-        let trip = sys.safety_trip().unwrap();
+        let trip = tripped(&sys, &out);
         assert!(
             matches!(trip.reason, SafetyReason::NonFiniteTorque { index: 1, .. }),
             "{trip}"

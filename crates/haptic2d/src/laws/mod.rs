@@ -3,6 +3,7 @@
 //! Every law works on one vertex–edge (VE) contact, or on the 1-D wall/peg harnesses, through plain
 //! input structs; the world never needs to know which model it is running.
 
+mod declare;
 pub mod friction;
 pub mod normal;
 pub mod params;

@@ -51,18 +51,12 @@ impl Scene {
     /// Parses and validates TOML scene text. `source` names the file in messages; `rate` overrides
     /// `world.rate` (Hz) when given.
     pub fn from_toml(text: &str, source: &str, rate: Option<f64>) -> Result<Scene, SceneErrors> {
-        let fail = |errors| SceneErrors {
-            source: source.to_string(),
-            errors,
-        };
-        let file: SceneFile = toml::from_str(text).map_err(|e| {
-            fail(vec![SceneError::from_toml(
-                text,
-                &e,
-                "check the TOML syntax and field names against docs/SCENES.md",
-            )])
-        })?;
-        build(&file, source, rate).map_err(fail)
+        let file: SceneFile = SceneErrors::parse(
+            text,
+            source,
+            "check the TOML syntax and field names against docs/SCENES.md",
+        )?;
+        build(&file, source, rate).map_err(|errors| SceneErrors::new(source, errors))
     }
 }
 

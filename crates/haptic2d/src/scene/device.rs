@@ -137,17 +137,8 @@ pub fn device_params_from_toml(
     source: &str,
     dt: Option<f64>,
 ) -> Result<DeviceParams, SceneErrors> {
-    let fail = |errors| SceneErrors {
-        source: source.to_string(),
-        errors,
-    };
-    let table: toml::Table = toml::from_str(text).map_err(|e| {
-        fail(vec![SceneError::from_toml(
-            text,
-            &e,
-            format!("check the TOML syntax against {DEVICE_TEMPLATE}"),
-        )])
-    })?;
+    let fix = format!("check the TOML syntax against {DEVICE_TEMPLATE}");
+    let table: toml::Table = SceneErrors::parse(text, source, fix)?;
     let mut errs = Vec::new();
     let params = match table.get("device") {
         Some(toml::Value::Table(device)) => {
@@ -172,6 +163,6 @@ pub fn device_params_from_toml(
     };
     match params {
         Some(p) if errs.is_empty() => Ok(p),
-        _ => Err(fail(errs)),
+        _ => Err(SceneErrors::new(source, errs)),
     }
 }

@@ -80,3 +80,24 @@ impl fmt::Display for SceneErrors {
 }
 
 impl std::error::Error for SceneErrors {}
+
+impl SceneErrors {
+    /// The problems `errors` of the file (or built-in scene) `source`.
+    pub(crate) fn new(source: &str, errors: Vec<SceneError>) -> Self {
+        Self {
+            source: source.to_string(),
+            errors,
+        }
+    }
+
+    /// `text`, the file `source`, read as TOML into a `T`; a syntax (or, for a typed `T`, a field)
+    /// error is the file's one problem, with the fix `fix`.
+    pub(crate) fn parse<T: serde::de::DeserializeOwned>(
+        text: &str,
+        source: &str,
+        fix: impl Into<String>,
+    ) -> Result<T, Self> {
+        toml::from_str(text)
+            .map_err(|e| Self::new(source, vec![SceneError::from_toml(text, &e, fix)]))
+    }
+}

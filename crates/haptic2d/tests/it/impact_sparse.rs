@@ -29,14 +29,15 @@ fn i3_i4_hold_on_the_sparse_path() {
         let y = 0.05 * k as f64;
         for x in [-0.025, 0.025] {
             let p = Vec2::new(x, y);
-            rows.push(ImpactRow {
-                body_a: upper,
-                body_b: lower,
-                n: Vec2::new(0.0, 1.0),
-                r_a: p - bodies[upper].pose.pos,
-                r_b: p - bodies[lower].pose.pos,
-                restitution: if k % 2 == 0 { 0.5 } else { 0.0 },
-            });
+            let e = if k % 2 == 0 { 0.5 } else { 0.0 };
+            rows.push(ImpactRow::at_point(
+                &bodies,
+                upper,
+                lower,
+                Vec2::new(0.0, 1.0),
+                p,
+                e,
+            ));
         }
     }
     assert!(rows.len() > DENSE_MAX_ROWS);

@@ -45,11 +45,11 @@
 //! body out through the joint; such pairs recompute every sample.)
 
 use super::sync::new_entry;
-use super::ContactSet;
 use super::PastPoses;
+use super::{release_record, start_continuous, ContactSet};
 use crate::body::Body;
 use crate::collide::{admissible_axis, clip_pairs, sat_face, Collider, VeCandidate, CLIP_MARGIN};
-use crate::contact::record::{ContactEvent, ContactState, EventKind, VeContact, NO_LAW};
+use crate::contact::record::{ContactEvent, ContactState, VeContact};
 use crate::laws::friction::FrictionModel;
 use crate::laws::normal::NormalModel;
 
@@ -256,26 +256,15 @@ impl ContactSet {
             let offset = self.laws.get(e.law).map_or(0.0, |l| l.normal.offset());
             let kept = (-e.d[0] - offset).max(0.0);
             let e = &mut self.entries[old];
-            e.state = None;
-            self.laws.release(e.law);
-            e.law = NO_LAW;
-            e.f_n = 0.0;
-            e.f_t = 0.0;
-            self.events.push(ContactEvent {
-                tick,
-                key: e.key,
-                kind: EventKind::Released,
-            });
+            release_record(e, &mut self.laws, &mut self.events, tick);
             kept
         } else {
             self.pool.pop().unwrap_or(0.0)
         };
-        let start = |n: &mut VeContact, laws: &mut crate::contact::law_pool::LawPool| {
-            n.state = Some(ContactState::Continuous);
-            n.since = tick;
-            n.m_eff = 0.0;
-            n.s_g = n.s.clamp(0.0, n.len);
-            n.s_entry = n.s_g;
+        let start = |n: &mut VeContact,
+                     laws: &mut crate::contact::law_pool::LawPool,
+                     events: &mut Vec<ContactEvent>| {
+            start_continuous(n, tick, events);
             n.law = laws.acquire(normal, friction, n.s_g);
             // Offset σ' = δ' − kept (the law's depth history shifted by it, `impact_offset.rs`).
             let depth = (-n.d[0]).max(0.0);
@@ -284,19 +273,14 @@ impl ContactSet {
         match self.entries.binary_search_by(|x| x.key.cmp(&key)) {
             Ok(t) => {
                 let n = &mut self.entries[t];
-                start(n, &mut self.laws);
+                start(n, &mut self.laws, &mut self.events);
             }
             Err(_) => {
                 let mut n = new_entry(tick, key, colliders, bodies, past);
-                start(&mut n, &mut self.laws);
+                start(&mut n, &mut self.laws, &mut self.events);
                 self.pending.push(n);
             }
         }
-        self.events.push(ContactEvent {
-            tick,
-            key,
-            kind: EventKind::Created(ContactState::Continuous),
-        });
     }
 }
 

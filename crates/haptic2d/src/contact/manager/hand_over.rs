@@ -3,11 +3,11 @@
 
 use super::invariant::overlap_ok;
 use super::sync::new_entry;
-use super::ContactSet;
 use super::PastPoses;
+use super::{release_record, start_continuous, ContactSet};
 use crate::body::Body;
 use crate::collide::{nearest_line, Collider, VeCandidate};
-use crate::contact::record::{ContactEvent, ContactState, EventKind, VeContact, NO_LAW};
+use crate::contact::record::ContactState;
 use crate::laws::friction::FrictionModel;
 use crate::laws::normal::NormalModel;
 
@@ -55,29 +55,20 @@ impl ContactSet {
                 && s_j >= cb.edge_range(j).0 - p.eps_s
                 && s_j <= cb.edge_range(j).1 + p.eps_s;
             let e = &mut self.entries[idx];
-            e.state = None;
-            self.laws.release(e.law);
-            e.law = NO_LAW;
-            e.f_n = 0.0;
-            e.f_t = 0.0;
-            self.events.push(ContactEvent {
-                tick,
-                key: e.key,
-                kind: EventKind::Released,
-            });
+            release_record(e, &mut self.laws, &mut self.events, tick);
             if !holds {
                 continue;
             }
             match self.entries.binary_search_by(|x| x.key.cmp(&key)) {
                 Ok(t) if !self.entries[t].is_contact() => {
                     let n = &mut self.entries[t];
-                    start_handed_over(n, tick, &mut self.events);
+                    start_continuous(n, tick, &mut self.events);
                     n.law = self.laws.acquire(normal, friction, n.s_g);
                 }
                 Ok(_) => {}
                 Err(_) => {
                     let mut n = new_entry(tick, key, colliders, bodies, past);
-                    start_handed_over(&mut n, tick, &mut self.events);
+                    start_continuous(&mut n, tick, &mut self.events);
                     n.law = self.laws.acquire(normal, friction, n.s_g);
                     self.pending.push(n);
                 }
@@ -89,20 +80,4 @@ impl ContactSet {
             self.pending.clear();
         }
     }
-}
-
-/// Starts the record a hand-over moves to (see `ContactSet::hand_over`): Continuous (the vertex
-/// is already in contact, so this is no impact), god-object at the projection. The caller gives it
-/// its law states.
-fn start_handed_over(e: &mut VeContact, tick: u64, events: &mut Vec<ContactEvent>) {
-    e.state = Some(ContactState::Continuous);
-    e.since = tick;
-    e.m_eff = 0.0;
-    e.s_g = e.s.clamp(0.0, e.len);
-    e.s_entry = e.s_g;
-    events.push(ContactEvent {
-        tick,
-        key: e.key,
-        kind: EventKind::Created(ContactState::Continuous),
-    });
 }

@@ -15,19 +15,10 @@ impl ContactSet {
     pub(super) fn resolve_impacts(&mut self, tick: u64, bodies: &mut [Body]) {
         // Islands of touching bodies: union–find over every record between two dynamic bodies
         // (fixed bodies connect nothing); an island is struck if one of its records collides.
-        for (i, p) in self.parent.iter_mut().enumerate() {
-            *p = i as u32;
-        }
+        singletons(&mut self.parent);
         for e in &self.entries {
             if e.state.is_some() && bodies[e.body_a].is_dynamic() && bodies[e.body_b].is_dynamic() {
-                let (a, b) = (
-                    find(&mut self.parent, e.body_a as u32),
-                    find(&mut self.parent, e.body_b as u32),
-                );
-                if a != b {
-                    let (lo, hi) = if a < b { (a, b) } else { (b, a) };
-                    self.parent[hi as usize] = lo;
-                }
+                union(&mut self.parent, e.body_a, e.body_b);
             }
         }
         for f in self.body_flag.iter_mut() {
@@ -192,19 +183,10 @@ impl ContactSet {
     /// identical to solving the whole set at once.
     fn solve_islands(&mut self, bodies: &mut [Body], mut reactions: Option<(&mut [Wrench2], f64)>) {
         // Union–find over dynamic bodies (fixed bodies connect nothing).
-        for (i, p) in self.parent.iter_mut().enumerate() {
-            *p = i as u32;
-        }
+        singletons(&mut self.parent);
         for r in &self.rows {
             if bodies[r.body_a].is_dynamic() && bodies[r.body_b].is_dynamic() {
-                let (a, b) = (
-                    find(&mut self.parent, r.body_a as u32),
-                    find(&mut self.parent, r.body_b as u32),
-                );
-                if a != b {
-                    let (lo, hi) = if a < b { (a, b) } else { (b, a) };
-                    self.parent[hi as usize] = lo;
-                }
+                union(&mut self.parent, r.body_a, r.body_b);
             }
         }
         // Island id of each row: the root of its dynamic body.
@@ -249,6 +231,24 @@ impl ContactSet {
                 }
             }
         }
+    }
+}
+
+/// Makes every body its own set (union–find roots: `parent[i] = i`).
+#[inline]
+fn singletons(parent: &mut [u32]) {
+    for (i, p) in parent.iter_mut().enumerate() {
+        *p = i as u32;
+    }
+}
+
+/// Joins the sets of bodies `a` and `b`; the root of the union is the smaller root.
+#[inline]
+fn union(parent: &mut [u32], a: usize, b: usize) {
+    let (a, b) = (find(parent, a as u32), find(parent, b as u32));
+    if a != b {
+        let (lo, hi) = if a < b { (a, b) } else { (b, a) };
+        parent[hi as usize] = lo;
     }
 }
 

@@ -29,7 +29,9 @@ use crate::collide::{VeCandidate, DEFAULT_DELTA_C, NEAR_PARALLEL_ANGLE};
 use crate::contact::impact::{ImpactRow, ImpactSolver};
 use crate::contact::law_pool::LawPool;
 use crate::contact::params::ContactParams;
-use crate::contact::record::{ContactEvent, LawState, Loaded, LoadedContact, VeContact};
+use crate::contact::record::{
+    ContactEvent, ContactState, EventKind, LawState, Loaded, LoadedContact, VeContact, NO_LAW,
+};
 use crate::geom::{Pose, Vec2};
 use crate::stage_time::{Lap, Stage};
 use crate::world::StepContext;
@@ -389,6 +391,44 @@ impl ContactSet {
             self.carry_delta.reserve(n);
         }
     }
+}
+
+/// Ends the contact of record `e` at `tick` (§8.2 rule 4, and the record a hand-over or a clip
+/// leaves): no state, its law slot back to `laws`, zero forces (N), a `Released` event.
+#[inline]
+fn release_record(
+    e: &mut VeContact,
+    laws: &mut LawPool,
+    events: &mut Vec<ContactEvent>,
+    tick: u64,
+) {
+    e.state = None;
+    laws.release(e.law);
+    e.law = NO_LAW;
+    e.f_n = 0.0;
+    e.f_t = 0.0;
+    events.push(ContactEvent {
+        tick,
+        key: e.key,
+        kind: EventKind::Released,
+    });
+}
+
+/// Starts the record a hand-over or a clip moves to (`ContactSet::hand_over`, `clip.rs`):
+/// Continuous (the vertex is already in contact, so this is no impact), god-object at the
+/// projection, a `Created(Continuous)` event. The caller gives it its law states.
+#[inline]
+fn start_continuous(e: &mut VeContact, tick: u64, events: &mut Vec<ContactEvent>) {
+    e.state = Some(ContactState::Continuous);
+    e.since = tick;
+    e.m_eff = 0.0;
+    e.s_g = e.s.clamp(0.0, e.len);
+    e.s_entry = e.s_g;
+    events.push(ContactEvent {
+        tick,
+        key: e.key,
+        kind: EventKind::Created(ContactState::Continuous),
+    });
 }
 
 #[cfg(test)]

@@ -2,9 +2,9 @@
 //! (re-collision, optional).
 
 use super::sync::in_range;
-use super::ContactSet;
+use super::{release_record, ContactSet};
 use crate::collide::Collider;
-use crate::contact::record::{ContactEvent, ContactState, EventKind, NO_LAW};
+use crate::contact::record::{ContactEvent, ContactState, EventKind};
 
 impl ContactSet {
     /// §8.2 rule 4 (release) and rule 5 (re-collision, optional).
@@ -26,16 +26,7 @@ impl ContactSet {
                         self.dropped.push(((a.min(b), a.max(b)), depth));
                     }
                 }
-                e.state = None;
-                self.laws.release(e.law);
-                e.law = NO_LAW;
-                e.f_n = 0.0;
-                e.f_t = 0.0;
-                self.events.push(ContactEvent {
-                    tick,
-                    key: e.key,
-                    kind: EventKind::Released,
-                });
+                release_record(e, &mut self.laws, &mut self.events, tick);
             } else if let Some(v_re) = p.v_re {
                 if p.impacts && e.c0 < -v_re {
                     e.state = Some(ContactState::Colliding);

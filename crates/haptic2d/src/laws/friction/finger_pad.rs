@@ -13,54 +13,40 @@
 use super::shell::{engage, friction_law, LoadedFriction};
 use super::{FrictionInput, FrictionMode};
 
-crate::law_params! { FingerPad, "friction model 'nahvi'";
-    k_p0 (self.k_p0) [] "N/m" Positive "pad stiffness at zero load",
-    k_p1 (self.k_p1) [] "1/m" NonNegative "load stiffening",
-    b_pad (self.b_pad) [] "N·s/m" NonNegative "pad damping",
-    mu_s (self.mu_s) [] "" Positive "static friction coefficient (≥ mu_k)",
-    mu_k (self.mu_k) [] "" Positive "kinetic friction coefficient",
-}
-
-/// Nahvi finger-pad friction (§3). Parameters are public; the state (`s_a`, mode) is private.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct FingerPad {
-    /// Pad tangential stiffness at zero load, `k_p0` (N/m).
-    pub k_p0: f64,
-    /// Load stiffening `k_p1` (1/m): `k_pad = k_p0 + k_p1·F_n`.
-    pub k_p1: f64,
-    /// Pad damping in stick, `b_pad` (N·s/m).
-    pub b_pad: f64,
-    /// Static friction coefficient `μs` (dimensionless).
-    pub mu_s: f64,
-    /// Kinetic friction coefficient `μk` (dimensionless).
-    pub mu_k: f64,
-    /// Anchor edge coordinate `s_a` (m, in the edge body's frame).
-    s_a: f64,
-    /// Whether `s_a` holds a valid anchor; if not, the next loaded update anchors at the current `s`.
-    engaged: bool,
-    /// Stick or slip.
-    mode: FrictionMode,
-    /// Pad stiffness used at the last update (N/m).
-    k_used: f64,
-    /// Deflection `u` after the last update (m).
-    u: f64,
+crate::declare_law! {
+    /// Nahvi finger-pad friction (§3). Parameters are public; the state (`s_a`, mode) is private.
+    pub struct FingerPad as "friction model 'nahvi'" {
+        /// Pad tangential stiffness at zero load, `k_p0` (N/m).
+        k_p0: f64 [] "N/m" Positive "pad stiffness at zero load",
+        /// Load stiffening `k_p1` (1/m): `k_pad = k_p0 + k_p1·F_n`.
+        k_p1: f64 [] "1/m" NonNegative "load stiffening",
+        /// Pad damping in stick, `b_pad` (N·s/m).
+        b_pad: f64 [] "N·s/m" NonNegative "pad damping",
+        /// Static friction coefficient `μs` (dimensionless).
+        mu_s: f64 [] "" Positive "static friction coefficient (≥ mu_k)",
+        /// Kinetic friction coefficient `μk` (dimensionless).
+        mu_k: f64 [] "" Positive "kinetic friction coefficient",
+    }
+    state {
+        /// Anchor edge coordinate `s_a` (m, in the edge body's frame).
+        s_a: f64 = 0.0,
+        /// Whether `s_a` holds a valid anchor; if not, the next loaded update anchors at the current `s`.
+        engaged: bool = false,
+        /// Stick or slip.
+        mode: FrictionMode = FrictionMode::Stick,
+        /// Pad stiffness used at the last update (N/m).
+        k_used: f64 = k_p0,
+        /// Deflection `u` after the last update (m).
+        u: f64 = 0.0,
+    }
+    /// A model with every parameter given: `k_p0` (N/m), `k_p1` (1/m), `b_pad` (N·s/m), `μs`, `μk`.
+    fn with_params;
 }
 
 impl FingerPad {
     /// A linear-pad model (`k_p1 = 0`) with stiffness `k_p0` (N/m), damping `b_pad` (N·s/m), `μs`, `μk`.
     pub fn new(k_p0: f64, b_pad: f64, mu_s: f64, mu_k: f64) -> Self {
-        Self {
-            k_p0,
-            k_p1: 0.0,
-            b_pad,
-            mu_s,
-            mu_k,
-            s_a: 0.0,
-            engaged: false,
-            mode: FrictionMode::Stick,
-            k_used: k_p0,
-            u: 0.0,
-        }
+        Self::with_params(k_p0, 0.0, b_pad, mu_s, mu_k)
     }
     /// 1-D defaults (§3 table): `k_p0 = 4000 N/m`, `k_p1 = 0`, `b_pad = 10 N·s/m`, `μs = 0.5`, `μk = 0.45`.
     pub fn one_d() -> Self {

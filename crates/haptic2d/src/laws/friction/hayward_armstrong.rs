@@ -15,14 +15,6 @@
 use super::shell::{friction_law, LoadedFriction};
 use super::{FrictionInput, FrictionMode};
 
-crate::law_params! { @impl HaywardArmstrong, |s: &HaywardArmstrong| if s.is_dahl() { "friction model 'dahl'" } else { "friction model 'hayward-armstrong'" };
-    k (self.k) [] "N/m" Positive "bristle stiffness",
-    mu_k (self.mu_k) [] "" Positive "kinetic friction coefficient",
-    r_stick (self.r_stick) [] "" OpenUnit "stick fraction of the breakaway strain",
-    sigma1 (self.sigma1) [] "N·s/m" NonNegative "bristle damping",
-    sigma2 (self.sigma2) [] "N·s/m" NonNegative "viscous friction"
-}
-
 /// Which adhesion map the model uses.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum AdhesionMap {
@@ -34,44 +26,36 @@ pub enum AdhesionMap {
     Dahl,
 }
 
-/// Hayward–Armstrong elasto-plastic friction (§2). Parameters are public; the state (`z`) is private.
-///
-/// Load dependence \[REC\]: `z_max = μk·F_n/k`, `z_stick = r_stick·z_max`; the single force level is
-/// `k·z_max = μk·F_n` (no separate static peak, so `μs` is not a parameter).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct HaywardArmstrong {
-    /// Presliding stiffness `k` per contact (N/m).
-    pub k: f64,
-    /// Kinetic friction coefficient `μk` (dimensionless); sets `z_max = μk·F_n/k`.
-    pub mu_k: f64,
-    /// Elastic-zone ratio `r_stick = z_stick/z_max` (dimensionless, strictly between 0 and 1).
-    pub r_stick: f64,
-    /// Damping on the elastic rate `dz/dt`, `σ1` (N·s/m).
-    pub sigma1: f64,
-    /// Viscous friction on the slip velocity, `σ2` (N·s/m).
-    pub sigma2: f64,
-    /// Adhesion map: Hayward–Armstrong (driftless) or Dahl (`α ≡ 1`).
-    pub map: AdhesionMap,
-    /// Elastic displacement `z` (m) after the last update.
-    z: f64,
-    /// Whether the adhesion point moved at the last update (`α·|Δs| > 0`), reported as `Slip`.
-    mode: FrictionMode,
+crate::declare_law! {
+    /// Hayward–Armstrong elasto-plastic friction (§2). Parameters are public; the state (`z`) is private.
+    ///
+    /// Load dependence \[REC\]: `z_max = μk·F_n/k`, `z_stick = r_stick·z_max`; the single force level is
+    /// `k·z_max = μk·F_n` (no separate static peak, so `μs` is not a parameter).
+    pub struct HaywardArmstrong named (|s: &HaywardArmstrong| if s.is_dahl() { "friction model 'dahl'" } else { "friction model 'hayward-armstrong'" }) {
+        /// Presliding stiffness `k` per contact (N/m).
+        k: f64 [] "N/m" Positive "bristle stiffness",
+        /// Kinetic friction coefficient `μk` (dimensionless); sets `z_max = μk·F_n/k`.
+        mu_k: f64 [] "" Positive "kinetic friction coefficient",
+        /// Elastic-zone ratio `r_stick = z_stick/z_max` (dimensionless, strictly between 0 and 1).
+        r_stick: f64 [] "" OpenUnit "stick fraction of the breakaway strain",
+        /// Damping on the elastic rate `dz/dt`, `σ1` (N·s/m).
+        sigma1: f64 [] "N·s/m" NonNegative "bristle damping",
+        /// Viscous friction on the slip velocity, `σ2` (N·s/m).
+        sigma2: f64 [] "N·s/m" NonNegative "viscous friction",
+    }
+    state {
+        /// Adhesion map: Hayward–Armstrong (driftless) or Dahl (`α ≡ 1`).
+        pub map: AdhesionMap = AdhesionMap::Driftless,
+        /// Elastic displacement `z` (m) after the last update.
+        z: f64 = 0.0,
+        /// Whether the adhesion point moved at the last update (`α·|Δs| > 0`), reported as `Slip`.
+        mode: FrictionMode = FrictionMode::Stick,
+    }
+    /// A driftless model with stiffness `k` (N/m), `μk`, `r_stick`, `σ1` and `σ2` (N·s/m).
+    pub fn new;
 }
 
 impl HaywardArmstrong {
-    /// A driftless model with stiffness `k` (N/m), `μk`, `r_stick`, `σ1` and `σ2` (N·s/m).
-    pub fn new(k: f64, mu_k: f64, r_stick: f64, sigma1: f64, sigma2: f64) -> Self {
-        Self {
-            k,
-            mu_k,
-            r_stick,
-            sigma1,
-            sigma2,
-            map: AdhesionMap::Driftless,
-            z: 0.0,
-            mode: FrictionMode::Stick,
-        }
-    }
     /// 1-D defaults (§2 table): `k = 5000 N/m`, `μk = 0.45`, `r_stick = 0.5`, `σ1 = 10 N·s/m`, `σ2 = 0`.
     pub fn one_d() -> Self {
         Self::new(5000.0, 0.45, 0.5, 10.0, 0.0)

@@ -8,38 +8,28 @@
 use super::shell::{friction_law, LoadedFriction};
 use super::{FrictionInput, FrictionMode};
 
-crate::law_params! { Karnopp, "friction model 'classical'";
-    v_th (self.v_th) [] "m/s" Positive "stick velocity band",
-    mu_s (self.mu_s) [] "" Positive "static friction coefficient (≥ mu_k)",
-    mu_k (self.mu_k) [] "" Positive "kinetic friction coefficient",
-}
-
-/// Karnopp's classical stick/slip model (§4.1). Stateless apart from the logged mode.
-///
-/// Needs [`FrictionInput::f_ext_t`]: this contact's share `(t·F_A^nonfric)/n_t` of the non-friction
-/// force on A along `+t` (N); in 1-D, `F_applied/n_contacts`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Karnopp {
-    /// Stick velocity band `v_th` (m/s).
-    pub v_th: f64,
-    /// Static friction coefficient `μs` (dimensionless).
-    pub mu_s: f64,
-    /// Kinetic friction coefficient `μk` (dimensionless).
-    pub mu_k: f64,
-    /// Stick or slip at the last update.
-    mode: FrictionMode,
+crate::declare_law! {
+    /// Karnopp's classical stick/slip model (§4.1). Stateless apart from the logged mode.
+    ///
+    /// Needs [`FrictionInput::f_ext_t`]: this contact's share `(t·F_A^nonfric)/n_t` of the non-friction
+    /// force on A along `+t` (N); in 1-D, `F_applied/n_contacts`.
+    pub struct Karnopp as "friction model 'classical'" {
+        /// Stick velocity band `v_th` (m/s).
+        v_th: f64 [] "m/s" Positive "stick velocity band",
+        /// Static friction coefficient `μs` (dimensionless).
+        mu_s: f64 [] "" Positive "static friction coefficient (≥ mu_k)",
+        /// Kinetic friction coefficient `μk` (dimensionless).
+        mu_k: f64 [] "" Positive "kinetic friction coefficient",
+    }
+    state {
+        /// Stick or slip at the last update.
+        mode: FrictionMode = FrictionMode::Stick,
+    }
+    /// A model with band `v_th` (m/s), `μs` and `μk`.
+    pub fn new;
 }
 
 impl Karnopp {
-    /// A model with band `v_th` (m/s), `μs` and `μk`.
-    pub fn new(v_th: f64, mu_s: f64, mu_k: f64) -> Self {
-        Self {
-            v_th,
-            mu_s,
-            mu_k,
-            mode: FrictionMode::Stick,
-        }
-    }
     /// Defaults (§4.1): `v_th = 0.01 m/s`, `μs = 0.5`, `μk = 0.45` (the same in 1-D and per 2-D contact).
     pub fn one_d() -> Self {
         Self::new(0.01, 0.5, 0.45)

@@ -8,56 +8,37 @@
 use super::shell::{engage, friction_law, LoadedFriction};
 use super::{FrictionInput, FrictionMode};
 
-crate::law_params! { SalcudeanVlaar, "friction model 'salcudean-vlaar'";
-    k_p (self.k_p) [] "N/m" Positive "stick PD stiffness",
-    k_d (self.k_d) [] "N·s/m" NonNegative "stick PD damping",
-    b_v (self.b_v) [] "N·s/m" NonNegative "viscous friction",
-    v_th (self.v_th) [] "m/s" Positive "stick velocity threshold",
-    mu_s (self.mu_s) [] "" Positive "static friction coefficient (≥ mu_k)",
-    mu_k (self.mu_k) [] "" Positive "kinetic friction coefficient",
-}
-
-/// Salcudean–Vlaar friction (§4.2). Parameters are public; the state (`s_a`, mode) is private.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SalcudeanVlaar {
-    /// Stick-point spring `K_p` (N/m).
-    pub k_p: f64,
-    /// Stick damping `K_d` (N·s/m).
-    pub k_d: f64,
-    /// Viscous friction in slip, `b_v` (N·s/m).
-    pub b_v: f64,
-    /// Re-stick velocity threshold `v_th` (m/s).
-    pub v_th: f64,
-    /// Static friction coefficient `μs` (dimensionless).
-    pub mu_s: f64,
-    /// Kinetic friction coefficient `μk` (dimensionless).
-    pub mu_k: f64,
-    /// Stick-point edge coordinate `s_a` (m, in the edge body's frame).
-    s_a: f64,
-    /// Whether `s_a` holds a valid stick point; if not, the next loaded update sticks at the current `s`.
-    engaged: bool,
-    /// Stick or slip.
-    mode: FrictionMode,
-    /// Stick-spring offset `s − s_a` after the last update (m); 0 in slip.
-    offset: f64,
+crate::declare_law! {
+    /// Salcudean–Vlaar friction (§4.2). Parameters are public; the state (`s_a`, mode) is private.
+    pub struct SalcudeanVlaar as "friction model 'salcudean-vlaar'" {
+        /// Stick-point spring `K_p` (N/m).
+        k_p: f64 [] "N/m" Positive "stick PD stiffness",
+        /// Stick damping `K_d` (N·s/m).
+        k_d: f64 [] "N·s/m" NonNegative "stick PD damping",
+        /// Viscous friction in slip, `b_v` (N·s/m).
+        b_v: f64 [] "N·s/m" NonNegative "viscous friction",
+        /// Re-stick velocity threshold `v_th` (m/s).
+        v_th: f64 [] "m/s" Positive "stick velocity threshold",
+        /// Static friction coefficient `μs` (dimensionless).
+        mu_s: f64 [] "" Positive "static friction coefficient (≥ mu_k)",
+        /// Kinetic friction coefficient `μk` (dimensionless).
+        mu_k: f64 [] "" Positive "kinetic friction coefficient",
+    }
+    state {
+        /// Stick-point edge coordinate `s_a` (m, in the edge body's frame).
+        s_a: f64 = 0.0,
+        /// Whether `s_a` holds a valid stick point; if not, the next loaded update sticks at the current `s`.
+        engaged: bool = false,
+        /// Stick or slip.
+        mode: FrictionMode = FrictionMode::Stick,
+        /// Stick-spring offset `s − s_a` after the last update (m); 0 in slip.
+        offset: f64 = 0.0,
+    }
+    /// A model with gains `K_p` (N/m), `K_d` (N·s/m), `b_v` (N·s/m), band `v_th` (m/s), `μs`, `μk`.
+    pub fn new;
 }
 
 impl SalcudeanVlaar {
-    /// A model with gains `K_p` (N/m), `K_d` (N·s/m), `b_v` (N·s/m), band `v_th` (m/s), `μs`, `μk`.
-    pub fn new(k_p: f64, k_d: f64, b_v: f64, v_th: f64, mu_s: f64, mu_k: f64) -> Self {
-        Self {
-            k_p,
-            k_d,
-            b_v,
-            v_th,
-            mu_s,
-            mu_k,
-            s_a: 0.0,
-            engaged: false,
-            mode: FrictionMode::Stick,
-            offset: 0.0,
-        }
-    }
     /// 1-D defaults (§4.2 table): `K_p = 3000 N/m`, `K_d = 15 N·s/m`, `b_v = 2 N·s/m`, `v_th = 0.01 m/s`,
     /// `μs = 0.5`, `μk = 0.45`.
     pub fn one_d() -> Self {

@@ -3,42 +3,31 @@
 use super::spring_wall::{spring_wall, SpringWall};
 use super::NormalInput;
 
-crate::law_params! { MassiePiLaw, "pi";
-    k (self.k) [] "N/m" NonNegative "proportional stiffness",
-    k_i (self.k_i) [] "N/(m·s)" NonNegative "integral gain",
-    i_max (self.i_max) [] "m·s" NonNegativeOrInfinite "anti-windup bound",
-}
-
-/// While `δ_k > 0`: `I_k = I_{k−1} + T·δ_k`, `F_w,k = max(0, K·δ_k + K_I·I_k)`; at `δ_k = 0` the
-/// integral resets. Optional anti-windup clamps `0 ≤ I_k ≤ I_max`.
-///
-/// The integral removes the steady-state penetration under a constant push, but its phase lag makes
-/// the wall strongly active.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct MassiePiLaw {
-    /// Proportional stiffness `K` (N/m).
-    pub k: f64,
-    /// Integral gain `K_I` (N/(m·s)).
-    pub k_i: f64,
-    /// Anti-windup bound `I_max` (m·s); `f64::INFINITY` disables it.
-    pub i_max: f64,
-    /// Integral of penetration `I_k` (m·s).
-    integral: f64,
-    /// Stored energy `½K·δ²` after the last sample (J).
-    stored: f64,
+crate::declare_law! {
+    /// While `δ_k > 0`: `I_k = I_{k−1} + T·δ_k`, `F_w,k = max(0, K·δ_k + K_I·I_k)`; at `δ_k = 0` the
+    /// integral resets. Optional anti-windup clamps `0 ≤ I_k ≤ I_max`.
+    ///
+    /// The integral removes the steady-state penetration under a constant push, but its phase lag makes
+    /// the wall strongly active.
+    pub struct MassiePiLaw as "pi" {
+        /// Proportional stiffness `K` (N/m).
+        k: f64 [] "N/m" NonNegative "proportional stiffness",
+        /// Integral gain `K_I` (N/(m·s)).
+        k_i: f64 [] "N/(m·s)" NonNegative "integral gain",
+        /// Anti-windup bound `I_max` (m·s); `f64::INFINITY` disables it.
+        i_max: f64 [] "m·s" NonNegativeOrInfinite "anti-windup bound",
+    }
+    state {
+        /// Integral of penetration `I_k` (m·s).
+        integral: f64 = 0.0,
+        /// Stored energy `½K·δ²` after the last sample (J).
+        stored: f64 = 0.0,
+    }
+    /// A PI wall with gains `k` (N/m), `k_i` (N/(m·s)) and anti-windup bound `i_max` (m·s).
+    pub fn new;
 }
 
 impl MassiePiLaw {
-    /// A PI wall with gains `k` (N/m), `k_i` (N/(m·s)) and anti-windup bound `i_max` (m·s).
-    pub fn new(k: f64, k_i: f64, i_max: f64) -> Self {
-        Self {
-            k,
-            k_i,
-            i_max,
-            integral: 0.0,
-            stored: 0.0,
-        }
-    }
     /// 1-D defaults: `K = 2000 N/m`, `K_I = 2×10⁴ N/(m·s)`, `I_max = ∞`.
     pub fn one_d() -> Self {
         Self::new(2000.0, 2.0e4, f64::INFINITY)

@@ -3,33 +3,25 @@
 use super::spring_wall::{spring_wall, SpringWall};
 use super::NormalInput;
 
-crate::law_params! { MinskyLaw, "minsky";
-    k (self.k) [] "N/m" NonNegative "wall stiffness",
-    b_m (self.b_m) ["b"] "N·s/m" NonNegative "wall damping",
-}
-
-/// `F_w,k = max(0, K·δ_k + B_M·v_in,k)` while `δ_k > 0`, else 0.
-///
-/// Rule of thumb: `B_M ≥ 2·(K·T/2)`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct MinskyLaw {
-    /// Wall stiffness `K` (N/m).
-    pub k: f64,
-    /// Wall damping `B_M` (N·s/m).
-    pub b_m: f64,
-    /// Stored energy `½K·δ²` after the last sample (J).
-    stored: f64,
+crate::declare_law! {
+    /// `F_w,k = max(0, K·δ_k + B_M·v_in,k)` while `δ_k > 0`, else 0.
+    ///
+    /// Rule of thumb: `B_M ≥ 2·(K·T/2)`.
+    pub struct MinskyLaw as "minsky" {
+        /// Wall stiffness `K` (N/m).
+        k: f64 [] "N/m" NonNegative "wall stiffness",
+        /// Wall damping `B_M` (N·s/m).
+        b_m: f64 ["b"] "N·s/m" NonNegative "wall damping",
+    }
+    state {
+        /// Stored energy `½K·δ²` after the last sample (J).
+        stored: f64 = 0.0,
+    }
+    /// A wall of stiffness `k` (N/m) and damping `b_m` (N·s/m).
+    pub fn new;
 }
 
 impl MinskyLaw {
-    /// A wall of stiffness `k` (N/m) and damping `b_m` (N·s/m).
-    pub fn new(k: f64, b_m: f64) -> Self {
-        Self {
-            k,
-            b_m,
-            stored: 0.0,
-        }
-    }
     /// 1-D defaults: `K = 2000 N/m`, `B_M = 10 N·s/m`.
     pub fn one_d() -> Self {
         Self::new(2000.0, 10.0)

@@ -113,6 +113,19 @@ pub const NORMAL_MODEL_NAMES: [&str; 9] = [
     "hysteretic",
 ];
 
+/// `$e` with `$l` bound to the law of whichever variant of [`NormalModel`] `$m` holds (the
+/// variants listed once).
+macro_rules! each_law {
+    ($m:expr, $l:ident => $e:expr) => {
+        each_law!(@ $m, $l => $e; Paper Zoh Minsky Colgate Seh MassiePi BrakingPulse Hysteretic)
+    };
+    (@ $m:expr, $l:ident => $e:expr; $($v:ident)+) => {
+        match $m {
+            $(NormalModel::$v($l) => $e,)+
+        }
+    };
+}
+
 impl NormalModel {
     /// The name used in scene files and on the command line.
     pub fn name(&self) -> &'static str {
@@ -132,43 +145,25 @@ impl NormalModel {
     /// The model called `name` with its spec defaults: the halved per-contact values when
     /// `per_contact` is true (a face on two contacts in 2-D), the 1-D values otherwise.
     pub fn from_name(name: &str, per_contact: bool) -> Result<Self, String> {
-        let pick = |one: Self, per: Self| if per_contact { per } else { one };
+        // Law `$l` with its per-contact or its 1-D defaults.
+        macro_rules! pick {
+            ($l:ident) => {
+                if per_contact {
+                    $l::per_contact()
+                } else {
+                    $l::one_d()
+                }
+            };
+        }
         Ok(match name {
-            "paper" => pick(
-                NormalModel::Paper(PaperLaw::one_d()),
-                NormalModel::Paper(PaperLaw::per_contact()),
-            ),
-            "zoh" => pick(
-                NormalModel::Zoh(ZohLaw::one_d()),
-                NormalModel::Zoh(ZohLaw::per_contact()),
-            ),
-            "minsky" => pick(
-                NormalModel::Minsky(MinskyLaw::one_d()),
-                NormalModel::Minsky(MinskyLaw::per_contact()),
-            ),
-            "colgate" => pick(
-                NormalModel::Colgate(ColgateLaw::one_d()),
-                NormalModel::Colgate(ColgateLaw::per_contact()),
-            ),
-            "seh" | "seh-pc" => {
-                let c = name == "seh-pc";
-                pick(
-                    NormalModel::Seh(SehLaw::one_d().with_corrector(c)),
-                    NormalModel::Seh(SehLaw::per_contact().with_corrector(c)),
-                )
-            }
-            "pi" => pick(
-                NormalModel::MassiePi(MassiePiLaw::one_d()),
-                NormalModel::MassiePi(MassiePiLaw::per_contact()),
-            ),
-            "pulse" => pick(
-                NormalModel::BrakingPulse(BrakingPulseLaw::one_d()),
-                NormalModel::BrakingPulse(BrakingPulseLaw::per_contact()),
-            ),
-            "hysteretic" => pick(
-                NormalModel::Hysteretic(HystereticLaw::one_d()),
-                NormalModel::Hysteretic(HystereticLaw::per_contact()),
-            ),
+            "paper" => NormalModel::Paper(pick!(PaperLaw)),
+            "zoh" => NormalModel::Zoh(pick!(ZohLaw)),
+            "minsky" => NormalModel::Minsky(pick!(MinskyLaw)),
+            "colgate" => NormalModel::Colgate(pick!(ColgateLaw)),
+            "seh" | "seh-pc" => NormalModel::Seh(pick!(SehLaw).with_corrector(name == "seh-pc")),
+            "pi" => NormalModel::MassiePi(pick!(MassiePiLaw)),
+            "pulse" => NormalModel::BrakingPulse(pick!(BrakingPulseLaw)),
+            "hysteretic" => NormalModel::Hysteretic(pick!(HystereticLaw)),
             _ => {
                 return Err(format!(
                     "unknown normal law `{name}`; valid names: {}",
@@ -192,30 +187,12 @@ impl NormalModel {
 
     /// The law behind this model as its parameter declarations, to set a value.
     fn params_mut(&mut self) -> &mut dyn Params {
-        match self {
-            NormalModel::Paper(l) => l,
-            NormalModel::Zoh(l) => l,
-            NormalModel::Minsky(l) => l,
-            NormalModel::Colgate(l) => l,
-            NormalModel::Seh(l) => l,
-            NormalModel::MassiePi(l) => l,
-            NormalModel::BrakingPulse(l) => l,
-            NormalModel::Hysteretic(l) => l,
-        }
+        each_law!(self, l => l)
     }
 
     /// The law behind this model as its parameter declarations: [`Params::get`] reads a value.
     pub fn params(&self) -> &dyn Params {
-        match self {
-            NormalModel::Paper(l) => l,
-            NormalModel::Zoh(l) => l,
-            NormalModel::Minsky(l) => l,
-            NormalModel::Colgate(l) => l,
-            NormalModel::Seh(l) => l,
-            NormalModel::MassiePi(l) => l,
-            NormalModel::BrakingPulse(l) => l,
-            NormalModel::Hysteretic(l) => l,
-        }
+        each_law!(self, l => l)
     }
 
     /// This model's parameters, declared once ([`crate::laws::params`]).

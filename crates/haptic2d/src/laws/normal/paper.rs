@@ -2,37 +2,29 @@
 
 use super::{NormalInput, NormalLaw};
 
-crate::law_params! { PaperLaw, "paper";
-    kc (self.kc) ["k"] "N/m" NonNegative "contact stiffness Kc",
-    bc (self.bc) ["b"] "N·s/m" NonNegative "contact damping Bc",
-}
-
-/// `F_n,k = max(0, −Kc·d̃_k − Bc·C0,k)` with `d̃_k = 2d_k − 1.5d_{k−1} + 0.5d_{k−2}` (paper eq. 1).
-///
-/// The clamp keeps the damper from pulling separating bodies together. Collisions faster than `v_c`
-/// are resolved by impulses (§7) before this law applies.
-///
-/// Outside the wall (`d_k > 0`, no contact record in 2-D) the force is 0: in the 1-D harness the law is
-/// called at every sample, and the damper must not act before contact.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PaperLaw {
-    /// Contact stiffness `Kc` (N/m).
-    pub kc: f64,
-    /// Contact damping `Bc` (N·s/m).
-    pub bc: f64,
-    /// Stored energy `½Kc·δ²` after the last sample (J).
-    stored: f64,
+crate::declare_law! {
+    /// `F_n,k = max(0, −Kc·d̃_k − Bc·C0,k)` with `d̃_k = 2d_k − 1.5d_{k−1} + 0.5d_{k−2}` (paper eq. 1).
+    ///
+    /// The clamp keeps the damper from pulling separating bodies together. Collisions faster than `v_c`
+    /// are resolved by impulses (§7) before this law applies.
+    ///
+    /// Outside the wall (`d_k > 0`, no contact record in 2-D) the force is 0: in the 1-D harness the law is
+    /// called at every sample, and the damper must not act before contact.
+    pub struct PaperLaw as "paper" {
+        /// Contact stiffness `Kc` (N/m).
+        kc: f64 ["k"] "N/m" NonNegative "contact stiffness Kc",
+        /// Contact damping `Bc` (N·s/m).
+        bc: f64 ["b"] "N·s/m" NonNegative "contact damping Bc",
+    }
+    state {
+        /// Stored energy `½Kc·δ²` after the last sample (J).
+        stored: f64 = 0.0,
+    }
+    /// A law with stiffness `kc` (N/m) and damping `bc` (N·s/m).
+    pub fn new;
 }
 
 impl PaperLaw {
-    /// A law with stiffness `kc` (N/m) and damping `bc` (N·s/m).
-    pub fn new(kc: f64, bc: f64) -> Self {
-        Self {
-            kc,
-            bc,
-            stored: 0.0,
-        }
-    }
     /// 1-D defaults: `Kc = 2000 N/m`, `Bc = 10 N·s/m`.
     pub fn one_d() -> Self {
         Self::new(2000.0, 10.0)

@@ -3,49 +3,36 @@
 use super::spring_wall::{spring_wall, SpringWall};
 use super::NormalInput;
 
-crate::law_params! { BrakingPulseLaw, "pulse";
-    k (self.k) [] "N/m" NonNegative "wall stiffness",
-    e_b (self.e_b) [] "" NonNegative "pulse restitution",
-    n_p (self.n_p) [] "samples" Count "pulse length",
-}
-
-/// Spring `K·δ_k` plus, for the first `N_p` samples inside, a braking pulse
-/// `F_b = (1 + e_b)·m_eff·v_c / (N_p·T)` sized to reverse the latched entry speed `v_c` to `e_b·v_c`.
-///
-/// On the first sample with `δ_k > 0` after being outside (in 2-D: the first call after creation or
-/// reset), the law latches `v_c = max(0, v_in,k)` and `m_eff` from [`NormalInput::m_eff`]. The counter
-/// resets when `δ = 0`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct BrakingPulseLaw {
-    /// Wall stiffness `K` (N/m).
-    pub k: f64,
-    /// Pulse restitution target `e_b` (dimensionless, ≥ 0).
-    pub e_b: f64,
-    /// Pulse length `N_p` (samples, ≥ 1).
-    pub n_p: u32,
-    /// Inside the wall at the previous call.
-    inside: bool,
-    /// Samples of the pulse already applied.
-    count: u32,
-    /// Latched pulse force `F_b` (N).
-    pulse: f64,
-    /// Stored energy `½K·δ²` after the last sample (J).
-    stored: f64,
+crate::declare_law! {
+    /// Spring `K·δ_k` plus, for the first `N_p` samples inside, a braking pulse
+    /// `F_b = (1 + e_b)·m_eff·v_c / (N_p·T)` sized to reverse the latched entry speed `v_c` to `e_b·v_c`.
+    ///
+    /// On the first sample with `δ_k > 0` after being outside (in 2-D: the first call after creation or
+    /// reset), the law latches `v_c = max(0, v_in,k)` and `m_eff` from [`NormalInput::m_eff`]. The counter
+    /// resets when `δ = 0`.
+    pub struct BrakingPulseLaw as "pulse" {
+        /// Wall stiffness `K` (N/m).
+        k: f64 [] "N/m" NonNegative "wall stiffness",
+        /// Pulse restitution target `e_b` (dimensionless, ≥ 0).
+        e_b: f64 [] "" NonNegative "pulse restitution",
+        /// Pulse length `N_p` (samples, ≥ 1).
+        n_p: u32 [] "samples" Count "pulse length",
+    }
+    state {
+        /// Inside the wall at the previous call.
+        inside: bool = false,
+        /// Samples of the pulse already applied.
+        count: u32 = 0,
+        /// Latched pulse force `F_b` (N).
+        pulse: f64 = 0.0,
+        /// Stored energy `½K·δ²` after the last sample (J).
+        stored: f64 = 0.0,
+    }
+    /// A wall of stiffness `k` (N/m) with pulse restitution `e_b` and length `n_p` samples.
+    pub fn new;
 }
 
 impl BrakingPulseLaw {
-    /// A wall of stiffness `k` (N/m) with pulse restitution `e_b` and length `n_p` samples.
-    pub fn new(k: f64, e_b: f64, n_p: u32) -> Self {
-        Self {
-            k,
-            e_b,
-            n_p,
-            inside: false,
-            count: 0,
-            pulse: 0.0,
-            stored: 0.0,
-        }
-    }
     /// 1-D defaults: `K = 2000 N/m`, `e_b = 0.3`, `N_p = 5` (10 ms at 500 Hz).
     pub fn one_d() -> Self {
         Self::new(2000.0, 0.3, 5)

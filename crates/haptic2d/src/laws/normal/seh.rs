@@ -3,43 +3,34 @@
 use super::spring_wall::{spring_wall, SpringWall};
 use super::NormalInput;
 
-crate::law_params! { SehLaw, "seh";
-    k (self.k) [] "N/m" NonNegative "wall stiffness",
-    corrector (self.corrector) [] "" Switch "predictor–corrector off (0) or on (1)",
-}
-
-/// SEH wall: hold `F_w,k = max(0, K·δ̃_k)` with the extrapolated penetration
-/// `δ̃_k = 2δ_k − 1.5δ_{k−1} + 0.5δ_{k−2}` over the coming interval (applied while `δ_k > 0`).
-///
-/// The history uses the **signed** gap (`δ_j := −d_j` even outside), so at onset the previous samples
-/// are negative penetrations. With fewer than three samples of history `δ̃_k = δ_k`.
-///
-/// Predictor–corrector option (\[REC\]): `F_w,k = max(0, K·(δ̃_k + δ̄_{k−1} − δ̃^{used}_{k−1}))`, where
-/// `δ̄_{k−1} = (δ_{k−1} + δ_k)/2` is the mean penetration actually seen over the last interval
-/// (clamped penetrations, `δ_j = max(0, −d_j)`) and `δ̃^{used}_{k−1} = F_w,k−1/K` is the estimate that was
-/// actually held at `k−1` (0 if the wall was inactive then).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SehLaw {
-    /// Wall stiffness `K` (N/m).
-    pub k: f64,
-    /// Use the predictor–corrector term.
-    pub corrector: bool,
-    /// Penetration estimate held at the previous sample, `F_w,k−1/K` (m); 0 when inactive.
-    used_prev: f64,
-    /// Stored energy `½K·δ²` after the last sample (J).
-    stored: f64,
+crate::declare_law! {
+    /// SEH wall: hold `F_w,k = max(0, K·δ̃_k)` with the extrapolated penetration
+    /// `δ̃_k = 2δ_k − 1.5δ_{k−1} + 0.5δ_{k−2}` over the coming interval (applied while `δ_k > 0`).
+    ///
+    /// The history uses the **signed** gap (`δ_j := −d_j` even outside), so at onset the previous samples
+    /// are negative penetrations. With fewer than three samples of history `δ̃_k = δ_k`.
+    ///
+    /// Predictor–corrector option (\[REC\]): `F_w,k = max(0, K·(δ̃_k + δ̄_{k−1} − δ̃^{used}_{k−1}))`, where
+    /// `δ̄_{k−1} = (δ_{k−1} + δ_k)/2` is the mean penetration actually seen over the last interval
+    /// (clamped penetrations, `δ_j = max(0, −d_j)`) and `δ̃^{used}_{k−1} = F_w,k−1/K` is the estimate that was
+    /// actually held at `k−1` (0 if the wall was inactive then).
+    pub struct SehLaw as "seh" {
+        /// Wall stiffness `K` (N/m).
+        k: f64 [] "N/m" NonNegative "wall stiffness",
+        /// Use the predictor–corrector term.
+        corrector: bool [] "" Switch "predictor–corrector off (0) or on (1)",
+    }
+    state {
+        /// Penetration estimate held at the previous sample, `F_w,k−1/K` (m); 0 when inactive.
+        used_prev: f64 = 0.0,
+        /// Stored energy `½K·δ²` after the last sample (J).
+        stored: f64 = 0.0,
+    }
+    /// A wall of stiffness `k` (N/m), with or without the corrector.
+    pub fn new;
 }
 
 impl SehLaw {
-    /// A wall of stiffness `k` (N/m), with or without the corrector.
-    pub fn new(k: f64, corrector: bool) -> Self {
-        Self {
-            k,
-            corrector,
-            used_prev: 0.0,
-            stored: 0.0,
-        }
-    }
     /// 1-D default: `K = 2000 N/m`, no corrector.
     pub fn one_d() -> Self {
         Self::new(2000.0, false)

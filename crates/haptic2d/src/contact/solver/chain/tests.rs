@@ -60,6 +60,18 @@ impl Column {
     }
 }
 
+/// One pass of damper `d` with `τ` = 0.2 ms at `T` = 1 ms, up to `sweeps` sweeps, over `loaded`;
+/// the energy it removed (J).
+fn pass(
+    d: &mut ChainDamping,
+    sweeps: u32,
+    loaded: Loaded<'_>,
+    bodies: &mut [Body],
+    wrenches: &mut [Wrench2],
+) -> f64 {
+    d.apply(Some(2e-4), sweeps, 1e-3, loaded, bodies, wrenches)
+}
+
 fn kinetic_of(bodies: &[Body]) -> f64 {
     bodies.iter().map(|b| b.kinetic_energy()).sum()
 }
@@ -71,17 +83,15 @@ fn warm_start_that_would_add_energy_is_scaled_down() {
     let (mut bodies, loaded) = column();
     let mut wrenches = vec![Wrench2::default(); bodies.len()];
     let mut chain = ChainDamping::default();
-    let dt = 1e-3;
     // Sample 1: every box falls faster than the one below: the dampers push the boxes apart
     // (λ > 0 on every row).
     for (i, b) in bodies.iter_mut().enumerate().skip(1) {
         b.vel = Vec2::new(0.0, -0.1 * i as f64);
     }
     let before = kinetic_of(&bodies);
-    let removed = chain.apply(
-        Some(2e-4),
+    let removed = pass(
+        &mut chain,
         16,
-        dt,
         loaded.view(3, 1),
         &mut bodies,
         &mut wrenches,
@@ -102,14 +112,7 @@ fn warm_start_that_would_add_energy_is_scaled_down() {
         b.force = Vec2::ZERO;
         b.torque = 0.0;
     }
-    let removed = chain.apply(
-        Some(2e-4),
-        0,
-        dt,
-        loaded.view(3, 1),
-        &mut bodies,
-        &mut wrenches,
-    );
+    let removed = pass(&mut chain, 0, loaded.view(3, 1), &mut bodies, &mut wrenches);
     assert!(
         chain.last_warm_scale < 1.0,
         "scale {}",
@@ -117,10 +120,9 @@ fn warm_start_that_would_add_energy_is_scaled_down() {
     );
     assert!(removed >= 0.0, "removed {removed} J");
     // And with sweeps the dampers pull nothing (F ≥ −f_n) and still only remove energy.
-    let removed = chain.apply(
-        Some(2e-4),
+    let removed = pass(
+        &mut chain,
         16,
-        dt,
         loaded.view(3, 1),
         &mut bodies,
         &mut wrenches,
@@ -143,20 +145,18 @@ fn warm_start_that_fits_is_kept_and_saves_sweeps() {
         }
     };
     set(&mut bodies);
-    chain.apply(
-        Some(2e-4),
+    pass(
+        &mut chain,
         64,
-        1e-3,
         loaded.view(3, 1),
         &mut bodies,
         &mut wrenches,
     );
     let cold = chain.last_sweeps;
     set(&mut bodies);
-    let removed = chain.apply(
-        Some(2e-4),
+    let removed = pass(
+        &mut chain,
         64,
-        1e-3,
         loaded.view(3, 1),
         &mut bodies,
         &mut wrenches,
@@ -210,18 +210,16 @@ fn a_degenerate_chain_contact_takes_no_colour() {
         // not patch its rows); the one
         // with the degenerate contact keeps its generation, and is rebuilt because a
         // contact was dropped (else it would be refreshed, which rounds differently).
-        let r_plain = plain.apply(
-            Some(2e-4),
+        let r_plain = pass(
+            &mut plain,
             3,
-            1e-3,
             loaded.view(3, 100 + k),
             &mut b_plain,
             &mut wrenches,
         );
-        let r_with = with.apply(
-            Some(2e-4),
+        let r_with = pass(
+            &mut with,
             3,
-            1e-3,
             degenerate.view(4, 1),
             &mut b_with,
             &mut wrenches,
@@ -242,7 +240,6 @@ fn a_degenerate_chain_contact_takes_no_colour() {
 #[test]
 fn rows_refreshed_in_place_match_rows_rebuilt() {
     let (bodies0, loaded) = column();
-    let dt = 1e-3;
     let (mut fast, mut full) = (ChainDamping::default(), ChainDamping::default());
     (fast.patching, full.patching) = (false, false);
     let (mut b_fast, mut b_full) = (bodies0.clone(), bodies0.clone());
@@ -258,18 +255,10 @@ fn rows_refreshed_in_place_match_rows_rebuilt() {
         }
         // A new generation of the same keys (the impulses are kept by key) forces a rebuild
         // every sample.
-        let r_fast = fast.apply(
-            Some(2e-4),
+        let r_fast = pass(&mut fast, 3, loaded.view(3, 1), &mut b_fast, &mut wrenches);
+        let r_full = pass(
+            &mut full,
             3,
-            dt,
-            loaded.view(3, 1),
-            &mut b_fast,
-            &mut wrenches,
-        );
-        let r_full = full.apply(
-            Some(2e-4),
-            3,
-            dt,
             loaded.view(3, 100 + k),
             &mut b_full,
             &mut wrenches,
@@ -293,14 +282,13 @@ fn rows_refreshed_in_place_match_rows_rebuilt() {
     }
     // One fewer contact: rebuilt (the top box is no longer a chain's end, two rows remain).
     let mut b = b_fast.clone();
-    fast.apply(Some(2e-4), 3, dt, loaded.view(2, 2), &mut b, &mut wrenches);
+    pass(&mut fast, 3, loaded.view(2, 2), &mut b, &mut wrenches);
     assert_eq!((fast.last_rows, fast.last_refreshed), (2, false));
     // A body that became fixed: rebuilt too (box 1 fixed: the floor–box 1 contact joins two
     // fixed bodies and is no row; box 2 still touches boxes 1 and 3).
-    fast.apply(
-        Some(2e-4),
+    pass(
+        &mut fast,
         3,
-        dt,
         loaded.view(3, 3),
         &mut b_fast.clone(),
         &mut wrenches,
@@ -309,7 +297,7 @@ fn rows_refreshed_in_place_match_rows_rebuilt() {
     let mut b = b_fast.clone();
     b[1] = Body::fixed("now fixed", b[1].pose);
     // (The same generation of keys: only the bodies changed.)
-    fast.apply(Some(2e-4), 3, dt, loaded.view(3, 3), &mut b, &mut wrenches);
+    pass(&mut fast, 3, loaded.view(3, 3), &mut b, &mut wrenches);
     assert_eq!((fast.last_rows, fast.last_refreshed), (2, false));
 }
 
@@ -355,7 +343,6 @@ fn rows_by_key(d: &ChainDamping) -> Vec<(VeCandidate, Row)> {
 #[test]
 fn rows_patched_are_the_rows_a_build_gives() {
     let (bodies0, all) = tall_column(30);
-    let dt = 1e-3;
     let mut rng = 0x2545_f491_4f6c_dd1du64;
     let mut next = move || {
         rng ^= rng << 13;
@@ -404,18 +391,16 @@ fn rows_patched_are_the_rows_a_build_gives() {
             }
             let holes_before = patched.holes;
             let n = list.keys.len();
-            let r_p = patched.apply(
-                Some(2e-4),
+            let r_p = pass(
+                &mut patched,
                 sweeps,
-                dt,
                 list.view(n, k + 1),
                 &mut b_p,
                 &mut wrenches,
             );
-            let r_b = built.apply(
-                Some(2e-4),
+            let r_b = pass(
+                &mut built,
                 sweeps,
-                dt,
                 list.view(n, k + 1),
                 &mut b_b,
                 &mut wrenches,
@@ -512,10 +497,9 @@ fn a_patch_appends_within_the_room_a_build_left() {
     let mut built = None;
     for k in 0..18usize {
         let n = 60 + k;
-        d.apply(
-            Some(2e-4),
+        pass(
+            &mut d,
             2,
-            1e-3,
             all.view(n, k as u64 + 1),
             &mut bodies,
             &mut wrenches,
@@ -550,10 +534,9 @@ fn the_dampers_forces_are_the_sums_of_their_rows_impulses() {
     let mut wrenches = vec![Wrench2::default(); bodies.len()];
     let mut chain = ChainDamping::default();
     let dt = 1e-3;
-    chain.apply(
-        Some(2e-4),
+    pass(
+        &mut chain,
         16,
-        dt,
         loaded.view(loaded.contacts.len(), 1),
         &mut bodies,
         &mut wrenches,
