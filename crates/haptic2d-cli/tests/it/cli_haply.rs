@@ -13,8 +13,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Duration;
 
-mod common;
-use common::{
+use crate::common::{
     cmd, column, cut_mid_run, emulate_haply, haply_file, interrupt, run, run_ok, signal, text, turn,
 };
 
@@ -70,7 +69,7 @@ fn run_against_the_emulator_for_3_s_logs_and_exits_clean() {
 /// A 20 s run against the emulated gen 3 board, cut once its loop is ticking (its log has rows):
 /// `cut` silences the emulator. The pty, the run's exit code and its output; the run ends within 5 s
 /// of the cut (asserted).
-fn run_then_cut(cut: impl FnOnce(&mut common::Killed)) -> (String, Option<i32>, String) {
+fn run_then_cut(cut: impl FnOnce(&mut crate::common::Killed)) -> (String, Option<i32>, String) {
     let _turn = turn();
     let dir = tempfile::tempdir().unwrap();
     let file = device_file(dir.path(), "gen3.toml", |t| t);
@@ -367,7 +366,7 @@ fn twin_runs_through_the_normal_loop_against_the_emulator() {
 #[test]
 fn stability_of_the_2diy_is_per_axis_x_and_y() {
     let dir = tempfile::tempdir().unwrap();
-    let file = common::root().join("devices/haply-2diy-gen3.toml");
+    let file = crate::common::root().join("devices/haply-2diy-gen3.toml");
     let run = |controller: &str| {
         let line = format!("stability --device-file {{}} --controller {controller} --out {{}}");
         run_ok(&line, &[&file, &dir.path()])

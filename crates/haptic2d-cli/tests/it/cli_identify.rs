@@ -10,8 +10,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
-mod common;
-use common::{cmd, emulate_haply, interrupt as stop, run, shipped_text, text, turn, write_in};
+use crate::common::{cmd, emulate_haply, interrupt as stop, run, shipped_text, text, turn, write_in};
 
 use haptic2d_devices::haply::{HaplyDeviceFile, HaplyKind};
 
@@ -25,7 +24,7 @@ fn device_file(dir: &Path, name: &str, edit: impl Fn(String) -> String) -> PathB
 }
 
 /// `haptic2d emulate haply --device-file FILE ARGS… --duration 30` and its pty path.
-fn emulate(file: &Path, args: &[&str]) -> (common::Killed, String) {
+fn emulate(file: &Path, args: &[&str]) -> (crate::common::Killed, String) {
     emulate_haply(file, &[args, &["--duration", "30"]].concat())
 }
 

@@ -3,9 +3,8 @@
 //! parser; here each example printed in the help is run with `--help` appended, which clap refuses
 //! when an option before it is unknown or its value does not parse.)
 
-mod common;
 
-use common::{haptic2d, text};
+use crate::common::{haptic2d, text};
 
 /// The longest help line allowed (characters).
 const MAX_COLUMNS: usize = 100;

@@ -15,8 +15,7 @@ use std::sync::Arc;
 use std::thread;
 use std::time::Duration;
 
-mod common;
-use common::{cmd, cut_mid_run, patient_device_file, root, spawn_announced, text, turn, Killed};
+use crate::common::{cmd, cut_mid_run, patient_device_file, root, spawn_announced, text, turn, Killed};
 
 /// The reference file with a patient timeout and no missed-deadline limit, in a temp dir.
 fn device_file(tag: &str) -> PathBuf {
@@ -287,7 +286,7 @@ fn a_pushed_handle_drives_the_box_into_the_wall_and_feels_it() {
         .unwrap();
     let out = text(&o);
     assert_eq!(o.status.code(), Some(0), "{out}");
-    let (col, rows) = common::csv_rows(&log);
+    let (col, rows) = crate::common::csv_rows(&log);
     let (dx, sx, fx, c) = (
         col("device.x"),
         col("slave.x"),
@@ -411,7 +410,7 @@ fn no_device_and_bad_arguments_are_clear_errors() {
         out.contains("no state from the device") && out.contains("sim_device.py"),
         "{out}"
     );
-    let o = common::run("run --device udp:nowhere --headless --duration 1", &[]);
+    let o = crate::common::run("run --device udp:nowhere --headless --duration 1", &[]);
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     assert!(text(&o).contains("udp:ADDR:PORT"), "{}", text(&o));
     let bad = file.with_file_name("bad.toml");

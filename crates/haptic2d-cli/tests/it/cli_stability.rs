@@ -1,9 +1,8 @@
 //! `haptic2d stability` end to end (issue 11): a verdict per axis and the poles, for the default
 //! configuration and for the spec's, and the plot files.
 
-mod common;
 
-use common::{haptic2d, run, text};
+use crate::common::{haptic2d, run, text};
 
 fn stability(args: &[&str], out: &std::path::Path) -> String {
     let mut a = vec!["stability"];
@@ -69,7 +68,7 @@ fn stability_rejects_bad_options_with_a_message() {
 #[test]
 fn stability_reads_a_controller_file() {
     let dir = tempfile::tempdir().unwrap();
-    let root = common::root();
+    let root = crate::common::root();
     let paper = root.join("controllers/paper-4ch.toml");
     let s = stability(
         &[
@@ -145,9 +144,9 @@ fn stability_refuses_a_bad_controller_file_naming_the_field() {
 /// and runs; `reproduce fig8` carries the claims with the file's controller, labelled by the file.
 #[test]
 fn run_and_reproduce_accept_a_controller_file() {
-    let _turn = common::turn(); // one real-time loop at a time
+    let _turn = crate::common::turn(); // one real-time loop at a time
     let dir = tempfile::tempdir().unwrap();
-    let root = common::root();
+    let root = crate::common::root();
     let soft = root.join("controllers/coupling-soft.toml");
     let o = run(
         "run --headless --no-rt --duration 0.2 --controller-file {}",

@@ -2,7 +2,6 @@
 //! every log ending on a whole row, exit status 130 (interrupted). Signals are sent with
 //! `libc::kill` to the spawned binary.
 
-mod common;
 
 use std::path::Path;
 use std::process::{Child, Command, Stdio};
@@ -37,7 +36,7 @@ fn signal_and_wait(child: Child, sig: libc::c_int) -> (Option<i32>, String) {
     let pid = child.id() as libc::pid_t;
     // SAFETY: kill(2) on the pid of a child we spawned and have not reaped.
     assert_eq!(unsafe { libc::kill(pid, sig) }, 0);
-    let Some((status, out)) = common::wait_with_limit(child, Duration::from_secs(30)) else {
+    let Some((status, out)) = crate::common::wait_with_limit(child, Duration::from_secs(30)) else {
         panic!("did not exit within 30 s of the signal");
     };
     (status.code(), out)
@@ -63,7 +62,7 @@ fn assert_whole_rows(path: &Path) -> usize {
 
 /// The "N ticks" of the run summary.
 fn ticks_in(out: &str) -> usize {
-    common::summary_ticks(out) as usize
+    crate::common::summary_ticks(out) as usize
 }
 
 fn run_log_then(sig: libc::c_int) {
@@ -194,7 +193,7 @@ fn convert_then(sig: libc::c_int) -> (Option<i32>, Option<i32>, String, Vec<Stri
     let pid = child.id() as libc::pid_t;
     // SAFETY: kill(2) on the pid of a child we spawned and have not reaped.
     assert_eq!(unsafe { libc::kill(pid, sig) }, 0);
-    let Some((status, text)) = common::wait_with_limit(child, Duration::from_secs(30)) else {
+    let Some((status, text)) = crate::common::wait_with_limit(child, Duration::from_secs(30)) else {
         panic!("log convert did not exit within 30 s of the signal");
     };
     let mut names: Vec<String> = std::fs::read_dir(dir.path())
@@ -249,8 +248,8 @@ fn log_convert_renames_its_complete_output_into_place() {
     let dir = tempfile::tempdir().unwrap();
     let csv = big_tick_csv(dir.path(), 1000);
     let out = dir.path().join("out.mcap");
-    let o = common::run("log convert {} {}", &[&csv, &out]);
-    assert!(o.status.success(), "{}", common::text(&o));
+    let o = crate::common::run("log convert {} {}", &[&csv, &out]);
+    assert!(o.status.success(), "{}", crate::common::text(&o));
     let mut names: Vec<String> = std::fs::read_dir(dir.path())
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
@@ -269,8 +268,8 @@ fn log_convert_into_a_named_pipe_writes_the_pipe_and_keeps_it() {
     let dir = tempfile::tempdir().unwrap();
     let csv = big_tick_csv(dir.path(), 100);
     let mcap = dir.path().join("x.mcap");
-    let o = common::run("log convert {} {}", &[&csv, &mcap]);
-    assert!(o.status.success(), "{}", common::text(&o));
+    let o = crate::common::run("log convert {} {}", &[&csv, &mcap]);
+    assert!(o.status.success(), "{}", crate::common::text(&o));
     let fifo = dir.path().join("pipe");
     let c = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
     // SAFETY: mkfifo(3) with a valid NUL-terminated path.
@@ -279,8 +278,8 @@ fn log_convert_into_a_named_pipe_writes_the_pipe_and_keeps_it() {
         let fifo = fifo.clone();
         std::thread::spawn(move || std::fs::read_to_string(fifo).unwrap())
     };
-    let o = common::run("log convert {} {}", &[&mcap, &fifo]);
-    assert!(o.status.success(), "{}", common::text(&o));
+    let o = crate::common::run("log convert {} {}", &[&mcap, &fifo]);
+    assert!(o.status.success(), "{}", crate::common::text(&o));
     // (Checked before joining the reader: had the pipe been renamed over, the reader would wait
     // for a writer forever.)
     use std::os::unix::fs::FileTypeExt;

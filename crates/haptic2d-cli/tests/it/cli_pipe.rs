@@ -1,22 +1,17 @@
 //! A printing command whose reader has gone (`haptic2d simulate … | head -1`) ends quietly of
 //! `SIGPIPE`, as `cat` does, instead of panicking in `println!` (found in session 4).
 
-#![cfg(unix)]
-
-use std::os::fd::FromRawFd;
 use std::os::unix::process::ExitStatusExt;
 use std::process::{Command, Stdio};
 
 /// Runs `haptic2d args` with stdout on a pipe whose read end is already closed, so the first write
 /// fails with `EPIPE`; returns (signal that ended it, stderr).
 fn run_into_closed_pipe(args: &[&str]) -> (Option<i32>, Option<i32>, String) {
-    let mut fds = [0i32; 2];
-    // SAFETY: `fds` has room for the two descriptors `pipe` writes.
-    assert_eq!(unsafe { libc::pipe(fds.as_mut_ptr()) }, 0, "pipe(2) failed");
-    // SAFETY: fds[0] is the read end just created and owned by no one else.
-    unsafe { libc::close(fds[0]) };
-    // SAFETY: fds[1] is the write end just created; the Stdio takes ownership and closes it.
-    let stdout = unsafe { Stdio::from_raw_fd(fds[1]) };
+    // Both ends are close-on-exec (`std::io::pipe`): a child that another test of this binary
+    // spawns meanwhile inherits neither, so no other process holds a read end open.
+    let (reader, writer) = std::io::pipe().expect("pipe(2)");
+    drop(reader);
+    let stdout = Stdio::from(writer);
     let out = Command::new(env!("CARGO_BIN_EXE_haptic2d"))
         .args(args)
         .stdout(stdout)

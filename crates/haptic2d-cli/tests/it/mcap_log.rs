@@ -3,9 +3,8 @@
 //! conversion is lossless; `--device replay:x.mcap` replays a recording; `simulate --out x.mcap`;
 //! the Foxglove live server serves a loopback client and survives a malformed message.
 
-mod common;
 
-use common::{haptic2d, run, text};
+use crate::common::{haptic2d, run, text};
 use haptic2d_rt::mcap::columns::{TickRow, Val, LOOP_COLUMN_COUNT, TICK_TABLE};
 use haptic2d_rt::mcap::reader::{read_file, read_info, read_ticks};
 use haptic2d_rt::mcap::schemas::*;
@@ -13,7 +12,7 @@ use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::Duration;
 
-use common::summary_ticks;
+use crate::common::summary_ticks;
 
 fn run_logged(log: &Path, extra: &[&str]) -> String {
     let mut args = vec![
@@ -140,7 +139,7 @@ fn mcap_log_of_a_2s_run_has_every_tick_and_matches_the_csv_log_of_the_same_run()
 
 #[test]
 fn sigint_mid_run_leaves_a_complete_readable_mcap() {
-    let _turn = common::turn(); // one real-time loop at a time
+    let _turn = crate::common::turn(); // one real-time loop at a time
     let dir = tempfile::tempdir().unwrap();
     let mcap = dir.path().join("int.mcap");
     let child = Command::new(env!("CARGO_BIN_EXE_haptic2d"))
@@ -338,7 +337,7 @@ fn simulate_out_mcap_writes_every_sample_of_the_world() {
 
 #[test]
 fn foxglove_live_server_serves_a_loopback_client_and_survives_a_malformed_message() {
-    let _turn = common::turn(); // one real-time loop at a time
+    let _turn = crate::common::turn(); // one real-time loop at a time
     use std::io::{BufRead, BufReader};
     use tungstenite::client::IntoClientRequest;
     use tungstenite::Message;
@@ -603,7 +602,7 @@ fn simulate_mcap_then(sig: libc::c_int) -> (Option<i32>, Option<i32>) {
     }
     // SAFETY: kill(2) on the pid of a child we spawned and have not reaped.
     assert_eq!(unsafe { libc::kill(child.id() as libc::pid_t, sig) }, 0);
-    let Some((status, text)) = common::wait_with_limit(child, Duration::from_secs(30)) else {
+    let Some((status, text)) = crate::common::wait_with_limit(child, Duration::from_secs(30)) else {
         panic!("did not exit within 30 s of the signal");
     };
     assert!(!text.contains("panicked"), "{text}");

@@ -18,8 +18,7 @@ use std::process::{Child, Command, Stdio};
 use std::sync::mpsc;
 use std::time::Duration;
 
-mod common;
-use common::{turn, wait_with_limit};
+use crate::common::{turn, wait_with_limit};
 
 const BIN: &str = env!("CARGO_BIN_EXE_haptic2d");
 
@@ -481,8 +480,8 @@ fn run_refuses_split_loop_options_without_world_and_local_world_options_with_it(
         ),
     ];
     for (args, what) in cases {
-        let o = common::haptic2d(args);
-        let t = common::text(&o);
+        let o = crate::common::haptic2d(args);
+        let t = crate::common::text(&o);
         assert_eq!(o.status.code(), Some(2), "{args:?}: {t}");
         assert!(t.contains(what) && t.contains("fix:"), "{args:?}: {t}");
     }
@@ -493,7 +492,7 @@ fn run_refuses_split_loop_options_without_world_and_local_world_options_with_it(
 /// and at a 50 ms round trip with 5 % loss the link creates no energy.
 #[test]
 fn teleop_of_two_simulated_devices_reproduces_the_wall_contact_at_the_master() {
-    let o = common::haptic2d(&[
+    let o = crate::common::haptic2d(&[
         "teleop",
         "--master",
         "sim",
@@ -504,7 +503,7 @@ fn teleop_of_two_simulated_devices_reproduces_the_wall_contact_at_the_master() {
         "--loss",
         "0.05",
     ]);
-    let t = common::text(&o);
+    let t = crate::common::text(&o);
     assert!(o.status.success(), "{t}");
     let wall = number(&t, "contact (last second):", "wall force on the slave ");
     let felt = number(
@@ -515,8 +514,8 @@ fn teleop_of_two_simulated_devices_reproduces_the_wall_contact_at_the_master() {
     assert!((1.4..2.1).contains(&wall), "{t}");
     assert!((felt - wall).abs() < 0.1 * wall, "{t}");
     assert!(number(&t, "network:", "created ") <= 1e-3, "{t}");
-    let o = common::haptic2d(&["teleop", "--master", "haply:/dev/null"]);
-    assert_eq!(o.status.code(), Some(2), "{}", common::text(&o));
+    let o = crate::common::haptic2d(&["teleop", "--master", "haply:/dev/null"]);
+    assert_eq!(o.status.code(), Some(2), "{}", crate::common::text(&o));
 }
 
 /// `haptic2d teleop --architecture four-channel`: the four channels hold master and slave
@@ -526,7 +525,7 @@ fn teleop_of_two_simulated_devices_reproduces_the_wall_contact_at_the_master() {
 /// 50 ms round trip, where position–force runs away (docs/TELEOP.md).
 #[test]
 fn teleop_four_channel_feels_the_wall_with_master_and_slave_together_even_at_50_ms_without_tdpa() {
-    let o = common::haptic2d(&[
+    let o = crate::common::haptic2d(&[
         "teleop",
         "--architecture",
         "four-channel",
@@ -534,7 +533,7 @@ fn teleop_four_channel_feels_the_wall_with_master_and_slave_together_even_at_50_
         "25",
         "--no-tdpa",
     ]);
-    let t = common::text(&o);
+    let t = crate::common::text(&o);
     assert!(o.status.success(), "{t}");
     assert!(t.contains("four-channel"), "{t}");
     let wall = number(&t, "contact (last second):", "wall force on the slave ");
@@ -558,13 +557,13 @@ fn teleop_four_channel_feels_the_wall_with_master_and_slave_together_even_at_50_
 #[test]
 fn teleop_stability_prints_the_delay_margin_and_writes_the_plot() {
     let dir = key_file("margin", 0x02).with_file_name("margin");
-    let o = common::haptic2d(&[
+    let o = crate::common::haptic2d(&[
         "teleop",
         "--stability",
         "--stability-plot",
         dir.to_str().unwrap(),
     ]);
-    let t = common::text(&o);
+    let t = crate::common::text(&o);
     assert!(o.status.success(), "{t}");
     let ms = number(&t, "position-force (chosen):", "round trip of ");
     assert!((10.0..50.0).contains(&ms), "{t}");
@@ -580,8 +579,8 @@ fn teleop_stability_prints_the_delay_margin_and_writes_the_plot() {
 #[test]
 fn teleop_figures_writes_the_table_and_a_plot_per_round_trip_into_the_given_dir() {
     let dir = key_file("figures", 0x01).with_file_name("figs");
-    let o = common::haptic2d(&["teleop", "--figures", dir.to_str().unwrap()]);
-    let t = common::text(&o);
+    let o = crate::common::haptic2d(&["teleop", "--figures", dir.to_str().unwrap()]);
+    let t = crate::common::text(&o);
     assert!(o.status.success(), "{t}");
     assert!(t.contains("| 50 ms | 5 % | wave |"), "{t}");
     for f in ["teleop-delays.md", "teleop-delays.csv"] {
@@ -598,10 +597,10 @@ fn teleop_figures_writes_the_table_and_a_plot_per_round_trip_into_the_given_dir(
 /// reported as passed where it cannot run: it needs `unshare -n`, the privilege to make a network
 /// namespace and a kernel with the netem qdisc (`sch_netem`; the VM this was written on lacks it,
 /// so this path has not run there). Run where they exist:
-/// `cargo test -p haptic2d-cli --test cli_teleop netem -- --ignored`; without them it fails and
+/// `cargo test -p haptic2d-cli --test it cli_teleop::netem -- --ignored`; without them it fails and
 /// says which is missing.
 #[test]
-#[ignore = "needs a network namespace with the netem qdisc (root, sch_netem): cargo test -p haptic2d-cli --test cli_teleop netem -- --ignored"]
+#[ignore = "needs a network namespace with the netem qdisc (root, sch_netem): cargo test -p haptic2d-cli --test it cli_teleop::netem -- --ignored"]
 fn netem_in_a_namespace_at_50_ms_and_5_percent_with_tdpa_creates_no_energy() {
     let _t = turn();
     let netem = "ip link set lo up && tc qdisc add dev lo root netem delay 25ms loss 5%";

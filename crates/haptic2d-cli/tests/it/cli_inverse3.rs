@@ -7,16 +7,10 @@
 //! 1000 periods: the tests run on machines shared with compilers and check the protocol and the
 //! exit paths, not the timing (the timeout is exercised by the driver tests in haptic2d-devices).
 
-// The Inverse3 driver is behind haptic2d-cli's `inverse3` feature (off by default, issue 39): these
-// tests run with it, e.g. `cargo test --workspace --features haptic2d-cli/inverse3` (CI); without it
-// the refusal is tested in tests/cli_exit.rs.
-#![cfg(feature = "inverse3")]
-
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
-mod common;
-use common::{cmd, column, cut_mid_run, patient_device_file, spawn_announced, text, turn, Killed};
+use crate::common::{cmd, column, cut_mid_run, patient_device_file, spawn_announced, text, turn, Killed};
 
 /// The shipped file, patient about the machine's timing, in a temp dir.
 fn device_file(tag: &str) -> PathBuf {
@@ -96,7 +90,7 @@ fn run_against_the_emulated_service_for_3_s_drives_the_box_into_the_wall() {
     assert_eq!(o.status.code(), Some(0), "{out}");
     assert!(out.contains("planar: world x = device x"), "{out}");
     assert!(!out.contains("panicked"), "{out}");
-    let (col, rows) = common::csv_rows(&log);
+    let (col, rows) = crate::common::csv_rows(&log);
     let (xs, contacts) = (col("slave.x"), col("contacts"));
     assert!(rows.len() > 1500, "{} rows", rows.len());
     let last = &rows[rows.len() - 300..];
@@ -160,7 +154,7 @@ fn no_service_and_bad_urls_are_clear_errors() {
     assert_eq!(o.status.code(), Some(4), "{out}");
     assert!(out.contains("haptic2d emulate inverse3"), "{out}");
     assert!(!out.contains("panicked"), "{out}");
-    let o = common::run(
+    let o = crate::common::run(
         "run --device inverse3:nonsense --headless --duration 1",
         &[],
     );
@@ -170,7 +164,7 @@ fn no_service_and_bad_urls_are_clear_errors() {
         "{}",
         text(&o)
     );
-    let o = common::run("emulate inverse3 --bind nowhere", &[]);
+    let o = crate::common::run("emulate inverse3 --bind nowhere", &[]);
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     assert!(text(&o).contains("--bind"), "{}", text(&o));
 }

@@ -3,7 +3,6 @@
 //! timeout: no panic, no abort (death by a signal), no hang, and an exit status from the documented
 //! table. The arguments come from a fixed-seed generator, so every run spawns the same processes.
 
-mod common;
 
 use std::time::Duration;
 
@@ -51,7 +50,7 @@ impl Rng {
 
 /// Runs `args` with a 60 s deadline; returns the exit code, panicking on a signal, a panic or a hang.
 fn run(args: &[String]) -> i32 {
-    let (code, out) = common::ends_within(args, Duration::from_secs(60));
+    let (code, out) = crate::common::ends_within(args, Duration::from_secs(60));
     assert!(!out.contains("panicked"), "{args:?} panicked:\n{out}");
     assert!(
         DOCUMENTED.contains(&code),

@@ -16,8 +16,7 @@
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-mod common;
-use common::{cmd, holds_for, patient_device_file, wait_for, Killed};
+use crate::common::{cmd, holds_for, patient_device_file, wait_for, Killed};
 use haptic2d_test_support::firmware::{compile_native_firmware, start_native_firmware};
 
 /// The firmware's default watchdog (µs).

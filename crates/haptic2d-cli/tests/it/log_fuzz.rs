@@ -4,9 +4,8 @@
 //! bulk of the fuzzing runs in-process in haptic2d-rt's tests/log_fuzz.rs (1 200 MCAP and 1 200
 //! CSV cases); this runs a few dozen through the binary, which adds the commands' own code.
 
-mod common;
 
-use common::{run, text};
+use crate::common::{run, text};
 use std::time::Duration;
 
 /// xorshift64*: seeded, the same cases on every run.
@@ -54,7 +53,7 @@ fn mutate(seed: &[u8], rng: &mut Rng, lens: &[usize]) -> Vec<u8> {
 
 /// Runs `args` with a 30 s limit; returns (exit code, output), failing on a signal or a hang.
 fn ends(args: &[&str]) -> (i32, String) {
-    common::ends_within(args, Duration::from_secs(30))
+    crate::common::ends_within(args, Duration::from_secs(30))
 }
 
 #[test]

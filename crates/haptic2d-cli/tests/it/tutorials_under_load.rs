@@ -16,12 +16,11 @@
 //! (virtual) machine's CPU away is run again, at most [`MAX_STOLEN`] times per tutorial (the whole
 //! machine stopped; the stall check rightly trips and no default can hold).
 //! Ignored by default (about 2 minutes, real-time priority needed):
-//! `cargo test -p haptic2d-cli [--features inverse3] --test tutorials_under_load -- --ignored
+//! `cargo test -p haptic2d-cli [--features inverse3] --test it tutorials_under_load:: -- --ignored
 //! --test-threads 1`.
 
-mod common;
 
-use common::{root, turn, wait_with_limit};
+use crate::common::{root, turn, wait_with_limit};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -380,7 +379,7 @@ fn udp(name: &str, device: &str, prepare: Option<&str>) {
                 let o = command(&w, dir).output().unwrap_or_else(|e| {
                     panic!("`{p}`: {e} (this test needs a C compiler: apt-get install gcc)")
                 });
-                assert!(o.status.success(), "`{p}`: {}", common::text(&o));
+                assert!(o.status.success(), "`{p}`: {}", crate::common::text(&o));
             }
             ready = true;
         }

@@ -1,8 +1,7 @@
 //! End-to-end tests of the `haptic2d` binary: what a new user types.
 
-mod common;
 
-use common::{haptic2d, run, text};
+use crate::common::{haptic2d, run, text};
 
 #[test]
 fn simulate_twice_gives_byte_identical_csv() {
@@ -86,7 +85,7 @@ fn unknown_scene_and_bad_options_fail_cleanly() {
 /// `my.toml`), so it cannot go stale.
 #[test]
 fn scenes_md_quotes_what_check_prints_for_overlapping_bodies() {
-    let doc = std::fs::read_to_string(common::root().join("docs/SCENES.md")).unwrap();
+    let doc = std::fs::read_to_string(crate::common::root().join("docs/SCENES.md")).unwrap();
     let section = doc
         .split_once("## Bodies that start overlapping")
         .expect("SCENES.md has the section")

@@ -1,9 +1,8 @@
 //! `haptic2d run`: a short headless run prints the timing summary and logs one row per tick; bad
 //! options fail with a clear message and a non-zero exit.
 
-mod common;
 
-use common::{haptic2d, run, text, turn};
+use crate::common::{haptic2d, run, text, turn};
 use std::process::Command;
 
 #[test]

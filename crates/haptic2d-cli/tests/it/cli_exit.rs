@@ -1,11 +1,10 @@
 //! Issue 10, items 4–6: every option and scene number bounded with a clear message, and the
 //! documented exit codes (`haptic2d --help`, docs/SCENES.md): 0 clean, 1 runtime failure, 2 bad
 //! input, 3 safety stop, 4 lost device (unit-tested in `cmd_run`), 5 energy excess under `--strict`,
-//! 6 divergence, 130 interrupted (tests/cli_signals.rs).
+//! 6 divergence, 130 interrupted (tests/it/cli_signals.rs).
 
-mod common;
 
-use common::{haptic2d, run, text};
+use crate::common::{haptic2d, run, text};
 use std::process::Output;
 
 fn code(o: &Output) -> i32 {
@@ -75,7 +74,7 @@ fn check_dev_zero_is_a_bounded_read_and_a_clear_error() {
 #[test]
 fn run_rate_above_cap_is_rejected_before_allocating_the_ring() {
     // Today's `--rate 1e9` sized a 624 GB telemetry ring.
-    let _turn = common::turn(); // one real-time loop at a time
+    let _turn = crate::common::turn(); // one real-time loop at a time
     assert_exit(
         &"run --headless --no-rt --rate 1e9 --duration 1"
             .split(' ')
@@ -87,7 +86,7 @@ fn run_rate_above_cap_is_rejected_before_allocating_the_ring() {
 
 #[test]
 fn run_duration_1e300_is_a_clear_error_not_a_panic() {
-    let _turn = common::turn(); // one real-time loop at a time
+    let _turn = crate::common::turn(); // one real-time loop at a time
     assert_exit(
         &["run", "--headless", "--no-rt", "--duration", "1e300"],
         2,
@@ -250,7 +249,7 @@ per_mass = true
 
 #[test]
 fn a_safety_stop_in_run_exits_3() {
-    let _turn = common::turn(); // one real-time loop at a time
+    let _turn = crate::common::turn(); // one real-time loop at a time
     let dir = tempfile::tempdir().unwrap();
     // Encoder angles of zero are no pose of the device: the closure monitor trips on tick 0.
     let replay = write(&dir, "zero.csv", "q1,q2,q3,q4\n0,0,0,0\n0,0,0,0\n");
@@ -313,11 +312,11 @@ fn hostile_logs(dir: &tempfile::TempDir) -> (String, String) {
 }
 
 /// Issue 38 item 3 and issue 39 items 5 and 7: every command into every ending, with its code and
-/// the message that says why. (Exit 4 is unit-tested in `cmd_run`; 141 is in tests/cli_pipe.rs;
-/// 130 in tests/cli_signals.rs and tests/mcap_log.rs.)
+/// the message that says why. (Exit 4 is unit-tested in `cmd_run`; 141 is in tests/it/cli_pipe.rs;
+/// 130 in tests/it/cli_signals.rs and tests/it/mcap_log.rs.)
 #[test]
 fn every_command_ends_with_its_documented_exit_code_and_message() {
-    let _turn = common::turn(); // one real-time loop at a time
+    let _turn = crate::common::turn(); // one real-time loop at a time
     let dir = tempfile::tempdir().unwrap();
     let zero_replay = write(&dir, "zero.csv", "q1,q2,q3,q4\n0,0,0,0\n0,0,0,0\n");
     let out_file = write(&dir, "a-file", "not a folder");
@@ -462,7 +461,7 @@ fn every_command_ends_with_its_documented_exit_code_and_message() {
 
 #[test]
 fn dev_zero_as_a_log_is_refused_at_once() {
-    let _turn = common::turn(); // one real-time loop at a time
+    let _turn = crate::common::turn(); // one real-time loop at a time
     let t0 = std::time::Instant::now();
     // As a CSV log (no .mcap extension): its first byte is a NUL.
     assert_exit(&["log", "info", "/dev/zero"], 2, "NUL byte");

@@ -1,4 +1,4 @@
-//! Helpers shared by the CLI end-to-end tests (each test binary uses some of them); the
+//! Helpers shared by the CLI end-to-end tests (the modules of the `it` binary); the
 //! crate-independent ones live in haptic2d-test-support.
 #![allow(dead_code, unused_imports)]
 
@@ -50,7 +50,8 @@ pub fn run_ok(line: &str, paths: &[&dyn AsRef<OsStr>]) -> String {
     out
 }
 
-/// Serialises the tests of one binary that start emulators or devices (keeps the load down).
+/// Serialises the tests that start emulators, devices or real-time loops, across every module of
+/// the binary (keeps the load down).
 pub fn turn() -> std::sync::MutexGuard<'static, ()> {
     static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
     ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner())

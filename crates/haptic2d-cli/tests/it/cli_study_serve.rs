@@ -5,9 +5,8 @@
 //! safety stop with 3 and a lost device with 4, each answering the pending presentation with the reason and zeroing the
 //! torques; non-loopback addresses are refused before anything starts.
 
-mod common;
 
-use common::{signal, spawn_announced, Killed, BIN};
+use crate::common::{signal, spawn_announced, Killed, BIN};
 use serde_json::{json, Value};
 use std::io::{BufRead, BufReader, Read, Write};
 use std::net::TcpStream;
@@ -201,7 +200,7 @@ fn requests_are_answered_bad_ones_with_reasons_and_stop_exits_0() {
 /// with exit 130, and the presentation's MCAP log is finished (`--out`).
 #[test]
 fn sigint_answers_the_pending_presentation_zeroes_the_torques_and_exits_130() {
-    let out_dir = common::temp_dir("cli-study-serve", "sigint");
+    let out_dir = crate::common::temp_dir("cli-study-serve", "sigint");
     let out_arg = out_dir.display().to_string();
     let mut s = Served::start("follow", &["--out", &out_arg]);
     let a = s.ask(json!({"cmd": "present", "condition": "spring-1000", "delta": null}));
@@ -289,11 +288,11 @@ fn a_safety_stop_answers_the_pending_presentation_with_the_trip_and_exits_3() {
 fn a_lost_device_answers_the_pending_presentation_and_exits_4() {
     let (mut dev, dev_addr) = spawn_announced(
         Command::new("python3")
-            .arg(common::root().join("devices/udp/sim_device.py"))
+            .arg(crate::common::root().join("devices/udp/sim_device.py"))
             .args(["--bind", "127.0.0.1:0"]),
         "listening on ",
     );
-    let file = common::patient_device_file("udp-pantograph.toml", ("3", "50"), "serve", "udp.toml");
+    let file = crate::common::patient_device_file("udp-pantograph.toml", ("3", "50"), "serve", "udp.toml");
     let device = format!("udp:{dev_addr}");
     let file_arg = file.display().to_string();
     let mut s = Served::start_on(&device, &["--device-file", &file_arg]);
