@@ -32,7 +32,7 @@ fn write(dir: &tempfile::TempDir, name: &str, text: &str) -> String {
     p.to_str().unwrap().to_string()
 }
 
-const BOX_IN_WALLS: &str = include_str!("../../../scenes/box-in-walls.toml");
+const BOX_IN_WALLS: &str = include_str!("../../../../scenes/box-in-walls.toml");
 
 #[test]
 fn help_lists_the_exit_codes() {
