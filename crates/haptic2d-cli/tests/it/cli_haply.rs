@@ -14,7 +14,9 @@ use std::process::Command;
 use std::time::Duration;
 
 use crate::common::{
-    cmd, column, cut_mid_run, emulate_haply, haply_file, interrupt, run, run_ok, signal, text, turn,
+    assert_has, assert_lacks, assert_lost_device, cmd, column, cut_mid_run, emulate_haply,
+    expect_exit, haply_file,
+    interrupt, joint1_reversed, motor1_flipped, run, run_ok, signal, text, turn,
 };
 
 /// The gen 3 file with the test settings and `edit` applied, written into `dir`.
@@ -36,14 +38,17 @@ fn haply_run(pty: &str, file: &Path, duration: &str) -> Command {
     c
 }
 
-#[test]
-fn run_against_the_emulator_for_3_s_logs_and_exits_clean() {
-    let _turn = turn();
-    let dir = tempfile::tempdir().unwrap();
-    let file = device_file(dir.path(), "gen3.toml", |t| t);
-    let (emu, pty) = emulate_haply(&file, &[]);
-    let log = dir.path().join("x.csv");
-    let o = haply_run(&pty, &file, "3")
+/// A `haptic2d run` of `secs` seconds against the emulator started on `file` with `emu_args`,
+/// logged to `dir/run.csv`, which must end clean: the pty, the run's output and the log's text.
+fn clean_logged_run(
+    dir: &Path,
+    file: &Path,
+    emu_args: &[&str],
+    secs: &str,
+) -> (String, String, String) {
+    let (emu, pty) = emulate_haply(file, emu_args);
+    let log = dir.join("run.csv");
+    let o = haply_run(&pty, file, secs)
         .arg("--log")
         .arg(&log)
         .output()
@@ -51,10 +56,16 @@ fn run_against_the_emulator_for_3_s_logs_and_exits_clean() {
     interrupt(emu);
     let out = text(&o);
     assert!(o.status.success(), "{out}");
-    assert!(
-        out.contains(&format!("device haply:{pty}")) && out.contains("on time:"),
-        "{out}"
-    );
+    (pty, out, std::fs::read_to_string(&log).unwrap())
+}
+
+#[test]
+fn run_against_the_emulator_for_3_s_logs_and_exits_clean() {
+    let _turn = turn();
+    let dir = tempfile::tempdir().unwrap();
+    let file = device_file(dir.path(), "gen3.toml", |t| t);
+    let (pty, out, csv) = clean_logged_run(dir.path(), &file, &[], "3");
+    assert_has(&out, &[&format!("device haply:{pty}"), "on time:"]);
     // The stock firmware has no watchdog: said once, at start (issue 34 finding 3).
     assert_eq!(
         out.matches("warning: this board's firmware has no watchdog")
@@ -62,7 +73,7 @@ fn run_against_the_emulator_for_3_s_logs_and_exits_clean() {
         1,
         "{out}"
     );
-    let rows = std::fs::read_to_string(&log).unwrap().lines().count() - 1;
+    let rows = csv.lines().count() - 1;
     assert!(rows > 500, "only {rows} rows logged:\n{out}");
 }
 
@@ -86,25 +97,22 @@ fn emulator_killed_mid_run_exits_4_naming_the_device() {
         emu.kill().unwrap();
         let _ = emu.wait();
     });
-    assert_eq!(code, Some(4), "{out}");
-    assert!(
-        out.contains(&format!("haply:{pty}"))
-            && out.contains("check")
-            && out.contains("torques were set to zero"),
-        "{out}"
-    );
-    assert!(!out.contains("panicked"), "{out}");
+    let device = format!("haply:{pty}");
+    assert_lost_device(code, &out, &device, &["check", "torques were set to zero"]);
     // The lost reading is not reported as a second fault.
-    assert!(!out.contains("non-finite device input"), "{out}");
+    assert_lacks(&out, &["non-finite device input"]);
 }
 
-/// `device check FILE --pulse` against the emulator at `pty`: the exit code and the output.
-fn device_check(pty: &str, file: &Path) -> (Option<i32>, String) {
+/// `device check FILE --pulse` against an emulator of `board` (started for it, at the rest pose):
+/// the exit code and the output.
+fn device_check(board: &Path, file: &Path) -> (Option<i32>, String) {
+    let (emu, pty) = emulate_haply(board, &[]);
     let device = format!("haply:{pty}");
     let o = run(
         "device check --device {} --pulse --device-file {}",
         &[&device, &file],
     );
+    interrupt(emu);
     (o.status.code(), text(&o))
 }
 
@@ -116,35 +124,28 @@ fn device_check_passes_on_a_correct_board_held_at_rest_and_finds_a_flipped_motor
     let _turn = turn();
     let dir = tempfile::tempdir().unwrap();
     let good = device_file(dir.path(), "gen3.toml", |t| t);
-    let (emu, pty) = emulate_haply(&good, &[]);
-    let (code, out) = device_check(&pty, &good);
+    let (code, out) = device_check(&good, &good);
     assert_eq!(code, Some(0), "{out}");
-    assert!(
-        out.contains("rest pose: end point (0.0190 m, 0.0357 m)") && out.contains("ok:"),
-        "{out}"
+    assert_has(
+        &out,
+        &[
+            "rest pose: end point (0.0190 m, 0.0357 m)",
+            "ok:",
+            "stock firmware",
+            "no watchdog",
+        ],
     );
-    assert!(
-        out.contains("stock firmware") && out.contains("no watchdog"),
-        "{out}"
-    );
-    // The emulated hand lets the handle settle back at the rest pose before the next check.
-    std::thread::sleep(Duration::from_millis(300));
-    // The host's file says motor 1 turns CW (its encoder still CCW): the emulated board, wired
-    // CCW, pushes that link backwards.
-    let flipped = device_file(dir.path(), "flipped.toml", |t| {
-        t.replacen(
-            "direction = \"ccw\"",
-            "direction = \"cw\"\nencoder_direction = \"ccw\"",
-            1,
-        )
-    });
-    let (code, out) = device_check(&pty, &flipped);
-    interrupt(emu);
+    // The host's file says motor 1 turns CW (its encoder still CCW): the emulated board (a fresh
+    // one, at the rest pose), wired CCW, pushes that link backwards.
+    let flipped = device_file(dir.path(), "flipped.toml", motor1_flipped);
+    let (code, out) = device_check(&good, &flipped);
     assert_eq!(code, Some(2), "{out}");
-    assert!(
-        out.contains("fix: motor[0] turns its link clockwise")
-            && out.contains("flip motor[0].direction"),
-        "{out}"
+    assert_has(
+        &out,
+        &[
+            "fix: motor[0] turns its link clockwise",
+            "flip motor[0].direction",
+        ],
     );
 }
 
@@ -156,17 +157,10 @@ fn device_check_tells_a_reversed_motor_and_encoder_from_a_correct_joint() {
     let dir = tempfile::tempdir().unwrap();
     let good = device_file(dir.path(), "gen3.toml", |t| t);
     // The emulated board is wired with motor 1 and its encoder both reversed against the file.
-    let board = device_file(dir.path(), "board.toml", |t| {
-        t.replacen("direction = \"ccw\"", "direction = \"cw\"", 1)
-    });
-    let (emu, pty) = emulate_haply(&board, &[]);
-    let (code, out) = device_check(&pty, &good);
-    interrupt(emu);
+    let board = device_file(dir.path(), "board.toml", joint1_reversed);
+    let (code, out) = device_check(&board, &good);
     assert_eq!(code, Some(2), "{out}");
-    assert!(
-        out.contains("motor[0]'s motor AND encoder are both reversed"),
-        "{out}"
-    );
+    assert_has(&out, &["motor[0]'s motor AND encoder are both reversed"]);
     // Both joints' angles still grow under a positive torque, as on a correct board.
     assert_eq!(out.matches("angle +").count(), 2, "{out}");
 }
@@ -178,22 +172,15 @@ fn device_check_on_the_twin_finds_a_joint_with_motor_and_encoder_reversed() {
     let _turn = turn();
     let dir = tempfile::tempdir().unwrap();
     let good = twin_file(dir.path(), "twin.toml", |t| t);
-    let (emu, pty) = emulate_haply(&good, &[]);
-    let (code, out) = device_check(&pty, &good);
-    interrupt(emu);
+    let (code, out) = device_check(&good, &good);
     assert_eq!(code, Some(0), "{out}");
-    let board = twin_file(dir.path(), "board.toml", |t| {
-        t.replacen("direction = \"ccw\"", "direction = \"cw\"", 1)
-    });
-    let (emu, pty) = emulate_haply(&board, &[]);
-    let (code, out) = device_check(&pty, &good);
-    interrupt(emu);
+    let board = twin_file(dir.path(), "board.toml", joint1_reversed);
+    let (code, out) = device_check(&board, &good);
     assert_eq!(code, Some(2), "{out}");
     assert_eq!(out.matches("angle +").count(), 4, "{out}");
-    assert!(
-        out.contains("no longer describe one rigid handle")
-            && out.contains("under motor[0]'s pulse"),
-        "{out}"
+    assert_has(
+        &out,
+        &["no longer describe one rigid handle", "under motor[0]'s pulse"],
     );
 }
 
@@ -207,14 +194,8 @@ fn twin_on_an_m0_board_is_refused_naming_the_port_count() {
     let (emu, pty) = emulate_haply(&file, &["--board", "m0"]);
     let o = haply_run(&pty, &file, "1").output().unwrap();
     interrupt(emu);
-    let out = text(&o);
-    assert_eq!(o.status.code(), Some(4), "{out}");
-    assert!(
-        out.contains("M0 board has 2 ports")
-            && out.contains("ports 1–4")
-            && !out.contains("USB cable"),
-        "{out}"
-    );
+    let out = expect_exit(&o, 4, &["M0 board has 2 ports", "ports 1–4"]);
+    assert_lacks(&out, &["USB cable"]);
 }
 
 #[test]
@@ -236,13 +217,8 @@ fn missing_port_and_bad_device_file_are_clear_errors() {
         "run --device haply:/dev/null --headless --device-file {}",
         &[&bad],
     );
-    let out = text(&o);
-    assert_eq!(o.status.code(), Some(2), "{out}");
-    assert!(
-        out.contains("board.torque_limit") && out.contains("N·m"),
-        "{out}"
-    );
-    assert!(!out.contains("panicked"), "{out}");
+    let out = expect_exit(&o, 2, &["board.torque_limit", "N·m"]);
+    assert_lacks(&out, &["panicked"]);
 }
 
 #[test]
@@ -251,7 +227,6 @@ fn devices_lists_ports_without_failing() {
     assert!(o.status.success(), "{}", text(&o));
 }
 
-/// Column `name` of a CSV log, as numbers.
 /// Task L item 1: the Haply board runs in the one loop of `run` — its CSV log has the same columns
 /// as the simulated device's, the torques start at exactly zero and ramp in (a hand push on the
 /// emulated handle after the ramp makes them grow), and every torque stays within the device file's
@@ -261,7 +236,8 @@ fn haply_run_is_the_normal_loop_torques_start_at_zero_ramp_in_and_stay_clamped()
     let _turn = turn();
     let dir = tempfile::tempdir().unwrap();
     let file = device_file(dir.path(), "gen3.toml", |t| t);
-    let (emu, pty) = emulate_haply(
+    let (_, out, csv) = clean_logged_run(
+        dir.path(),
         &file,
         &[
             // The user holds the handle at the rest pose while the board is set up (docs/DEVICES.md
@@ -271,17 +247,8 @@ fn haply_run_is_the_normal_loop_torques_start_at_zero_ramp_in_and_stay_clamped()
             "--hand",
             "script:0.8,0.5,0,0,5",
         ],
+        "1.5",
     );
-    let log = dir.path().join("ramp.csv");
-    let o = haply_run(&pty, &file, "1.5")
-        .arg("--log")
-        .arg(&log)
-        .output()
-        .unwrap();
-    interrupt(emu);
-    let out = text(&o);
-    assert!(o.status.success(), "{out}");
-    let csv = std::fs::read_to_string(&log).unwrap();
     let header = csv.lines().next().unwrap();
     assert!(
         header.starts_with("t,") && header.contains("tau1"),
@@ -313,16 +280,14 @@ fn a_silent_emulated_device_exits_4_with_the_reason() {
         // Stopped, then resumed and killed when the guard drops.
         signal(emu.id(), "-STOP");
     });
-    assert_eq!(code, Some(4), "{out}");
-    assert!(
-        out.contains(&format!("haply:{pty}"))
-            && out.contains("emulator on a pseudo-terminal (no USB cable)")
-            && out.contains("the device was late")
-            && out.contains("torques were set to zero")
-            && !out.contains("stalled"),
-        "{out}"
-    );
-    assert!(!out.contains("panicked"), "{out}");
+    let device = format!("haply:{pty}");
+    let says = [
+        "emulator on a pseudo-terminal (no USB cable)",
+        "the device was late",
+        "torques were set to zero",
+    ];
+    assert_lost_device(code, &out, &device, &says);
+    assert_lacks(&out, &["stalled"]);
 }
 
 /// Task L items 1 and 3: the twin pantograph of two 2DIY linkages (4 ports) through the one loop of
@@ -333,18 +298,9 @@ fn twin_runs_through_the_normal_loop_against_the_emulator() {
     let _turn = turn();
     let dir = tempfile::tempdir().unwrap();
     let file = twin_file(dir.path(), "twin.toml", |t| t);
-    let (emu, pty) = emulate_haply(&file, &["--hand", "script:0.8,0.3,0,0,100"]);
-    let log = dir.path().join("twin.csv");
-    let o = haply_run(&pty, &file, "1.5")
-        .arg("--log")
-        .arg(&log)
-        .output()
-        .unwrap();
-    interrupt(emu);
-    let out = text(&o);
-    assert!(o.status.success(), "{out}");
-    assert!(out.contains("twin pantograph"), "{out}");
-    let csv = std::fs::read_to_string(&log).unwrap();
+    let hand = ["--hand", "script:0.8,0.3,0,0,100"];
+    let (_, out, csv) = clean_logged_run(dir.path(), &file, &hand, "1.5");
+    assert_has(&out, &["twin pantograph"]);
     let taus: Vec<Vec<f64>> = ["tau1", "tau2", "tau3", "tau4"]
         .iter()
         .map(|c| column(&csv, c))
@@ -372,11 +328,8 @@ fn stability_of_the_2diy_is_per_axis_x_and_y() {
         run_ok(&line, &[&file, &dir.path()])
     };
     let out = run("four-channel");
-    assert!(
-        out.contains("2-DOF device") && out.contains("axis x") && out.contains("axis y"),
-        "{out}"
-    );
-    assert!(!out.contains("axis theta"), "{out}");
+    assert_has(&out, &["2-DOF device", "axis x", "axis y"]);
+    assert_lacks(&out, &["axis theta"]);
     assert_eq!(out.matches("verdict: stable").count(), 2, "{out}");
     let out = run("four-channel-spec");
     assert_eq!(
@@ -401,13 +354,7 @@ fn run_refuses_an_unstable_released_configuration_on_a_haply_board() {
             .output()
             .unwrap()
     };
-    let o = args(&[]);
-    let out = text(&o);
-    assert_eq!(o.status.code(), Some(2), "{out}");
-    assert!(
-        out.contains("unstable on axis") && out.contains("--allow-unstable"),
-        "{out}"
-    );
+    expect_exit(&args(&[]), 2, &["unstable on axis", "--allow-unstable"]);
     let o = args(&["--allow-unstable"]);
     interrupt(emu);
     let out = text(&o);

@@ -50,6 +50,39 @@ pub fn run_ok(line: &str, paths: &[&dyn AsRef<OsStr>]) -> String {
     out
 }
 
+/// Panics unless `out` contains every one of `needles` (the message names the missing one and
+/// shows `out` whole).
+pub fn assert_has(out: &str, needles: &[&str]) {
+    for n in needles {
+        assert!(out.contains(n), "no `{n}` in:\n{out}");
+    }
+}
+
+/// Panics if `out` contains any of `needles`.
+pub fn assert_lacks(out: &str, needles: &[&str]) {
+    for n in needles {
+        assert!(!out.contains(n), "`{n}` in:\n{out}");
+    }
+}
+
+/// The stdout and stderr of `o`, asserting that it exited with `code` and that they contain every
+/// one of `needles`.
+pub fn expect_exit(o: &Output, code: i32, needles: &[&str]) -> String {
+    let out = text(o);
+    assert_eq!(o.status.code(), Some(code), "{out}");
+    assert_has(&out, needles);
+    out
+}
+
+/// A run that lost its device (the exit code and output of [`cut_mid_run`] or a run): exit 4, the
+/// output names `device` and has every one of `needles`, and nothing panicked.
+pub fn assert_lost_device(code: Option<i32>, out: &str, device: &str, needles: &[&str]) {
+    assert_eq!(code, Some(4), "{out}");
+    assert_has(out, &[device]);
+    assert_has(out, needles);
+    assert_lacks(out, &["panicked"]);
+}
+
 /// Serialises the tests that start emulators, devices or real-time loops, across every module of
 /// the binary (keeps the load down).
 pub fn turn() -> std::sync::MutexGuard<'static, ()> {
@@ -88,6 +121,22 @@ pub fn haply_file(dir: &Path, file: &str, name: &str, edit: impl Fn(String) -> S
         .replace("max_missed_deadlines = 10 ", "max_missed_deadlines = 0 ")
         .replace("max_stall_periods = 5 ", "max_stall_periods = 1000 ");
     write_in(dir, name, &edit(text))
+}
+
+/// A Haply device file's text with motor 1 said to turn CW while its encoder still counts CCW: a
+/// host file that disagrees with a board wired CCW (the pulse pushes that link backwards).
+pub fn motor1_flipped(text: String) -> String {
+    text.replacen(
+        "direction = \"ccw\"",
+        "direction = \"cw\"\nencoder_direction = \"ccw\"",
+        1,
+    )
+}
+
+/// A Haply device file's text with motor 1 and its encoder both reversed (every angle still grows
+/// under a positive torque, as on a correct board).
+pub fn joint1_reversed(text: String) -> String {
+    text.replacen("direction = \"ccw\"", "direction = \"cw\"", 1)
 }
 
 /// `haptic2d emulate haply --device-file FILE ARGS…`, killed on drop, and its pty path (its first
