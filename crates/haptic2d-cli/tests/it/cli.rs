@@ -1,7 +1,7 @@
 //! End-to-end tests of the `haptic2d` binary: what a new user types.
 
 
-use crate::common::{haptic2d, run, text};
+use crate::common::{haptic2d, run_ok, text};
 
 #[test]
 fn simulate_twice_gives_byte_identical_csv() {
@@ -9,8 +9,7 @@ fn simulate_twice_gives_byte_identical_csv() {
     let a = dir.path().join("a.csv");
     let b = dir.path().join("b.csv");
     for p in [&a, &b] {
-        let o = run("simulate box-in-walls-tilt --duration 1.5 --out {}", &[&p]);
-        assert!(o.status.success(), "{}", text(&o));
+        run_ok("simulate box-in-walls-tilt --duration 1.5 --out {}", &[&p]);
     }
     let (x, y) = (std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
     assert!(x.len() > 1000);
@@ -21,11 +20,10 @@ fn simulate_twice_gives_byte_identical_csv() {
 fn simulate_writes_the_documented_columns() {
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path().join("b.csv");
-    let o = run(
+    run_ok(
         "simulate box-in-walls --duration 1 --every 10 --out {}",
         &[&p],
     );
-    assert!(o.status.success(), "{}", text(&o));
     let csv = std::fs::read_to_string(&p).unwrap();
     let mut lines = csv.lines();
     assert_eq!(

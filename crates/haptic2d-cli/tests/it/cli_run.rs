@@ -2,7 +2,7 @@
 //! options fail with a clear message and a non-zero exit.
 
 
-use crate::common::{haptic2d, run, text, turn};
+use crate::common::{haptic2d, run, run_ok, text, turn};
 use std::process::Command;
 
 #[test]
@@ -90,8 +90,7 @@ fn run_replays_recorded_encoders() {
     let log = dir.path().join("rec.csv");
     // Record 0.2 s of the simulated device, then replay its encoder angles.
     let rec = dir.path().join("q.csv");
-    let o = run("run --headless --duration 0.2 --log {}", &[&log]);
-    assert!(o.status.success(), "{}", text(&o));
+    run_ok("run --headless --duration 0.2 --log {}", &[&log]);
     // Build q1..q4 from the device pose with the same model the binary uses.
     let params = haptic2d::device::DeviceParams::default();
     let kin = haptic2d::device::TwinKinematics::new(&params);

@@ -2,7 +2,7 @@
 //! configuration and for the spec's, and the plot files.
 
 
-use crate::common::{haptic2d, run, text};
+use crate::common::{haptic2d, run, run_ok, text};
 
 fn stability(args: &[&str], out: &std::path::Path) -> String {
     let mut a = vec!["stability"];
@@ -155,11 +155,10 @@ fn run_and_reproduce_accept_a_controller_file() {
     assert!(o.status.success(), "{}", text(&o));
     assert!(text(&o).contains("controller coupling"), "{}", text(&o));
     let out = dir.path().join("repro");
-    let o = run(
+    run_ok(
         "reproduce fig8 --out {} --controller-file {}",
         &[&out, &soft],
     );
-    assert!(o.status.success(), "{}", text(&o));
     let report = std::fs::read_to_string(out.join("fig8/report.md")).unwrap();
     assert!(
         report.contains("| coupling-soft/classical | yes |"),

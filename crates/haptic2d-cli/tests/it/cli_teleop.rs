@@ -18,7 +18,7 @@ use std::process::{Child, Command, Stdio};
 use std::sync::mpsc;
 use std::time::Duration;
 
-use crate::common::{turn, wait_with_limit};
+use crate::common::{assert_has, turn, wait_with_limit};
 
 const BIN: &str = env!("CARGO_BIN_EXE_haptic2d");
 
@@ -201,6 +201,40 @@ struct Pushed {
     plants_created: f64,
 }
 
+impl Pushed {
+    /// Both processes' output, for the failure messages.
+    fn all(&self) -> String {
+        format!("{}\n{}", self.device, self.world)
+    }
+
+    /// What every passive link must show on the acceptance run: a clean exit with no safety stop,
+    /// no energy created (≤ 1 mJ) by the ports' books nor as the plants received it, the delay and
+    /// the loss really there (round trip p50 in 49–80 ms, over 20 datagrams dropped), and the
+    /// session closed by the device side. Both processes' output.
+    fn assert_passive(&self) -> String {
+        let all = self.all();
+        assert_eq!(self.status, 0, "{all}");
+        assert!(self.device.contains("no safety stop"), "{all}");
+        assert!(self.created <= 1e-3, "books: created {} J\n{all}", self.created);
+        assert!(
+            self.plants_created <= 1e-3,
+            "plants: created {} J\n{all}",
+            self.plants_created
+        );
+        let rtt = number(&self.device, "link: round trip", "p50 ");
+        assert!(
+            (49.0..80.0).contains(&rtt),
+            "round trip p50 {rtt} ms\n{all}"
+        );
+        assert!(number(&self.device, "link: ", "send errors, ") > 20.0, "{all}");
+        assert!(
+            self.world.contains("the device side closed the session"),
+            "{all}"
+        );
+        all
+    }
+}
+
 /// The acceptance run: 25 ms each way, 5 % loss each way; the gripping hand (300 N/m, 5 N·s/m)
 /// holds still for 0.6 s (the ramp), then its target moves 15 mm to the left at 50 mm/s: the box,
 /// 3 mm from the wall, is pushed into it, with about 2.3 N at rest (hand and coupling springs in
@@ -266,17 +300,9 @@ fn with_tdpa_a_50_ms_round_trip_with_5_percent_loss_creates_no_energy_pushing_in
 ) {
     let _t = turn();
     let r = pushed_into_the_wall("tdpa", "tdpa");
-    let all = format!("{}\n{}", r.device, r.world);
-    assert_eq!(r.status, 0, "{all}");
-    assert!(r.device.contains("no safety stop"), "{all}");
-    assert!(r.created <= 1e-3, "created {} J\n{all}", r.created);
     // Not only by the books: the plants really received no energy from the network (measured
     // −2.2 mJ; docs/TELEOP.md).
-    assert!(
-        r.plants_created <= 1e-3,
-        "plants: created {} J\n{all}",
-        r.plants_created
-    );
+    let all = r.assert_passive();
     // The world port books what the body really received (the force held over the world step ×
     // the body's displacement over it): its books are the body's ledger.
     assert_eq!(
@@ -284,14 +310,7 @@ fn with_tdpa_a_50_ms_round_trip_with_5_percent_loss_creates_no_energy_pushing_in
         port(&r.world, "world port (body, true displacement):"),
         "{all}"
     );
-    // The run did what it claims: the delay and the loss were there, the wall was felt.
-    let rtt = number(&r.device, "link: round trip", "p50 ");
-    assert!(
-        (49.0..80.0).contains(&rtt),
-        "round trip p50 {rtt} ms\n{all}"
-    );
-    let dropped = number(&r.device, "link: ", "send errors, ");
-    assert!(dropped > 20.0, "{all}");
+    // The run did what it claims: the wall was felt.
     let f = number(&r.device, "link: ", "largest force on the handle ");
     assert!(f > 2.0, "the wall was not felt: {f} N\n{all}");
     // Transparency: in contact, the coupling force on the slave follows the wall's (issue 41
@@ -302,17 +321,13 @@ fn with_tdpa_a_50_ms_round_trip_with_5_percent_loss_creates_no_energy_pushing_in
         wall > 1.5 && diff < 0.1 * wall,
         "wall {wall} N, error {diff} N\n{all}"
     );
-    assert!(
-        r.world.contains("the device side closed the session"),
-        "{all}"
-    );
 }
 
 #[test]
 fn without_tdpa_the_same_run_creates_energy() {
     let _t = turn();
     let r = pushed_into_the_wall("none", "none");
-    let all = format!("{}\n{}", r.device, r.world);
+    let all = r.all();
     assert!(
         r.created > 0.02 && r.plants_created > 0.02,
         "created {} J (books), {} J (plants): the delayed link should create energy without TDPA\n{all}",
@@ -330,31 +345,13 @@ fn without_tdpa_the_same_run_creates_energy() {
 fn with_waves_a_50_ms_round_trip_with_5_percent_loss_creates_no_energy_pushing_into_a_wall() {
     let _t = turn();
     let r = pushed_into_the_wall("wave", "wave");
-    let all = format!("{}\n{}", r.device, r.world);
-    assert_eq!(r.status, 0, "{all}");
-    assert!(r.device.contains("no safety stop"), "{all}");
+    let all = r.assert_passive();
     assert!(r.device.contains("link wave (b 20, 20, 0.04"), "{all}");
-    assert!(
-        r.plants_created <= 1e-3,
-        "plants: created {} J\n{all}",
-        r.plants_created
-    );
-    assert!(r.created <= 1e-3, "books: created {} J\n{all}", r.created);
-    let rtt = number(&r.device, "link: round trip", "p50 ");
-    assert!(
-        (49.0..80.0).contains(&rtt),
-        "round trip p50 {rtt} ms\n{all}"
-    );
-    assert!(number(&r.device, "link: ", "send errors, ") > 20.0, "{all}");
     // The waves did the work: each end used wave energy the other sent, and the wall is felt.
     let used = number(&r.world, "waves: ", "used ");
     assert!(used > 0.01, "{all}");
     let wall = number(&r.world, "contact: ", "mean wall force ");
     assert!(wall > 1.0, "the wall was not felt: {wall} N\n{all}");
-    assert!(
-        r.world.contains("the device side closed the session"),
-        "{all}"
-    );
 }
 
 /// A device side running waves against a world side running TDPA latches zero torques at the
@@ -363,17 +360,12 @@ fn with_waves_a_50_ms_round_trip_with_5_percent_loss_creates_no_energy_pushing_i
 fn a_wave_device_side_against_a_tdpa_world_latches_and_says_link_mismatch() {
     let _t = turn();
     let r = pushed_into_the_wall_as("tdpa", "wave", "mismatch");
-    let all = format!("{}\n{}", r.device, r.world);
-    assert_eq!(r.status, 3, "{all}");
-    assert!(
-        r.device
-            .contains("link mismatch: the world side runs force/velocity"),
-        "{all}"
-    );
-    assert!(
-        r.device.contains("torques set to zero and latched"),
-        "{all}"
-    );
+    assert_eq!(r.status, 3, "{}", r.all());
+    let says = [
+        "link mismatch: the world side runs force/velocity",
+        "torques set to zero and latched",
+    ];
+    assert_has(&r.device, &says);
 }
 
 #[test]

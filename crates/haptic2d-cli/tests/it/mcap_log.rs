@@ -4,7 +4,7 @@
 //! the Foxglove live server serves a loopback client and survives a malformed message.
 
 
-use crate::common::{haptic2d, run, text};
+use crate::common::{haptic2d, run, run_ok, text};
 use haptic2d_rt::mcap::columns::{TickRow, Val, LOOP_COLUMN_COUNT, TICK_TABLE};
 use haptic2d_rt::mcap::reader::{read_file, read_info, read_ticks};
 use haptic2d_rt::mcap::schemas::*;
@@ -545,8 +545,7 @@ fn mcap_to_csv_writes_the_bodies_contacts_and_energy_channels_next_to_the_tick_c
 
     // A world recording of `simulate` (no tick channel) with resting contacts: the world CSVs only.
     let (w, wc) = (dir.path().join("pile.mcap"), dir.path().join("pile.csv"));
-    let o = run("simulate pile --duration 0.3 --out {}", &[&w]);
-    assert!(o.status.success(), "{}", text(&o));
+    run_ok("simulate pile --duration 0.3 --out {}", &[&w]);
     let r = haptic2d(&["log", "convert", w.to_str().unwrap(), wc.to_str().unwrap()]);
     assert!(r.status.success(), "{}", text(&r));
     assert!(!wc.exists(), "no tick CSV without tick messages");
@@ -681,8 +680,7 @@ fn mcap_log_time_is_unix_epoch_ns_the_deadline_plus_the_recorded_offset() {
     // simulate: the start's Unix time + round(t · 1e9).
     let s = dir.path().join("sim.mcap");
     let before = unix_now_ns();
-    let o = run("simulate box-in-walls --duration 0.05 --out {}", &[&s]);
-    assert!(o.status.success(), "{}", text(&o));
+    run_ok("simulate box-in-walls --duration 0.05 --out {}", &[&s]);
     let bytes = read_file(&s).unwrap();
     let info = read_info(&bytes, "sim.mcap").unwrap();
     let clock = info.metadata("haptic2d.clock").expect("haptic2d.clock");
