@@ -1,6 +1,5 @@
 //! End-to-end tests of the `haptic2d` binary: what a new user types.
 
-
 use crate::common::{haptic2d, run_ok, text};
 
 #[test]

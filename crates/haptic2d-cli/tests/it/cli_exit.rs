@@ -3,7 +3,6 @@
 //! input, 3 safety stop, 4 lost device (unit-tested in `cmd_run`), 5 energy excess under `--strict`,
 //! 6 divergence, 130 interrupted (tests/it/cli_signals.rs).
 
-
 use crate::common::{haptic2d, run, text};
 use std::process::Output;
 

@@ -3,7 +3,6 @@
 //! timeout: no panic, no abort (death by a signal), no hang, and an exit status from the documented
 //! table. The arguments come from a fixed-seed generator, so every run spawns the same processes.
 
-
 use std::time::Duration;
 
 const NUMBERS: &[&str] = &[

@@ -15,8 +15,8 @@ use std::time::Duration;
 
 use crate::common::{
     assert_has, assert_lacks, assert_lost_device, cmd, column, cut_mid_run, emulate_haply,
-    expect_exit, haply_file,
-    interrupt, joint1_reversed, motor1_flipped, run, run_ok, signal, text, turn,
+    expect_exit, haply_file, interrupt, joint1_reversed, motor1_flipped, run, run_ok, signal, text,
+    turn,
 };
 
 /// The gen 3 file with the test settings and `edit` applied, written into `dir`.
@@ -180,7 +180,10 @@ fn device_check_on_the_twin_finds_a_joint_with_motor_and_encoder_reversed() {
     assert_eq!(out.matches("angle +").count(), 4, "{out}");
     assert_has(
         &out,
-        &["no longer describe one rigid handle", "under motor[0]'s pulse"],
+        &[
+            "no longer describe one rigid handle",
+            "under motor[0]'s pulse",
+        ],
     );
 }
 

@@ -3,11 +3,26 @@
 //! parser; here each example printed in the help is run with `--help` appended, which clap refuses
 //! when an option before it is unknown or its value does not parse.)
 
-
 use crate::common::{haptic2d, text};
 
 /// The longest help line allowed (characters).
 const MAX_COLUMNS: usize = 100;
+
+/// `haptic2d WORDS… --help`, which must succeed with no line wider than [`MAX_COLUMNS`]: the help.
+fn narrow_help(words: &[&str]) -> String {
+    let o = haptic2d(&[words, &["--help"]].concat());
+    let help = text(&o);
+    let cmd = words.join(" ");
+    assert!(o.status.success(), "{cmd} --help:\n{help}");
+    for line in help.lines() {
+        let n = line.chars().count();
+        assert!(
+            n <= MAX_COLUMNS,
+            "{cmd} --help: line of {n} columns: {line}"
+        );
+    }
+    help
+}
 
 #[test]
 fn every_command_help_has_examples_that_parse() {
@@ -24,18 +39,7 @@ fn every_command_help_has_examples_that_parse() {
     ];
     for words in screens {
         let cmd = words.join(" ");
-        let mut help_args = words.to_vec();
-        help_args.push("--help");
-        let o = haptic2d(&help_args);
-        let help = text(&o);
-        assert!(o.status.success(), "{cmd} --help:\n{help}");
-        for line in help.lines() {
-            let n = line.chars().count();
-            assert!(
-                n <= MAX_COLUMNS,
-                "{cmd} --help: line of {n} columns: {line}"
-            );
-        }
+        let help = narrow_help(words);
         let (_, examples) = help
             .split_once("\nExamples:\n")
             .unwrap_or_else(|| panic!("{cmd} --help has no Examples: block:\n{help}"));
@@ -98,14 +102,6 @@ fn every_other_help_fits_in_100_columns() {
         &["log", "convert"],
     ];
     for words in screens {
-        let mut args = words.to_vec();
-        args.push("--help");
-        let o = haptic2d(&args);
-        let help = text(&o);
-        assert!(o.status.success(), "{args:?}:\n{help}");
-        for line in help.lines() {
-            let n = line.chars().count();
-            assert!(n <= MAX_COLUMNS, "{args:?}: line of {n} columns: {line}");
-        }
+        narrow_help(words);
     }
 }

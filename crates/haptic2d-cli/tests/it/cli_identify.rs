@@ -113,7 +113,10 @@ fn device_identify_detects_a_reversed_motor_and_a_reversed_motor_and_encoder() {
     expect_exit(
         &o,
         2,
-        &["fix: motor[0] turns its link clockwise", "nothing identified"],
+        &[
+            "fix: motor[0] turns its link clockwise",
+            "nothing identified",
+        ],
     );
     assert!(HaplyDeviceFile::from_path(&flipped)
         .unwrap()
@@ -149,7 +152,10 @@ fn device_identify_refuses_bad_options_with_exit_2() {
         ("--torque 0.1", "--torque 0.1"),
         ("--write", "--write needs --device-file"),
     ] {
-        let o = run(&format!("device identify --device haply:/nonexistent {args}"), &[]);
+        let o = run(
+            &format!("device identify --device haply:/nonexistent {args}"),
+            &[],
+        );
         expect_exit(&o, 2, &[says]);
     }
 }

@@ -2,7 +2,6 @@
 //! every log ending on a whole row, exit status 130 (interrupted). Signals are sent with
 //! `libc::kill` to the spawned binary.
 
-
 use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
@@ -29,6 +28,19 @@ fn wait_for_file(path: &Path, bytes: u64, child: &mut Child) {
         );
         std::thread::sleep(Duration::from_millis(20));
     }
+}
+
+/// `haptic2d ARGS…` signalled with `sig` once `file` holds `bytes` bytes (it is under way): its
+/// exit code and output, as [`signal_and_wait`].
+fn signalled_while_writing(
+    args: &[&str],
+    file: &Path,
+    bytes: u64,
+    sig: libc::c_int,
+) -> (Option<i32>, String) {
+    let mut child = spawn(args);
+    wait_for_file(file, bytes, &mut child);
+    signal_and_wait(child, sig)
 }
 
 /// Sends `sig`, waits (at most 30 s: no hang) and returns (exit code, stdout + stderr).
@@ -68,16 +80,15 @@ fn ticks_in(out: &str) -> usize {
 fn run_log_then(sig: libc::c_int) {
     let dir = tempfile::tempdir().unwrap();
     let log = dir.path().join("run.csv");
-    let mut child = spawn(&[
+    let args = [
         "run",
         "--headless",
         "--no-rt",
         "--log",
         log.to_str().unwrap(),
-    ]);
-    // ~100 rows written (the logger flushes its 64 KiB buffer as it goes).
-    wait_for_file(&log, 70_000, &mut child);
-    let (code, out) = signal_and_wait(child, sig);
+    ];
+    // Once ~100 rows are written (the logger flushes its 64 KiB buffer as it goes).
+    let (code, out) = signalled_while_writing(&args, &log, 70_000, sig);
     assert_eq!(
         code,
         Some(130),
@@ -103,18 +114,11 @@ fn sigint_on_run_log_ends_on_a_whole_row_and_prints_the_summary() {
 fn simulate_then(sig: libc::c_int) {
     let dir = tempfile::tempdir().unwrap();
     let out_csv = dir.path().join("sim.csv");
-    // pile:100 for 1000 s: far longer than the test; the signal ends it.
-    let mut child = spawn(&[
-        "simulate",
-        "pile:100",
-        "--duration",
-        "1000",
-        "--out",
-        out_csv.to_str().unwrap(),
-    ]);
-    // The 1 MiB CSV buffer has been flushed at least once.
-    wait_for_file(&out_csv, 1 << 20, &mut child);
-    let (code, out) = signal_and_wait(child, sig);
+    // pile:100 for 1000 s: far longer than the test; the signal ends it, once the 1 MiB CSV
+    // buffer has been flushed at least once.
+    let path = out_csv.to_str().unwrap();
+    let args = ["simulate", "pile:100", "--duration", "1000", "--out", path];
+    let (code, out) = signalled_while_writing(&args, &out_csv, 1 << 20, sig);
     assert_eq!(code, Some(130), "exit status:\n{out}");
     assert!(out.contains("interrupted by a signal"), "{out}");
     assert!(out.contains("energy: initial"), "summary printed:\n{out}");
@@ -193,7 +197,8 @@ fn convert_then(sig: libc::c_int) -> (Option<i32>, Option<i32>, String, Vec<Stri
     let pid = child.id() as libc::pid_t;
     // SAFETY: kill(2) on the pid of a child we spawned and have not reaped.
     assert_eq!(unsafe { libc::kill(pid, sig) }, 0);
-    let Some((status, text)) = crate::common::wait_with_limit(child, Duration::from_secs(30)) else {
+    let Some((status, text)) = crate::common::wait_with_limit(child, Duration::from_secs(30))
+    else {
         panic!("log convert did not exit within 30 s of the signal");
     };
     let mut names: Vec<String> = std::fs::read_dir(dir.path())

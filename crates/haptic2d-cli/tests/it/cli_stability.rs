@@ -1,7 +1,6 @@
 //! `haptic2d stability` end to end (issue 11): a verdict per axis and the poles, for the default
 //! configuration and for the spec's, and the plot files.
 
-
 use crate::common::{haptic2d, run, run_ok, text};
 
 fn stability(args: &[&str], out: &std::path::Path) -> String {

@@ -5,7 +5,6 @@
 //! safety stop with 3 and a lost device with 4, each answering the pending presentation with the reason and zeroing the
 //! torques; non-loopback addresses are refused before anything starts.
 
-
 use crate::common::{signal, spawn_announced, Killed, BIN};
 use serde_json::{json, Value};
 use std::io::{BufRead, BufReader, Read, Write};
@@ -292,7 +291,8 @@ fn a_lost_device_answers_the_pending_presentation_and_exits_4() {
             .args(["--bind", "127.0.0.1:0"]),
         "listening on ",
     );
-    let file = crate::common::patient_device_file("udp-pantograph.toml", ("3", "50"), "serve", "udp.toml");
+    let file =
+        crate::common::patient_device_file("udp-pantograph.toml", ("3", "50"), "serve", "udp.toml");
     let device = format!("udp:{dev_addr}");
     let file_arg = file.display().to_string();
     let mut s = Served::start_on(&device, &["--device-file", &file_arg]);

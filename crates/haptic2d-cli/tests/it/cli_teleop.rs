@@ -215,7 +215,11 @@ impl Pushed {
         let all = self.all();
         assert_eq!(self.status, 0, "{all}");
         assert!(self.device.contains("no safety stop"), "{all}");
-        assert!(self.created <= 1e-3, "books: created {} J\n{all}", self.created);
+        assert!(
+            self.created <= 1e-3,
+            "books: created {} J\n{all}",
+            self.created
+        );
         assert!(
             self.plants_created <= 1e-3,
             "plants: created {} J\n{all}",
@@ -226,7 +230,10 @@ impl Pushed {
             (49.0..80.0).contains(&rtt),
             "round trip p50 {rtt} ms\n{all}"
         );
-        assert!(number(&self.device, "link: ", "send errors, ") > 20.0, "{all}");
+        assert!(
+            number(&self.device, "link: ", "send errors, ") > 20.0,
+            "{all}"
+        );
         assert!(
             self.world.contains("the device side closed the session"),
             "{all}"
@@ -479,13 +486,24 @@ fn run_refuses_split_loop_options_without_world_and_local_world_options_with_it(
     }
 }
 
+/// `haptic2d teleop ARGS…`, which must succeed: its output, and the last second of contact's mean
+/// wall force on the slave and force of the master on the hand (N).
+fn teleop_contact(args: &[&str]) -> (String, f64, f64) {
+    let o = crate::common::haptic2d(&[&["teleop"], args].concat());
+    let t = crate::common::text(&o);
+    assert!(o.status.success(), "{t}");
+    let contact = "contact (last second):";
+    let wall = number(&t, contact, "wall force on the slave ");
+    let felt = number(&t, contact, "force of the master on the hand ");
+    (t, wall, felt)
+}
+
 /// `haptic2d teleop` with two simulated devices: the slave's wall contact is felt at the master
 /// (static force `(15 − 5) mm / (1/300 + 1/500 + 1/2000) m/N = 1.76 N`, device friction aside),
 /// and at a 50 ms round trip with 5 % loss the link creates no energy.
 #[test]
 fn teleop_of_two_simulated_devices_reproduces_the_wall_contact_at_the_master() {
-    let o = crate::common::haptic2d(&[
-        "teleop",
+    let args = [
         "--master",
         "sim",
         "--slave",
@@ -494,15 +512,8 @@ fn teleop_of_two_simulated_devices_reproduces_the_wall_contact_at_the_master() {
         "25",
         "--loss",
         "0.05",
-    ]);
-    let t = crate::common::text(&o);
-    assert!(o.status.success(), "{t}");
-    let wall = number(&t, "contact (last second):", "wall force on the slave ");
-    let felt = number(
-        &t,
-        "contact (last second):",
-        "force of the master on the hand ",
-    );
+    ];
+    let (t, wall, felt) = teleop_contact(&args);
     assert!((1.4..2.1).contains(&wall), "{t}");
     assert!((felt - wall).abs() < 0.1 * wall, "{t}");
     assert!(number(&t, "network:", "created ") <= 1e-3, "{t}");
@@ -517,23 +528,15 @@ fn teleop_of_two_simulated_devices_reproduces_the_wall_contact_at_the_master() {
 /// 50 ms round trip, where position–force runs away (docs/TELEOP.md).
 #[test]
 fn teleop_four_channel_feels_the_wall_with_master_and_slave_together_even_at_50_ms_without_tdpa() {
-    let o = crate::common::haptic2d(&[
-        "teleop",
+    let args = [
         "--architecture",
         "four-channel",
         "--delay-ms",
         "25",
         "--no-tdpa",
-    ]);
-    let t = crate::common::text(&o);
-    assert!(o.status.success(), "{t}");
+    ];
+    let (t, wall, felt) = teleop_contact(&args);
     assert!(t.contains("four-channel"), "{t}");
-    let wall = number(&t, "contact (last second):", "wall force on the slave ");
-    let felt = number(
-        &t,
-        "contact (last second):",
-        "force of the master on the hand ",
-    );
     assert!((2.26..2.96).contains(&wall), "{t}");
     assert!((felt - wall).abs() < 0.1 * wall, "{t}");
     assert!(

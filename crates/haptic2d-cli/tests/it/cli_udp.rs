@@ -34,7 +34,9 @@ fn sim_device(extra: &[&str]) -> Device {
     let mut python = Command::new("python3");
     python.arg("--version").stdout(Stdio::null());
     if python.status().is_err() {
-        panic!("python3 not found: this test needs it (bash scripts/install-test-deps.sh installs it)");
+        panic!(
+            "python3 not found: this test needs it (bash scripts/install-test-deps.sh installs it)"
+        );
     }
     let mut c = Command::new("python3");
     c.arg(root().join("devices/udp/sim_device.py"))

@@ -217,14 +217,19 @@ pub fn ends_within<S: AsRef<OsStr> + std::fmt::Debug>(
     (code, out)
 }
 
-/// The "N ticks" of a run's timing summary.
-pub fn summary_ticks(out: &str) -> u64 {
+/// The first whole number `N` that stands before the word `word` ("N ticks", "N samples") in `out`.
+pub fn count_of(out: &str, word: &str) -> u64 {
     out.split_whitespace()
         .collect::<Vec<_>>()
         .windows(2)
-        .find(|w| w[1] == "ticks")
+        .find(|w| w[1] == word)
         .and_then(|w| w[0].parse().ok())
-        .unwrap_or_else(|| panic!("no tick count in:\n{out}"))
+        .unwrap_or_else(|| panic!("no {word} count in:\n{out}"))
+}
+
+/// The "N ticks" of a run's timing summary.
+pub fn summary_ticks(out: &str) -> u64 {
+    count_of(out, "ticks")
 }
 
 /// A CSV log read whole: the column index of each name (panicking on a missing one) and the rows as

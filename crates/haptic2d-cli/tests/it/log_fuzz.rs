@@ -4,7 +4,6 @@
 //! bulk of the fuzzing runs in-process in haptic2d-rt's tests/log_fuzz.rs (1 200 MCAP and 1 200
 //! CSV cases); this runs a few dozen through the binary, which adds the commands' own code.
 
-
 use crate::common::{run, run_ok};
 use std::time::Duration;
 
@@ -65,7 +64,15 @@ fn ends_as_documented(args: &[&str]) -> i32 {
 
 /// `run --headless --no-rt --device REPLAY --duration 1`.
 fn replay_run(replay: &str) -> Vec<&str> {
-    vec!["run", "--headless", "--no-rt", "--device", replay, "--duration", "1"]
+    vec![
+        "run",
+        "--headless",
+        "--no-rt",
+        "--device",
+        replay,
+        "--duration",
+        "1",
+    ]
 }
 
 #[test]

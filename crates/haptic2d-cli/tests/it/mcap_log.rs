@@ -3,8 +3,7 @@
 //! conversion is lossless; `--device replay:x.mcap` replays a recording; `simulate --out x.mcap`;
 //! the Foxglove live server serves a loopback client and survives a malformed message.
 
-
-use crate::common::{haptic2d, run, run_ok, text};
+use crate::common::{haptic2d, run_ok, text};
 use haptic2d_rt::mcap::columns::{TickRow, Val, LOOP_COLUMN_COUNT, TICK_TABLE};
 use haptic2d_rt::mcap::reader::{read_file, read_info, read_ticks};
 use haptic2d_rt::mcap::schemas::*;
@@ -12,7 +11,7 @@ use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::Duration;
 
-use crate::common::summary_ticks;
+use crate::common::{count_of, summary_ticks};
 
 fn run_logged(log: &Path, extra: &[&str]) -> String {
     let mut args = vec![
@@ -314,16 +313,8 @@ fn replay_of_a_run_csv_log_reproduces_its_device_motion() {
 fn simulate_out_mcap_writes_every_sample_of_the_world() {
     let dir = tempfile::tempdir().unwrap();
     let m = dir.path().join("sim.mcap");
-    let o = run("simulate box-in-walls --duration 0.5 --out {}", &[&m]);
-    let out = text(&o);
-    assert!(o.status.success(), "{out}");
-    let samples: u64 = out
-        .split_whitespace()
-        .collect::<Vec<_>>()
-        .windows(2)
-        .find(|w| w[1] == "samples")
-        .and_then(|w| w[0].parse().ok())
-        .unwrap_or_else(|| panic!("no sample count in {out}"));
+    let out = run_ok("simulate box-in-walls --duration 0.5 --out {}", &[&m]);
+    let samples = count_of(&out, "samples");
     assert!(samples > 100, "{out}");
     let bytes = read_file(&m).unwrap();
     let info = read_info(&bytes, "sim.mcap").unwrap();
@@ -601,7 +592,8 @@ fn simulate_mcap_then(sig: libc::c_int) -> (Option<i32>, Option<i32>) {
     }
     // SAFETY: kill(2) on the pid of a child we spawned and have not reaped.
     assert_eq!(unsafe { libc::kill(child.id() as libc::pid_t, sig) }, 0);
-    let Some((status, text)) = crate::common::wait_with_limit(child, Duration::from_secs(30)) else {
+    let Some((status, text)) = crate::common::wait_with_limit(child, Duration::from_secs(30))
+    else {
         panic!("did not exit within 30 s of the signal");
     };
     assert!(!text.contains("panicked"), "{text}");

@@ -19,7 +19,6 @@
 //! `cargo test -p haptic2d-cli [--features inverse3] --test it tutorials_under_load:: -- --ignored
 //! --test-threads 1`.
 
-
 use crate::common::{root, turn, wait_with_limit};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
@@ -309,6 +308,25 @@ fn tutorial(name: &str, mut start: impl FnMut(&Path) -> (Device, Vec<String>)) {
     );
 }
 
+/// Starts a tutorial's device command `line` in `dir` and fills the address it announced into the
+/// host's command: the device's first line must start with `prefix`; the `placeholder` of `host`
+/// becomes `scheme` followed by the rest of that line. The device and the host's command.
+fn start_and_fill(
+    line: &[String],
+    dir: &Path,
+    prefix: &str,
+    host: &str,
+    (placeholder, scheme): (&str, &str),
+) -> (Device, Vec<String>) {
+    let mut d = Device::start(command(line, dir), dir);
+    let first = d.first_line();
+    let found = first
+        .strip_prefix(prefix)
+        .unwrap_or_else(|| panic!("first line `{first}`"));
+    let host = fill(host, &[(placeholder, &format!("{scheme}{found}"))]);
+    (d, host)
+}
+
 /// docs/HARDWARE.md, "Quick start": `haptic2d emulate haply` and `run --device haply:PTY` on the
 /// pseudo-terminal it printed.
 fn haply(tutorial_name: &str, emulate: &str, run: &str) {
@@ -318,13 +336,8 @@ fn haply(tutorial_name: &str, emulate: &str, run: &str) {
         doc_line(&hw, "HARDWARE.md", run),
     );
     tutorial(tutorial_name, |dir| {
-        let mut d = Device::start(command(&fill(&emu, &[]), dir), dir);
-        let pty = d.first_line();
-        let path = pty
-            .strip_prefix("pty: ")
-            .unwrap_or_else(|| panic!("first line `{pty}`"));
-        let host = fill(&host, &[("haply:/dev/pts/N", &format!("haply:{path}"))]);
-        (d, host)
+        let pty = ("haply:/dev/pts/N", "haply:");
+        start_and_fill(&fill(&emu, &[]), dir, "pty: ", &host, pty)
     });
 }
 
@@ -384,13 +397,8 @@ fn udp(name: &str, device: &str, prepare: Option<&str>) {
             ready = true;
         }
         let w = fill(&dev, &[("127.0.0.1:5005", "127.0.0.1:0")]);
-        let mut d = Device::start(command(&w, dir), dir);
-        let first = d.first_line();
-        let addr = first
-            .strip_prefix("listening on ")
-            .unwrap_or_else(|| panic!("first line `{first}`"));
-        let host = fill(&host, &[("udp:127.0.0.1:5005", &format!("udp:{addr}"))]);
-        (d, host)
+        let addr = ("udp:127.0.0.1:5005", "udp:");
+        start_and_fill(&w, dir, "listening on ", &host, addr)
     });
 }
 
@@ -435,16 +443,8 @@ fn inverse3_emulator_tutorial_runs_clean_ten_times_under_load() {
         "haptic2d run --device inverse3:http://127.0.0.1:N",
     );
     tutorial("Inverse3 emulator", |dir| {
-        let mut d = Device::start(command(&fill(&emu, &[]), dir), dir);
-        let first = d.first_line();
-        let url = first
-            .strip_prefix("listening: ")
-            .unwrap_or_else(|| panic!("first line `{first}`"));
-        let host = fill(
-            &host,
-            &[("inverse3:http://127.0.0.1:N", &format!("inverse3:{url}"))],
-        );
-        (d, host)
+        let url = ("inverse3:http://127.0.0.1:N", "inverse3:");
+        start_and_fill(&fill(&emu, &[]), dir, "listening: ", &host, url)
     });
 }
 
