@@ -103,9 +103,9 @@ fn emulator_killed_mid_run_exits_4_naming_the_device() {
     assert_lacks(&out, &["non-finite device input"]);
 }
 
-/// `device check FILE --pulse` against an emulator of `board` (started for it, at the rest pose):
-/// the exit code and the output.
-fn device_check(board: &Path, file: &Path) -> (Option<i32>, String) {
+/// `device check FILE --pulse` against an emulator of `board` (started for it, at the rest pose),
+/// which must exit with `code` and say every one of `needles`: its output.
+fn device_check(board: &Path, file: &Path, code: i32, needles: &[&str]) -> String {
     let (emu, pty) = emulate_haply(board, &[]);
     let device = format!("haply:{pty}");
     let o = run(
@@ -113,7 +113,7 @@ fn device_check(board: &Path, file: &Path) -> (Option<i32>, String) {
         &[&device, &file],
     );
     interrupt(emu);
-    (o.status.code(), text(&o))
+    expect_exit(&o, code, needles)
 }
 
 /// Issue 34 finding 1: against a board that sets its encoders at setup, `device check` said "far
@@ -124,29 +124,21 @@ fn device_check_passes_on_a_correct_board_held_at_rest_and_finds_a_flipped_motor
     let _turn = turn();
     let dir = tempfile::tempdir().unwrap();
     let good = device_file(dir.path(), "gen3.toml", |t| t);
-    let (code, out) = device_check(&good, &good);
-    assert_eq!(code, Some(0), "{out}");
-    assert_has(
-        &out,
-        &[
-            "rest pose: end point (0.0190 m, 0.0357 m)",
-            "ok:",
-            "stock firmware",
-            "no watchdog",
-        ],
-    );
+    let passes = [
+        "rest pose: end point (0.0190 m, 0.0357 m)",
+        "ok:",
+        "stock firmware",
+        "no watchdog",
+    ];
+    device_check(&good, &good, 0, &passes);
     // The host's file says motor 1 turns CW (its encoder still CCW): the emulated board (a fresh
     // one, at the rest pose), wired CCW, pushes that link backwards.
     let flipped = device_file(dir.path(), "flipped.toml", motor1_flipped);
-    let (code, out) = device_check(&good, &flipped);
-    assert_eq!(code, Some(2), "{out}");
-    assert_has(
-        &out,
-        &[
-            "fix: motor[0] turns its link clockwise",
-            "flip motor[0].direction",
-        ],
-    );
+    let fix = [
+        "fix: motor[0] turns its link clockwise",
+        "flip motor[0].direction",
+    ];
+    device_check(&good, &flipped, 2, &fix);
 }
 
 /// Issue 34 finding 8: a joint whose motor AND encoder are both reversed read "+" like a correct
@@ -158,9 +150,8 @@ fn device_check_tells_a_reversed_motor_and_encoder_from_a_correct_joint() {
     let good = device_file(dir.path(), "gen3.toml", |t| t);
     // The emulated board is wired with motor 1 and its encoder both reversed against the file.
     let board = device_file(dir.path(), "board.toml", joint1_reversed);
-    let (code, out) = device_check(&board, &good);
-    assert_eq!(code, Some(2), "{out}");
-    assert_has(&out, &["motor[0]'s motor AND encoder are both reversed"]);
+    let both = ["motor[0]'s motor AND encoder are both reversed"];
+    let out = device_check(&board, &good, 2, &both);
     // Both joints' angles still grow under a positive torque, as on a correct board.
     assert_eq!(out.matches("angle +").count(), 2, "{out}");
 }
@@ -172,19 +163,14 @@ fn device_check_on_the_twin_finds_a_joint_with_motor_and_encoder_reversed() {
     let _turn = turn();
     let dir = tempfile::tempdir().unwrap();
     let good = twin_file(dir.path(), "twin.toml", |t| t);
-    let (code, out) = device_check(&good, &good);
-    assert_eq!(code, Some(0), "{out}");
+    device_check(&good, &good, 0, &[]);
     let board = twin_file(dir.path(), "board.toml", joint1_reversed);
-    let (code, out) = device_check(&board, &good);
-    assert_eq!(code, Some(2), "{out}");
+    let closure = [
+        "no longer describe one rigid handle",
+        "under motor[0]'s pulse",
+    ];
+    let out = device_check(&board, &good, 2, &closure);
     assert_eq!(out.matches("angle +").count(), 4, "{out}");
-    assert_has(
-        &out,
-        &[
-            "no longer describe one rigid handle",
-            "under motor[0]'s pulse",
-        ],
-    );
 }
 
 /// Issue 34 finding 4 / item 7: the twin on an M0 ended with "check the USB cable" although the

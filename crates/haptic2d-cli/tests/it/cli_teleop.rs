@@ -13,7 +13,7 @@
 //! the tests take turns.
 
 use std::io::{BufRead, BufReader, Read};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::sync::mpsc;
 use std::time::Duration;
@@ -82,20 +82,25 @@ impl Drop for World {
     }
 }
 
+/// `haptic2d ARGS… --key KEY EXTRA…` started with its output piped: either end of the split loop.
+fn spawn_keyed(args: &[&str], key: &Path, extra: &[&str]) -> Child {
+    Command::new(BIN)
+        .args(args)
+        .arg("--key")
+        .arg(key)
+        .args(extra)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
 impl World {
     fn start(key: &PathBuf, extra: &[&str]) -> World {
         let scene = key.with_file_name("near-wall.toml");
         std::fs::write(&scene, NEAR_WALL).unwrap();
-        let mut child = Command::new(BIN)
-            .arg("serve-world")
-            .arg(&scene)
-            .args(["--bind", "127.0.0.1:0", "--key"])
-            .arg(key)
-            .args(extra)
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap();
+        let scene = scene.to_str().unwrap();
+        let mut child = spawn_keyed(&["serve-world", scene, "--bind", "127.0.0.1:0"], key, extra);
         let (tx, lines) = mpsc::channel();
         let out = child.stdout.take().unwrap();
         std::thread::spawn(move || {
@@ -150,15 +155,8 @@ fn device(world: &World, key: &PathBuf, extra: &[&str]) -> (i32, String) {
 
 /// The device side started as `command` (`run …` or the alias `remote-device`).
 fn device_as(command: &[&str], world: &World, key: &PathBuf, extra: &[&str]) -> (i32, String) {
-    let child = Command::new(BIN)
-        .args(command)
-        .args(["--world", &format!("udp:{}", world.addr), "--key"])
-        .arg(key)
-        .args(extra)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
+    let addr = format!("udp:{}", world.addr);
+    let child = spawn_keyed(&[command, &["--world", &addr]].concat(), key, extra);
     let (status, text) =
         wait_with_limit(child, Duration::from_secs(60)).expect("remote-device ends in time");
     (status.code().unwrap_or(-1), text)
