@@ -96,7 +96,7 @@ fn spawn_keyed(args: &[&str], key: &Path, extra: &[&str]) -> Child {
 }
 
 impl World {
-    fn start(key: &PathBuf, extra: &[&str]) -> World {
+    fn start(key: &Path, extra: &[&str]) -> World {
         let scene = key.with_file_name("near-wall.toml");
         std::fs::write(&scene, NEAR_WALL).unwrap();
         let scene = scene.to_str().unwrap();
@@ -149,12 +149,12 @@ impl World {
 }
 
 /// The device side as `run --device sim --world udp:…`.
-fn device(world: &World, key: &PathBuf, extra: &[&str]) -> (i32, String) {
+fn device(world: &World, key: &Path, extra: &[&str]) -> (i32, String) {
     device_as(&["run", "--device", "sim"], world, key, extra)
 }
 
 /// The device side started as `command` (`run …` or the alias `remote-device`).
-fn device_as(command: &[&str], world: &World, key: &PathBuf, extra: &[&str]) -> (i32, String) {
+fn device_as(command: &[&str], world: &World, key: &Path, extra: &[&str]) -> (i32, String) {
     let addr = format!("udp:{}", world.addr);
     let child = spawn_keyed(&[command, &["--world", &addr]].concat(), key, extra);
     let (status, text) =

@@ -1,10 +1,9 @@
 //! Helpers shared by the CLI end-to-end tests (the modules of the `it` binary); the
 //! crate-independent ones live in haptic2d-test-support.
-#![allow(dead_code, unused_imports)]
 
 pub use haptic2d_test_support::files::{repo_root as root, temp_dir, write_in};
 pub use haptic2d_test_support::process::{signal, spawn_announced, text, wait_with_limit, Killed};
-pub use haptic2d_test_support::{holds_for, wait_for, wait_until};
+pub use haptic2d_test_support::{holds_for, wait_for};
 
 use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
