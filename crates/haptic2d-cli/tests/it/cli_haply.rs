@@ -40,6 +40,7 @@ fn haply_run(pty: &str, file: &Path, duration: &str) -> Command {
 
 /// A `haptic2d run` of `secs` seconds against the emulator started on `file` with `emu_args`,
 /// logged to `dir/run.csv`, which must end clean: the pty, the run's output and the log's text.
+#[track_caller]
 fn clean_logged_run(
     dir: &Path,
     file: &Path,
@@ -105,6 +106,7 @@ fn emulator_killed_mid_run_exits_4_naming_the_device() {
 
 /// `device check FILE --pulse` against an emulator of `board` (started for it, at the rest pose),
 /// which must exit with `code` and say every one of `needles`: its output.
+#[track_caller]
 fn device_check(board: &Path, file: &Path, code: i32, needles: &[&str]) -> String {
     let (emu, pty) = emulate_haply(board, &[]);
     let device = format!("haply:{pty}");

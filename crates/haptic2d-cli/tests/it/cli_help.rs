@@ -9,6 +9,7 @@ use crate::common::{haptic2d, text};
 const MAX_COLUMNS: usize = 100;
 
 /// `haptic2d WORDS… --help`, which must succeed with no line wider than [`MAX_COLUMNS`]: the help.
+#[track_caller]
 fn narrow_help(words: &[&str]) -> String {
     let o = haptic2d(&[words, &["--help"]].concat());
     let help = text(&o);

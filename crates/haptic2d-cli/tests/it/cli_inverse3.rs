@@ -42,6 +42,7 @@ fn run(url: &str, file: &Path, duration: &str) -> Command {
 /// A 3 s `run --controller coupling` against an emulator started with `emu_args` (killed after),
 /// logged into the temp dir of the device file `tag`: the run's output (asserted to exit 0) and the
 /// log's path.
+#[track_caller]
 fn coupling_run(emu_args: &[&str], tag: &str) -> (String, PathBuf) {
     let emu = emulator(emu_args);
     let file = device_file(tag);

@@ -209,6 +209,7 @@ impl Pushed {
     /// no energy created (≤ 1 mJ) by the ports' books nor as the plants received it, the delay and
     /// the loss really there (round trip p50 in 49–80 ms, over 20 datagrams dropped), and the
     /// session closed by the device side. Both processes' output.
+    #[track_caller]
     fn assert_passive(&self) -> String {
         let all = self.all();
         assert_eq!(self.status, 0, "{all}");
@@ -486,6 +487,7 @@ fn run_refuses_split_loop_options_without_world_and_local_world_options_with_it(
 
 /// `haptic2d teleop ARGS…`, which must succeed: its output, and the last second of contact's mean
 /// wall force on the slave and force of the master on the hand (N).
+#[track_caller]
 fn teleop_contact(args: &[&str]) -> (String, f64, f64) {
     let o = crate::common::haptic2d(&[&["teleop"], args].concat());
     let t = crate::common::text(&o);

@@ -42,6 +42,7 @@ pub fn run(line: &str, paths: &[&dyn AsRef<OsStr>]) -> Output {
 }
 
 /// [`run`], asserting it succeeded; stdout followed by stderr.
+#[track_caller]
 pub fn run_ok(line: &str, paths: &[&dyn AsRef<OsStr>]) -> String {
     let o = run(line, paths);
     let out = text(&o);
@@ -51,6 +52,7 @@ pub fn run_ok(line: &str, paths: &[&dyn AsRef<OsStr>]) -> String {
 
 /// Panics unless `out` contains every one of `needles` (the message names the missing one and
 /// shows `out` whole).
+#[track_caller]
 pub fn assert_has(out: &str, needles: &[&str]) {
     for n in needles {
         assert!(out.contains(n), "no `{n}` in:\n{out}");
@@ -58,6 +60,7 @@ pub fn assert_has(out: &str, needles: &[&str]) {
 }
 
 /// Panics if `out` contains any of `needles`.
+#[track_caller]
 pub fn assert_lacks(out: &str, needles: &[&str]) {
     for n in needles {
         assert!(!out.contains(n), "`{n}` in:\n{out}");
@@ -66,6 +69,7 @@ pub fn assert_lacks(out: &str, needles: &[&str]) {
 
 /// The stdout and stderr of `o`, asserting that it exited with `code` and that they contain every
 /// one of `needles`.
+#[track_caller]
 pub fn expect_exit(o: &Output, code: i32, needles: &[&str]) -> String {
     let out = text(o);
     assert_eq!(o.status.code(), Some(code), "{out}");
@@ -75,6 +79,7 @@ pub fn expect_exit(o: &Output, code: i32, needles: &[&str]) -> String {
 
 /// A run that lost its device (the exit code and output of [`cut_mid_run`] or a run): exit 4, the
 /// output names `device` and has every one of `needles`, and nothing panicked.
+#[track_caller]
 pub fn assert_lost_device(code: Option<i32>, out: &str, device: &str, needles: &[&str]) {
     assert_eq!(code, Some(4), "{out}");
     assert_has(out, &[device]);

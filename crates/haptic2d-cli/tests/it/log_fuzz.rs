@@ -52,6 +52,7 @@ fn mutate(seed: &[u8], rng: &mut Rng, lens: &[usize]) -> Vec<u8> {
 
 /// Runs `args` with a 30 s limit and asserts it ended as documented: exit 0, 2 (with an `error:`
 /// line) or 3, no panic, no signal, no hang. Its exit code.
+#[track_caller]
 fn ends_as_documented(args: &[&str]) -> i32 {
     let (code, out) = crate::common::ends_within(args, Duration::from_secs(30));
     assert!(!out.contains("panicked"), "{args:?}:\n{out}");
