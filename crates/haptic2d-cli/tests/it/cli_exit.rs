@@ -35,6 +35,7 @@ const BOX_IN_WALLS: &str = include_str!("../../../../scenes/box-in-walls.toml");
 
 #[test]
 fn help_lists_the_exit_codes() {
+    let _m = crate::common::module_turn(module_path!());
     let out = assert_exit(&["--help"], 0, "Exit codes:");
     for c in ["0 ", "1 ", "2 ", "3 ", "4 ", "5 ", "6 ", "130 "] {
         assert!(
@@ -46,6 +47,7 @@ fn help_lists_the_exit_codes() {
 
 #[test]
 fn a_clean_simulate_exits_0() {
+    let _m = crate::common::module_turn(module_path!());
     assert_exit(
         &["simulate", "box-in-walls", "--duration", "0.5"],
         0,
@@ -55,6 +57,7 @@ fn a_clean_simulate_exits_0() {
 
 #[test]
 fn bad_scene_exits_2_naming_the_field() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let r1 = write(
         &dir,
@@ -67,11 +70,13 @@ fn bad_scene_exits_2_naming_the_field() {
 
 #[test]
 fn check_dev_zero_is_a_bounded_read_and_a_clear_error() {
+    let _m = crate::common::module_turn(module_path!());
     assert_exit(&["check", "/dev/zero"], 2, "larger than the documented cap");
 }
 
 #[test]
 fn run_rate_above_cap_is_rejected_before_allocating_the_ring() {
+    let _m = crate::common::module_turn(module_path!());
     // Today's `--rate 1e9` sized a 624 GB telemetry ring.
     let _turn = crate::common::turn(); // one real-time loop at a time
     assert_exit(
@@ -85,6 +90,7 @@ fn run_rate_above_cap_is_rejected_before_allocating_the_ring() {
 
 #[test]
 fn run_duration_1e300_is_a_clear_error_not_a_panic() {
+    let _m = crate::common::module_turn(module_path!());
     let _turn = crate::common::turn(); // one real-time loop at a time
     assert_exit(
         &["run", "--headless", "--no-rt", "--duration", "1e300"],
@@ -95,6 +101,7 @@ fn run_duration_1e300_is_a_clear_error_not_a_panic() {
 
 #[test]
 fn simulate_duration_1e300_is_a_clear_error() {
+    let _m = crate::common::module_turn(module_path!());
     assert_exit(
         &["simulate", "box-in-walls", "--duration", "1e300"],
         2,
@@ -116,6 +123,7 @@ fn simulate_duration_1e300_is_a_clear_error() {
 
 #[test]
 fn pile_count_above_cap_exits_2() {
+    let _m = crate::common::module_turn(module_path!());
     assert_exit(
         &["check", "pile:100000000000"],
         2,
@@ -125,6 +133,7 @@ fn pile_count_above_cap_exits_2() {
 
 #[test]
 fn overlapping_bodies_are_an_error_in_check_unless_accepted() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     // The box's face 5 mm inside the left wall (face at x = 0; half width 0.02 m).
     let text = BOX_IN_WALLS.replace("position = [0.04, 0.0]", "position = [0.015, 0.0]");
@@ -155,6 +164,7 @@ fn overlapping_bodies_are_an_error_in_check_unless_accepted() {
 
 #[test]
 fn energy_excess_is_a_warning_and_exit_5_with_strict() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     // The pure-stiffness ZOH wall under exact-ZOH integration gains energy at every bounce (§5.10).
     let zoh = BOX_IN_WALLS
@@ -200,6 +210,7 @@ fn energy_excess_is_a_warning_and_exit_5_with_strict() {
 
 #[test]
 fn divergence_is_detected_before_the_row_is_written_and_exits_6() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     // 1e6 m/s² on a free body: the speed passes the divergence bound (1e6 m/s) after 1 s.
     let scene = r#"
@@ -248,6 +259,7 @@ per_mass = true
 
 #[test]
 fn a_safety_stop_in_run_exits_3() {
+    let _m = crate::common::module_turn(module_path!());
     let _turn = crate::common::turn(); // one real-time loop at a time
     let dir = tempfile::tempdir().unwrap();
     // Encoder angles of zero are no pose of the device: the closure monitor trips on tick 0.
@@ -269,6 +281,7 @@ fn a_safety_stop_in_run_exits_3() {
 
 #[test]
 fn clap_usage_errors_exit_2() {
+    let _m = crate::common::module_turn(module_path!());
     assert_exit(&["simulate", "box-in-walls", "--bogus"], 2, "--bogus");
 }
 
@@ -315,6 +328,7 @@ fn hostile_logs(dir: &tempfile::TempDir) -> (String, String) {
 /// 130 in tests/it/cli_signals.rs and tests/it/mcap_log.rs.)
 #[test]
 fn every_command_ends_with_its_documented_exit_code_and_message() {
+    let _m = crate::common::module_turn(module_path!());
     let _turn = crate::common::turn(); // one real-time loop at a time
     let dir = tempfile::tempdir().unwrap();
     let zero_replay = write(&dir, "zero.csv", "q1,q2,q3,q4\n0,0,0,0\n0,0,0,0\n");
@@ -460,6 +474,7 @@ fn every_command_ends_with_its_documented_exit_code_and_message() {
 
 #[test]
 fn dev_zero_as_a_log_is_refused_at_once() {
+    let _m = crate::common::module_turn(module_path!());
     let _turn = crate::common::turn(); // one real-time loop at a time
     let t0 = std::time::Instant::now();
     // As a CSV log (no .mcap extension): its first byte is a NUL.

@@ -98,6 +98,7 @@ fn text_of(path: &Path) -> String {
 
 #[test]
 fn kill_9_of_run_against_our_firmware_zeroes_the_motors_within_the_watchdog_time() {
+    let _m = crate::common::module_turn(module_path!());
     let dir =
         Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("cli-firmware-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();

@@ -66,6 +66,7 @@ fn run(args: &[String]) -> i32 {
 
 #[test]
 fn hostile_cli_arguments_never_panic_abort_or_hang() {
+    let _m = crate::common::module_turn(module_path!());
     let mut rng = Rng(0x4841_5054_4943_3244);
     let mut cases: Vec<Vec<String>> = Vec::new();
     let s = |v: &[&str]| v.iter().map(|x| x.to_string()).collect::<Vec<_>>();

@@ -62,6 +62,7 @@ fn clean_logged_run(
 
 #[test]
 fn run_against_the_emulator_for_3_s_logs_and_exits_clean() {
+    let _m = crate::common::module_turn(module_path!());
     let _turn = turn();
     let dir = tempfile::tempdir().unwrap();
     let file = device_file(dir.path(), "gen3.toml", |t| t);
@@ -94,6 +95,7 @@ fn run_then_cut(cut: impl FnOnce(&mut crate::common::Killed)) -> (String, Option
 
 #[test]
 fn emulator_killed_mid_run_exits_4_naming_the_device() {
+    let _m = crate::common::module_turn(module_path!());
     let (pty, code, out) = run_then_cut(|emu| {
         emu.kill().unwrap();
         let _ = emu.wait();
@@ -123,6 +125,7 @@ fn device_check(board: &Path, file: &Path, code: i32, needles: &[&str]) -> Strin
 /// emulator's default start), a correct board now passes, and the check says which firmware it is.
 #[test]
 fn device_check_passes_on_a_correct_board_held_at_rest_and_finds_a_flipped_motor() {
+    let _m = crate::common::module_turn(module_path!());
     let _turn = turn();
     let dir = tempfile::tempdir().unwrap();
     let good = device_file(dir.path(), "gen3.toml", |t| t);
@@ -147,6 +150,7 @@ fn device_check_passes_on_a_correct_board_held_at_rest_and_finds_a_flipped_motor
 /// one. The other joint's motion under the pulse (the five-bar's coupling) now tells them apart.
 #[test]
 fn device_check_tells_a_reversed_motor_and_encoder_from_a_correct_joint() {
+    let _m = crate::common::module_turn(module_path!());
     let _turn = turn();
     let dir = tempfile::tempdir().unwrap();
     let good = device_file(dir.path(), "gen3.toml", |t| t);
@@ -162,6 +166,7 @@ fn device_check_tells_a_reversed_motor_and_encoder_from_a_correct_joint() {
 /// angle still grows, and the closure of the readings under the pulses gives it away.
 #[test]
 fn device_check_on_the_twin_finds_a_joint_with_motor_and_encoder_reversed() {
+    let _m = crate::common::module_turn(module_path!());
     let _turn = turn();
     let dir = tempfile::tempdir().unwrap();
     let good = twin_file(dir.path(), "twin.toml", |t| t);
@@ -179,6 +184,7 @@ fn device_check_on_the_twin_finds_a_joint_with_motor_and_encoder_reversed() {
 /// board answered. It is refused at open, naming the port count, before any torque.
 #[test]
 fn twin_on_an_m0_board_is_refused_naming_the_port_count() {
+    let _m = crate::common::module_turn(module_path!());
     let _turn = turn();
     let dir = tempfile::tempdir().unwrap();
     let file = twin_file(dir.path(), "twin.toml", |t| t);
@@ -191,6 +197,7 @@ fn twin_on_an_m0_board_is_refused_naming_the_port_count() {
 
 #[test]
 fn missing_port_and_bad_device_file_are_clear_errors() {
+    let _m = crate::common::module_turn(module_path!());
     let o = run(
         "run --device haply:/dev/no-such-board --headless --duration 1",
         &[],
@@ -214,6 +221,7 @@ fn missing_port_and_bad_device_file_are_clear_errors() {
 
 #[test]
 fn devices_lists_ports_without_failing() {
+    let _m = crate::common::module_turn(module_path!());
     run_ok("devices", &[]);
 }
 
@@ -223,6 +231,7 @@ fn devices_lists_ports_without_failing() {
 /// limit.
 #[test]
 fn haply_run_is_the_normal_loop_torques_start_at_zero_ramp_in_and_stay_clamped() {
+    let _m = crate::common::module_turn(module_path!());
     let _turn = turn();
     let dir = tempfile::tempdir().unwrap();
     let file = device_file(dir.path(), "gen3.toml", |t| t);
@@ -266,6 +275,7 @@ fn haply_run_is_the_normal_loop_torques_start_at_zero_ramp_in_and_stay_clamped()
 /// what to check — not a stall.
 #[test]
 fn a_silent_emulated_device_exits_4_with_the_reason() {
+    let _m = crate::common::module_turn(module_path!());
     let (pty, code, out) = run_then_cut(|emu| {
         // Stopped, then resumed and killed when the guard drops.
         signal(emu.id(), "-STOP");
@@ -285,6 +295,7 @@ fn a_silent_emulated_device_exits_4_with_the_reason() {
 /// every torque within the limit.
 #[test]
 fn twin_runs_through_the_normal_loop_against_the_emulator() {
+    let _m = crate::common::module_turn(module_path!());
     let _turn = turn();
     let dir = tempfile::tempdir().unwrap();
     let file = twin_file(dir.path(), "twin.toml", |t| t);
@@ -311,6 +322,7 @@ fn twin_runs_through_the_normal_loop_against_the_emulator() {
 /// with the hand released.
 #[test]
 fn stability_of_the_2diy_is_per_axis_x_and_y() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let file = crate::common::root().join("devices/haply-2diy-gen3.toml");
     let run = |controller: &str| {
@@ -333,6 +345,7 @@ fn stability_of_the_2diy_is_per_axis_x_and_y() {
 /// hand released (exit 2, nothing opened), unless `--allow-unstable`.
 #[test]
 fn run_refuses_an_unstable_released_configuration_on_a_haply_board() {
+    let _m = crate::common::module_turn(module_path!());
     let _turn = turn();
     let dir = tempfile::tempdir().unwrap();
     let file = device_file(dir.path(), "gen3.toml", |t| t);

@@ -27,6 +27,7 @@ fn narrow_help(words: &[&str]) -> String {
 
 #[test]
 fn every_command_help_has_examples_that_parse() {
+    let _m = crate::common::module_turn(module_path!());
     let screens: [&[&str]; 9] = [
         &["run"],
         &["simulate"],
@@ -68,6 +69,7 @@ fn every_command_help_has_examples_that_parse() {
 /// to the other emulator.
 #[test]
 fn an_unknown_option_before_help_is_refused() {
+    let _m = crate::common::module_turn(module_path!());
     let o = haptic2d(&["run", "--headles", "--help"]);
     assert!(!o.status.success(), "{}", text(&o));
     let o = haptic2d(&["emulate", "haply", "--bind", "127.0.0.1:0", "--help"]);
@@ -78,6 +80,7 @@ fn an_unknown_option_before_help_is_refused() {
 /// the subcommands listed.
 #[test]
 fn emulate_without_a_known_emulator_lists_haply_and_inverse3() {
+    let _m = crate::common::module_turn(module_path!());
     for args in [&["emulate"][..], &["emulate", "foo"]] {
         let o = haptic2d(args);
         let t = text(&o);
@@ -92,6 +95,7 @@ fn emulate_without_a_known_emulator_lists_haply_and_inverse3() {
 /// Every other help screen fits in the same width (the top level carries the exit codes).
 #[test]
 fn every_other_help_fits_in_100_columns() {
+    let _m = crate::common::module_turn(module_path!());
     let screens: [&[&str]; 8] = [
         &[],
         &["check"],

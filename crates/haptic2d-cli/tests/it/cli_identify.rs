@@ -54,6 +54,7 @@ fn identify(board: &Path, emu_args: &[&str], file: &Path, extra: &[&str]) -> Out
 /// are the emulated linkage's; `--write` stores them and `stability` says it uses them.
 #[test]
 fn device_identify_writes_the_emulated_inertia_and_the_gate_uses_it() {
+    let _m = crate::common::module_turn(module_path!());
     let _turn = turn();
     let dir = tempfile::tempdir().unwrap();
     let file = device_file(dir.path(), "gen3.toml", |t| t);
@@ -105,6 +106,7 @@ fn device_identify_writes_the_emulated_inertia_and_the_gate_uses_it() {
 /// identified and the fix names the field (exit 2).
 #[test]
 fn device_identify_detects_a_reversed_motor_and_a_reversed_motor_and_encoder() {
+    let _m = crate::common::module_turn(module_path!());
     let _turn = turn();
     let dir = tempfile::tempdir().unwrap();
     let good = device_file(dir.path(), "gen3.toml", |t| t);
@@ -133,6 +135,7 @@ fn device_identify_detects_a_reversed_motor_and_a_reversed_motor_and_encoder() {
 /// creeping about 1 cm/s against the hand's damping) is refused before any torque, exit 2.
 #[test]
 fn device_identify_refuses_a_handle_that_is_not_still_at_the_rest_pose() {
+    let _m = crate::common::module_turn(module_path!());
     let _turn = turn();
     let dir = tempfile::tempdir().unwrap();
     let file = device_file(dir.path(), "gen3.toml", |t| t);
@@ -148,6 +151,7 @@ fn device_identify_refuses_a_handle_that_is_not_still_at_the_rest_pose() {
 /// Bad options exit 2 before the device is opened: a pulse above the cap, --write on a built-in file.
 #[test]
 fn device_identify_refuses_bad_options_with_exit_2() {
+    let _m = crate::common::module_turn(module_path!());
     for (args, says) in [
         ("--torque 0.1", "--torque 0.1"),
         ("--write", "--write needs --device-file"),

@@ -27,6 +27,7 @@ fn run_into_closed_pipe(args: &[&str]) -> (Option<i32>, Option<i32>, String) {
 
 #[test]
 fn printing_commands_end_quietly_when_the_reader_closes_the_pipe() {
+    let _m = crate::common::module_turn(module_path!());
     for args in [
         &["scenes"][..],
         &["simulate", "box-in-walls", "--duration", "0.1"][..],
@@ -44,6 +45,7 @@ fn printing_commands_end_quietly_when_the_reader_closes_the_pipe() {
 
 #[test]
 fn run_ends_quietly_of_sigpipe_after_finishing_its_log_when_the_reader_is_gone() {
+    let _m = crate::common::module_turn(module_path!());
     // `haptic2d run … | head -1` panicked with exit 101 (issue 39); the run now finishes as it
     // would (torques zeroed, the MCAP log's footer written), then ends of SIGPIPE (shell 141).
     let dir = tempfile::tempdir().unwrap();

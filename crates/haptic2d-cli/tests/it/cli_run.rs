@@ -6,6 +6,7 @@ use std::process::Command;
 
 #[test]
 fn run_headless_one_second_prints_the_summary_and_logs_every_tick() {
+    let _m = crate::common::module_turn(module_path!());
     // One real-time loop at a time: two loops at SCHED_FIFO pinned to the same core starve
     // each other, and these tests check timing and the display.
     let _turn = turn();
@@ -41,6 +42,7 @@ fn run_headless_one_second_prints_the_summary_and_logs_every_tick() {
 
 #[test]
 fn run_rejects_bad_options_clearly() {
+    let _m = crate::common::module_turn(module_path!());
     for (args, needle) in [
         (
             vec!["run", "--controller", "pid", "--duration", "1"],
@@ -76,6 +78,7 @@ fn run_rejects_bad_options_clearly() {
 
 #[test]
 fn run_replays_recorded_encoders() {
+    let _m = crate::common::module_turn(module_path!());
     // One real-time loop at a time: two loops at SCHED_FIFO pinned to the same core starve
     // each other, and these tests check timing and the display.
     let _turn = turn();
@@ -223,6 +226,7 @@ fn slave_pose(f: &serde_json::Value) -> [f64; 3] {
 /// switches take effect. At the end of `--duration` it still prints its timing summary.
 #[test]
 fn run_display_serves_frames_and_applies_commands() {
+    let _m = crate::common::module_turn(module_path!());
     // One real-time loop at a time: two loops at SCHED_FIFO pinned to the same core starve
     // each other, and these tests check timing and the display.
     let _turn = turn();
@@ -318,6 +322,7 @@ fn run_display_serves_frames_and_applies_commands() {
 
 #[test]
 fn run_display_port_taken_is_a_clear_error() {
+    let _m = crate::common::module_turn(module_path!());
     // One real-time loop at a time: two loops at SCHED_FIFO pinned to the same core starve
     // each other, and these tests check timing and the display.
     let _turn = turn();
@@ -336,6 +341,7 @@ fn run_display_port_taken_is_a_clear_error() {
 
 #[test]
 fn run_display_on_a_non_loopback_address_prints_the_token() {
+    let _m = crate::common::module_turn(module_path!());
     // One real-time loop at a time: two loops at SCHED_FIFO pinned to the same core starve
     // each other, and these tests check timing and the display.
     let _turn = turn();
@@ -350,6 +356,7 @@ fn run_display_on_a_non_loopback_address_prints_the_token() {
 
 #[test]
 fn run_device_file() {
+    let _m = crate::common::module_turn(module_path!());
     // One real-time loop at a time: two loops at SCHED_FIFO pinned to the same core starve
     // each other, and these tests check timing and the display.
     let _turn = turn();

@@ -103,11 +103,13 @@ fn run_log_then(sig: libc::c_int) {
 
 #[test]
 fn sigterm_on_run_log_ends_on_a_whole_row_and_prints_the_summary() {
+    let _m = crate::common::module_turn(module_path!());
     run_log_then(libc::SIGTERM);
 }
 
 #[test]
 fn sigint_on_run_log_ends_on_a_whole_row_and_prints_the_summary() {
+    let _m = crate::common::module_turn(module_path!());
     run_log_then(libc::SIGINT);
 }
 
@@ -135,11 +137,13 @@ fn simulate_then(sig: libc::c_int) {
 
 #[test]
 fn sigterm_on_simulate_flushes_whole_rows_and_prints_the_summary() {
+    let _m = crate::common::module_turn(module_path!());
     simulate_then(libc::SIGTERM);
 }
 
 #[test]
 fn sigint_on_simulate_flushes_whole_rows_and_prints_the_summary() {
+    let _m = crate::common::module_turn(module_path!());
     simulate_then(libc::SIGINT);
 }
 
@@ -214,6 +218,7 @@ fn convert_then(sig: libc::c_int) -> (Option<i32>, Option<i32>, String, Vec<Stri
 /// leaves the older file of the output's name as it was; exit 130 with the reason.
 #[test]
 fn sigterm_during_log_convert_leaves_no_partial_file_and_the_old_output_untouched() {
+    let _m = crate::common::module_turn(module_path!());
     for sig in [libc::SIGTERM, libc::SIGINT] {
         let (code, _, text, names, content) = convert_then(sig);
         assert_eq!(code, Some(130), "signal {sig}:\n{text}");
@@ -227,6 +232,7 @@ fn sigterm_during_log_convert_leaves_no_partial_file_and_the_old_output_untouche
 /// untouched, and the process then ends of SIGPIPE (shell status 141) as a closed pipe says.
 #[test]
 fn sigpipe_during_log_convert_leaves_no_partial_file_then_ends_of_sigpipe() {
+    let _m = crate::common::module_turn(module_path!());
     let (code, signal, text, names, content) = convert_then(libc::SIGPIPE);
     assert_eq!((code, signal), (None, Some(libc::SIGPIPE)), "{text}");
     assert_eq!(names, ["big.csv", "out.mcap"], "no partial file left");
@@ -237,6 +243,7 @@ fn sigpipe_during_log_convert_leaves_no_partial_file_then_ends_of_sigpipe() {
 /// half-written (the rename is the last step).
 #[test]
 fn sigkill_during_log_convert_never_leaves_a_half_file_under_the_output_name() {
+    let _m = crate::common::module_turn(module_path!());
     let (_, signal, text, names, content) = convert_then(libc::SIGKILL);
     assert_eq!(signal, Some(libc::SIGKILL), "{text}");
     assert_eq!(content, b"the previous output");
@@ -250,6 +257,7 @@ fn sigkill_during_log_convert_never_leaves_a_half_file_under_the_output_name() {
 /// file; the result is a complete MCAP.
 #[test]
 fn log_convert_renames_its_complete_output_into_place() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let csv = big_tick_csv(dir.path(), 1000);
     let out = dir.path().join("out.mcap");
@@ -270,6 +278,7 @@ fn log_convert_renames_its_complete_output_into_place() {
 /// replaced by a rename: `log convert in.mcap FIFO` streams the CSV into the pipe.
 #[test]
 fn log_convert_into_a_named_pipe_writes_the_pipe_and_keeps_it() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let csv = big_tick_csv(dir.path(), 100);
     let mcap = dir.path().join("x.mcap");

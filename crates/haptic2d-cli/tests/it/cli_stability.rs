@@ -14,6 +14,7 @@ fn stability(args: &[&str], out: &std::path::Path) -> String {
 
 #[test]
 fn stability_prints_a_verdict_and_poles_per_axis_for_the_default() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let s = stability(&[], dir.path());
     println!("{s}");
@@ -29,6 +30,7 @@ fn stability_prints_a_verdict_and_poles_per_axis_for_the_default() {
 
 #[test]
 fn stability_shows_the_spec_configuration_unstable_released() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let s = stability(
         &[
@@ -47,6 +49,7 @@ fn stability_shows_the_spec_configuration_unstable_released() {
 
 #[test]
 fn stability_rejects_bad_options_with_a_message() {
+    let _m = crate::common::module_turn(module_path!());
     for (args, needle) in [
         (
             vec!["stability", "--controller", "nope"],
@@ -66,6 +69,7 @@ fn stability_rejects_bad_options_with_a_message() {
 /// the plot is named after the file.
 #[test]
 fn stability_reads_a_controller_file() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let root = crate::common::root();
     let paper = root.join("controllers/paper-4ch.toml");
@@ -93,6 +97,7 @@ fn stability_reads_a_controller_file() {
 /// A bad controller file is refused with the file, the field and the fix; unknown keys are refused.
 #[test]
 fn stability_refuses_a_bad_controller_file_naming_the_field() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     for (body, needles) in [
         (
@@ -143,6 +148,7 @@ fn stability_refuses_a_bad_controller_file_naming_the_field() {
 /// and runs; `reproduce fig8` carries the claims with the file's controller, labelled by the file.
 #[test]
 fn run_and_reproduce_accept_a_controller_file() {
+    let _m = crate::common::module_turn(module_path!());
     let _turn = crate::common::turn(); // one real-time loop at a time
     let dir = tempfile::tempdir().unwrap();
     let root = crate::common::root();

@@ -26,6 +26,7 @@ fn rows(path: &Path) -> usize {
 /// it and writes its table and plot.
 #[test]
 fn study_interrupted_by_sigint_resumes_with_no_trial_lost_or_repeated() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     // A longer session than the shipped one, so the signal lands mid-run.
     let long = dir.path().join("long.toml");
@@ -103,6 +104,7 @@ fn study_interrupted_by_sigint_resumes_with_no_trial_lost_or_repeated() {
 /// (exit 2, bad input); an observer that is not built is refused, not faked.
 #[test]
 fn study_check_and_run_refuse_bad_input_with_the_field_and_the_fix() {
+    let _m = crate::common::module_turn(module_path!());
     let o = run(&["study", "check", shipped().to_str().unwrap()]);
     assert!(o.status.success(), "{}", text(&o));
     assert!(

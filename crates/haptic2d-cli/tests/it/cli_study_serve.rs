@@ -102,6 +102,7 @@ fn error_of(v: &Value) -> String {
 /// until `end`; `stop` answers, zeroes the torques and exits 0.
 #[test]
 fn requests_are_answered_bad_ones_with_reasons_and_stop_exits_0() {
+    let _m = crate::common::module_turn(module_path!());
     let mut s = Served::start("follow", &[]);
     for (line, why) in [
         ("this is not json", "not JSON"),
@@ -199,6 +200,7 @@ fn requests_are_answered_bad_ones_with_reasons_and_stop_exits_0() {
 /// with exit 130, and the presentation's MCAP log is finished (`--out`).
 #[test]
 fn sigint_answers_the_pending_presentation_zeroes_the_torques_and_exits_130() {
+    let _m = crate::common::module_turn(module_path!());
     let out_dir = crate::common::temp_dir("cli-study-serve", "sigint");
     let out_arg = out_dir.display().to_string();
     let mut s = Served::start("follow", &["--out", &out_arg]);
@@ -225,6 +227,7 @@ fn sigint_answers_the_pending_presentation_zeroes_the_torques_and_exits_130() {
 /// its open-ended presentation, and the server serves the next client.
 #[test]
 fn a_second_client_is_refused_and_a_lost_clients_presentation_is_ended() {
+    let _m = crate::common::module_turn(module_path!());
     let mut s = Served::start("follow", &[]);
     let addr = s.conn.get_ref().peer_addr().unwrap();
     let a = s.ask(json!({"cmd": "present", "condition": "spring-1000"}));
@@ -265,6 +268,7 @@ fn a_second_client_is_refused_and_a_lost_clients_presentation_is_ended() {
 /// answered with the trip's reason, and a last line says why the server ended.
 #[test]
 fn a_safety_stop_answers_the_pending_presentation_with_the_trip_and_exits_3() {
+    let _m = crate::common::module_turn(module_path!());
     let mut s = Served::start("script:3.0,-50,0,0,10", &[]);
     let r = s.ask(json!({"cmd": "present", "condition": "spring-1000", "duration_s": 20}));
     let e = error_of(&r);
@@ -285,6 +289,7 @@ fn a_safety_stop_answers_the_pending_presentation_with_the_trip_and_exits_3() {
 /// ends the server as `haptic2d run`: exit 4, the pending presentation answered with the reason.
 #[test]
 fn a_lost_device_answers_the_pending_presentation_and_exits_4() {
+    let _m = crate::common::module_turn(module_path!());
     let (mut dev, dev_addr) = spawn_announced(
         Command::new("python3")
             .arg(crate::common::root().join("devices/udp/sim_device.py"))
@@ -310,6 +315,7 @@ fn a_lost_device_answers_the_pending_presentation_and_exits_4() {
 /// The server has no key: any address beyond loopback is refused before the device is opened.
 #[test]
 fn a_listen_address_beyond_loopback_is_refused() {
+    let _m = crate::common::module_turn(module_path!());
     let o = Command::new(BIN)
         .args(["study", "serve"])
         .arg(study())

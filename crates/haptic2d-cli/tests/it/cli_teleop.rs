@@ -304,6 +304,7 @@ fn pushed_into_the_wall_as(world_link: &str, device_link: &str, tag: &str) -> Pu
 #[test]
 fn with_tdpa_a_50_ms_round_trip_with_5_percent_loss_creates_no_energy_pushing_into_a_wall_and_the_world_books_the_body(
 ) {
+    let _m = crate::common::module_turn(module_path!());
     let _t = turn();
     let r = pushed_into_the_wall("tdpa", "tdpa");
     // Not only by the books: the plants really received no energy from the network (measured
@@ -331,6 +332,7 @@ fn with_tdpa_a_50_ms_round_trip_with_5_percent_loss_creates_no_energy_pushing_in
 
 #[test]
 fn without_tdpa_the_same_run_creates_energy() {
+    let _m = crate::common::module_turn(module_path!());
     let _t = turn();
     let r = pushed_into_the_wall("none", "none");
     let all = r.all();
@@ -349,6 +351,7 @@ fn without_tdpa_the_same_run_creates_energy() {
 /// safety stop. Measured (docs/TELEOP.md): plants −7.5 mJ, books −6.3 mJ, wall 1.6 N.
 #[test]
 fn with_waves_a_50_ms_round_trip_with_5_percent_loss_creates_no_energy_pushing_into_a_wall() {
+    let _m = crate::common::module_turn(module_path!());
     let _t = turn();
     let r = pushed_into_the_wall("wave", "wave");
     let all = r.assert_passive();
@@ -364,6 +367,7 @@ fn with_waves_a_50_ms_round_trip_with_5_percent_loss_creates_no_energy_pushing_i
 /// first message and says why (the two ends would read each other's fields wrongly).
 #[test]
 fn a_wave_device_side_against_a_tdpa_world_latches_and_says_link_mismatch() {
+    let _m = crate::common::module_turn(module_path!());
     let _t = turn();
     let r = pushed_into_the_wall_as("tdpa", "wave", "mismatch");
     assert_eq!(r.status, 3, "{}", r.all());
@@ -376,6 +380,7 @@ fn a_wave_device_side_against_a_tdpa_world_latches_and_says_link_mismatch() {
 
 #[test]
 fn a_silent_world_latches_zero_torques_and_says_lost_link() {
+    let _m = crate::common::module_turn(module_path!());
     let _t = turn();
     let key = key_file("silent", 0x33);
     // The world side stops after 1 s without a goodbye; the device side must notice.
@@ -395,6 +400,7 @@ fn a_silent_world_latches_zero_torques_and_says_lost_link() {
 
 #[test]
 fn a_device_side_with_another_key_gets_no_session() {
+    let _m = crate::common::module_turn(module_path!());
     let _t = turn();
     let world = World::start(&key_file("k1", 0x11), &["--accept-timeout", "3"]);
     // Through the alias `remote-device`, which runs the same device side.
@@ -414,6 +420,7 @@ fn a_device_side_with_another_key_gets_no_session() {
 /// local world or a device not built for it yet, each with the fix (exit 2, before any socket).
 #[test]
 fn run_refuses_split_loop_options_without_world_and_local_world_options_with_it() {
+    let _m = crate::common::module_turn(module_path!());
     let key = key_file("refuse", 0x44);
     let k = key.to_str().unwrap();
     let cases: &[(&[&str], &str)] = &[
@@ -503,6 +510,7 @@ fn teleop_contact(args: &[&str]) -> (String, f64, f64) {
 /// and at a 50 ms round trip with 5 % loss the link creates no energy.
 #[test]
 fn teleop_of_two_simulated_devices_reproduces_the_wall_contact_at_the_master() {
+    let _m = crate::common::module_turn(module_path!());
     let args = [
         "--master",
         "sim",
@@ -528,6 +536,7 @@ fn teleop_of_two_simulated_devices_reproduces_the_wall_contact_at_the_master() {
 /// 50 ms round trip, where position–force runs away (docs/TELEOP.md).
 #[test]
 fn teleop_four_channel_feels_the_wall_with_master_and_slave_together_even_at_50_ms_without_tdpa() {
+    let _m = crate::common::module_turn(module_path!());
     let args = [
         "--architecture",
         "four-channel",
@@ -551,6 +560,7 @@ fn teleop_four_channel_feels_the_wall_with_master_and_slave_together_even_at_50_
 /// writes the margin plot where asked.
 #[test]
 fn teleop_stability_prints_the_delay_margin_and_writes_the_plot() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = key_file("margin", 0x02).with_file_name("margin");
     let o = crate::common::haptic2d(&[
         "teleop",
@@ -573,6 +583,7 @@ fn teleop_stability_prints_the_delay_margin_and_writes_the_plot() {
 /// trip into the directory the user gives, and prints the table (docs/TELEOP.md).
 #[test]
 fn teleop_figures_writes_the_table_and_a_plot_per_round_trip_into_the_given_dir() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = key_file("figures", 0x01).with_file_name("figs");
     let o = crate::common::haptic2d(&["teleop", "--figures", dir.to_str().unwrap()]);
     let t = crate::common::text(&o);
@@ -597,6 +608,7 @@ fn teleop_figures_writes_the_table_and_a_plot_per_round_trip_into_the_given_dir(
 #[test]
 #[ignore = "needs a network namespace with the netem qdisc (root, sch_netem): cargo test -p haptic2d-cli --test it cli_teleop::netem -- --ignored"]
 fn netem_in_a_namespace_at_50_ms_and_5_percent_with_tdpa_creates_no_energy() {
+    let _m = crate::common::module_turn(module_path!());
     let _t = turn();
     let netem = "ip link set lo up && tc qdisc add dev lo root netem delay 25ms loss 5%";
     match Command::new("unshare")

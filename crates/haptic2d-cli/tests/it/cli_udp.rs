@@ -168,6 +168,7 @@ fn proxy(device: SocketAddr, mischief: Mischief) -> Proxy {
 
 #[test]
 fn run_against_the_python_reference_device_for_3_s_exits_clean() {
+    let _m = crate::common::module_turn(module_path!());
     let _t = turn();
     let dev = sim_device(&[]);
     let file = device_file("clean");
@@ -188,6 +189,7 @@ fn run_against_the_python_reference_device_for_3_s_exits_clean() {
 /// device has the same key; the run opens a session, and nothing is dropped.
 #[test]
 fn run_with_a_key_file_speaks_version_2_and_drops_nothing() {
+    let _m = crate::common::module_turn(module_path!());
     use std::os::unix::fs::PermissionsExt;
     let _t = turn();
     let file = device_file("v2");
@@ -225,6 +227,7 @@ fn run_with_a_key_file_speaks_version_2_and_drops_nothing() {
 /// key. Every case is refused before a socket is opened (nothing is sent anywhere).
 #[test]
 fn multicast_broadcast_and_remote_addresses_are_refused_or_need_the_flag() {
+    let _m = crate::common::module_turn(module_path!());
     let _t = turn();
     let file = device_file("addr");
     for (addr, says) in [
@@ -260,6 +263,7 @@ fn multicast_broadcast_and_remote_addresses_are_refused_or_need_the_flag() {
 /// device pushes back on the hand with F.
 #[test]
 fn a_pushed_handle_drives_the_box_into_the_wall_and_feels_it() {
+    let _m = crate::common::module_turn(module_path!());
     let _t = turn();
     let dev = sim_device(&["--push=-0.8,0", "--push-after", "0.3", "--k-hand", "0"]);
     let file = device_file("wall");
@@ -308,6 +312,7 @@ fn a_pushed_handle_drives_the_box_into_the_wall_and_feels_it() {
 
 #[test]
 fn loss_and_reordering_through_a_proxy_are_counted_and_survived() {
+    let _m = crate::common::module_turn(module_path!());
     let _t = turn();
     let dev = sim_device(&[]);
     let p = proxy(dev.1, Mischief::LossAndReorder { drop: 17, swap: 23 });
@@ -327,6 +332,7 @@ fn loss_and_reordering_through_a_proxy_are_counted_and_survived() {
 
 #[test]
 fn malformed_datagrams_are_counted_and_ignored() {
+    let _m = crate::common::module_turn(module_path!());
     let _t = turn();
     let dev = sim_device(&[]);
     let p = proxy(dev.1, Mischief::Garbage { every: 3 });
@@ -352,6 +358,7 @@ fn malformed_datagrams_are_counted_and_ignored() {
 
 #[test]
 fn device_killed_mid_run_exits_4_naming_the_device() {
+    let _m = crate::common::module_turn(module_path!());
     let _t = turn();
     let mut dev = sim_device(&[]);
     let file = device_file("kill");
@@ -365,6 +372,7 @@ fn device_killed_mid_run_exits_4_naming_the_device() {
 
 #[test]
 fn no_device_and_bad_arguments_are_clear_errors() {
+    let _m = crate::common::module_turn(module_path!());
     let _t = turn();
     let free = UdpSocket::bind("127.0.0.1:0")
         .unwrap()

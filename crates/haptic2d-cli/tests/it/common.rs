@@ -8,6 +8,7 @@ pub use haptic2d_test_support::{holds_for, wait_for};
 use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
+use std::sync::{Condvar, Mutex};
 
 /// The `haptic2d` binary built for these tests.
 pub const BIN: &str = env!("CARGO_BIN_EXE_haptic2d");
@@ -87,8 +88,43 @@ pub fn assert_lost_device(code: Option<i32>, out: &str, device: &str, needles: &
     assert_lacks(out, &["panicked"]);
 }
 
-/// Serialises the tests that start emulators, devices or real-time loops, across every module of
-/// the binary (keeps the load down).
+/// Which module's tests run now, and how many of them.
+static MODULE_NOW: (Mutex<(Option<&str>, usize)>, Condvar) =
+    (Mutex::new((None, 0)), Condvar::new());
+
+/// Held by a test while it runs: see [`module_turn`].
+pub struct ModuleTurn;
+
+/// Keeps the modules apart as their own binaries kept them: the tests of one module (one former
+/// test file) run beside each other, never beside another module's. A clean normal-priority `run`
+/// beside another file's heavy tests stalled 47 ms in CI and tripped its safety stop (the reason
+/// the first merge into one binary was reverted); this keeps what each test runs beside as it was.
+/// Every test takes it first: `let _m = crate::common::module_turn(module_path!());`.
+pub fn module_turn(module: &'static str) -> ModuleTurn {
+    let (lock, changed) = &MODULE_NOW;
+    let mut now = lock.lock().unwrap_or_else(|e| e.into_inner());
+    while now.0.is_some_and(|m| m != module) {
+        now = changed.wait(now).unwrap_or_else(|e| e.into_inner());
+    }
+    now.0 = Some(module);
+    now.1 += 1;
+    ModuleTurn
+}
+
+impl Drop for ModuleTurn {
+    fn drop(&mut self) {
+        let (lock, changed) = &MODULE_NOW;
+        let mut now = lock.lock().unwrap_or_else(|e| e.into_inner());
+        now.1 -= 1;
+        if now.1 == 0 {
+            now.0 = None;
+            changed.notify_all();
+        }
+    }
+}
+
+/// Serialises the tests that start emulators, devices or real-time loops (within a module: see
+/// [`module_turn`]), to keep the load down.
 pub fn turn() -> std::sync::MutexGuard<'static, ()> {
     static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
     ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner())

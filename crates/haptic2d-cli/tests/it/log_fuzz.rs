@@ -78,6 +78,7 @@ fn replay_run(replay: &str) -> Vec<&str> {
 
 #[test]
 fn mutated_logs_through_log_info_log_convert_and_replay_end_with_a_documented_code() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let seed_path = dir.path().join("seed.mcap");
     run_ok(

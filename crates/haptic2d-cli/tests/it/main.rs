@@ -9,8 +9,13 @@
 //! Nothing here changes process-wide state: no environment variable is set, no signal handler is
 //! installed (signals go to spawned children), the working directory stays, and the one pipe made
 //! by hand (`cli_pipe`) is close-on-exec, so no child that another test spawns meanwhile inherits
-//! it. So no former file needed a binary of its own. The tests that start emulators, devices or
-//! real-time loops take turns across all modules ([`common::turn`]).
+//! it. So no former file needed a binary of its own.
+//!
+//! What runs beside what stays as it was with one binary per file: every test first takes
+//! [`common::module_turn`], so the tests of one module run beside each other (two at a time on
+//! two cores) but never beside another module's (a first merge, reverted, let a clean `run` stall
+//! beside another file's heavy tests and trip its safety stop in CI); within a module, the tests
+//! that start emulators, devices or real-time loops take turns ([`common::turn`]), as before.
 
 mod common;
 

@@ -344,6 +344,7 @@ fn haply(tutorial_name: &str, emulate: &str, run: &str) {
 #[test]
 #[ignore = "about 2 minutes, needs real-time priority (root or `ulimit -r 80`), and a stall of the whole machine (a virtual machine whose CPUs its host takes away) rightly stops a run: CI runs it with --ignored"]
 fn haply_2diy_tutorial_runs_clean_ten_times_under_load() {
+    let _m = crate::common::module_turn(module_path!());
     haply(
         "Haply 2DIY emulator",
         "haptic2d emulate haply ",
@@ -354,6 +355,7 @@ fn haply_2diy_tutorial_runs_clean_ten_times_under_load() {
 #[test]
 #[ignore = "about 2 minutes, needs real-time priority (root or `ulimit -r 80`), and a stall of the whole machine (a virtual machine whose CPUs its host takes away) rightly stops a run: CI runs it with --ignored"]
 fn haply_twin_tutorial_runs_clean_ten_times_under_load() {
+    let _m = crate::common::module_turn(module_path!());
     haply(
         "Haply twin emulator",
         "haptic2d emulate haply --device-file haply-twin",
@@ -405,6 +407,7 @@ fn udp(name: &str, device: &str, prepare: Option<&str>) {
 #[test]
 #[ignore = "about 2 minutes, needs real-time priority (root or `ulimit -r 80`), and a stall of the whole machine (a virtual machine whose CPUs its host takes away) rightly stops a run: CI runs it with --ignored"]
 fn udp_python_reference_device_tutorial_runs_clean_ten_times_under_load() {
+    let _m = crate::common::module_turn(module_path!());
     assert!(
         Command::new("python3").arg("--version").output().is_ok(),
         "python3 not found: this test needs it (bash scripts/install-test-deps.sh installs it)"
@@ -419,6 +422,7 @@ fn udp_python_reference_device_tutorial_runs_clean_ten_times_under_load() {
 #[test]
 #[ignore = "about 2 minutes, needs real-time priority (root or `ulimit -r 80`), and a stall of the whole machine (a virtual machine whose CPUs its host takes away) rightly stops a run: CI runs it with --ignored"]
 fn udp_c_reference_device_tutorial_runs_clean_ten_times_under_load() {
+    let _m = crate::common::module_turn(module_path!());
     udp(
         "UDP reference device (C)",
         "./sim_device --bind 127.0.0.1:5005 --key-file udp.key",
@@ -431,6 +435,7 @@ fn udp_c_reference_device_tutorial_runs_clean_ten_times_under_load() {
 #[test]
 #[ignore = "about 2 minutes, needs real-time priority (root or `ulimit -r 80`), and a stall of the whole machine (a virtual machine whose CPUs its host takes away) rightly stops a run: CI runs it with --ignored"]
 fn inverse3_emulator_tutorial_runs_clean_ten_times_under_load() {
+    let _m = crate::common::module_turn(module_path!());
     let hw = doc("HARDWARE.md");
     let emu = doc_line(
         &hw,
@@ -451,6 +456,7 @@ fn inverse3_emulator_tutorial_runs_clean_ten_times_under_load() {
 /// The check above can fail: a run that loses its device is not clean.
 #[test]
 fn a_lost_device_is_not_a_clean_run() {
+    let _m = crate::common::module_turn(module_path!());
     let out = "stopped: device lost: Haply board haply:/dev/pts/3: no reply within 20.0 ms\n  real-time: scheduler SCHED_FIFO 80";
     use std::os::unix::process::ExitStatusExt;
     let (ok, four) = (
@@ -476,6 +482,7 @@ fn a_lost_device_is_not_a_clean_run() {
 /// anyway — the Haply emulator and the Python reference device alike.
 #[test]
 fn a_device_refused_real_time_priority_says_how_to_get_it_and_runs() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let drop_nice = ["--bounding-set=-sys_nice", "--inh-caps=-sys_nice"];
     let py = root()
