@@ -90,8 +90,7 @@ fn run_rate_above_cap_is_rejected_before_allocating_the_ring() {
 
 #[test]
 fn run_duration_1e300_is_a_clear_error_not_a_panic() {
-    let _m = crate::common::module_turn(module_path!());
-    let _turn = crate::common::turn(); // one real-time loop at a time
+    let _turn = crate::common::loop_turn(module_path!()); // one real-time loop at a time
     assert_exit(
         &["run", "--headless", "--no-rt", "--duration", "1e300"],
         2,
@@ -259,8 +258,7 @@ per_mass = true
 
 #[test]
 fn a_safety_stop_in_run_exits_3() {
-    let _m = crate::common::module_turn(module_path!());
-    let _turn = crate::common::turn(); // one real-time loop at a time
+    let _turn = crate::common::loop_turn(module_path!()); // one real-time loop at a time
     let dir = tempfile::tempdir().unwrap();
     // Encoder angles of zero are no pose of the device: the closure monitor trips on tick 0.
     let replay = write(&dir, "zero.csv", "q1,q2,q3,q4\n0,0,0,0\n0,0,0,0\n");
@@ -328,8 +326,7 @@ fn hostile_logs(dir: &tempfile::TempDir) -> (String, String) {
 /// 130 in tests/it/cli_signals.rs and tests/it/mcap_log.rs.)
 #[test]
 fn every_command_ends_with_its_documented_exit_code_and_message() {
-    let _m = crate::common::module_turn(module_path!());
-    let _turn = crate::common::turn(); // one real-time loop at a time
+    let _turn = crate::common::loop_turn(module_path!()); // one real-time loop at a time
     let dir = tempfile::tempdir().unwrap();
     let zero_replay = write(&dir, "zero.csv", "q1,q2,q3,q4\n0,0,0,0\n0,0,0,0\n");
     let out_file = write(&dir, "a-file", "not a folder");
@@ -474,8 +471,7 @@ fn every_command_ends_with_its_documented_exit_code_and_message() {
 
 #[test]
 fn dev_zero_as_a_log_is_refused_at_once() {
-    let _m = crate::common::module_turn(module_path!());
-    let _turn = crate::common::turn(); // one real-time loop at a time
+    let _turn = crate::common::loop_turn(module_path!()); // one real-time loop at a time
     let t0 = std::time::Instant::now();
     // As a CSV log (no .mcap extension): its first byte is a NUL.
     assert_exit(&["log", "info", "/dev/zero"], 2, "NUL byte");

@@ -62,8 +62,7 @@ fn clean_logged_run(
 
 #[test]
 fn run_against_the_emulator_for_3_s_logs_and_exits_clean() {
-    let _m = crate::common::module_turn(module_path!());
-    let _turn = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let file = device_file(dir.path(), "gen3.toml", |t| t);
     let (pty, out, csv) = clean_logged_run(dir.path(), &file, &[], "3");
@@ -125,8 +124,7 @@ fn device_check(board: &Path, file: &Path, code: i32, needles: &[&str]) -> Strin
 /// emulator's default start), a correct board now passes, and the check says which firmware it is.
 #[test]
 fn device_check_passes_on_a_correct_board_held_at_rest_and_finds_a_flipped_motor() {
-    let _m = crate::common::module_turn(module_path!());
-    let _turn = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let good = device_file(dir.path(), "gen3.toml", |t| t);
     let passes = [
@@ -150,8 +148,7 @@ fn device_check_passes_on_a_correct_board_held_at_rest_and_finds_a_flipped_motor
 /// one. The other joint's motion under the pulse (the five-bar's coupling) now tells them apart.
 #[test]
 fn device_check_tells_a_reversed_motor_and_encoder_from_a_correct_joint() {
-    let _m = crate::common::module_turn(module_path!());
-    let _turn = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let good = device_file(dir.path(), "gen3.toml", |t| t);
     // The emulated board is wired with motor 1 and its encoder both reversed against the file.
@@ -166,8 +163,7 @@ fn device_check_tells_a_reversed_motor_and_encoder_from_a_correct_joint() {
 /// angle still grows, and the closure of the readings under the pulses gives it away.
 #[test]
 fn device_check_on_the_twin_finds_a_joint_with_motor_and_encoder_reversed() {
-    let _m = crate::common::module_turn(module_path!());
-    let _turn = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let good = twin_file(dir.path(), "twin.toml", |t| t);
     device_check(&good, &good, 0, &[]);
@@ -184,8 +180,7 @@ fn device_check_on_the_twin_finds_a_joint_with_motor_and_encoder_reversed() {
 /// board answered. It is refused at open, naming the port count, before any torque.
 #[test]
 fn twin_on_an_m0_board_is_refused_naming_the_port_count() {
-    let _m = crate::common::module_turn(module_path!());
-    let _turn = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let file = twin_file(dir.path(), "twin.toml", |t| t);
     let (emu, pty) = emulate_haply(&file, &["--board", "m0"]);
@@ -231,8 +226,7 @@ fn devices_lists_ports_without_failing() {
 /// limit.
 #[test]
 fn haply_run_is_the_normal_loop_torques_start_at_zero_ramp_in_and_stay_clamped() {
-    let _m = crate::common::module_turn(module_path!());
-    let _turn = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let file = device_file(dir.path(), "gen3.toml", |t| t);
     let (_, out, csv) = clean_logged_run(
@@ -295,8 +289,7 @@ fn a_silent_emulated_device_exits_4_with_the_reason() {
 /// every torque within the limit.
 #[test]
 fn twin_runs_through_the_normal_loop_against_the_emulator() {
-    let _m = crate::common::module_turn(module_path!());
-    let _turn = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let file = twin_file(dir.path(), "twin.toml", |t| t);
     let hand = ["--hand", "script:0.8,0.3,0,0,100"];
@@ -345,8 +338,7 @@ fn stability_of_the_2diy_is_per_axis_x_and_y() {
 /// hand released (exit 2, nothing opened), unless `--allow-unstable`.
 #[test]
 fn run_refuses_an_unstable_released_configuration_on_a_haply_board() {
-    let _m = crate::common::module_turn(module_path!());
-    let _turn = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let file = device_file(dir.path(), "gen3.toml", |t| t);
     let (emu, pty) = emulate_haply(&file, &[]);

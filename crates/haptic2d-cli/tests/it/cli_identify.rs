@@ -12,7 +12,7 @@ use std::process::Output;
 
 use crate::common::{
     assert_has, assert_lacks, cmd, emulate_haply, expect_exit, interrupt as stop, joint1_reversed,
-    motor1_flipped, run, shipped_text, text, turn, write_in,
+    motor1_flipped, run, shipped_text, text, write_in,
 };
 
 use haptic2d_devices::haply::{HaplyDeviceFile, HaplyKind};
@@ -54,8 +54,7 @@ fn identify(board: &Path, emu_args: &[&str], file: &Path, extra: &[&str]) -> Out
 /// are the emulated linkage's; `--write` stores them and `stability` says it uses them.
 #[test]
 fn device_identify_writes_the_emulated_inertia_and_the_gate_uses_it() {
-    let _m = crate::common::module_turn(module_path!());
-    let _turn = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let file = device_file(dir.path(), "gen3.toml", |t| t);
     let o = identify(&file, &RELEASED, &file, &["--write"]);
@@ -106,8 +105,7 @@ fn device_identify_writes_the_emulated_inertia_and_the_gate_uses_it() {
 /// identified and the fix names the field (exit 2).
 #[test]
 fn device_identify_detects_a_reversed_motor_and_a_reversed_motor_and_encoder() {
-    let _m = crate::common::module_turn(module_path!());
-    let _turn = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let good = device_file(dir.path(), "gen3.toml", |t| t);
     let flipped = device_file(dir.path(), "flipped.toml", motor1_flipped);
@@ -135,8 +133,7 @@ fn device_identify_detects_a_reversed_motor_and_a_reversed_motor_and_encoder() {
 /// creeping about 1 cm/s against the hand's damping) is refused before any torque, exit 2.
 #[test]
 fn device_identify_refuses_a_handle_that_is_not_still_at_the_rest_pose() {
-    let _m = crate::common::module_turn(module_path!());
-    let _turn = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let file = device_file(dir.path(), "gen3.toml", |t| t);
     let o = identify(&file, &["--hand", "constant:0,0.02,0"], &file, &["--write"]);

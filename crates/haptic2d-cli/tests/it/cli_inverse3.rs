@@ -12,7 +12,7 @@ use std::process::{Command, Stdio};
 
 use crate::common::{
     assert_has, assert_lacks, assert_lost_device, cmd, column, cut_mid_run, expect_exit,
-    patient_device_file, spawn_announced, text, turn, Killed,
+    patient_device_file, spawn_announced, text, Killed,
 };
 
 /// The shipped file, patient about the machine's timing, in a temp dir.
@@ -63,8 +63,7 @@ fn coupling_run(emu_args: &[&str], tag: &str) -> (String, PathBuf) {
 /// start-up ramp, has turned more than half of that and not past it.
 #[test]
 fn a_turning_versegrip_turns_the_slave() {
-    let _m = crate::common::module_turn(module_path!());
-    let _t = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let (_, log) = coupling_run(&["--grip-rate", "0.3"], "grip");
     let theta = column(&std::fs::read_to_string(&log).unwrap(), "slave.theta");
     let end = *theta.last().unwrap();
@@ -84,8 +83,7 @@ fn a_turning_versegrip_turns_the_slave() {
 
 #[test]
 fn run_against_the_emulated_service_for_3_s_drives_the_box_into_the_wall() {
-    let _m = crate::common::module_turn(module_path!());
-    let _t = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     // The hand holds for 0.5 s, then pushes 0.8 N towards the left wall (the box starts 0.02 m
     // from it, grasped at its centre: the cursor must travel 0.02 m to the contact).
     let (out, log) = coupling_run(&["--hand", "push:-0.8,0,0,0.5"], "clean");
@@ -106,8 +104,7 @@ fn run_against_the_emulated_service_for_3_s_drives_the_box_into_the_wall() {
 
 #[test]
 fn service_killed_mid_run_exits_4_naming_the_device() {
-    let _m = crate::common::module_turn(module_path!());
-    let _t = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let mut emu = emulator(&[]);
     let file = device_file("kill");
     let log = file.with_file_name("kill.csv");
@@ -121,8 +118,7 @@ fn service_killed_mid_run_exits_4_naming_the_device() {
 /// message names the missing field.
 #[test]
 fn a_state_without_a_cursor_position_exits_4_naming_the_field() {
-    let _m = crate::common::module_turn(module_path!());
-    let _t = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let emu = emulator(&["--drop-position-after", "1500"]);
     let file = device_file("noposition");
     let o = run(&emu.1, &file, "10").output().unwrap();
@@ -132,8 +128,7 @@ fn a_state_without_a_cursor_position_exits_4_naming_the_field() {
 
 #[test]
 fn no_service_and_bad_urls_are_clear_errors() {
-    let _m = crate::common::module_turn(module_path!());
-    let _t = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let port = std::net::TcpListener::bind("127.0.0.1:0")
         .unwrap()
         .local_addr()

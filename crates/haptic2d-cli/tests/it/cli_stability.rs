@@ -148,8 +148,7 @@ fn stability_refuses_a_bad_controller_file_naming_the_field() {
 /// and runs; `reproduce fig8` carries the claims with the file's controller, labelled by the file.
 #[test]
 fn run_and_reproduce_accept_a_controller_file() {
-    let _m = crate::common::module_turn(module_path!());
-    let _turn = crate::common::turn(); // one real-time loop at a time
+    let _turn = crate::common::loop_turn(module_path!()); // one real-time loop at a time
     let dir = tempfile::tempdir().unwrap();
     let root = crate::common::root();
     let soft = root.join("controllers/coupling-soft.toml");

@@ -18,7 +18,7 @@ use std::process::{Child, Command, Stdio};
 use std::sync::mpsc;
 use std::time::Duration;
 
-use crate::common::{assert_has, turn, wait_with_limit};
+use crate::common::{assert_has, wait_with_limit};
 
 const BIN: &str = env!("CARGO_BIN_EXE_haptic2d");
 
@@ -304,8 +304,7 @@ fn pushed_into_the_wall_as(world_link: &str, device_link: &str, tag: &str) -> Pu
 #[test]
 fn with_tdpa_a_50_ms_round_trip_with_5_percent_loss_creates_no_energy_pushing_into_a_wall_and_the_world_books_the_body(
 ) {
-    let _m = crate::common::module_turn(module_path!());
-    let _t = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let r = pushed_into_the_wall("tdpa", "tdpa");
     // Not only by the books: the plants really received no energy from the network (measured
     // −2.2 mJ; docs/TELEOP.md).
@@ -332,8 +331,7 @@ fn with_tdpa_a_50_ms_round_trip_with_5_percent_loss_creates_no_energy_pushing_in
 
 #[test]
 fn without_tdpa_the_same_run_creates_energy() {
-    let _m = crate::common::module_turn(module_path!());
-    let _t = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let r = pushed_into_the_wall("none", "none");
     let all = r.all();
     assert!(
@@ -351,8 +349,7 @@ fn without_tdpa_the_same_run_creates_energy() {
 /// safety stop. Measured (docs/TELEOP.md): plants −7.5 mJ, books −6.3 mJ, wall 1.6 N.
 #[test]
 fn with_waves_a_50_ms_round_trip_with_5_percent_loss_creates_no_energy_pushing_into_a_wall() {
-    let _m = crate::common::module_turn(module_path!());
-    let _t = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let r = pushed_into_the_wall("wave", "wave");
     let all = r.assert_passive();
     assert!(r.device.contains("link wave (b 20, 20, 0.04"), "{all}");
@@ -367,8 +364,7 @@ fn with_waves_a_50_ms_round_trip_with_5_percent_loss_creates_no_energy_pushing_i
 /// first message and says why (the two ends would read each other's fields wrongly).
 #[test]
 fn a_wave_device_side_against_a_tdpa_world_latches_and_says_link_mismatch() {
-    let _m = crate::common::module_turn(module_path!());
-    let _t = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let r = pushed_into_the_wall_as("tdpa", "wave", "mismatch");
     assert_eq!(r.status, 3, "{}", r.all());
     let says = [
@@ -380,8 +376,7 @@ fn a_wave_device_side_against_a_tdpa_world_latches_and_says_link_mismatch() {
 
 #[test]
 fn a_silent_world_latches_zero_torques_and_says_lost_link() {
-    let _m = crate::common::module_turn(module_path!());
-    let _t = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let key = key_file("silent", 0x33);
     // The world side stops after 1 s without a goodbye; the device side must notice.
     let world = World::start(&key, &["--duration", "1"]);
@@ -400,8 +395,7 @@ fn a_silent_world_latches_zero_torques_and_says_lost_link() {
 
 #[test]
 fn a_device_side_with_another_key_gets_no_session() {
-    let _m = crate::common::module_turn(module_path!());
-    let _t = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let world = World::start(&key_file("k1", 0x11), &["--accept-timeout", "3"]);
     // Through the alias `remote-device`, which runs the same device side.
     let (status, text) = device_as(
@@ -608,8 +602,7 @@ fn teleop_figures_writes_the_table_and_a_plot_per_round_trip_into_the_given_dir(
 #[test]
 #[ignore = "needs a network namespace with the netem qdisc (root, sch_netem): cargo test -p haptic2d-cli --test it cli_teleop::netem -- --ignored"]
 fn netem_in_a_namespace_at_50_ms_and_5_percent_with_tdpa_creates_no_energy() {
-    let _m = crate::common::module_turn(module_path!());
-    let _t = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let netem = "ip link set lo up && tc qdisc add dev lo root netem delay 25ms loss 5%";
     match Command::new("unshare")
         .args(["-n", "sh", "-c", netem])

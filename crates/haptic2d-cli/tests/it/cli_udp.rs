@@ -168,8 +168,7 @@ fn proxy(device: SocketAddr, mischief: Mischief) -> Proxy {
 
 #[test]
 fn run_against_the_python_reference_device_for_3_s_exits_clean() {
-    let _m = crate::common::module_turn(module_path!());
-    let _t = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let dev = sim_device(&[]);
     let file = device_file("clean");
     let o = run(dev.1, &file, "3").output().unwrap();
@@ -227,8 +226,7 @@ fn run_with_a_key_file_speaks_version_2_and_drops_nothing() {
 /// key. Every case is refused before a socket is opened (nothing is sent anywhere).
 #[test]
 fn multicast_broadcast_and_remote_addresses_are_refused_or_need_the_flag() {
-    let _m = crate::common::module_turn(module_path!());
-    let _t = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let file = device_file("addr");
     for (addr, says) in [
         ("224.0.0.1:5005", "multicast"),
@@ -263,8 +261,7 @@ fn multicast_broadcast_and_remote_addresses_are_refused_or_need_the_flag() {
 /// device pushes back on the hand with F.
 #[test]
 fn a_pushed_handle_drives_the_box_into_the_wall_and_feels_it() {
-    let _m = crate::common::module_turn(module_path!());
-    let _t = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let dev = sim_device(&["--push=-0.8,0", "--push-after", "0.3", "--k-hand", "0"]);
     let file = device_file("wall");
     let log = file.with_file_name("wall.csv");
@@ -312,8 +309,7 @@ fn a_pushed_handle_drives_the_box_into_the_wall_and_feels_it() {
 
 #[test]
 fn loss_and_reordering_through_a_proxy_are_counted_and_survived() {
-    let _m = crate::common::module_turn(module_path!());
-    let _t = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let dev = sim_device(&[]);
     let p = proxy(dev.1, Mischief::LossAndReorder { drop: 17, swap: 23 });
     let file = device_file("loss");
@@ -332,8 +328,7 @@ fn loss_and_reordering_through_a_proxy_are_counted_and_survived() {
 
 #[test]
 fn malformed_datagrams_are_counted_and_ignored() {
-    let _m = crate::common::module_turn(module_path!());
-    let _t = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let dev = sim_device(&[]);
     let p = proxy(dev.1, Mischief::Garbage { every: 3 });
     let file = device_file("garbage");
@@ -358,8 +353,7 @@ fn malformed_datagrams_are_counted_and_ignored() {
 
 #[test]
 fn device_killed_mid_run_exits_4_naming_the_device() {
-    let _m = crate::common::module_turn(module_path!());
-    let _t = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let mut dev = sim_device(&[]);
     let file = device_file("kill");
     let log = file.with_file_name("kill.csv");
@@ -372,8 +366,7 @@ fn device_killed_mid_run_exits_4_naming_the_device() {
 
 #[test]
 fn no_device_and_bad_arguments_are_clear_errors() {
-    let _m = crate::common::module_turn(module_path!());
-    let _t = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let free = UdpSocket::bind("127.0.0.1:0")
         .unwrap()
         .local_addr()

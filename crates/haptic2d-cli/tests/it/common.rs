@@ -123,6 +123,22 @@ impl Drop for ModuleTurn {
     }
 }
 
+/// A test's [`module_turn`] and then, within its module, the one-at-a-time [`turn`] of the tests
+/// that start emulators, devices or real-time loops; released in the reverse order.
+pub struct LoopTurn {
+    _alone: std::sync::MutexGuard<'static, ()>,
+    _module: ModuleTurn,
+}
+
+/// [`LoopTurn`] for a test of `module` (`module_path!()`).
+pub fn loop_turn(module: &'static str) -> LoopTurn {
+    let module = module_turn(module);
+    LoopTurn {
+        _alone: turn(),
+        _module: module,
+    }
+}
+
 /// Serialises the tests that start emulators, devices or real-time loops (within a module: see
 /// [`module_turn`]), to keep the load down.
 pub fn turn() -> std::sync::MutexGuard<'static, ()> {

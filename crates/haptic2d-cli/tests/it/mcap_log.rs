@@ -139,8 +139,7 @@ fn mcap_log_of_a_2s_run_has_every_tick_and_matches_the_csv_log_of_the_same_run()
 
 #[test]
 fn sigint_mid_run_leaves_a_complete_readable_mcap() {
-    let _m = crate::common::module_turn(module_path!());
-    let _turn = crate::common::turn(); // one real-time loop at a time
+    let _turn = crate::common::loop_turn(module_path!()); // one real-time loop at a time
     let dir = tempfile::tempdir().unwrap();
     let mcap = dir.path().join("int.mcap");
     let child = Command::new(env!("CARGO_BIN_EXE_haptic2d"))
@@ -336,8 +335,7 @@ fn simulate_out_mcap_writes_every_sample_of_the_world() {
 
 #[test]
 fn foxglove_live_server_serves_a_loopback_client_and_survives_a_malformed_message() {
-    let _m = crate::common::module_turn(module_path!());
-    let _turn = crate::common::turn(); // one real-time loop at a time
+    let _turn = crate::common::loop_turn(module_path!()); // one real-time loop at a time
     use std::io::{BufRead, BufReader};
     use tungstenite::client::IntoClientRequest;
     use tungstenite::Message;
