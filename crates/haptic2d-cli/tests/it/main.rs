@@ -12,10 +12,11 @@
 //! it. So no former file needed a binary of its own.
 //!
 //! What runs beside what stays as it was with one binary per file: every test first takes
-//! [`common::module_turn`], so the tests of one module run beside each other (two at a time on
-//! two cores) but never beside another module's (a first merge, reverted, let a clean `run` stall
-//! beside another file's heavy tests and trip its safety stop in CI); within a module, the tests
-//! that start emulators, devices or real-time loops take turns ([`common::turn`]), as before.
+//! [`common::module_turn`] (or [`common::loop_turn`]), so the tests of one module run beside each
+//! other (as many at a time as the harness has threads) but never beside another module's (a
+//! first merge, 0e23490, was reverted because a clean `run` stalled beside another file's heavy
+//! tests and tripped its safety stop in CI); within a module, the tests that start emulators,
+//! devices or real-time loops take turns ([`common::turn`]), as before.
 
 mod common;
 
