@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Installs what the browser end-to-end test (crates/haptic2d-cli/tests/browser_e2e.rs) needs: Debian's Chromium and the
+# Installs what the browser end-to-end test (crates/haptic2d-cli/tests/it/browser_e2e.rs) needs: Debian's Chromium and the
 # pinned playwright-core (from package-lock.json). Idempotent; CI calls it before `cargo test`.
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"

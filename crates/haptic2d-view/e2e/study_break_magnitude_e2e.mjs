@@ -1,5 +1,5 @@
 // End-to-end test of a magnitude-estimation study with rest breaks on the page, in headless
-// Chromium (crates/haptic2d-cli/tests/browser_study.rs runs it).
+// Chromium (crates/haptic2d-cli/tests/it/browser_study.rs runs it).
 //
 // Usage: node study_break_magnitude_e2e.mjs URL ANSWERS BREAK_BEFORE
 //   URL           the page of `haptic2d study run FILE --observer browser --device sim` (a

@@ -1,13 +1,12 @@
 //! `haptic2d run`: a short headless run prints the timing summary and logs one row per tick; bad
 //! options fail with a clear message and a non-zero exit.
 
-mod common;
-
-use common::{haptic2d, run, text, turn};
+use crate::common::{haptic2d, run, run_ok, summary_ticks, text, turn};
 use std::process::Command;
 
 #[test]
 fn run_headless_one_second_prints_the_summary_and_logs_every_tick() {
+    let _m = crate::common::module_turn(module_path!());
     // One real-time loop at a time: two loops at SCHED_FIFO pinned to the same core starve
     // each other, and these tests check timing and the display.
     let _turn = turn();
@@ -29,13 +28,7 @@ fn run_headless_one_second_prints_the_summary_and_logs_every_tick() {
         assert!(out.contains(needle), "missing `{needle}` in:\n{out}");
     }
     // "N ticks" from the summary = data rows in the log (nothing lost at the end).
-    let ticks: usize = out
-        .split_whitespace()
-        .collect::<Vec<_>>()
-        .windows(2)
-        .find(|w| w[1] == "ticks")
-        .and_then(|w| w[0].parse().ok())
-        .expect("tick count in the summary");
+    let ticks = summary_ticks(&out) as usize;
     assert!(
         ticks > 900 && ticks <= 1000,
         "{ticks} ticks in 1 s at 1 kHz"
@@ -49,6 +42,7 @@ fn run_headless_one_second_prints_the_summary_and_logs_every_tick() {
 
 #[test]
 fn run_rejects_bad_options_clearly() {
+    let _m = crate::common::module_turn(module_path!());
     for (args, needle) in [
         (
             vec!["run", "--controller", "pid", "--duration", "1"],
@@ -84,6 +78,7 @@ fn run_rejects_bad_options_clearly() {
 
 #[test]
 fn run_replays_recorded_encoders() {
+    let _m = crate::common::module_turn(module_path!());
     // One real-time loop at a time: two loops at SCHED_FIFO pinned to the same core starve
     // each other, and these tests check timing and the display.
     let _turn = turn();
@@ -91,8 +86,7 @@ fn run_replays_recorded_encoders() {
     let log = dir.path().join("rec.csv");
     // Record 0.2 s of the simulated device, then replay its encoder angles.
     let rec = dir.path().join("q.csv");
-    let o = run("run --headless --duration 0.2 --log {}", &[&log]);
-    assert!(o.status.success(), "{}", text(&o));
+    run_ok("run --headless --duration 0.2 --log {}", &[&log]);
     // Build q1..q4 from the device pose with the same model the binary uses.
     let params = haptic2d::device::DeviceParams::default();
     let kin = haptic2d::device::TwinKinematics::new(&params);
@@ -232,6 +226,7 @@ fn slave_pose(f: &serde_json::Value) -> [f64; 3] {
 /// switches take effect. At the end of `--duration` it still prints its timing summary.
 #[test]
 fn run_display_serves_frames_and_applies_commands() {
+    let _m = crate::common::module_turn(module_path!());
     // One real-time loop at a time: two loops at SCHED_FIFO pinned to the same core starve
     // each other, and these tests check timing and the display.
     let _turn = turn();
@@ -327,6 +322,7 @@ fn run_display_serves_frames_and_applies_commands() {
 
 #[test]
 fn run_display_port_taken_is_a_clear_error() {
+    let _m = crate::common::module_turn(module_path!());
     // One real-time loop at a time: two loops at SCHED_FIFO pinned to the same core starve
     // each other, and these tests check timing and the display.
     let _turn = turn();
@@ -345,6 +341,7 @@ fn run_display_port_taken_is_a_clear_error() {
 
 #[test]
 fn run_display_on_a_non_loopback_address_prints_the_token() {
+    let _m = crate::common::module_turn(module_path!());
     // One real-time loop at a time: two loops at SCHED_FIFO pinned to the same core starve
     // each other, and these tests check timing and the display.
     let _turn = turn();
@@ -359,6 +356,7 @@ fn run_display_on_a_non_loopback_address_prints_the_token() {
 
 #[test]
 fn run_device_file() {
+    let _m = crate::common::module_turn(module_path!());
     // One real-time loop at a time: two loops at SCHED_FIFO pinned to the same core starve
     // each other, and these tests check timing and the display.
     let _turn = turn();
@@ -367,34 +365,28 @@ fn run_device_file() {
         env!("CARGO_MANIFEST_DIR"),
         "/../../devices/twin-pantograph.toml"
     );
-    let start_line = |out: &str| -> String {
-        out.lines()
-            .find(|l| l.starts_with("running "))
-            .unwrap_or_else(|| panic!("no start line in:\n{out}"))
-            .to_string()
-    };
     let run = |extra: &[&str]| {
         let mut args = vec!["run", "--headless", "--duration", "0.2", "--no-rt"];
         args.extend_from_slice(extra);
         haptic2d(&args)
     };
+    // A clean run with `extra` whose start line names where its device parameters came from.
+    let parameters_from = |extra: &[&str], source: &str| {
+        let o = run(extra);
+        let out = text(&o);
+        assert!(o.status.success(), "{out}");
+        let start = out.lines().find(|l| l.starts_with("running "));
+        let want = format!("(parameters: {source})");
+        assert!(start.is_some_and(|l| l.contains(&want)), "{out}");
+    };
 
     // No device file, no [device] table: the spec defaults.
-    let o = run(&[]);
-    let out = text(&o);
-    assert!(o.status.success(), "{out}");
-    assert!(
-        start_line(&out).contains("(parameters: spec defaults)"),
-        "{out}"
-    );
+    parameters_from(&[], "spec defaults");
 
     // The template as a device file.
-    let o = run(&["--device-file", template]);
-    let out = text(&o);
-    assert!(o.status.success(), "{out}");
-    assert!(
-        start_line(&out).contains(&format!("(parameters: device file {template})")),
-        "{out}"
+    parameters_from(
+        &["--device-file", template],
+        &format!("device file {template}"),
     );
 
     // A scene with a [device] table; a device file wins over it.
@@ -406,13 +398,7 @@ fn run_device_file() {
     .unwrap();
     std::fs::write(&scene, format!("{scene_text}\n[device]\nf_c = 0.002\n")).unwrap();
     let scene = scene.to_str().unwrap();
-    let o = run(&[scene]);
-    let out = text(&o);
-    assert!(o.status.success(), "{out}");
-    assert!(
-        start_line(&out).contains(&format!("(parameters: scene {scene})")),
-        "{out}"
-    );
+    parameters_from(&[scene], &format!("scene {scene}"));
     let subset = dir.path().join("subset.toml");
     std::fs::write(
         &subset,
@@ -421,19 +407,14 @@ fn run_device_file() {
     .unwrap();
     let subset = subset.to_str().unwrap();
     let log = dir.path().join("subset.csv");
-    let o = run(&[
+    let args = [
         scene,
         "--device-file",
         subset,
         "--log",
         log.to_str().unwrap(),
-    ]);
-    let out = text(&o);
-    assert!(o.status.success(), "{out}");
-    assert!(
-        start_line(&out).contains(&format!("(parameters: device file {subset})")),
-        "{out}"
-    );
+    ];
+    parameters_from(&args, &format!("device file {subset}"));
     // The file's parameters reach the device: it starts at the file's workspace centre (the spec
     // default is y = 0.14 m).
     let csv = std::fs::read_to_string(&log).unwrap();

@@ -3,8 +3,6 @@
 //! timeout: no panic, no abort (death by a signal), no hang, and an exit status from the documented
 //! table. The arguments come from a fixed-seed generator, so every run spawns the same processes.
 
-mod common;
-
 use std::time::Duration;
 
 const NUMBERS: &[&str] = &[
@@ -51,7 +49,7 @@ impl Rng {
 
 /// Runs `args` with a 60 s deadline; returns the exit code, panicking on a signal, a panic or a hang.
 fn run(args: &[String]) -> i32 {
-    let (code, out) = common::ends_within(args, Duration::from_secs(60));
+    let (code, out) = crate::common::ends_within(args, Duration::from_secs(60));
     assert!(!out.contains("panicked"), "{args:?} panicked:\n{out}");
     assert!(
         DOCUMENTED.contains(&code),
@@ -68,6 +66,7 @@ fn run(args: &[String]) -> i32 {
 
 #[test]
 fn hostile_cli_arguments_never_panic_abort_or_hang() {
+    let _m = crate::common::module_turn(module_path!());
     let mut rng = Rng(0x4841_5054_4943_3244);
     let mut cases: Vec<Vec<String>> = Vec::new();
     let s = |v: &[&str]| v.iter().map(|x| x.to_string()).collect::<Vec<_>>();

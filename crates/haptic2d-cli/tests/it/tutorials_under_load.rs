@@ -16,12 +16,10 @@
 //! (virtual) machine's CPU away is run again, at most [`MAX_STOLEN`] times per tutorial (the whole
 //! machine stopped; the stall check rightly trips and no default can hold).
 //! Ignored by default (about 2 minutes, real-time priority needed):
-//! `cargo test -p haptic2d-cli [--features inverse3] --test tutorials_under_load -- --ignored
+//! `cargo test -p haptic2d-cli [--features inverse3] --test it tutorials_under_load:: -- --ignored
 //! --test-threads 1`.
 
-mod common;
-
-use common::{root, turn, wait_with_limit};
+use crate::common::{root, turn, wait_with_limit};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -310,6 +308,25 @@ fn tutorial(name: &str, mut start: impl FnMut(&Path) -> (Device, Vec<String>)) {
     );
 }
 
+/// Starts a tutorial's device command `line` in `dir` and fills the address it announced into the
+/// host's command: the device's first line must start with `prefix`; the `placeholder` of `host`
+/// becomes `scheme` followed by the rest of that line. The device and the host's command.
+fn start_and_fill(
+    line: &[String],
+    dir: &Path,
+    prefix: &str,
+    host: &str,
+    (placeholder, scheme): (&str, &str),
+) -> (Device, Vec<String>) {
+    let mut d = Device::start(command(line, dir), dir);
+    let first = d.first_line();
+    let found = first
+        .strip_prefix(prefix)
+        .unwrap_or_else(|| panic!("first line `{first}`"));
+    let host = fill(host, &[(placeholder, &format!("{scheme}{found}"))]);
+    (d, host)
+}
+
 /// docs/HARDWARE.md, "Quick start": `haptic2d emulate haply` and `run --device haply:PTY` on the
 /// pseudo-terminal it printed.
 fn haply(tutorial_name: &str, emulate: &str, run: &str) {
@@ -319,19 +336,15 @@ fn haply(tutorial_name: &str, emulate: &str, run: &str) {
         doc_line(&hw, "HARDWARE.md", run),
     );
     tutorial(tutorial_name, |dir| {
-        let mut d = Device::start(command(&fill(&emu, &[]), dir), dir);
-        let pty = d.first_line();
-        let path = pty
-            .strip_prefix("pty: ")
-            .unwrap_or_else(|| panic!("first line `{pty}`"));
-        let host = fill(&host, &[("haply:/dev/pts/N", &format!("haply:{path}"))]);
-        (d, host)
+        let pty = ("haply:/dev/pts/N", "haply:");
+        start_and_fill(&fill(&emu, &[]), dir, "pty: ", &host, pty)
     });
 }
 
 #[test]
 #[ignore = "about 2 minutes, needs real-time priority (root or `ulimit -r 80`), and a stall of the whole machine (a virtual machine whose CPUs its host takes away) rightly stops a run: CI runs it with --ignored"]
 fn haply_2diy_tutorial_runs_clean_ten_times_under_load() {
+    let _m = crate::common::module_turn(module_path!());
     haply(
         "Haply 2DIY emulator",
         "haptic2d emulate haply ",
@@ -342,6 +355,7 @@ fn haply_2diy_tutorial_runs_clean_ten_times_under_load() {
 #[test]
 #[ignore = "about 2 minutes, needs real-time priority (root or `ulimit -r 80`), and a stall of the whole machine (a virtual machine whose CPUs its host takes away) rightly stops a run: CI runs it with --ignored"]
 fn haply_twin_tutorial_runs_clean_ten_times_under_load() {
+    let _m = crate::common::module_turn(module_path!());
     haply(
         "Haply twin emulator",
         "haptic2d emulate haply --device-file haply-twin",
@@ -380,24 +394,20 @@ fn udp(name: &str, device: &str, prepare: Option<&str>) {
                 let o = command(&w, dir).output().unwrap_or_else(|e| {
                     panic!("`{p}`: {e} (this test needs a C compiler: apt-get install gcc)")
                 });
-                assert!(o.status.success(), "`{p}`: {}", common::text(&o));
+                assert!(o.status.success(), "`{p}`: {}", crate::common::text(&o));
             }
             ready = true;
         }
         let w = fill(&dev, &[("127.0.0.1:5005", "127.0.0.1:0")]);
-        let mut d = Device::start(command(&w, dir), dir);
-        let first = d.first_line();
-        let addr = first
-            .strip_prefix("listening on ")
-            .unwrap_or_else(|| panic!("first line `{first}`"));
-        let host = fill(&host, &[("udp:127.0.0.1:5005", &format!("udp:{addr}"))]);
-        (d, host)
+        let addr = ("udp:127.0.0.1:5005", "udp:");
+        start_and_fill(&w, dir, "listening on ", &host, addr)
     });
 }
 
 #[test]
 #[ignore = "about 2 minutes, needs real-time priority (root or `ulimit -r 80`), and a stall of the whole machine (a virtual machine whose CPUs its host takes away) rightly stops a run: CI runs it with --ignored"]
 fn udp_python_reference_device_tutorial_runs_clean_ten_times_under_load() {
+    let _m = crate::common::module_turn(module_path!());
     assert!(
         Command::new("python3").arg("--version").output().is_ok(),
         "python3 not found: this test needs it (bash scripts/install-test-deps.sh installs it)"
@@ -412,6 +422,7 @@ fn udp_python_reference_device_tutorial_runs_clean_ten_times_under_load() {
 #[test]
 #[ignore = "about 2 minutes, needs real-time priority (root or `ulimit -r 80`), and a stall of the whole machine (a virtual machine whose CPUs its host takes away) rightly stops a run: CI runs it with --ignored"]
 fn udp_c_reference_device_tutorial_runs_clean_ten_times_under_load() {
+    let _m = crate::common::module_turn(module_path!());
     udp(
         "UDP reference device (C)",
         "./sim_device --bind 127.0.0.1:5005 --key-file udp.key",
@@ -424,6 +435,7 @@ fn udp_c_reference_device_tutorial_runs_clean_ten_times_under_load() {
 #[test]
 #[ignore = "about 2 minutes, needs real-time priority (root or `ulimit -r 80`), and a stall of the whole machine (a virtual machine whose CPUs its host takes away) rightly stops a run: CI runs it with --ignored"]
 fn inverse3_emulator_tutorial_runs_clean_ten_times_under_load() {
+    let _m = crate::common::module_turn(module_path!());
     let hw = doc("HARDWARE.md");
     let emu = doc_line(
         &hw,
@@ -436,22 +448,15 @@ fn inverse3_emulator_tutorial_runs_clean_ten_times_under_load() {
         "haptic2d run --device inverse3:http://127.0.0.1:N",
     );
     tutorial("Inverse3 emulator", |dir| {
-        let mut d = Device::start(command(&fill(&emu, &[]), dir), dir);
-        let first = d.first_line();
-        let url = first
-            .strip_prefix("listening: ")
-            .unwrap_or_else(|| panic!("first line `{first}`"));
-        let host = fill(
-            &host,
-            &[("inverse3:http://127.0.0.1:N", &format!("inverse3:{url}"))],
-        );
-        (d, host)
+        let url = ("inverse3:http://127.0.0.1:N", "inverse3:");
+        start_and_fill(&fill(&emu, &[]), dir, "listening: ", &host, url)
     });
 }
 
 /// The check above can fail: a run that loses its device is not clean.
 #[test]
 fn a_lost_device_is_not_a_clean_run() {
+    let _m = crate::common::module_turn(module_path!());
     let out = "stopped: device lost: Haply board haply:/dev/pts/3: no reply within 20.0 ms\n  real-time: scheduler SCHED_FIFO 80";
     use std::os::unix::process::ExitStatusExt;
     let (ok, four) = (
@@ -477,6 +482,7 @@ fn a_lost_device_is_not_a_clean_run() {
 /// anyway — the Haply emulator and the Python reference device alike.
 #[test]
 fn a_device_refused_real_time_priority_says_how_to_get_it_and_runs() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let drop_nice = ["--bounding-set=-sys_nice", "--inh-caps=-sys_nice"];
     let py = root()

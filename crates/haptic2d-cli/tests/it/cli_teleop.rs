@@ -13,13 +13,12 @@
 //! the tests take turns.
 
 use std::io::{BufRead, BufReader, Read};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::sync::mpsc;
 use std::time::Duration;
 
-mod common;
-use common::{turn, wait_with_limit};
+use crate::common::{assert_has, wait_with_limit};
 
 const BIN: &str = env!("CARGO_BIN_EXE_haptic2d");
 
@@ -83,20 +82,25 @@ impl Drop for World {
     }
 }
 
+/// `haptic2d ARGS… --key KEY EXTRA…` started with its output piped: either end of the split loop.
+fn spawn_keyed(args: &[&str], key: &Path, extra: &[&str]) -> Child {
+    Command::new(BIN)
+        .args(args)
+        .arg("--key")
+        .arg(key)
+        .args(extra)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
 impl World {
-    fn start(key: &PathBuf, extra: &[&str]) -> World {
+    fn start(key: &Path, extra: &[&str]) -> World {
         let scene = key.with_file_name("near-wall.toml");
         std::fs::write(&scene, NEAR_WALL).unwrap();
-        let mut child = Command::new(BIN)
-            .arg("serve-world")
-            .arg(&scene)
-            .args(["--bind", "127.0.0.1:0", "--key"])
-            .arg(key)
-            .args(extra)
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap();
+        let scene = scene.to_str().unwrap();
+        let mut child = spawn_keyed(&["serve-world", scene, "--bind", "127.0.0.1:0"], key, extra);
         let (tx, lines) = mpsc::channel();
         let out = child.stdout.take().unwrap();
         std::thread::spawn(move || {
@@ -145,21 +149,14 @@ impl World {
 }
 
 /// The device side as `run --device sim --world udp:…`.
-fn device(world: &World, key: &PathBuf, extra: &[&str]) -> (i32, String) {
+fn device(world: &World, key: &Path, extra: &[&str]) -> (i32, String) {
     device_as(&["run", "--device", "sim"], world, key, extra)
 }
 
 /// The device side started as `command` (`run …` or the alias `remote-device`).
-fn device_as(command: &[&str], world: &World, key: &PathBuf, extra: &[&str]) -> (i32, String) {
-    let child = Command::new(BIN)
-        .args(command)
-        .args(["--world", &format!("udp:{}", world.addr), "--key"])
-        .arg(key)
-        .args(extra)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
+fn device_as(command: &[&str], world: &World, key: &Path, extra: &[&str]) -> (i32, String) {
+    let addr = format!("udp:{}", world.addr);
+    let child = spawn_keyed(&[command, &["--world", &addr]].concat(), key, extra);
     let (status, text) =
         wait_with_limit(child, Duration::from_secs(60)).expect("remote-device ends in time");
     (status.code().unwrap_or(-1), text)
@@ -200,6 +197,48 @@ struct Pushed {
     /// As the simulated handle and the world's body really received it: the applied forces times
     /// their true displacements (J).
     plants_created: f64,
+}
+
+impl Pushed {
+    /// Both processes' output, for the failure messages.
+    fn all(&self) -> String {
+        format!("{}\n{}", self.device, self.world)
+    }
+
+    /// What every passive link must show on the acceptance run: a clean exit with no safety stop,
+    /// no energy created (≤ 1 mJ) by the ports' books nor as the plants received it, the delay and
+    /// the loss really there (round trip p50 in 49–80 ms, over 20 datagrams dropped), and the
+    /// session closed by the device side. Both processes' output.
+    #[track_caller]
+    fn assert_passive(&self) -> String {
+        let all = self.all();
+        assert_eq!(self.status, 0, "{all}");
+        assert!(self.device.contains("no safety stop"), "{all}");
+        assert!(
+            self.created <= 1e-3,
+            "books: created {} J\n{all}",
+            self.created
+        );
+        assert!(
+            self.plants_created <= 1e-3,
+            "plants: created {} J\n{all}",
+            self.plants_created
+        );
+        let rtt = number(&self.device, "link: round trip", "p50 ");
+        assert!(
+            (49.0..80.0).contains(&rtt),
+            "round trip p50 {rtt} ms\n{all}"
+        );
+        assert!(
+            number(&self.device, "link: ", "send errors, ") > 20.0,
+            "{all}"
+        );
+        assert!(
+            self.world.contains("the device side closed the session"),
+            "{all}"
+        );
+        all
+    }
 }
 
 /// The acceptance run: 25 ms each way, 5 % loss each way; the gripping hand (300 N/m, 5 N·s/m)
@@ -265,19 +304,11 @@ fn pushed_into_the_wall_as(world_link: &str, device_link: &str, tag: &str) -> Pu
 #[test]
 fn with_tdpa_a_50_ms_round_trip_with_5_percent_loss_creates_no_energy_pushing_into_a_wall_and_the_world_books_the_body(
 ) {
-    let _t = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let r = pushed_into_the_wall("tdpa", "tdpa");
-    let all = format!("{}\n{}", r.device, r.world);
-    assert_eq!(r.status, 0, "{all}");
-    assert!(r.device.contains("no safety stop"), "{all}");
-    assert!(r.created <= 1e-3, "created {} J\n{all}", r.created);
     // Not only by the books: the plants really received no energy from the network (measured
     // −2.2 mJ; docs/TELEOP.md).
-    assert!(
-        r.plants_created <= 1e-3,
-        "plants: created {} J\n{all}",
-        r.plants_created
-    );
+    let all = r.assert_passive();
     // The world port books what the body really received (the force held over the world step ×
     // the body's displacement over it): its books are the body's ledger.
     assert_eq!(
@@ -285,14 +316,7 @@ fn with_tdpa_a_50_ms_round_trip_with_5_percent_loss_creates_no_energy_pushing_in
         port(&r.world, "world port (body, true displacement):"),
         "{all}"
     );
-    // The run did what it claims: the delay and the loss were there, the wall was felt.
-    let rtt = number(&r.device, "link: round trip", "p50 ");
-    assert!(
-        (49.0..80.0).contains(&rtt),
-        "round trip p50 {rtt} ms\n{all}"
-    );
-    let dropped = number(&r.device, "link: ", "send errors, ");
-    assert!(dropped > 20.0, "{all}");
+    // The run did what it claims: the wall was felt.
     let f = number(&r.device, "link: ", "largest force on the handle ");
     assert!(f > 2.0, "the wall was not felt: {f} N\n{all}");
     // Transparency: in contact, the coupling force on the slave follows the wall's (issue 41
@@ -303,17 +327,13 @@ fn with_tdpa_a_50_ms_round_trip_with_5_percent_loss_creates_no_energy_pushing_in
         wall > 1.5 && diff < 0.1 * wall,
         "wall {wall} N, error {diff} N\n{all}"
     );
-    assert!(
-        r.world.contains("the device side closed the session"),
-        "{all}"
-    );
 }
 
 #[test]
 fn without_tdpa_the_same_run_creates_energy() {
-    let _t = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let r = pushed_into_the_wall("none", "none");
-    let all = format!("{}\n{}", r.device, r.world);
+    let all = r.all();
     assert!(
         r.created > 0.02 && r.plants_created > 0.02,
         "created {} J (books), {} J (plants): the delayed link should create energy without TDPA\n{all}",
@@ -329,57 +349,34 @@ fn without_tdpa_the_same_run_creates_energy() {
 /// safety stop. Measured (docs/TELEOP.md): plants −7.5 mJ, books −6.3 mJ, wall 1.6 N.
 #[test]
 fn with_waves_a_50_ms_round_trip_with_5_percent_loss_creates_no_energy_pushing_into_a_wall() {
-    let _t = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let r = pushed_into_the_wall("wave", "wave");
-    let all = format!("{}\n{}", r.device, r.world);
-    assert_eq!(r.status, 0, "{all}");
-    assert!(r.device.contains("no safety stop"), "{all}");
+    let all = r.assert_passive();
     assert!(r.device.contains("link wave (b 20, 20, 0.04"), "{all}");
-    assert!(
-        r.plants_created <= 1e-3,
-        "plants: created {} J\n{all}",
-        r.plants_created
-    );
-    assert!(r.created <= 1e-3, "books: created {} J\n{all}", r.created);
-    let rtt = number(&r.device, "link: round trip", "p50 ");
-    assert!(
-        (49.0..80.0).contains(&rtt),
-        "round trip p50 {rtt} ms\n{all}"
-    );
-    assert!(number(&r.device, "link: ", "send errors, ") > 20.0, "{all}");
     // The waves did the work: each end used wave energy the other sent, and the wall is felt.
     let used = number(&r.world, "waves: ", "used ");
     assert!(used > 0.01, "{all}");
     let wall = number(&r.world, "contact: ", "mean wall force ");
     assert!(wall > 1.0, "the wall was not felt: {wall} N\n{all}");
-    assert!(
-        r.world.contains("the device side closed the session"),
-        "{all}"
-    );
 }
 
 /// A device side running waves against a world side running TDPA latches zero torques at the
 /// first message and says why (the two ends would read each other's fields wrongly).
 #[test]
 fn a_wave_device_side_against_a_tdpa_world_latches_and_says_link_mismatch() {
-    let _t = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let r = pushed_into_the_wall_as("tdpa", "wave", "mismatch");
-    let all = format!("{}\n{}", r.device, r.world);
-    assert_eq!(r.status, 3, "{all}");
-    assert!(
-        r.device
-            .contains("link mismatch: the world side runs force/velocity"),
-        "{all}"
-    );
-    assert!(
-        r.device.contains("torques set to zero and latched"),
-        "{all}"
-    );
+    assert_eq!(r.status, 3, "{}", r.all());
+    let says = [
+        "link mismatch: the world side runs force/velocity",
+        "torques set to zero and latched",
+    ];
+    assert_has(&r.device, &says);
 }
 
 #[test]
 fn a_silent_world_latches_zero_torques_and_says_lost_link() {
-    let _t = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let key = key_file("silent", 0x33);
     // The world side stops after 1 s without a goodbye; the device side must notice.
     let world = World::start(&key, &["--duration", "1"]);
@@ -398,7 +395,7 @@ fn a_silent_world_latches_zero_torques_and_says_lost_link() {
 
 #[test]
 fn a_device_side_with_another_key_gets_no_session() {
-    let _t = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let world = World::start(&key_file("k1", 0x11), &["--accept-timeout", "3"]);
     // Through the alias `remote-device`, which runs the same device side.
     let (status, text) = device_as(
@@ -417,6 +414,7 @@ fn a_device_side_with_another_key_gets_no_session() {
 /// local world or a device not built for it yet, each with the fix (exit 2, before any socket).
 #[test]
 fn run_refuses_split_loop_options_without_world_and_local_world_options_with_it() {
+    let _m = crate::common::module_turn(module_path!());
     let key = key_file("refuse", 0x44);
     let k = key.to_str().unwrap();
     let cases: &[(&[&str], &str)] = &[
@@ -481,11 +479,24 @@ fn run_refuses_split_loop_options_without_world_and_local_world_options_with_it(
         ),
     ];
     for (args, what) in cases {
-        let o = common::haptic2d(args);
-        let t = common::text(&o);
+        let o = crate::common::haptic2d(args);
+        let t = crate::common::text(&o);
         assert_eq!(o.status.code(), Some(2), "{args:?}: {t}");
         assert!(t.contains(what) && t.contains("fix:"), "{args:?}: {t}");
     }
+}
+
+/// `haptic2d teleop ARGS…`, which must succeed: its output, and the last second of contact's mean
+/// wall force on the slave and force of the master on the hand (N).
+#[track_caller]
+fn teleop_contact(args: &[&str]) -> (String, f64, f64) {
+    let o = crate::common::haptic2d(&[&["teleop"], args].concat());
+    let t = crate::common::text(&o);
+    assert!(o.status.success(), "{t}");
+    let contact = "contact (last second):";
+    let wall = number(&t, contact, "wall force on the slave ");
+    let felt = number(&t, contact, "force of the master on the hand ");
+    (t, wall, felt)
 }
 
 /// `haptic2d teleop` with two simulated devices: the slave's wall contact is felt at the master
@@ -493,8 +504,8 @@ fn run_refuses_split_loop_options_without_world_and_local_world_options_with_it(
 /// and at a 50 ms round trip with 5 % loss the link creates no energy.
 #[test]
 fn teleop_of_two_simulated_devices_reproduces_the_wall_contact_at_the_master() {
-    let o = common::haptic2d(&[
-        "teleop",
+    let _m = crate::common::module_turn(module_path!());
+    let args = [
         "--master",
         "sim",
         "--slave",
@@ -503,20 +514,13 @@ fn teleop_of_two_simulated_devices_reproduces_the_wall_contact_at_the_master() {
         "25",
         "--loss",
         "0.05",
-    ]);
-    let t = common::text(&o);
-    assert!(o.status.success(), "{t}");
-    let wall = number(&t, "contact (last second):", "wall force on the slave ");
-    let felt = number(
-        &t,
-        "contact (last second):",
-        "force of the master on the hand ",
-    );
+    ];
+    let (t, wall, felt) = teleop_contact(&args);
     assert!((1.4..2.1).contains(&wall), "{t}");
     assert!((felt - wall).abs() < 0.1 * wall, "{t}");
     assert!(number(&t, "network:", "created ") <= 1e-3, "{t}");
-    let o = common::haptic2d(&["teleop", "--master", "haply:/dev/null"]);
-    assert_eq!(o.status.code(), Some(2), "{}", common::text(&o));
+    let o = crate::common::haptic2d(&["teleop", "--master", "haply:/dev/null"]);
+    assert_eq!(o.status.code(), Some(2), "{}", crate::common::text(&o));
 }
 
 /// `haptic2d teleop --architecture four-channel`: the four channels hold master and slave
@@ -526,23 +530,16 @@ fn teleop_of_two_simulated_devices_reproduces_the_wall_contact_at_the_master() {
 /// 50 ms round trip, where position–force runs away (docs/TELEOP.md).
 #[test]
 fn teleop_four_channel_feels_the_wall_with_master_and_slave_together_even_at_50_ms_without_tdpa() {
-    let o = common::haptic2d(&[
-        "teleop",
+    let _m = crate::common::module_turn(module_path!());
+    let args = [
         "--architecture",
         "four-channel",
         "--delay-ms",
         "25",
         "--no-tdpa",
-    ]);
-    let t = common::text(&o);
-    assert!(o.status.success(), "{t}");
+    ];
+    let (t, wall, felt) = teleop_contact(&args);
     assert!(t.contains("four-channel"), "{t}");
-    let wall = number(&t, "contact (last second):", "wall force on the slave ");
-    let felt = number(
-        &t,
-        "contact (last second):",
-        "force of the master on the hand ",
-    );
     assert!((2.26..2.96).contains(&wall), "{t}");
     assert!((felt - wall).abs() < 0.1 * wall, "{t}");
     assert!(
@@ -557,14 +554,15 @@ fn teleop_four_channel_feels_the_wall_with_master_and_slave_together_even_at_50_
 /// writes the margin plot where asked.
 #[test]
 fn teleop_stability_prints_the_delay_margin_and_writes_the_plot() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = key_file("margin", 0x02).with_file_name("margin");
-    let o = common::haptic2d(&[
+    let o = crate::common::haptic2d(&[
         "teleop",
         "--stability",
         "--stability-plot",
         dir.to_str().unwrap(),
     ]);
-    let t = common::text(&o);
+    let t = crate::common::text(&o);
     assert!(o.status.success(), "{t}");
     let ms = number(&t, "position-force (chosen):", "round trip of ");
     assert!((10.0..50.0).contains(&ms), "{t}");
@@ -579,9 +577,10 @@ fn teleop_stability_prints_the_delay_margin_and_writes_the_plot() {
 /// trip into the directory the user gives, and prints the table (docs/TELEOP.md).
 #[test]
 fn teleop_figures_writes_the_table_and_a_plot_per_round_trip_into_the_given_dir() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = key_file("figures", 0x01).with_file_name("figs");
-    let o = common::haptic2d(&["teleop", "--figures", dir.to_str().unwrap()]);
-    let t = common::text(&o);
+    let o = crate::common::haptic2d(&["teleop", "--figures", dir.to_str().unwrap()]);
+    let t = crate::common::text(&o);
     assert!(o.status.success(), "{t}");
     assert!(t.contains("| 50 ms | 5 % | wave |"), "{t}");
     for f in ["teleop-delays.md", "teleop-delays.csv"] {
@@ -598,12 +597,12 @@ fn teleop_figures_writes_the_table_and_a_plot_per_round_trip_into_the_given_dir(
 /// reported as passed where it cannot run: it needs `unshare -n`, the privilege to make a network
 /// namespace and a kernel with the netem qdisc (`sch_netem`; the VM this was written on lacks it,
 /// so this path has not run there). Run where they exist:
-/// `cargo test -p haptic2d-cli --test cli_teleop netem -- --ignored`; without them it fails and
+/// `cargo test -p haptic2d-cli --test it cli_teleop::netem -- --ignored`; without them it fails and
 /// says which is missing.
 #[test]
-#[ignore = "needs a network namespace with the netem qdisc (root, sch_netem): cargo test -p haptic2d-cli --test cli_teleop netem -- --ignored"]
+#[ignore = "needs a network namespace with the netem qdisc (root, sch_netem): cargo test -p haptic2d-cli --test it cli_teleop::netem -- --ignored"]
 fn netem_in_a_namespace_at_50_ms_and_5_percent_with_tdpa_creates_no_energy() {
-    let _t = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let netem = "ip link set lo up && tc qdisc add dev lo root netem delay 25ms loss 5%";
     match Command::new("unshare")
         .args(["-n", "sh", "-c", netem])

@@ -4,9 +4,7 @@
 //! bulk of the fuzzing runs in-process in haptic2d-rt's tests/log_fuzz.rs (1 200 MCAP and 1 200
 //! CSV cases); this runs a few dozen through the binary, which adds the commands' own code.
 
-mod common;
-
-use common::{run, text};
+use crate::common::{run, run_ok};
 use std::time::Duration;
 
 /// xorshift64*: seeded, the same cases on every run.
@@ -52,20 +50,41 @@ fn mutate(seed: &[u8], rng: &mut Rng, lens: &[usize]) -> Vec<u8> {
     b
 }
 
-/// Runs `args` with a 30 s limit; returns (exit code, output), failing on a signal or a hang.
-fn ends(args: &[&str]) -> (i32, String) {
-    common::ends_within(args, Duration::from_secs(30))
+/// Runs `args` with a 30 s limit and asserts it ended as documented: exit 0, 2 (with an `error:`
+/// line) or 3, no panic, no signal, no hang. Its exit code.
+#[track_caller]
+fn ends_as_documented(args: &[&str]) -> i32 {
+    let (code, out) = crate::common::ends_within(args, Duration::from_secs(30));
+    assert!(!out.contains("panicked"), "{args:?}:\n{out}");
+    assert!([0, 2, 3].contains(&code), "{args:?}: exit {code}\n{out}");
+    if code == 2 {
+        assert!(out.contains("error: "), "{args:?}: no error line\n{out}");
+    }
+    code
+}
+
+/// `run --headless --no-rt --device REPLAY --duration 1`.
+fn replay_run(replay: &str) -> Vec<&str> {
+    vec![
+        "run",
+        "--headless",
+        "--no-rt",
+        "--device",
+        replay,
+        "--duration",
+        "1",
+    ]
 }
 
 #[test]
 fn mutated_logs_through_log_info_log_convert_and_replay_end_with_a_documented_code() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let seed_path = dir.path().join("seed.mcap");
-    let o = run(
+    run_ok(
         "run --headless --no-rt --duration 0.05 --log {}",
         &[&seed_path],
     );
-    assert!(o.status.success(), "{}", text(&o));
     let seed = std::fs::read(&seed_path).unwrap();
     let lens = record_lengths(&seed);
     let mut rng = Rng(0x10F_F022);
@@ -79,22 +98,9 @@ fn mutated_logs_through_log_info_log_convert_and_replay_end_with_a_documented_co
         for args in [
             vec!["log", "info", m],
             vec!["log", "convert", m, out_csv.to_str().unwrap()],
-            vec![
-                "run",
-                "--headless",
-                "--no-rt",
-                "--device",
-                &replay,
-                "--duration",
-                "1",
-            ],
+            replay_run(&replay),
         ] {
-            let (code, out) = ends(&args);
-            assert!(!out.contains("panicked"), "{args:?}:\n{out}");
-            assert!([0, 2, 3].contains(&code), "{args:?}: exit {code}\n{out}");
-            if code == 2 {
-                assert!(out.contains("error: "), "{args:?}: no error line\n{out}");
-            }
+            let code = ends_as_documented(&args);
             let cmd = if args[0] == "run" {
                 "run replay:"
             } else {
@@ -124,19 +130,9 @@ fn mutated_logs_through_log_info_log_convert_and_replay_end_with_a_documented_co
         let replay = format!("replay:{}", p.display());
         for args in [
             vec!["log", "info", p.to_str().unwrap()],
-            vec![
-                "run",
-                "--headless",
-                "--no-rt",
-                "--device",
-                &replay,
-                "--duration",
-                "1",
-            ],
+            replay_run(&replay),
         ] {
-            let (code, out) = ends(&args);
-            assert!(!out.contains("panicked"), "{args:?}:\n{out}");
-            assert!([0, 2, 3].contains(&code), "{args:?}: exit {code}\n{out}");
+            ends_as_documented(&args);
         }
     }
 }

@@ -1,14 +1,14 @@
-//! Helpers shared by the CLI end-to-end tests (each test binary uses some of them); the
+//! Helpers shared by the CLI end-to-end tests (the modules of the `it` binary); the
 //! crate-independent ones live in haptic2d-test-support.
-#![allow(dead_code, unused_imports)]
 
 pub use haptic2d_test_support::files::{repo_root as root, temp_dir, write_in};
 pub use haptic2d_test_support::process::{signal, spawn_announced, text, wait_with_limit, Killed};
-pub use haptic2d_test_support::{holds_for, wait_for, wait_until};
+pub use haptic2d_test_support::{holds_for, wait_for};
 
 use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
+use std::sync::{Condvar, Mutex};
 
 /// The `haptic2d` binary built for these tests.
 pub const BIN: &str = env!("CARGO_BIN_EXE_haptic2d");
@@ -43,6 +43,7 @@ pub fn run(line: &str, paths: &[&dyn AsRef<OsStr>]) -> Output {
 }
 
 /// [`run`], asserting it succeeded; stdout followed by stderr.
+#[track_caller]
 pub fn run_ok(line: &str, paths: &[&dyn AsRef<OsStr>]) -> String {
     let o = run(line, paths);
     let out = text(&o);
@@ -50,7 +51,96 @@ pub fn run_ok(line: &str, paths: &[&dyn AsRef<OsStr>]) -> String {
     out
 }
 
-/// Serialises the tests of one binary that start emulators or devices (keeps the load down).
+/// Panics unless `out` contains every one of `needles` (the message names the missing one and
+/// shows `out` whole).
+#[track_caller]
+pub fn assert_has(out: &str, needles: &[&str]) {
+    for n in needles {
+        assert!(out.contains(n), "no `{n}` in:\n{out}");
+    }
+}
+
+/// Panics if `out` contains any of `needles`.
+#[track_caller]
+pub fn assert_lacks(out: &str, needles: &[&str]) {
+    for n in needles {
+        assert!(!out.contains(n), "`{n}` in:\n{out}");
+    }
+}
+
+/// The stdout and stderr of `o`, asserting that it exited with `code` and that they contain every
+/// one of `needles`.
+#[track_caller]
+pub fn expect_exit(o: &Output, code: i32, needles: &[&str]) -> String {
+    let out = text(o);
+    assert_eq!(o.status.code(), Some(code), "{out}");
+    assert_has(&out, needles);
+    out
+}
+
+/// A run that lost its device (the exit code and output of [`cut_mid_run`] or a run): exit 4, the
+/// output names `device` and has every one of `needles`, and nothing panicked.
+#[track_caller]
+pub fn assert_lost_device(code: Option<i32>, out: &str, device: &str, needles: &[&str]) {
+    assert_eq!(code, Some(4), "{out}");
+    assert_has(out, &[device]);
+    assert_has(out, needles);
+    assert_lacks(out, &["panicked"]);
+}
+
+/// Which module's tests run now, and how many of them.
+static MODULE_NOW: (Mutex<(Option<&str>, usize)>, Condvar) =
+    (Mutex::new((None, 0)), Condvar::new());
+
+/// Held by a test while it runs: see [`module_turn`].
+pub struct ModuleTurn;
+
+/// Keeps the modules apart as their own binaries kept them: the tests of one module (one former
+/// test file) run beside each other, never beside another module's. A clean normal-priority `run`
+/// beside another file's heavy tests stalled 47 ms in CI and tripped its safety stop (the reason
+/// the first merge into one binary was reverted); this keeps what each test runs beside as it was.
+/// Every test takes it first: `let _m = crate::common::module_turn(module_path!());`.
+pub fn module_turn(module: &'static str) -> ModuleTurn {
+    let (lock, changed) = &MODULE_NOW;
+    let mut now = lock.lock().unwrap_or_else(|e| e.into_inner());
+    while now.0.is_some_and(|m| m != module) {
+        now = changed.wait(now).unwrap_or_else(|e| e.into_inner());
+    }
+    now.0 = Some(module);
+    now.1 += 1;
+    ModuleTurn
+}
+
+impl Drop for ModuleTurn {
+    fn drop(&mut self) {
+        let (lock, changed) = &MODULE_NOW;
+        let mut now = lock.lock().unwrap_or_else(|e| e.into_inner());
+        now.1 -= 1;
+        if now.1 == 0 {
+            now.0 = None;
+            changed.notify_all();
+        }
+    }
+}
+
+/// A test's [`module_turn`] and then, within its module, the one-at-a-time [`turn`] of the tests
+/// that start emulators, devices or real-time loops; released in the reverse order.
+pub struct LoopTurn {
+    _alone: std::sync::MutexGuard<'static, ()>,
+    _module: ModuleTurn,
+}
+
+/// [`LoopTurn`] for a test of `module` (`module_path!()`).
+pub fn loop_turn(module: &'static str) -> LoopTurn {
+    let module = module_turn(module);
+    LoopTurn {
+        _alone: turn(),
+        _module: module,
+    }
+}
+
+/// Serialises the tests that start emulators, devices or real-time loops (within a module: see
+/// [`module_turn`]), to keep the load down.
 pub fn turn() -> std::sync::MutexGuard<'static, ()> {
     static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
     ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner())
@@ -87,6 +177,22 @@ pub fn haply_file(dir: &Path, file: &str, name: &str, edit: impl Fn(String) -> S
         .replace("max_missed_deadlines = 10 ", "max_missed_deadlines = 0 ")
         .replace("max_stall_periods = 5 ", "max_stall_periods = 1000 ");
     write_in(dir, name, &edit(text))
+}
+
+/// A Haply device file's text with motor 1 said to turn CW while its encoder still counts CCW: a
+/// host file that disagrees with a board wired CCW (the pulse pushes that link backwards).
+pub fn motor1_flipped(text: String) -> String {
+    text.replacen(
+        "direction = \"ccw\"",
+        "direction = \"cw\"\nencoder_direction = \"ccw\"",
+        1,
+    )
+}
+
+/// A Haply device file's text with motor 1 and its encoder both reversed (every angle still grows
+/// under a positive torque, as on a correct board).
+pub fn joint1_reversed(text: String) -> String {
+    text.replacen("direction = \"ccw\"", "direction = \"cw\"", 1)
 }
 
 /// `haptic2d emulate haply --device-file FILE ARGS…`, killed on drop, and its pty path (its first
@@ -167,14 +273,19 @@ pub fn ends_within<S: AsRef<OsStr> + std::fmt::Debug>(
     (code, out)
 }
 
-/// The "N ticks" of a run's timing summary.
-pub fn summary_ticks(out: &str) -> u64 {
+/// The first whole number `N` that stands before the word `word` ("N ticks", "N samples") in `out`.
+pub fn count_of(out: &str, word: &str) -> u64 {
     out.split_whitespace()
         .collect::<Vec<_>>()
         .windows(2)
-        .find(|w| w[1] == "ticks")
+        .find(|w| w[1] == word)
         .and_then(|w| w[0].parse().ok())
-        .unwrap_or_else(|| panic!("no tick count in:\n{out}"))
+        .unwrap_or_else(|| panic!("no {word} count in:\n{out}"))
+}
+
+/// The "N ticks" of a run's timing summary.
+pub fn summary_ticks(out: &str) -> u64 {
+    count_of(out, "ticks")
 }
 
 /// A CSV log read whole: the column index of each name (panicking on a missing one) and the rows as

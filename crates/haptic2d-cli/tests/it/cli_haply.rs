@@ -13,9 +13,10 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Duration;
 
-mod common;
-use common::{
-    cmd, column, cut_mid_run, emulate_haply, haply_file, interrupt, run, run_ok, signal, text, turn,
+use crate::common::{
+    assert_has, assert_lacks, assert_lost_device, cmd, column, cut_mid_run, emulate_haply,
+    expect_exit, haply_file, interrupt, joint1_reversed, motor1_flipped, run, run_ok, signal, text,
+    turn,
 };
 
 /// The gen 3 file with the test settings and `edit` applied, written into `dir`.
@@ -37,14 +38,18 @@ fn haply_run(pty: &str, file: &Path, duration: &str) -> Command {
     c
 }
 
-#[test]
-fn run_against_the_emulator_for_3_s_logs_and_exits_clean() {
-    let _turn = turn();
-    let dir = tempfile::tempdir().unwrap();
-    let file = device_file(dir.path(), "gen3.toml", |t| t);
-    let (emu, pty) = emulate_haply(&file, &[]);
-    let log = dir.path().join("x.csv");
-    let o = haply_run(&pty, &file, "3")
+/// A `haptic2d run` of `secs` seconds against the emulator started on `file` with `emu_args`,
+/// logged to `dir/run.csv`, which must end clean: the pty, the run's output and the log's text.
+#[track_caller]
+fn clean_logged_run(
+    dir: &Path,
+    file: &Path,
+    emu_args: &[&str],
+    secs: &str,
+) -> (String, String, String) {
+    let (emu, pty) = emulate_haply(file, emu_args);
+    let log = dir.join("run.csv");
+    let o = haply_run(&pty, file, secs)
         .arg("--log")
         .arg(&log)
         .output()
@@ -52,10 +57,16 @@ fn run_against_the_emulator_for_3_s_logs_and_exits_clean() {
     interrupt(emu);
     let out = text(&o);
     assert!(o.status.success(), "{out}");
-    assert!(
-        out.contains(&format!("device haply:{pty}")) && out.contains("on time:"),
-        "{out}"
-    );
+    (pty, out, std::fs::read_to_string(&log).unwrap())
+}
+
+#[test]
+fn run_against_the_emulator_for_3_s_logs_and_exits_clean() {
+    let _turn = crate::common::loop_turn(module_path!());
+    let dir = tempfile::tempdir().unwrap();
+    let file = device_file(dir.path(), "gen3.toml", |t| t);
+    let (pty, out, csv) = clean_logged_run(dir.path(), &file, &[], "3");
+    assert_has(&out, &[&format!("device haply:{pty}"), "on time:"]);
     // The stock firmware has no watchdog: said once, at start (issue 34 finding 3).
     assert_eq!(
         out.matches("warning: this board's firmware has no watchdog")
@@ -63,14 +74,14 @@ fn run_against_the_emulator_for_3_s_logs_and_exits_clean() {
         1,
         "{out}"
     );
-    let rows = std::fs::read_to_string(&log).unwrap().lines().count() - 1;
+    let rows = csv.lines().count() - 1;
     assert!(rows > 500, "only {rows} rows logged:\n{out}");
 }
 
 /// A 20 s run against the emulated gen 3 board, cut once its loop is ticking (its log has rows):
 /// `cut` silences the emulator. The pty, the run's exit code and its output; the run ends within 5 s
 /// of the cut (asserted).
-fn run_then_cut(cut: impl FnOnce(&mut common::Killed)) -> (String, Option<i32>, String) {
+fn run_then_cut(cut: impl FnOnce(&mut crate::common::Killed)) -> (String, Option<i32>, String) {
     let _turn = turn();
     let dir = tempfile::tempdir().unwrap();
     let file = device_file(dir.path(), "gen3.toml", |t| t);
@@ -83,30 +94,29 @@ fn run_then_cut(cut: impl FnOnce(&mut common::Killed)) -> (String, Option<i32>, 
 
 #[test]
 fn emulator_killed_mid_run_exits_4_naming_the_device() {
+    let _m = crate::common::module_turn(module_path!());
     let (pty, code, out) = run_then_cut(|emu| {
         emu.kill().unwrap();
         let _ = emu.wait();
     });
-    assert_eq!(code, Some(4), "{out}");
-    assert!(
-        out.contains(&format!("haply:{pty}"))
-            && out.contains("check")
-            && out.contains("torques were set to zero"),
-        "{out}"
-    );
-    assert!(!out.contains("panicked"), "{out}");
+    let device = format!("haply:{pty}");
+    assert_lost_device(code, &out, &device, &["check", "torques were set to zero"]);
     // The lost reading is not reported as a second fault.
-    assert!(!out.contains("non-finite device input"), "{out}");
+    assert_lacks(&out, &["non-finite device input"]);
 }
 
-/// `device check FILE --pulse` against the emulator at `pty`: the exit code and the output.
-fn device_check(pty: &str, file: &Path) -> (Option<i32>, String) {
+/// `device check FILE --pulse` against an emulator of `board` (started for it, at the rest pose),
+/// which must exit with `code` and say every one of `needles`: its output.
+#[track_caller]
+fn device_check(board: &Path, file: &Path, code: i32, needles: &[&str]) -> String {
+    let (emu, pty) = emulate_haply(board, &[]);
     let device = format!("haply:{pty}");
     let o = run(
         "device check --device {} --pulse --device-file {}",
         &[&device, &file],
     );
-    (o.status.code(), text(&o))
+    interrupt(emu);
+    expect_exit(&o, code, needles)
 }
 
 /// Issue 34 finding 1: against a board that sets its encoders at setup, `device check` said "far
@@ -114,60 +124,37 @@ fn device_check(pty: &str, file: &Path) -> (Option<i32>, String) {
 /// emulator's default start), a correct board now passes, and the check says which firmware it is.
 #[test]
 fn device_check_passes_on_a_correct_board_held_at_rest_and_finds_a_flipped_motor() {
-    let _turn = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let good = device_file(dir.path(), "gen3.toml", |t| t);
-    let (emu, pty) = emulate_haply(&good, &[]);
-    let (code, out) = device_check(&pty, &good);
-    assert_eq!(code, Some(0), "{out}");
-    assert!(
-        out.contains("rest pose: end point (0.0190 m, 0.0357 m)") && out.contains("ok:"),
-        "{out}"
-    );
-    assert!(
-        out.contains("stock firmware") && out.contains("no watchdog"),
-        "{out}"
-    );
-    // The emulated hand lets the handle settle back at the rest pose before the next check.
-    std::thread::sleep(Duration::from_millis(300));
-    // The host's file says motor 1 turns CW (its encoder still CCW): the emulated board, wired
-    // CCW, pushes that link backwards.
-    let flipped = device_file(dir.path(), "flipped.toml", |t| {
-        t.replacen(
-            "direction = \"ccw\"",
-            "direction = \"cw\"\nencoder_direction = \"ccw\"",
-            1,
-        )
-    });
-    let (code, out) = device_check(&pty, &flipped);
-    interrupt(emu);
-    assert_eq!(code, Some(2), "{out}");
-    assert!(
-        out.contains("fix: motor[0] turns its link clockwise")
-            && out.contains("flip motor[0].direction"),
-        "{out}"
-    );
+    let passes = [
+        "rest pose: end point (0.0190 m, 0.0357 m)",
+        "ok:",
+        "stock firmware",
+        "no watchdog",
+    ];
+    device_check(&good, &good, 0, &passes);
+    // The host's file says motor 1 turns CW (its encoder still CCW): the emulated board (a fresh
+    // one, at the rest pose), wired CCW, pushes that link backwards.
+    let flipped = device_file(dir.path(), "flipped.toml", motor1_flipped);
+    let fix = [
+        "fix: motor[0] turns its link clockwise",
+        "flip motor[0].direction",
+    ];
+    device_check(&good, &flipped, 2, &fix);
 }
 
 /// Issue 34 finding 8: a joint whose motor AND encoder are both reversed read "+" like a correct
 /// one. The other joint's motion under the pulse (the five-bar's coupling) now tells them apart.
 #[test]
 fn device_check_tells_a_reversed_motor_and_encoder_from_a_correct_joint() {
-    let _turn = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let good = device_file(dir.path(), "gen3.toml", |t| t);
     // The emulated board is wired with motor 1 and its encoder both reversed against the file.
-    let board = device_file(dir.path(), "board.toml", |t| {
-        t.replacen("direction = \"ccw\"", "direction = \"cw\"", 1)
-    });
-    let (emu, pty) = emulate_haply(&board, &[]);
-    let (code, out) = device_check(&pty, &good);
-    interrupt(emu);
-    assert_eq!(code, Some(2), "{out}");
-    assert!(
-        out.contains("motor[0]'s motor AND encoder are both reversed"),
-        "{out}"
-    );
+    let board = device_file(dir.path(), "board.toml", joint1_reversed);
+    let both = ["motor[0]'s motor AND encoder are both reversed"];
+    let out = device_check(&board, &good, 2, &both);
     // Both joints' angles still grow under a positive torque, as on a correct board.
     assert_eq!(out.matches("angle +").count(), 2, "{out}");
 }
@@ -176,50 +163,36 @@ fn device_check_tells_a_reversed_motor_and_encoder_from_a_correct_joint() {
 /// angle still grows, and the closure of the readings under the pulses gives it away.
 #[test]
 fn device_check_on_the_twin_finds_a_joint_with_motor_and_encoder_reversed() {
-    let _turn = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let good = twin_file(dir.path(), "twin.toml", |t| t);
-    let (emu, pty) = emulate_haply(&good, &[]);
-    let (code, out) = device_check(&pty, &good);
-    interrupt(emu);
-    assert_eq!(code, Some(0), "{out}");
-    let board = twin_file(dir.path(), "board.toml", |t| {
-        t.replacen("direction = \"ccw\"", "direction = \"cw\"", 1)
-    });
-    let (emu, pty) = emulate_haply(&board, &[]);
-    let (code, out) = device_check(&pty, &good);
-    interrupt(emu);
-    assert_eq!(code, Some(2), "{out}");
+    device_check(&good, &good, 0, &[]);
+    let board = twin_file(dir.path(), "board.toml", joint1_reversed);
+    let closure = [
+        "no longer describe one rigid handle",
+        "under motor[0]'s pulse",
+    ];
+    let out = device_check(&board, &good, 2, &closure);
     assert_eq!(out.matches("angle +").count(), 4, "{out}");
-    assert!(
-        out.contains("no longer describe one rigid handle")
-            && out.contains("under motor[0]'s pulse"),
-        "{out}"
-    );
 }
 
 /// Issue 34 finding 4 / item 7: the twin on an M0 ended with "check the USB cable" although the
 /// board answered. It is refused at open, naming the port count, before any torque.
 #[test]
 fn twin_on_an_m0_board_is_refused_naming_the_port_count() {
-    let _turn = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let file = twin_file(dir.path(), "twin.toml", |t| t);
     let (emu, pty) = emulate_haply(&file, &["--board", "m0"]);
     let o = haply_run(&pty, &file, "1").output().unwrap();
     interrupt(emu);
-    let out = text(&o);
-    assert_eq!(o.status.code(), Some(4), "{out}");
-    assert!(
-        out.contains("M0 board has 2 ports")
-            && out.contains("ports 1–4")
-            && !out.contains("USB cable"),
-        "{out}"
-    );
+    let out = expect_exit(&o, 4, &["M0 board has 2 ports", "ports 1–4"]);
+    assert_lacks(&out, &["USB cable"]);
 }
 
 #[test]
 fn missing_port_and_bad_device_file_are_clear_errors() {
+    let _m = crate::common::module_turn(module_path!());
     let o = run(
         "run --device haply:/dev/no-such-board --headless --duration 1",
         &[],
@@ -237,32 +210,27 @@ fn missing_port_and_bad_device_file_are_clear_errors() {
         "run --device haply:/dev/null --headless --device-file {}",
         &[&bad],
     );
-    let out = text(&o);
-    assert_eq!(o.status.code(), Some(2), "{out}");
-    assert!(
-        out.contains("board.torque_limit") && out.contains("N·m"),
-        "{out}"
-    );
-    assert!(!out.contains("panicked"), "{out}");
+    let out = expect_exit(&o, 2, &["board.torque_limit", "N·m"]);
+    assert_lacks(&out, &["panicked"]);
 }
 
 #[test]
 fn devices_lists_ports_without_failing() {
-    let o = run("devices", &[]);
-    assert!(o.status.success(), "{}", text(&o));
+    let _m = crate::common::module_turn(module_path!());
+    run_ok("devices", &[]);
 }
 
-/// Column `name` of a CSV log, as numbers.
 /// Task L item 1: the Haply board runs in the one loop of `run` — its CSV log has the same columns
 /// as the simulated device's, the torques start at exactly zero and ramp in (a hand push on the
 /// emulated handle after the ramp makes them grow), and every torque stays within the device file's
 /// limit.
 #[test]
 fn haply_run_is_the_normal_loop_torques_start_at_zero_ramp_in_and_stay_clamped() {
-    let _turn = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let file = device_file(dir.path(), "gen3.toml", |t| t);
-    let (emu, pty) = emulate_haply(
+    let (_, out, csv) = clean_logged_run(
+        dir.path(),
         &file,
         &[
             // The user holds the handle at the rest pose while the board is set up (docs/DEVICES.md
@@ -272,17 +240,8 @@ fn haply_run_is_the_normal_loop_torques_start_at_zero_ramp_in_and_stay_clamped()
             "--hand",
             "script:0.8,0.5,0,0,5",
         ],
+        "1.5",
     );
-    let log = dir.path().join("ramp.csv");
-    let o = haply_run(&pty, &file, "1.5")
-        .arg("--log")
-        .arg(&log)
-        .output()
-        .unwrap();
-    interrupt(emu);
-    let out = text(&o);
-    assert!(o.status.success(), "{out}");
-    let csv = std::fs::read_to_string(&log).unwrap();
     let header = csv.lines().next().unwrap();
     assert!(
         header.starts_with("t,") && header.contains("tau1"),
@@ -310,20 +269,19 @@ fn haply_run_is_the_normal_loop_torques_start_at_zero_ramp_in_and_stay_clamped()
 /// what to check — not a stall.
 #[test]
 fn a_silent_emulated_device_exits_4_with_the_reason() {
+    let _m = crate::common::module_turn(module_path!());
     let (pty, code, out) = run_then_cut(|emu| {
         // Stopped, then resumed and killed when the guard drops.
         signal(emu.id(), "-STOP");
     });
-    assert_eq!(code, Some(4), "{out}");
-    assert!(
-        out.contains(&format!("haply:{pty}"))
-            && out.contains("emulator on a pseudo-terminal (no USB cable)")
-            && out.contains("the device was late")
-            && out.contains("torques were set to zero")
-            && !out.contains("stalled"),
-        "{out}"
-    );
-    assert!(!out.contains("panicked"), "{out}");
+    let device = format!("haply:{pty}");
+    let says = [
+        "emulator on a pseudo-terminal (no USB cable)",
+        "the device was late",
+        "torques were set to zero",
+    ];
+    assert_lost_device(code, &out, &device, &says);
+    assert_lacks(&out, &["stalled"]);
 }
 
 /// Task L items 1 and 3: the twin pantograph of two 2DIY linkages (4 ports) through the one loop of
@@ -331,21 +289,12 @@ fn a_silent_emulated_device_exits_4_with_the_reason() {
 /// every torque within the limit.
 #[test]
 fn twin_runs_through_the_normal_loop_against_the_emulator() {
-    let _turn = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let file = twin_file(dir.path(), "twin.toml", |t| t);
-    let (emu, pty) = emulate_haply(&file, &["--hand", "script:0.8,0.3,0,0,100"]);
-    let log = dir.path().join("twin.csv");
-    let o = haply_run(&pty, &file, "1.5")
-        .arg("--log")
-        .arg(&log)
-        .output()
-        .unwrap();
-    interrupt(emu);
-    let out = text(&o);
-    assert!(o.status.success(), "{out}");
-    assert!(out.contains("twin pantograph"), "{out}");
-    let csv = std::fs::read_to_string(&log).unwrap();
+    let hand = ["--hand", "script:0.8,0.3,0,0,100"];
+    let (_, out, csv) = clean_logged_run(dir.path(), &file, &hand, "1.5");
+    assert_has(&out, &["twin pantograph"]);
     let taus: Vec<Vec<f64>> = ["tau1", "tau2", "tau3", "tau4"]
         .iter()
         .map(|c| column(&csv, c))
@@ -366,18 +315,16 @@ fn twin_runs_through_the_normal_loop_against_the_emulator() {
 /// with the hand released.
 #[test]
 fn stability_of_the_2diy_is_per_axis_x_and_y() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
-    let file = common::root().join("devices/haply-2diy-gen3.toml");
+    let file = crate::common::root().join("devices/haply-2diy-gen3.toml");
     let run = |controller: &str| {
         let line = format!("stability --device-file {{}} --controller {controller} --out {{}}");
         run_ok(&line, &[&file, &dir.path()])
     };
     let out = run("four-channel");
-    assert!(
-        out.contains("2-DOF device") && out.contains("axis x") && out.contains("axis y"),
-        "{out}"
-    );
-    assert!(!out.contains("axis theta"), "{out}");
+    assert_has(&out, &["2-DOF device", "axis x", "axis y"]);
+    assert_lacks(&out, &["axis theta"]);
     assert_eq!(out.matches("verdict: stable").count(), 2, "{out}");
     let out = run("four-channel-spec");
     assert_eq!(
@@ -391,7 +338,7 @@ fn stability_of_the_2diy_is_per_axis_x_and_y() {
 /// hand released (exit 2, nothing opened), unless `--allow-unstable`.
 #[test]
 fn run_refuses_an_unstable_released_configuration_on_a_haply_board() {
-    let _turn = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let file = device_file(dir.path(), "gen3.toml", |t| t);
     let (emu, pty) = emulate_haply(&file, &[]);
@@ -402,13 +349,7 @@ fn run_refuses_an_unstable_released_configuration_on_a_haply_board() {
             .output()
             .unwrap()
     };
-    let o = args(&[]);
-    let out = text(&o);
-    assert_eq!(o.status.code(), Some(2), "{out}");
-    assert!(
-        out.contains("unstable on axis") && out.contains("--allow-unstable"),
-        "{out}"
-    );
+    expect_exit(&args(&[]), 2, &["unstable on axis", "--allow-unstable"]);
     let o = args(&["--allow-unstable"]);
     interrupt(emu);
     let out = text(&o);

@@ -221,6 +221,7 @@ fn rows(tsv: &Path) -> (Vec<(u32, u8, f64)>, String) {
 
 #[test]
 fn browser_study_answers_trials_and_resumes_after_sigint_with_no_trial_lost_or_repeated() {
+    let _m = crate::common::module_turn(module_path!());
     require_prerequisites(&e2e_dir());
     let dir = tempfile::tempdir().unwrap();
     let tsv = dir.path().join("sub-e2e01/ses-1/trials.tsv");
@@ -332,6 +333,7 @@ fn magnitude_rows(tsv: &Path) -> Vec<(u32, u8, f64, f64)> {
 /// Space (a continue naming another trial refused), and each answered trial has its MCAP.
 #[test]
 fn browser_magnitude_study_takes_typed_numbers_and_holds_at_the_break_screen() {
+    let _m = crate::common::module_turn(module_path!());
     require_prerequisites(&e2e_dir());
     let dir = tempfile::tempdir().unwrap();
     let text = std::fs::read_to_string(

@@ -7,16 +7,13 @@
 //! 1000 periods: the tests run on machines shared with compilers and check the protocol and the
 //! exit paths, not the timing (the timeout is exercised by the driver tests in haptic2d-devices).
 
-// The Inverse3 driver is behind haptic2d-cli's `inverse3` feature (off by default, issue 39): these
-// tests run with it, e.g. `cargo test --workspace --features haptic2d-cli/inverse3` (CI); without it
-// the refusal is tested in tests/cli_exit.rs.
-#![cfg(feature = "inverse3")]
-
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
-mod common;
-use common::{cmd, column, cut_mid_run, patient_device_file, spawn_announced, text, turn, Killed};
+use crate::common::{
+    assert_has, assert_lacks, assert_lost_device, cmd, column, cut_mid_run, expect_exit,
+    patient_device_file, spawn_announced, text, Killed,
+};
 
 /// The shipped file, patient about the machine's timing, in a temp dir.
 fn device_file(tag: &str) -> PathBuf {
@@ -42,6 +39,22 @@ fn run(url: &str, file: &Path, duration: &str) -> Command {
     c
 }
 
+/// A 3 s `run --controller coupling` against an emulator started with `emu_args` (killed after),
+/// logged into the temp dir of the device file `tag`: the run's output (asserted to exit 0) and the
+/// log's path.
+#[track_caller]
+fn coupling_run(emu_args: &[&str], tag: &str) -> (String, PathBuf) {
+    let emu = emulator(emu_args);
+    let file = device_file(tag);
+    let log = file.with_file_name("run.csv");
+    let o = run(&emu.1, &file, "3")
+        .args(["--controller", "coupling", "--log"])
+        .arg(&log)
+        .output()
+        .unwrap();
+    (expect_exit(&o, 0, &[]), log)
+}
+
 /// The VerseGrip's orientation turns the slave (issue 15: "θ comes from the handle's orientation
 /// where the service reports one"): the emulated grip turns at 0.3 rad/s while the hand holds the
 /// cursor still, the loop makes the grip's turn since the first reading the slave's twist target, and
@@ -50,18 +63,8 @@ fn run(url: &str, file: &Path, duration: &str) -> Command {
 /// start-up ramp, has turned more than half of that and not past it.
 #[test]
 fn a_turning_versegrip_turns_the_slave() {
-    let _t = turn();
-    let emu = emulator(&["--grip-rate", "0.3"]);
-    let file = device_file("grip");
-    let dir = file.parent().unwrap().to_path_buf();
-    let log = dir.join("grip.csv");
-    let o = run(&emu.1, &file, "3")
-        .args(["--controller", "coupling", "--log"])
-        .arg(&log)
-        .output()
-        .unwrap();
-    let out = text(&o);
-    assert_eq!(o.status.code(), Some(0), "{out}");
+    let _turn = crate::common::loop_turn(module_path!());
+    let (_, log) = coupling_run(&["--grip-rate", "0.3"], "grip");
     let theta = column(&std::fs::read_to_string(&log).unwrap(), "slave.theta");
     let end = *theta.last().unwrap();
     assert!(theta[0].abs() < 1e-6, "starts at {}", theta[0]);
@@ -75,28 +78,18 @@ fn a_turning_versegrip_turns_the_slave() {
         top = top.max(t);
         assert!(t > top - 0.05, "turned back: {t} after {top}");
     }
-    let _ = std::fs::remove_dir_all(dir);
+    let _ = std::fs::remove_dir_all(log.parent().unwrap());
 }
 
 #[test]
 fn run_against_the_emulated_service_for_3_s_drives_the_box_into_the_wall() {
-    let _t = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     // The hand holds for 0.5 s, then pushes 0.8 N towards the left wall (the box starts 0.02 m
     // from it, grasped at its centre: the cursor must travel 0.02 m to the contact).
-    let emu = emulator(&["--hand", "push:-0.8,0,0,0.5"]);
-    let file = device_file("clean");
-    let dir = file.parent().unwrap().to_path_buf();
-    let log = dir.join("run.csv");
-    let o = run(&emu.1, &file, "3")
-        .args(["--controller", "coupling", "--log"])
-        .arg(&log)
-        .output()
-        .unwrap();
-    let out = text(&o);
-    assert_eq!(o.status.code(), Some(0), "{out}");
-    assert!(out.contains("planar: world x = device x"), "{out}");
-    assert!(!out.contains("panicked"), "{out}");
-    let (col, rows) = common::csv_rows(&log);
+    let (out, log) = coupling_run(&["--hand", "push:-0.8,0,0,0.5"], "clean");
+    assert_has(&out, &["planar: world x = device x"]);
+    assert_lacks(&out, &["panicked"]);
+    let (col, rows) = crate::common::csv_rows(&log);
     let (xs, contacts) = (col("slave.x"), col("contacts"));
     assert!(rows.len() > 1500, "{} rows", rows.len());
     let last = &rows[rows.len() - 300..];
@@ -106,23 +99,18 @@ fn run_against_the_emulated_service_for_3_s_drives_the_box_into_the_wall() {
     );
     let slave = last.iter().map(|r| r[xs]).sum::<f64>() / last.len() as f64;
     assert!((slave - 0.02).abs() < 2e-3, "box centre at {slave} m");
-    let _ = std::fs::remove_dir_all(dir);
+    let _ = std::fs::remove_dir_all(log.parent().unwrap());
 }
 
 #[test]
 fn service_killed_mid_run_exits_4_naming_the_device() {
-    let _t = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let mut emu = emulator(&[]);
     let file = device_file("kill");
     let log = file.with_file_name("kill.csv");
     let (code, out, _) = cut_mid_run(run(&emu.1, &file, "10"), &log, || emu.0.kill().unwrap());
-    assert_eq!(code, Some(4), "{out}");
-    assert!(out.contains(&format!("inverse3:{}", emu.1)), "{out}");
-    assert!(
-        out.contains("check:") && out.contains("Inverse Service"),
-        "{out}"
-    );
-    assert!(!out.contains("panicked"), "{out}");
+    let device = format!("inverse3:{}", emu.1);
+    assert_lost_device(code, &out, &device, &["check:", "Inverse Service"]);
 }
 
 /// Regression (issue 34, finding 9): a service state without a cursor position was read as
@@ -130,22 +118,17 @@ fn service_killed_mid_run_exits_4_naming_the_device() {
 /// message names the missing field.
 #[test]
 fn a_state_without_a_cursor_position_exits_4_naming_the_field() {
-    let _t = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let emu = emulator(&["--drop-position-after", "1500"]);
     let file = device_file("noposition");
     let o = run(&emu.1, &file, "10").output().unwrap();
-    let out = text(&o);
-    assert_eq!(o.status.code(), Some(4), "{out}");
-    assert!(
-        out.contains("state.cursor_position") && out.contains("zero force latched"),
-        "{out}"
-    );
+    let out = expect_exit(&o, 4, &["state.cursor_position", "zero force latched"]);
     assert!(!out.contains("panicked"), "{out}");
 }
 
 #[test]
 fn no_service_and_bad_urls_are_clear_errors() {
-    let _t = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let port = std::net::TcpListener::bind("127.0.0.1:0")
         .unwrap()
         .local_addr()
@@ -160,17 +143,11 @@ fn no_service_and_bad_urls_are_clear_errors() {
     assert_eq!(o.status.code(), Some(4), "{out}");
     assert!(out.contains("haptic2d emulate inverse3"), "{out}");
     assert!(!out.contains("panicked"), "{out}");
-    let o = common::run(
+    let o = crate::common::run(
         "run --device inverse3:nonsense --headless --duration 1",
         &[],
     );
-    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
-    assert!(
-        text(&o).contains("inverse3:http://HOST:PORT"),
-        "{}",
-        text(&o)
-    );
-    let o = common::run("emulate inverse3 --bind nowhere", &[]);
-    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
-    assert!(text(&o).contains("--bind"), "{}", text(&o));
+    expect_exit(&o, 2, &["inverse3:http://HOST:PORT"]);
+    let o = crate::common::run("emulate inverse3 --bind nowhere", &[]);
+    expect_exit(&o, 2, &["--bind"]);
 }

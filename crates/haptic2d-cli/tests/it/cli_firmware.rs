@@ -16,8 +16,7 @@
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-mod common;
-use common::{cmd, holds_for, patient_device_file, wait_for, Killed};
+use crate::common::{cmd, holds_for, patient_device_file, wait_for, Killed};
 use haptic2d_test_support::firmware::{compile_native_firmware, start_native_firmware};
 
 /// The firmware's default watchdog (µs).
@@ -99,6 +98,7 @@ fn text_of(path: &Path) -> String {
 
 #[test]
 fn kill_9_of_run_against_our_firmware_zeroes_the_motors_within_the_watchdog_time() {
+    let _m = crate::common::module_turn(module_path!());
     let dir =
         Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("cli-firmware-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();

@@ -1,11 +1,9 @@
 //! Issue 10, items 4–6: every option and scene number bounded with a clear message, and the
 //! documented exit codes (`haptic2d --help`, docs/SCENES.md): 0 clean, 1 runtime failure, 2 bad
 //! input, 3 safety stop, 4 lost device (unit-tested in `cmd_run`), 5 energy excess under `--strict`,
-//! 6 divergence, 130 interrupted (tests/cli_signals.rs).
+//! 6 divergence, 130 interrupted (tests/it/cli_signals.rs).
 
-mod common;
-
-use common::{haptic2d, run, text};
+use crate::common::{haptic2d, run, text};
 use std::process::Output;
 
 fn code(o: &Output) -> i32 {
@@ -33,10 +31,11 @@ fn write(dir: &tempfile::TempDir, name: &str, text: &str) -> String {
     p.to_str().unwrap().to_string()
 }
 
-const BOX_IN_WALLS: &str = include_str!("../../../scenes/box-in-walls.toml");
+const BOX_IN_WALLS: &str = include_str!("../../../../scenes/box-in-walls.toml");
 
 #[test]
 fn help_lists_the_exit_codes() {
+    let _m = crate::common::module_turn(module_path!());
     let out = assert_exit(&["--help"], 0, "Exit codes:");
     for c in ["0 ", "1 ", "2 ", "3 ", "4 ", "5 ", "6 ", "130 "] {
         assert!(
@@ -48,6 +47,7 @@ fn help_lists_the_exit_codes() {
 
 #[test]
 fn a_clean_simulate_exits_0() {
+    let _m = crate::common::module_turn(module_path!());
     assert_exit(
         &["simulate", "box-in-walls", "--duration", "0.5"],
         0,
@@ -57,6 +57,7 @@ fn a_clean_simulate_exits_0() {
 
 #[test]
 fn bad_scene_exits_2_naming_the_field() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let r1 = write(
         &dir,
@@ -69,13 +70,15 @@ fn bad_scene_exits_2_naming_the_field() {
 
 #[test]
 fn check_dev_zero_is_a_bounded_read_and_a_clear_error() {
+    let _m = crate::common::module_turn(module_path!());
     assert_exit(&["check", "/dev/zero"], 2, "larger than the documented cap");
 }
 
 #[test]
 fn run_rate_above_cap_is_rejected_before_allocating_the_ring() {
+    let _m = crate::common::module_turn(module_path!());
     // Today's `--rate 1e9` sized a 624 GB telemetry ring.
-    let _turn = common::turn(); // one real-time loop at a time
+    let _turn = crate::common::turn(); // one real-time loop at a time
     assert_exit(
         &"run --headless --no-rt --rate 1e9 --duration 1"
             .split(' ')
@@ -87,7 +90,7 @@ fn run_rate_above_cap_is_rejected_before_allocating_the_ring() {
 
 #[test]
 fn run_duration_1e300_is_a_clear_error_not_a_panic() {
-    let _turn = common::turn(); // one real-time loop at a time
+    let _turn = crate::common::loop_turn(module_path!()); // one real-time loop at a time
     assert_exit(
         &["run", "--headless", "--no-rt", "--duration", "1e300"],
         2,
@@ -97,6 +100,7 @@ fn run_duration_1e300_is_a_clear_error_not_a_panic() {
 
 #[test]
 fn simulate_duration_1e300_is_a_clear_error() {
+    let _m = crate::common::module_turn(module_path!());
     assert_exit(
         &["simulate", "box-in-walls", "--duration", "1e300"],
         2,
@@ -118,6 +122,7 @@ fn simulate_duration_1e300_is_a_clear_error() {
 
 #[test]
 fn pile_count_above_cap_exits_2() {
+    let _m = crate::common::module_turn(module_path!());
     assert_exit(
         &["check", "pile:100000000000"],
         2,
@@ -127,6 +132,7 @@ fn pile_count_above_cap_exits_2() {
 
 #[test]
 fn overlapping_bodies_are_an_error_in_check_unless_accepted() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     // The box's face 5 mm inside the left wall (face at x = 0; half width 0.02 m).
     let text = BOX_IN_WALLS.replace("position = [0.04, 0.0]", "position = [0.015, 0.0]");
@@ -157,6 +163,7 @@ fn overlapping_bodies_are_an_error_in_check_unless_accepted() {
 
 #[test]
 fn energy_excess_is_a_warning_and_exit_5_with_strict() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     // The pure-stiffness ZOH wall under exact-ZOH integration gains energy at every bounce (§5.10).
     let zoh = BOX_IN_WALLS
@@ -202,6 +209,7 @@ fn energy_excess_is_a_warning_and_exit_5_with_strict() {
 
 #[test]
 fn divergence_is_detected_before_the_row_is_written_and_exits_6() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     // 1e6 m/s² on a free body: the speed passes the divergence bound (1e6 m/s) after 1 s.
     let scene = r#"
@@ -250,7 +258,7 @@ per_mass = true
 
 #[test]
 fn a_safety_stop_in_run_exits_3() {
-    let _turn = common::turn(); // one real-time loop at a time
+    let _turn = crate::common::loop_turn(module_path!()); // one real-time loop at a time
     let dir = tempfile::tempdir().unwrap();
     // Encoder angles of zero are no pose of the device: the closure monitor trips on tick 0.
     let replay = write(&dir, "zero.csv", "q1,q2,q3,q4\n0,0,0,0\n0,0,0,0\n");
@@ -271,6 +279,7 @@ fn a_safety_stop_in_run_exits_3() {
 
 #[test]
 fn clap_usage_errors_exit_2() {
+    let _m = crate::common::module_turn(module_path!());
     assert_exit(&["simulate", "box-in-walls", "--bogus"], 2, "--bogus");
 }
 
@@ -313,11 +322,11 @@ fn hostile_logs(dir: &tempfile::TempDir) -> (String, String) {
 }
 
 /// Issue 38 item 3 and issue 39 items 5 and 7: every command into every ending, with its code and
-/// the message that says why. (Exit 4 is unit-tested in `cmd_run`; 141 is in tests/cli_pipe.rs;
-/// 130 in tests/cli_signals.rs and tests/mcap_log.rs.)
+/// the message that says why. (Exit 4 is unit-tested in `cmd_run`; 141 is in tests/it/cli_pipe.rs;
+/// 130 in tests/it/cli_signals.rs and tests/it/mcap_log.rs.)
 #[test]
 fn every_command_ends_with_its_documented_exit_code_and_message() {
-    let _turn = common::turn(); // one real-time loop at a time
+    let _turn = crate::common::loop_turn(module_path!()); // one real-time loop at a time
     let dir = tempfile::tempdir().unwrap();
     let zero_replay = write(&dir, "zero.csv", "q1,q2,q3,q4\n0,0,0,0\n0,0,0,0\n");
     let out_file = write(&dir, "a-file", "not a folder");
@@ -462,7 +471,7 @@ fn every_command_ends_with_its_documented_exit_code_and_message() {
 
 #[test]
 fn dev_zero_as_a_log_is_refused_at_once() {
-    let _turn = common::turn(); // one real-time loop at a time
+    let _turn = crate::common::loop_turn(module_path!()); // one real-time loop at a time
     let t0 = std::time::Instant::now();
     // As a CSV log (no .mcap extension): its first byte is a NUL.
     assert_exit(&["log", "info", "/dev/zero"], 2, "NUL byte");

@@ -2,8 +2,6 @@
 //! every log ending on a whole row, exit status 130 (interrupted). Signals are sent with
 //! `libc::kill` to the spawned binary.
 
-mod common;
-
 use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
@@ -32,12 +30,25 @@ fn wait_for_file(path: &Path, bytes: u64, child: &mut Child) {
     }
 }
 
+/// `haptic2d ARGS…` signalled with `sig` once `file` holds `bytes` bytes (it is under way): its
+/// exit code and output, as [`signal_and_wait`].
+fn signalled_while_writing(
+    args: &[&str],
+    file: &Path,
+    bytes: u64,
+    sig: libc::c_int,
+) -> (Option<i32>, String) {
+    let mut child = spawn(args);
+    wait_for_file(file, bytes, &mut child);
+    signal_and_wait(child, sig)
+}
+
 /// Sends `sig`, waits (at most 30 s: no hang) and returns (exit code, stdout + stderr).
 fn signal_and_wait(child: Child, sig: libc::c_int) -> (Option<i32>, String) {
     let pid = child.id() as libc::pid_t;
     // SAFETY: kill(2) on the pid of a child we spawned and have not reaped.
     assert_eq!(unsafe { libc::kill(pid, sig) }, 0);
-    let Some((status, out)) = common::wait_with_limit(child, Duration::from_secs(30)) else {
+    let Some((status, out)) = crate::common::wait_with_limit(child, Duration::from_secs(30)) else {
         panic!("did not exit within 30 s of the signal");
     };
     (status.code(), out)
@@ -63,22 +74,21 @@ fn assert_whole_rows(path: &Path) -> usize {
 
 /// The "N ticks" of the run summary.
 fn ticks_in(out: &str) -> usize {
-    common::summary_ticks(out) as usize
+    crate::common::summary_ticks(out) as usize
 }
 
 fn run_log_then(sig: libc::c_int) {
     let dir = tempfile::tempdir().unwrap();
     let log = dir.path().join("run.csv");
-    let mut child = spawn(&[
+    let args = [
         "run",
         "--headless",
         "--no-rt",
         "--log",
         log.to_str().unwrap(),
-    ]);
-    // ~100 rows written (the logger flushes its 64 KiB buffer as it goes).
-    wait_for_file(&log, 70_000, &mut child);
-    let (code, out) = signal_and_wait(child, sig);
+    ];
+    // Once ~100 rows are written (the logger flushes its 64 KiB buffer as it goes).
+    let (code, out) = signalled_while_writing(&args, &log, 70_000, sig);
     assert_eq!(
         code,
         Some(130),
@@ -93,29 +103,24 @@ fn run_log_then(sig: libc::c_int) {
 
 #[test]
 fn sigterm_on_run_log_ends_on_a_whole_row_and_prints_the_summary() {
+    let _m = crate::common::module_turn(module_path!());
     run_log_then(libc::SIGTERM);
 }
 
 #[test]
 fn sigint_on_run_log_ends_on_a_whole_row_and_prints_the_summary() {
+    let _m = crate::common::module_turn(module_path!());
     run_log_then(libc::SIGINT);
 }
 
 fn simulate_then(sig: libc::c_int) {
     let dir = tempfile::tempdir().unwrap();
     let out_csv = dir.path().join("sim.csv");
-    // pile:100 for 1000 s: far longer than the test; the signal ends it.
-    let mut child = spawn(&[
-        "simulate",
-        "pile:100",
-        "--duration",
-        "1000",
-        "--out",
-        out_csv.to_str().unwrap(),
-    ]);
-    // The 1 MiB CSV buffer has been flushed at least once.
-    wait_for_file(&out_csv, 1 << 20, &mut child);
-    let (code, out) = signal_and_wait(child, sig);
+    // pile:100 for 1000 s: far longer than the test; the signal ends it, once the 1 MiB CSV
+    // buffer has been flushed at least once.
+    let path = out_csv.to_str().unwrap();
+    let args = ["simulate", "pile:100", "--duration", "1000", "--out", path];
+    let (code, out) = signalled_while_writing(&args, &out_csv, 1 << 20, sig);
     assert_eq!(code, Some(130), "exit status:\n{out}");
     assert!(out.contains("interrupted by a signal"), "{out}");
     assert!(out.contains("energy: initial"), "summary printed:\n{out}");
@@ -132,11 +137,13 @@ fn simulate_then(sig: libc::c_int) {
 
 #[test]
 fn sigterm_on_simulate_flushes_whole_rows_and_prints_the_summary() {
+    let _m = crate::common::module_turn(module_path!());
     simulate_then(libc::SIGTERM);
 }
 
 #[test]
 fn sigint_on_simulate_flushes_whole_rows_and_prints_the_summary() {
+    let _m = crate::common::module_turn(module_path!());
     simulate_then(libc::SIGINT);
 }
 
@@ -194,7 +201,8 @@ fn convert_then(sig: libc::c_int) -> (Option<i32>, Option<i32>, String, Vec<Stri
     let pid = child.id() as libc::pid_t;
     // SAFETY: kill(2) on the pid of a child we spawned and have not reaped.
     assert_eq!(unsafe { libc::kill(pid, sig) }, 0);
-    let Some((status, text)) = common::wait_with_limit(child, Duration::from_secs(30)) else {
+    let Some((status, text)) = crate::common::wait_with_limit(child, Duration::from_secs(30))
+    else {
         panic!("log convert did not exit within 30 s of the signal");
     };
     let mut names: Vec<String> = std::fs::read_dir(dir.path())
@@ -210,6 +218,7 @@ fn convert_then(sig: libc::c_int) -> (Option<i32>, Option<i32>, String, Vec<Stri
 /// leaves the older file of the output's name as it was; exit 130 with the reason.
 #[test]
 fn sigterm_during_log_convert_leaves_no_partial_file_and_the_old_output_untouched() {
+    let _m = crate::common::module_turn(module_path!());
     for sig in [libc::SIGTERM, libc::SIGINT] {
         let (code, _, text, names, content) = convert_then(sig);
         assert_eq!(code, Some(130), "signal {sig}:\n{text}");
@@ -223,6 +232,7 @@ fn sigterm_during_log_convert_leaves_no_partial_file_and_the_old_output_untouche
 /// untouched, and the process then ends of SIGPIPE (shell status 141) as a closed pipe says.
 #[test]
 fn sigpipe_during_log_convert_leaves_no_partial_file_then_ends_of_sigpipe() {
+    let _m = crate::common::module_turn(module_path!());
     let (code, signal, text, names, content) = convert_then(libc::SIGPIPE);
     assert_eq!((code, signal), (None, Some(libc::SIGPIPE)), "{text}");
     assert_eq!(names, ["big.csv", "out.mcap"], "no partial file left");
@@ -233,6 +243,7 @@ fn sigpipe_during_log_convert_leaves_no_partial_file_then_ends_of_sigpipe() {
 /// half-written (the rename is the last step).
 #[test]
 fn sigkill_during_log_convert_never_leaves_a_half_file_under_the_output_name() {
+    let _m = crate::common::module_turn(module_path!());
     let (_, signal, text, names, content) = convert_then(libc::SIGKILL);
     assert_eq!(signal, Some(libc::SIGKILL), "{text}");
     assert_eq!(content, b"the previous output");
@@ -246,11 +257,12 @@ fn sigkill_during_log_convert_never_leaves_a_half_file_under_the_output_name() {
 /// file; the result is a complete MCAP.
 #[test]
 fn log_convert_renames_its_complete_output_into_place() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let csv = big_tick_csv(dir.path(), 1000);
     let out = dir.path().join("out.mcap");
-    let o = common::run("log convert {} {}", &[&csv, &out]);
-    assert!(o.status.success(), "{}", common::text(&o));
+    let o = crate::common::run("log convert {} {}", &[&csv, &out]);
+    assert!(o.status.success(), "{}", crate::common::text(&o));
     let mut names: Vec<String> = std::fs::read_dir(dir.path())
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
@@ -266,11 +278,12 @@ fn log_convert_renames_its_complete_output_into_place() {
 /// replaced by a rename: `log convert in.mcap FIFO` streams the CSV into the pipe.
 #[test]
 fn log_convert_into_a_named_pipe_writes_the_pipe_and_keeps_it() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let csv = big_tick_csv(dir.path(), 100);
     let mcap = dir.path().join("x.mcap");
-    let o = common::run("log convert {} {}", &[&csv, &mcap]);
-    assert!(o.status.success(), "{}", common::text(&o));
+    let o = crate::common::run("log convert {} {}", &[&csv, &mcap]);
+    assert!(o.status.success(), "{}", crate::common::text(&o));
     let fifo = dir.path().join("pipe");
     let c = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
     // SAFETY: mkfifo(3) with a valid NUL-terminated path.
@@ -279,8 +292,8 @@ fn log_convert_into_a_named_pipe_writes_the_pipe_and_keeps_it() {
         let fifo = fifo.clone();
         std::thread::spawn(move || std::fs::read_to_string(fifo).unwrap())
     };
-    let o = common::run("log convert {} {}", &[&mcap, &fifo]);
-    assert!(o.status.success(), "{}", common::text(&o));
+    let o = crate::common::run("log convert {} {}", &[&mcap, &fifo]);
+    assert!(o.status.success(), "{}", crate::common::text(&o));
     // (Checked before joining the reader: had the pipe been renamed over, the reader would wait
     // for a writer forever.)
     use std::os::unix::fs::FileTypeExt;

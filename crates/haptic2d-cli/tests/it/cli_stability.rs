@@ -1,9 +1,7 @@
 //! `haptic2d stability` end to end (issue 11): a verdict per axis and the poles, for the default
 //! configuration and for the spec's, and the plot files.
 
-mod common;
-
-use common::{haptic2d, run, text};
+use crate::common::{haptic2d, run, run_ok, text};
 
 fn stability(args: &[&str], out: &std::path::Path) -> String {
     let mut a = vec!["stability"];
@@ -16,6 +14,7 @@ fn stability(args: &[&str], out: &std::path::Path) -> String {
 
 #[test]
 fn stability_prints_a_verdict_and_poles_per_axis_for_the_default() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let s = stability(&[], dir.path());
     println!("{s}");
@@ -31,6 +30,7 @@ fn stability_prints_a_verdict_and_poles_per_axis_for_the_default() {
 
 #[test]
 fn stability_shows_the_spec_configuration_unstable_released() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let s = stability(
         &[
@@ -49,6 +49,7 @@ fn stability_shows_the_spec_configuration_unstable_released() {
 
 #[test]
 fn stability_rejects_bad_options_with_a_message() {
+    let _m = crate::common::module_turn(module_path!());
     for (args, needle) in [
         (
             vec!["stability", "--controller", "nope"],
@@ -68,8 +69,9 @@ fn stability_rejects_bad_options_with_a_message() {
 /// the plot is named after the file.
 #[test]
 fn stability_reads_a_controller_file() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
-    let root = common::root();
+    let root = crate::common::root();
     let paper = root.join("controllers/paper-4ch.toml");
     let s = stability(
         &[
@@ -95,6 +97,7 @@ fn stability_reads_a_controller_file() {
 /// A bad controller file is refused with the file, the field and the fix; unknown keys are refused.
 #[test]
 fn stability_refuses_a_bad_controller_file_naming_the_field() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     for (body, needles) in [
         (
@@ -145,9 +148,9 @@ fn stability_refuses_a_bad_controller_file_naming_the_field() {
 /// and runs; `reproduce fig8` carries the claims with the file's controller, labelled by the file.
 #[test]
 fn run_and_reproduce_accept_a_controller_file() {
-    let _turn = common::turn(); // one real-time loop at a time
+    let _turn = crate::common::loop_turn(module_path!()); // one real-time loop at a time
     let dir = tempfile::tempdir().unwrap();
-    let root = common::root();
+    let root = crate::common::root();
     let soft = root.join("controllers/coupling-soft.toml");
     let o = run(
         "run --headless --no-rt --duration 0.2 --controller-file {}",
@@ -156,11 +159,10 @@ fn run_and_reproduce_accept_a_controller_file() {
     assert!(o.status.success(), "{}", text(&o));
     assert!(text(&o).contains("controller coupling"), "{}", text(&o));
     let out = dir.path().join("repro");
-    let o = run(
+    run_ok(
         "reproduce fig8 --out {} --controller-file {}",
         &[&out, &soft],
     );
-    assert!(o.status.success(), "{}", text(&o));
     let report = std::fs::read_to_string(out.join("fig8/report.md")).unwrap();
     assert!(
         report.contains("| coupling-soft/classical | yes |"),

@@ -1,22 +1,17 @@
 //! A printing command whose reader has gone (`haptic2d simulate … | head -1`) ends quietly of
 //! `SIGPIPE`, as `cat` does, instead of panicking in `println!` (found in session 4).
 
-#![cfg(unix)]
-
-use std::os::fd::FromRawFd;
 use std::os::unix::process::ExitStatusExt;
 use std::process::{Command, Stdio};
 
 /// Runs `haptic2d args` with stdout on a pipe whose read end is already closed, so the first write
 /// fails with `EPIPE`; returns (signal that ended it, stderr).
 fn run_into_closed_pipe(args: &[&str]) -> (Option<i32>, Option<i32>, String) {
-    let mut fds = [0i32; 2];
-    // SAFETY: `fds` has room for the two descriptors `pipe` writes.
-    assert_eq!(unsafe { libc::pipe(fds.as_mut_ptr()) }, 0, "pipe(2) failed");
-    // SAFETY: fds[0] is the read end just created and owned by no one else.
-    unsafe { libc::close(fds[0]) };
-    // SAFETY: fds[1] is the write end just created; the Stdio takes ownership and closes it.
-    let stdout = unsafe { Stdio::from_raw_fd(fds[1]) };
+    // Both ends are close-on-exec (`std::io::pipe`): a child that another test of this binary
+    // spawns meanwhile inherits neither, so no other process holds a read end open.
+    let (reader, writer) = std::io::pipe().expect("pipe(2)");
+    drop(reader);
+    let stdout = Stdio::from(writer);
     let out = Command::new(env!("CARGO_BIN_EXE_haptic2d"))
         .args(args)
         .stdout(stdout)
@@ -32,6 +27,7 @@ fn run_into_closed_pipe(args: &[&str]) -> (Option<i32>, Option<i32>, String) {
 
 #[test]
 fn printing_commands_end_quietly_when_the_reader_closes_the_pipe() {
+    let _m = crate::common::module_turn(module_path!());
     for args in [
         &["scenes"][..],
         &["simulate", "box-in-walls", "--duration", "0.1"][..],
@@ -49,6 +45,7 @@ fn printing_commands_end_quietly_when_the_reader_closes_the_pipe() {
 
 #[test]
 fn run_ends_quietly_of_sigpipe_after_finishing_its_log_when_the_reader_is_gone() {
+    let _m = crate::common::module_turn(module_path!());
     // `haptic2d run … | head -1` panicked with exit 101 (issue 39); the run now finishes as it
     // would (torques zeroed, the MCAP log's footer written), then ends of SIGPIPE (shell 141).
     let dir = tempfile::tempdir().unwrap();

@@ -15,8 +15,10 @@ use std::sync::Arc;
 use std::thread;
 use std::time::Duration;
 
-mod common;
-use common::{cmd, cut_mid_run, patient_device_file, root, spawn_announced, text, turn, Killed};
+use crate::common::{
+    assert_lacks, assert_lost_device, cmd, cut_mid_run, expect_exit, patient_device_file, root,
+    spawn_announced, text, turn, Killed,
+};
 
 /// The reference file with a patient timeout and no missed-deadline limit, in a temp dir.
 fn device_file(tag: &str) -> PathBuf {
@@ -26,17 +28,22 @@ fn device_file(tag: &str) -> PathBuf {
 /// The reference device (killed on drop) and its address.
 struct Device(Killed, SocketAddr);
 
-/// devices/udp/sim_device.py on an ephemeral loopback port, or `None` without python3.
-fn sim_device(extra: &[&str]) -> Option<Device> {
+/// devices/udp/sim_device.py on an ephemeral loopback port; without python3 the test fails with
+/// the install hint.
+fn sim_device(extra: &[&str]) -> Device {
     let mut python = Command::new("python3");
     python.arg("--version").stdout(Stdio::null());
-    python.status().ok()?;
+    if python.status().is_err() {
+        panic!(
+            "python3 not found: this test needs it (bash scripts/install-test-deps.sh installs it)"
+        );
+    }
     let mut c = Command::new("python3");
     c.arg(root().join("devices/udp/sim_device.py"))
         .args(["--bind", "127.0.0.1:0"])
         .args(extra);
     let (child, addr) = spawn_announced(&mut c, "listening on ");
-    Some(Device(child, addr.parse().unwrap()))
+    Device(child, addr.parse().unwrap())
 }
 
 fn run(addr: SocketAddr, file: &Path, duration: &str) -> Command {
@@ -161,17 +168,11 @@ fn proxy(device: SocketAddr, mischief: Mischief) -> Proxy {
 
 #[test]
 fn run_against_the_python_reference_device_for_3_s_exits_clean() {
-    let _t = turn();
-    let Some(dev) = sim_device(&[]) else {
-        panic!(
-            "python3 not found: this test needs it (bash scripts/install-test-deps.sh installs it)"
-        );
-    };
+    let _turn = crate::common::loop_turn(module_path!());
+    let dev = sim_device(&[]);
     let file = device_file("clean");
     let o = run(dev.1, &file, "3").output().unwrap();
-    let out = text(&o);
-    assert_eq!(o.status.code(), Some(0), "{out}");
-    assert!(out.contains("joints in, torques out"), "{out}");
+    let out = expect_exit(&o, 0, &["joints in, torques out"]);
     // A loaded machine skips deadlines (the loop never runs two ticks to catch up), so the counts
     // are checked against what was sent, not against 3000 ticks.
     let sent = counter(&out, "sent");
@@ -187,6 +188,7 @@ fn run_against_the_python_reference_device_for_3_s_exits_clean() {
 /// device has the same key; the run opens a session, and nothing is dropped.
 #[test]
 fn run_with_a_key_file_speaks_version_2_and_drops_nothing() {
+    let _m = crate::common::module_turn(module_path!());
     use std::os::unix::fs::PermissionsExt;
     let _t = turn();
     let file = device_file("v2");
@@ -203,15 +205,9 @@ fn run_with_a_key_file_speaks_version_2_and_drops_nothing() {
         toml.replace("[protocol]\n", "[protocol]\nkey_file = \"udp.key\"\n"),
     )
     .unwrap();
-    let Some(dev) = sim_device(&["--key-file", key.to_str().unwrap()]) else {
-        panic!(
-            "python3 not found: this test needs it (bash scripts/install-test-deps.sh installs it)"
-        );
-    };
+    let dev = sim_device(&["--key-file", key.to_str().unwrap()]);
     let o = run(dev.1, &file, "2").output().unwrap();
-    let out = text(&o);
-    assert_eq!(o.status.code(), Some(0), "{out}");
-    assert!(out.contains("protocol version 2"), "{out}");
+    let out = expect_exit(&o, 0, &["protocol version 2"]);
     assert!(!out.contains("protocol version 1"), "{out}");
     let sent = counter(&out, "sent");
     assert!(sent > 300, "{out}");
@@ -222,8 +218,7 @@ fn run_with_a_key_file_speaks_version_2_and_drops_nothing() {
     // A key file others can read is refused before anything is sent, with the fix.
     std::fs::set_permissions(&key, std::fs::Permissions::from_mode(0o644)).unwrap();
     let o = run(dev.1, &file, "1").output().unwrap();
-    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
-    assert!(text(&o).contains("chmod 600"), "{}", text(&o));
+    expect_exit(&o, 2, &["chmod 600"]);
 }
 
 /// Issue 38 item 5: `--device udp:224.0.0.1:5005` sent zero-torque datagrams to every host on the
@@ -231,7 +226,7 @@ fn run_with_a_key_file_speaks_version_2_and_drops_nothing() {
 /// key. Every case is refused before a socket is opened (nothing is sent anywhere).
 #[test]
 fn multicast_broadcast_and_remote_addresses_are_refused_or_need_the_flag() {
-    let _t = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let file = device_file("addr");
     for (addr, says) in [
         ("224.0.0.1:5005", "multicast"),
@@ -248,19 +243,13 @@ fn multicast_broadcast_and_remote_addresses_are_refused_or_need_the_flag() {
     }
     let remote: SocketAddr = "192.0.2.1:5005".parse().unwrap();
     let o = run(remote, &file, "1").output().unwrap();
-    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
-    assert!(text(&o).contains("--allow-remote-device"), "{}", text(&o));
+    expect_exit(&o, 2, &["--allow-remote-device"]);
     // With the flag: warned, and still refused without a key (version 1 is loopback only).
     let o = run(remote, &file, "1")
         .arg("--allow-remote-device")
         .output()
         .unwrap();
-    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
-    assert!(
-        text(&o).contains("key_file") && text(&o).contains("loopback only"),
-        "{}",
-        text(&o)
-    );
+    expect_exit(&o, 2, &["key_file", "loopback only"]);
 }
 
 /// Closed loop over UDP: the reference device's hand (no spring, a constant 0.8 N push towards
@@ -272,12 +261,8 @@ fn multicast_broadcast_and_remote_addresses_are_refused_or_need_the_flag() {
 /// device pushes back on the hand with F.
 #[test]
 fn a_pushed_handle_drives_the_box_into_the_wall_and_feels_it() {
-    let _t = turn();
-    let Some(dev) = sim_device(&["--push=-0.8,0", "--push-after", "0.3", "--k-hand", "0"]) else {
-        panic!(
-            "python3 not found: this test needs it (bash scripts/install-test-deps.sh installs it)"
-        );
-    };
+    let _turn = crate::common::loop_turn(module_path!());
+    let dev = sim_device(&["--push=-0.8,0", "--push-after", "0.3", "--k-hand", "0"]);
     let file = device_file("wall");
     let log = file.with_file_name("wall.csv");
     let o = run(dev.1, &file, "4")
@@ -287,7 +272,7 @@ fn a_pushed_handle_drives_the_box_into_the_wall_and_feels_it() {
         .unwrap();
     let out = text(&o);
     assert_eq!(o.status.code(), Some(0), "{out}");
-    let (col, rows) = common::csv_rows(&log);
+    let (col, rows) = crate::common::csv_rows(&log);
     let (dx, sx, fx, c) = (
         col("device.x"),
         col("slave.x"),
@@ -324,12 +309,8 @@ fn a_pushed_handle_drives_the_box_into_the_wall_and_feels_it() {
 
 #[test]
 fn loss_and_reordering_through_a_proxy_are_counted_and_survived() {
-    let _t = turn();
-    let Some(dev) = sim_device(&[]) else {
-        panic!(
-            "python3 not found: this test needs it (bash scripts/install-test-deps.sh installs it)"
-        );
-    };
+    let _turn = crate::common::loop_turn(module_path!());
+    let dev = sim_device(&[]);
     let p = proxy(dev.1, Mischief::LossAndReorder { drop: 17, swap: 23 });
     let file = device_file("loss");
     let o = run(p.addr, &file, "2").output().unwrap();
@@ -347,12 +328,8 @@ fn loss_and_reordering_through_a_proxy_are_counted_and_survived() {
 
 #[test]
 fn malformed_datagrams_are_counted_and_ignored() {
-    let _t = turn();
-    let Some(dev) = sim_device(&[]) else {
-        panic!(
-            "python3 not found: this test needs it (bash scripts/install-test-deps.sh installs it)"
-        );
-    };
+    let _turn = crate::common::loop_turn(module_path!());
+    let dev = sim_device(&[]);
     let p = proxy(dev.1, Mischief::Garbage { every: 3 });
     let file = device_file("garbage");
     let o = run(p.addr, &file, "2").output().unwrap();
@@ -376,47 +353,31 @@ fn malformed_datagrams_are_counted_and_ignored() {
 
 #[test]
 fn device_killed_mid_run_exits_4_naming_the_device() {
-    let _t = turn();
-    let Some(mut dev) = sim_device(&[]) else {
-        panic!(
-            "python3 not found: this test needs it (bash scripts/install-test-deps.sh installs it)"
-        );
-    };
+    let _turn = crate::common::loop_turn(module_path!());
+    let mut dev = sim_device(&[]);
     let file = device_file("kill");
     let log = file.with_file_name("kill.csv");
     let (code, out, _) = cut_mid_run(run(dev.1, &file, "20"), &log, || dev.0.kill().unwrap());
-    assert_eq!(code, Some(4), "{out}");
-    assert!(out.contains(&format!("udp:{}", dev.1)), "{out}");
-    assert!(
-        out.contains("no state for") && out.contains("latched"),
-        "{out}"
-    );
-    assert!(!out.contains("panicked"), "{out}");
+    let device = format!("udp:{}", dev.1);
+    assert_lost_device(code, &out, &device, &["no state for", "latched"]);
     // The lost reading is not reported as a second fault.
-    assert!(!out.contains("non-finite device input"), "{out}");
+    assert_lacks(&out, &["non-finite device input"]);
 }
 
 #[test]
 fn no_device_and_bad_arguments_are_clear_errors() {
-    let _t = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let free = UdpSocket::bind("127.0.0.1:0")
         .unwrap()
         .local_addr()
         .unwrap();
     let file = device_file("bad");
     let o = run(free, &file, "1").output().unwrap();
-    let out = text(&o);
-    assert_eq!(o.status.code(), Some(4), "{out}");
-    assert!(
-        out.contains("no state from the device") && out.contains("sim_device.py"),
-        "{out}"
-    );
-    let o = common::run("run --device udp:nowhere --headless --duration 1", &[]);
-    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
-    assert!(text(&o).contains("udp:ADDR:PORT"), "{}", text(&o));
+    expect_exit(&o, 4, &["no state from the device", "sim_device.py"]);
+    let o = crate::common::run("run --device udp:nowhere --headless --duration 1", &[]);
+    expect_exit(&o, 2, &["udp:ADDR:PORT"]);
     let bad = file.with_file_name("bad.toml");
     std::fs::write(&bad, "kind = \"udp\"\n[protocol]\ninput = \"angles\"\n[linkage]\nd = 0.038\nl1 = 0.07\nl2 = 0.09\n").unwrap();
     let o = run(free, &bad, "1").output().unwrap();
-    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
-    assert!(text(&o).contains("protocol.input"), "{}", text(&o));
+    expect_exit(&o, 2, &["protocol.input"]);
 }

@@ -30,6 +30,7 @@ fn start_run() -> Served {
 
 #[test]
 fn browser_drag_hand_target_pushes_box_into_left_wall() {
+    let _m = crate::common::module_turn(module_path!());
     let e2e = e2e_dir();
     // Never reported as passed without running: a missing prerequisite is a failure that says
     // how to install it (the README's test command, `bash scripts/test.sh`, installs it).

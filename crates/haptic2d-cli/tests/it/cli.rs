@@ -1,17 +1,15 @@
 //! End-to-end tests of the `haptic2d` binary: what a new user types.
 
-mod common;
-
-use common::{haptic2d, run, text};
+use crate::common::{haptic2d, run_ok, text};
 
 #[test]
 fn simulate_twice_gives_byte_identical_csv() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let a = dir.path().join("a.csv");
     let b = dir.path().join("b.csv");
     for p in [&a, &b] {
-        let o = run("simulate box-in-walls-tilt --duration 1.5 --out {}", &[&p]);
-        assert!(o.status.success(), "{}", text(&o));
+        run_ok("simulate box-in-walls-tilt --duration 1.5 --out {}", &[&p]);
     }
     let (x, y) = (std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
     assert!(x.len() > 1000);
@@ -20,13 +18,13 @@ fn simulate_twice_gives_byte_identical_csv() {
 
 #[test]
 fn simulate_writes_the_documented_columns() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path().join("b.csv");
-    let o = run(
+    run_ok(
         "simulate box-in-walls --duration 1 --every 10 --out {}",
         &[&p],
     );
-    assert!(o.status.success(), "{}", text(&o));
     let csv = std::fs::read_to_string(&p).unwrap();
     let mut lines = csv.lines();
     assert_eq!(
@@ -39,6 +37,7 @@ fn simulate_writes_the_documented_columns() {
 
 #[test]
 fn scenes_lists_the_builtins() {
+    let _m = crate::common::module_turn(module_path!());
     let o = haptic2d(&["scenes"]);
     assert!(o.status.success());
     let t = text(&o);
@@ -49,6 +48,7 @@ fn scenes_lists_the_builtins() {
 
 #[test]
 fn check_explains_a_bad_scene_and_fails() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path().join("bad.toml");
     std::fs::write(
@@ -70,6 +70,7 @@ fn check_explains_a_bad_scene_and_fails() {
 
 #[test]
 fn unknown_scene_and_bad_options_fail_cleanly() {
+    let _m = crate::common::module_turn(module_path!());
     let o = haptic2d(&["simulate", "no-such-scene"]);
     assert!(!o.status.success());
     assert!(text(&o).contains("built-in scenes"), "{}", text(&o));
@@ -86,7 +87,8 @@ fn unknown_scene_and_bad_options_fail_cleanly() {
 /// `my.toml`), so it cannot go stale.
 #[test]
 fn scenes_md_quotes_what_check_prints_for_overlapping_bodies() {
-    let doc = std::fs::read_to_string(common::root().join("docs/SCENES.md")).unwrap();
+    let _m = crate::common::module_turn(module_path!());
+    let doc = std::fs::read_to_string(crate::common::root().join("docs/SCENES.md")).unwrap();
     let section = doc
         .split_once("## Bodies that start overlapping")
         .expect("SCENES.md has the section")
@@ -122,6 +124,7 @@ fn scenes_md_quotes_what_check_prints_for_overlapping_bodies() {
 /// nothing about it.
 #[test]
 fn simulate_reports_the_impact_sweep_budget_when_a_large_island_hits_it() {
+    let _m = crate::common::module_turn(module_path!());
     let o = haptic2d(&["simulate", "pile:100", "--duration", "0.3"]);
     assert!(o.status.success(), "{}", text(&o));
     let out = String::from_utf8_lossy(&o.stdout).to_string();

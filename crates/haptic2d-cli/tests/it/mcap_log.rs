@@ -3,9 +3,7 @@
 //! conversion is lossless; `--device replay:x.mcap` replays a recording; `simulate --out x.mcap`;
 //! the Foxglove live server serves a loopback client and survives a malformed message.
 
-mod common;
-
-use common::{haptic2d, run, text};
+use crate::common::{haptic2d, run_ok, text};
 use haptic2d_rt::mcap::columns::{TickRow, Val, LOOP_COLUMN_COUNT, TICK_TABLE};
 use haptic2d_rt::mcap::reader::{read_file, read_info, read_ticks};
 use haptic2d_rt::mcap::schemas::*;
@@ -13,7 +11,7 @@ use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::Duration;
 
-use common::summary_ticks;
+use crate::common::{count_of, summary_ticks};
 
 fn run_logged(log: &Path, extra: &[&str]) -> String {
     let mut args = vec![
@@ -57,6 +55,7 @@ fn csv_rows(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
 
 #[test]
 fn mcap_log_of_a_2s_run_has_every_tick_and_matches_the_csv_log_of_the_same_run() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let mcap = dir.path().join("x.mcap");
     let out = run_logged(&mcap, &["--duration", "2"]);
@@ -140,7 +139,7 @@ fn mcap_log_of_a_2s_run_has_every_tick_and_matches_the_csv_log_of_the_same_run()
 
 #[test]
 fn sigint_mid_run_leaves_a_complete_readable_mcap() {
-    let _turn = common::turn(); // one real-time loop at a time
+    let _turn = crate::common::loop_turn(module_path!()); // one real-time loop at a time
     let dir = tempfile::tempdir().unwrap();
     let mcap = dir.path().join("int.mcap");
     let child = Command::new(env!("CARGO_BIN_EXE_haptic2d"))
@@ -178,6 +177,7 @@ fn sigint_mid_run_leaves_a_complete_readable_mcap() {
 
 #[test]
 fn csv_to_mcap_to_csv_is_lossless_and_mcap_to_csv_keeps_every_tick_column() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let (a, b, c) = (
         dir.path().join("a.csv"),
@@ -221,6 +221,7 @@ fn csv_to_mcap_to_csv_is_lossless_and_mcap_to_csv_keeps_every_tick_column() {
 
 #[test]
 fn log_info_prints_channels_counts_duration_and_the_timing_summary() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let m = dir.path().join("run.mcap");
     let out = run_logged(&m, &["--duration", "0.5"]);
@@ -248,6 +249,7 @@ fn log_info_prints_channels_counts_duration_and_the_timing_summary() {
 /// watchdog mid-replay (the replay test failed that way) and measured intervals entered the twist.
 #[test]
 fn mcap_replay_is_paced_by_the_ticks_like_the_csv_replay() {
+    let _m = crate::common::module_turn(module_path!());
     use haptic2d_rt::io::{DeviceIo, ReplayEnd};
     let dir = tempfile::tempdir().unwrap();
     let rec = dir.path().join("rec.mcap");
@@ -258,6 +260,7 @@ fn mcap_replay_is_paced_by_the_ticks_like_the_csv_replay() {
 
 #[test]
 fn replay_of_an_mcap_recording_reproduces_its_device_motion() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let (rec, rep) = (dir.path().join("rec.mcap"), dir.path().join("rep.mcap"));
     run_logged(&rec, &["--duration", "0.5", "--hand", "sine:0.3,2"]);
@@ -280,6 +283,7 @@ fn replay_of_an_mcap_recording_reproduces_its_device_motion() {
 /// angles in and so the same device pose out (forward kinematics), ending "the replay ended".
 #[test]
 fn replay_of_a_run_csv_log_reproduces_its_device_motion() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let (rec, rep) = (dir.path().join("rec.csv"), dir.path().join("rep.csv"));
     run_logged(&rec, &["--duration", "0.5", "--hand", "sine:0.3,2"]);
@@ -313,18 +317,11 @@ fn replay_of_a_run_csv_log_reproduces_its_device_motion() {
 
 #[test]
 fn simulate_out_mcap_writes_every_sample_of_the_world() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let m = dir.path().join("sim.mcap");
-    let o = run("simulate box-in-walls --duration 0.5 --out {}", &[&m]);
-    let out = text(&o);
-    assert!(o.status.success(), "{out}");
-    let samples: u64 = out
-        .split_whitespace()
-        .collect::<Vec<_>>()
-        .windows(2)
-        .find(|w| w[1] == "samples")
-        .and_then(|w| w[0].parse().ok())
-        .unwrap_or_else(|| panic!("no sample count in {out}"));
+    let out = run_ok("simulate box-in-walls --duration 0.5 --out {}", &[&m]);
+    let samples = count_of(&out, "samples");
     assert!(samples > 100, "{out}");
     let bytes = read_file(&m).unwrap();
     let info = read_info(&bytes, "sim.mcap").unwrap();
@@ -338,7 +335,7 @@ fn simulate_out_mcap_writes_every_sample_of_the_world() {
 
 #[test]
 fn foxglove_live_server_serves_a_loopback_client_and_survives_a_malformed_message() {
-    let _turn = common::turn(); // one real-time loop at a time
+    let _turn = crate::common::loop_turn(module_path!()); // one real-time loop at a time
     use std::io::{BufRead, BufReader};
     use tungstenite::client::IntoClientRequest;
     use tungstenite::Message;
@@ -506,6 +503,7 @@ fn check_world_csv(mcap: &Path, csv: &Path, topic: &str, array: Option<&str>) ->
 
 #[test]
 fn mcap_to_csv_writes_the_bodies_contacts_and_energy_channels_next_to_the_tick_csv() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     // A haptic run: the tick CSV and the three world CSVs, one energy row per tick.
     let (m, c) = (dir.path().join("r.mcap"), dir.path().join("r.csv"));
@@ -546,8 +544,7 @@ fn mcap_to_csv_writes_the_bodies_contacts_and_energy_channels_next_to_the_tick_c
 
     // A world recording of `simulate` (no tick channel) with resting contacts: the world CSVs only.
     let (w, wc) = (dir.path().join("pile.mcap"), dir.path().join("pile.csv"));
-    let o = run("simulate pile --duration 0.3 --out {}", &[&w]);
-    assert!(o.status.success(), "{}", text(&o));
+    run_ok("simulate pile --duration 0.3 --out {}", &[&w]);
     let r = haptic2d(&["log", "convert", w.to_str().unwrap(), wc.to_str().unwrap()]);
     assert!(r.status.success(), "{}", text(&r));
     assert!(!wc.exists(), "no tick CSV without tick messages");
@@ -603,7 +600,8 @@ fn simulate_mcap_then(sig: libc::c_int) -> (Option<i32>, Option<i32>) {
     }
     // SAFETY: kill(2) on the pid of a child we spawned and have not reaped.
     assert_eq!(unsafe { libc::kill(child.id() as libc::pid_t, sig) }, 0);
-    let Some((status, text)) = common::wait_with_limit(child, Duration::from_secs(30)) else {
+    let Some((status, text)) = crate::common::wait_with_limit(child, Duration::from_secs(30))
+    else {
         panic!("did not exit within 30 s of the signal");
     };
     assert!(!text.contains("panicked"), "{text}");
@@ -622,6 +620,7 @@ fn simulate_mcap_then(sig: libc::c_int) -> (Option<i32>, Option<i32>) {
 
 #[test]
 fn sigpipe_during_simulate_out_mcap_leaves_a_readable_mcap_then_ends_of_sigpipe() {
+    let _m = crate::common::module_turn(module_path!());
     assert_eq!(
         simulate_mcap_then(libc::SIGPIPE),
         (None, Some(libc::SIGPIPE))
@@ -630,6 +629,7 @@ fn sigpipe_during_simulate_out_mcap_leaves_a_readable_mcap_then_ends_of_sigpipe(
 
 #[test]
 fn sigterm_during_simulate_out_mcap_leaves_a_readable_mcap_and_exits_130() {
+    let _m = crate::common::module_turn(module_path!());
     assert_eq!(simulate_mcap_then(libc::SIGTERM).0, Some(130));
 }
 
@@ -659,6 +659,7 @@ fn unix_now_ns() -> u64 {
 /// `simulate` recording's is its start time plus the simulated time.
 #[test]
 fn mcap_log_time_is_unix_epoch_ns_the_deadline_plus_the_recorded_offset() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let m = dir.path().join("clock.mcap");
     let before = unix_now_ns();
@@ -682,8 +683,7 @@ fn mcap_log_time_is_unix_epoch_ns_the_deadline_plus_the_recorded_offset() {
     // simulate: the start's Unix time + round(t · 1e9).
     let s = dir.path().join("sim.mcap");
     let before = unix_now_ns();
-    let o = run("simulate box-in-walls --duration 0.05 --out {}", &[&s]);
-    assert!(o.status.success(), "{}", text(&o));
+    run_ok("simulate box-in-walls --duration 0.05 --out {}", &[&s]);
     let bytes = read_file(&s).unwrap();
     let info = read_info(&bytes, "sim.mcap").unwrap();
     let clock = info.metadata("haptic2d.clock").expect("haptic2d.clock");
@@ -704,6 +704,7 @@ fn mcap_log_time_is_unix_epoch_ns_the_deadline_plus_the_recorded_offset() {
 /// tick messages of the same tick carry: translation (x, y, 0), rotation θ about z.
 #[test]
 fn frame_transforms_place_the_bodies_and_the_device_where_the_messages_say() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let m = dir.path().join("tf.mcap");
     run_logged(&m, &["--duration", "0.3", "--hand", "sine:0.3,2"]);
@@ -781,6 +782,7 @@ fn at_path<'a>(msg: &'a serde_json::Value, path: &str) -> Option<&'a serde_json:
 /// that `/haptic2d/tf` publishes — so opening a recording with it shows data, not empty panels.
 #[test]
 fn the_shipped_foxglove_layout_names_topics_fields_and_frames_a_recording_has() {
+    let _m = crate::common::module_turn(module_path!());
     let layout_path =
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../../foxglove/haptic2d-layout.json");
     let layout: serde_json::Value =

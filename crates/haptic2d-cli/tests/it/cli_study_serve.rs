@@ -5,9 +5,7 @@
 //! safety stop with 3 and a lost device with 4, each answering the pending presentation with the reason and zeroing the
 //! torques; non-loopback addresses are refused before anything starts.
 
-mod common;
-
-use common::{signal, spawn_announced, Killed, BIN};
+use crate::common::{signal, spawn_announced, Killed, BIN};
 use serde_json::{json, Value};
 use std::io::{BufRead, BufReader, Read, Write};
 use std::net::TcpStream;
@@ -104,6 +102,7 @@ fn error_of(v: &Value) -> String {
 /// until `end`; `stop` answers, zeroes the torques and exits 0.
 #[test]
 fn requests_are_answered_bad_ones_with_reasons_and_stop_exits_0() {
+    let _m = crate::common::module_turn(module_path!());
     let mut s = Served::start("follow", &[]);
     for (line, why) in [
         ("this is not json", "not JSON"),
@@ -201,7 +200,8 @@ fn requests_are_answered_bad_ones_with_reasons_and_stop_exits_0() {
 /// with exit 130, and the presentation's MCAP log is finished (`--out`).
 #[test]
 fn sigint_answers_the_pending_presentation_zeroes_the_torques_and_exits_130() {
-    let out_dir = common::temp_dir("cli-study-serve", "sigint");
+    let _m = crate::common::module_turn(module_path!());
+    let out_dir = crate::common::temp_dir("cli-study-serve", "sigint");
     let out_arg = out_dir.display().to_string();
     let mut s = Served::start("follow", &["--out", &out_arg]);
     let a = s.ask(json!({"cmd": "present", "condition": "spring-1000", "delta": null}));
@@ -227,6 +227,7 @@ fn sigint_answers_the_pending_presentation_zeroes_the_torques_and_exits_130() {
 /// its open-ended presentation, and the server serves the next client.
 #[test]
 fn a_second_client_is_refused_and_a_lost_clients_presentation_is_ended() {
+    let _m = crate::common::module_turn(module_path!());
     let mut s = Served::start("follow", &[]);
     let addr = s.conn.get_ref().peer_addr().unwrap();
     let a = s.ask(json!({"cmd": "present", "condition": "spring-1000"}));
@@ -267,6 +268,7 @@ fn a_second_client_is_refused_and_a_lost_clients_presentation_is_ended() {
 /// answered with the trip's reason, and a last line says why the server ended.
 #[test]
 fn a_safety_stop_answers_the_pending_presentation_with_the_trip_and_exits_3() {
+    let _m = crate::common::module_turn(module_path!());
     let mut s = Served::start("script:3.0,-50,0,0,10", &[]);
     let r = s.ask(json!({"cmd": "present", "condition": "spring-1000", "duration_s": 20}));
     let e = error_of(&r);
@@ -287,13 +289,15 @@ fn a_safety_stop_answers_the_pending_presentation_with_the_trip_and_exits_3() {
 /// ends the server as `haptic2d run`: exit 4, the pending presentation answered with the reason.
 #[test]
 fn a_lost_device_answers_the_pending_presentation_and_exits_4() {
+    let _m = crate::common::module_turn(module_path!());
     let (mut dev, dev_addr) = spawn_announced(
         Command::new("python3")
-            .arg(common::root().join("devices/udp/sim_device.py"))
+            .arg(crate::common::root().join("devices/udp/sim_device.py"))
             .args(["--bind", "127.0.0.1:0"]),
         "listening on ",
     );
-    let file = common::patient_device_file("udp-pantograph.toml", ("3", "50"), "serve", "udp.toml");
+    let file =
+        crate::common::patient_device_file("udp-pantograph.toml", ("3", "50"), "serve", "udp.toml");
     let device = format!("udp:{dev_addr}");
     let file_arg = file.display().to_string();
     let mut s = Served::start_on(&device, &["--device-file", &file_arg]);
@@ -311,6 +315,7 @@ fn a_lost_device_answers_the_pending_presentation_and_exits_4() {
 /// The server has no key: any address beyond loopback is refused before the device is opened.
 #[test]
 fn a_listen_address_beyond_loopback_is_refused() {
+    let _m = crate::common::module_turn(module_path!());
     let o = Command::new(BIN)
         .args(["study", "serve"])
         .arg(study())

@@ -3,15 +3,31 @@
 //! parser; here each example printed in the help is run with `--help` appended, which clap refuses
 //! when an option before it is unknown or its value does not parse.)
 
-mod common;
-
-use common::{haptic2d, text};
+use crate::common::{haptic2d, text};
 
 /// The longest help line allowed (characters).
 const MAX_COLUMNS: usize = 100;
 
+/// `haptic2d WORDS… --help`, which must succeed with no line wider than [`MAX_COLUMNS`]: the help.
+#[track_caller]
+fn narrow_help(words: &[&str]) -> String {
+    let o = haptic2d(&[words, &["--help"]].concat());
+    let help = text(&o);
+    let cmd = words.join(" ");
+    assert!(o.status.success(), "{cmd} --help:\n{help}");
+    for line in help.lines() {
+        let n = line.chars().count();
+        assert!(
+            n <= MAX_COLUMNS,
+            "{cmd} --help: line of {n} columns: {line}"
+        );
+    }
+    help
+}
+
 #[test]
 fn every_command_help_has_examples_that_parse() {
+    let _m = crate::common::module_turn(module_path!());
     let screens: [&[&str]; 9] = [
         &["run"],
         &["simulate"],
@@ -25,18 +41,7 @@ fn every_command_help_has_examples_that_parse() {
     ];
     for words in screens {
         let cmd = words.join(" ");
-        let mut help_args = words.to_vec();
-        help_args.push("--help");
-        let o = haptic2d(&help_args);
-        let help = text(&o);
-        assert!(o.status.success(), "{cmd} --help:\n{help}");
-        for line in help.lines() {
-            let n = line.chars().count();
-            assert!(
-                n <= MAX_COLUMNS,
-                "{cmd} --help: line of {n} columns: {line}"
-            );
-        }
+        let help = narrow_help(words);
         let (_, examples) = help
             .split_once("\nExamples:\n")
             .unwrap_or_else(|| panic!("{cmd} --help has no Examples: block:\n{help}"));
@@ -64,6 +69,7 @@ fn every_command_help_has_examples_that_parse() {
 /// to the other emulator.
 #[test]
 fn an_unknown_option_before_help_is_refused() {
+    let _m = crate::common::module_turn(module_path!());
     let o = haptic2d(&["run", "--headles", "--help"]);
     assert!(!o.status.success(), "{}", text(&o));
     let o = haptic2d(&["emulate", "haply", "--bind", "127.0.0.1:0", "--help"]);
@@ -74,6 +80,7 @@ fn an_unknown_option_before_help_is_refused() {
 /// the subcommands listed.
 #[test]
 fn emulate_without_a_known_emulator_lists_haply_and_inverse3() {
+    let _m = crate::common::module_turn(module_path!());
     for args in [&["emulate"][..], &["emulate", "foo"]] {
         let o = haptic2d(args);
         let t = text(&o);
@@ -88,6 +95,7 @@ fn emulate_without_a_known_emulator_lists_haply_and_inverse3() {
 /// Every other help screen fits in the same width (the top level carries the exit codes).
 #[test]
 fn every_other_help_fits_in_100_columns() {
+    let _m = crate::common::module_turn(module_path!());
     let screens: [&[&str]; 8] = [
         &[],
         &["check"],
@@ -99,14 +107,6 @@ fn every_other_help_fits_in_100_columns() {
         &["log", "convert"],
     ];
     for words in screens {
-        let mut args = words.to_vec();
-        args.push("--help");
-        let o = haptic2d(&args);
-        let help = text(&o);
-        assert!(o.status.success(), "{args:?}:\n{help}");
-        for line in help.lines() {
-            let n = line.chars().count();
-            assert!(n <= MAX_COLUMNS, "{args:?}: line of {n} columns: {line}");
-        }
+        narrow_help(words);
     }
 }

@@ -10,8 +10,10 @@
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
-mod common;
-use common::{cmd, emulate_haply, interrupt as stop, run, shipped_text, text, turn, write_in};
+use crate::common::{
+    assert_has, assert_lacks, cmd, emulate_haply, expect_exit, interrupt as stop, joint1_reversed,
+    motor1_flipped, run, shipped_text, text, write_in,
+};
 
 use haptic2d_devices::haply::{HaplyDeviceFile, HaplyKind};
 
@@ -25,34 +27,38 @@ fn device_file(dir: &Path, name: &str, edit: impl Fn(String) -> String) -> PathB
 }
 
 /// `haptic2d emulate haply --device-file FILE ARGS… --duration 30` and its pty path.
-fn emulate(file: &Path, args: &[&str]) -> (common::Killed, String) {
+fn emulate(file: &Path, args: &[&str]) -> (crate::common::Killed, String) {
     emulate_haply(file, &[args, &["--duration", "30"]].concat())
 }
 
-fn identify(pty: &str, file: &Path, extra: &[&str]) -> Output {
+/// The hand of the emulator for a released handle: no hand, no hand damping.
+const RELEASED: [&str; 4] = ["--hand", "free", "--hand-damping", "0"];
+
+/// `device identify --device-file FILE EXTRA…` against an emulator of `board` started with
+/// `emu_args` (stopped after).
+fn identify(board: &Path, emu_args: &[&str], file: &Path, extra: &[&str]) -> Output {
+    let (emu, pty) = emulate(board, emu_args);
     let device = format!("haply:{pty}");
-    cmd(
+    let o = cmd(
         "device identify --device {} --release-delay 0 --device-file {}",
         &[&device, &file],
     )
     .args(extra)
     .output()
-    .unwrap()
+    .unwrap();
+    stop(emu);
+    o
 }
 
 /// A released handle (no hand, no hand damping): the identified joint inertias and the lumped model
 /// are the emulated linkage's; `--write` stores them and `stability` says it uses them.
 #[test]
 fn device_identify_writes_the_emulated_inertia_and_the_gate_uses_it() {
-    let _turn = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let file = device_file(dir.path(), "gen3.toml", |t| t);
-    let (emu, pty) = emulate(&file, &["--hand", "free", "--hand-damping", "0"]);
-    let o = identify(&pty, &file, &["--write"]);
-    stop(emu);
-    let out = text(&o);
-    assert_eq!(o.status.code(), Some(0), "{out}");
-    assert!(out.contains("wrote [identified]"), "{out}");
+    let o = identify(&file, &RELEASED, &file, &["--write"]);
+    let out = expect_exit(&o, 0, &["wrote [identified]"]);
     let f = HaplyDeviceFile::from_path(&file).unwrap();
     let id = f.identified.clone().expect("an [identified] table");
     assert!(id.command.contains("device identify") && id.date.ends_with('Z'));
@@ -91,11 +97,7 @@ fn device_identify_writes_the_emulated_inertia_and_the_gate_uses_it() {
         "stability --controller coupling --device-file {}",
         &[&plain],
     );
-    assert!(
-        text(&o).contains("built-in estimates, not measured"),
-        "{}",
-        text(&o)
-    );
+    assert_has(&text(&o), &["built-in estimates, not measured"]);
 }
 
 /// A reversed motor (the host's file says CW, the board's motor turns CCW) and a motor and encoder
@@ -103,43 +105,27 @@ fn device_identify_writes_the_emulated_inertia_and_the_gate_uses_it() {
 /// identified and the fix names the field (exit 2).
 #[test]
 fn device_identify_detects_a_reversed_motor_and_a_reversed_motor_and_encoder() {
-    let _turn = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let good = device_file(dir.path(), "gen3.toml", |t| t);
-    let flipped = device_file(dir.path(), "flipped.toml", |t| {
-        t.replacen(
-            "direction = \"ccw\"",
-            "direction = \"cw\"\nencoder_direction = \"ccw\"",
-            1,
-        )
-    });
-    let (emu, pty) = emulate(&good, &["--hand", "free", "--hand-damping", "0"]);
-    let o = identify(&pty, &flipped, &["--write"]);
-    stop(emu);
-    let out = text(&o);
-    assert_eq!(o.status.code(), Some(2), "{out}");
-    assert!(
-        out.contains("fix: motor[0] turns its link clockwise")
-            && out.contains("nothing identified"),
-        "{out}"
+    let flipped = device_file(dir.path(), "flipped.toml", motor1_flipped);
+    let o = identify(&good, &RELEASED, &flipped, &["--write"]);
+    expect_exit(
+        &o,
+        2,
+        &[
+            "fix: motor[0] turns its link clockwise",
+            "nothing identified",
+        ],
     );
     assert!(HaplyDeviceFile::from_path(&flipped)
         .unwrap()
         .identified
         .is_none());
     // The board has motor 1's motor and encoder both reversed against the host's file.
-    let board = device_file(dir.path(), "board.toml", |t| {
-        t.replacen("direction = \"ccw\"", "direction = \"cw\"", 1)
-    });
-    let (emu, pty) = emulate(&board, &["--hand", "free", "--hand-damping", "0"]);
-    let o = identify(&pty, &good, &[]);
-    stop(emu);
-    let out = text(&o);
-    assert_eq!(o.status.code(), Some(2), "{out}");
-    assert!(
-        out.contains("motor[0]'s motor AND encoder are both reversed"),
-        "{out}"
-    );
+    let board = device_file(dir.path(), "board.toml", joint1_reversed);
+    let o = identify(&board, &RELEASED, &good, &[]);
+    expect_exit(&o, 2, &["motor[0]'s motor AND encoder are both reversed"]);
 }
 
 /// The stock firmware reports the offsets wherever the handle is, so the host checks what it can:
@@ -147,18 +133,12 @@ fn device_identify_detects_a_reversed_motor_and_a_reversed_motor_and_encoder() {
 /// creeping about 1 cm/s against the hand's damping) is refused before any torque, exit 2.
 #[test]
 fn device_identify_refuses_a_handle_that_is_not_still_at_the_rest_pose() {
-    let _turn = turn();
+    let _turn = crate::common::loop_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let file = device_file(dir.path(), "gen3.toml", |t| t);
-    let (emu, pty) = emulate(&file, &["--hand", "constant:0,0.02,0"]);
-    let o = identify(&pty, &file, &["--write"]);
-    stop(emu);
-    let out = text(&o);
-    assert_eq!(o.status.code(), Some(2), "{out}");
-    assert!(
-        out.contains("rest pose") && out.contains("fix:") && !out.contains("identified at"),
-        "{out}"
-    );
+    let o = identify(&file, &["--hand", "constant:0,0.02,0"], &file, &["--write"]);
+    let out = expect_exit(&o, 2, &["rest pose", "fix:"]);
+    assert_lacks(&out, &["identified at"]);
     assert!(HaplyDeviceFile::from_path(&file)
         .unwrap()
         .identified
@@ -168,17 +148,15 @@ fn device_identify_refuses_a_handle_that_is_not_still_at_the_rest_pose() {
 /// Bad options exit 2 before the device is opened: a pulse above the cap, --write on a built-in file.
 #[test]
 fn device_identify_refuses_bad_options_with_exit_2() {
-    let o = run(
-        "device identify --device haply:/nonexistent --torque 0.1",
-        &[],
-    );
-    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
-    assert!(text(&o).contains("--torque 0.1"), "{}", text(&o));
-    let o = run("device identify --device haply:/nonexistent --write", &[]);
-    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
-    assert!(
-        text(&o).contains("--write needs --device-file"),
-        "{}",
-        text(&o)
-    );
+    let _m = crate::common::module_turn(module_path!());
+    for (args, says) in [
+        ("--torque 0.1", "--torque 0.1"),
+        ("--write", "--write needs --device-file"),
+    ] {
+        let o = run(
+            &format!("device identify --device haply:/nonexistent {args}"),
+            &[],
+        );
+        expect_exit(&o, 2, &[says]);
+    }
 }

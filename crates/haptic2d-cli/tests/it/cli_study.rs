@@ -2,27 +2,17 @@
 //! study file's errors; the observer that is not built yet is refused.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
+use crate::common::{expect_exit, haptic2d as run, text, BIN};
+
 fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_haptic2d"))
+    Command::new(BIN)
 }
 
 fn shipped() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../studies/stiffness-walls.toml")
-}
-
-fn run(args: &[&str]) -> Output {
-    bin().args(args).output().unwrap()
-}
-
-fn text(o: &Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
 }
 
 fn rows(path: &Path) -> usize {
@@ -36,6 +26,7 @@ fn rows(path: &Path) -> usize {
 /// it and writes its table and plot.
 #[test]
 fn study_interrupted_by_sigint_resumes_with_no_trial_lost_or_repeated() {
+    let _m = crate::common::module_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     // A longer session than the shipped one, so the signal lands mid-run.
     let long = dir.path().join("long.toml");
@@ -113,6 +104,7 @@ fn study_interrupted_by_sigint_resumes_with_no_trial_lost_or_repeated() {
 /// (exit 2, bad input); an observer that is not built is refused, not faked.
 #[test]
 fn study_check_and_run_refuse_bad_input_with_the_field_and_the_fix() {
+    let _m = crate::common::module_turn(module_path!());
     let o = run(&["study", "check", shipped().to_str().unwrap()]);
     assert!(o.status.success(), "{}", text(&o));
     assert!(
@@ -130,54 +122,21 @@ fn study_check_and_run_refuse_bad_input_with_the_field_and_the_fix() {
     )
     .unwrap();
     let o = run(&["study", "check", bad.to_str().unwrap()]);
-    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
-    assert!(
-        text(&o).contains("task.kind") && text(&o).contains("fix:"),
-        "{}",
-        text(&o)
-    );
-    let o = run(&[
-        "study",
-        "run",
-        shipped().to_str().unwrap(),
-        "--observer",
-        "buttons",
-        "--out",
-        dir.path().to_str().unwrap(),
-    ]);
-    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
-    assert!(
-        text(&o).contains("unknown observer") && text(&o).contains("--observer browser"),
-        "{}",
-        text(&o)
-    );
-    // The browser session checks its options before anything starts.
-    let o = run(&[
-        "study",
-        "run",
-        shipped().to_str().unwrap(),
-        "--observer",
-        "browser",
-        "--interval",
-        "0",
-        "--out",
-        dir.path().to_str().unwrap(),
-    ]);
-    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
-    assert!(
-        text(&o).contains("--interval") && text(&o).contains("fix:"),
-        "{}",
-        text(&o)
-    );
-    let o = run(&[
-        "study",
-        "run",
-        shipped().to_str().unwrap(),
-        "--participant",
-        "Jane Doe",
-        "--out",
-        dir.path().to_str().unwrap(),
-    ]);
+    expect_exit(&o, 2, &["task.kind", "fix:"]);
+    // `study run` refuses what it cannot run; the browser session checks its options before
+    // anything starts; a participant ID that could be a name is refused.
+    let study = shipped();
+    let run_with = |options: &[&str]| {
+        let mut args = vec!["study", "run", study.to_str().unwrap()];
+        args.extend(options);
+        args.extend(["--out", dir.path().to_str().unwrap()]);
+        run(&args)
+    };
+    let o = run_with(&["--observer", "buttons"]);
+    expect_exit(&o, 2, &["unknown observer", "--observer browser"]);
+    let o = run_with(&["--observer", "browser", "--interval", "0"]);
+    expect_exit(&o, 2, &["--interval", "fix:"]);
+    let o = run_with(&["--participant", "Jane Doe"]);
     assert!(
         !o.status.success() && text(&o).contains("pseudonymous"),
         "{}",

@@ -105,6 +105,7 @@ fn edge() -> f64 {
 /// runs far past it.
 #[test]
 fn five_bar_a_1_n_push_is_held_within_a_few_mm_of_the_workspace_edge() {
+    let _m = crate::common::module_turn(module_path!());
     for controller in ["coupling", "four-channel"] {
         let mut l = Loop::new(controller, 1.0, true, grip_at_centre());
         let mut max_x = f64::NEG_INFINITY;
@@ -155,6 +156,7 @@ fn five_bar_a_1_n_push_is_held_within_a_few_mm_of_the_workspace_edge() {
 /// past the trip distance (10 mm), with zero torques in that tick and the reason naming the edge.
 #[test]
 fn five_bar_a_push_that_overpowers_the_wall_trips_at_the_trip_distance() {
+    let _m = crate::common::module_turn(module_path!());
     let mut l = Loop::new("coupling", 1.0, true, grip_at_centre());
     let mut prev_x = l.handle().x;
     for k in 0..(4.0 * RATE) as usize {
@@ -233,6 +235,7 @@ fn tap() -> HandModel {
 /// estimate saturates the motors for a few ticks at most (under 1 %) and trips nothing.
 #[test]
 fn a_device_lighter_than_the_gate_assumes_trips_on_its_limit_cycle() {
+    let _m = crate::common::module_turn(module_path!());
     for (controller, share) in [("four-channel", 0.33), ("coupling", 0.1)] {
         // As heavy as the estimate: quiet.
         let mut l = Loop::new(controller, 1.0, true, tap());
