@@ -498,24 +498,16 @@ fn silent(read_sleep: Duration) -> impl Read + Write {
 #[test]
 fn a_timeout_says_whether_the_host_or_the_device_was_late() {
     let setup = device_file("haply-2diy-gen3.toml").board_setup();
-    let mut t = Transport::from_stream(
-        silent(Duration::from_micros(200)),
-        setup,
-        // Long enough that a loaded test machine does not deschedule the host for half of it.
-        Duration::from_millis(200),
-    )
-    .unwrap();
-    t.send_write(&[0.0, 0.0]).unwrap();
-    let e = t.read_reply().unwrap_err().to_string();
+    // The error of one write whose reply never comes: each read takes `read_sleep`.
+    let late = |read_sleep: Duration, timeout: Duration| {
+        let mut t = Transport::from_stream(silent(read_sleep), setup, timeout).unwrap();
+        t.send_write(&[0.0, 0.0]).unwrap();
+        t.read_reply().unwrap_err().to_string()
+    };
+    // A timeout long enough that a loaded test machine does not deschedule the host for half of it.
+    let e = late(Duration::from_micros(200), Duration::from_millis(200));
     assert!(e.contains("the device was late"), "{e}");
-    let mut t = Transport::from_stream(
-        silent(Duration::from_millis(30)),
-        setup,
-        Duration::from_millis(10),
-    )
-    .unwrap();
-    t.send_write(&[0.0, 0.0]).unwrap();
-    let e = t.read_reply().unwrap_err().to_string();
+    let e = late(Duration::from_millis(30), Duration::from_millis(10));
     assert!(
         e.contains("the host itself was not running") && e.contains("timeout_periods"),
         "{e}"

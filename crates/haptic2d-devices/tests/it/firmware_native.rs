@@ -271,6 +271,21 @@ fn truncated_angle(offset: f32, resolution: f32) -> f32 {
 
 const WAIT: Duration = Duration::from_secs(3);
 
+/// An M3 board started as `tag`, its watchdog set to `watchdog_ms` first where given (the 20 ms
+/// default otherwise), then set up with motors and encoders on ports 1 and 2 ([`GEN3`]); the
+/// board and its port.
+fn set_up_m3(tag: &str, watchdog_ms: Option<u16>) -> (Firmware, BoardPort) {
+    let fw = Firmware::start(Board::M3, tag);
+    let mut port = fw.port();
+    if let Some(ms) = watchdog_ms {
+        let [lo, hi] = ms.to_le_bytes();
+        send(&mut port, &[0x04, lo, hi]);
+        assert_eq!(read_n(&mut port, 10, WAIT), identity(4, ms));
+    }
+    send(&mut port, &setup_frame(0b11, &[], &GEN3));
+    (fw, port)
+}
+
 #[test]
 fn identify_answers_h2df_version_1_its_ports_its_capabilities_and_the_20_ms_default() {
     for (board, ports) in [(Board::M3, 4u8), (Board::M0, 2u8)] {
@@ -328,9 +343,7 @@ fn motors_are_zero_at_power_up_and_nothing_answers_reset_or_setup() {
 
 #[test]
 fn a_write_of_0_3_nm_is_clamped_to_0_123_on_the_board_and_answered_with_truncated_angles() {
-    let fw = Firmware::start(Board::M3, "clamp");
-    let mut port = fw.port();
-    send(&mut port, &setup_frame(0b11, &[], &GEN3));
+    let (fw, mut port) = set_up_m3("clamp", None);
     send(&mut port, &write_frame(&[0.3, -0.3]));
     let reply = read_n(&mut port, 9, WAIT);
     assert_eq!(reply.len(), 9, "reply {reply:?}");
@@ -357,9 +370,7 @@ fn a_write_of_0_3_nm_is_clamped_to_0_123_on_the_board_and_answered_with_truncate
 
 #[test]
 fn non_finite_torques_drive_nothing() {
-    let fw = Firmware::start(Board::M3, "nan");
-    let mut port = fw.port();
-    send(&mut port, &setup_frame(0b11, &[], &GEN3));
+    let (fw, mut port) = set_up_m3("nan", None);
     send(&mut port, &write_frame(&[f32::NAN, f32::INFINITY]));
     assert_eq!(read_n(&mut port, 9, WAIT).len(), 9);
     let log = fw.wait_log(WAIT, "the write", |l| l.has_event("write"));
@@ -389,12 +400,8 @@ fn analog_inputs_are_reported_in_ascending_pin_order() {
 
 #[test]
 fn reset_zeroes_the_motors_at_once() {
-    let fw = Firmware::start(Board::M3, "reset");
-    let mut port = fw.port();
     // A long watchdog, so that only the reset can zero the motors within the test's wait.
-    send(&mut port, &[0x04, 0xe8, 0x03]);
-    assert_eq!(read_n(&mut port, 10, WAIT), identity(4, 1000));
-    send(&mut port, &setup_frame(0b11, &[], &GEN3));
+    let (fw, mut port) = set_up_m3("reset", Some(1000));
     send(&mut port, &write_frame(&[0.1, -0.05]));
     assert_eq!(read_n(&mut port, 9, WAIT).len(), 9);
     fw.wait_log(WAIT, "torque on", |l| l.now()[0] > 0.09);
@@ -409,11 +416,7 @@ fn reset_zeroes_the_motors_at_once() {
 
 #[test]
 fn a_new_setup_zeroes_the_motors() {
-    let fw = Firmware::start(Board::M3, "re-setup");
-    let mut port = fw.port();
-    send(&mut port, &[0x04, 0xe8, 0x03]);
-    assert_eq!(read_n(&mut port, 10, WAIT), identity(4, 1000));
-    send(&mut port, &setup_frame(0b11, &[], &GEN3));
+    let (fw, mut port) = set_up_m3("re-setup", Some(1000));
     send(&mut port, &write_frame(&[0.1, 0.1]));
     assert_eq!(read_n(&mut port, 9, WAIT).len(), 9);
     fw.wait_log(WAIT, "torque on", |l| l.now()[0] > 0.09);
@@ -467,14 +470,8 @@ fn stop_writing_and_time_the_zero(fw: &Firmware, port: &mut BoardPort, for_ms: u
 /// Sets up an M3 board (its watchdog set to `set_ms` first, where given; 20 ms otherwise), stops
 /// writing and checks that the motors are zero `watchdog_ms` after the last write, within the
 /// scheduling margin.
-fn check_watchdog_zeroes_the_motors(tag: &str, set_ms: Option<u8>, watchdog_ms: u64) {
-    let fw = Firmware::start(Board::M3, tag);
-    let mut port = fw.port();
-    if let Some(ms) = set_ms {
-        send(&mut port, &[0x04, ms, 0]);
-        assert_eq!(read_n(&mut port, 10, WAIT), identity(4, ms.into()));
-    }
-    send(&mut port, &setup_frame(0b11, &[], &GEN3));
+fn check_watchdog_zeroes_the_motors(tag: &str, set_ms: Option<u16>, watchdog_ms: u64) {
+    let (fw, mut port) = set_up_m3(tag, set_ms);
     let dt = stop_writing_and_time_the_zero(&fw, &mut port, 100);
     let at = watchdog_ms * 1000;
     assert!(
@@ -495,11 +492,7 @@ fn a_watchdog_set_to_80_ms_zeroes_the_motors_80_ms_after_the_last_write() {
 
 #[test]
 fn an_incomplete_frame_left_for_10_ms_is_dropped_not_completed_by_later_bytes() {
-    let fw = Firmware::start(Board::M3, "stale");
-    let mut port = fw.port();
-    send(&mut port, &[0x04, 0xe8, 0x03]);
-    assert_eq!(read_n(&mut port, 10, WAIT), identity(4, 1000));
-    send(&mut port, &setup_frame(0b11, &[], &GEN3));
+    let (fw, mut port) = set_up_m3("stale", Some(1000));
     // A host dies after the first 2 bytes of a write; its torques arrive (from someone) 50 ms later.
     send(&mut port, &[0x02, 1]);
     fw.wait_log(WAIT, "the stale frame dropped", |l| {

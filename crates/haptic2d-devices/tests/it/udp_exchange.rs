@@ -12,7 +12,7 @@ use std::time::{Duration, Instant};
 use haptic2d_devices::udp::codec::{
     Command, State, FLAG_ENABLE, FLAG_LATCHED, STATE_LEN, STATUS_ENABLED, STATUS_FAULT,
 };
-use haptic2d_devices::udp::{UdpDevice, UdpDeviceFile};
+use haptic2d_devices::udp::{UdpCounters, UdpDevice, UdpDeviceFile};
 use haptic2d_rt::{DeviceError, DeviceIo};
 use haptic2d_test_support::process::Killed;
 use haptic2d_test_support::udp_device::{start_reference_device, Which};
@@ -139,6 +139,17 @@ fn open_patient(addr: SocketAddr) -> UdpDevice {
     UdpDevice::open(addr, &file, PERIOD, "udp:test").unwrap()
 }
 
+/// `ticks` ticks (torque ±0.01 N·m) against the in-test device with `fault`, the driver patient
+/// ([`open_patient`]); the driver's counters.
+fn patient_run(fault: Fault, ticks: usize) -> UdpCounters {
+    let fake = FakeDevice::start(fault);
+    let mut dev = open_patient(fake.addr);
+    run(&mut dev, ticks, 0.01).unwrap();
+    let c = *dev.counters();
+    fake.finish();
+    c
+}
+
 #[test]
 fn clean_exchange_answers_every_command_and_clamps_torques() {
     let fake = FakeDevice::start(Fault::None);
@@ -172,11 +183,7 @@ fn clean_exchange_answers_every_command_and_clamps_torques() {
 
 #[test]
 fn dropped_answers_are_counted_and_survived() {
-    let fake = FakeDevice::start(Fault::DropEvery(10));
-    let mut dev = open_patient(fake.addr);
-    run(&mut dev, 500, 0.01).unwrap();
-    let c = *dev.counters();
-    fake.finish();
+    let c = patient_run(Fault::DropEvery(10), 500);
     // 1 in 10 answers dropped: ~50 of ~500 lost, each a timed-out wait.
     assert!((40..=60).contains(&c.lost()), "{c}");
     assert!(c.timeouts >= c.lost(), "{c}");
@@ -185,11 +192,7 @@ fn dropped_answers_are_counted_and_survived() {
 
 #[test]
 fn reordered_answers_are_counted_and_survived() {
-    let fake = FakeDevice::start(Fault::SwapEvery(10));
-    let mut dev = open_patient(fake.addr);
-    run(&mut dev, 500, 0.01).unwrap();
-    let c = *dev.counters();
-    fake.finish();
+    let c = patient_run(Fault::SwapEvery(10), 500);
     assert!((40..=60).contains(&c.reordered), "{c}");
     // A reordered state is not lost; only an answer still held back when the run ends can be.
     assert!(c.lost() <= 1, "a reordered state is not lost: {c}");
@@ -198,11 +201,7 @@ fn reordered_answers_are_counted_and_survived() {
 
 #[test]
 fn malformed_datagrams_are_counted_and_ignored() {
-    let fake = FakeDevice::start(Fault::Garbage);
-    let mut dev = open_patient(fake.addr);
-    run(&mut dev, 300, 0.01).unwrap();
-    let c = *dev.counters();
-    fake.finish();
+    let c = patient_run(Fault::Garbage, 300);
     assert!(c.malformed >= 300, "{c}");
     // The garbage arrives before each answer and costs no answer.
     assert_eq!(c.lost() + c.reordered, 0, "{c}");
