@@ -79,6 +79,7 @@ async fn phase(addr: &str, n: usize, secs: f64) -> Phase {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn five_viewers_keep_receiving_frames() {
+    let _cores = crate::CORES.write().await;
     let demo = common::start_demo(&[]);
     let secs = 4.0;
     let one = phase(&demo.addr, 1, secs).await;

@@ -33,6 +33,7 @@ fn running_p99(w: &haptic2d::world::World, steps: usize) -> f64 {
 
 #[test]
 fn the_1000_box_pile_is_refused_at_1khz_and_box_in_walls_accepted() {
+    let _cores = crate::CORES.blocking_read();
     let rate = 1000.0;
     let t0 = Instant::now();
     let pile = assess("pile", &world("pile", rate), rate, DEFAULT_STEP_FRACTION);
@@ -61,6 +62,7 @@ fn the_1000_box_pile_is_refused_at_1khz_and_box_in_walls_accepted() {
 
 #[test]
 fn a_heavy_trial_stops_as_soon_as_the_percentile_is_over_the_budget() {
+    let _cores = crate::CORES.blocking_read();
     // pile at 10 kHz: 3000 steps planned, 30 may exceed the 50 µs budget (with the margin: 33 µs);
     // the pile's steps do.
     let t = trial(&world("pile", 10_000.0), 50e-6, COST_MARGIN);
@@ -77,6 +79,7 @@ fn a_heavy_trial_stops_as_soon_as_the_percentile_is_over_the_budget() {
 /// margin against the p99 of the next 0.5 s, timed the same way.
 #[test]
 fn the_trial_with_its_margin_bounds_the_cost_of_the_steps_that_follow_it() {
+    let _cores = crate::CORES.blocking_read();
     let rate = 1000.0;
     let w0 = world("pile:100", rate);
     // The whole trial (no wall-clock cut, whatever the machine's load).
