@@ -142,7 +142,9 @@ fn the_service_killed_mid_run_is_a_lost_device_with_its_reason() {
         hand: Some(Hand3::hold([0.0; 3], 300.0, 5.0)),
         ..Emulator3Config::default()
     });
-    let file = file_for(&emu, 20.0);
+    // 50 periods: at 20, one run in a few of the one-binary suite lost the service in the live
+    // phase, beside a neighbour's load.
+    let file = file_for(&emu, 50.0);
     let mut dev = open(&file);
     drive(&mut dev, &emu, [0.1, 0.0], 200);
     emu.stop();
@@ -166,7 +168,7 @@ fn the_service_killed_mid_run_is_a_lost_device_with_its_reason() {
         msg.contains("check:") && msg.contains("Inverse Service"),
         "{msg}"
     );
-    // The timeout is 20 ms; a closed connection may be noticed sooner.
+    // The timeout is 50 ms; a closed connection may be noticed sooner.
     assert!(lost_after < Duration::from_millis(500), "{lost_after:?}");
     assert!(matches!(dev.read_point(), Err(DeviceError::Lost(_))));
     assert!(matches!(

@@ -17,7 +17,7 @@ pub fn emulator(cfg: Emulator3Config) -> Inverse3Emulator {
 /// The emulator, the client's socket thread and the test's loop share two cores with the rest of
 /// a debug build's test run: a CI run stalled one of them for 65.7 ms, past the 50 ms these tests
 /// used, and the closed-loop test failed with a lost device that was not lost. The tests of the
-/// timeout set their own (module `inverse3_safety`, the service killed mid-run: 20 periods).
+/// timeout set their own (module `inverse3_safety`, the service killed mid-run: 50 periods).
 pub const NOT_THE_TIMEOUT_UNDER_TEST: f64 = 1000.0;
 
 /// The shipped file, talking to `emu`, with the timeout at `timeout_periods` periods.
