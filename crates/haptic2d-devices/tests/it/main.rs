@@ -4,9 +4,10 @@
 //! modules build with the driver's feature only: `cargo test -p haptic2d-devices --features
 //! inverse3 --test it inverse3_`.
 //!
-//! Process-wide state, checked safe in one binary: `udp_interrupted` installs a SIGUSR1 handler
-//! (no `SA_RESTART`) and signals its own thread only (`pthread_kill`); no other module sends or
-//! handles SIGUSR1, and children started here get the default disposition back at `exec`.
+//! `udp_interrupted.rs` stays its own binary: its SIGUSR1 handler is process-wide and it counts
+//! three signals sent 10 ms apart to its waiting thread. Beside the other modules (two test
+//! threads on a 2-core machine) its signal count was wrong in 1 suite run of 13, likely two sends
+//! merged while the thread waited for a core (standard signals do not queue); alone it passes.
 
 // The no-allocation modules count this thread's allocations (haptic2d-test-support).
 haptic2d_test_support::install_counting_allocator!();
@@ -41,6 +42,5 @@ mod inverse3_wire;
 mod udp_auth;
 mod udp_auth_devices;
 mod udp_exchange;
-mod udp_interrupted;
 mod udp_no_alloc;
 mod world_link_no_alloc;

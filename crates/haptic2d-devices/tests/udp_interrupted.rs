@@ -11,7 +11,11 @@ use std::time::{Duration, Instant};
 
 use haptic2d_devices::udp::UdpTransport;
 
-use crate::udp_echo::{spawn_echo_device, ECHO_POSITION};
+// Its own binary (not a module of `it`): see tests/it/main.rs.
+#[path = "it/udp_echo.rs"]
+#[allow(dead_code)]
+mod udp_echo;
+use udp_echo::{spawn_echo_device, ECHO_POSITION};
 
 static SIGNALS: AtomicUsize = AtomicUsize::new(0);
 
