@@ -301,14 +301,21 @@ fn garbage(soup: Vec<u8>) -> impl Read + Write {
     })
 }
 
-#[test]
-fn emulator_killed_mid_run_is_a_lost_device_within_the_timeout() {
-    // 50 periods: the live phase must not time out on a machine shared with compilers (at 20, one
-    // run in a few of the one-binary suite lost the emulator mid-run beside a neighbour's load).
+/// The shipped gen 3 file with a lost-device timeout of 50 periods, and its emulated board with the
+/// handle gripped at rest. 50: the live phase must not time out on a machine shared with compilers
+/// (at 20, one run in a few of the one-binary suite lost the emulator mid-run beside a neighbour's
+/// load).
+fn gen3_with_a_50_period_timeout() -> (HaplyDeviceFile, Emu) {
     let mut file = device_file("haply-2diy-gen3.toml");
     file.timeout_periods = 50.0;
     let start = file.rest_pose().unwrap();
-    let mut emu = start_emulator(&file, HandModel::grip(start), 0.001);
+    let emu = start_emulator(&file, HandModel::grip(start), 0.001);
+    (file, emu)
+}
+
+#[test]
+fn emulator_killed_mid_run_is_a_lost_device_within_the_timeout() {
+    let (file, mut emu) = gen3_with_a_50_period_timeout();
     let port = haptic2d_devices::haply::serial::open_port(&emu.path).unwrap();
     let mut dev = HaplyDevice::open(port, &file, Duration::from_millis(1), "haply:pty").unwrap();
     for _ in 0..100 {
@@ -519,11 +526,7 @@ fn a_timeout_says_whether_the_host_or_the_device_was_late() {
 /// USB cable.
 #[test]
 fn a_lost_emulator_on_a_pseudo_terminal_is_not_blamed_on_a_usb_cable() {
-    let mut file = device_file("haply-2diy-gen3.toml");
-    // As in `emulator_killed_mid_run_is_a_lost_device_within_the_timeout`: 50 periods.
-    file.timeout_periods = 50.0;
-    let start = file.rest_pose().unwrap();
-    let mut emu = start_emulator(&file, HandModel::grip(start), 0.001);
+    let (file, mut emu) = gen3_with_a_50_period_timeout();
     let mut dev = open_driver(&emu, &file, 0.001);
     dev.read_encoders().unwrap();
     dev.write_torques(&[0.0; 4]).unwrap();

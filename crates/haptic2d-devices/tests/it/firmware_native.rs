@@ -145,13 +145,9 @@ impl MotorLog {
     /// Torques after the whole log.
     fn now(&self) -> [f64; 4] {
         self.entries
-            .iter()
-            .rev()
-            .find_map(|e| match e {
-                Entry::Motors(_, t) => Some(*t),
-                _ => None,
-            })
-            .unwrap_or([0.0; 4])
+            .len()
+            .checked_sub(1)
+            .map_or([0.0; 4], |i| self.at(i))
     }
 
     /// Index and time of the last event `name`.
