@@ -11,7 +11,9 @@ use std::time::{Duration, Instant};
 
 use haptic2d_devices::udp::UdpTransport;
 
-#[path = "support/udp_echo.rs"]
+// Its own binary (not a module of `it`): see tests/it/main.rs.
+#[path = "it/udp_echo.rs"]
+#[allow(dead_code)]
 mod udp_echo;
 use udp_echo::{spawn_echo_device, ECHO_POSITION};
 

@@ -4,6 +4,7 @@
 //! - [`alloc`]: the counting global allocator of the no-allocation tests;
 //! - [`wait`]: deadline polls (`wait_until`, `wait_for`, `holds_for`) instead of sleep-then-assert;
 //! - [`process`]: children killed on drop, first-line and banner handshakes, bounded waits;
+//! - [`stop`]: a stop flag raised from another thread after a delay (a loop stopped mid-run);
 //! - [`files`]: temp copies of the shipped device files with edits;
 //! - [`firmware`]: the native build of the board firmware, started on its pseudo-terminal;
 //! - [`udp_device`]: the UDP reference devices (Python, C) in processes of their own;
@@ -14,6 +15,7 @@ pub mod browser;
 pub mod files;
 pub mod firmware;
 pub mod process;
+pub mod stop;
 pub mod udp_device;
 pub mod wait;
 

@@ -2,8 +2,8 @@
 //! over any byte stream, moving a simulated linkage ([`Plant`]) under the motor torques and a
 //! simulated hand.
 //!
-//! What it reproduces (each item is pinned by a test in `tests/codec_vectors.rs` or
-//! `tests/driver_safety.rs`):
+//! What it reproduces (each item is pinned by a test in `tests/it/codec_vectors.rs` or
+//! `tests/it/driver_safety.rs`):
 //!
 //! - reset, setup, write; a reply **only** after a write; nothing after reset or setup;
 //! - a service time of at least 50 µs between two serviced frames;

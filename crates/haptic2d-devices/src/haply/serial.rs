@@ -12,7 +12,7 @@ pub const STREAM_TIMEOUT: Duration = Duration::from_micros(500);
 
 /// A board's serial port whose reads do not allocate: `serialport`'s read builds a boxed
 /// `io::Error` for every read timeout, which the driver's exchange would hit under load (caught by
-/// `tests/haply_no_alloc.rs`). Reads wait with `ppoll` for at most [`STREAM_TIMEOUT`] and return
+/// `tests/it/haply_no_alloc.rs`). Reads wait with `ppoll` for at most [`STREAM_TIMEOUT`] and return
 /// `Ok(0)` when nothing came; errors are OS errors (no allocation). Writes go through `serialport`.
 #[derive(Debug)]
 pub struct BoardPort {
