@@ -4,7 +4,7 @@
 //! **transparency** (quasi-static values of the linear loop: what a held hand feels in free motion
 //! and at a wall), and the **claims** of Figs. 5–6 and 8–11 it reproduces (the device-in-the-loop
 //! runs of [`crate::scenarios`], unchanged criteria). The study itself is
-//! `tests/design_search.rs`.
+//! `tests/it/design_search.rs`.
 
 use haptic2d::control::coupling::VirtualCoupling;
 use haptic2d::device::linalg::V3;

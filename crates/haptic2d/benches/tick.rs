@@ -22,7 +22,7 @@ fn setup(scene: &str, hand: HandModel) -> (HapticSystem, SimDevice, HandModel) {
     let config = HapticConfig::default();
     // The steady-state tick, without the start-up ramp: a hand that pushes from the first tick
     // would carry the handle past the workspace while the torques ramp in (a safety stop, by
-    // design; the ramp's own path is tested in `tests/startup_ramp.rs`).
+    // design; the ramp's own path is tested in `tests/it/startup_ramp.rs`).
     let safety = SafetyConfig {
         ramp_time: 0.0,
         ..SafetyConfig::default()

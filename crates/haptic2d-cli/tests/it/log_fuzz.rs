@@ -1,7 +1,7 @@
 //! Issue 38, item 2, end to end: mutated logs through the real `haptic2d log info`, `log convert`
 //! and `run --device replay:` — every one ends with exit 0, 2 (a clear `error:` line) or 3 (the
 //! replayed angles tripped the safety latch), never a panic (101), an abort (134) or a hang. The
-//! bulk of the fuzzing runs in-process in haptic2d-rt's tests/log_fuzz.rs (1 200 MCAP and 1 200
+//! bulk of the fuzzing runs in-process in haptic2d-rt's tests/it/log_fuzz.rs (1 200 MCAP and 1 200
 //! CSV cases); this runs a few dozen through the binary, which adds the commands' own code.
 
 use crate::common::{run, run_ok};

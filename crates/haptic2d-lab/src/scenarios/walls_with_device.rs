@@ -46,7 +46,7 @@
 //! dissipative at the wall: the box bounces at most once, so the "keeps bouncing" claims of SEH and
 //! ZOH fail while the hysteretic wall passes. The bouncing claim needs the handle to stop with the
 //! box, i.e. force reflection `C2 = 1`, which is exactly the released-unstable path; no design of
-//! the study of issue 36 (`tests/design_search.rs`, 700+ candidates, MODELS.md §11.4) has both.
+//! the study of issue 36 (`tests/it/design_search.rs`, 700+ candidates, MODELS.md §11.4) has both.
 
 use crate::schema::Check;
 use haptic2d::device::dynamics::LumpedDynamics;

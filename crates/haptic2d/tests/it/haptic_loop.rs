@@ -279,7 +279,7 @@ fn safety_closure_fault_is_zeroed_in_the_same_tick_and_latched() {
 
 #[test]
 fn safety_singularity_margin_trips() {
-    // The workspace bound would trip first out there (tests/workspace_bound.rs): move it out of the
+    // The workspace bound would trip first out there (tests/it/workspace_bound.rs): move it out of the
     // way, so that this test sees the singularity check itself.
     let config = HapticConfig {
         device: DeviceParams {

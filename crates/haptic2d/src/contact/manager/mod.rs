@@ -510,7 +510,7 @@ mod tests {
         );
 
         // A hand-over: the tip of a triangle resting on a square's top edge is carried 11 mm
-        // below it, 1 mm inside the right edge (`tests/repro_contacts.rs`).
+        // below it, 1 mm inside the right edge (`tests/it/repro_contacts.rs`).
         let text = include_str!("../../../tests/repro/hand-over-triangle.toml");
         let tri = crate::scene::Scene::from_toml(text, "hand-over", None)
             .unwrap()

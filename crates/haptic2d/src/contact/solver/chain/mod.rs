@@ -39,17 +39,17 @@
 //! 16 gives 2.15 s while a settled pile runs 1–4 sweeps. A stop at 1e-4 m/s (issue 17, session
 //! 9; the default until session 15) gives the same rest time and largest speed after 2.5 s
 //! (2.15 s, 6.7 mm/s) with 1.2 sweeps per sample over 1–5 s instead of 3.7, and the 25 aligned
-//! 10-box stacks of `tests/stack_corners.rs` at 8.3e-4 m/s after 2 s (6.4e-4 with 1e-5). A stop
+//! 10-box stacks of `tests/it/stack_corners.rs` at 8.3e-4 m/s after 2 s (6.4e-4 with 1e-5). A stop
 //! at 2e-4 m/s (session 15; the default) halves the samples that need four sweeps or more, the slowest
 //! samples of a settling pile (pile:1000 over 1–3 s: 38 of 2000 samples, then 19; pile:5000 over
 //! 1–5 s: 23 of 4000, then 15), with the same rest times (pile:100 0.16 s, pile:1000 2.15 s,
 //! pile:5000 1.62 s then 1.61 s, pyramid 0.19 s: `--rest-time 5`), the same settle table to four
 //! digits, and the stacks at 7.6e-4 m/s after 2 s; 5e-4 and 1e-3 left the stacks at 1.2e-3 and
-//! 4.2e-3 m/s. 4 or 6 fixed sweeps left the 10-box stacks of `tests/stack_corners.rs` with
+//! 4.2e-3 m/s. 4 or 6 fixed sweeps left the 10-box stacks of `tests/it/stack_corners.rs` with
 //! contacts churning after 2 s (4: 3.9 cm/s, 6: 7.7 mm/s), 8 passed (4.3 mm/s), 16 with the stop
 //! 0.64 mm/s.
 //! The sweeps matter beyond the pile: with 8 sweeps at τ = 0.2 ms the 25 aligned 10-box stacks
-//! of `tests/stack_corners.rs` kept rocking (2 cm/s, contacts churning after 2 s); with 16 they
+//! of `tests/it/stack_corners.rs` kept rocking (2 cm/s, contacts churning after 2 s); with 16 they
 //! pass (2e-3 m/s). A sweep that has not converged leaves `F ≠ −B_c·v⁺` (still passive, but the
 //! impulses then shuffle energy between the stack's modes instead of removing it).
 //!
