@@ -353,6 +353,8 @@ mod tests {
             Ok(ClientMessage::Command(c)) => c,
             other => panic!("{s}: {other:?}"),
         };
+        let answer = |trial, choice| Command::Answer { trial, choice };
+        let magnitude = |trial, value| Command::Magnitude { trial, value };
         let table = [
             (
                 r#"{"type":"set_hand_target","x":0.01,"y":-0.02,"theta":0.5}"#,
@@ -389,34 +391,16 @@ mod tests {
             (r#"{"type":"pause"}"#, Command::Pause),
             (r#"{"type":"resume"}"#, Command::Resume),
             (r#"{"type":"reset"}"#, Command::Reset),
-            (
-                r#"{"type":"answer","trial":7,"choice":2}"#,
-                Command::Answer {
-                    trial: 7,
-                    choice: 2,
-                },
-            ),
-            (
-                r#"{"type":"answer","trial":1,"choice":0}"#,
-                Command::Answer {
-                    trial: 1,
-                    choice: 0,
-                },
-            ),
+            (r#"{"type":"answer","trial":7,"choice":2}"#, answer(7, 2)),
+            (r#"{"type":"answer","trial":1,"choice":0}"#, answer(1, 0)),
             (r#"{"type":"stop_study"}"#, Command::StopStudy),
             (
                 r#"{"type":"magnitude","trial":4,"value":125.5}"#,
-                Command::Magnitude {
-                    trial: 4,
-                    value: 125.5,
-                },
+                magnitude(4, 125.5),
             ),
             (
                 r#"{"type":"magnitude","trial":4,"value":3}"#,
-                Command::Magnitude {
-                    trial: 4,
-                    value: 3.0,
-                },
+                magnitude(4, 3.0),
             ),
             (
                 r#"{"type":"continue_study","trial":9}"#,
