@@ -152,6 +152,25 @@ fn five() -> f64 {
     5.0
 }
 
+/// A field of two values, `(field, value)`: false for `no`, true for `yes`; any other value is an
+/// error ("`x` is not {what}", with `fix`) and false.
+fn either(
+    (field, value): (&str, &str),
+    (no, yes): (&str, &str),
+    what: &str,
+    fix: &str,
+    errs: &mut Vec<SceneError>,
+) -> bool {
+    match value {
+        v if v == no => false,
+        v if v == yes => true,
+        o => {
+            errs.push(SceneError::new(field, format!("`{o}` is not {what}"), fix));
+            false
+        }
+    }
+}
+
 impl UdpDeviceFile {
     /// The reference device's file (devices/udp-pantograph.toml, embedded).
     pub fn reference() -> Self {
@@ -185,30 +204,22 @@ impl UdpDeviceFile {
             ));
         }
         let p = raw.protocol.unwrap_or_default();
-        let pose_input = match p.input.as_str() {
-            "joints" => false,
-            "pose" => true,
-            o => {
-                errs.push(SceneError::new(
-                    "protocol.input",
-                    format!("`{o}` is not a kind of state"),
-                    "write input = \"joints\" (joint angles) or \"pose\" (x, y, θ)",
-                ));
-                false
-            }
-        };
-        let wrench_output = match p.output.as_str() {
-            "torques" => false,
-            "wrench" => true,
-            o => {
-                errs.push(SceneError::new(
-                    "protocol.output",
-                    format!("`{o}` is not a kind of command"),
-                    "write output = \"torques\" (joint torques) or \"wrench\" (fx, fy, τ)",
-                ));
-                false
-            }
-        };
+        // The two two-valued fields: (field, value), (false, true), what a value is, the fix.
+        let [pose_input, wrench_output] = [
+            (
+                ("protocol.input", p.input.as_str()),
+                ("joints", "pose"),
+                "a kind of state",
+                "write input = \"joints\" (joint angles) or \"pose\" (x, y, θ)",
+            ),
+            (
+                ("protocol.output", p.output.as_str()),
+                ("torques", "wrench"),
+                "a kind of command",
+                "write output = \"torques\" (joint torques) or \"wrench\" (fx, fy, τ)",
+            ),
+        ]
+        .map(|(field, values, what, fix)| either(field, values, what, fix, &mut errs));
         device_toml::check_timeout("protocol.timeout_periods", p.timeout_periods, 3, &mut errs);
         if !(p.reply_wait_periods.is_finite()
             && p.reply_wait_periods > 0.0
