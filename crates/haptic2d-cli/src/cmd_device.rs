@@ -4,6 +4,7 @@
 
 use crate::cmd_device_check::CheckArgs;
 use crate::cmd_device_identify::IdentifyArgs;
+use crate::haply_arg::exit_code;
 use std::process::ExitCode;
 
 /// Subcommands of `haptic2d device`.
@@ -19,7 +20,7 @@ pub enum DeviceCommand {
 /// Runs `device SUBCOMMAND`.
 pub fn run(c: &DeviceCommand) -> ExitCode {
     match c {
-        DeviceCommand::Check(a) => crate::cmd_device_check::run(a),
-        DeviceCommand::Identify(a) => crate::cmd_device_identify::run(a),
+        DeviceCommand::Check(a) => exit_code(crate::cmd_device_check::check(a)),
+        DeviceCommand::Identify(a) => exit_code(crate::cmd_device_identify::identify(a)),
     }
 }

@@ -16,7 +16,7 @@
 //! them equally (a joint with both reversed looks like the other joint with both reversed). Flipping
 //! all four is a mirror image no pulse can see.
 
-use crate::haply_arg::{exit, fail, load_file, port_of};
+use crate::haply_arg::{exit, load_file, port_of, Outcome, BENCH_PERIOD};
 use haptic2d::device::pantograph2::Pantograph2;
 use haptic2d::device::TwinKinematics;
 use haptic2d_devices::haply::serial::open_port;
@@ -24,7 +24,6 @@ use haptic2d_devices::haply::{HaplyDevice, HaplyDeviceFile, HaplyKind};
 use haptic2d_rt::DeviceIo;
 use std::io::{Read, Write};
 use std::path::PathBuf;
-use std::process::ExitCode;
 use std::time::{Duration, Instant};
 
 /// Options of `haptic2d device check`.
@@ -45,17 +44,8 @@ pub struct CheckArgs {
     pub pulse_torque: f64,
 }
 
-/// Runs `device check`.
-pub fn run(a: &CheckArgs) -> ExitCode {
-    match check(a) {
-        Ok(code) => ExitCode::from(code),
-        Err((code, msg)) => fail(code, &msg),
-    }
-}
-
-const PERIOD: Duration = Duration::from_millis(1);
-
-fn check(a: &CheckArgs) -> Result<u8, (u8, String)> {
+/// Runs `device check`: its exit code, or the code and message of what stopped it.
+pub fn check(a: &CheckArgs) -> Outcome {
     let bad = |m: String| (exit::BAD_INPUT, m);
     let file = load_file(a.device_file.as_deref()).map_err(bad)?;
     if !(a.pulse_torque.is_finite() && a.pulse_torque > 0.0 && a.pulse_torque <= file.torque_limit)
@@ -70,7 +60,7 @@ fn check(a: &CheckArgs) -> Result<u8, (u8, String)> {
     let port = open_port(&path).map_err(|e| (exit::DEVICE_LOST, e))?;
     println!("{name}: hold the handle still at its rest pose: the board is being set up");
     let mut dev =
-        HaplyDevice::open(port, &file, PERIOD, &name).map_err(|e| (exit::DEVICE_LOST, e))?;
+        HaplyDevice::open(port, &file, BENCH_PERIOD, &name).map_err(|e| (exit::DEVICE_LOST, e))?;
     println!("{name}: {}", dev.firmware_summary());
     if let Some(w) = dev.start_warning() {
         eprintln!("warning: {w}");
@@ -322,7 +312,7 @@ fn hold<S: Read + Write>(
     let mut q = dev.read_encoders()?;
     while Instant::now() < end {
         dev.write_torques(&tau)?;
-        std::thread::sleep(PERIOD);
+        std::thread::sleep(BENCH_PERIOD);
         q = dev.read_encoders()?;
     }
     Ok(q)

@@ -13,7 +13,7 @@
 //! pulse along the heavy direction; the final fit, printed, and with `--write` stored in the file.
 
 use crate::cmd_device_check::{diagnose_2dof, Pulse};
-use crate::haply_arg::{exit, fail, load_file, port_of};
+use crate::haply_arg::{exit, load_file, port_of, Outcome, BENCH_PERIOD};
 use haptic2d_devices::haply::identified::{replace_table, utc_iso8601, Identified};
 use haptic2d_devices::haply::identify::{
     estimate, heavy_direction, joint_directions, lumped, record_pulses, Identification,
@@ -23,7 +23,6 @@ use haptic2d_devices::haply::serial::open_port;
 use haptic2d_devices::haply::{HaplyDevice, HaplyDeviceFile, HaplyKind};
 use haptic2d_rt::DeviceIo;
 use std::path::PathBuf;
-use std::process::ExitCode;
 use std::time::{Duration, Instant};
 
 /// Largest doublet amplitude accepted (N·m): identification needs small pulses.
@@ -53,17 +52,8 @@ pub struct IdentifyArgs {
     pub write: bool,
 }
 
-/// Runs `device identify`.
-pub fn run(a: &IdentifyArgs) -> ExitCode {
-    match identify(a) {
-        Ok(code) => ExitCode::from(code),
-        Err((code, msg)) => fail(code, &msg),
-    }
-}
-
-const PERIOD: Duration = Duration::from_millis(1);
-
-fn identify(a: &IdentifyArgs) -> Result<u8, (u8, String)> {
+/// Runs `device identify`: its exit code, or the code and message of what stopped it.
+pub fn identify(a: &IdentifyArgs) -> Outcome {
     let bad = |m: String| (exit::BAD_INPUT, m);
     let file = load_file(a.device_file.as_deref()).map_err(bad)?;
     let HaplyKind::TwoDiy { linkage, .. } = &file.kind else {
@@ -95,7 +85,7 @@ fn identify(a: &IdentifyArgs) -> Result<u8, (u8, String)> {
     let name = format!("haply:{path}");
     let port = open_port(&path).map_err(|e| (exit::DEVICE_LOST, e))?;
     println!("{name}: hold the handle still at its rest pose: the board is being set up");
-    let mut dev = HaplyDevice::open(port, &file, PERIOD, &name).map_err(|e| {
+    let mut dev = HaplyDevice::open(port, &file, BENCH_PERIOD, &name).map_err(|e| {
         // The rest-pose check (the handle moved during the set-up) is the user's to fix.
         if e.contains("right after the set-up") {
             (exit::BAD_INPUT, e)
@@ -116,14 +106,14 @@ fn identify(a: &IdentifyArgs) -> Result<u8, (u8, String)> {
         let end = Instant::now() + Duration::from_secs_f64(a.release_delay);
         while Instant::now() < end {
             dev.write_torques(&[0.0; 4]).map_err(lost)?;
-            std::thread::sleep(PERIOD);
+            std::thread::sleep(BENCH_PERIOD);
             dev.read_encoders().map_err(lost)?;
         }
     }
     let plan = PulsePlan {
         amplitude: a.torque,
         timebase: Timebase::Wall,
-        period: PERIOD.as_secs_f64(),
+        period: BENCH_PERIOD.as_secs_f64(),
         ..PulsePlan::default()
     };
     let rest4 = file.rest_joint_angles();

@@ -15,7 +15,7 @@
 //! item 4). When the kernel refuses, the emulator says so and how to get it, and runs anyway.
 
 use crate::hand_arg::HandSpec;
-use crate::haply_arg::{exit, fail, load_file};
+use crate::haply_arg::{exit, exit_code, load_file};
 use haptic2d_devices::haply::serial::Pty;
 use haptic2d_devices::haply::{
     emulator, serve, BoardKind, EmulatorClock, EmulatorConfig, HaplyKind,
@@ -182,10 +182,7 @@ pub fn run(a: &EmulateArgs) -> ExitCode {
         EmulateTarget::Haply(h) => run_haply(h),
         EmulateTarget::Inverse3(i) => run_inverse3(i),
     };
-    match r {
-        Ok(code) => ExitCode::from(code),
-        Err((code, msg)) => fail(code, &msg),
-    }
+    exit_code(r)
 }
 
 /// `haptic2d emulate haply`.

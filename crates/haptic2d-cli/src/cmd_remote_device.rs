@@ -45,7 +45,8 @@ use haptic2d_rt::{
 use crate::exit::{Failure, Status};
 use crate::hand_arg::HandSpec;
 use crate::outln;
-use crate::world_link_arg::{energies, LinkArgs, LinkStats, Outbox};
+use crate::world_link_arg::{energies, report_link, wave_totals, EndWording};
+use crate::world_link_arg::{LinkArgs, LinkStats, Outbox};
 
 /// Examples of `remote-device --help`.
 pub const EXAMPLES: &[crate::Example] = &[
@@ -397,13 +398,8 @@ impl DeviceSide {
             wave_energy: we,
             wave_x: wx,
         };
-        msg.seal(
-            self.ep.key(),
-            KIND_TO_WORLD,
-            self.ep.session(),
-            &mut self.buf,
-        );
-        self.outbox.send(&mut self.ep, k, &self.buf);
+        let buf = &mut self.buf;
+        (self.outbox).seal_and_send(&mut self.ep, &msg, KIND_TO_WORLD, k, buf);
     }
 
     /// `FLAG_TDPA` or `FLAG_WAVE` as this end runs.
@@ -692,33 +688,21 @@ fn report(
             bal.created
         );
     }
-    if let Some(wm) = &side.wave {
-        let (used, cut) = wm.iter().fold((0.0, 0.0), |(u, c), m| {
-            (u + m.budget().used(), c + m.budget().cut())
-        });
-        let sent: f64 = side.wave_out.iter().map(|o| o.energy).sum();
-        let got: f64 = side.last.map_or(0.0, |m| m.wave_energy.iter().sum::<f64>());
-        outln!(
-            "waves: sent {sent:.6} J; returning waves: the world sent {got:.6} J (as last received), used {used:.6} J, {cut:.6} J cut by the budget"
-        );
-    }
-    let c = side.ep.counters;
-    if c.old_version > 0 {
-        outln!(
-            "link: {} authentic port messages of the older world-link message version 1 refused: the world side is an older build (update both ends)",
-            c.old_version
-        );
-    }
-    outln!(
-        "link: {} received, {} stale, {} bad MAC, {} wrong session, {} malformed, {} send errors, {} dropped by the test impairment; largest force on the handle {:.3} N",
-        c.received,
-        c.stale,
-        c.bad_mac,
-        c.wrong_session,
-        c.malformed,
-        c.send_errors,
+    let waves = (side.wave.as_ref()).map(|wm| {
+        let budgets = wm.iter().map(|m| m.budget());
+        wave_totals(budgets, &side.wave_out, side.last.as_ref())
+    });
+    let end = EndWording {
+        peer: "world",
+        peer_waves: "returning waves: the world",
+        used_note: "",
+    };
+    report_link(
+        &end,
+        waves,
+        &side.ep.counters,
         side.outbox.dropped(),
-        side.max_force
+        format_args!("largest force on the handle {:.3} N", side.max_force),
     );
     outln!("link: {}", side.stats.describe());
     outln!(

@@ -28,7 +28,8 @@ use haptic2d_rt::{run_loop, LoopConfig, TickControl, TickInfo};
 
 use crate::exit::{Failure, Status};
 use crate::outln;
-use crate::world_link_arg::{energies, LinkArgs, LinkStats, Outbox};
+use crate::world_link_arg::{energies, report_link, wave_totals, EndWording};
+use crate::world_link_arg::{LinkArgs, LinkStats, Outbox};
 
 /// Examples of `serve-world --help`.
 pub const EXAMPLES: &[crate::Example] = &[
@@ -236,13 +237,8 @@ impl WorldSide {
             wave_energy: self.wave_out.map(|o| o.energy),
             wave_x: self.wave_out.map(|o| o.x),
         };
-        msg.seal(
-            self.ep.key(),
-            KIND_TO_DEVICE,
-            self.ep.session(),
-            &mut self.buf,
-        );
-        self.outbox.send(&mut self.ep, k, &self.buf);
+        let buf = &mut self.buf;
+        (self.outbox).seal_and_send(&mut self.ep, &msg, KIND_TO_DEVICE, k, buf);
         let (x, _) = self.slave_state();
         if !x.iter().all(|v| v.is_finite()) {
             self.end = Some("the world diverged (non-finite slave pose)");
@@ -391,34 +387,27 @@ fn report(side: &mut WorldSide, summary: &haptic2d_rt::TimingSummary) {
         plant.0,
         plant.1
     );
-    if let Some(ws) = &side.wave {
-        let (used, cut) = ws.iter().fold((0.0, 0.0), |(u, c), s| {
-            (u + s.budget().used(), c + s.budget().cut())
-        });
-        let sent: f64 = side.wave_out.iter().map(|o| o.energy).sum();
-        let got: f64 = side.last.map_or(0.0, |m| m.wave_energy.iter().sum::<f64>());
-        outln!(
-            "waves: sent {sent:.6} J; forward waves: the device side sent {got:.6} J (as last received), used {used:.6} J (drift compensation included), {cut:.6} J cut by the budget"
-        );
-    }
-    let c = side.ep.counters;
-    if c.old_version > 0 {
-        outln!(
-            "link: {} authentic port messages of the older world-link message version 1 refused: the device side is an older build (update both ends)",
-            c.old_version
-        );
-    }
-    outln!(
-        "link: {} received, {} stale, {} bad MAC, {} wrong session, {} malformed, {} send errors, {} dropped by the test impairment; {} periods live; largest coupling force {:.3} N",
-        c.received,
-        c.stale,
-        c.bad_mac,
-        c.wrong_session,
-        c.malformed,
-        c.send_errors,
+    let totals = |ws: &[WaveSlave; 3]| {
+        wave_totals(
+            ws.iter().map(|s| s.budget()),
+            &side.wave_out,
+            side.last.as_ref(),
+        )
+    };
+    let end = EndWording {
+        peer: "device",
+        peer_waves: "forward waves: the device side",
+        used_note: " (drift compensation included)",
+    };
+    report_link(
+        &end,
+        side.wave.as_ref().map(totals),
+        &side.ep.counters,
         side.outbox.dropped(),
-        side.live_ticks,
-        side.max_force
+        format_args!(
+            "{} periods live; largest coupling force {:.3} N",
+            side.live_ticks, side.max_force
+        ),
     );
     outln!("link: {}", side.stats.describe());
     let (n, wall, coupling, diff) = side.contact;

@@ -23,3 +23,18 @@ pub fn fail(code: u8, msg: &str) -> ExitCode {
     eprintln!("error: {}", msg.trim_end());
     ExitCode::from(code)
 }
+
+/// How a Haply command (`device check`, `device identify`, `emulate`) ended: its exit code, or
+/// an exit code and the message to print as `error: …`.
+pub type Outcome = Result<u8, (u8, String)>;
+
+/// The process exit of an [`Outcome`]: its code, or `error: msg` printed ([`fail`]) and its code.
+pub fn exit_code(r: Outcome) -> ExitCode {
+    match r {
+        Ok(code) => ExitCode::from(code),
+        Err((code, msg)) => fail(code, &msg),
+    }
+}
+
+/// The control period of the bench-top commands `device check` and `device identify` (1 ms).
+pub const BENCH_PERIOD: std::time::Duration = std::time::Duration::from_millis(1);

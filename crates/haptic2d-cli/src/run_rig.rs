@@ -134,12 +134,28 @@ impl Rig {
             _ => Box::new(Self::sim(&system, &config, &hand, target.as_ref())?),
         };
         Ok(Self {
-            system: DeviceSystem::Twin(system),
+            hand,
+            target,
+            ..Self::fresh(DeviceSystem::Twin(system), io, config, device)
+        })
+    }
+
+    /// A rig of `system` driving `io`, the hand following (no target, no real device), with the
+    /// per-run state of the tick fresh: no released-stability gate, no interval measured yet, one
+    /// period elapsed, no grip turn.
+    fn fresh(
+        system: DeviceSystem,
+        io: Box<dyn DeviceIo + Send>,
+        config: HapticConfig,
+        device: DeviceChoice,
+    ) -> Self {
+        Self {
+            system,
             io,
             config,
             device,
-            hand,
-            target,
+            hand: HandSpec::Follow,
+            target: None,
             real: None,
             match_controller: None,
             released_gate: false,
@@ -148,7 +164,7 @@ impl Rig {
             prev_read_wait_ns: 0,
             elapsed_periods: 1.0,
             grip: GripTwist::default(),
-        })
+        }
     }
 
     /// Builds the system for the real device `real` around `world` (errors name the scene and the
@@ -180,20 +196,9 @@ impl Rig {
         })?;
         let io = (real.open)(period).map_err(RealOpenError::Open)?;
         Ok(Self {
-            system,
-            io,
-            config,
-            device,
-            hand: HandSpec::Follow,
-            target: None,
             real: Some(limits),
             match_controller: real.match_controller,
-            released_gate: false,
-            interval: TickInterval::new(),
-            read_wait_ns: 0,
-            prev_read_wait_ns: 0,
-            elapsed_periods: 1.0,
-            grip: GripTwist::default(),
+            ..Self::fresh(system, io, config, device)
         })
     }
 
@@ -510,13 +515,16 @@ pub enum RealOpenError {
 pub(crate) mod test_rig {
     use super::*;
 
+    /// The world of the built-in scene `box-in-walls` at 1 kHz.
+    pub(crate) fn box_in_walls() -> World {
+        let scene = haptic2d::scene::builtin("box-in-walls", Some(1000.0));
+        scene.unwrap().unwrap().world
+    }
+
     /// The simulated twin on `box-in-walls` at 1 kHz, the hand following its target.
     pub(crate) fn sim_rig() -> Rig {
-        let scene = haptic2d::scene::builtin("box-in-walls", Some(1000.0))
-            .unwrap()
-            .unwrap();
         Rig::new(
-            scene.world,
+            box_in_walls(),
             "box-in-walls",
             HapticConfig::default(),
             DeviceChoice::Sim,
@@ -542,11 +550,10 @@ pub(crate) mod test_rig {
 
 #[cfg(test)]
 mod tests {
-    use super::test_rig::{sim_rig as rig, tick_info as info};
+    use super::test_rig::{box_in_walls, sim_rig as rig, tick_info as info};
     use super::*;
     use haptic2d::device::pantograph2::Pantograph2;
     use haptic2d::haptic::WorkspaceSquare;
-    use haptic2d::scene::builtin;
     use haptic2d_rt::Watchdog;
 
     /// Issue 11: `run` gave the watchdog a nominal singularity margin (1) and no closure fault.
@@ -657,7 +664,6 @@ mod tests {
     /// A rig on a fake gen 3 2DIY held at its workspace centre; the read of tick `slow_at` waits
     /// `wait`; the device's own timeout is `wait_periods`.
     fn board_rig(slow_at: u64, wait: std::time::Duration, wait_periods: f64) -> Rig {
-        let scene = builtin("box-in-walls", Some(1000.0)).unwrap().unwrap();
         let linkage = Pantograph2::new(0.038, 0.07, 0.09).unwrap();
         let q = linkage.ik(haptic2d::geom::Vec2::new(0.019, 0.10)).unwrap();
         let real = RealDevice {
@@ -685,8 +691,14 @@ mod tests {
                 }) as Box<dyn DeviceIo + Send>)
             }),
         };
+        fake_board_rig(real)
+    }
+
+    /// The rig of `haptic2d run` on the built-in `box-in-walls` scene at 1 kHz, default settings,
+    /// driving the (fake) Haply board `real`.
+    fn fake_board_rig(real: RealDevice) -> Rig {
         Rig::with_real(
-            scene.world,
+            box_in_walls(),
             "box-in-walls",
             HapticConfig::default(),
             DeviceChoice::Haply("fake".into()),
@@ -750,15 +762,7 @@ mod tests {
             DeviceModel::Twin(_) => panic!("a 2-DOF or point device"),
         };
         real.open = Box::new(move |_| Ok(Box::new(MovingBoard { q, step: 0.01 }) as _));
-        let scene = builtin("box-in-walls", Some(1000.0)).unwrap().unwrap();
-        let mut rig = Rig::with_real(
-            scene.world,
-            "box-in-walls",
-            HapticConfig::default(),
-            DeviceChoice::Haply("fake".into()),
-            real,
-        )
-        .unwrap();
+        let mut rig = fake_board_rig(real);
         for k in 0..20 {
             let q = rig.read().unwrap();
             rig.tick_system(&q, &info(k), false);
@@ -804,15 +808,7 @@ mod tests {
                 step: 0.0,
             }) as _)
         });
-        let scene = builtin("box-in-walls", Some(1000.0)).unwrap().unwrap();
-        let rig = Rig::with_real(
-            scene.world,
-            "box-in-walls",
-            HapticConfig::default(),
-            DeviceChoice::Haply("fake".into()),
-            real,
-        )
-        .unwrap();
+        let rig = fake_board_rig(real);
         let stall = rig.watchdog_config().max_stall_periods.unwrap();
         assert!((stall - 100.0).abs() < 1e-9, "{stall}");
     }
@@ -927,11 +923,7 @@ mod tests {
         }
         assert_eq!(rig.hand_target_world()[2], 0.3);
         // A rebuild (the page's reset) keeps the device and starts a fresh 2-DOF system.
-        let world = builtin("box-in-walls", Some(1000.0))
-            .unwrap()
-            .unwrap()
-            .world;
-        rig.rebuild(world).unwrap();
+        rig.rebuild(box_in_walls()).unwrap();
         assert!(matches!(rig.system, DeviceSystem::TwoDof(_)));
         assert_eq!(rig.io.name(), "fake-board");
     }
@@ -991,13 +983,12 @@ mod tests {
             match_controller: None,
             open: Box::new(move |_| Ok(Box::new(FakePoint(shared)) as Box<dyn DeviceIo + Send>)),
         };
-        let scene = builtin("box-in-walls", Some(1000.0)).unwrap().unwrap();
         let config = HapticConfig {
             controller: ControllerKind::from_name("coupling").unwrap(),
             ..HapticConfig::default()
         };
         let rig = Rig::with_real(
-            scene.world,
+            box_in_walls(),
             "box-in-walls",
             config,
             DeviceChoice::Inverse3(None),
@@ -1034,11 +1025,7 @@ mod tests {
             last = out.torques[0];
         }
         assert!(last < -0.1, "pulled back: {last} N");
-        let world = builtin("box-in-walls", Some(1000.0))
-            .unwrap()
-            .unwrap()
-            .world;
-        rig.rebuild(world).unwrap();
+        rig.rebuild(box_in_walls()).unwrap();
         assert!(matches!(rig.system, DeviceSystem::Point(_)));
         assert_eq!(rig.io.name(), "fake-point");
     }
@@ -1096,13 +1083,9 @@ mod tests {
         );
     }
 
-    /// The released-handle stability gate applies to a point device, linearised with the
-    /// Inverse3's gate dynamics: the spec's four-channel gains are refused, the default passes.
-    #[test]
-    fn display_controller_switch_on_a_point_device_passes_the_released_stability_gate() {
-        let (mut rig, _) = point_rig();
-        rig.enforce_released_stability();
-        let spec = ControllerKind::from_name("four-channel-spec").unwrap();
+    /// The released-handle stability gate refuses to switch `rig` to `spec`, naming the unstable
+    /// axis (x) and the way around it.
+    fn assert_gate_refuses(rig: &mut Rig, spec: ControllerKind) {
         let e = rig
             .set_controller(spec)
             .expect_err("the gate refuses the switch");
@@ -1110,6 +1093,16 @@ mod tests {
             e.contains("axis x") && e.contains("--allow-unstable"),
             "{e}"
         );
+    }
+
+    /// The released-handle stability gate applies to a point device, linearised with the
+    /// Inverse3's gate dynamics: the spec's four-channel gains are refused, the default passes.
+    #[test]
+    fn display_controller_switch_on_a_point_device_passes_the_released_stability_gate() {
+        let (mut rig, _) = point_rig();
+        rig.enforce_released_stability();
+        let spec = ControllerKind::from_name("four-channel-spec").unwrap();
+        assert_gate_refuses(&mut rig, spec);
         rig.set_controller(ControllerKind::default()).unwrap();
     }
 
@@ -1135,13 +1128,7 @@ mod tests {
             verdict.is_err(),
             "premise: the spec gains are unstable released here"
         );
-        let e = rig
-            .set_controller(spec)
-            .expect_err("the gate refuses the switch");
-        assert!(
-            e.contains("axis x") && e.contains("--allow-unstable"),
-            "{e}"
-        );
+        assert_gate_refuses(&mut rig, spec);
         assert_eq!(rig.config.controller.name(), before, "refused: unchanged");
         // The default (stable released, by the analysis) is accepted.
         rig.set_controller(ControllerKind::default()).unwrap();

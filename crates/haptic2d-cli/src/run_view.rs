@@ -324,21 +324,28 @@ mod tests {
         haptic2d_test_support::wait_for(what, Duration::from_secs(10), cond);
     }
 
-    /// The loop's side of the display — polling commands, the haptic tick, capturing and publishing
-    /// frames for a connected viewer, recording timing — allocates nothing in steady state, with the
-    /// box held against the wall by the hand target (contacts and the device linkage in every
-    /// frame). Ticks are driven by hand here (simulated time), on this thread.
-    #[test]
-    fn loop_side_of_the_display_does_not_allocate_in_steady_state() {
+    /// A simulated rig and the display started for it on a free loopback port, with the built-in
+    /// `box-in-walls` scene loaded at 1 kHz.
+    fn start_on_box_in_walls() -> (Rig, ViewHandle, LiveView) {
         let scene = builtin("box-in-walls", Some(1000.0)).unwrap().unwrap();
         let loaded = LoadedScene {
             name: scene.name.clone(),
             description: scene.description.clone(),
             world: scene.world.clone(),
         };
-        let mut rig = crate::run_rig::test_rig::sim_rig();
-        let (server, mut view) =
+        let rig = crate::run_rig::test_rig::sim_rig();
+        let (server, view) =
             start("127.0.0.1:0".parse().unwrap(), &rig, loaded, 1000.0, false).unwrap();
+        (rig, server, view)
+    }
+
+    /// The loop's side of the display — polling commands, the haptic tick, capturing and publishing
+    /// frames for a connected viewer, recording timing — allocates nothing in steady state, with the
+    /// box held against the wall by the hand target (contacts and the device linkage in every
+    /// frame). Ticks are driven by hand here (simulated time), on this thread.
+    #[test]
+    fn loop_side_of_the_display_does_not_allocate_in_steady_state() {
+        let (mut rig, server, mut view) = start_on_box_in_walls();
         let addr = server.local_addr();
         let stream = std::net::TcpStream::connect(addr).unwrap();
         let (mut ws, _) = tungstenite::client(format!("ws://{addr}/ws"), stream).unwrap();
@@ -401,15 +408,7 @@ mod tests {
     /// scene and paused state are what they were; the page's own origin still commands it.
     #[test]
     fn cross_origin_page_cannot_change_the_running_loop() {
-        let scene = builtin("box-in-walls", Some(1000.0)).unwrap().unwrap();
-        let loaded = LoadedScene {
-            name: scene.name.clone(),
-            description: scene.description.clone(),
-            world: scene.world.clone(),
-        };
-        let mut rig = crate::run_rig::test_rig::sim_rig();
-        let (server, mut view) =
-            start("127.0.0.1:0".parse().unwrap(), &rig, loaded, 1000.0, false).unwrap();
+        let (mut rig, server, mut view) = start_on_box_in_walls();
         let addr = server.local_addr();
         let before = (
             rig.config.controller.name(),

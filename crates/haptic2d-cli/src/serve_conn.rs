@@ -148,17 +148,11 @@ impl<'a> Protocol<'a> {
             .iter()
             .position(|x| x.name == condition)
         else {
-            let names: Vec<&str> = self
-                .study
-                .conditions
-                .iter()
-                .map(|x| x.name.as_str())
-                .collect();
             return Some(error(
                 "present",
                 format!(
                     "unknown condition `{condition}`; the study's: {}",
-                    names.join(", ")
+                    self.condition_names().join(", ")
                 ),
             ));
         };
@@ -218,6 +212,12 @@ impl<'a> Protocol<'a> {
         }
     }
 
+    /// The names of the study's conditions, in file order.
+    fn condition_names(&self) -> Vec<&str> {
+        let c = &self.study.conditions;
+        c.iter().map(|c| c.name.as_str()).collect()
+    }
+
     /// The reply to `status` at loop time `t_s` (s).
     pub fn status(&self, t_s: f64) -> Value {
         let state = match &self.pending {
@@ -225,12 +225,7 @@ impl<'a> Protocol<'a> {
             Some(p) if p.started_s.is_none() => "waiting_for_free_space",
             Some(_) => "presenting",
         };
-        let conditions: Vec<&str> = self
-            .study
-            .conditions
-            .iter()
-            .map(|c| c.name.as_str())
-            .collect();
+        let conditions = self.condition_names();
         json!({
             "ok": true, "cmd": "status", "state": state, "study": self.study.name,
             "conditions": conditions, "device": self.device, "presented": self.done,

@@ -35,7 +35,7 @@ use haptic2d_lab::study::session::session_dir;
 use haptic2d_lab::study::{run as run_session, session_seed, stimulus, Study};
 use haptic2d_rt::clock::now_ns;
 use haptic2d_rt::signal::install_stop_signals;
-use haptic2d_rt::{run_loop, LoopConfig, TickControl, TickInfo, Watchdog};
+use haptic2d_rt::{run_loop, LoopConfig, TickControl, TickInfo, TimingSummary, Watchdog};
 use std::collections::HashMap;
 use std::net::SocketAddr;
 use std::path::{Path, PathBuf};
@@ -130,51 +130,80 @@ pub fn run(
         rest_next: false,
         early: None,
     };
-    let (session_result, timing) = std::thread::scope(|s| {
-        let handle = std::thread::Builder::new()
-            .name("haptic2d-rt".into())
-            .spawn_scoped(s, || {
-                let r = run_loop(&loop_config, &stop, |info| state.tick(&info));
-                ended.store(true, Ordering::SeqCst);
-                r
-            });
-        let handle = match handle {
-            Ok(h) => h,
-            Err(e) => {
-                return (
-                    Err(format!("cannot start the real-time loop thread: {e}")),
-                    None,
-                )
-            }
-        };
-        let mut progress = |done: u32, planned: u32| {
-            eprintln!("  trial {done} of at most {planned} answered");
-        };
-        let r = run_session(
-            &study,
-            &text,
-            out,
-            participant,
-            session,
-            &mut observer,
-            &mut progress,
-            stop_after,
-        );
-        // The session is over (complete, stopped or failed): end the loop.
-        stop.store(true, Ordering::SeqCst);
-        let timing = handle.join().ok();
-        (r, timing)
-    });
+    let beside = beside_the_loop(
+        &loop_config,
+        &stop,
+        &ended,
+        |i| state.tick(&i),
+        || {
+            let mut progress = |done: u32, planned: u32| {
+                eprintln!("  trial {done} of at most {planned} answered");
+            };
+            run_session(
+                &study,
+                &text,
+                out,
+                participant,
+                session,
+                &mut observer,
+                &mut progress,
+                stop_after,
+            )
+        },
+    );
+    let (session_result, timing) = beside.unwrap_or_else(|e| (Err(e), None));
     // Zero torques before anything else.
     state.rig.io.zero_torques();
     let end = state.end.take();
     drop(state);
     server.shutdown();
-    match trial_log.finish() {
-        Ok(r) => crate::outln!("{r}"),
-        Err(e) => crate::outln!("warning: {e}"),
+    report_trials_and_timing(
+        Some(trial_log),
+        timing.as_ref().and_then(|t| t.as_ref().ok()),
+    );
+    if let Some(trip) = rig.system.safety_trip() {
+        crate::outln!("{trip}");
     }
-    if let Some(Ok(t)) = &timing {
+    finish(end, observer.early, session_result)
+}
+
+/// Runs the study's loop (`tick` at each deadline of `config`) on its own thread, `ended` set when
+/// it ends, while `session` runs on this one; when the session is over (complete, stopped or
+/// failed), sets `stop` and joins the loop. Returns the session's result and the loop's timing
+/// (`None` if the loop's thread panicked), or why the loop's thread could not start.
+#[allow(clippy::type_complexity)]
+pub(crate) fn beside_the_loop<R>(
+    config: &LoopConfig,
+    stop: &AtomicBool,
+    ended: &AtomicBool,
+    tick: impl FnMut(TickInfo) -> TickControl + Send,
+    session: impl FnOnce() -> R,
+) -> Result<(R, Option<Result<TimingSummary, String>>), String> {
+    std::thread::scope(|s| {
+        let handle = std::thread::Builder::new()
+            .name("haptic2d-rt".into())
+            .spawn_scoped(s, || {
+                let r = run_loop(config, stop, tick);
+                ended.store(true, Ordering::SeqCst);
+                r
+            })
+            .map_err(|e| format!("cannot start the real-time loop thread: {e}"))?;
+        let r = session();
+        stop.store(true, Ordering::SeqCst);
+        Ok((r, handle.join().ok()))
+    })
+}
+
+/// Prints, once a study's loop has stopped, what its trial logger wrote (a failure as a warning:
+/// the answers are in `trials.tsv` all the same) and how many of the loop's deadlines it met.
+pub(crate) fn report_trials_and_timing(log: Option<TrialLogger>, timing: Option<&TimingSummary>) {
+    if let Some(l) = log {
+        match l.finish() {
+            Ok(r) => crate::outln!("{r}"),
+            Err(e) => crate::outln!("warning: {e}"),
+        }
+    }
+    if let Some(t) = timing {
         crate::outln!(
             "on time: {:.3} % of {} deadlines ({} overruns)",
             t.on_time_fraction * 100.0,
@@ -182,10 +211,6 @@ pub fn run(
             t.overruns
         );
     }
-    if let Some(trip) = rig.system.safety_trip() {
-        crate::outln!("{trip}");
-    }
-    finish(end, observer.early, session_result)
 }
 
 /// Checks the options that need no file: `--interval` and `--bind`.

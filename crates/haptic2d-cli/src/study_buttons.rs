@@ -83,21 +83,28 @@ mod tests {
         assert_eq!(choice_of(Task::ThreeAfc, 255), None);
     }
 
+    /// The answers of fresh [`ButtonAnswers`] of a 2AFC task to the ticks `(answer phase,
+    /// buttons)` in turn.
+    fn two_afc_answers(ticks: &[(bool, u8)]) -> Vec<Option<u8>> {
+        let mut b = ButtonAnswers::default();
+        ticks
+            .iter()
+            .map(|&(a, p)| b.tick(Task::TwoAfc, a, p))
+            .collect()
+    }
+
     #[test]
     fn a_button_held_through_the_interval_answers_only_after_a_release_and_a_new_press() {
-        let mut b = ButtonAnswers::default();
         // Held during the last interval and into the answer phase: no answer, however long.
-        assert_eq!(b.tick(Task::TwoAfc, false, 0b01), None);
-        for _ in 0..100 {
-            assert_eq!(b.tick(Task::TwoAfc, true, 0b01), None);
-        }
+        let mut ticks = vec![(false, 0b01)];
+        ticks.extend([(true, 0b01); 100]);
         // A second button pressed while the first is held: still not armed.
-        assert_eq!(b.tick(Task::TwoAfc, true, 0b11), None);
-        assert_eq!(b.tick(Task::TwoAfc, true, 0b10), None);
+        ticks.extend([(true, 0b11), (true, 0b10)]);
         // Released, then pressed: answers.
-        assert_eq!(b.tick(Task::TwoAfc, true, 0), None);
-        assert_eq!(b.tick(Task::TwoAfc, true, 0), None);
-        assert_eq!(b.tick(Task::TwoAfc, true, 0b10), Some(2));
+        ticks.extend([(true, 0), (true, 0), (true, 0b10)]);
+        let mut want = vec![None; ticks.len()];
+        *want.last_mut().unwrap() = Some(2);
+        assert_eq!(two_afc_answers(&ticks), want);
     }
 
     #[test]
@@ -114,11 +121,8 @@ mod tests {
         // Released through the interval, pressed exactly as the answer phase begins: the phase's
         // first tick arms on "all released" only, so this press (begun before the prompt could be
         // seen) needs a release first.
-        let mut b = ButtonAnswers::default();
-        assert_eq!(b.tick(Task::TwoAfc, false, 0), None);
-        assert_eq!(b.tick(Task::TwoAfc, true, 0b01), None);
-        assert_eq!(b.tick(Task::TwoAfc, true, 0), None);
-        assert_eq!(b.tick(Task::TwoAfc, true, 0b01), Some(1));
+        let ticks = [(false, 0), (true, 0b01), (true, 0), (true, 0b01)];
+        assert_eq!(two_afc_answers(&ticks), [None, None, None, Some(1)]);
     }
 
     #[test]
@@ -132,7 +136,7 @@ mod tests {
         assert_eq!(m.tick(Task::Magnitude, true, 0b1), None);
     }
 
-    /// The presenter with a device's buttons: trial `trial` of a 2-interval `task` presented with
+    /// The presenter with a device's buttons: trial 4 of a 2-interval `task` presented with
     /// `held` down throughout, up to its answer phase; returns the presenter, the world, the slave
     /// and the prompt's time (ns).
     fn to_answer(
@@ -144,20 +148,15 @@ mod tests {
         usize,
         u64,
     ) {
-        use crate::study_present::{Phase, Plan, Presenter};
+        use crate::study_present::Plan;
         use haptic2d::laws::friction::FrictionModel;
         use haptic2d::laws::normal::NormalModel;
-        let scene = haptic2d::scene::builtin("box-in-walls", Some(1000.0))
-            .unwrap()
-            .unwrap();
-        let mut w = scene.world;
-        let slave = w.body_index("box").unwrap();
+        let mut b = crate::study_present::tests::Bench::new(task, 0.005);
         let law = (
             NormalModel::from_name("paper", true).unwrap(),
             FrictionModel::default(),
         );
-        let mut p = Presenter::new(task, 0.005);
-        p.start(Plan {
+        b.p.start(Plan {
             trial: 4,
             done: 3,
             planned: 10,
@@ -165,17 +164,8 @@ mod tests {
             laws: [law; 3],
             rest: false,
         });
-        let mut t = 0;
-        while !matches!(p.phase(), Phase::Answer(_)) {
-            t += 1_000_000;
-            p.set_buttons(held);
-            assert_eq!(
-                p.tick(&mut w, slave, 1e-3, false, true, t, Default::default()),
-                None
-            );
-            assert!(t < 100_000_000, "the intervals end");
-        }
-        (p, w, slave, t)
+        let t = b.until_answer(0, held);
+        (b.p, b.w, b.slave, t)
     }
 
     /// End to end through the presenter: a button held through the last interval does not answer;

@@ -15,6 +15,7 @@
 
 use haptic2d::haptic::TickRecord;
 use haptic2d::world::World;
+use haptic2d_rt::drain_thread::DrainThread;
 use haptic2d_rt::mcap::{LoggedTick, McapSetup, McapSink, Metadata};
 use haptic2d_rt::telemetry::{ring_capacity, MAX_RING_BYTES};
 use haptic2d_rt::{telemetry_channel, RecordRx, TelemetryTx, TickInfo};
@@ -23,8 +24,6 @@ use std::fs::File;
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
-use std::thread::JoinHandle;
 use std::time::Duration;
 
 /// What the loop pushes to the trial logger.
@@ -148,8 +147,7 @@ pub struct TrialLogReport {
 
 /// The logger thread writing `trials/trial-NNNN.mcap`.
 pub struct TrialLogger {
-    stop: Arc<AtomicBool>,
-    thread: Option<JoinHandle<Result<TrialLogReport, String>>>,
+    thread: DrainThread<TrialLogReport>,
 }
 
 impl TrialLogger {
@@ -160,40 +158,16 @@ impl TrialLogger {
         dir: PathBuf,
         setup: McapSetup,
     ) -> Result<Self, String> {
-        let stop = Arc::new(AtomicBool::new(false));
-        let s = stop.clone();
-        let thread = std::thread::Builder::new()
-            .name("haptic2d-trials".into())
-            .spawn(move || Rotator::new(dir, setup).run(rx, &s))
-            .map_err(|e| format!("cannot start the trial logger thread: {e}"))?;
-        Ok(Self {
-            stop,
-            thread: Some(thread),
-        })
+        let thread = DrainThread::spawn("haptic2d-trials", "trial logger", move |stop| {
+            Rotator::new(dir, setup).run(rx, &stop)
+        })?;
+        Ok(Self { thread })
     }
 
     /// Drains the ring, finishes an open trial's file as interrupted, and reports. Call it after
     /// the loop stopped.
-    pub fn finish(mut self) -> Result<TrialLogReport, String> {
-        self.stop.store(true, Ordering::Release);
-        match self.thread.take() {
-            Some(t) => {
-                t.thread().unpark();
-                t.join()
-                    .map_err(|_| "the trial logger thread panicked".to_string())?
-            }
-            None => Err("the trial logger was already finished".into()),
-        }
-    }
-}
-
-impl Drop for TrialLogger {
-    fn drop(&mut self) {
-        self.stop.store(true, Ordering::Release);
-        if let Some(t) = self.thread.take() {
-            t.thread().unpark();
-            let _ = t.join();
-        }
+    pub fn finish(self) -> Result<TrialLogReport, String> {
+        self.thread.finish("trial logger")
     }
 }
 

@@ -340,9 +340,51 @@ impl Presenter {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use haptic2d::scene::builtin;
+
+    /// A presenter on the built-in `box-in-walls` world (1 kHz) and the world's slave, for the
+    /// presenter's tests and the buttons' ([`crate::study_buttons`]).
+    pub(crate) struct Bench {
+        /// The presenter.
+        pub p: Presenter,
+        /// Its world.
+        pub w: World,
+        /// The slave body's index.
+        pub slave: usize,
+    }
+
+    impl Bench {
+        /// A presenter of `task` whose intervals last `interval` s.
+        pub(crate) fn new(task: Task, interval: f64) -> Self {
+            let scene = builtin("box-in-walls", Some(1000.0)).unwrap().unwrap();
+            let w = scene.world;
+            let slave = w.body_index("box").unwrap();
+            Self {
+                p: Presenter::new(task, interval),
+                w,
+                slave,
+            }
+        }
+
+        /// One 1 ms tick at `now_ns`, unpaused, the page watching, with `inbox`.
+        pub(crate) fn tick(&mut self, now_ns: u64, inbox: StudyInbox) -> Option<Event> {
+            (self.p).tick(&mut self.w, self.slave, 1e-3, false, true, now_ns, inbox)
+        }
+
+        /// Ticks 1 ms apart from `t` ns on, `buttons` held and nothing from the page (no tick
+        /// may answer), until the answer phase, within 100 ms; returns its start (ns).
+        pub(crate) fn until_answer(&mut self, mut t: u64, buttons: u8) -> u64 {
+            while !matches!(self.p.phase(), Phase::Answer(_)) {
+                t += 1_000_000;
+                self.p.set_buttons(buttons);
+                assert_eq!(self.tick(t, StudyInbox::default()), None);
+                assert!(t < 100_000_000, "the intervals end");
+            }
+            t
+        }
+    }
 
     /// Two different stimuli: the paper's wall and Minsky's.
     pub(crate) fn two_laws() -> [(NormalModel, FrictionModel); MAX_INTERVALS] {
@@ -371,42 +413,39 @@ mod tests {
         }
     }
 
+    /// The page's "continue" to `trial` after a break.
+    fn inbox_cont(trial: u32) -> StudyInbox {
+        StudyInbox {
+            cont: Some(trial),
+            ..StudyInbox::default()
+        }
+    }
+
+    /// The page's magnitude `value` for `trial`.
+    fn inbox_magnitude(trial: u32, value: f64) -> StudyInbox {
+        StudyInbox {
+            magnitude: Some((trial, value)),
+            ..StudyInbox::default()
+        }
+    }
+
     #[test]
     fn answers_for_another_trial_or_outside_the_answer_phase_are_refused() {
-        let scene = builtin("box-in-walls", Some(1000.0)).unwrap().unwrap();
-        let mut w = scene.world;
-        let slave = w.body_index("box").unwrap();
-        let mut p = Presenter::new(Task::TwoAfc, 0.01);
-        assert!(p.start(plan(&w, 3)));
-        assert!(!p.start(plan(&w, 4)), "one trial at a time");
+        let mut b = Bench::new(Task::TwoAfc, 0.01);
+        assert!(b.p.start(plan(&b.w, 3)));
+        assert!(!b.p.start(plan(&b.w, 4)), "one trial at a time");
         // An answer while presenting is refused.
-        assert_eq!(p.tick(&mut w, slave, 1e-3, false, true, 0, ans(3, 1)), None);
-        assert_eq!(p.refused(), 1);
-        let mut t = 0;
-        while !matches!(p.phase(), Phase::Answer(_)) {
-            t += 1_000_000;
-            assert_eq!(
-                p.tick(&mut w, slave, 1e-3, false, true, t, StudyInbox::default()),
-                None
-            );
-            assert!(t < 100_000_000, "the intervals end");
-        }
+        assert_eq!(b.tick(0, ans(3, 1)), None);
+        assert_eq!(b.p.refused(), 1);
+        let t = b.until_answer(0, 0);
         let prompt = t;
         // Another trial, an impossible choice: refused, still waiting.
-        assert_eq!(p.tick(&mut w, slave, 1e-3, false, true, t, ans(2, 1)), None);
-        assert_eq!(p.tick(&mut w, slave, 1e-3, false, true, t, ans(3, 3)), None);
-        assert_eq!(p.tick(&mut w, slave, 1e-3, false, true, t, ans(3, 0)), None);
-        assert_eq!(p.refused(), 4);
-        assert!(matches!(p.phase(), Phase::Answer(_)));
-        let ev = p.tick(
-            &mut w,
-            slave,
-            1e-3,
-            false,
-            true,
-            prompt + 640_000_000,
-            ans(3, 2),
-        );
+        assert_eq!(b.tick(t, ans(2, 1)), None);
+        assert_eq!(b.tick(t, ans(3, 3)), None);
+        assert_eq!(b.tick(t, ans(3, 0)), None);
+        assert_eq!(b.p.refused(), 4);
+        assert!(matches!(b.p.phase(), Phase::Answer(_)));
+        let ev = b.tick(prompt + 640_000_000, ans(3, 2));
         assert_eq!(
             ev,
             Some(Event::Answered {
@@ -416,31 +455,37 @@ mod tests {
                 magnitude: None
             })
         );
-        assert_eq!(p.phase(), Phase::Idle);
+        assert_eq!(b.p.phase(), Phase::Idle);
         // A second click on the same answer: refused.
-        assert_eq!(p.tick(&mut w, slave, 1e-3, false, true, t, ans(3, 2)), None);
-        assert_eq!(p.refused(), 5);
-        assert_eq!(p.view().last_saved, 3);
-        assert_eq!(p.view().done, 3);
+        assert_eq!(b.tick(t, ans(3, 2)), None);
+        assert_eq!(b.p.refused(), 5);
+        assert_eq!(b.p.view().last_saved, 3);
+        assert_eq!(b.p.view().done, 3);
     }
 
     #[test]
     fn paused_ticks_do_not_count_toward_an_interval() {
-        let scene = builtin("box-in-walls", Some(1000.0)).unwrap().unwrap();
-        let mut w = scene.world;
-        let slave = w.body_index("box").unwrap();
-        let mut p = Presenter::new(Task::TwoAfc, 0.005);
-        p.start(plan(&w, 1));
-        p.tick(&mut w, slave, 1e-3, false, true, 0, StudyInbox::default());
-        assert_eq!(p.phase(), Phase::Presenting(0, 0.005));
+        let mut b = Bench::new(Task::TwoAfc, 0.005);
+        b.p.start(plan(&b.w, 1));
+        b.tick(0, StudyInbox::default());
+        assert_eq!(b.p.phase(), Phase::Presenting(0, 0.005));
         for _ in 0..100 {
-            p.tick(&mut w, slave, 1e-3, true, true, 0, StudyInbox::default());
+            let paused = true;
+            (b.p).tick(
+                &mut b.w,
+                b.slave,
+                1e-3,
+                paused,
+                true,
+                0,
+                StudyInbox::default(),
+            );
         }
-        assert_eq!(p.phase(), Phase::Presenting(0, 0.005));
+        assert_eq!(b.p.phase(), Phase::Presenting(0, 0.005));
         for _ in 0..5 {
-            p.tick(&mut w, slave, 1e-3, false, true, 0, StudyInbox::default());
+            b.tick(0, StudyInbox::default());
         }
-        assert_eq!(p.phase(), Phase::FreeSpace(1));
+        assert_eq!(b.p.phase(), Phase::FreeSpace(1));
     }
 
     #[test]
@@ -451,30 +496,17 @@ mod tests {
         assert!(valid_choice(Task::ThreeAfc, 3) && !valid_choice(Task::ThreeAfc, 0));
     }
 
-    fn inbox_cont(trial: u32) -> StudyInbox {
-        StudyInbox {
-            cont: Some(trial),
-            ..StudyInbox::default()
-        }
-    }
-
-    fn inbox_magnitude(trial: u32, value: f64) -> StudyInbox {
-        StudyInbox {
-            magnitude: Some((trial, value)),
-            ..StudyInbox::default()
-        }
-    }
-
     /// A trial with a rest break before it: the loop holds (`on_break`, no law installed, no
     /// trial log opened) until the page continues this trial, with a page connected; a continue for
     /// another trial, or a second one, is refused and changes nothing.
     #[test]
     fn a_break_holds_the_trial_until_the_page_continues_it() {
-        let scene = builtin("box-in-walls", Some(1000.0)).unwrap().unwrap();
-        let mut w = scene.world;
-        let slave = w.body_index("box").unwrap();
+        let Bench {
+            mut p,
+            mut w,
+            slave,
+        } = Bench::new(Task::TwoAfc, 0.005);
         let before = w.normal;
-        let mut p = Presenter::new(Task::TwoAfc, 0.005);
         assert!(p.start(Plan {
             rest: true,
             ..plan(&w, 5)
@@ -515,18 +547,10 @@ mod tests {
     /// is 0, as the simulated path's) and refuses interval choices and bad numbers.
     #[test]
     fn magnitude_takes_a_positive_number_for_its_trial_and_refuses_choices() {
-        let scene = builtin("box-in-walls", Some(1000.0)).unwrap().unwrap();
-        let mut w = scene.world;
-        let slave = w.body_index("box").unwrap();
-        let mut p = Presenter::new(Task::Magnitude, 0.005);
-        assert_eq!(p.view().task, "magnitude");
-        p.start(plan(&w, 2));
-        let mut t = 0;
-        while !matches!(p.phase(), Phase::Answer(_)) {
-            t += 1_000_000;
-            p.tick(&mut w, slave, 1e-3, false, true, t, StudyInbox::default());
-            assert!(t < 100_000_000, "the intervals end");
-        }
+        let mut b = Bench::new(Task::Magnitude, 0.005);
+        assert_eq!(b.p.view().task, "magnitude");
+        b.p.start(plan(&b.w, 2));
+        let t = b.until_answer(0, 0);
         for bad in [
             ans(2, 1),
             inbox_magnitude(1, 50.0),
@@ -535,18 +559,10 @@ mod tests {
             inbox_magnitude(2, f64::NAN),
             inbox_magnitude(2, f64::INFINITY),
         ] {
-            assert_eq!(p.tick(&mut w, slave, 1e-3, false, true, t, bad), None);
+            assert_eq!(b.tick(t, bad), None);
         }
-        assert_eq!(p.refused(), 6);
-        let ev = p.tick(
-            &mut w,
-            slave,
-            1e-3,
-            false,
-            true,
-            t + 2_000_000_000,
-            inbox_magnitude(2, 137.5),
-        );
+        assert_eq!(b.p.refused(), 6);
+        let ev = b.tick(t + 2_000_000_000, inbox_magnitude(2, 137.5));
         assert_eq!(
             ev,
             Some(Event::Answered {
@@ -557,15 +573,10 @@ mod tests {
             })
         );
         // A magnitude in a 2AFC study is refused.
-        let mut q = Presenter::new(Task::TwoAfc, 0.005);
-        q.start(plan(&w, 1));
-        while !matches!(q.phase(), Phase::Answer(_)) {
-            q.tick(&mut w, slave, 1e-3, false, true, 0, StudyInbox::default());
-        }
-        assert_eq!(
-            q.tick(&mut w, slave, 1e-3, false, true, 0, inbox_magnitude(1, 5.0)),
-            None
-        );
-        assert_eq!(q.refused(), 1);
+        let mut q = Bench::new(Task::TwoAfc, 0.005);
+        q.p.start(plan(&q.w, 1));
+        let t = q.until_answer(0, 0);
+        assert_eq!(q.tick(t, inbox_magnitude(1, 5.0)), None);
+        assert_eq!(q.p.refused(), 1);
     }
 }

@@ -25,7 +25,7 @@ use crate::study_browser::{self, BrowserOptions};
 use crate::study_mcap::{self, TrialLogger, TrialTap};
 use haptic2d_lab::study::Study;
 use haptic2d_rt::signal::install_stop_signals;
-use haptic2d_rt::{run_loop, TickControl, TickInfo, Watchdog};
+use haptic2d_rt::{TickControl, TickInfo, Watchdog};
 use haptic2d_view::ViewHandle;
 use serde_json::Value;
 use std::io::{ErrorKind, Read, Write};
@@ -188,21 +188,11 @@ pub fn run(file: &Path, o: &ServeOptions) -> Result<Status, Failure> {
         client: None,
         reports: from_rx,
     };
-    let (client_stop, timing) = std::thread::scope(|s| {
-        let handle = std::thread::Builder::new()
-            .name("haptic2d-rt".into())
-            .spawn_scoped(s, || {
-                let r = run_loop(&loop_config, &stop, |info| state.tick(&info));
-                ended.store(true, Ordering::SeqCst);
-                r
-            });
-        let Ok(handle) = handle else {
-            return (false, None);
-        };
-        let client_stop = link.serve(&mut proto, &ended, &stop, &t_bits);
-        stop.store(true, Ordering::SeqCst);
-        (client_stop, handle.join().ok())
-    });
+    let serve = || link.serve(&mut proto, &ended, &stop, &t_bits);
+    let beside =
+        study_browser::beside_the_loop(&loop_config, &stop, &ended, |i| state.tick(&i), serve);
+    // A loop that could not start serves nobody: the session ends as if interrupted.
+    let (client_stop, timing) = beside.unwrap_or((false, None));
     // Zero torques before anything else.
     state.rig.io.zero_torques();
     let (end, page_stop) = (state.end.take(), state.page_stop);
@@ -226,20 +216,7 @@ pub fn run(file: &Path, o: &ServeOptions) -> Result<Status, Failure> {
     };
     let reason = format!("{why}; torques were set to zero");
     link.farewell(&mut proto, &reason, status == Status::Clean && client_stop);
-    if let Some(l) = logger {
-        match l.finish() {
-            Ok(r) => crate::outln!("{r}"),
-            Err(e) => crate::outln!("warning: {e}"),
-        }
-    }
-    if let Some(Ok(t)) = &timing {
-        crate::outln!(
-            "on time: {:.3} % of {} deadlines ({} overruns)",
-            t.on_time_fraction * 100.0,
-            t.deadlines,
-            t.overruns
-        );
-    }
+    study_browser::report_trials_and_timing(logger, timing.as_ref().and_then(|t| t.as_ref().ok()));
     crate::outln!("stopped: {reason}");
     Ok(status)
 }

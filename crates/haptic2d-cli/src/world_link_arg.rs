@@ -5,8 +5,8 @@
 use std::path::PathBuf;
 
 use haptic2d_devices::udp::UdpKey;
-use haptic2d_devices::world_link::{LinkEndpoint, PORT_LEN};
-use haptic2d_lab::network::wave::WaveParams;
+use haptic2d_devices::world_link::{LinkCounters, LinkEndpoint, PortMessage, PORT_LEN};
+use haptic2d_lab::network::wave::{WaveBudget, WaveMsg, WaveParams};
 use haptic2d_lab::network::{Impairment, Link};
 
 /// The default wave impedances (N·s/m, N·s/m, N·m·s/rad): the lab's 20 N·s/m
@@ -167,6 +167,21 @@ pub struct Outbox {
 }
 
 impl Outbox {
+    /// Seals `msg` as a port message of `kind` in `ep`'s session into `buf`, then sends it at
+    /// deadline `k` ([`send`](Self::send)).
+    #[inline]
+    pub fn seal_and_send(
+        &mut self,
+        ep: &mut LinkEndpoint,
+        msg: &PortMessage,
+        kind: u8,
+        k: u64,
+        buf: &mut [u8; PORT_LEN],
+    ) {
+        msg.seal(ep.key(), kind, ep.session(), buf);
+        self.send(ep, k, buf);
+    }
+
     /// Sends `datagram` at deadline `k` (through the impairment, if any).
     #[inline]
     pub fn send(&mut self, ep: &mut LinkEndpoint, k: u64, datagram: &[u8; PORT_LEN]) {
@@ -270,4 +285,72 @@ pub fn energies(totals: (f64, f64, f64)) -> String {
         "energy in {:.6} J, out {:.6} J, dissipated by TDPA {:.6} J",
         totals.0, totals.1, totals.2
     )
+}
+
+/// The wave energies of one end of the link over a run (J), for its closing report.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WaveTotals {
+    /// Put on the link by this end's waves, summed over the axes.
+    pub sent: f64,
+    /// Put on the link by the other end's waves, as its last message received said.
+    pub got: f64,
+    /// Used by this end's energy budgets.
+    pub used: f64,
+    /// Cut by this end's energy budgets.
+    pub cut: f64,
+}
+
+/// The [`WaveTotals`] of an end whose axes' budgets are `budgets`, whose last outgoing waves are
+/// `wave_out` and whose last message received is `last`.
+pub fn wave_totals(
+    budgets: impl Iterator<Item = WaveBudget>,
+    wave_out: &[WaveMsg; 3],
+    last: Option<&PortMessage>,
+) -> WaveTotals {
+    let (used, cut) = budgets.fold((0.0, 0.0), |(u, c), b| (u + b.used(), c + b.cut()));
+    WaveTotals {
+        sent: wave_out.iter().map(|o| o.energy).sum(),
+        got: last.map_or(0.0, |m| m.wave_energy.iter().sum::<f64>()),
+        used,
+        cut,
+    }
+}
+
+/// How one end of the link words its closing report: the other end, and its waves.
+#[derive(Clone, Copy, Debug)]
+pub struct EndWording {
+    /// The other end, as in "the world side is an older build": `world` or `device`.
+    pub peer: &'static str,
+    /// The other end's waves, as in "returning waves: the world sent 0.1 J".
+    pub peer_waves: &'static str,
+    /// Added after the energy the budgets used (the world side's includes the drift compensation).
+    pub used_note: &'static str,
+}
+
+/// The link lines of one end's closing report: the waves' energies (`waves`, with wave variables),
+/// a warning if authentic messages of the older message version 1 were refused, then the link's
+/// counters `c` (`dropped`: by the test impairment in front of the socket) followed by `tail`.
+pub fn report_link(
+    end: &EndWording,
+    waves: Option<WaveTotals>,
+    c: &LinkCounters,
+    dropped: u64,
+    tail: std::fmt::Arguments,
+) {
+    if let Some(w) = waves {
+        crate::outln!(
+            "waves: sent {:.6} J; {} sent {:.6} J (as last received), used {:.6} J{}, {:.6} J cut by the budget",
+            w.sent, end.peer_waves, w.got, w.used, end.used_note, w.cut
+        );
+    }
+    if c.old_version > 0 {
+        crate::outln!(
+            "link: {} authentic port messages of the older world-link message version 1 refused: the {} side is an older build (update both ends)",
+            c.old_version, end.peer
+        );
+    }
+    crate::outln!(
+        "link: {} received, {} stale, {} bad MAC, {} wrong session, {} malformed, {} send errors, {} dropped by the test impairment; {tail}",
+        c.received, c.stale, c.bad_mac, c.wrong_session, c.malformed, c.send_errors, dropped
+    );
 }

@@ -30,3 +30,72 @@ pub fn parse<T: DeserializeOwned>(
         )],
     })
 }
+
+/// Reads the device file at `path` ([`read`]: `kind` and `template` name what was expected in the
+/// fix of an error) and parses its text with `parse(text, source)`; a parse error becomes its
+/// message.
+pub fn load<T>(
+    path: &Path,
+    kind: &str,
+    template: &str,
+    parse: impl FnOnce(&str, &str) -> Result<T, SceneErrors>,
+) -> Result<T, String> {
+    let (text, source) = read(path, kind, template)?;
+    parse(&text, &source).map_err(|e| e.to_string())
+}
+
+/// The parsed file `value` when no check failed (`errs` empty), else every error, the file named
+/// by `source`.
+pub fn checked<T>(source: &str, errs: Vec<SceneError>, value: Option<T>) -> Result<T, SceneErrors> {
+    match value {
+        Some(v) if errs.is_empty() => Ok(v),
+        _ => Err(SceneErrors {
+            source: source.to_string(),
+            errors: errs,
+        }),
+    }
+}
+
+/// Checks `TABLE.timeout_periods` (`field`): no state for this many control periods means the
+/// device is lost, so it must be a finite number ≥ 1; `default` is the file kind's default, named
+/// in the fix.
+pub fn check_timeout(field: &str, periods: f64, default: u32, errs: &mut Vec<SceneError>) {
+    if !(periods.is_finite() && periods >= 1.0) {
+        errs.push(SceneError::new(
+            field,
+            format!("{periods} periods is not a timeout"),
+            format!("give a number of control periods ≥ 1 (default {default})"),
+        ));
+    }
+}
+
+/// Checks the watchdog limits of the device file's table `table` (`protocol`, `service`):
+/// `max_missed_deadlines` a count (0 turns the check off) that fits a `u32`, `max_stall_periods` a
+/// finite number of periods ≥ 1.
+pub fn check_watchdog(
+    table: &str,
+    max_missed_deadlines: i64,
+    max_stall_periods: f64,
+    errs: &mut Vec<SceneError>,
+) {
+    if max_missed_deadlines < 0 || max_missed_deadlines > u32::MAX as i64 {
+        errs.push(SceneError::new(
+            format!("{table}.max_missed_deadlines"),
+            format!("{max_missed_deadlines} is not a count"),
+            "give a number of consecutive deadlines ≥ 0 (0 turns the check off)",
+        ));
+    }
+    if !(max_stall_periods.is_finite() && max_stall_periods >= 1.0) {
+        errs.push(SceneError::new(
+            format!("{table}.max_stall_periods"),
+            format!("{max_stall_periods} periods is not a stall limit"),
+            "give the loop's longest delay between two ticks in periods, ≥ 1 (default 5)",
+        ));
+    }
+}
+
+/// The watchdog's limit of consecutive missed deadlines from a checked file value: `None` (off)
+/// for 0 (or a value out of `u32` range, which the checks have already refused).
+pub fn missed_deadline_limit(max_missed_deadlines: i64) -> Option<u32> {
+    u32::try_from(max_missed_deadlines).ok().filter(|n| *n > 0)
+}

@@ -10,7 +10,7 @@
 //!   [`TimingSummary`] printed at exit;
 //! - [`telemetry`]: wait-free ring (every record) and triple buffer (latest
 //!   record) from the RT thread to other threads;
-//! - [`logger`]: the CSV logger thread draining the ring;
+//! - [`logger`]: the CSV logger thread draining the ring (its handle a [`drain_thread`]);
 //! - [`io`]: the [`DeviceIo`] trait the loop drives, and [`ReplayDevice`];
 //! - [`watchdog`]: the latching safety watchdog that zeroes torques;
 //! - [`signal`]: Ctrl-C to a stop flag;
@@ -20,6 +20,7 @@
 #![warn(missing_docs)]
 
 pub mod clock;
+pub mod drain_thread;
 pub mod histogram;
 pub mod io;
 pub mod logger;

@@ -8,11 +8,11 @@
 //! records were written and how many the RT thread had to drop because the
 //! ring was full. Nothing that reached the ring is lost.
 
+use crate::drain_thread::DrainThread;
 use crate::telemetry::RecordRx;
 use std::io::Write;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
-use std::thread::JoinHandle;
 use std::time::Duration;
 
 /// A record type the CSV logger can write.
@@ -71,10 +71,10 @@ impl std::fmt::Display for LogReport {
     }
 }
 
-/// Handle of a running CSV logger thread.
+/// Handle of a running CSV logger thread. A logger dropped without [`finish`](CsvLogger::finish)
+/// still drains and flushes (errors are then lost).
 pub struct CsvLogger {
-    stop: Arc<AtomicBool>,
-    thread: Option<JoinHandle<Result<LogReport, String>>>,
+    thread: DrainThread<LogReport>,
 }
 
 impl CsvLogger {
@@ -87,17 +87,11 @@ impl CsvLogger {
         label: &str,
         config: LoggerConfig,
     ) -> Result<Self, String> {
-        let stop = Arc::new(AtomicBool::new(false));
-        let stop_thread = stop.clone();
         let label = label.to_string();
-        let thread = std::thread::Builder::new()
-            .name("haptic2d-logger".into())
-            .spawn(move || logger_thread(rx, out, label, config, stop_thread))
-            .map_err(|e| format!("cannot start the logger thread: {e}"))?;
-        Ok(Self {
-            stop,
-            thread: Some(thread),
-        })
+        let thread = DrainThread::spawn("haptic2d-logger", "logger", move |stop| {
+            logger_thread(rx, out, label, config, stop)
+        })?;
+        Ok(Self { thread })
     }
 
     /// Creates (truncates) the file at `path` and starts a logger writing to
@@ -116,28 +110,8 @@ impl CsvLogger {
     /// Stops the logger after it has written every record still in the ring,
     /// flushes the output, and reports. Call it after the producer has
     /// stopped publishing (records published later may not be written).
-    pub fn finish(mut self) -> Result<LogReport, String> {
-        self.stop.store(true, Ordering::Release);
-        match self.thread.take() {
-            Some(t) => {
-                t.thread().unpark();
-                t.join()
-                    .map_err(|_| "the logger thread panicked".to_string())?
-            }
-            None => Err("the logger was already finished".into()),
-        }
-    }
-}
-
-impl Drop for CsvLogger {
-    /// A logger dropped without [`finish`](CsvLogger::finish) still drains and
-    /// flushes (errors are then lost).
-    fn drop(&mut self) {
-        self.stop.store(true, Ordering::Release);
-        if let Some(t) = self.thread.take() {
-            t.thread().unpark();
-            let _ = t.join();
-        }
+    pub fn finish(self) -> Result<LogReport, String> {
+        self.thread.finish("logger")
     }
 }
 

@@ -353,78 +353,67 @@ mod tests {
             Ok(ClientMessage::Command(c)) => c,
             other => panic!("{s}: {other:?}"),
         };
-        assert_eq!(
-            ok(r#"{"type":"set_hand_target","x":0.01,"y":-0.02,"theta":0.5}"#),
-            Command::SetHandTarget {
-                x: 0.01,
-                y: -0.02,
-                theta: 0.5
-            }
-        );
-        assert_eq!(
-            ok(r#"{"type":"switch_scene","name":"peg-in-hole"}"#),
-            Command::SwitchScene {
-                name: "peg-in-hole"
-            }
-        );
-        assert_eq!(
-            ok(r#"{"type":"set_wall_law","name":"seh-pc"}"#),
-            Command::SetWallLaw { name: "seh-pc" }
-        );
-        assert_eq!(
-            ok(r#"{"type":"set_friction","name":"dahl"}"#),
-            Command::SetFriction { name: "dahl" }
-        );
-        assert_eq!(
-            ok(r#"{"type":"set_impact_friction","name":"coulomb"}"#),
-            Command::SetImpactFriction { name: "coulomb" }
-        );
-        assert_eq!(
-            ok(r#"{"type":"set_controller","name":"coupling"}"#),
-            Command::SetController {
-                kind: ControllerKind::Coupling
-            }
-        );
+        let answer = |trial, choice| Command::Answer { trial, choice };
+        let magnitude = |trial, value| Command::Magnitude { trial, value };
+        let table = [
+            (
+                r#"{"type":"set_hand_target","x":0.01,"y":-0.02,"theta":0.5}"#,
+                Command::SetHandTarget {
+                    x: 0.01,
+                    y: -0.02,
+                    theta: 0.5,
+                },
+            ),
+            (
+                r#"{"type":"switch_scene","name":"peg-in-hole"}"#,
+                Command::SwitchScene {
+                    name: "peg-in-hole",
+                },
+            ),
+            (
+                r#"{"type":"set_wall_law","name":"seh-pc"}"#,
+                Command::SetWallLaw { name: "seh-pc" },
+            ),
+            (
+                r#"{"type":"set_friction","name":"dahl"}"#,
+                Command::SetFriction { name: "dahl" },
+            ),
+            (
+                r#"{"type":"set_impact_friction","name":"coulomb"}"#,
+                Command::SetImpactFriction { name: "coulomb" },
+            ),
+            (
+                r#"{"type":"set_controller","name":"coupling"}"#,
+                Command::SetController {
+                    kind: ControllerKind::Coupling,
+                },
+            ),
+            (r#"{"type":"pause"}"#, Command::Pause),
+            (r#"{"type":"resume"}"#, Command::Resume),
+            (r#"{"type":"reset"}"#, Command::Reset),
+            (r#"{"type":"answer","trial":7,"choice":2}"#, answer(7, 2)),
+            (r#"{"type":"answer","trial":1,"choice":0}"#, answer(1, 0)),
+            (r#"{"type":"stop_study"}"#, Command::StopStudy),
+            (
+                r#"{"type":"magnitude","trial":4,"value":125.5}"#,
+                magnitude(4, 125.5),
+            ),
+            (
+                r#"{"type":"magnitude","trial":4,"value":3}"#,
+                magnitude(4, 3.0),
+            ),
+            (
+                r#"{"type":"continue_study","trial":9}"#,
+                Command::ContinueStudy { trial: 9 },
+            ),
+        ];
+        for (msg, cmd) in table {
+            assert_eq!(ok(msg), cmd, "{msg}");
+        }
         for kind in ControllerKind::ALL {
             let msg = format!(r#"{{"type":"set_controller","name":"{}"}}"#, kind.name());
             assert_eq!(ok(&msg), Command::SetController { kind });
         }
-        assert_eq!(ok(r#"{"type":"pause"}"#), Command::Pause);
-        assert_eq!(ok(r#"{"type":"resume"}"#), Command::Resume);
-        assert_eq!(ok(r#"{"type":"reset"}"#), Command::Reset);
-        assert_eq!(
-            ok(r#"{"type":"answer","trial":7,"choice":2}"#),
-            Command::Answer {
-                trial: 7,
-                choice: 2
-            }
-        );
-        assert_eq!(
-            ok(r#"{"type":"answer","trial":1,"choice":0}"#),
-            Command::Answer {
-                trial: 1,
-                choice: 0
-            }
-        );
-        assert_eq!(ok(r#"{"type":"stop_study"}"#), Command::StopStudy);
-        assert_eq!(
-            ok(r#"{"type":"magnitude","trial":4,"value":125.5}"#),
-            Command::Magnitude {
-                trial: 4,
-                value: 125.5
-            }
-        );
-        assert_eq!(
-            ok(r#"{"type":"magnitude","trial":4,"value":3}"#),
-            Command::Magnitude {
-                trial: 4,
-                value: 3.0
-            }
-        );
-        assert_eq!(
-            ok(r#"{"type":"continue_study","trial":9}"#),
-            Command::ContinueStudy { trial: 9 }
-        );
         assert_eq!(
             parse_client_message(r#"{"type":"hello","token":"abc"}"#),
             Ok(ClientMessage::Hello {

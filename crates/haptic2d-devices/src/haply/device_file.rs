@@ -44,6 +44,7 @@ use super::buttons::{ButtonSpec, RawButton};
 use super::codec::{BoardSetup, Rotation, FIRMWARE_TORQUE_LIMIT, PORTS};
 use super::identified::{Identified, RawIdentified};
 use crate::device_safety::{DeviceSafety, RawSafety};
+use crate::device_toml;
 
 /// Which device a file describes.
 #[derive(Clone, Debug, PartialEq)]
@@ -256,17 +257,12 @@ fn usb_ids(raw: &[String], errs: &mut Vec<SceneError>) -> Vec<(u16, u16)> {
 impl HaplyDeviceFile {
     /// Reads and parses the file at `path`.
     pub fn from_path(path: &std::path::Path) -> Result<Self, String> {
-        let (text, source) = crate::device_toml::read(path, "a Haply device file", HAPLY_TEMPLATE)?;
-        Self::from_toml(&text, &source).map_err(|e| e.to_string())
+        device_toml::load(path, "a Haply device file", HAPLY_TEMPLATE, Self::from_toml)
     }
 
     /// Parses a device file's text; `source` names it in messages.
     pub fn from_toml(text: &str, source: &str) -> Result<Self, SceneErrors> {
-        let fail = |errors| SceneErrors {
-            source: source.to_string(),
-            errors,
-        };
-        let raw: RawFile = crate::device_toml::parse(text, source, HAPLY_TEMPLATE)?;
+        let raw: RawFile = device_toml::parse(text, source, HAPLY_TEMPLATE)?;
         let mut errs = Vec::new();
         let b = &raw.board;
         if !(0..=255).contains(&b.id) {
@@ -466,27 +462,23 @@ impl HaplyDeviceFile {
                 None
             }
         };
-        match kind {
-            Some(kind) if errs.is_empty() => Ok(Self {
-                name: raw.name.unwrap_or_else(|| raw.kind.clone()),
-                source: source.to_string(),
-                id: b.id as u8,
-                usb_ids,
-                torque_limit: b.torque_limit,
-                timeout_periods: b.timeout_periods,
-                max_missed_deadlines: u32::try_from(b.max_missed_deadlines)
-                    .ok()
-                    .filter(|n| *n > 0),
-                max_stall_periods: b.max_stall_periods,
-                watchdog_ms: b.watchdog_ms.clamp(1, 1000) as u16,
-                motors,
-                kind,
-                safety,
-                identified,
-                buttons,
-            }),
-            _ => Err(fail(errs)),
-        }
+        let file = kind.map(|kind| Self {
+            name: raw.name.unwrap_or_else(|| raw.kind.clone()),
+            source: source.to_string(),
+            id: b.id as u8,
+            usb_ids,
+            torque_limit: b.torque_limit,
+            timeout_periods: b.timeout_periods,
+            max_missed_deadlines: device_toml::missed_deadline_limit(b.max_missed_deadlines),
+            max_stall_periods: b.max_stall_periods,
+            watchdog_ms: b.watchdog_ms.clamp(1, 1000) as u16,
+            motors,
+            kind,
+            safety,
+            identified,
+            buttons,
+        });
+        device_toml::checked(source, errs, file)
     }
 
     /// The board set-up this file asks for: motors and encoders on the motor ports, the buttons'

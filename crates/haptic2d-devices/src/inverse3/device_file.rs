@@ -22,6 +22,7 @@
 //! half_width = 0.15             # m
 //! ```
 
+use crate::device_toml;
 use haptic2d::scene::{SceneError, SceneErrors};
 use serde::Deserialize;
 
@@ -174,24 +175,20 @@ impl Inverse3DeviceFile {
 
     /// Reads and parses the file at `path`.
     pub fn from_path(path: &std::path::Path) -> Result<Self, String> {
-        let (text, source) =
-            crate::device_toml::read(path, "an Inverse3 device file", INVERSE3_TEMPLATE)?;
-        Self::from_toml(&text, &source).map_err(|e| e.to_string())
+        let kind = "an Inverse3 device file";
+        device_toml::load(path, kind, INVERSE3_TEMPLATE, Self::from_toml)
     }
 
     /// Parses a device file's text; `source` names it in messages.
     pub fn from_toml(text: &str, source: &str) -> Result<Self, SceneErrors> {
-        let fail = |errors| SceneErrors {
-            source: source.to_string(),
-            errors,
-        };
-        let raw: RawFile = crate::device_toml::parse(text, source, INVERSE3_TEMPLATE)?;
+        let raw: RawFile = device_toml::parse(text, source, INVERSE3_TEMPLATE)?;
         let mut errs = Vec::new();
-        let mut bad = |field: &str, msg: String, fix: &str| {
+        let bad = |errs: &mut Vec<SceneError>, field: &str, msg: String, fix: &str| {
             errs.push(SceneError::new(field, msg, fix));
         };
         if raw.kind != "inverse3" {
             bad(
+                &mut errs,
                 "kind",
                 format!("`{}` is not an Inverse3 device file", raw.kind),
                 "write kind = \"inverse3\" (Haply boards: --device haply:PATH; UDP devices: --device udp:ADDR:PORT)",
@@ -200,6 +197,7 @@ impl Inverse3DeviceFile {
         let s = &raw.service;
         if !s.http_url.starts_with("http://") {
             bad(
+                &mut errs,
                 "service.http_url",
                 format!("`{}` is not an http:// address", s.http_url),
                 "give the Inverse Service's HTTP base, e.g. \"http://localhost:10001\"",
@@ -207,38 +205,22 @@ impl Inverse3DeviceFile {
         }
         if !s.ws_url.starts_with("ws://") {
             bad(
+                &mut errs,
                 "service.ws_url",
                 format!("`{}` is not a ws:// address", s.ws_url),
                 "give the Inverse Service's WebSocket, e.g. \"ws://localhost:10001/\"",
             );
         }
-        if !(s.timeout_periods.is_finite() && s.timeout_periods >= 1.0) {
-            bad(
-                "service.timeout_periods",
-                format!("{} periods is not a timeout", s.timeout_periods),
-                "give a number of control periods ≥ 1 (default 20)",
-            );
-        }
-        if s.max_missed_deadlines < 0 || s.max_missed_deadlines > u32::MAX as i64 {
-            bad(
-                "service.max_missed_deadlines",
-                format!("{} is not a count", s.max_missed_deadlines),
-                "give a number of consecutive deadlines ≥ 0 (0 turns the check off)",
-            );
-        }
-        if !(s.max_stall_periods.is_finite() && s.max_stall_periods >= 1.0) {
-            bad(
-                "service.max_stall_periods",
-                format!("{} periods is not a stall limit", s.max_stall_periods),
-                "give the loop's longest delay between two ticks in periods, ≥ 1 (default 5)",
-            );
-        }
+        device_toml::check_timeout("service.timeout_periods", s.timeout_periods, 20, &mut errs);
+        let (missed, stall) = (s.max_missed_deadlines, s.max_stall_periods);
+        device_toml::check_watchdog("service", missed, stall, &mut errs);
         let p = &raw.plane;
         let axes: Vec<Option<SignedAxis>> = p.axes.iter().map(|a| parse_axis(a)).collect();
         let mut mapped = None;
         match axes.as_slice() {
             [Some(a), Some(b)] if a.index != b.index => mapped = Some([*a, *b]),
             _ => bad(
+                &mut errs,
                 "plane.axes",
                 format!("{:?} is not two different device axes", p.axes),
                 "give the device axes of world x and y, e.g. [\"x\", \"y\"] or [\"x\", \"-z\"] (x, y, z; a leading - flips)",
@@ -250,6 +232,7 @@ impl Inverse3DeviceFile {
         ] {
             if !(v.is_finite() && v >= 0.0) {
                 bad(
+                    &mut errs,
                     field,
                     format!("{v} {unit} is not ≥ 0"),
                     "give a finite value ≥ 0 (the virtual plane holding the third axis)",
@@ -258,6 +241,7 @@ impl Inverse3DeviceFile {
         }
         if !p.position.is_finite() {
             bad(
+                &mut errs,
                 "plane.position",
                 format!("{} m is not a position", p.position),
                 "give where the held axis is held, in metres (device frame)",
@@ -269,6 +253,7 @@ impl Inverse3DeviceFile {
             && l.force_limit <= INVERSE3_FORCE_MAX)
         {
             bad(
+                &mut errs,
                 "limits.force_limit",
                 format!("{} N is outside (0, {INVERSE3_FORCE_MAX}] N", l.force_limit),
                 "give the largest force magnitude to send, in newtons, at most the device's",
@@ -276,6 +261,7 @@ impl Inverse3DeviceFile {
         }
         if !(l.ramp_time.is_finite() && l.ramp_time >= 0.0) {
             bad(
+                &mut errs,
                 "limits.ramp_time",
                 format!("{} s is not a ramp time", l.ramp_time),
                 "give a time ≥ 0 s (default 0.5)",
@@ -284,6 +270,7 @@ impl Inverse3DeviceFile {
         let w = &raw.workspace;
         if !w.center.iter().all(|c| c.is_finite()) {
             bad(
+                &mut errs,
                 "workspace.center",
                 format!("{:?} m is not a point", w.center),
                 "give [x, y] in metres, plane coordinates",
@@ -291,36 +278,33 @@ impl Inverse3DeviceFile {
         }
         if !(w.half_width.is_finite() && w.half_width > 0.0 && w.half_width <= MAX_HALF_WIDTH) {
             bad(
+                &mut errs,
                 "workspace.half_width",
                 format!("{} m is outside (0, {MAX_HALF_WIDTH}] m", w.half_width),
                 "give half the side of the usable square in metres",
             );
         }
         let safety = crate::device_safety::RawSafety::check(raw.safety.as_ref(), &mut errs);
-        match mapped {
-            Some(axes) if errs.is_empty() => Ok(Self {
-                name: raw.name.unwrap_or_else(|| "Haply Inverse3".into()),
-                source: source.to_string(),
-                http_url: s.http_url.clone(),
-                ws_url: s.ws_url.clone(),
-                timeout_periods: s.timeout_periods,
-                max_missed_deadlines: u32::try_from(s.max_missed_deadlines)
-                    .ok()
-                    .filter(|n| *n > 0),
-                max_stall_periods: s.max_stall_periods,
-                held_axis: 3 - axes[0].index - axes[1].index,
-                axes,
-                plane_position: p.position,
-                plane_stiffness: p.stiffness,
-                plane_damping: p.damping,
-                force_limit: l.force_limit,
-                ramp_time: l.ramp_time,
-                center: w.center,
-                half_width: w.half_width,
-                safety,
-            }),
-            _ => Err(fail(errs)),
-        }
+        let file = mapped.map(|axes| Self {
+            name: raw.name.unwrap_or_else(|| "Haply Inverse3".into()),
+            source: source.to_string(),
+            http_url: s.http_url.clone(),
+            ws_url: s.ws_url.clone(),
+            timeout_periods: s.timeout_periods,
+            max_missed_deadlines: device_toml::missed_deadline_limit(missed),
+            max_stall_periods: stall,
+            held_axis: 3 - axes[0].index - axes[1].index,
+            axes,
+            plane_position: p.position,
+            plane_stiffness: p.stiffness,
+            plane_damping: p.damping,
+            force_limit: l.force_limit,
+            ramp_time: l.ramp_time,
+            center: w.center,
+            half_width: w.half_width,
+            safety,
+        });
+        device_toml::checked(source, errs, file)
     }
 
     /// The same file with the service at `http_url` / `ws_url` (from `--device inverse3:URL`).

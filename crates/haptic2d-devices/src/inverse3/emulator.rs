@@ -637,6 +637,21 @@ fn grip_state(q: [f64; 4]) -> (VerseGripState, VerseGripStatus) {
     )
 }
 
+/// The payload's VerseGrip list: one entry made by `entry` from the grip's state and status when
+/// the emulator reports a grip ([`grip_now`]), none otherwise.
+fn grip_entries<T>(
+    cfg: &Emulator3Config,
+    plant: &Plant3,
+    entry: impl FnOnce(VerseGripState, VerseGripStatus) -> T,
+) -> Vec<T> {
+    grip_now(cfg, plant.t)
+        .map(|q| {
+            let (state, status) = grip_state(q);
+            vec![entry(state, status)]
+        })
+        .unwrap_or_default()
+}
+
 /// The full payload (`ServiceData`, devices with their `config`) for the plant's state.
 pub fn full_payload(cfg: &Emulator3Config, plant: &Plant3) -> ServiceData {
     let (state, status) = inverse3_state(plant);
@@ -651,21 +666,16 @@ pub fn full_payload(cfg: &Emulator3Config, plant: &Plant3) -> ServiceData {
             state,
             status,
         }],
-        verse_grip: grip_now(cfg, plant.t)
-            .map(|q| {
-                let (state, status) = grip_state(q);
-                vec![VerseGripDevice {
-                    device_id: EMULATED_GRIP_ID.into(),
-                    config: Some(VGConfig {
-                        id: EMULATED_GRIP_ID.into(),
-                        port: "emulated".into(),
-                        ..Default::default()
-                    }),
-                    state,
-                    status,
-                }]
-            })
-            .unwrap_or_default(),
+        verse_grip: grip_entries(cfg, plant, |state, status| VerseGripDevice {
+            device_id: EMULATED_GRIP_ID.into(),
+            config: Some(VGConfig {
+                id: EMULATED_GRIP_ID.into(),
+                port: "emulated".into(),
+                ..Default::default()
+            }),
+            state,
+            status,
+        }),
         session_id: 1,
         ..Default::default()
     }
@@ -680,16 +690,11 @@ pub fn state_payload(cfg: &Emulator3Config, plant: &Plant3) -> ServiceState {
             state,
             status,
         }],
-        verse_grip: grip_now(cfg, plant.t)
-            .map(|q| {
-                let (state, status) = grip_state(q);
-                vec![VerseGripMessage {
-                    device_id: EMULATED_GRIP_ID.into(),
-                    state,
-                    status,
-                }]
-            })
-            .unwrap_or_default(),
+        verse_grip: grip_entries(cfg, plant, |state, status| VerseGripMessage {
+            device_id: EMULATED_GRIP_ID.into(),
+            state,
+            status,
+        }),
         session_id: 1,
         ..Default::default()
     }

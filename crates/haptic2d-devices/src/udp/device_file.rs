@@ -32,6 +32,7 @@ use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
 use super::auth::UdpKey;
+use crate::device_toml;
 
 /// The template named in error messages.
 pub const UDP_TEMPLATE: &str = "devices/udp-pantograph.toml";
@@ -151,6 +152,25 @@ fn five() -> f64 {
     5.0
 }
 
+/// A field of two values, `(field, value)`: false for `no`, true for `yes`; any other value is an
+/// error ("`x` is not {what}", with `fix`) and false.
+fn either(
+    (field, value): (&str, &str),
+    (no, yes): (&str, &str),
+    what: &str,
+    fix: &str,
+    errs: &mut Vec<SceneError>,
+) -> bool {
+    match value {
+        v if v == no => false,
+        v if v == yes => true,
+        o => {
+            errs.push(SceneError::new(field, format!("`{o}` is not {what}"), fix));
+            false
+        }
+    }
+}
+
 impl UdpDeviceFile {
     /// The reference device's file (devices/udp-pantograph.toml, embedded).
     pub fn reference() -> Self {
@@ -160,9 +180,10 @@ impl UdpDeviceFile {
 
     /// Reads and parses the file at `path` (a relative `key_file` is relative to its directory).
     pub fn from_path(path: &Path) -> Result<Self, String> {
-        let (text, source) = crate::device_toml::read(path, "a UDP device file", UDP_TEMPLATE)?;
         let dir = path.parent().unwrap_or(Path::new("."));
-        Self::from_toml_in(&text, &source, dir).map_err(|e| e.to_string())
+        device_toml::load(path, "a UDP device file", UDP_TEMPLATE, |text, source| {
+            Self::from_toml_in(text, source, dir)
+        })
     }
 
     /// Parses a device file's text; `source` names it in messages; a relative `key_file` is
@@ -173,11 +194,7 @@ impl UdpDeviceFile {
 
     /// Parses a device file's text; a relative `key_file` is relative to `dir`.
     pub fn from_toml_in(text: &str, source: &str, dir: &Path) -> Result<Self, SceneErrors> {
-        let fail = |errors| SceneErrors {
-            source: source.to_string(),
-            errors,
-        };
-        let raw: RawFile = crate::device_toml::parse(text, source, UDP_TEMPLATE)?;
+        let raw: RawFile = device_toml::parse(text, source, UDP_TEMPLATE)?;
         let mut errs = Vec::new();
         if raw.kind != "udp" {
             errs.push(SceneError::new(
@@ -187,37 +204,23 @@ impl UdpDeviceFile {
             ));
         }
         let p = raw.protocol.unwrap_or_default();
-        let pose_input = match p.input.as_str() {
-            "joints" => false,
-            "pose" => true,
-            o => {
-                errs.push(SceneError::new(
-                    "protocol.input",
-                    format!("`{o}` is not a kind of state"),
-                    "write input = \"joints\" (joint angles) or \"pose\" (x, y, θ)",
-                ));
-                false
-            }
-        };
-        let wrench_output = match p.output.as_str() {
-            "torques" => false,
-            "wrench" => true,
-            o => {
-                errs.push(SceneError::new(
-                    "protocol.output",
-                    format!("`{o}` is not a kind of command"),
-                    "write output = \"torques\" (joint torques) or \"wrench\" (fx, fy, τ)",
-                ));
-                false
-            }
-        };
-        if !(p.timeout_periods.is_finite() && p.timeout_periods >= 1.0) {
-            errs.push(SceneError::new(
-                "protocol.timeout_periods",
-                format!("{} periods is not a timeout", p.timeout_periods),
-                "give a number of control periods ≥ 1 (default 3)",
-            ));
-        }
+        // The two two-valued fields: (field, value), (false, true), what a value is, the fix.
+        let [pose_input, wrench_output] = [
+            (
+                ("protocol.input", p.input.as_str()),
+                ("joints", "pose"),
+                "a kind of state",
+                "write input = \"joints\" (joint angles) or \"pose\" (x, y, θ)",
+            ),
+            (
+                ("protocol.output", p.output.as_str()),
+                ("torques", "wrench"),
+                "a kind of command",
+                "write output = \"torques\" (joint torques) or \"wrench\" (fx, fy, τ)",
+            ),
+        ]
+        .map(|(field, values, what, fix)| either(field, values, what, fix, &mut errs));
+        device_toml::check_timeout("protocol.timeout_periods", p.timeout_periods, 3, &mut errs);
         if !(p.reply_wait_periods.is_finite()
             && p.reply_wait_periods > 0.0
             && p.reply_wait_periods < 1.0)
@@ -235,20 +238,8 @@ impl UdpDeviceFile {
                 "give the device's joint torque limit in N·m, > 0",
             ));
         }
-        if p.max_missed_deadlines < 0 || p.max_missed_deadlines > u32::MAX as i64 {
-            errs.push(SceneError::new(
-                "protocol.max_missed_deadlines",
-                format!("{} is not a count", p.max_missed_deadlines),
-                "give a number of consecutive deadlines ≥ 0 (0 turns the check off)",
-            ));
-        }
-        if !(p.max_stall_periods.is_finite() && p.max_stall_periods >= 1.0) {
-            errs.push(SceneError::new(
-                "protocol.max_stall_periods",
-                format!("{} periods is not a stall limit", p.max_stall_periods),
-                "give the loop's longest delay between two ticks in periods, ≥ 1 (default 5)",
-            ));
-        }
+        let (missed, stall) = (p.max_missed_deadlines, p.max_stall_periods);
+        device_toml::check_watchdog("protocol", missed, stall, &mut errs);
         let (key, key_file) = match &p.key_file {
             None => (None, None),
             Some(k) => {
@@ -279,26 +270,22 @@ impl UdpDeviceFile {
             }
         };
         let safety = crate::device_safety::RawSafety::check(raw.safety.as_ref(), &mut errs);
-        match linkage {
-            Some(linkage) if errs.is_empty() => Ok(Self {
-                name: raw.name.unwrap_or_else(|| "UDP device".into()),
-                source: source.to_string(),
-                pose_input,
-                wrench_output,
-                timeout_periods: p.timeout_periods,
-                reply_wait_periods: p.reply_wait_periods,
-                torque_limit: p.torque_limit,
-                max_missed_deadlines: u32::try_from(p.max_missed_deadlines)
-                    .ok()
-                    .filter(|n| *n > 0),
-                max_stall_periods: p.max_stall_periods,
-                linkage,
-                key,
-                key_file,
-                safety,
-            }),
-            _ => Err(fail(errs)),
-        }
+        let file = linkage.map(|linkage| Self {
+            name: raw.name.unwrap_or_else(|| "UDP device".into()),
+            source: source.to_string(),
+            pose_input,
+            wrench_output,
+            timeout_periods: p.timeout_periods,
+            reply_wait_periods: p.reply_wait_periods,
+            torque_limit: p.torque_limit,
+            max_missed_deadlines: device_toml::missed_deadline_limit(missed),
+            max_stall_periods: stall,
+            linkage,
+            key,
+            key_file,
+            safety,
+        });
+        device_toml::checked(source, errs, file)
     }
 }
 

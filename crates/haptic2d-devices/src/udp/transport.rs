@@ -259,17 +259,25 @@ impl UdpTransport {
                     }
                     return Ok(Some(n));
                 }
-                Err(e)
-                    if matches!(
-                        e.kind(),
-                        ErrorKind::WouldBlock | ErrorKind::TimedOut | ErrorKind::Interrupted
-                    ) => {}
-                Err(e) if e.kind() == ErrorKind::ConnectionRefused => {
-                    self.counters.refused += 1;
-                    std::thread::sleep(until.saturating_duration_since(Instant::now()));
-                }
-                Err(e) => return Err(e),
+                Err(e) => self.absorb_recv_error(e, until)?,
             }
+        }
+    }
+
+    /// A failed blocking receive that was to end by `until`. A timeout or an interruption (a
+    /// signal, or SIGSTOP/SIGCONT — job control, a suspended VM — on a socket with a read timeout)
+    /// is nothing: the caller re-checks its deadline. "Connection refused" (nothing listens) is
+    /// counted and the rest of the wait slept out quietly rather than spun on. Any other error is
+    /// returned.
+    fn absorb_recv_error(&mut self, e: std::io::Error, until: Instant) -> std::io::Result<()> {
+        match e.kind() {
+            ErrorKind::WouldBlock | ErrorKind::TimedOut | ErrorKind::Interrupted => Ok(()),
+            ErrorKind::ConnectionRefused => {
+                self.counters.refused += 1;
+                std::thread::sleep(until.saturating_duration_since(Instant::now()));
+                Ok(())
+            }
+            _ => Err(e),
         }
     }
 
@@ -343,19 +351,7 @@ impl UdpTransport {
             self.socket.set_nonblocking(false)?;
             match self.socket.recv_from(&mut self.buf) {
                 Ok((n, from)) => self.classify(n, from),
-                // Interrupted: a signal, or SIGSTOP/SIGCONT (job control, a suspended VM) on a
-                // socket with a read timeout; the loop re-checks the deadline.
-                Err(e)
-                    if matches!(
-                        e.kind(),
-                        ErrorKind::WouldBlock | ErrorKind::TimedOut | ErrorKind::Interrupted
-                    ) => {}
-                Err(e) if e.kind() == ErrorKind::ConnectionRefused => {
-                    self.counters.refused += 1;
-                    // Nothing listens: do not spin on the error, wait out the deadline quietly.
-                    std::thread::sleep(deadline.saturating_duration_since(Instant::now()));
-                }
-                Err(e) => return Err(e),
+                Err(e) => self.absorb_recv_error(e, deadline)?,
             }
         }
     }

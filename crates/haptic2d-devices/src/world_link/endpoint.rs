@@ -110,14 +110,7 @@ impl LinkEndpoint {
                 }
             }
         }
-        let why = if counters.bad_mac > 0 {
-            format!(
-                " ({} answers with a bad MAC: the two sides' keys differ)",
-                counters.bad_mac
-            )
-        } else {
-            String::new()
-        };
+        let why = bad_mac_note(&counters, "answers", "the two sides' keys differ");
         Err(format!(
             "no WELCOME from the world at {peer} in {:.1} s{why}\n    fix: start `haptic2d serve-world SCENE --bind {peer} --key KEY` there first, with the same key file",
             timeout.as_secs_f64()
@@ -170,14 +163,7 @@ impl LinkEndpoint {
                 counters,
             });
         }
-        let why = if counters.bad_mac > 0 {
-            format!(
-                " ({} HELLOs with a bad MAC: the device side's key differs)",
-                counters.bad_mac
-            )
-        } else {
-            String::new()
-        };
+        let why = bad_mac_note(&counters, "HELLOs", "the device side's key differs");
         Err(format!(
             "no device opened a session in {:.1} s{why}",
             timeout.as_secs_f64()
@@ -242,6 +228,16 @@ impl LinkEndpoint {
 
 /// The port message size, for callers sizing their buffers.
 pub const DATAGRAM_LEN: usize = PORT_LEN;
+
+/// The note a handshake that timed out adds when datagrams (`what`: "answers", "HELLOs") failed the
+/// MAC: " (3 HELLOs with a bad MAC: {why})"; empty when none did.
+fn bad_mac_note(counters: &LinkCounters, what: &str, why: &str) -> String {
+    if counters.bad_mac > 0 {
+        format!(" ({} {what} with a bad MAC: {why})", counters.bad_mac)
+    } else {
+        String::new()
+    }
+}
 
 #[cfg(test)]
 mod tests {

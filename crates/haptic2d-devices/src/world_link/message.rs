@@ -249,22 +249,17 @@ mod tests {
         let other = UdpKey::from_bytes(&[4; 32]).unwrap();
         let mut b = [0u8; PORT_LEN];
         example().seal(&k, KIND_TO_WORLD, 42, &mut b);
-        assert_eq!(
-            PortMessage::open(&other, &b, KIND_TO_WORLD, 42),
-            Err(Drop2::BadMac)
-        );
-        assert_eq!(
-            PortMessage::open(&k, &b, KIND_TO_WORLD, 43),
-            Err(Drop2::WrongSession)
-        );
-        assert_eq!(
-            PortMessage::open(&k, &b, KIND_TO_DEVICE, 42),
-            Err(Drop2::Malformed)
-        );
-        assert_eq!(
-            PortMessage::open(&k, &b[..PORT_LEN - 1], KIND_TO_WORLD, 42),
-            Err(Drop2::Malformed)
-        );
+        // (key, datagram, kind, session) → why it is dropped.
+        let cases: [(&UdpKey, &[u8], u8, u64, Drop2); 4] = [
+            (&other, &b, KIND_TO_WORLD, 42, Drop2::BadMac),
+            (&k, &b, KIND_TO_WORLD, 43, Drop2::WrongSession),
+            (&k, &b, KIND_TO_DEVICE, 42, Drop2::Malformed),
+            (&k, &b[..PORT_LEN - 1], KIND_TO_WORLD, 42, Drop2::Malformed),
+        ];
+        for (key, bytes, kind, session, why) in cases {
+            let got = PortMessage::open(key, bytes, kind, session);
+            assert_eq!(got, Err(why), "kind {kind}, session {session}");
+        }
         for i in 4 * 8..b.len() * 8 {
             let mut c = b;
             c[i / 8] ^= 1 << (i % 8);

@@ -11,6 +11,7 @@
 //! - a CSV log is text: a NUL byte or a line longer than [`MAX_CSV_LINE_BYTES`] (1 MiB) is refused
 //!   where it is found ([`TextGuard`]), before a record of it is buffered.
 
+use std::fs::{File, Metadata};
 use std::io::Read;
 use std::path::Path;
 
@@ -26,17 +27,23 @@ pub const MAX_CSV_LINE_BYTES: u64 = 1 << 20;
 /// [`MAX_LOG_BYTES`]. With `magic`, the file must start with those bytes (checked before the rest
 /// is read). Errors name the file, the cap and the fix.
 pub fn read_log_file(path: &Path, what: &str, magic: Option<&[u8]>) -> Result<Vec<u8>, String> {
+    let (file, meta, label) = open_log_file(path, what)?;
+    let declared = meta.is_file().then_some(meta.len());
+    read_capped(file, &label, what, declared, MAX_LOG_BYTES, magic)
+}
+
+/// Opens the log file `path` for reading (`what` names it in errors: "CSV log", "MCAP file"):
+/// the file, its metadata and its label (the path as text). A directory is refused.
+pub fn open_log_file(path: &Path, what: &str) -> Result<(File, Metadata, String), String> {
     let label = path.display().to_string();
-    let file =
-        std::fs::File::open(path).map_err(|e| format!("cannot read the {what} {label}: {e}"))?;
+    let file = File::open(path).map_err(|e| format!("cannot read the {what} {label}: {e}"))?;
     let meta = file
         .metadata()
         .map_err(|e| format!("cannot read the {what} {label}: {e}"))?;
     if meta.is_dir() {
         return Err(format!("the {what} {label} is a directory"));
     }
-    let declared = meta.is_file().then_some(meta.len());
-    read_capped(file, &label, what, declared, MAX_LOG_BYTES, magic)
+    Ok((file, meta, label))
 }
 
 /// [`read_log_file`] from any reader: `declared` is the reader's length if it has one (a regular

@@ -5,6 +5,7 @@
 //! timing summary), the summary section and the index. Nothing that reached the ring is lost; the
 //! [`LogReport`] says how many ticks were written and how many the RT thread dropped.
 
+use crate::drain_thread::DrainThread;
 use crate::logger::LogReport;
 use crate::mcap::record::LoggedTick;
 use crate::mcap::writer::{McapSetup, McapSink, McapStats};
@@ -13,7 +14,6 @@ use ::mcap::records::Metadata;
 use std::io::{BufWriter, Seek, Write};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
-use std::thread::JoinHandle;
 use std::time::Duration;
 
 /// What the MCAP logger did.
@@ -47,11 +47,11 @@ impl std::fmt::Display for McapReport {
 
 type Shared = Arc<Mutex<Vec<Metadata>>>;
 
-/// Handle of a running MCAP logger thread.
+/// Handle of a running MCAP logger thread. A logger dropped without
+/// [`finish`](McapLogger::finish) still drains and writes a complete file (errors are then lost).
 pub struct McapLogger {
-    stop: Arc<AtomicBool>,
     last_metadata: Shared,
-    thread: Option<JoinHandle<Result<McapReport, String>>>,
+    thread: DrainThread<McapReport>,
 }
 
 impl McapLogger {
@@ -67,17 +67,14 @@ impl McapLogger {
         let label = label.to_string();
         let sink = McapSink::new(out, setup)
             .map_err(|e| format!("cannot start the MCAP log {label}: {e}"))?;
-        let stop = Arc::new(AtomicBool::new(false));
         let last_metadata: Shared = Arc::default();
-        let (s, m) = (stop.clone(), last_metadata.clone());
-        let thread = std::thread::Builder::new()
-            .name("haptic2d-mcap".into())
-            .spawn(move || logger_thread(rx, sink, label, poll, s, m))
-            .map_err(|e| format!("cannot start the logger thread: {e}"))?;
+        let m = last_metadata.clone();
+        let thread = DrainThread::spawn("haptic2d-mcap", "logger", move |stop| {
+            logger_thread(rx, sink, label, poll, stop, m)
+        })?;
         Ok(Self {
-            stop,
             last_metadata,
-            thread: Some(thread),
+            thread,
         })
     }
 
@@ -102,31 +99,11 @@ impl McapLogger {
     /// Stops the logger after it has written every record still in the ring, writes `metadata`
     /// (e.g. the timing summary) and the summary section, and reports. Call it after the producer
     /// stopped publishing.
-    pub fn finish(mut self, metadata: Vec<Metadata>) -> Result<McapReport, String> {
+    pub fn finish(self, metadata: Vec<Metadata>) -> Result<McapReport, String> {
         if let Ok(mut m) = self.last_metadata.lock() {
             *m = metadata;
         }
-        self.stop.store(true, Ordering::Release);
-        match self.thread.take() {
-            Some(t) => {
-                t.thread().unpark();
-                t.join()
-                    .map_err(|_| "the MCAP logger thread panicked".to_string())?
-            }
-            None => Err("the logger was already finished".into()),
-        }
-    }
-}
-
-impl Drop for McapLogger {
-    /// A logger dropped without [`finish`](McapLogger::finish) still drains and writes a complete
-    /// file (errors are then lost).
-    fn drop(&mut self) {
-        self.stop.store(true, Ordering::Release);
-        if let Some(t) = self.thread.take() {
-            t.thread().unpark();
-            let _ = t.join();
-        }
+        self.thread.finish("MCAP logger")
     }
 }
 

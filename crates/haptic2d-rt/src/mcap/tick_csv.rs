@@ -6,7 +6,7 @@
 //! [`limits`]: crate::mcap::limits
 
 use crate::mcap::columns::{column_index, parse_cell, Val, TICK_TABLE};
-use crate::mcap::limits::{TextGuard, MAX_LOG_BYTES};
+use crate::mcap::limits::{open_log_file, TextGuard, MAX_LOG_BYTES};
 use std::io::Read;
 use std::path::Path;
 
@@ -16,15 +16,7 @@ pub type TickCsv = (Vec<usize>, Vec<Vec<Val>>);
 /// Reads the CSV tick log at `path` (errors name the file, the line and the column). A regular
 /// file above [`MAX_LOG_BYTES`] is refused before it is read.
 pub fn read_tick_csv(path: &Path) -> Result<TickCsv, String> {
-    let label = path.display().to_string();
-    let file =
-        std::fs::File::open(path).map_err(|e| format!("cannot read the CSV log {label}: {e}"))?;
-    let meta = file
-        .metadata()
-        .map_err(|e| format!("cannot read the CSV log {label}: {e}"))?;
-    if meta.is_dir() {
-        return Err(format!("the CSV log {label} is a directory"));
-    }
+    let (file, meta, label) = open_log_file(path, "CSV log")?;
     if meta.is_file() && meta.len() > MAX_LOG_BYTES {
         return Err(format!(
             "the CSV log {label} is {} bytes, above the cap of {MAX_LOG_BYTES} bytes (1 GiB)\n    fix: cut the recording into parts",
