@@ -23,6 +23,8 @@ import tempfile
 import tomllib
 from pathlib import Path
 
+from planted import verdict
+
 ROOT = Path(__file__).resolve().parent.parent
 TEST_SUPPORT = "haptic2d-test-support"
 
@@ -164,7 +166,7 @@ def self_test():
             "`haptic2d-test-support` is dev-only (of haptic2d-app, haptic2d-rt).\n\n## 3. Next\n",
             encoding="utf-8",
         )
-        got = sorted(check(root))
+        got = check(root)
     want = sorted([
         "§2's crate list does not name crates/lost/",
         "§2's crate list names crates/ghost/, which has no Cargo.toml",
@@ -175,15 +177,7 @@ def self_test():
         "the text names the users of haptic2d-test-support as ['haptic2d-app', 'haptic2d-rt']; "
         "the Cargo.toml files: ['haptic2d-app']",
     ])
-    if got != want:
-        print("self-test FAILED")
-        for e in sorted(set(want) - set(got)):
-            print(f"  missed: {e}")
-        for e in sorted(set(got) - set(want)):
-            print(f"  extra:  {e}")
-        return 1
-    print(f"self-test: the {len(want)} planted mismatches found, nothing else")
-    return 0
+    return verdict("check_architecture", want, got, "planted mismatches")
 
 
 def main():

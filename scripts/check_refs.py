@@ -23,6 +23,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+from planted import verdict
+
 ROOT = Path(__file__).resolve().parent.parent
 SKIP_DIRS = ("docs/archive/", "scripts/check_refs.py")
 
@@ -112,16 +114,7 @@ def self_test():
         "lib.rs:1: `MODELS §1.3`: no section 1.3 in docs/MODELS.md",
         "lib.rs:1: `MODELS §F`: no section F in docs/MODELS.md",
     }
-    found = set(problems)
-    if found != expected:
-        print("check_refs self-test FAILED")
-        for p in sorted(expected - found):
-            print(f"  not found: {p}")
-        for p in sorted(found - expected):
-            print(f"  unexpected: {p}")
-        return 1
-    print(f"check_refs self-test: the {len(expected)} broken references found, no sound one reported")
-    return 0
+    return verdict("check_refs", expected, problems, "broken references")
 
 
 def main():

@@ -433,18 +433,7 @@ pub(crate) fn stimulus_laws(
     comparison: bool,
     delta: f64,
 ) -> Result<(NormalModel, FrictionModel), String> {
-    let cond = &study.conditions[c];
-    let (name, vary) = if comparison {
-        (&cond.comparison, Some((&cond.vary, delta)))
-    } else {
-        (&cond.reference, None)
-    };
-    let w = stimulus::world(study, name, vary).map_err(|e| {
-        e.iter()
-            .map(|s| s.to_string())
-            .collect::<Vec<_>>()
-            .join("; ")
-    })?;
+    let w = stimulus::interval_world(study, c, comparison, delta)?;
     Ok((w.normal, w.friction))
 }
 

@@ -363,17 +363,7 @@ impl SimulatedObserver {
             return Ok(*k);
         }
         let cond = &study.conditions[c];
-        let (name, vary) = if comparison {
-            (&cond.comparison, Some((&cond.vary, delta)))
-        } else {
-            (&cond.reference, None)
-        };
-        let world = stimulus::world(study, name, vary).map_err(|e| {
-            e.iter()
-                .map(|s| s.to_string())
-                .collect::<Vec<_>>()
-                .join("; ")
-        })?;
+        let world = stimulus::interval_world(study, c, comparison, delta)?;
         let probe = world
             .body_index(&study.probe)
             .ok_or_else(|| format!("the scene has no body called `{}`", study.probe))?;

@@ -107,3 +107,26 @@ pub fn world(
         .map(|s| s.world)
         .map_err(|e| e.errors)
 }
+
+/// The world of one interval of condition `c`: its comparison with the varied parameter raised by
+/// `delta` when `comparison`, else its reference (`delta` unused). Scene errors are joined into one
+/// message.
+pub fn interval_world(
+    study: &Study,
+    c: usize,
+    comparison: bool,
+    delta: f64,
+) -> Result<World, String> {
+    let cond = &study.conditions[c];
+    let (name, vary) = if comparison {
+        (&cond.comparison, Some((&cond.vary, delta)))
+    } else {
+        (&cond.reference, None)
+    };
+    world(study, name, vary).map_err(|e| {
+        e.iter()
+            .map(|s| s.to_string())
+            .collect::<Vec<_>>()
+            .join("; ")
+    })
+}
