@@ -62,6 +62,11 @@ def deps(manifest, table="dependencies"):
     return out
 
 
+def comma_list(text):
+    """The names of a comma-separated list, blanks dropped."""
+    return {n.strip() for n in text.split(",") if n.strip()}
+
+
 def diagram(blocks):
     """{crate: (workspace deps, outside deps)} from the block of `X ───► …` lines."""
     arrow = re.compile(r"^(haptic2d[\w-]*)\s+─+►\s*(.*)$")
@@ -74,8 +79,7 @@ def diagram(blocks):
                 while re.search(r"\([^()]*\)", rest):  # notes, innermost first: `devices()`
                     rest = re.sub(r"\([^()]*\)", "", rest)
                 inside, _, outside = rest.partition(";")
-                names = lambda s: {n.strip() for n in s.split(",") if n.strip()}
-                out[m.group(1)] = (names(inside), names(outside))
+                out[m.group(1)] = (comma_list(inside), comma_list(outside))
             return out
     return None
 
@@ -103,7 +107,8 @@ def check(root):
         errors.append("§2 has no dependency diagram (a code block of `CRATE ───► …` lines)")
         drawn = {}
     workspace = set(names)
-    excluded = {n for n, d in names.items() if d in excluded_members(root)}
+    outside_workspace = excluded_members(root)
+    excluded = {n for n, d in names.items() if d in outside_workspace}
     for name in sorted(workspace - {TEST_SUPPORT} - excluded - set(drawn)):
         errors.append(f"the dependency diagram has no line for {name}")
     for name, (inside, outside) in sorted(drawn.items()):

@@ -204,22 +204,20 @@ impl UdpDeviceFile {
             ));
         }
         let p = raw.protocol.unwrap_or_default();
-        // The two two-valued fields: (field, value), (false, true), what a value is, the fix.
-        let [pose_input, wrench_output] = [
-            (
-                ("protocol.input", p.input.as_str()),
-                ("joints", "pose"),
-                "a kind of state",
-                "write input = \"joints\" (joint angles) or \"pose\" (x, y, θ)",
-            ),
-            (
-                ("protocol.output", p.output.as_str()),
-                ("torques", "wrench"),
-                "a kind of command",
-                "write output = \"torques\" (joint torques) or \"wrench\" (fx, fy, τ)",
-            ),
-        ]
-        .map(|(field, values, what, fix)| either(field, values, what, fix, &mut errs));
+        let pose_input = either(
+            ("protocol.input", &p.input),
+            ("joints", "pose"),
+            "a kind of state",
+            "write input = \"joints\" (joint angles) or \"pose\" (x, y, θ)",
+            &mut errs,
+        );
+        let wrench_output = either(
+            ("protocol.output", &p.output),
+            ("torques", "wrench"),
+            "a kind of command",
+            "write output = \"torques\" (joint torques) or \"wrench\" (fx, fy, τ)",
+            &mut errs,
+        );
         device_toml::check_timeout("protocol.timeout_periods", p.timeout_periods, 3, &mut errs);
         if !(p.reply_wait_periods.is_finite()
             && p.reply_wait_periods > 0.0
@@ -312,6 +310,16 @@ mod tests {
             "{e}"
         );
         assert!(e.contains("protocol.reply_wait_periods"), "{e}");
+        let text = "kind = \"udp\"\n[protocol]\noutput = \"forces\"\n[linkage]\nd = 0.0\nl1 = 0.07\nl2 = 0.09\n";
+        let e = UdpDeviceFile::from_toml(text, "f").unwrap_err().to_string();
+        assert!(
+            e.contains("protocol.output") && e.contains("`forces` is not a kind of command"),
+            "{e}"
+        );
+        assert!(
+            e.contains("\"wrench\"") && !e.contains("protocol.input"),
+            "{e}"
+        );
         let e = UdpDeviceFile::from_toml(
             "kind = \"udp\"\n[linkage]\nd = 0\nl1 = 0.07\nl2 = 0.09\nfoo = 1\n",
             "f",
