@@ -38,7 +38,7 @@ pub mod udp;
 use crate::device_safety::DeviceSafety;
 use haptic2d::device::pantograph2::Pantograph2;
 use haptic2d::device::DeviceParams;
-use haptic2d::haptic::{ControllerKind, WorkspaceSquare};
+use haptic2d::haptic::{ControllerKind, DeviceEnd, SafetyConfig, WorkspaceSquare};
 use haptic2d_rt::DeviceIo;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -215,5 +215,55 @@ impl std::fmt::Debug for RealDevice {
             .field("max_stall_periods", &self.max_stall_periods)
             .field("safety", &self.safety)
             .finish_non_exhaustive()
+    }
+}
+
+impl RealDevice {
+    /// The safety settings of this device's tick: the shared defaults with the device file's
+    /// `[safety]` table, and a stall limit of the loop's allowance plus the device's own reply
+    /// timeout (the interval a tick sees includes the wait for the device; see `haptic2d run`'s
+    /// rig).
+    pub fn safety_config(&self) -> SafetyConfig {
+        self.safety.apply(SafetyConfig {
+            max_stall_periods: self.max_stall_periods + self.wait_periods,
+            ..SafetyConfig::default()
+        })
+    }
+
+    /// The device as a [`DeviceEnd`] at period `dt` (s): its model with [`Self::safety_config`].
+    /// A five-bar's and a point device's handle mass (for a link's damping caps; the tick has no
+    /// dynamic model of them) is the device file's identified end mass, else the built-in
+    /// estimate of the 2DIY's end mass (the emulator's linkage), or the point device's gate mass.
+    /// The five-bar's joint inertia, reflected to the handle, only adds to it: the value is a lower
+    /// bound, which keeps a cap `2·m/T` on the stable side.
+    pub fn device_end(&self, dt: f64) -> Result<DeviceEnd, String> {
+        let safety = self.safety_config();
+        match &self.model {
+            DeviceModel::Twin(p) => DeviceEnd::twin(*p, safety, dt),
+            DeviceModel::FiveBar {
+                linkage,
+                tau_max,
+                center,
+                workspace,
+                identified,
+            } => {
+                let mass = match identified {
+                    Some(i) if i.end_mass > 0.0 => i.end_mass,
+                    _ => {
+                        let c = haptic2d::geom::Vec2::new(center[0], center[1]);
+                        crate::haply::plant::Plant2::new(*linkage, c)?.m_e
+                    }
+                };
+                let margin = haptic2d::haptic::planar2::Planar2Config::new(*linkage, *tau_max)
+                    .min_singularity_margin;
+                let tau = [*tau_max; 2];
+                DeviceEnd::five_bar(*linkage, tau, margin, *workspace, mass, safety, dt)
+            }
+            DeviceModel::Point {
+                force_limit,
+                workspace,
+                gate_dynamics,
+            } => DeviceEnd::point(*force_limit, *workspace, gate_dynamics.mass, safety, dt),
+        }
     }
 }

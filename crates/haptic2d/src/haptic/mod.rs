@@ -10,6 +10,7 @@
 pub mod config;
 mod controller;
 pub mod coupling;
+pub mod device_end;
 pub mod device_system;
 pub mod experiment;
 pub mod limit_cycle;
@@ -26,6 +27,7 @@ pub mod workspace;
 
 pub use config::{ControllerKind, HapticConfig};
 pub use coupling::{DeviceCoupling, SlaveState};
+pub use device_end::{DeviceEnd, EndDevice, EndOutput};
 pub use device_system::DeviceSystem;
 pub use experiment::DeviceInTheLoop;
 pub use limit_cycle::LimitCycleMonitor;
