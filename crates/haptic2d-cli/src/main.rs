@@ -27,6 +27,7 @@ mod hand_arg;
 mod haply_arg;
 mod loop_end;
 mod pipe;
+mod push_arg;
 mod run_log;
 mod run_rig;
 mod run_view;
