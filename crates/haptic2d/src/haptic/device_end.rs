@@ -227,6 +227,14 @@ impl DeviceEnd {
         Some(est)
     }
 
+    /// Step 0, stall alone, for a device whose signals use one period whatever the interval (a
+    /// simulated plant advanced per tick): trips when `elapsed` (s since the previous tick, of
+    /// which `device_wait` s waiting for the device) exceeds the stall limit. Call it before
+    /// [`Self::sense`], which then gets one period.
+    pub fn check_stall(&mut self, at: TickClock, elapsed: f64, device_wait: f64) {
+        self.safety.check_stall(at, elapsed, device_wait);
+    }
+
     /// Steps 8b–9 for the wrench `f` (N, N, N·m; device frame) asked of the handle sensed as `est`
     /// (`None`: not sensed this tick, no torque): the workspace wall, the torques, the limit
     /// cycle, a singular pose, the ramp and the final gate. Remembers the torques for the next

@@ -1,0 +1,120 @@
+//! The device side of the split loop on a real device (issue 41): `haptic2d run --device
+//! haply:PTY --world udp:…` against `haptic2d emulate haply` (a 2DIY with Haply's stock firmware on
+//! a pseudo-terminal, as DEVICES.md describes it) and a `haptic2d serve-world` over loopback —
+//! three processes. The device side runs the board as a `DeviceEnd`, the same safety stage as
+//! every device's in `run`.
+//!
+//! The world side's coupling is softened for the 2DIY (100 N/m, 0.5 N·s/m: its handle is about
+//! 0.03 kg, against the twin's 0.4 kg for which the defaults are set; docs/TELEOP.md). Timing
+//! settings are patient, as in the other device tests: the tests check the link, the energy and
+//! the exit paths, not the machine's timing.
+
+use std::path::Path;
+use std::time::Duration;
+
+use crate::cli_teleop::{key_file, number, World};
+use crate::common::{assert_has, assert_lost_device, emulate_haply, haply_file, wait_with_limit};
+
+const BIN: &str = env!("CARGO_BIN_EXE_haptic2d");
+
+/// A world side on the near-wall scene with the 2DIY's softer coupling.
+fn world(key: &Path) -> World {
+    let soft = [
+        "--coupling-k",
+        "100",
+        "100",
+        "1",
+        "--coupling-b",
+        "0.5",
+        "0.5",
+        "0.01",
+    ];
+    World::start(key, &[&soft[..], &["--link-timeout-ms", "300"]].concat())
+}
+
+/// The device side on the emulated board at `pty` (device file `file`) for `secs` seconds.
+fn device_side(
+    pty: &str,
+    file: &Path,
+    world: &World,
+    key: &Path,
+    secs: &str,
+) -> std::process::Child {
+    std::process::Command::new(BIN)
+        .args(["run", "--device", &format!("haply:{pty}"), "--device-file"])
+        .arg(file)
+        .args(["--world", &format!("udp:{}", world.addr), "--key"])
+        .arg(key)
+        .args(["--duration", secs, "--no-rt", "--link-timeout-ms", "300"])
+        .args(["--max-stall-periods", "100"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
+#[test]
+fn a_2diy_board_on_the_device_side_renders_the_world_and_the_link_stays_passive() {
+    let _m = crate::common::module_turn(module_path!());
+    let dir = tempfile::tempdir().unwrap();
+    let file = haply_file(dir.path(), "haply-2diy-gen3.toml", "gen3.toml", |t| t);
+    // The emulated hand holds the handle for 0.6 s (the ramp), then pushes 1 N along +y for 2.4 s.
+    let (emu, pty) = emulate_haply(&file, &["--hand", "script:0.6,0,1,0,2.4", "--no-rt"]);
+    let key = key_file("board", 0x3c);
+    let w = world(&key);
+    let child = device_side(&pty, &file, &w, &key, "3");
+    let (status, out) = wait_with_limit(child, Duration::from_secs(60)).expect("ends in time");
+    drop(emu);
+    let world_out = w.finish(Duration::from_secs(10));
+    let all = format!("{out}\n{world_out}");
+    assert_eq!(status.code(), Some(0), "{all}");
+    assert_has(&out, &[&format!("haply:{pty}"), "2DIY", "no safety stop"]);
+    // The push moved the handle, the world's body followed through the coupling, and the
+    // coupling's reaction came back and was rendered by the board's motors.
+    let excursion = number(&out, "handle: largest excursion", "excursion ");
+    assert!(excursion > 3.0, "excursion {excursion} mm\n{all}");
+    let felt = number(&out, "link: ", "largest force on the handle ");
+    assert!(felt > 0.2, "largest force on the handle {felt} N\n{all}");
+    let coupling = number(&world_out, "link: ", "largest coupling force ");
+    assert!(coupling > 0.2, "{all}");
+    let created = number(&out, "network: energy created", "created ");
+    assert!(created <= 1e-3, "network created {created} J\n{all}");
+    // A real device's plant is not known: the report says so instead of printing zeros.
+    assert_has(&out, &["master port (plant, true displacement): not known"]);
+    assert!(
+        world_out.contains("the device side closed the session"),
+        "{all}"
+    );
+}
+
+#[test]
+fn a_2diy_board_lost_mid_run_latches_zero_torques_and_exits_4_naming_it() {
+    let _m = crate::common::module_turn(module_path!());
+    let dir = tempfile::tempdir().unwrap();
+    let file = haply_file(dir.path(), "haply-2diy-gen3.toml", "gen3.toml", |t| t);
+    let (mut emu, pty) = emulate_haply(&file, &["--no-rt"]);
+    let key = key_file("board-lost", 0x3d);
+    let w = world(&key);
+    let child = device_side(&pty, &file, &w, &key, "20");
+    // The loop is ticking once the world side has a session; then the board goes.
+    let t0 = std::time::Instant::now();
+    std::thread::sleep(Duration::from_millis(1500));
+    emu.kill().unwrap();
+    let _ = emu.wait();
+    let (status, out) = wait_with_limit(child, Duration::from_secs(30)).expect("ends in time");
+    let world_out = w.finish(Duration::from_secs(10));
+    let all = format!("{out}\n{world_out}");
+    assert!(t0.elapsed() < Duration::from_secs(10), "{all}");
+    assert_lost_device(
+        status.code(),
+        &all,
+        &format!("haply:{pty}"),
+        &["torques set to zero and latched"],
+    );
+    assert_has(&out, &["device lost"]);
+    // The world hears of it: the device side says goodbye with the latch flag.
+    assert!(
+        world_out.contains("the device side closed the session"),
+        "{all}"
+    );
+}
