@@ -609,7 +609,7 @@ fn real_device(p: &Plan, dt: f64) -> Result<Opened, Failure> {
         .map_err(Failure::from)?
         .ok_or_else(|| Failure::from(format!("--device {}: not a real device", p.device)))?;
     let end = real.device_end(dt).map_err(Failure::from)?;
-    let what = real.summary.clone();
+    let what = format!("{} ({})", real.name, real.summary);
     let io = (real.open)(Duration::from_secs_f64(dt)).map_err(|m| Failure {
         status: Status::DeviceLost,
         message: m,

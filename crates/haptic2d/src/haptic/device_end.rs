@@ -14,8 +14,9 @@
 //! 9.            τ = Jᵀ·f saturated, limit cycle, singular pose, ramp, final gate
 //! ```
 //!
-//! [`DeviceEnd::actuate`] returns the wrench the motors really apply (the request scaled by the
-//! saturation, the ramp and the final clamp; zero when gated): what a port's energy books. No
+//! [`DeviceEnd::actuate`] returns the part of the motors' wrench the request produced (the request
+//! scaled by the saturation, the ramp and the final clamp; zero when gated): what a port's energy
+//! books, as the tick's passivity observer books its port (step 9b). No
 //! method allocates, locks, prints or does I/O.
 
 use crate::device::linalg::{V3, V4};
@@ -87,9 +88,12 @@ impl EndDevice {
 pub struct EndOutput {
     /// The motor commands to write now (N·m; a point device: N in `τ[0..2]`); zero when gated.
     pub tau: V4,
-    /// The wrench the motors apply with `tau` (N, N, N·m; device frame): the request with the
-    /// workspace wall, scaled by the saturation, the ramp and the final clamp.
+    /// The part of the motors' wrench that the request `f` produced (N, N, N·m; device frame): `f`
+    /// scaled by the saturation, the ramp and the final clamp; zero when gated. What a port's
+    /// books count: the workspace wall's share is the device's own passive wall, not the port's.
     pub applied: V3,
+    /// That scale, in [0, 1]: saturation × ramp × final clamp (0 when gated).
+    pub factor: f64,
     /// True when the final gate zeroed the torques (latched, or tripped this tick).
     pub gated: bool,
 }
@@ -274,7 +278,8 @@ impl DeviceEnd {
         self.tau_prev = tau;
         EndOutput {
             tau,
-            applied: w.map(|x| x * applied),
+            applied: f.map(|x| x * applied),
+            factor: applied,
             gated,
         }
     }
