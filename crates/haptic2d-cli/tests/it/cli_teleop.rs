@@ -100,7 +100,12 @@ impl World {
         let scene = key.with_file_name("near-wall.toml");
         std::fs::write(&scene, NEAR_WALL).unwrap();
         let scene = scene.to_str().unwrap();
-        let mut child = spawn_keyed(&["serve-world", scene, "--bind", "127.0.0.1:0"], key, extra);
+        World::start_as(&["serve-world", scene, "--bind", "127.0.0.1:0"], key, extra)
+    }
+
+    /// A world side started as `command` (`serve-world SCENE …` or `serve-world --device …`).
+    pub(crate) fn start_as(command: &[&str], key: &Path, extra: &[&str]) -> World {
+        let mut child = spawn_keyed(command, key, extra);
         let (tx, lines) = mpsc::channel();
         let out = child.stdout.take().unwrap();
         std::thread::spawn(move || {
