@@ -43,15 +43,16 @@ impl ContactSet {
 /// The two checks of [`ContactSet::assert_depth_invariant`] on the record `key` at the current
 /// poses (distances in m), with the round-off allowance [`TOL`]: first, `d_e ≥ max_j d_j − δ_c −
 /// TOL` or the overlap bound ([`overlap_ok`] with `δ_c + TOL`); second, `−d_e ≤ depth_SAT + δ_c +
-/// TOL` or the vertex is across a seam of the edge collider. A vertex across a seam of `cb` (in the piece under it,
-/// `Collider::across_seam`) is outside `cb`: the pair's SAT depth does not see the piece that
-/// holds it.
+/// TOL` or the vertex is across a seam of the edge collider. A vertex across a seam of `cb` (in
+/// the piece under it, `Collider::across_seam`) is outside `cb`: the pair's SAT depth does not
+/// see the piece that holds it.
 ///
 /// The SAT depth costs `O((n_a + n_b)²)`, so it is computed only where a cheaper test has not
 /// already decided: the overlap bound of the first check only where the nearest-line test fails,
 /// and the second check's SAT depth only for a record deeper than `δ_c + TOL`. That shortcut
-/// gives the full test's answer: `sat_depth ≥ 0`, and IEEE rounding is monotone, so
-/// `(depth_SAT + δ_c) + TOL ≥ (0 + δ_c) + TOL`. A landing pile:100 run in the dev profile spent
+/// gives the full test's answer: `sat_depth ≥ 0` (never NaN: its minima start at `+∞` and
+/// `f64::min` passes over NaN), and IEEE rounding is monotone, so `(depth_SAT + δ_c) + TOL ≥
+/// (0 + δ_c) + TOL`. A landing pile:100 run in the dev profile spent
 /// two thirds of its instructions on two eager SAT depths a record a step (docs/PERFORMANCE.md,
 /// session 29).
 #[cfg(any(debug_assertions, test))]
