@@ -270,6 +270,15 @@ mod tests {
         [0.004, -0.002, 0.0009],
     ];
     const T: f64 = 1e-3;
+    /// A free body of 0.2 kg on x and y and 0.001 kg·m² on θ, without coupling.
+    const FREE: M3 = [[0.2, 0.0, 0.0], [0.0, 0.2, 0.0], [0.0, 0.0, 0.001]];
+
+    /// The controller's force on x for the free body [`FREE`] at `v` m/s on x, asked `f` N on x,
+    /// with `far` J come in at the far side on x and no other force.
+    fn on_x(c: &mut HeldWorkControl, ports: &PlanarTdpa, f: f64, v: f64, far: f64) -> f64 {
+        let (f, v, far) = ([f, 0.0, 0.0], [v, 0.0, 0.0], [far, 0.0, 0.0]);
+        c.control(ports, &f, &v, &[0.0; 3], &FREE, &far, T)[0]
+    }
 
     /// The kinetic-energy change (J) of a body of mass matrix `m` from velocity `v` under the
     /// constant total force `total`, its velocity stepped in 10 000 sub-steps of `M·dv = total·dt`.
@@ -334,21 +343,12 @@ mod tests {
     fn a_free_handle_force_is_scaled_until_its_work_fits_the_room_exactly() {
         // One axis: a 0.2 kg free body at 0.05 m/s, 3 N along the motion would do
         // 3·0.05·1e-3 + 9·1e-6/0.4 = 172.5 µJ; only 100 µJ came in at the far side.
-        let m = [[0.2, 0.0, 0.0], [0.0, 0.2, 0.0], [0.0, 0.0, 0.001]];
         let mut c = HeldWorkControl::new(50.0, T);
         let mut ports = PlanarTdpa::default();
-        let out = c.control(
-            &ports,
-            &[3.0, 0.0, 0.0],
-            &[0.05, 0.0, 0.0],
-            &[0.0; 3],
-            &m,
-            &[1e-4, 0.0, 0.0],
-            T,
-        );
+        let out = [on_x(&mut c, &ports, 3.0, 0.05, 1e-4), 0.0, 0.0];
         assert!(out[0] > 0.0 && out[0] < 3.0, "{out:?}");
         // The scaled force's work on the free body, by its kinetic-energy change, is the room.
-        let exact = kinetic_change(&m, &[0.05, 0.0, 0.0], &out, T);
+        let exact = kinetic_change(&FREE, &[0.05, 0.0, 0.0], &out, T);
         assert!((exact - 1e-4).abs() < 1e-12, "{exact}");
         c.book(&mut ports, &out);
         assert!((ports.energy_out()[0] - 1e-4).abs() < 1e-15);
@@ -364,40 +364,20 @@ mod tests {
     fn a_damping_force_at_the_explicit_cap_books_no_dissipation() {
         // α = 2m/T reverses a free body's velocity in one period: no work (F·v·T would book
         // α·v²·T dissipated).
-        let m = [[0.2, 0.0, 0.0], [0.0, 0.2, 0.0], [0.0, 0.0, 0.001]];
         let v = [0.03, 0.0, 0.0];
         let f = [-(2.0 * 0.2 / T) * v[0], 0.0, 0.0];
-        let w = held_work(&f, &v, &[0.0; 3], &inv3(&m).unwrap(), T);
+        let w = held_work(&f, &v, &[0.0; 3], &inv3(&FREE).unwrap(), T);
         assert!(w[0].abs() < 1e-15, "{w:?}");
     }
 
     #[test]
     fn the_force_keeps_its_direction_and_a_debt_cuts_an_output_to_zero() {
-        let m = [[0.2, 0.0, 0.0], [0.0, 0.2, 0.0], [0.0, 0.0, 0.001]];
         let mut c = HeldWorkControl::new(50.0, T);
         let mut ports = PlanarTdpa::default();
         ports.axes[0].book_work(1e-4, 0.0); // 0.1 mJ out, nothing came in: a debt
-        let out = c.control(
-            &ports,
-            &[1.0, 0.0, 0.0],
-            &[0.1, 0.0, 0.0],
-            &[0.0; 3],
-            &m,
-            &[0.0; 3],
-            T,
-        );
-        assert_eq!(out[0], 0.0);
+        assert_eq!(on_x(&mut c, &ports, 1.0, 0.1, 0.0), 0.0);
         // An input (the force against the motion) is not cut by the debt.
-        let out = c.control(
-            &ports,
-            &[-1.0, 0.0, 0.0],
-            &[0.1, 0.0, 0.0],
-            &[0.0; 3],
-            &m,
-            &[0.0; 3],
-            T,
-        );
-        assert_eq!(out[0], -1.0);
+        assert_eq!(on_x(&mut c, &ports, -1.0, 0.1, 0.0), -1.0);
     }
 
     #[test]
