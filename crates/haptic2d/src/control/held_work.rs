@@ -57,11 +57,31 @@ use crate::device::linalg::{inv3, m3_mul_v, M3, V3};
 
 /// The work (J, or N·m·rad) per axis of the forces `f` (N, N, N·m) held for `dt` (s) on a body of
 /// inverse mass matrix `m_inv` moving at `v` (m/s, m/s, rad/s) at the start, with the other forces
-/// `other` (N, N, N·m) held on it too: `f_i·(v_i·dt + (m_inv·(f + other))_i·dt²/2)`.
-pub fn held_work(f: &V3, v: &V3, other: &V3, m_inv: &M3, dt: f64) -> V3 {
+/// `other` (N, N, N·m) held on it too: `f_i·(v_i·dt + c·(m_inv·(f + other))_i·dt²)`, with `c = ½`
+/// for a body in continuous time and `c = 1` for one semi-implicit Euler step (`v' = v + a·T`,
+/// `x' = x + v'·T`).
+pub fn held_work(f: &V3, v: &V3, other: &V3, m_inv: &M3, dt: f64, c: f64) -> V3 {
     let total: V3 = std::array::from_fn(|i| f[i] + other[i]);
     let a = m3_mul_v(m_inv, &total);
-    std::array::from_fn(|i| f[i] * (v[i] * dt + a[i] * dt * dt / 2.0))
+    std::array::from_fn(|i| f[i] * (v[i] * dt + a[i] * c * dt * dt))
+}
+
+/// The least damping `α ≥ 0` (N·s/m, N·m·s/rad) with `(f − α·v)·s + (f − α·v)²·k ≤ room` (J),
+/// the work of the damped force `f − α·v` over the period (`s` m, `k` m/N: see
+/// [`HeldWorkControl::control`]), up to the `α` of least work; 0 where damping cannot lower the
+/// work (`v = 0`, or the least work is at `α ≤ 0`).
+pub fn least_damping(f: f64, v: f64, s: f64, k: f64, room: f64) -> f64 {
+    let (q, l, w0) = (v * v * k, -v * (s + 2.0 * f * k), f * s + f * f * k);
+    if w0 <= room || q <= 0.0 || l >= 0.0 {
+        return 0.0;
+    }
+    let vertex = -l / (2.0 * q);
+    let disc = l * l - 4.0 * q * (w0 - room);
+    if disc < 0.0 {
+        return vertex;
+    }
+    // The smaller root, in the form without cancellation (both roots are positive here).
+    (2.0 * (w0 - room) / (-l + disc.sqrt())).min(vertex)
 }
 
 /// The body's velocity at the start of the period from its sampled poses and the acceleration the
@@ -168,6 +188,11 @@ pub struct HeldWorkControl {
     cut: V3,
     /// The scale of the last period per axis.
     beta: V3,
+    /// The displacement's acceleration factor: `Δx = v·T + c·a·T²` (½ for a body in continuous
+    /// time, 1 for a world's semi-implicit Euler step).
+    c: f64,
+    /// Damp first (`F − α·v`, `α` up to the damping of least work), then scale.
+    damp: bool,
 }
 
 impl HeldWorkControl {
@@ -182,7 +207,24 @@ impl HeldWorkControl {
             dt: 0.0,
             cut: [0.0; 3],
             beta: [0.0; 3],
+            c: 0.5,
+            damp: false,
         }
+    }
+
+    /// The same controller for a body stepped by semi-implicit Euler (`v' = v + a·T`,
+    /// `x' = x + v'·T`, so `Δx = v·T + a·T²`): a world's body.
+    pub fn semi_implicit(self) -> Self {
+        Self { c: 1.0, ..self }
+    }
+
+    /// The same controller damping before it scales: per axis the least damping `α ≥ 0` (the
+    /// force `F − α·v`) whose predicted work fits the room, up to the `α` of least work (for a
+    /// lone body stepped by semi-implicit Euler `m/(2T)`: beyond it the damping does less, and at
+    /// `2m/T` it reverses the body and does positive work); then the scale, if the room is still
+    /// short. Damping takes the motion's share and leaves a steady force alone.
+    pub fn damping(self) -> Self {
+        Self { damp: true, ..self }
     }
 
     /// The scale `β` per axis of the last [`Self::control`] (1: the force as requested).
@@ -223,20 +265,26 @@ impl HeldWorkControl {
         self.m_inv = inv3(m).unwrap_or([[0.0; 3]; 3]);
         (self.other, self.v, self.dt) = (*other, *v, dt);
         let ext = m3_mul_v(&self.m_inv, other);
-        let h = dt * dt / 2.0;
+        let h = self.c * dt * dt;
         std::array::from_fn(|i| {
-            let f = force[i];
             let cross: f64 = (0..3)
                 .filter(|&j| j != i)
                 .map(|j| self.m_inv[i][j] * force[j])
                 .sum();
-            let q = f * f * self.m_inv[i][i] * h;
-            let l = f * (v[i] * dt + (cross + ext[i]) * h);
+            // The work of a force g on this axis: g·s + g²·k.
+            let (s, k) = (v[i] * dt + (cross + ext[i]) * h, self.m_inv[i][i] * h);
             let room = far_e_in[i].max(0.0) - ports.axes[i].energy_out();
-            let b = largest_scale(q, l, room);
+            let f = force[i];
+            let g = if self.damp {
+                f - least_damping(f, v[i], s, k, room) * v[i]
+            } else {
+                f
+            };
+            let b = largest_scale(g * g * k, g * s, room);
             self.beta[i] = b;
-            self.cut[i] = ((q + l) - (q * b * b + l * b)).max(0.0);
-            b * f
+            let (w_asked, w_out) = (f * s + f * f * k, b * g * s + b * g * b * g * k);
+            self.cut[i] = (w_asked - w_out).max(0.0);
+            b * g
         })
     }
 
@@ -248,12 +296,25 @@ impl HeldWorkControl {
         if !(self.dt > 0.0 && applied.iter().all(|f| f.is_finite())) {
             return;
         }
-        let w = held_work(applied, &self.v, &self.other, &self.m_inv, self.dt);
+        let w = held_work(applied, &self.v, &self.other, &self.m_inv, self.dt, self.c);
         for ((port, w), cut) in ports.axes.iter_mut().zip(w).zip(self.cut) {
             port.book_work(w, cut);
         }
         let total: V3 = std::array::from_fn(|i| applied[i] + self.other[i]);
         self.vel.set_acceleration(&m3_mul_v(&self.m_inv, &total));
+    }
+
+    /// Books into `ports` the period in which `applied` (N, N, N·m) was applied and the body
+    /// really moved at the mean velocity `moved` (its displacement over the period / `dt`; m/s,
+    /// m/s, rad/s): the work `applied·moved·dt` (a world side knows its body's displacement at
+    /// once), and the predicted work the controller removed as dissipated.
+    pub fn book_measured(&self, ports: &mut PlanarTdpa, applied: &V3, moved: &V3) {
+        if self.dt <= 0.0 {
+            return;
+        }
+        for (i, port) in ports.axes.iter_mut().enumerate() {
+            port.book_work(applied[i] * moved[i] * self.dt, self.cut[i]);
+        }
     }
 }
 
@@ -301,7 +362,7 @@ mod tests {
             ([2.0, -1.0, 0.01], [0.01, 0.02, -0.3]),
             ([-3.0, 0.5, 0.0], [-0.05, 0.0, 0.1]),
         ] {
-            let w = held_work(&f, &v, &[0.0; 3], &mi, T);
+            let w = held_work(&f, &v, &[0.0; 3], &mi, T, 0.5);
             let exact = kinetic_change(&M, &v, &f, T);
             assert!(
                 (w.iter().sum::<f64>() - exact).abs() < 1e-12,
@@ -316,8 +377,8 @@ mod tests {
         // same displacement; their sum is the body's kinetic-energy change.
         let mi = inv3(&M).unwrap();
         let (f, h, v) = ([1.5, -0.4, 0.02], [-0.7, 0.9, -0.01], [0.03, -0.01, 0.2]);
-        let wf: f64 = held_work(&f, &v, &h, &mi, T).iter().sum();
-        let wh: f64 = held_work(&h, &v, &f, &mi, T).iter().sum();
+        let wf: f64 = held_work(&f, &v, &h, &mi, T, 0.5).iter().sum();
+        let wh: f64 = held_work(&h, &v, &f, &mi, T, 0.5).iter().sum();
         let total = [f[0] + h[0], f[1] + h[1], f[2] + h[2]];
         assert!((wf + wh - kinetic_change(&M, &v, &total, T)).abs() < 1e-12);
     }
@@ -366,7 +427,7 @@ mod tests {
         // α·v²·T dissipated).
         let v = [0.03, 0.0, 0.0];
         let f = [-(2.0 * 0.2 / T) * v[0], 0.0, 0.0];
-        let w = held_work(&f, &v, &[0.0; 3], &inv3(&FREE).unwrap(), T);
+        let w = held_work(&f, &v, &[0.0; 3], &inv3(&FREE).unwrap(), T, 0.5);
         assert!(w[0].abs() < 1e-15, "{w:?}");
     }
 
@@ -378,6 +439,78 @@ mod tests {
         assert_eq!(on_x(&mut c, &ports, 1.0, 0.1, 0.0), 0.0);
         // An input (the force against the motion) is not cut by the debt.
         assert_eq!(on_x(&mut c, &ports, -1.0, 0.1, 0.0), -1.0);
+    }
+
+    /// The work (J) of the force `f` over one semi-implicit Euler step of a lone body (mass `m`) at
+    /// velocity `v` with the other force `w` on it: `v' = v + (f + w)·T/m`, `x' = x + v'·T`.
+    fn euler_work(f: f64, w: f64, v: f64, m: f64) -> f64 {
+        let v1 = v + (f + w) * T / m;
+        f * v1 * T
+    }
+
+    #[test]
+    fn the_held_work_of_a_semi_implicit_euler_step_is_the_force_times_the_steps_displacement() {
+        let mi = inv3(&FREE).unwrap();
+        let (f, w, v) = ([1.2, -0.3, 0.0], [-0.5, 0.1, 0.0], [0.04, 0.01, 0.0]);
+        let held = held_work(&f, &v, &w, &mi, T, 1.0);
+        for i in 0..2 {
+            assert!(
+                (held[i] - euler_work(f[i], w[i], v[i], 0.2)).abs() < 1e-18,
+                "{held:?}"
+            );
+        }
+    }
+
+    /// A world's body of 0.5 kg (x, y) stepped by semi-implicit Euler, its controller damping first.
+    fn world_body() -> (HeldWorkControl, M3) {
+        let m = [[0.5, 0.0, 0.0], [0.0, 0.5, 0.0], [0.0, 0.0, 1e-4]];
+        (HeldWorkControl::new(50.0, T).semi_implicit().damping(), m)
+    }
+
+    #[test]
+    fn a_damping_controller_damps_a_moving_body_to_the_room_and_keeps_the_force_direction() {
+        // 2 N along a body moving at 0.05 m/s, no room: the least damping whose work over the
+        // Euler step is zero, the force reversed by the damping as in TDPA.
+        let (mut c, m) = world_body();
+        let ports = PlanarTdpa::default();
+        let (f, v) = ([2.0, 0.0, 0.0], [0.05, 0.0, 0.0]);
+        let out = c.control(&ports, &f, &v, &[0.0; 3], &m, &[0.0; 3], T);
+        assert!(out[0] < 2.0, "{out:?}");
+        assert!(euler_work(out[0], 0.0, 0.05, 0.5).abs() < 1e-15, "{out:?}");
+        // The damping leaves the scale alone where it suffices.
+        assert_eq!(c.beta()[0], 1.0);
+    }
+
+    #[test]
+    fn the_damping_stops_at_the_least_work_m_over_2t_never_at_the_reversing_cap() {
+        // A debt nothing pays in one step: the damping of least work, α = m/(2T) for a lone body,
+        // whose work is −m·v²/4 (at the TDPA cap 2m/T the same damping would give +α·v²·T).
+        assert!(
+            (least_damping(0.0, 0.05, 0.05 * T, T * T / 0.5, -1.0) - 0.5 / (2.0 * T)).abs() < 1e-9
+        );
+        let f = -(0.5 / (2.0 * T)) * 0.05;
+        assert!((euler_work(f, 0.0, 0.05, 0.5) + 0.5 * 0.05 * 0.05 / 4.0).abs() < 1e-15);
+        let cap = -(2.0 * 0.5 / T) * 0.05;
+        assert!(
+            (euler_work(cap, 0.0, 0.05, 0.5) - (2.0 * 0.5 / T) * 0.05 * 0.05 * T).abs() < 1e-15
+        );
+    }
+
+    #[test]
+    fn a_damping_controller_leaves_a_resting_contact_alone() {
+        // The body rests on a wall that pushes back 3 N against the 3 N coupling force.
+        let (mut c, m) = world_body();
+        let ports = PlanarTdpa::default();
+        let out = c.control(
+            &ports,
+            &[-3.0, 0.0, 0.0],
+            &[0.0; 3],
+            &[3.0, 0.0, 0.0],
+            &m,
+            &[0.0; 3],
+            T,
+        );
+        assert_eq!(out, [-3.0, 0.0, 0.0]);
     }
 
     #[test]
