@@ -47,10 +47,15 @@
 //!
 //! The velocity at the start of the period matters as much as the self-term: the device's 50 Hz
 //! velocity filter lags 3.2 ms, which left +1.1–1.7 mJ on the handle at a 200 ms round trip;
-//! [`ForcedVelocity`] carries the velocity with the known acceleration instead. Measured in the
-//! split loop (docs/TELEOP.md, "The held-work controller, tried"): the handle's share at 200 ms
-//! went from +5.7 mJ to about 0, but the world port's share remained, so the device side does not
-//! use this controller yet. Pure arithmetic, no allocation, fixed order.
+//! [`ForcedVelocity`] carries the velocity with the known acceleration instead. For a world's body
+//! stepped by semi-implicit Euler ([`HeldWorkControl::semi_implicit`]) a damping alone does its
+//! least work at `α = m/(2T)` and positive work at the usual cap `2m/T`, so there the controller
+//! damps first, up to the damping of least work ([`HeldWorkControl::damping`]).
+//!
+//! Measured in the split loop (docs/TELEOP.md, "The held-work controller with the hand's wrench,
+//! tried"): on both ports the plants at a 200 ms round trip received +0.5 mJ instead of +7 mJ, but
+//! the honest ports are stricter — the contact softened at 50 ms and collapsed at 200 ms — so the
+//! split loop does not use this controller. Pure arithmetic, no allocation, fixed order.
 
 use super::tdpa::PlanarTdpa;
 use crate::device::linalg::{inv3, m3_mul_v, M3, V3};
