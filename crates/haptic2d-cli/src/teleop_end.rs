@@ -83,8 +83,12 @@ pub struct LiveEnd {
     rate: V3,
     /// How long this tick's read waited for the device (ns; 0 for the simulated device).
     read_wait_ns: u64,
-    /// The torques written last (N·m; a point device: N): zeros once the run stopped.
+    /// This tick's torques (N·m; a point device: N), written by [`Self::write`].
     pub tau: V4,
+    /// When (s, loop time) non-zero torques were last written, and when zero torques were first
+    /// written on a stop (`None`: not yet; the loop's end zeroes again, unrecorded).
+    pub last_torque_t: Option<f64>,
+    pub zeroed_t: Option<f64>,
     /// Largest applied force `|(f_x, f_y)|` (N).
     pub max_force: f64,
     /// The handle's displacement from its origin at the last sensed tick (m, m, rad).
@@ -184,6 +188,8 @@ impl LiveEnd {
             rate: [0.0; 3],
             read_wait_ns: 0,
             tau: [0.0; 4],
+            last_torque_t: None,
+            zeroed_t: None,
             max_force: 0.0,
             displacement: [0.0; 3],
             max_excursion: 0.0,
@@ -237,9 +243,9 @@ impl LiveEnd {
         self.est = self.end.sense(at, q, elapsed, device_wait);
         let est = self.est?;
         let o = self.end.origin().unwrap_or(est.pose);
-        let rate = self
-            .prev
-            .map_or([0.0; 3], |p| std::array::from_fn(|i| (est.pose[i] - p[i]) / dt));
+        let rate = self.prev.map_or([0.0; 3], |p| {
+            std::array::from_fn(|i| (est.pose[i] - p[i]) / dt)
+        });
         (self.prev, self.rate) = (Some(est.pose), rate);
         let x: V3 = std::array::from_fn(|i| est.pose[i] - o[i]);
         self.displacement = x;
@@ -276,16 +282,22 @@ impl LiveEnd {
         out.applied
     }
 
-    /// Writes this tick's torques.
-    pub fn write(&mut self) -> Result<(), DeviceError> {
+    /// Writes this tick's torques at loop time `t` (s).
+    pub fn write(&mut self, t: f64) -> Result<(), DeviceError> {
         let tau = self.tau;
+        if tau.iter().any(|v| *v != 0.0) {
+            self.last_torque_t = Some(t);
+        }
         self.io().write_torques(&tau)
     }
 
-    /// Zero torques, written now (a lost device: best effort) and latched in the device's
-    /// `zero_torques`; the end's `tau` is zero from here on.
-    pub fn zero(&mut self) {
+    /// Zero torques at loop time `t` (s; `None`: after the loop), written now (a lost device:
+    /// best effort) and latched in the device's `zero_torques`.
+    pub fn zero(&mut self, t: Option<f64>) {
         self.tau = [0.0; 4];
+        if self.zeroed_t.is_none() {
+            self.zeroed_t = t;
+        }
         let _ = self.io().write_torques(&[0.0; 4]);
         self.io().zero_torques();
     }

@@ -160,7 +160,10 @@ impl Live {
         let sm = self.m.sense(at, &qm, elapsed, wait, dt);
         let ss = self.s.sense(at, &qs, elapsed, wait, dt);
         // Master: the newest message from the slave through its port.
-        let (f_req, far_s) = self.down.receive(k).map_or(([0.0; 3], [0.0; 3]), |d| (d.f, d.e_in));
+        let (f_req, far_s) = self
+            .down
+            .receive(k)
+            .map_or(([0.0; 3], [0.0; 3]), |d| (d.f, d.e_in));
         let f_m = self.m.drive(at, &f_req, &far_s, self.tdpa, dt);
         if let Some((x, v)) = sm {
             let e_in = self.m.port.energy_in();
@@ -170,28 +173,34 @@ impl Live {
         let newest = self.up.receive(k);
         let far_m = newest.map_or([0.0; 3], |u| u.e_in);
         let f_c: V3 = match (newest, ss) {
-            (Some(u), Some((xs, vs))) => std::array::from_fn(|i| {
-                self.k[i] * (u.x[i] - xs[i]) + self.b[i] * (u.v[i] - vs[i])
-            }),
+            (Some(u), Some((xs, vs))) => {
+                std::array::from_fn(|i| self.k[i] * (u.x[i] - xs[i]) + self.b[i] * (u.v[i] - vs[i]))
+            }
             _ => [0.0; 3],
         };
         self.s.drive(at, &f_c, &far_m, self.tdpa, dt);
         let e_in = self.s.port.energy_in();
-        self.down.send(k, Down { f: f_c.map(|f| -f), e_in });
+        self.down.send(
+            k,
+            Down {
+                f: f_c.map(|f| -f),
+                e_in,
+            },
+        );
         self.book_contact(t, f_m[0]);
         // A latch at either end zeroes both in this tick.
         let trip = (self.m.end.trip_info().map(|r| (Role::Master, r)))
             .or_else(|| self.s.end.trip_info().map(|r| (Role::Slave, r)));
         if let Some((role, trip)) = trip {
-            self.m.zero();
-            self.s.zero();
+            self.m.zero(Some(t));
+            self.s.zero(Some(t));
             self.stop.get_or_insert((t, LiveStop::Latch(role, trip)));
             return TickControl::Stop;
         }
-        if let Err(e) = self.m.write() {
+        if let Err(e) = self.m.write(t) {
             return self.lost(t, Role::Master, e);
         }
-        if let Err(e) = self.s.write() {
+        if let Err(e) = self.s.write(t) {
             return self.lost(t, Role::Slave, e);
         }
         TickControl::Continue
@@ -213,15 +222,18 @@ impl Live {
 
     /// `role`'s device was lost with `e`: both ends zeroed (the lost one best effort), stop.
     fn lost(&mut self, t: f64, role: Role, e: DeviceError) -> TickControl {
-        self.m.zero();
-        self.s.zero();
+        self.m.zero(Some(t));
+        self.s.zero(Some(t));
         self.stop.get_or_insert((t, LiveStop::Lost(role, e)));
         TickControl::Stop
     }
 
     /// The link's counters: (lost, stale) master → slave and slave → master.
     pub fn link_counters(&self) -> [(u64, u64); 2] {
-        [(self.up.lost, self.up.stale), (self.down.lost, self.down.stale)]
+        [
+            (self.up.lost, self.up.stale),
+            (self.down.lost, self.down.stale),
+        ]
     }
 }
 
@@ -245,7 +257,10 @@ fn refuse_sim_only(a: &TeleopArgs) -> Result<(), Failure> {
         return refuse("--stability / --figures", "are analyses, not runs");
     }
     if a.push.is_some() && a.master != "sim" {
-        return refuse("--push", "moves the simulated master's grip: it needs --master sim");
+        return refuse(
+            "--push",
+            "moves the simulated master's grip: it needs --master sim",
+        );
     }
     Ok(())
 }
@@ -255,13 +270,29 @@ pub fn run(a: &TeleopArgs, link: Impairment) -> Result<Status, Failure> {
     refuse_sim_only(a)?;
     let dt = 1e-3;
     let push = match (a.master.as_str(), &a.push) {
-        ("sim", p) => Some(Push::parse(p.as_deref().unwrap_or(DEFAULT_PUSH)).map_err(Failure::from)?),
+        ("sim", p) => {
+            Some(Push::parse(p.as_deref().unwrap_or(DEFAULT_PUSH)).map_err(Failure::from)?)
+        }
         _ => None,
     };
     let file = |f: &Option<std::path::PathBuf>| f.as_deref().map(|p| p.to_path_buf());
     let (mf, sf) = (file(&a.master_device_file), file(&a.slave_device_file));
-    let m = LiveEnd::open(Role::Master, &a.master, mf.as_deref(), a.allow_remote_device, push, dt)?;
-    let s = LiveEnd::open(Role::Slave, &a.slave, sf.as_deref(), a.allow_remote_device, None, dt)?;
+    let m = LiveEnd::open(
+        Role::Master,
+        &a.master,
+        mf.as_deref(),
+        a.allow_remote_device,
+        push,
+        dt,
+    )?;
+    let s = LiveEnd::open(
+        Role::Slave,
+        &a.slave,
+        sf.as_deref(),
+        a.allow_remote_device,
+        None,
+        dt,
+    )?;
     let stop = haptic2d_rt::signal::install_stop_signals().map_err(Failure::error)?;
     let coupling = (a.stiffness, a.damping);
     let mut live = Live::new(m, s, link, coupling, !a.no_tdpa, dt, a.duration);
@@ -286,8 +317,12 @@ pub fn run(a: &TeleopArgs, link: Impairment) -> Result<Status, Failure> {
             .map_err(Failure::error)
     });
     // Whatever ended the loop (the duration, a signal, a stop, a failure): both at zero.
-    live.m.zero();
-    live.s.zero();
+    live.m.zero(None);
+    live.s.zero(None);
     let summary = summary?;
-    Ok(crate::teleop_report::report(&live, &summary, stop.load(Ordering::Relaxed)))
+    Ok(crate::teleop_report::report(
+        &live,
+        &summary,
+        stop.load(Ordering::Relaxed),
+    ))
 }

@@ -92,12 +92,16 @@ pub fn report(live: &Live, summary: &TimingSummary, interrupted: bool) -> Status
 
 /// Why the run ended, and its status.
 fn stop_lines(live: &Live, interrupted: bool) -> Status {
-    let torques = |e: &LiveEnd| format!("{} τ = {:?}", e.role.name(), e.tau);
-    let zeroed = format!(
-        "torques of both devices set to zero in that tick ({}, {})",
-        torques(&live.m),
-        torques(&live.s)
-    );
+    let when = |t: Option<f64>| t.map_or("-".to_string(), |t| format!("{t:.3} s"));
+    for e in [&live.m, &live.s] {
+        outln!(
+            "{} torques: last non-zero written at t = {}; zero written at the stop at t = {}; none written after",
+            e.role.name(),
+            when(e.last_torque_t),
+            when(e.zeroed_t)
+        );
+    }
+    let zeroed = "torques of both devices set to zero";
     let name = |r| {
         if r == crate::teleop_end::Role::Master {
             &live.m.name

@@ -181,7 +181,10 @@ mod tests {
     #[test]
     fn a_wall_out_of_contact_exerts_nothing() {
         for x in [0.10, 0.12] {
-            assert_eq!(WALL.wrench(&[x, 0.0, 0.0], &[-1.0, 0.0, 0.0], 0.0), [0.0; 3]);
+            assert_eq!(
+                WALL.wrench(&[x, 0.0, 0.0], &[-1.0, 0.0, 0.0], 0.0),
+                [0.0; 3]
+            );
         }
     }
 
