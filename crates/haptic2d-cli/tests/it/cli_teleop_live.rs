@@ -135,46 +135,18 @@ fn the_slave_emulator_killed_mid_run_exits_4_naming_the_slave_with_the_master_ze
     let file = gen3(dir.path());
     let (mut emu, pty) = emulate_haply(&file, &["--hand", "free", "--no-rt"]);
     let slave = format!("haply:{pty}");
-    let mut child = cmd("teleop --live --no-rt --duration 20 --slave", &[])
-        .arg(&slave)
-        .arg("--slave-device-file")
-        .arg(&file)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut reader = BufReader::new(child.stdout.take().unwrap());
-    let mut out = String::new();
-    // The start line comes once both devices are open and the loop is about to run.
-    while !out.contains("teleop live:") {
-        let n = reader.read_line(&mut out).unwrap();
-        assert!(n > 0, "the run ended before its loop started:\n{out}");
-    }
+    let mut run = cmd("teleop --live --no-rt --duration 20 --slave", &[]);
+    run.arg(&slave).arg("--slave-device-file").arg(&file);
+    let (child, reader, out) = spawn_until_looping(run);
     std::thread::sleep(Duration::from_millis(1500));
     emu.kill().unwrap();
     let _ = emu.wait();
     let t0 = Instant::now();
-    reader.read_to_string(&mut out).unwrap();
-    let status = child.wait().unwrap();
-    let mut err = String::new();
-    child
-        .stderr
-        .take()
-        .unwrap()
-        .read_to_string(&mut err)
-        .unwrap();
-    out.push_str(&err);
-    assert!(
-        t0.elapsed() < Duration::from_secs(5),
-        "{:?}\n{out}",
-        t0.elapsed()
-    );
-    assert_lost_device(
-        status.code(),
-        &out,
-        &slave,
-        &[&format!("the slave ({slave}) was lost")],
-    );
+    let (code, out) = finish(child, reader, out);
+    let took = t0.elapsed();
+    assert!(took < Duration::from_secs(5), "{took:?}\n{out}");
+    let says = format!("the slave ({slave}) was lost");
+    assert_lost_device(code, &out, &slave, &[&says]);
     let stop = number(&out, "master torques:", "zero written at the stop at t =");
     let last = number(&out, "master torques:", "last non-zero written at t =");
     assert!(stop > 1.0, "stopped at {stop} s:\n{out}");
@@ -246,4 +218,108 @@ fn udp_reference_device(args: &[&str]) -> (Killed, String) {
         .args(args)
         .stderr(Stdio::null());
     spawn_announced(&mut c, "listening on ")
+}
+
+/// `run` (a `haptic2d teleop --live` command) spawned with its output piped, returned once its
+/// loop is about to run (its start line read, printed once both devices are open), with what it
+/// printed so far.
+fn spawn_until_looping(
+    mut run: Command,
+) -> (
+    std::process::Child,
+    BufReader<std::process::ChildStdout>,
+    String,
+) {
+    let mut child = run
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut reader = BufReader::new(child.stdout.take().unwrap());
+    let mut out = String::new();
+    while !out.contains("teleop live:") {
+        let n = reader.read_line(&mut out).unwrap();
+        assert!(n > 0, "the run ended before its loop started:\n{out}");
+    }
+    (child, reader, out)
+}
+
+/// Two simulated twins for 10 s, spawned as [`spawn_until_looping`].
+fn spawn_two_sims() -> (
+    std::process::Child,
+    BufReader<std::process::ChildStdout>,
+    String,
+) {
+    spawn_until_looping(cmd("teleop --live --no-rt --duration 10", &[]))
+}
+
+/// The rest of `child`'s output after `out` (stdout then stderr) and its exit code.
+fn finish(
+    mut child: std::process::Child,
+    mut reader: BufReader<std::process::ChildStdout>,
+    mut out: String,
+) -> (Option<i32>, String) {
+    reader.read_to_string(&mut out).unwrap();
+    let status = child.wait().unwrap();
+    let mut err = String::new();
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut err)
+        .unwrap();
+    out.push_str(&err);
+    (status.code(), out)
+}
+
+/// The whole process stopped (SIGSTOP) for 300 ms mid-run: the loop's next tick sees a stall
+/// far past the simulated devices' 40 ms limit; the latch at one end zeroes both devices in that
+/// same tick (each end's zero torques written at the stop's time, its last non-zero ones before),
+/// and the run exits 3 saying why.
+#[test]
+fn a_stalled_loop_latches_and_zeroes_both_devices_in_the_same_tick() {
+    let _m = crate::common::module_turn(module_path!());
+    let _t = turn();
+    let (child, reader, out) = spawn_two_sims();
+    std::thread::sleep(Duration::from_millis(1000));
+    assert!(crate::common::signal(child.id(), "-STOP"));
+    std::thread::sleep(Duration::from_millis(300));
+    assert!(crate::common::signal(child.id(), "-CONT"));
+    let (code, out) = finish(child, reader, out);
+    assert_eq!(code, Some(3), "{out}");
+    assert_has(&out, &["latched at t =", "stalled"]);
+    let at = |end: &str, key: &str| number(&out, &format!("{end} torques:"), key);
+    let (zm, zs) = (
+        at("master", "at the stop at t ="),
+        at("slave", "at the stop at t ="),
+    );
+    assert_eq!(
+        zm, zs,
+        "the two ends were zeroed in different ticks:\n{out}"
+    );
+    for end in ["master", "slave"] {
+        assert!(
+            at(end, "last non-zero written at t =") < zm,
+            "{end}:\n{out}"
+        );
+    }
+}
+
+/// Ctrl-C (SIGINT) mid-run: the loop ends, both devices get zero torques, exit 130.
+#[test]
+fn ctrl_c_ends_the_live_run_with_both_devices_at_zero() {
+    let _m = crate::common::module_turn(module_path!());
+    let _t = turn();
+    let (child, reader, out) = spawn_two_sims();
+    std::thread::sleep(Duration::from_millis(800));
+    assert!(crate::common::signal(child.id(), "-INT"));
+    let (code, out) = finish(child, reader, out);
+    assert_eq!(code, Some(130), "{out}");
+    assert_has(
+        &out,
+        &[
+            "stopped: interrupted by a signal",
+            "torques of both devices set to zero",
+        ],
+    );
 }
