@@ -13,7 +13,7 @@
 //! take turns.
 
 use std::io::{BufRead, BufReader, Read};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
@@ -47,6 +47,13 @@ fn teleop(args: &[&str]) -> (Option<i32>, String) {
         .output()
         .unwrap();
     (o.status.code(), text(&o))
+}
+
+/// A 3 s [`teleop`] with `device` (its device file `file`) as the `end` (`master` or `slave`),
+/// the other end simulated.
+fn teleop_with(end: &str, device: &str, file: &Path) -> (Option<i32>, String) {
+    let (e, f) = (format!("--{end}"), format!("--{end}-device-file"));
+    teleop(&[&e, device, &f, file.to_str().unwrap(), "--duration", "3"])
 }
 
 /// Two simulated twins, 25 ms each way and 5 % loss each way, TDPA on: the grip's target moves
@@ -86,9 +93,14 @@ fn two_simulated_devices_live_across_50_ms_and_loss_feel_the_wall_and_create_no_
     assert!((60.0..300.0).contains(&lost), "{lost} lost:\n{out}");
 }
 
-/// The shipped gen 3 2DIY file, patient (see the module doc), in `dir`.
-fn gen3(dir: &Path) -> std::path::PathBuf {
-    haply_file(dir, "haply-2diy-gen3.toml", "gen3.toml", |t| t)
+/// An emulated 2DIY with its hand released (`--hand free`), on the shipped gen 3 file made
+/// patient (see the module doc) in a temp dir: the dir (kept while it lives), the file, the
+/// emulator (killed on drop) and the device's name, `haply:PTY`.
+fn free_2diy() -> (tempfile::TempDir, PathBuf, Killed, String) {
+    let dir = tempfile::tempdir().unwrap();
+    let file = haply_file(dir.path(), "haply-2diy-gen3.toml", "gen3.toml", |t| t);
+    let (emu, pty) = emulate_haply(&file, &["--hand", "free", "--no-rt"]);
+    (dir, file, emu, format!("haply:{pty}"))
 }
 
 /// A simulated master pushed 15 mm left drives the emulated 2DIY (its hand released): with no
@@ -99,19 +111,8 @@ fn gen3(dir: &Path) -> std::path::PathBuf {
 fn a_simulated_master_moves_an_emulated_2diy_slave_with_its_push() {
     let _m = crate::common::module_turn(module_path!());
     let _t = turn();
-    let dir = tempfile::tempdir().unwrap();
-    let file = gen3(dir.path());
-    let (emu, pty) = emulate_haply(&file, &["--hand", "free", "--no-rt"]);
-    let slave = format!("haply:{pty}");
-    let f = file.to_str().unwrap();
-    let (code, out) = teleop(&[
-        "--slave",
-        &slave,
-        "--slave-device-file",
-        f,
-        "--duration",
-        "3",
-    ]);
+    let (_dir, file, emu, slave) = free_2diy();
+    let (code, out) = teleop_with("slave", &slave, &file);
     interrupt(emu);
     assert_eq!(code, Some(0), "{out}");
     assert_has(&out, &[&format!("slave {slave}: "), "no safety stop"]);
@@ -131,10 +132,7 @@ fn a_simulated_master_moves_an_emulated_2diy_slave_with_its_push() {
 fn the_slave_emulator_killed_mid_run_exits_4_naming_the_slave_with_the_master_zeroed() {
     let _m = crate::common::module_turn(module_path!());
     let _t = turn();
-    let dir = tempfile::tempdir().unwrap();
-    let file = gen3(dir.path());
-    let (mut emu, pty) = emulate_haply(&file, &["--hand", "free", "--no-rt"]);
-    let slave = format!("haply:{pty}");
+    let (_dir, file, mut emu, slave) = free_2diy();
     let mut run = cmd("teleop --live --no-rt --duration 20 --slave", &[]);
     run.arg(&slave).arg("--slave-device-file").arg(&file);
     let (child, reader, out) = spawn_until_looping(run);
@@ -172,15 +170,7 @@ fn a_udp_reference_master_feels_the_simulated_slaves_wall() {
     );
     let (device, addr) = udp_reference_device(&["--push=-1.5,0", "--push-after", "0.6"]);
     let master = format!("udp:{addr}");
-    let f = file.to_str().unwrap();
-    let (code, out) = teleop(&[
-        "--master",
-        &master,
-        "--master-device-file",
-        f,
-        "--duration",
-        "3",
-    ]);
+    let (code, out) = teleop_with("master", &master, &file);
     drop(device);
     assert_eq!(code, Some(0), "{out}");
     let contact = "slave contact (simulated wall)";
@@ -244,13 +234,16 @@ fn spawn_until_looping(
     (child, reader, out)
 }
 
-/// Two simulated twins for 10 s, spawned as [`spawn_until_looping`].
-fn spawn_two_sims() -> (
-    std::process::Child,
-    BufReader<std::process::ChildStdout>,
-    String,
-) {
-    spawn_until_looping(cmd("teleop --live --no-rt --duration 10", &[]))
+/// Two simulated twins for 10 s, spawned as [`spawn_until_looping`], sent each `(ms, SIGNAL)`
+/// of `signals` in turn `ms` after the one before (the first after the start line), run to their
+/// end: exit code and output.
+fn two_sims_signalled(signals: &[(u64, &str)]) -> (Option<i32>, String) {
+    let (child, reader, out) = spawn_until_looping(cmd("teleop --live --no-rt --duration 10", &[]));
+    for (ms, sig) in signals {
+        std::thread::sleep(Duration::from_millis(*ms));
+        assert!(crate::common::signal(child.id(), sig), "{sig}");
+    }
+    finish(child, reader, out)
 }
 
 /// The rest of `child`'s output after `out` (stdout then stderr) and its exit code.
@@ -280,12 +273,7 @@ fn finish(
 fn a_stalled_loop_latches_and_zeroes_both_devices_in_the_same_tick() {
     let _m = crate::common::module_turn(module_path!());
     let _t = turn();
-    let (child, reader, out) = spawn_two_sims();
-    std::thread::sleep(Duration::from_millis(1000));
-    assert!(crate::common::signal(child.id(), "-STOP"));
-    std::thread::sleep(Duration::from_millis(300));
-    assert!(crate::common::signal(child.id(), "-CONT"));
-    let (code, out) = finish(child, reader, out);
+    let (code, out) = two_sims_signalled(&[(1000, "-STOP"), (300, "-CONT")]);
     assert_eq!(code, Some(3), "{out}");
     assert_has(&out, &["latched at t =", "stalled"]);
     let at = |end: &str, key: &str| number(&out, &format!("{end} torques:"), key);
@@ -310,10 +298,7 @@ fn a_stalled_loop_latches_and_zeroes_both_devices_in_the_same_tick() {
 fn ctrl_c_ends_the_live_run_with_both_devices_at_zero() {
     let _m = crate::common::module_turn(module_path!());
     let _t = turn();
-    let (child, reader, out) = spawn_two_sims();
-    std::thread::sleep(Duration::from_millis(800));
-    assert!(crate::common::signal(child.id(), "-INT"));
-    let (code, out) = finish(child, reader, out);
+    let (code, out) = two_sims_signalled(&[(800, "-INT")]);
     assert_eq!(code, Some(130), "{out}");
     assert_has(
         &out,
