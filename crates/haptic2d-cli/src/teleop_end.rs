@@ -198,6 +198,12 @@ impl LiveEnd {
         }
     }
 
+    /// An end on the device `io` with `end` (tests: a fake device).
+    #[cfg(test)]
+    pub(crate) fn with_io(role: Role, io: Box<dyn DeviceIo + Send>, end: DeviceEnd) -> Self {
+        Self::assemble(role, "fake".into(), String::new(), EndIo::Real(io), end)
+    }
+
     fn io(&mut self) -> &mut dyn DeviceIo {
         match &mut self.io {
             EndIo::Sim { io, .. } => io,

@@ -18,7 +18,8 @@
 //! render (x, y; θ too between two twins), in each device's own frame: the two frames must point
 //! the same way. Velocities are the unfiltered rate of the measured pose over the period, as in the
 //! lab's teleop. The tick allocates nothing once the link's queues have grown to the delay (the
-//! lab's `Link` keeps its messages in a `VecDeque` that grows during the first `delay` ticks).
+//! lab's `Link` keeps its messages in a `VecDeque` that grows during the first `delay` ticks: 8
+//! allocations at 25 ms each way, counted in `tests::once_the_link_is_full_a_tick_allocates_nothing`).
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
@@ -326,3 +327,7 @@ pub fn run(a: &TeleopArgs, link: Impairment) -> Result<Status, Failure> {
         stop.load(Ordering::Relaxed),
     ))
 }
+
+#[cfg(test)]
+#[path = "teleop_live_tests.rs"]
+mod tests;
