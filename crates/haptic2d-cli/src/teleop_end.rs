@@ -133,8 +133,11 @@ impl LiveEnd {
         };
         let end = real.device_end(dt).map_err(named)?;
         let (name, summary) = (real.name.clone(), real.summary.clone());
-        let io = (real.open)(Duration::from_secs_f64(dt))
-            .map_err(|e| Failure::error(format!("--{} {spec}: {e}", role.name())))?;
+        // As `run`: a device that cannot be opened or does not answer is a lost device (exit 4).
+        let io = (real.open)(Duration::from_secs_f64(dt)).map_err(|e| Failure {
+            status: crate::exit::Status::DeviceLost,
+            message: format!("--{} {spec}: {e}", role.name()),
+        })?;
         Ok(Self::assemble(role, name, summary, EndIo::Real(io), end))
     }
 

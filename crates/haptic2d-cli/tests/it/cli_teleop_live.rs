@@ -308,3 +308,17 @@ fn ctrl_c_ends_the_live_run_with_both_devices_at_zero() {
         ],
     );
 }
+
+/// What `--live` refuses, before anything opens: four channels (no device has a force sensor at
+/// its handle: exit 2 with the reason); a master that cannot be opened is a lost device (exit 4,
+/// as `run`), named by its option.
+#[test]
+fn four_channels_are_refused_live_and_a_device_that_cannot_open_is_lost() {
+    let _m = crate::common::module_turn(module_path!());
+    let (code, out) = teleop(&["--architecture", "four-channel"]);
+    assert_eq!(code, Some(2), "{out}");
+    assert_has(&out, &["no force sensor at the handle"]);
+    let (code, out) = teleop(&["--master", "haply:/dev/null"]);
+    assert_eq!(code, Some(4), "{out}");
+    assert_has(&out, &["--master haply:/dev/null: cannot open"]);
+}
