@@ -1,18 +1,20 @@
 //! `haptic2d run --world udp:HOST:PORT --key FILE` (alias: `haptic2d remote-device --world …`): the
 //! device side of the haptic loop split at a network (issue 41, docs/TELEOP.md). It runs the device (the simulated twin
-//! pantograph and its simulated hand) with its local safety, and renders the force the world side
+//! pantograph and its simulated hand, or any real device of the registry: a Haply board, a UDP
+//! device, an Inverse3) as a [`DeviceEnd`] with its local safety, and renders the force the world side
 //! sends through the master port's TDPA passivity controller — or, with `--link wave`, the force
 //! of the lab's wave master ([`WaveMaster`], one per axis) from the returning waves, under their
 //! energy budget. Every period:
 //!
 //! ```text
-//! encoders → pose, twist (TwinPantograph::estimate)          stall, joint plausibility (SafetyStage)
+//! encoders → pose, twist (DeviceEnd::sense)                  stall, joint plausibility (SafetyStage)
 //! newest world message (authenticated, by sequence number)    lost link: none for --link-timeout-ms → latch
-//! force · ramp → TDPA master port (energy in from the world)  workspace bound (trip past it)
+//! force → TDPA master port (energy in from the world)          (DeviceEnd::actuate:) workspace bound
 //!   (wave: F = −(b·v − √(2b)·w), w the newest wave within the world's wave energy sent)
-//! → torques (redundancy, saturation) → limit cycle, gate → motors   book the force really applied
+//! → torques (saturation) → limit cycle, ramp, gate → motors   book the force really applied
 //!
-//! The safety steps are the shared `SafetyStage`, the same as every device's in `run`.
+//! The safety steps are the shared `SafetyStage`, the same as every device's in `run`; a device
+//! sends only the axes it renders (x and y on a five-bar or a point device).
 //! send: handle pose and twist from the start pose, the applied force, the port's energies
 //! ```
 //!
@@ -26,12 +28,11 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use haptic2d::control::tdpa::{planar_balance, PlanarTdpa};
-use haptic2d::device::cartesian::CartesianDevice;
-use haptic2d::device::linalg::V3;
-use haptic2d::device::{DeviceParams, ObserverKind, TwinPantograph};
-use haptic2d::haptic::safety::{Safety, SafetyConfig, SafetyReason};
-use haptic2d::haptic::workspace::WorkspaceBound;
-use haptic2d::haptic::SafetyStage;
+use haptic2d::device::linalg::{V3, V4};
+use haptic2d::device::DeviceParams;
+use haptic2d::haptic::safety::{SafetyConfig, SafetyReason};
+use haptic2d::haptic::DeviceEnd;
+use haptic2d_devices::registry::DeviceChoice;
 use haptic2d_devices::world_link::message::{FLAG_BYE, FLAG_LATCHED, FLAG_TDPA, FLAG_WAVE};
 use haptic2d_devices::world_link::{
     LinkEndpoint, PortMessage, KIND_TO_DEVICE, KIND_TO_WORLD, PORT_LEN,
@@ -39,7 +40,8 @@ use haptic2d_devices::world_link::{
 use haptic2d_lab::network::wave::{WaveMaster, WaveMsg};
 use haptic2d_rt::clock::now_ns;
 use haptic2d_rt::{
-    run_loop, DeviceIo, LoopConfig, SharedTarget, SimIo, TickControl, TickInfo, TickInterval,
+    run_loop, DeviceError, DeviceIo, LoopConfig, SharedTarget, SimIo, TickControl, TickInfo,
+    TickInterval,
 };
 
 use crate::exit::{Failure, Status};
@@ -121,6 +123,12 @@ pub struct RemoteDeviceArgs {
 /// One device side to run, from `run --world` or `remote-device`.
 struct Plan<'a> {
     world: &'a str,
+    /// `--device`: `sim` or a real device of the registry.
+    device: &'a str,
+    /// A real device's own device file (`--device-file`).
+    device_file: Option<&'a std::path::Path>,
+    /// `--allow-remote-device` (a UDP device beyond loopback).
+    allow_remote: bool,
     hand: &'a str,
     /// Run length (s); `None`: until a signal.
     duration: Option<f64>,
@@ -131,7 +139,7 @@ struct Plan<'a> {
 }
 
 /// Why the device side latched zero torques.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 enum Latch {
     /// The core's safety latch (stall, gate, workspace, device fault, singularity).
     Safety(SafetyReason),
@@ -141,19 +149,44 @@ enum Latch {
     WorldClosed,
     /// The world side runs the other kind of link (waves against forces): `true` if it runs waves.
     Mismatch { world_waves: bool },
-    /// The simulated device failed.
-    DeviceIo,
+    /// The device stopped answering, or a read or write failed (the driver's words).
+    DeviceLost(DeviceError),
+}
+
+/// The device the side drives: the simulated twin (whose plant's true motion is known, for the
+/// plants' ledger) or a real device of the registry. One per run, never moved in the loop.
+#[allow(clippy::large_enum_variant)]
+enum SideIo {
+    Sim(SimIo),
+    Real(Box<dyn DeviceIo + Send>),
+}
+
+impl SideIo {
+    fn io(&mut self) -> &mut dyn DeviceIo {
+        match self {
+            SideIo::Sim(s) => s,
+            SideIo::Real(r) => r.as_mut(),
+        }
+    }
+
+    /// The simulated plant's true pose (m, m, rad); `None` on a real device.
+    fn plant_pose(&self) -> Option<V3> {
+        match self {
+            SideIo::Sim(s) => Some(s.plant().pose()),
+            SideIo::Real(_) => None,
+        }
+    }
 }
 
 /// The device side's state, owned by the loop.
 struct DeviceSide {
-    io: SimIo,
-    push: Option<(Push, Arc<SharedTarget>)>,
-    dev: TwinPantograph,
-    /// The tick's safety steps, the same as every device's (stall, joint plausibility, workspace
-    /// bound, limit cycle, ramp, final gate).
-    safety: SafetyStage,
-    origin: V3,
+    io: SideIo,
+    push: Option<(Push, Arc<SharedTarget>, V3)>,
+    /// The device with the tick's safety steps, the same as every device's (stall, joint
+    /// plausibility, workspace bound, limit cycle, ramp, final gate).
+    end: DeviceEnd,
+    /// The axes the device renders (x, y, θ): the others send and apply nothing.
+    axes: [bool; 3],
     tdpa: bool,
     /// The wave master per axis with `--link wave`, and what it sent last.
     wave: Option<[WaveMaster; 3]>,
@@ -165,19 +198,20 @@ struct DeviceSide {
 
     ports: PlanarTdpa,
     /// The port's energy as the plant really received it: the applied force times the simulated
-    /// plant's true displacement over the period.
+    /// plant's true displacement over the period (the simulated device only).
     plant_ledger: PlanarTdpa,
     ep: LinkEndpoint,
     outbox: Outbox,
     stats: LinkStats,
     interval: TickInterval,
+    /// Time the last read waited for a real device, and the previous tick's (ns).
+    read_wait_ns: (u64, u64),
     timeout_periods: u64,
     first_timeout_periods: u64,
     last: Option<PortMessage>,
     last_k: u64,
     last_arrival_ns: u64,
     seq: u32,
-    tau: [f64; 4],
     ticks: u64,
     buf: [u8; PORT_LEN],
     max_force: f64,
@@ -189,44 +223,109 @@ struct DeviceSide {
 impl DeviceSide {
     fn tick(&mut self, info: &TickInfo) -> TickControl {
         let (k, dt, t) = (info.deadline_index, info.period_s, info.t_s);
-        let elapsed = self.interval.update(info) as f64 * 1e-9;
-        if let Some((p, target)) = &self.push {
-            target.set(p.target(&self.origin, t));
-        }
-        let q = match self.io.read_encoders() {
-            Ok(q) => q,
-            Err(_) => return self.stop(t, Latch::DeviceIo),
-        };
-        let est = match self.dev.estimate(&q, &self.tau) {
-            Ok(e) => e,
-            Err(f) => return self.stop(t, Latch::Safety(SafetyReason::Device(f))),
-        };
         let at = (k, t);
-        self.safety.supervise_input(at, &q, elapsed, f64::NAN);
+        if let Some((p, target, start)) = &self.push {
+            target.set(p.target(start, t));
+        }
+        let q = match self.read() {
+            Ok(q) => q,
+            Err(e) => return self.stop(t, Latch::DeviceLost(e)),
+        };
+        let est = self.sense(info, &q);
         let fresh = match self.receive(k, t, dt) {
             Ok(m) => m,
             Err(stop) => return stop,
         };
-        // The world's force, ramped in, through the master port's passivity controller. (Unlike
-        // the lab's teleop, the port keeps the filtered velocity: measured over the split loop,
-        // the plants' true ledger showed no gain from the unfiltered rate; docs/TELEOP.md.)
+        let Some(est) = est else {
+            // Not sensed: the latch holds the fault; zero torques and stop below.
+            self.end.actuate(at, None, &[0.0; 3]);
+            return self.finish(t);
+        };
         let (x, v) = (est.pose, est.velocity);
-        let ramp = self.safety.ramp();
-        let (f_req, far) = self.last.map_or(([0.0; 3], [0.0; 3]), |m| {
-            (m.force.map(|f| f * ramp), m.energy_in)
-        });
+        let origin = self.end.origin().unwrap_or(x);
+        let f_net = self.port_force(&x, &v, &origin, fresh, dt);
+        // Local safety: the workspace bound, the torques, the ramp, the gate.
+        let out = self.end.actuate(at, Some(&est), &self.mask(f_net));
+        let applied = self.mask(out.applied);
+        self.prev_applied = applied;
+        if self.wave.is_some() {
+            // Booked at the next period, on the displacement measured over this one.
+        } else if self.tdpa {
+            self.ports.book(&applied, &v, dt);
+        } else {
+            self.ports.observe(&applied, &v, dt);
+        }
+        self.max_force = self.max_force.max(applied[0].hypot(applied[1]));
+        let d = (x[0] - origin[0]).hypot(x[1] - origin[1]);
+        self.max_excursion = self.max_excursion.max(d);
+        let before = self.io.plant_pose();
+        if let Err(e) = self.io.io().write_torques(&out.tau) {
+            return self.stop(t, Latch::DeviceLost(e));
+        }
+        if let (Some(b), Some(a)) = (before, self.io.plant_pose()) {
+            let moved: V3 = std::array::from_fn(|i| (a[i] - b[i]) / dt);
+            self.plant_ledger.observe(&applied, &moved, dt);
+        }
+        self.send(k, &x, &origin, &v, &applied, 0);
+        self.ticks += 1;
+        self.finish(t)
+    }
+
+    /// Reads the device, timing the wait of a real one (left out of the stall check, as in `run`).
+    fn read(&mut self) -> Result<V4, DeviceError> {
+        let t0 = now_ns();
+        let q = self.io.io().read_encoders();
+        self.read_wait_ns = (now_ns().saturating_sub(t0), self.read_wait_ns.0);
+        q
+    }
+
+    /// Steps 0–2 of the device: the stall check on the loop's own time, the pose and twist. The
+    /// simulated plant advances one period a tick, so its signals use one period (the run stays
+    /// deterministic) while the stall check sees the real interval; a real device's signals use
+    /// the measured interval, less the previous read's wait for the stall check.
+    fn sense(&mut self, info: &TickInfo, q: &V4) -> Option<haptic2d::device::DeviceEstimate> {
+        let at = (info.deadline_index, info.t_s);
+        let elapsed = self.interval.update(info) as f64 * 1e-9;
+        match self.io {
+            SideIo::Sim(_) => {
+                self.end.check_stall(at, elapsed, 0.0);
+                self.end.sense(at, q, info.period_s, f64::NAN)
+            }
+            SideIo::Real(_) => {
+                let wait = self.read_wait_ns.1 as f64 * 1e-9;
+                self.end.sense(at, q, elapsed, wait)
+            }
+        }
+    }
+
+    /// The force to render this period from the world's newest message: through the master
+    /// port's passivity controller, or the wave master's force (the ramp, the saturation and the
+    /// gate come after, in [`DeviceEnd::actuate`]).
+    fn port_force(
+        &mut self,
+        x: &V3,
+        v: &V3,
+        origin: &V3,
+        fresh: Option<PortMessage>,
+        dt: f64,
+    ) -> V3 {
+        // (Unlike the lab's teleop, the port keeps the filtered velocity: measured over the split
+        // loop, the plants' true ledger showed no gain from the unfiltered rate; docs/TELEOP.md.)
+        let (f_req, far) = self
+            .last
+            .map_or(([0.0; 3], [0.0; 3]), |m| (self.mask(m.force), m.energy_in));
         let moved: Option<V3> = self
             .prev_pose_for_books
             .map(|p| std::array::from_fn(|i| (x[i] - p[i]) / dt));
-        self.prev_pose_for_books = Some(x);
-        let f_net = if let Some(wm) = &mut self.wave {
+        self.prev_pose_for_books = Some(*x);
+        if let Some(wm) = &mut self.wave {
             // Waves. First the period just ended, as the plant received it: the force really
             // applied over it and the measured displacement (the waves sent are those, one period
             // late; the wave drawn beyond what the budget granted is a debt).
             if let Some(mv) = moved {
                 for i in 0..3 {
                     self.wave_out[i] =
-                        wm[i].book(x[i] - self.origin[i], mv[i], self.prev_applied[i], dt);
+                        wm[i].book(x[i] - origin[i], mv[i], self.prev_applied[i], dt);
                 }
                 self.ports.observe(&self.prev_applied, &mv, dt);
             }
@@ -239,58 +338,26 @@ impl DeviceSide {
                     energy: m.wave_energy[i],
                     x: m.wave_x[i],
                 });
-                wm[i].force(v[i], msg, dt) * ramp
+                wm[i].force(v[i], msg, dt)
             })
         } else if self.tdpa {
-            let m = self.dev.mass_matrix();
-            let alpha_max = [0, 1, 2].map(|i| 2.0 * m[i][i].abs() / dt);
-            self.ports.control(&f_req, &v, &far, dt, &alpha_max)
+            let m = self.end.mass_diagonal();
+            let alpha_max = m.map(|m| 2.0 * m / dt);
+            self.ports.control(&f_req, v, &far, dt, &alpha_max)
         } else {
             f_req
-        };
-        // Local safety: the workspace bound, the torques, the gate.
-        let mut w = f_net;
-        self.safety.workspace_wall(at, &x, &v, &mut w);
-        let mut scale = 0.0;
-        self.tau = [0.0; 4];
-        match self.dev.torques_for_wrench(&w, 0.0) {
-            Ok(c) if c.near_singular => {
-                let limit = self.safety.latch().min_margin;
-                let margin = c.margin;
-                self.safety
-                    .trip(at, SafetyReason::Singularity { margin, limit })
-            }
-            Ok(c) => (self.tau, scale) = (c.tau, c.wrench_scale),
-            Err(f) => self.safety.trip(at, SafetyReason::Torques(f)),
         }
-        let tau_max = self.dev.tau_max();
-        self.safety.observe_limit_cycle(at, &self.tau, &tau_max);
-        if self.safety.gate(at, &mut self.tau, true) {
-            scale = 0.0;
-        }
-        let applied = f_net.map(|f| f * scale);
-        self.prev_applied = applied;
-        if self.wave.is_some() {
-            // Booked at the next period, on the displacement measured over this one.
-        } else if self.tdpa {
-            self.ports.book(&applied, &v, dt);
-        } else {
-            self.ports.observe(&applied, &v, dt);
-        }
-        self.max_force = self.max_force.max(applied[0].hypot(applied[1]));
-        let d = (x[0] - self.origin[0]).hypot(x[1] - self.origin[1]);
-        self.max_excursion = self.max_excursion.max(d);
-        let before = self.io.plant().pose();
-        if self.io.write_torques(&self.tau).is_err() {
-            return self.stop(t, Latch::DeviceIo);
-        }
-        let after = self.io.plant().pose();
-        let moved: V3 = std::array::from_fn(|i| (after[i] - before[i]) / dt);
-        self.plant_ledger.observe(&applied, &moved, dt);
-        self.send(k, &x, &v, &applied, 0);
-        self.ticks += 1;
-        match self.safety.trip_info() {
-            Some(trip) => self.stop(trip.t, Latch::Safety(trip.reason)),
+    }
+
+    /// `w` on the axes the device renders, zero on the others.
+    fn mask(&self, w: V3) -> V3 {
+        std::array::from_fn(|i| if self.axes[i] { w[i] } else { 0.0 })
+    }
+
+    /// Stops on a latch of the safety stage, else continues.
+    fn finish(&mut self, t: f64) -> TickControl {
+        match self.end.trip_info() {
+            Some(trip) => self.stop(trip.t.min(t), Latch::Safety(trip.reason)),
             None => TickControl::Continue,
         }
     }
@@ -327,7 +394,7 @@ impl DeviceSide {
         Ok(fresh)
     }
 
-    fn send(&mut self, k: u64, x: &V3, v: &V3, force: &V3, flags: u32) {
+    fn send(&mut self, k: u64, x: &V3, origin: &V3, v: &V3, force: &V3, flags: u32) {
         self.seq = self.seq.wrapping_add(1);
         let now = now_ns();
         let (w, we, wx) = (
@@ -343,8 +410,8 @@ impl DeviceSide {
             echo_age_ns: u32::try_from(now.saturating_sub(self.last_arrival_ns))
                 .unwrap_or(u32::MAX),
             echo_seq: self.last.map_or(0, |m| m.seq),
-            pose: std::array::from_fn(|i| x[i] - self.origin[i]),
-            twist: *v,
+            pose: self.mask(std::array::from_fn(|i| x[i] - origin[i])),
+            twist: self.mask(*v),
             force: *force,
             energy_in: self.ports.energy_in(),
             energy_out: self.ports.energy_out(),
@@ -369,8 +436,7 @@ impl DeviceSide {
 
     /// Latches zero torques, says so to the world, and stops the loop.
     fn stop(&mut self, t: f64, why: Latch) -> TickControl {
-        self.tau = [0.0; 4];
-        self.io.zero_torques();
+        self.io.io().zero_torques();
         if self.latch.is_none() {
             self.latch = Some((t, why));
         }
@@ -415,6 +481,9 @@ fn world_addr(s: &str) -> Result<&str, String> {
 pub fn run(a: &RemoteDeviceArgs) -> Result<Status, Failure> {
     run_device_side(&Plan {
         world: &a.world,
+        device: "sim",
+        device_file: None,
+        allow_remote: false,
         hand: &a.hand,
         duration: Some(a.duration),
         rate: a.rate,
@@ -426,16 +495,17 @@ pub fn run(a: &RemoteDeviceArgs) -> Result<Status, Failure> {
 
 /// Runs `run --world udp:HOST:PORT`: the device side of the split loop. `run`'s options that
 /// belong to a local world (its log, display feeds, controller, passivity on the device port) are
-/// refused with the reason; so is a device other than the simulated one (not built yet).
+/// refused with the reason. The device is the simulated twin or any real device of the registry
+/// (`--device haply:…`, `udp:…`, `inverse3…`, with its `--device-file`).
 pub fn run_from_run(a: &crate::cmd_run::RunArgs, world: &str) -> Result<Status, Failure> {
     let refuse = |what: &str| -> Result<Status, Failure> {
         Err(Failure::from(format!(
             "--world {world}: {what} does not apply to the device side of a split loop (the world, its controller and its logs are on the world side, `haptic2d serve-world`)\n    fix: leave it out, or run without --world"
         )))
     };
-    if a.device != "sim" {
+    if a.device.starts_with("replay:") {
         return Err(Failure::from(format!(
-            "--world {world} --device {}: across a network the device side runs the simulated twin pantograph only so far (docs/TELEOP.md, \"Not built yet\")\n    fix: --device sim",
+            "--world {world} --device {}: a replay renders no force; the device side needs a device that moves\n    fix: --device sim, haply:PATH, udp:ADDR:PORT or inverse3",
             a.device
         )));
     }
@@ -451,12 +521,15 @@ pub fn run_from_run(a: &crate::cmd_run::RunArgs, world: &str) -> Result<Status, 
     if a.controller_file.is_some() || a.controller != "four-channel" {
         return refuse("--controller / --controller-file");
     }
-    if a.device_file.is_some() {
-        return refuse("--device-file");
+    if a.device_file.is_some() && a.device == "sim" {
+        return refuse("--device-file with --device sim (the simulated twin runs its defaults)");
     }
     crate::cmd_run::check_rate(a.rate)?;
     run_device_side(&Plan {
         world,
+        device: &a.device,
+        device_file: a.device_file.as_deref(),
+        allow_remote: a.allow_remote_device,
         hand: a.hand.as_deref().unwrap_or("follow"),
         duration: a.duration,
         rate: a.rate,
@@ -484,29 +557,20 @@ fn check_run_settings(
     Ok(safety_config)
 }
 
-fn run_device_side(p: &Plan) -> Result<Status, Failure> {
-    let a = p.side;
-    let key = a.link.key().map_err(Failure::from)?;
-    let addr = world_addr(p.world).map_err(Failure::from)?;
-    let hand = HandSpec::parse(p.hand).map_err(Failure::from)?;
-    let safety_config = check_run_settings(p.duration, a.max_stall_periods)?;
-    let dt = 1.0 / p.rate;
+/// The simulated twin at rest at the workspace centre, gripped by `hand` (whose target `--push`
+/// moves), as a device side's I/O and end.
+fn sim_device(p: &Plan, hand: &HandSpec, safety: SafetyConfig, dt: f64) -> Result<Opened, Failure> {
     let params = DeviceParams::default();
-    let origin = [params.workspace_center_x, params.workspace_center_y, 0.0];
-    let mut io = SimIo::new(
-        &params,
-        origin,
-        hand.model(origin),
-        dt,
-        ((dt / 0.0005).ceil() as u32).max(1),
-    )
-    .map_err(Failure::from)?;
-    let push = match &a.push {
+    let start = [params.workspace_center_x, params.workspace_center_y, 0.0];
+    let substeps = ((dt / 0.0005).ceil() as u32).max(1);
+    let mut io =
+        SimIo::new(&params, start, hand.model(start), dt, substeps).map_err(Failure::from)?;
+    let push = match &p.side.push {
         None => None,
-        Some(v) if hand == HandSpec::Follow => {
-            let target = Arc::new(SharedTarget::new(origin));
+        Some(v) if *hand == HandSpec::Follow => {
+            let target = Arc::new(SharedTarget::new(start));
             io.follow(target.clone());
-            Some((Push::parse(v).map_err(Failure::from)?, target))
+            Some((Push::parse(v).map_err(Failure::from)?, target, start))
         }
         Some(_) => {
             return Err(Failure::from(format!(
@@ -515,9 +579,56 @@ fn run_device_side(p: &Plan) -> Result<Status, Failure> {
             )))
         }
     };
-    let mut dev =
-        TwinPantograph::new(params, dt, ObserverKind::default()).map_err(Failure::from)?;
-    dev.reset(origin[2]);
+    let mut end = DeviceEnd::twin(params, safety, dt).map_err(Failure::from)?;
+    if let haptic2d::haptic::EndDevice::Twin(d) = end.device_mut() {
+        d.reset(start[2]);
+    }
+    let what = format!("simulated twin pantograph, hand {}", p.hand);
+    Ok((SideIo::Sim(io), end, push, what))
+}
+
+/// A device side's I/O, its end, the `--push` of a simulated hand and a description.
+type Opened = (
+    SideIo,
+    DeviceEnd,
+    Option<(Push, Arc<SharedTarget>, V3)>,
+    String,
+);
+
+/// A real device of the registry, its device file read and checked, then opened at period `dt`.
+fn real_device(p: &Plan, dt: f64) -> Result<Opened, Failure> {
+    if p.side.push.is_some() || p.hand != "follow" {
+        return Err(Failure::from(format!(
+            "--push and --hand move the simulated hand: with --device {} the hand is yours\n    fix: leave them out",
+            p.device
+        )));
+    }
+    let choice = DeviceChoice::parse(p.device).map_err(Failure::from)?;
+    let real = choice
+        .load_real(p.device_file, p.allow_remote)
+        .map_err(Failure::from)?
+        .ok_or_else(|| Failure::from(format!("--device {}: not a real device", p.device)))?;
+    let end = real.device_end(dt).map_err(Failure::from)?;
+    let what = format!("{} ({})", real.name, real.summary);
+    let io = (real.open)(Duration::from_secs_f64(dt)).map_err(|m| Failure {
+        status: Status::DeviceLost,
+        message: m,
+    })?;
+    Ok((SideIo::Real(io), end, None, what))
+}
+
+fn run_device_side(p: &Plan) -> Result<Status, Failure> {
+    let a = p.side;
+    let key = a.link.key().map_err(Failure::from)?;
+    let addr = world_addr(p.world).map_err(Failure::from)?;
+    let hand = HandSpec::parse(p.hand).map_err(Failure::from)?;
+    let safety_config = check_run_settings(p.duration, a.max_stall_periods)?;
+    let dt = 1.0 / p.rate;
+    let (io, end, push, what) = if p.device == "sim" {
+        sim_device(p, &hand, safety_config, dt)?
+    } else {
+        real_device(p, dt)?
+    };
     let stop = haptic2d_rt::signal::install_stop_signals().map_err(Failure::error)?;
     let ep = LinkEndpoint::connect(
         addr,
@@ -526,10 +637,9 @@ fn run_device_side(p: &Plan) -> Result<Status, Failure> {
     )
     .map_err(Failure::error)?;
     outln!(
-        "device side: session {:016x} with the world at {}, simulated twin pantograph, hand {}, {} Hz, link {}, impairment: {}; no display (the world is on the world side)",
+        "device side: session {:016x} with the world at {}, {what}, {} Hz, link {}, impairment: {}; no display (the world is on the world side)",
         ep.session(),
         ep.peer(),
-        p.hand,
         p.rate,
         a.link.method(),
         a.link.describe(p.rate)
@@ -538,18 +648,8 @@ fn run_device_side(p: &Plan) -> Result<Status, Failure> {
     let mut side = DeviceSide {
         io,
         push,
-        dev,
-        safety: SafetyStage::new(
-            safety_config,
-            Safety::new(
-                params.min_singularity_margin,
-                params.tau_max,
-                safety_config.torque_trip_margin,
-            ),
-            WorkspaceBound::new(&params, dt),
-            dt,
-        ),
-        origin,
+        axes: end.axes(),
+        end,
         tdpa: a.link.tdpa(),
         wave: a.link.wave().map(|w| w.map(WaveMaster::new)),
         wave_out: [WaveMsg::default(); 3],
@@ -564,6 +664,7 @@ fn run_device_side(p: &Plan) -> Result<Status, Failure> {
         ),
         ep,
         interval: TickInterval::new(),
+        read_wait_ns: (0, 0),
         timeout_periods,
         // The first message needs the world's start and both delays on top.
         first_timeout_periods: timeout_periods.max((p.rate as u64).max(1))
@@ -572,7 +673,6 @@ fn run_device_side(p: &Plan) -> Result<Status, Failure> {
         last_k: 0,
         last_arrival_ns: 0,
         seq: 0,
-        tau: [0.0; 4],
         ticks: 0,
         buf: [0; PORT_LEN],
         max_force: 0.0,
@@ -598,7 +698,7 @@ fn run_device_side(p: &Plan) -> Result<Status, Failure> {
             .map_err(|_| Failure::error("the loop thread panicked"))?
             .map_err(Failure::error)
     })?;
-    side.io.zero_torques();
+    side.io.io().zero_torques();
     side.bye(side.latch.is_some());
     Ok(report(&mut side, &summary, stop.load(Ordering::Relaxed)))
 }
@@ -616,11 +716,15 @@ fn report(
     outln!("master port (device): {}", energies(mine));
 
     let plant = side.plant_ledger.totals();
-    outln!(
-        "master port (plant, true displacement): energy in {:.6} J, out {:.6} J",
-        plant.0,
-        plant.1
-    );
+    if side.io.plant_pose().is_some() {
+        outln!(
+            "master port (plant, true displacement): energy in {:.6} J, out {:.6} J",
+            plant.0,
+            plant.1
+        );
+    } else {
+        outln!("master port (plant, true displacement): not known (a real device; the books above are the encoders')");
+    }
     let per_axis = |p: &PlanarTdpa| -> [f64; 3] {
         let (i, o) = (p.energy_in(), p.energy_out());
         std::array::from_fn(|k| o[k] - i[k])
@@ -663,7 +767,7 @@ fn report(
         "handle: largest excursion {:.1} mm from the start pose",
         side.max_excursion * 1e3
     );
-    match side.latch {
+    match side.latch.clone() {
         None if interrupted => {
             outln!("stopped: interrupted by a signal (SIGINT or SIGTERM)");
             Status::Interrupted
@@ -686,7 +790,10 @@ fn report(
                     if world_waves { "wave variables" } else { "force/velocity (tdpa or none)" },
                     if world_waves { "force/velocity (tdpa or none)" } else { "wave variables" },
                 ),
-                Latch::DeviceIo => "safety stop: the simulated device failed".into(),
+                Latch::DeviceLost(e) => {
+                outln!("stopped: {e} at t = {t:.3} s; torques set to zero and latched");
+                return Status::DeviceLost;
+            }
             };
             outln!("stopped: {what} at t = {t:.3} s; torques set to zero and latched");
             Status::SafetyStop

@@ -121,8 +121,9 @@ pub struct RunArgs {
     #[arg(long)]
     pub allow_remote_device: bool,
     /// The world across a network: `udp:HOST:PORT` of a `haptic2d serve-world SCENE` (docs/TELEOP.md).
-    /// This process is then the device side of the split loop (the simulated device, --hand, its
-    /// local safety and the link's passivity controller); SCENE is the world side's, not read here.
+    /// This process is then the device side of the split loop (the simulated device and --hand, or
+    /// a real device with its --device-file; its local safety and the link's passivity controller);
+    /// SCENE is the world side's, not read here.
     #[arg(long, value_name = "udp:HOST:PORT")]
     pub world: Option<String>,
     /// The device side's options (with --world only).

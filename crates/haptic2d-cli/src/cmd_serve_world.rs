@@ -16,9 +16,8 @@ use std::sync::atomic::AtomicBool;
 use std::time::Duration;
 
 use haptic2d::control::tdpa::PlanarTdpa;
-use haptic2d::geom::Vec2;
-use haptic2d::world::World;
-use haptic2d_devices::world_link::message::{FLAG_BYE, FLAG_TDPA, FLAG_WAVE};
+use haptic2d_devices::registry::DeviceChoice;
+use haptic2d_devices::world_link::message::{FLAG_BYE, FLAG_LATCHED, FLAG_TDPA, FLAG_WAVE};
 use haptic2d_devices::world_link::{
     LinkEndpoint, PortMessage, KIND_TO_DEVICE, KIND_TO_WORLD, PORT_LEN,
 };
@@ -28,6 +27,7 @@ use haptic2d_rt::{run_loop, LoopConfig, TickControl, TickInfo};
 
 use crate::exit::{Failure, Status};
 use crate::outln;
+use crate::slave_plant::{BodySlave, DeviceSlave, SlavePlant, SlaveStop};
 use crate::world_link_arg::{energies, report_link, wave_totals, EndWording};
 use crate::world_link_arg::{LinkArgs, LinkStats, Outbox};
 
@@ -50,13 +50,29 @@ pub const EXAMPLES: &[crate::Example] = &[
 /// `serve-world`'s options.
 #[derive(clap::Args, Debug)]
 pub struct ServeWorldArgs {
-    /// A scene file path, or a built-in scene name.
-    pub scene: String,
+    /// A scene file path, or a built-in scene name (not with --device).
+    #[arg(required_unless_present = "device", conflicts_with = "device")]
+    pub scene: Option<String>,
+    /// Serve a slave DEVICE instead of a scene's body: `haply:PATH`, `udp:ADDR:PORT`,
+    /// `inverse3[:URL]` — the slave of a bilateral teleoperation whose master is
+    /// `haptic2d run --device DEV --world udp:HOST:PORT` (docs/TELEOP.md).
+    #[arg(long, value_name = "DEVICE")]
+    pub device: Option<String>,
+    /// The slave device's own device file (with --device).
+    #[arg(long, value_name = "FILE.toml", requires = "device")]
+    pub device_file: Option<std::path::PathBuf>,
+    /// Let a UDP slave device be beyond loopback (with --device).
+    #[arg(long, requires = "device")]
+    pub allow_remote_device: bool,
+    /// Normal scheduling for the loop of a slave device (by default it runs at real-time priority,
+    /// as `run` does; a scene's world always runs at normal priority: it drives no motor).
+    #[arg(long, requires = "device")]
+    pub no_rt: bool,
     /// Address to listen on (`127.0.0.1:0` picks a free port; it is printed).
     #[arg(long, default_value = "127.0.0.1:7420")]
     pub bind: String,
     /// Name of the slave body (default: the first dynamic body).
-    #[arg(long)]
+    #[arg(long, conflicts_with = "device")]
     pub slave: Option<String>,
     /// Loop rate (Hz), overriding the scene's; the device side must run at the same rate.
     #[arg(long, default_value_t = 1000.0)]
@@ -79,9 +95,8 @@ pub struct ServeWorldArgs {
 
 /// The world side's state, owned by the loop.
 struct WorldSide {
-    world: World,
-    slave: usize,
-    origin: [f64; 3],
+    /// The slave: the scene's body, or a device (`--device`).
+    plant: SlavePlant,
     alpha_max: [f64; 3],
     k: [f64; 3],
     b: [f64; 3],
@@ -116,18 +131,6 @@ struct WorldSide {
 }
 
 impl WorldSide {
-    fn slave_state(&self) -> ([f64; 3], [f64; 3]) {
-        let b = &self.world.bodies[self.slave];
-        (
-            [
-                b.pose.pos.x - self.origin[0],
-                b.pose.pos.y - self.origin[1],
-                b.pose.angle - self.origin[2],
-            ],
-            [b.vel.x, b.vel.y, b.omega],
-        )
-    }
-
     /// The device side's newest message this period, if one arrived: kept as the last, with the
     /// link's statistics and the peer's link kind; a goodbye or a link mismatch ends the session.
     fn receive(&mut self, k: u64) -> Option<PortMessage> {
@@ -152,8 +155,12 @@ impl WorldSide {
         let (k, dt) = (info.deadline_index, info.period_s);
         let fresh = self.receive(k);
         let silent = k.saturating_sub(self.last_k);
-        let (x_s, v_s) = self.slave_state();
-        let live = self.last.is_some() && silent <= self.timeout_periods && self.end.is_none();
+        let sensed = self.plant.sense(info);
+        let (x_s, v_s) = sensed.unwrap_or(([0.0; 3], [0.0; 3]));
+        let live = self.last.is_some()
+            && silent <= self.timeout_periods
+            && self.end.is_none()
+            && sensed.is_some();
         let (mut f_s, mut f_c) = ([0.0; 3], [0.0; 3]);
         let far = self.last.map_or([0.0; 3], |m| m.energy_in);
         if let (true, Some(ws)) = (live, &mut self.wave) {
@@ -183,15 +190,12 @@ impl WorldSide {
             self.live_ticks += 1;
             self.max_force = self.max_force.max(f_s[0].hypot(f_s[1]));
         }
-        self.world
-            .set_drive(self.slave, Vec2::new(f_s[0], f_s[1]), f_s[2]);
-        self.world.step();
-        let (x_after, _) = self.slave_state();
-        let moved: [f64; 3] = std::array::from_fn(|i| (x_after[i] - x_s[i]) / dt);
-        self.plant_ledger.observe(&f_s, &moved, dt);
-        let wall = self.world.contact_wrench(self.slave).force;
-        let (wall, coupling) = (wall.x.hypot(wall.y), f_s[0].hypot(f_s[1]));
-        if live && wall > 0.01 {
+        let applied = self.plant.apply(info, &f_s, &x_s);
+        if applied.exact {
+            self.plant_ledger.observe(&applied.force, &applied.rate, dt);
+        }
+        let coupling = applied.force[0].hypot(applied.force[1]);
+        if let (true, Some(wall)) = (live, applied.wall.filter(|w| *w > 0.01)) {
             let c = &mut self.contact;
             *c = (
                 c.0 + 1,
@@ -200,14 +204,15 @@ impl WorldSide {
                 c.3 + (wall - coupling).abs(),
             );
         }
-        // The port books what the body really received: the force held over the world step
-        // times the body's displacement over it (the world knows it at once). Booked on the
-        // velocity at the start of the step instead, the controller's damping near its cap
-        // `2m/T` counted as dissipated what the body did not lose (docs/TELEOP.md).
+        // The port books what the slave really received: a body's force held over the world step
+        // times its displacement over it (the world knows it at once; booked on the velocity at
+        // the start of the step instead, the controller's damping near its cap `2m/T` counted as
+        // dissipated what the body did not lose, docs/TELEOP.md); a device's applied force (after
+        // its ramp, saturation and gate) times its twist.
         if self.tdpa {
-            self.ports.book(&f_s, &moved, dt);
+            self.ports.book(&applied.force, &applied.rate, dt);
         } else {
-            self.ports.observe(&f_s, &moved, dt);
+            self.ports.observe(&applied.force, &applied.rate, dt);
         }
         self.seq = self.seq.wrapping_add(1);
         let now = now_ns();
@@ -239,9 +244,11 @@ impl WorldSide {
         };
         let buf = &mut self.buf;
         (self.outbox).seal_and_send(&mut self.ep, &msg, KIND_TO_DEVICE, k, buf);
-        let (x, _) = self.slave_state();
-        if !x.iter().all(|v| v.is_finite()) {
+        if sensed.is_some_and(|(x, _)| !x.iter().all(|v| v.is_finite())) {
             self.end = Some("the world diverged (non-finite slave pose)");
+        }
+        if self.plant.stop().is_some() && self.end.is_none() {
+            self.end = Some("the slave device stopped");
         }
         if self.end.is_none() && silent as f64 * dt > 2.0 {
             self.end = Some("the device side fell silent for 2 s");
@@ -250,6 +257,31 @@ impl WorldSide {
             TickControl::Stop
         } else {
             TickControl::Continue
+        }
+    }
+}
+
+impl WorldSide {
+    /// Tells the device side the session is over and latched (three times, past the impairment):
+    /// a slave device that stopped stops its master at once rather than after its link timeout.
+    fn bye(&mut self) {
+        for _ in 0..3 {
+            self.seq = self.seq.wrapping_add(1);
+            let msg = PortMessage {
+                seq: self.seq,
+                flags: FLAG_BYE | FLAG_LATCHED,
+                time_ns: now_ns(),
+                energy_in: self.ports.energy_in(),
+                energy_out: self.ports.energy_out(),
+                ..PortMessage::default()
+            };
+            msg.seal(
+                self.ep.key(),
+                KIND_TO_DEVICE,
+                self.ep.session(),
+                &mut self.buf,
+            );
+            self.ep.send(&self.buf);
         }
     }
 }
@@ -270,51 +302,18 @@ pub fn run(a: &ServeWorldArgs) -> Result<Status, Failure> {
         check_gains("--coupling-k", &a.coupling_k).map_err(Failure::from)?,
         check_gains("--coupling-b", &a.coupling_b).map_err(Failure::from)?,
     );
-    let scene = crate::scene_arg::load(&a.scene, Some(a.rate)).map_err(Failure::from)?;
-    let mut world = scene.world;
-    let slave = match &a.slave {
-        Some(n) => world.body_index(n).ok_or_else(|| {
-            Failure::from(format!(
-                "--slave {n}: no body of that name in {}",
-                scene.source
-            ))
-        })?,
-        None => world
-            .bodies
-            .iter()
-            .position(|b| b.is_dynamic())
-            .ok_or_else(|| {
-                Failure::from(format!("{}: no dynamic body to be the slave", scene.source))
-            })?,
+    let dt = 1.0 / a.rate;
+    let (plant, what) = match &a.device {
+        Some(d) => slave_device(a, d, dt)?,
+        None => slave_body(a)?,
     };
-    if !world.bodies[slave].is_dynamic() {
-        return Err(Failure::from(format!(
-            "slave body `{}` is fixed; the device needs a dynamic body",
-            world.bodies[slave].name
-        )));
-    }
-    // The hand drives the slave: the scene's loads on it are for the world alone (as in `run`).
-    world.loads.retain(|l| l.body != slave);
-    world.prime();
-    let dt = world.params.dt;
-    let body = &world.bodies[slave];
-    let origin = [body.pose.pos.x, body.pose.pos.y, body.pose.angle];
-    let alpha_max = [
-        2.0 * body.mass / dt,
-        2.0 * body.mass / dt,
-        2.0 * body.inertia / dt,
-    ];
     let socket = UdpSocket::bind(&a.bind)
         .map_err(|e| Failure::error(format!("cannot listen on {}: {e}", a.bind)))?;
     let local = socket
         .local_addr()
         .map_err(|e| Failure::error(e.to_string()))?;
     outln!(
-        "serve-world: {} ({}), slave `{}` ({} kg), {} Hz, link {}, impairment: {}",
-        scene.name,
-        scene.source,
-        body.name,
-        body.mass,
+        "serve-world: {what}, {} Hz, link {}, impairment: {}",
         a.rate,
         a.link.method(),
         a.link.describe(a.rate)
@@ -334,10 +333,8 @@ pub fn run(a: &ServeWorldArgs) -> Result<Status, Failure> {
         ep.peer()
     );
     let mut side = WorldSide {
-        world,
-        slave,
-        origin,
-        alpha_max,
+        alpha_max: plant.alpha_max(dt),
+        plant,
         k,
         b,
         tdpa: a.link.tdpa(),
@@ -364,29 +361,106 @@ pub fn run(a: &ServeWorldArgs) -> Result<Status, Failure> {
     let config = LoopConfig {
         rate_hz: a.rate,
         duration: a.duration.map(Duration::from_secs_f64),
-        rt: false,
+        rt: a.device.is_some() && !a.no_rt,
         spin_us: 100.0,
         ..LoopConfig::default()
     };
     let summary =
         run_loop(&config, &stop as &AtomicBool, |info| side.tick(&info)).map_err(Failure::error)?;
+    side.plant.zero();
+    if side.plant.stop().is_some() {
+        side.bye();
+    }
     report(&mut side, &summary);
-    Ok(match side.end {
-        Some(e) if e.contains("diverged") => Status::Diverged,
+    Ok(match (side.end, side.plant.stop()) {
+        (_, Some(SlaveStop::Safety(_))) => Status::SafetyStop,
+        (_, Some(SlaveStop::Lost(_))) => Status::DeviceLost,
+        (Some(e), _) if e.contains("diverged") => Status::Diverged,
         _ if stop.load(std::sync::atomic::Ordering::Relaxed) => Status::Interrupted,
         _ => Status::Clean,
     })
+}
+
+/// The scene's slave body, with the start line's description.
+fn slave_body(a: &ServeWorldArgs) -> Result<(SlavePlant, String), Failure> {
+    let source = a.scene.as_deref().unwrap_or_default();
+    let scene = crate::scene_arg::load(source, Some(a.rate)).map_err(Failure::from)?;
+    let mut world = scene.world;
+    let slave = match &a.slave {
+        Some(n) => world.body_index(n).ok_or_else(|| {
+            Failure::from(format!(
+                "--slave {n}: no body of that name in {}",
+                scene.source
+            ))
+        })?,
+        None => world
+            .bodies
+            .iter()
+            .position(|b| b.is_dynamic())
+            .ok_or_else(|| {
+                Failure::from(format!("{}: no dynamic body to be the slave", scene.source))
+            })?,
+    };
+    if !world.bodies[slave].is_dynamic() {
+        return Err(Failure::from(format!(
+            "slave body `{}` is fixed; the device needs a dynamic body",
+            world.bodies[slave].name
+        )));
+    }
+    // The hand drives the slave: the scene's loads on it are for the world alone (as in `run`).
+    world.loads.retain(|l| l.body != slave);
+    world.prime();
+    let body = &world.bodies[slave];
+    let what = format!(
+        "{} ({}), slave `{}` ({} kg)",
+        scene.name, scene.source, body.name, body.mass
+    );
+    let origin = [body.pose.pos.x, body.pose.pos.y, body.pose.angle];
+    let plant = SlavePlant::Body(BodySlave {
+        world,
+        slave,
+        origin,
+    });
+    Ok((plant, what))
+}
+
+/// A slave device of the registry, its device file read and checked, opened at period `dt` (s).
+fn slave_device(
+    a: &ServeWorldArgs,
+    device: &str,
+    dt: f64,
+) -> Result<(SlavePlant, String), Failure> {
+    let choice = DeviceChoice::parse(device).map_err(Failure::from)?;
+    let real = choice
+        .load_real(a.device_file.as_deref(), a.allow_remote_device)
+        .map_err(Failure::from)?
+        .ok_or_else(|| {
+            Failure::from(format!(
+                "--device {device}: serve-world drives a real device (haply:PATH, udp:ADDR:PORT, inverse3); the simulated twin is `haptic2d teleop`'s"
+            ))
+        })?;
+    let end = real.device_end(dt).map_err(Failure::from)?;
+    let what = format!("slave device {} ({})", real.name, real.summary);
+    let io = (real.open)(Duration::from_secs_f64(dt)).map_err(|m| Failure {
+        status: Status::DeviceLost,
+        message: m,
+    })?;
+    Ok((SlavePlant::Device(DeviceSlave::new(io, end)), what))
 }
 
 fn report(side: &mut WorldSide, summary: &haptic2d_rt::TimingSummary) {
     outln!("{summary}");
     outln!("world port (slave): {}", energies(side.ports.totals()));
     let plant = side.plant_ledger.totals();
-    outln!(
-        "world port (body, true displacement): energy in {:.6} J, out {:.6} J",
-        plant.0,
-        plant.1
-    );
+    if let SlavePlant::Body(_) = side.plant {
+        outln!(
+            "world port (body, true displacement): energy in {:.6} J, out {:.6} J",
+            plant.0,
+            plant.1
+        );
+    } else {
+        outln!("world port (body, true displacement): not known (a slave device; the books above are its encoders')");
+    }
     let totals = |ws: &[WaveSlave; 3]| {
         wave_totals(
             ws.iter().map(|s| s.budget()),
@@ -412,12 +486,16 @@ fn report(side: &mut WorldSide, summary: &haptic2d_rt::TimingSummary) {
     outln!("link: {}", side.stats.describe());
     let (n, wall, coupling, diff) = side.contact;
     let m = n.max(1) as f64;
-    outln!(
+    if let SlavePlant::Device(_) = side.plant {
+        outln!("contact: not measured (a slave device has no force sensor)");
+    } else {
+        outln!(
         "contact: {n} periods with the slave in contact; mean wall force {:.3} N, mean coupling force {:.3} N, mean |difference| {:.3} N",
         wall / m,
         coupling / m,
         diff / m
-    );
+        );
+    }
     if side.peer_tdpa.is_some_and(|p| p == side.tdpa) {
     } else if let Some(p) = side.peer_tdpa {
         outln!(
@@ -426,8 +504,17 @@ fn report(side: &mut WorldSide, summary: &haptic2d_rt::TimingSummary) {
             if p { "on" } else { "off" }
         );
     }
-    outln!(
-        "stopped: {}",
-        side.end.unwrap_or("the duration ended or a signal arrived")
-    );
+    match side.plant.stop() {
+        Some(SlaveStop::Safety(trip)) => outln!(
+            "stopped: safety stop: {} at t = {:.3} s; the slave's torques set to zero and latched; the device side told",
+            trip.reason, trip.t
+        ),
+        Some(SlaveStop::Lost(e)) => outln!(
+            "stopped: {e}; the slave's torques set to zero and latched; the device side told"
+        ),
+        None => outln!(
+            "stopped: {}",
+            side.end.unwrap_or("the duration ended or a signal arrived")
+        ),
+    }
 }

@@ -34,6 +34,7 @@ mod run_view;
 mod scene_arg;
 mod serve_conn;
 mod serve_present;
+mod slave_plant;
 mod study_browser;
 mod study_buttons;
 mod study_mcap;

@@ -23,7 +23,7 @@ use crate::common::{assert_has, wait_with_limit};
 const BIN: &str = env!("CARGO_BIN_EXE_haptic2d");
 
 /// A fresh key file (mode 600) in a temp dir of its own.
-fn key_file(tag: &str, byte: u8) -> PathBuf {
+pub(crate) fn key_file(tag: &str, byte: u8) -> PathBuf {
     use std::os::unix::fs::PermissionsExt;
     let dir = std::env::temp_dir().join(format!("haptic2d-teleop-{}-{tag}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -36,7 +36,7 @@ fn key_file(tag: &str, byte: u8) -> PathBuf {
 /// The wall scene of the acceptance test (docs/TELEOP.md): box-in-walls with the box 3 mm from
 /// the left wall and a stiffer contact (5 000 N/m per corner, 10 000 N/m on a face), so that the
 /// wall is reached well inside the device's workspace.
-const NEAR_WALL: &str = r#"name = "box-near-wall"
+pub(crate) const NEAR_WALL: &str = r#"name = "box-near-wall"
 description = "a 0.5 kg box 3 mm from a stiff wall (the world link's acceptance test)"
 [world]
 rate = 1000
@@ -69,9 +69,9 @@ position = [0.023, 0.0]
 "#;
 
 /// A running `serve-world`, its address, and its output so far (the rest is read on a thread).
-struct World {
+pub(crate) struct World {
     child: Child,
-    addr: String,
+    pub(crate) addr: String,
     lines: mpsc::Receiver<String>,
 }
 
@@ -83,7 +83,7 @@ impl Drop for World {
 }
 
 /// `haptic2d ARGS… --key KEY EXTRA…` started with its output piped: either end of the split loop.
-fn spawn_keyed(args: &[&str], key: &Path, extra: &[&str]) -> Child {
+pub(crate) fn spawn_keyed(args: &[&str], key: &Path, extra: &[&str]) -> Child {
     Command::new(BIN)
         .args(args)
         .arg("--key")
@@ -96,11 +96,16 @@ fn spawn_keyed(args: &[&str], key: &Path, extra: &[&str]) -> Child {
 }
 
 impl World {
-    fn start(key: &Path, extra: &[&str]) -> World {
+    pub(crate) fn start(key: &Path, extra: &[&str]) -> World {
         let scene = key.with_file_name("near-wall.toml");
         std::fs::write(&scene, NEAR_WALL).unwrap();
         let scene = scene.to_str().unwrap();
-        let mut child = spawn_keyed(&["serve-world", scene, "--bind", "127.0.0.1:0"], key, extra);
+        World::start_as(&["serve-world", scene, "--bind", "127.0.0.1:0"], key, extra)
+    }
+
+    /// A world side started as `command` (`serve-world SCENE …` or `serve-world --device …`).
+    pub(crate) fn start_as(command: &[&str], key: &Path, extra: &[&str]) -> World {
+        let mut child = spawn_keyed(command, key, extra);
         let (tx, lines) = mpsc::channel();
         let out = child.stdout.take().unwrap();
         std::thread::spawn(move || {
@@ -133,7 +138,7 @@ impl World {
     }
 
     /// Waits for the world side to end (at most `limit`) and returns the rest of its output.
-    fn finish(mut self, limit: Duration) -> String {
+    pub(crate) fn finish(mut self, limit: Duration) -> String {
         let t0 = std::time::Instant::now();
         while self.child.try_wait().unwrap().is_none() && t0.elapsed() < limit {
             std::thread::sleep(Duration::from_millis(20));
@@ -163,7 +168,7 @@ fn device_as(command: &[&str], world: &World, key: &Path, extra: &[&str]) -> (i3
 }
 
 /// The number after `prefix` in the line starting with `line_start`.
-fn number(text: &str, line_start: &str, prefix: &str) -> f64 {
+pub(crate) fn number(text: &str, line_start: &str, prefix: &str) -> f64 {
     let line = text
         .lines()
         .find(|l| l.starts_with(line_start))
@@ -181,7 +186,7 @@ fn number(text: &str, line_start: &str, prefix: &str) -> f64 {
 }
 
 /// (energy in, energy out) of a port's ledger line (J).
-fn port(text: &str, line_start: &str) -> (f64, f64) {
+pub(crate) fn port(text: &str, line_start: &str) -> (f64, f64) {
     (
         number(text, line_start, "energy in "),
         number(text, line_start, ", out "),
@@ -428,9 +433,23 @@ fn run_refuses_split_loop_options_without_world_and_local_world_options_with_it(
                 "--key",
                 k,
                 "--device",
-                "haply:auto",
+                "replay:x.csv",
             ],
-            "simulated twin pantograph only",
+            "a replay renders no force",
+        ),
+        (
+            &[
+                "run",
+                "--world",
+                "udp:127.0.0.1:9",
+                "--key",
+                k,
+                "--device",
+                "haply:auto",
+                "--push",
+                "-0.01,0,0.05,0.5",
+            ],
+            "the hand is yours",
         ),
         (
             &[

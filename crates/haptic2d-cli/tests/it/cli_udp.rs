@@ -21,16 +21,16 @@ use crate::common::{
 };
 
 /// The reference file with a patient timeout and no missed-deadline limit, in a temp dir.
-fn device_file(tag: &str) -> PathBuf {
+pub(crate) fn device_file(tag: &str) -> PathBuf {
     patient_device_file("udp-pantograph.toml", ("3", "50"), tag, "udp.toml")
 }
 
 /// The reference device (killed on drop) and its address.
-struct Device(Killed, SocketAddr);
+pub(crate) struct Device(pub(crate) Killed, pub(crate) SocketAddr);
 
 /// devices/udp/sim_device.py on an ephemeral loopback port; without python3 the test fails with
 /// the install hint.
-fn sim_device(extra: &[&str]) -> Device {
+pub(crate) fn sim_device(extra: &[&str]) -> Device {
     let mut python = Command::new("python3");
     python.arg("--version").stdout(Stdio::null());
     if python.status().is_err() {

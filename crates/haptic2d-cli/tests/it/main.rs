@@ -44,6 +44,7 @@ mod cli_study_serve;
 mod cli_teleop;
 mod cli_teleop_live;
 mod cli_udp;
+mod cli_world_device;
 mod device_safety;
 mod log_fuzz;
 mod mcap_log;

@@ -14,8 +14,9 @@
 //! 9.            τ = Jᵀ·f saturated, limit cycle, singular pose, ramp, final gate
 //! ```
 //!
-//! [`DeviceEnd::actuate`] returns the wrench the motors really apply (the request scaled by the
-//! saturation, the ramp and the final clamp; zero when gated): what a port's energy books. No
+//! [`DeviceEnd::actuate`] returns the part of the motors' wrench the request produced (the request
+//! scaled by the saturation, the ramp and the final clamp; zero when gated): what a port's energy
+//! books, as the tick's passivity observer books its port (step 9b). No
 //! method allocates, locks, prints or does I/O.
 
 use crate::device::linalg::{V3, V4};
@@ -87,9 +88,12 @@ impl EndDevice {
 pub struct EndOutput {
     /// The motor commands to write now (N·m; a point device: N in `τ[0..2]`); zero when gated.
     pub tau: V4,
-    /// The wrench the motors apply with `tau` (N, N, N·m; device frame): the request with the
-    /// workspace wall, scaled by the saturation, the ramp and the final clamp.
+    /// The part of the motors' wrench that the request `f` produced (N, N, N·m; device frame): `f`
+    /// scaled by the saturation, the ramp and the final clamp; zero when gated. What a port's
+    /// books count: the workspace wall's share is the device's own passive wall, not the port's.
     pub applied: V3,
+    /// That scale, in [0, 1]: saturation × ramp × final clamp (0 when gated).
+    pub factor: f64,
     /// True when the final gate zeroed the torques (latched, or tripped this tick).
     pub gated: bool,
 }
@@ -227,6 +231,14 @@ impl DeviceEnd {
         Some(est)
     }
 
+    /// Step 0, stall alone, for a device whose signals use one period whatever the interval (a
+    /// simulated plant advanced per tick): trips when `elapsed` (s since the previous tick, of
+    /// which `device_wait` s waiting for the device) exceeds the stall limit. Call it before
+    /// [`Self::sense`], which then gets one period.
+    pub fn check_stall(&mut self, at: TickClock, elapsed: f64, device_wait: f64) {
+        self.safety.check_stall(at, elapsed, device_wait);
+    }
+
     /// Steps 8b–9 for the wrench `f` (N, N, N·m; device frame) asked of the handle sensed as `est`
     /// (`None`: not sensed this tick, no torque): the workspace wall, the torques, the limit
     /// cycle, a singular pose, the ramp and the final gate. Remembers the torques for the next
@@ -266,7 +278,8 @@ impl DeviceEnd {
         self.tau_prev = tau;
         EndOutput {
             tau,
-            applied: w.map(|x| x * applied),
+            applied: f.map(|x| x * applied),
+            factor: applied,
             gated,
         }
     }
