@@ -239,7 +239,8 @@ impl LiveEnd {
     }
 
     /// The device's sensing and input checks on the reading `q` ([`DeviceEnd::sense`]: `elapsed`
-    /// s since the previous tick, `device_wait` s of it waiting for devices). `Some((x, v))`: the
+    /// s since the previous tick, `device_wait` s of it waiting for devices; the simulated twin
+    /// checks the stall on them and senses over one period `dt`, as `run` does). `Some((x, v))`: the
     /// pose from the origin (m, m, rad) and the unfiltered rate of the measured pose over the
     /// period `dt`, `(x_k − x_{k−1})/T` (zero at the first reading), as the lab's teleop uses for
     /// its coupling and ports; `None` when the device could not be sensed (the latch holds why).
@@ -251,7 +252,14 @@ impl LiveEnd {
         device_wait: f64,
         dt: f64,
     ) -> Option<(V3, V3)> {
-        self.est = self.end.sense(at, q, elapsed, device_wait);
+        self.est = if let EndIo::Sim { .. } = self.io {
+            // A simulated plant advances one period per tick: its signals use one period (the
+            // run stays deterministic when nothing stalls), the stall check the real interval.
+            self.end.check_stall(at, elapsed, device_wait);
+            self.end.sense(at, q, dt, 0.0)
+        } else {
+            self.end.sense(at, q, elapsed, device_wait)
+        };
         let est = self.est?;
         let o = self.end.origin().unwrap_or(est.pose);
         let rate = self.prev.map_or([0.0; 3], |p| {
