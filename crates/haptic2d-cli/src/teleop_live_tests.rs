@@ -95,15 +95,22 @@ fn both_ends_start_at_zero_force_and_ramp_in() {
     assert!(w[799][0] < 0.0, "{:?}", w[799]);
 }
 
+/// [`live`] run for 800 ms, then the slave reads `reading` at tick 800, which must stop the loop
+/// (its master's last non-zero torques were written at 0.799 s).
+fn slave_reads_at_800_ms(reading: Reading) -> (Live, Arc<Mutex<Shared>>) {
+    let (mut l, shared) = live();
+    run(&mut l, 0, 800);
+    shared.lock().unwrap().reading = Some(reading);
+    assert_eq!(l.tick(&tick_info(800)), TickControl::Stop);
+    (l, shared)
+}
+
 /// A latch at the slave alone (a non-finite reading) zeroes the master too, in the same tick:
 /// the master's zero torques are written at the trip's time, its last non-zero ones a tick
 /// before, and the slave is written zero.
 #[test]
 fn a_latch_at_the_slave_zeroes_the_master_in_the_same_tick() {
-    let (mut l, shared) = live();
-    run(&mut l, 0, 800);
-    shared.lock().unwrap().reading = Some(Reading::NonFinite);
-    assert_eq!(l.tick(&tick_info(800)), TickControl::Stop);
+    let (l, shared) = slave_reads_at_800_ms(Reading::NonFinite);
     assert!(
         matches!(l.stop, Some((_, LiveStop::Latch(Role::Slave, _)))),
         "{:?}",
@@ -122,10 +129,7 @@ fn a_latch_at_the_slave_zeroes_the_master_in_the_same_tick() {
 /// A lost slave zeroes the master in that tick, and the stop names the slave.
 #[test]
 fn a_lost_slave_zeroes_the_master_and_names_the_slave() {
-    let (mut l, shared) = live();
-    run(&mut l, 0, 800);
-    shared.lock().unwrap().reading = Some(Reading::Lost);
-    assert_eq!(l.tick(&tick_info(800)), TickControl::Stop);
+    let (l, _) = slave_reads_at_800_ms(Reading::Lost);
     assert!(
         matches!(
             l.stop,
