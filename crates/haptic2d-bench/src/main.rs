@@ -25,6 +25,7 @@
 #![warn(missing_docs)]
 
 mod box2d_world;
+mod phases;
 mod rapier_world;
 mod reference;
 mod report;
@@ -112,6 +113,12 @@ struct Args {
     /// the start, warm-up included) and plot them, one `steps_<scene>_<n>.svg` per case.
     #[arg(long)]
     step_times: bool,
+    /// Also split every engine's timed steps into a landing phase (steps before LANDING_END) and a
+    /// settled phase (from SETTLED_FROM): median, p99 and p99/median per phase, haptic2d's ratio
+    /// to each peer per phase, and its landing p99 against its settled median (issue 42's
+    /// targets). Time from the start with `--warmup 0`, e.g. `--warmup 0 --steps 3000 --phases 1000,2000`.
+    #[arg(long, value_name = "LANDING_END,SETTLED_FROM")]
+    phases: Option<phases::Phases>,
 }
 
 fn out_dir(args: &Args) -> PathBuf {
@@ -152,6 +159,9 @@ fn run(args: &Args) -> Result<(), String> {
     }
     if args.pile.contains(&0) {
         return Err("--pile sizes must be at least 1".into());
+    }
+    if let Some(p) = args.phases {
+        p.check(args.steps)?;
     }
     let cases = scenes::cases(&args.pile, &args.scenes)?;
     if cases.is_empty() {
@@ -314,6 +324,14 @@ fn run(args: &Args) -> Result<(), String> {
             std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
             let svg = dir.join(format!("steps_{}_{}.svg", case.scene, case.n));
             report::steps_svg(&label, &all_keys, &all, &svg)?;
+        }
+        if let Some(p) = args.phases {
+            let named: Vec<(&str, &timing::Samples)> = keys
+                .iter()
+                .map(String::as_str)
+                .zip(samples.iter())
+                .collect();
+            print!("{}", phases::table(&label, p, &named));
         }
         let states = [
             state::of(&h, &haptic_poses),

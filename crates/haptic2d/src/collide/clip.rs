@@ -59,6 +59,22 @@ fn deepest_behind(p: &Collider, e: usize, q: &Collider) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
+/// [`deepest_behind`] where no vertex of `q` is behind `p`'s edge line `e` by more than both 0
+/// and `floor` (m); `None` as soon as one is (then the overlap along `n_e` exceeds both, and the
+/// axis decides nothing in [`sat_depth_above`]). The same distances, compared in the same order.
+#[inline]
+fn deepest_behind_within(p: &Collider, e: usize, q: &Collider, floor: f64) -> Option<f64> {
+    let mut min_d = f64::INFINITY;
+    for &v in q.world_vertices() {
+        let d = p.edge_distance(e, v);
+        if d < 0.0 && -d > floor {
+            return None;
+        }
+        min_d = min_d.min(d);
+    }
+    Some(min_d)
+}
+
 /// The separating-axis depth of `a` and `b` with its reference face; `None` if some axis
 /// separates them (or one has no edge). The same search, order and ties as
 /// [`sat_depth`](super::sat_depth), which calls it.
@@ -103,12 +119,16 @@ pub fn sat_face(a: &Collider, b: &Collider) -> Option<SatFace> {
 /// value as [`sat_depth`](super::sat_depth) where it is returned. The search stops at the first
 /// admissible axis (no seam, no motion out through one) whose overlap is at most `floor`: the
 /// depth, the least overlap over the admissible axes, cannot exceed it. That is how
-/// [`max_overlap`](super::overlap::max_overlap) skips most of a pile's shallow contacts.
+/// [`max_overlap`](super::overlap::max_overlap) skips most of a pile's shallow contacts. On
+/// each axis the scan of the other polygon's vertices stops at the first one deeper than both 0
+/// and `floor` (`deepest_behind_within`): neither exit can fire on that axis then.
 pub fn sat_depth_above(a: &Collider, b: &Collider, floor: f64) -> Option<f64> {
     let seams = a.seams != 0 || b.seams != 0;
     for (p, q, sign) in [(a, b, -1.0), (b, a, 1.0)] {
         for e in 0..p.len() {
-            let min_d = deepest_behind(p, e, q);
+            let Some(min_d) = deepest_behind_within(p, e, q, floor) else {
+                continue;
+            };
             if min_d >= 0.0 {
                 return None;
             }

@@ -3,5 +3,6 @@
 pub mod coupling;
 pub mod file;
 pub mod four_channel;
+pub mod held_work;
 pub mod passivity;
 pub mod tdpa;

@@ -136,11 +136,30 @@ impl TdpaPort {
     /// into `E_in` otherwise.
     #[inline]
     fn book_power(&mut self, p: f64, dt: f64) {
-        if p > 0.0 {
-            self.e_out += p * dt;
+        self.add_work(p * dt);
+    }
+
+    /// Books the work `w` (J) the network did on the port's body: into `E_out` when it is
+    /// positive, into `E_in` otherwise.
+    #[inline]
+    fn add_work(&mut self, w: f64) {
+        if w > 0.0 {
+            self.e_out += w;
         } else {
-            self.e_in -= p * dt;
+            self.e_in -= w;
         }
+    }
+
+    /// Books one sample by its work rather than its power: the network did the work `work` (J,
+    /// `> 0`: energy out to the port's body) and a controller removed `dissipated` (J) from it
+    /// (for a controller that predicts the work of a held force,
+    /// [`super::held_work::HeldWorkControl`]). Non-finite values book nothing.
+    pub fn book_work(&mut self, work: f64, dissipated: f64) {
+        if !(work.is_finite() && dissipated.is_finite()) {
+            return;
+        }
+        self.dissipated += dissipated;
+        self.add_work(work);
     }
 
     /// Books one sample without a controller: the network applied `force` to a body moving at `v`
@@ -324,6 +343,18 @@ mod tests {
         assert!((out[2] - 0.1e-3).abs() < 1e-15, "{out:?}");
         let bal = planar_balance((0.0, side.totals().1), (0.3e-3, 0.0));
         assert!((bal.created - 0.0).abs() < 1e-15, "{bal:?}");
+    }
+
+    #[test]
+    fn booking_by_work_puts_positive_work_out_negative_work_in_and_adds_the_dissipation() {
+        let mut p = TdpaPort::new();
+        p.book_work(2e-3, 1e-4);
+        p.book_work(-5e-4, 0.0);
+        p.book_work(f64::NAN, 1.0);
+        assert_eq!(
+            (p.energy_out(), p.energy_in(), p.dissipated()),
+            (2e-3, 5e-4, 1e-4)
+        );
     }
 
     #[test]

@@ -74,6 +74,8 @@ pub struct ContactSet {
     crossing: Vec<(u32, u32)>,
     /// Per pair of `crossing`: deepest record (m), any Colliding, any record clearing it.
     crossing_info: Vec<(f64, bool, bool)>,
+    /// Per collider: whether it is in a pair of `crossing` (all false between samples).
+    crossing_mark: Vec<bool>,
     clip_keys: Vec<VeCandidate>,
     /// Effective depths handed from released records to a crossing pair's clip records (`clip`),
     /// and the records released out of their edge range this sample, with their pair (a < b).
@@ -133,6 +135,7 @@ impl ContactSet {
             pending: Vec::with_capacity(16),
             crossing: Vec::with_capacity(16),
             crossing_info: Vec::with_capacity(16),
+            crossing_mark: Vec::new(),
             clip_keys: Vec::with_capacity(16),
             pool: Vec::with_capacity(16),
             dropped: Vec::with_capacity(16),
