@@ -91,6 +91,9 @@ pub struct LiveEnd {
     /// written on a stop (`None`: not yet; the loop's end zeroes again, unrecorded).
     pub last_torque_t: Option<f64>,
     pub zeroed_t: Option<f64>,
+    /// The watchdog's limit of consecutive missed deadlines for this device (its device file's
+    /// `max_missed_deadlines`; `None`: off, and for the simulated twin).
+    pub max_missed_run: Option<u32>,
     /// Largest applied force `|(f_x, f_y)|` (N).
     pub max_force: f64,
     /// The handle's displacement from its origin at the last sensed tick (m, m, rad).
@@ -132,13 +135,16 @@ impl LiveEnd {
             return Err(named("not a real device".into()));
         };
         let end = real.device_end(dt).map_err(named)?;
-        let (name, summary) = (real.name.clone(), real.summary.clone());
+        let (name, summary, missed) =
+            (real.name.clone(), real.summary.clone(), real.max_missed_run);
         // As `run`: a device that cannot be opened or does not answer is a lost device (exit 4).
         let io = (real.open)(Duration::from_secs_f64(dt)).map_err(|e| Failure {
             status: crate::exit::Status::DeviceLost,
             message: format!("--{} {spec}: {e}", role.name()),
         })?;
-        Ok(Self::assemble(role, name, summary, EndIo::Real(io), end))
+        let mut e = Self::assemble(role, name, summary, EndIo::Real(io), end);
+        e.max_missed_run = missed;
+        Ok(e)
     }
 
     /// The simulated twin at the centre of its workspace: the master with the grip and `push`,
@@ -195,6 +201,7 @@ impl LiveEnd {
             tau: [0.0; 4],
             last_torque_t: None,
             zeroed_t: None,
+            max_missed_run: None,
             max_force: 0.0,
             displacement: [0.0; 3],
             max_excursion: 0.0,

@@ -60,6 +60,16 @@ pub enum LiveStop {
     Latch(Role, SafetyTrip),
     /// This end's device was lost (the other end was zeroed in the same tick).
     Lost(Role, DeviceError),
+    /// `run` consecutive ticks missed their deadline, reaching this end's device file's limit
+    /// (both ends zeroed in that tick).
+    Missed {
+        /// The end whose limit it was.
+        role: Role,
+        /// Consecutive ticks that missed.
+        run: u32,
+        /// The limit.
+        limit: u32,
+    },
 }
 
 /// The slave's contact with the simulated wall (see [`LiveEnd::contact`]).
@@ -97,6 +107,8 @@ pub struct Live {
     interval: TickInterval,
     /// The previous tick's wait for both devices (ns).
     prev_wait_ns: u64,
+    /// Consecutive ticks that missed their deadline (the watchdog of `run`).
+    missed_run: u32,
     /// Slave contact (a simulated slave only).
     pub contact: Option<Contact>,
     /// Why and when (s) it stopped, if the tick stopped it.
@@ -137,6 +149,7 @@ impl Live {
             tail_from: duration - 1.0,
             interval: TickInterval::new(),
             prev_wait_ns: 0,
+            missed_run: 0,
             contact,
             stop: None,
         }
@@ -149,6 +162,12 @@ impl Live {
         let at = (k, t);
         let elapsed = self.interval.update(info) as f64 * 1e-9;
         let wait = self.prev_wait_ns as f64 * 1e-9;
+        if let Some(stop) = self.watch_deadlines(info) {
+            self.m.zero(Some(t));
+            self.s.zero(Some(t));
+            self.stop.get_or_insert((t, stop));
+            return TickControl::Stop;
+        }
         let qm = match self.m.read(t) {
             Ok(q) => q,
             Err(e) => return self.lost(t, Role::Master, e),
@@ -205,6 +224,24 @@ impl Live {
             return self.lost(t, Role::Slave, e);
         }
         TickControl::Continue
+    }
+
+    /// Counts consecutive ticks that missed their deadline; the stop when the count reaches a real
+    /// device's limit (its device file's `max_missed_deadlines`, as `run`'s watchdog).
+    fn watch_deadlines(&mut self, info: &TickInfo) -> Option<LiveStop> {
+        self.missed_run = if info.missed_deadline() {
+            self.missed_run.saturating_add(1)
+        } else {
+            0
+        };
+        [&self.m, &self.s].into_iter().find_map(|e| {
+            let limit = e.max_missed_run?;
+            (self.missed_run >= limit).then_some(LiveStop::Missed {
+                role: e.role,
+                run: self.missed_run,
+                limit,
+            })
+        })
     }
 
     /// The simulated slave's wall contact at time `t` (s), with the master's force `f_mx` (N, x).

@@ -5,7 +5,7 @@ use std::sync::{Arc, Mutex};
 
 use haptic2d::haptic::{DeviceEnd, SafetyConfig, WorkspaceSquare};
 use haptic2d_lab::network::Impairment;
-use haptic2d_rt::{DeviceError, DeviceIo, TickControl};
+use haptic2d_rt::{DeviceError, DeviceIo, TickControl, TickInfo};
 
 use super::{Live, LiveStop};
 use crate::push_arg::Push;
@@ -166,4 +166,44 @@ fn once_the_link_is_full_a_tick_allocates_nothing() {
     let a1 = count();
     run(&mut l, 100, 1100);
     assert_eq!(count() - a1, 0, "allocations in 1 000 ticks");
+}
+
+/// `run`'s watchdog: with the slave's device file allowing 10 consecutive missed deadlines, the
+/// tenth late tick stops the loop before reading, both ends zeroed in it; nine do not.
+#[test]
+fn ten_missed_deadlines_in_a_row_stop_with_both_ends_zeroed() {
+    let (mut l, _) = live();
+    l.s.max_missed_run = Some(10);
+    run(&mut l, 0, 600);
+    let late = |k: u64| TickInfo {
+        skipped: 1,
+        ..tick_info(k)
+    };
+    for k in 600..609 {
+        assert_eq!(l.tick(&late(k)), TickControl::Continue, "tick {k}");
+    }
+    run(&mut l, 609, 700);
+    for k in 700..709 {
+        assert_eq!(l.tick(&late(k)), TickControl::Continue, "tick {k}");
+    }
+    assert_eq!(l.tick(&late(709)), TickControl::Stop);
+    assert!(
+        matches!(
+            l.stop,
+            Some((
+                _,
+                LiveStop::Missed {
+                    role: Role::Slave,
+                    run: 10,
+                    limit: 10
+                }
+            ))
+        ),
+        "{:?}",
+        l.stop
+    );
+    assert_eq!(
+        (l.m.zeroed_t, l.m.last_torque_t),
+        (Some(0.709), Some(0.708))
+    );
 }

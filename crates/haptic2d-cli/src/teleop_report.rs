@@ -126,6 +126,14 @@ fn stop_lines(live: &Live, interrupted: bool) -> Status {
             );
             Status::SafetyStop
         }
+        Some((t, LiveStop::Missed { role, run, limit })) => {
+            outln!(
+                "stopped: safety stop at t = {t:.3} s: {run} consecutive ticks missed their deadline (limit {limit}, the {}'s device file, {}): the machine is too loaded for this rate (give the loop real-time priority, close other programs, or raise max_missed_deadlines); {zeroed}",
+                role.name(),
+                name(*role)
+            );
+            Status::SafetyStop
+        }
         Some((t, LiveStop::Lost(role, e))) => {
             let check = match e {
                 DeviceError::Lost(_) => "check its cable, power and port",
