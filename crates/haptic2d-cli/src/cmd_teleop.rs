@@ -13,12 +13,34 @@ use crate::outln;
 /// `teleop`'s options.
 #[derive(clap::Args, Clone, Debug)]
 pub struct TeleopArgs {
-    /// The master device: `sim` (the simulated twin pantograph, pushed by a simulated grip).
+    /// The master device: `sim` (the simulated twin pantograph, pushed by a simulated grip), or
+    /// with `--live` a real one: `haply:PATH`, `udp:ADDR:PORT`, `inverse3[:URL]`.
     #[arg(long, default_value = "sim")]
     pub master: String,
-    /// The slave device: `sim` (the simulated twin pantograph, with a wall 5 mm to its left).
+    /// The slave device: `sim` (the simulated twin pantograph, with a wall 5 mm to its left), or
+    /// with `--live` a real one: `haply:PATH`, `udp:ADDR:PORT`, `inverse3[:URL]`.
     #[arg(long, default_value = "sim")]
     pub slave: String,
+    /// Run in real time, both devices in one 1 kHz loop (docs/TELEOP.md, "Two devices in real
+    /// time"); implied when either device is not `sim`.
+    #[arg(long)]
+    pub live: bool,
+    /// The master's device file (a real master; as `run --device-file`).
+    #[arg(long, value_name = "FILE.toml")]
+    pub master_device_file: Option<std::path::PathBuf>,
+    /// The slave's device file (a real slave; as `run --device-file`).
+    #[arg(long, value_name = "FILE.toml")]
+    pub slave_device_file: Option<std::path::PathBuf>,
+    /// Let a UDP device be beyond loopback (as `run --allow-remote-device`).
+    #[arg(long)]
+    pub allow_remote_device: bool,
+    /// Live, simulated master: the grip's target moves from the start pose by (DX, DY) (m) at
+    /// SPEED (m/s) from time AT (s); default -0.015,0,0.05,0.6 (15 mm left from 0.6 s).
+    #[arg(long, value_name = "DX,DY,SPEED,AT", allow_hyphen_values = true)]
+    pub push: Option<String>,
+    /// Live: normal scheduling instead of real-time priority for the loop.
+    #[arg(long)]
+    pub no_rt: bool,
     /// Simulated time (s).
     #[arg(long, default_value_t = 3.0)]
     pub duration: f64,
@@ -159,13 +181,6 @@ pub fn run(a: &TeleopArgs) -> Result<Status, Failure> {
         }
         return Ok(Status::Clean);
     }
-    for (which, v) in [("--master", &a.master), ("--slave", &a.slave)] {
-        if v != "sim" {
-            return Err(Failure::from(format!(
-                "{which} {v}: only `sim` (the simulated twin pantograph) is built so far\n    fix: {which} sim"
-            )));
-        }
-    }
     if !(a.duration.is_finite() && a.duration > 1.0 && a.duration <= 600.0) {
         return Err(Failure::from(format!(
             "--duration must be within (1, 600] s (got {})",
@@ -190,6 +205,23 @@ pub fn run(a: &TeleopArgs) -> Result<Status, Failure> {
         return Err(Failure::from(format!(
             "--stiffness must be > 0 and --damping ≥ 0 (got {}, {})",
             a.stiffness, a.damping
+        )));
+    }
+    if a.live || a.master != "sim" || a.slave != "sim" {
+        return crate::teleop_live::run(a, link);
+    }
+    if let Some(o) = [(a.push.is_some(), "--push"), (a.no_rt, "--no-rt")]
+        .iter()
+        .chain(&[
+            (a.master_device_file.is_some(), "--master-device-file"),
+            (a.slave_device_file.is_some(), "--slave-device-file"),
+            (a.allow_remote_device, "--allow-remote-device"),
+        ])
+        .find(|o| o.0)
+    {
+        return Err(Failure::from(format!(
+            "{}: only with --live (two devices in real time)\n    fix: add --live",
+            o.1
         )));
     }
     let cfg = config(a, link);

@@ -42,6 +42,7 @@ mod cli_stability;
 mod cli_study;
 mod cli_study_serve;
 mod cli_teleop;
+mod cli_teleop_live;
 mod cli_udp;
 mod cli_world_device;
 mod device_safety;

@@ -55,6 +55,18 @@ pub enum HandModel {
         /// Wrench after release (N, N, N·m).
         release: V3,
     },
+    /// An environment rather than a hand: a one-sided spring–damper wall along x filling
+    /// `x < surface`. At penetration `p = surface − x > 0` it pushes `+x` with
+    /// `F_x = max(0, K·p − B·ẋ)` (it never pulls); out of contact, zero. The simulated slave's
+    /// wall of `haptic2d teleop --live` (the lab's teleop wall, docs/TELEOP.md).
+    Wall {
+        /// The wall's surface (m, handle x).
+        surface: f64,
+        /// Stiffness `K` (N/m).
+        stiffness: f64,
+        /// Damping `B` (N·s/m).
+        damping: f64,
+    },
 }
 
 /// `K·(target − x) − B·ẋ` with the θ error wrapped.
@@ -114,6 +126,19 @@ impl HandModel {
                     *release
                 }
             }
+            HandModel::Wall {
+                surface,
+                stiffness,
+                damping,
+            } => {
+                let pen = surface - x[0];
+                let f = if pen > 0.0 {
+                    (stiffness * pen - damping * xd[0]).max(0.0)
+                } else {
+                    0.0
+                };
+                [f, 0.0, 0.0]
+            }
         }
     }
 
@@ -131,5 +156,45 @@ impl HandModel {
             }
             _ => false,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const WALL: HandModel = HandModel::Wall {
+        surface: 0.10,
+        stiffness: 2000.0,
+        damping: 2.0,
+    };
+
+    /// Hooke's law at rest: 3 mm into a 2 000 N/m wall is 6 N pushing out (+x), whatever y and θ.
+    #[test]
+    fn a_wall_at_rest_pushes_out_with_stiffness_times_penetration() {
+        let f = WALL.wrench(&[0.097, 0.05, 1.0], &[0.0; 3], 0.0);
+        assert!((f[0] - 6.0).abs() < 1e-9, "{f:?}");
+        assert_eq!((f[1], f[2]), (0.0, 0.0));
+    }
+
+    /// Out of contact (at or right of the surface) the wall exerts nothing, even moving into it.
+    #[test]
+    fn a_wall_out_of_contact_exerts_nothing() {
+        for x in [0.10, 0.12] {
+            assert_eq!(
+                WALL.wrench(&[x, 0.0, 0.0], &[-1.0, 0.0, 0.0], 0.0),
+                [0.0; 3]
+            );
+        }
+    }
+
+    /// The damper adds `−B·ẋ`: moving in at 0.5 m/s, 1 mm deep: 2 N + 1 N = 3 N. Leaving fast, the
+    /// damper would pull (2 N − 10 N < 0): a one-sided wall never pulls, so zero.
+    #[test]
+    fn the_damper_resists_motion_but_the_wall_never_pulls() {
+        let into = WALL.wrench(&[0.099, 0.0, 0.0], &[-0.5, 0.0, 0.0], 0.0);
+        assert!((into[0] - 3.0).abs() < 1e-9, "{into:?}");
+        let leaving = WALL.wrench(&[0.099, 0.0, 0.0], &[5.0, 0.0, 0.0], 0.0);
+        assert_eq!(leaving, [0.0; 3]);
     }
 }
