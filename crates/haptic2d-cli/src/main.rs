@@ -153,11 +153,14 @@ enum Command {
     #[command(after_help = examples_help(cmd_serve_world::EXAMPLES))]
     ServeWorld(cmd_serve_world::ServeWorldArgs),
     /// The device side of a loop split at the network (an alias of `run --device sim --world
-    /// udp:HOST:PORT`): the simulated twin pantograph with its local safety (docs/TELEOP.md).
+    /// udp:HOST:PORT`): the simulated twin pantograph with its local safety (docs/TELEOP.md; `run
+    /// --world` takes a real device too).
     #[command(after_help = examples_help(cmd_remote_device::EXAMPLES))]
     RemoteDevice(cmd_remote_device::RemoteDeviceArgs),
-    /// Bilateral teleoperation of two simulated devices across a simulated link, with TDPA: the
-    /// slave's wall contact felt at the master (docs/TELEOP.md).
+    /// Bilateral teleoperation of two devices across a simulated link, with TDPA: the slave's
+    /// contact felt at the master; two simulated devices in simulated time, or any two devices
+    /// (simulated twin, Haply board, UDP device, Inverse3) in real time with `--live`
+    /// (docs/TELEOP.md).
     Teleop(cmd_teleop::TeleopArgs),
     /// Parameter sweeps; `walls`: stiffness × damping of every wall law, classified by energy gain.
     Sweep {

@@ -99,7 +99,7 @@ fn two_simulated_devices_live_across_50_ms_and_loss_feel_the_wall_and_create_no_
 fn free_2diy() -> (tempfile::TempDir, PathBuf, Killed, String) {
     let dir = tempfile::tempdir().unwrap();
     let file = haply_file(dir.path(), "haply-2diy-gen3.toml", "gen3.toml", |t| t);
-    let (emu, pty) = emulate_haply(&file, &["--hand", "free", "--no-rt"]);
+    let (emu, pty) = emulate_haply(&file, &["--hand", "free"]);
     (dir, file, emu, format!("haply:{pty}"))
 }
 

@@ -112,7 +112,7 @@ fn a_2diy_board_on_the_device_side_runs_clean_and_the_link_stays_passive() {
     // The emulated hand holds the handle at its rest pose (where the board is set up). A scripted
     // push is left out here: on the emulated 2DIY it also ends in safety stops with a local world
     // (docs/TELEOP.md, "Choose the coupling for the device"); the UDP test above pushes.
-    let (emu, pty) = emulate_haply(&file, &["--no-rt"]);
+    let (emu, pty) = emulate_haply(&file, &[]);
     let key = key_file("board", 0x3c);
     let w = world(&key);
     let child = device_side(&format!("haply:{pty}"), &file, &w, &key, "3");
@@ -128,7 +128,7 @@ fn a_2diy_board_lost_mid_run_latches_zero_torques_and_exits_4_naming_it() {
     let _m = crate::common::module_turn(module_path!());
     let dir = tempfile::tempdir().unwrap();
     let file = haply_file(dir.path(), "haply-2diy-gen3.toml", "gen3.toml", |t| t);
-    let (mut emu, pty) = emulate_haply(&file, &["--no-rt"]);
+    let (mut emu, pty) = emulate_haply(&file, &[]);
     let key = key_file("board-lost", 0x3d);
     let w = world(&key);
     let child = device_side(&format!("haply:{pty}"), &file, &w, &key, "20");
