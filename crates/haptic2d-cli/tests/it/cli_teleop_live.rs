@@ -133,7 +133,12 @@ fn the_slave_emulator_killed_mid_run_exits_4_naming_the_slave_with_the_master_ze
     let _m = crate::common::module_turn(module_path!());
     let _t = turn();
     let (_dir, file, mut emu, slave) = free_2diy();
-    let mut run = cmd("teleop --live --no-rt --duration 20 --slave", &[]);
+    // The grip pushes from 0.3 s, so that the coupling pulls the slave and the master's torques
+    // are non-zero well before the cut (at rest both devices read exactly still: zero force).
+    let mut run = cmd(
+        "teleop --live --no-rt --duration 20 --push -0.015,0,0.05,0.3 --slave",
+        &[],
+    );
     run.arg(&slave).arg("--slave-device-file").arg(&file);
     let (child, reader, out) = spawn_until_looping(run);
     std::thread::sleep(Duration::from_millis(1500));
