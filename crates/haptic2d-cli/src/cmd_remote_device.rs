@@ -32,7 +32,6 @@ use haptic2d::device::linalg::{V3, V4};
 use haptic2d::device::DeviceParams;
 use haptic2d::haptic::safety::{SafetyConfig, SafetyReason};
 use haptic2d::haptic::DeviceEnd;
-use haptic2d_devices::registry::DeviceChoice;
 use haptic2d_devices::world_link::message::{FLAG_BYE, FLAG_LATCHED, FLAG_TDPA, FLAG_WAVE};
 use haptic2d_devices::world_link::{
     LinkEndpoint, PortMessage, KIND_TO_DEVICE, KIND_TO_WORLD, PORT_LEN,
@@ -603,17 +602,9 @@ fn real_device(p: &Plan, dt: f64) -> Result<Opened, Failure> {
             p.device
         )));
     }
-    let choice = DeviceChoice::parse(p.device).map_err(Failure::from)?;
-    let real = choice
-        .load_real(p.device_file, p.allow_remote)
-        .map_err(Failure::from)?
-        .ok_or_else(|| Failure::from(format!("--device {}: not a real device", p.device)))?;
-    let end = real.device_end(dt).map_err(Failure::from)?;
-    let what = format!("{} ({})", real.name, real.summary);
-    let io = (real.open)(Duration::from_secs_f64(dt)).map_err(|m| Failure {
-        status: Status::DeviceLost,
-        message: m,
-    })?;
+    let r = crate::real_end::open(p.device, p.device_file, p.allow_remote, dt)?;
+    let what = format!("{} ({})", r.name, r.summary);
+    let (io, end) = (r.io, r.end);
     Ok((SideIo::Real(io), end, None, what))
 }
 

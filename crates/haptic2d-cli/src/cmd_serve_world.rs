@@ -16,7 +16,6 @@ use std::sync::atomic::AtomicBool;
 use std::time::Duration;
 
 use haptic2d::control::tdpa::PlanarTdpa;
-use haptic2d_devices::registry::DeviceChoice;
 use haptic2d_devices::world_link::message::{FLAG_BYE, FLAG_LATCHED, FLAG_TDPA, FLAG_WAVE};
 use haptic2d_devices::world_link::{
     LinkEndpoint, PortMessage, KIND_TO_DEVICE, KIND_TO_WORLD, PORT_LEN,
@@ -430,21 +429,9 @@ fn slave_device(
     device: &str,
     dt: f64,
 ) -> Result<(SlavePlant, String), Failure> {
-    let choice = DeviceChoice::parse(device).map_err(Failure::from)?;
-    let real = choice
-        .load_real(a.device_file.as_deref(), a.allow_remote_device)
-        .map_err(Failure::from)?
-        .ok_or_else(|| {
-            Failure::from(format!(
-                "--device {device}: serve-world drives a real device (haply:PATH, udp:ADDR:PORT, inverse3); the simulated twin is `haptic2d teleop`'s"
-            ))
-        })?;
-    let end = real.device_end(dt).map_err(Failure::from)?;
-    let what = format!("slave device {} ({})", real.name, real.summary);
-    let io = (real.open)(Duration::from_secs_f64(dt)).map_err(|m| Failure {
-        status: Status::DeviceLost,
-        message: m,
-    })?;
+    let r = crate::real_end::open(device, a.device_file.as_deref(), a.allow_remote_device, dt)?;
+    let what = format!("slave device {} ({})", r.name, r.summary);
+    let (io, end) = (r.io, r.end);
     Ok((SlavePlant::Device(DeviceSlave::new(io, end)), what))
 }
 

@@ -28,6 +28,7 @@ mod haply_arg;
 mod loop_end;
 mod pipe;
 mod push_arg;
+mod real_end;
 mod run_log;
 mod run_rig;
 mod run_view;

@@ -11,14 +11,12 @@
 
 use std::path::Path;
 use std::sync::Arc;
-use std::time::Duration;
 
 use haptic2d::control::tdpa::PlanarTdpa;
 use haptic2d::device::linalg::{V3, V4};
 use haptic2d::device::{DeviceEstimate, DeviceParams, HandModel};
 use haptic2d::haptic::safety_stage::TickClock;
 use haptic2d::haptic::{DeviceEnd, SafetyConfig};
-use haptic2d_devices::registry::DeviceChoice;
 use haptic2d_rt::clock::now_ns;
 use haptic2d_rt::{DeviceError, DeviceIo, SharedTarget, SimIo};
 
@@ -125,23 +123,16 @@ impl LiveEnd {
             }
             return Self::sim(role, push, dt).map_err(named);
         }
-        let choice = DeviceChoice::parse(spec).map_err(named)?;
-        if !choice.is_real() {
+        if spec.starts_with("replay:") {
             return Err(named(
                 "a replay cannot be teleoperated\n    fix: sim, haply:PATH, udp:ADDR:PORT or inverse3[:URL]".into(),
             ));
         }
-        let Some(real) = choice.load_real(file, allow_remote).map_err(named)? else {
-            return Err(named("not a real device".into()));
-        };
-        let end = real.device_end(dt).map_err(named)?;
-        let (name, summary, missed) =
-            (real.name.clone(), real.summary.clone(), real.max_missed_run);
-        // As `run`: a device that cannot be opened or does not answer is a lost device (exit 4).
-        let io = (real.open)(Duration::from_secs_f64(dt)).map_err(|e| Failure {
-            status: crate::exit::Status::DeviceLost,
-            message: format!("--{} {spec}: {e}", role.name()),
+        let r = crate::real_end::open(spec, file, allow_remote, dt).map_err(|f| Failure {
+            message: format!("--{} {spec}: {}", role.name(), f.message),
+            ..f
         })?;
+        let (io, end, name, summary, missed) = (r.io, r.end, r.name, r.summary, r.max_missed_run);
         let mut e = Self::assemble(role, name, summary, EndIo::Real(io), end);
         e.max_missed_run = missed;
         Ok(e)

@@ -14,6 +14,7 @@
 //! the exit paths, not the machine's timing.
 
 use std::path::Path;
+use std::process::{Child, Command};
 use std::time::Duration;
 
 use crate::cli_teleop::{key_file, number, World};
@@ -21,40 +22,53 @@ use crate::common::{assert_has, assert_lost_device, emulate_haply, haply_file, w
 
 const BIN: &str = env!("CARGO_BIN_EXE_haptic2d");
 
-/// A world side on the near-wall scene with the 2DIY's softer coupling.
+/// The world side's coupling softened for the 2DIY and the UDP five-bar, and the patient link
+/// timeout of the tests.
+const SOFT: [&str; 10] = [
+    "--coupling-k",
+    "100",
+    "100",
+    "1",
+    "--coupling-b",
+    "0.5",
+    "0.5",
+    "0.01",
+    "--link-timeout-ms",
+    "300",
+];
+
+/// A world side on the near-wall scene with the softer coupling.
 fn world(key: &Path) -> World {
-    let soft = [
-        "--coupling-k",
-        "100",
-        "100",
-        "1",
-        "--coupling-b",
-        "0.5",
-        "0.5",
-        "0.01",
-    ];
-    World::start(key, &[&soft[..], &["--link-timeout-ms", "300"]].concat())
+    World::start(key, &SOFT)
 }
 
-/// The device side on `device` (`haply:PTY`, `udp:ADDR:PORT`; device file `file`) for `secs` seconds.
-fn device_side(
-    device: &str,
-    file: &Path,
-    world: &World,
-    key: &Path,
-    secs: &str,
-) -> std::process::Child {
-    std::process::Command::new(BIN)
-        .args(["run", "--device", device, "--device-file"])
-        .arg(file)
+/// `haptic2d run DEVICE… --world udp:… --key KEY --duration SECS` with the tests' patient timing,
+/// `extra` appended: a device side.
+fn run_side(device: &[&str], world: &World, key: &Path, secs: &str, extra: &[&str]) -> Child {
+    Command::new(BIN)
+        .arg("run")
+        .args(device)
         .args(["--world", &format!("udp:{}", world.addr), "--key"])
         .arg(key)
         .args(["--duration", secs, "--no-rt", "--link-timeout-ms", "300"])
         .args(["--max-stall-periods", "100"])
+        .args(extra)
         .stdout(std::process::Stdio::piped())
         .stderr(std::process::Stdio::piped())
         .spawn()
         .unwrap()
+}
+
+/// The device side on `device` (`haply:PTY`, `udp:ADDR:PORT`; device file `file`) for `secs` seconds.
+fn device_side(device: &str, file: &Path, world: &World, key: &Path, secs: &str) -> Child {
+    let file = file.to_str().unwrap();
+    run_side(
+        &["--device", device, "--device-file", file],
+        world,
+        key,
+        secs,
+        &[],
+    )
 }
 
 /// What every device side must show: a clean exit with no safety stop, no energy created, the
@@ -165,48 +179,23 @@ fn slave_world(
     let file = crate::cli_udp::device_file(tag);
     let key = key_file(tag, 0x3f);
     let device = format!("udp:{}", dev.1);
-    let command = [
+    let file = file.to_str().unwrap();
+    let served = [
         "serve-world",
         "--device",
         &device,
         "--device-file",
-        file.to_str().unwrap(),
+        file,
         "--bind",
-        "127.0.0.1:0",
-        "--no-rt",
-        "--coupling-k",
-        "100",
-        "100",
-        "1",
-        "--coupling-b",
-        "0.5",
-        "0.5",
-        "0.01",
-        "--link-timeout-ms",
-        "300",
     ];
+    let command = [&served[..], &["127.0.0.1:0", "--no-rt"], &SOFT[..]].concat();
     (World::start_as(&command, &key, extra), key)
 }
 
 /// The simulated master of a slave world: the grip pushes 15 mm left from 0.6 s; `extra` appended.
-fn master(w: &World, key: &Path, secs: &str, extra: &[&str]) -> std::process::Child {
-    std::process::Command::new(BIN)
-        .args([
-            "run",
-            "--device",
-            "sim",
-            "--world",
-            &format!("udp:{}", w.addr),
-            "--key",
-        ])
-        .arg(key)
-        .args(["--duration", secs, "--no-rt", "--push", "-0.015,0,0.05,0.6"])
-        .args(["--link-timeout-ms", "300", "--max-stall-periods", "100"])
-        .args(extra)
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap()
+fn master(w: &World, key: &Path, secs: &str, extra: &[&str]) -> Child {
+    let sim = ["--device", "sim", "--push", "-0.015,0,0.05,0.6"];
+    run_side(&sim, w, key, secs, extra)
 }
 
 #[test]

@@ -143,21 +143,12 @@ impl DeviceEnd {
         safety: SafetyConfig,
         dt: f64,
     ) -> Result<Self, String> {
-        safety.validate()?;
-        workspace.validate()?;
-        check_positive("tau_max", tau_max[0].min(tau_max[1]), "N·m")?;
-        check_positive("mass", mass, "kg")?;
-        let device = Pantograph2Device::new(linkage, tau_max, min_margin, 50.0, dt);
         let gate = tau_max[0].min(tau_max[1]);
-        let latch = Safety::new(min_margin, gate, safety.torque_trip_margin);
-        let bound = WorkspaceBound::of_square(&workspace, dt);
-        let stage = SafetyStage::new(safety, latch, bound, dt);
-        Ok(Self::assemble(
-            EndDevice::FiveBar(device),
-            stage,
-            [mass, mass, 0.0],
-            true,
-        ))
+        check_positive("tau_max", gate, "N·m")?;
+        let stage = square_stage(workspace, mass, (min_margin, gate), safety, dt)?;
+        let device = Pantograph2Device::new(linkage, tau_max, min_margin, 50.0, dt);
+        let end = EndDevice::FiveBar(device);
+        Ok(Self::assemble(end, stage, [mass, mass, 0.0], true))
     }
 
     /// A Cartesian point device with force limit `force_limit` (N), workspace square `workspace`,
@@ -169,21 +160,11 @@ impl DeviceEnd {
         safety: SafetyConfig,
         dt: f64,
     ) -> Result<Self, String> {
-        safety.validate()?;
-        workspace.validate()?;
         check_positive("force_limit", force_limit, "N")?;
-        check_positive("mass", mass, "kg")?;
-        let device = PointDevice::new(force_limit, 50.0, dt);
         // No singularity: the margin is 1 at every reading.
-        let latch = Safety::new(0.0, force_limit, safety.torque_trip_margin);
-        let bound = WorkspaceBound::of_square(&workspace, dt);
-        let stage = SafetyStage::new(safety, latch, bound, dt);
-        Ok(Self::assemble(
-            EndDevice::Point(device),
-            stage,
-            [mass, mass, 0.0],
-            false,
-        ))
+        let stage = square_stage(workspace, mass, (0.0, force_limit), safety, dt)?;
+        let end = EndDevice::Point(PointDevice::new(force_limit, 50.0, dt));
+        Ok(Self::assemble(end, stage, [mass, mass, 0.0], false))
     }
 
     fn assemble(device: EndDevice, safety: SafetyStage, nominal_mass: V3, at_sense: bool) -> Self {
@@ -335,6 +316,24 @@ impl DeviceEnd {
     pub fn ramp(&self) -> f64 {
         self.safety.ramp()
     }
+}
+
+/// The safety stage of a device bounded by the workspace square `workspace` (a five-bar, a point
+/// device), with the latch's singularity limit and gate `(min_margin, gate)`, after checking the
+/// settings and the handle's `mass` (kg).
+fn square_stage(
+    workspace: WorkspaceSquare,
+    mass: f64,
+    (min_margin, gate): (f64, f64),
+    safety: SafetyConfig,
+    dt: f64,
+) -> Result<SafetyStage, String> {
+    safety.validate()?;
+    workspace.validate()?;
+    check_positive("mass", mass, "kg")?;
+    let latch = Safety::new(min_margin, gate, safety.torque_trip_margin);
+    let bound = WorkspaceBound::of_square(&workspace, dt);
+    Ok(SafetyStage::new(safety, latch, bound, dt))
 }
 
 fn check_positive(name: &str, v: f64, unit: &str) -> Result<(), String> {
