@@ -1,5 +1,5 @@
 //! A world port that paces its body's approach (issue 41, docs/TELEOP.md "Pacing the world's
-//! body"): a TDPA port whose body may carry as kinetic energy only a share of the room it has, or
+//! body: `control::paced`, tried"): a TDPA port whose body may carry as kinetic energy only a share of the room it has, or
 //! move as fast as the master does.
 //!
 //! # Why
@@ -33,10 +33,33 @@
 //! the body's true displacement ([`PacedPort::book_measured`]) with the predicted work the clamp
 //! and the scale removed as dissipated. Diagonal mass only (a world's body: mass, mass, inertia).
 //! Pure arithmetic, no allocation, fixed order.
+//!
+//! Measured in the split loop (docs/TELEOP.md), with the held-work controller on the device side:
+//! at γ = 0.1 and `v_m` passed as zero the plants received at most +0.5 mJ at 0–200 ms and the
+//! 200 ms contact was kept (2.7–2.9 N), but the 50 ms contact stiffened (3.8 N against 2.8 N
+//! shipped); with `v_m` 50 ms kept (3.3 N) and 200 ms was lost (1.7 N). So the split loop does
+//! not use this controller.
 
 use super::held_work::largest_scale;
 use super::tdpa::PlanarTdpa;
 use crate::device::linalg::V3;
+
+/// What the world side knows of one period, per axis (x, y, θ), for [`PacedPort::control`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PacedInput {
+    /// The coupling's force on the body (N, N, N·m).
+    pub force: V3,
+    /// The body's velocity at the start of the period (m/s, m/s, rad/s).
+    pub v: V3,
+    /// The other forces on the body over the period, e.g. the wall's last contact wrench (N, N, N·m).
+    pub other: V3,
+    /// The body's mass and inertia (kg, kg, kg·m²).
+    pub m: V3,
+    /// The energy the far (master's) port has put into the network, as last received (J).
+    pub far_e_in: V3,
+    /// The master's velocity as received (m/s, m/s, rad/s); zero for the room's cap alone.
+    pub v_master: V3,
+}
 
 /// The pacing controller of a world side's three ports (x, y, θ), with a [`PlanarTdpa`] that keeps
 /// the books: [`Self::control`], then [`Self::book_measured`] in the same period.
@@ -60,23 +83,18 @@ impl PacedPort {
         }
     }
 
-    /// The force to apply (N, N, N·m) over a period `dt` (s) to a body of mass `m` (kg, kg, kg·m²)
-    /// at velocity `v` (m/s, m/s, rad/s) with the other forces `other` on it (N, N, N·m): `force`
-    /// as the coupling asks, clamped to the speed cap and scaled to fit `far_e_in − E_out` of
-    /// `ports` (J), the master moving at `v_master` (m/s, m/s, rad/s). A non-finite input, a
-    /// non-positive mass or `dt` returns no force.
-    #[allow(clippy::too_many_arguments)]
-    pub fn control(
-        &mut self,
-        ports: &PlanarTdpa,
-        force: &V3,
-        v: &V3,
-        other: &V3,
-        m: &V3,
-        far_e_in: &V3,
-        v_master: &V3,
-        dt: f64,
-    ) -> V3 {
+    /// The force to apply (N, N, N·m) over a period `dt` (s) for the period's [`PacedInput`]:
+    /// the coupling's force clamped to the speed cap and scaled to fit `far_e_in − E_out` of
+    /// `ports` (J). A non-finite input, a non-positive mass or `dt` returns no force.
+    pub fn control(&mut self, ports: &PlanarTdpa, input: &PacedInput, dt: f64) -> V3 {
+        let PacedInput {
+            force,
+            v,
+            other,
+            m,
+            far_e_in,
+            v_master,
+        } = input;
         let finite = |x: &V3| x.iter().all(|c| c.is_finite());
         self.cut = [0.0; 3];
         let ok = [force, v, other, far_e_in, v_master]
@@ -140,19 +158,22 @@ mod tests {
     const M: f64 = 0.5;
     const MASS: V3 = [M, M, 1e-4];
 
-    /// A port whose far side has put `e_in` (J) into the network on x.
+    /// One period on x: the coupling's force `f`, the body's velocity `v`, the wall's force `w`,
+    /// the far side's energy in `e_in` (J) and the master's velocity `v_m`.
+    fn on_x(f: f64, v: f64, w: f64, e_in: f64, v_m: f64) -> PacedInput {
+        PacedInput {
+            force: [f, 0.0, 0.0],
+            v: [v, 0.0, 0.0],
+            other: [w, 0.0, 0.0],
+            m: MASS,
+            far_e_in: [e_in, 0.0, 0.0],
+            v_master: [v_m, 0.0, 0.0],
+        }
+    }
+
+    /// The force on x of one period without the master's motion.
     fn room_of(c: &mut PacedPort, ports: &PlanarTdpa, f: f64, v: f64, w: f64, e_in: f64) -> f64 {
-        let far = [e_in, 0.0, 0.0];
-        c.control(
-            ports,
-            &[f, 0.0, 0.0],
-            &[v, 0.0, 0.0],
-            &[w, 0.0, 0.0],
-            &MASS,
-            &far,
-            &[0.0; 3],
-            T,
-        )[0]
+        c.control(ports, &on_x(f, v, w, e_in, 0.0), T)[0]
     }
 
     #[test]
@@ -194,17 +215,7 @@ mod tests {
         // rest reaches 10 mm/s, under the cap, so the clamp leaves it (the scale then fits the
         // room, here ample).
         let (mut c, ports) = (PacedPort::new(0.1), PlanarTdpa::default());
-        let far = [1.0, 0.0, 0.0];
-        let out = c.control(
-            &ports,
-            &[-5.0, 0.0, 0.0],
-            &[0.0; 3],
-            &[0.0; 3],
-            &MASS,
-            &far,
-            &[-0.05, 0.0, 0.0],
-            T,
-        );
+        let out = c.control(&ports, &on_x(-5.0, 0.0, 0.0, 1.0, -0.05), T);
         assert_eq!(out[0], -5.0);
         // Without the master's motion and with little room (1 µJ, cap 0.63 mm/s) the same force
         // is clamped to the step that reaches the cap: m·cap/T.
@@ -242,19 +253,8 @@ mod tests {
         let mut c = PacedPort::new(gamma.unwrap_or(1e12));
         let mut ports = PlanarTdpa::default();
         let (mut x, mut v, mut wall) = (0.0_f64, 0.0_f64, 0.0_f64);
-        let far = [room, 0.0, 0.0];
         for _ in 0..2000 {
-            let (vv, w) = ([v, 0.0, 0.0], [wall, 0.0, 0.0]);
-            let f = c.control(
-                &ports,
-                &[-5.0, 0.0, 0.0],
-                &vv,
-                &w,
-                &MASS,
-                &far,
-                &[0.0; 3],
-                T,
-            )[0];
+            let f = room_of(&mut c, &ports, -5.0, v, wall, room);
             let mut v1 = v + (f + wall) * T / M;
             let mut x1 = x + v1 * T;
             if x1 < -gap && x >= -gap && v1 < -0.02 {
