@@ -4,5 +4,6 @@ pub mod coupling;
 pub mod file;
 pub mod four_channel;
 pub mod held_work;
+pub mod paced;
 pub mod passivity;
 pub mod tdpa;
