@@ -23,7 +23,7 @@
 //! holding device and world together (crates/haptic2d/src/haptic/), which this split does not
 //! change; the device side is this loop, with the same `SafetyStage` as that tick.
 
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::Ordering;
 use std::sync::Arc;
 use std::time::Duration;
 
@@ -39,8 +39,7 @@ use haptic2d_devices::world_link::{
 use haptic2d_lab::network::wave::{WaveMaster, WaveMsg};
 use haptic2d_rt::clock::now_ns;
 use haptic2d_rt::{
-    run_loop, DeviceError, DeviceIo, LoopConfig, SharedTarget, SimIo, TickControl, TickInfo,
-    TickInterval,
+    DeviceError, DeviceIo, LoopConfig, SharedTarget, SimIo, TickControl, TickInfo, TickInterval,
 };
 
 use crate::exit::{Failure, Status};
@@ -678,17 +677,7 @@ fn run_device_side(p: &Plan) -> Result<Status, Failure> {
         ..LoopConfig::default()
     };
     config.validate().map_err(Failure::from)?;
-    let summary = std::thread::scope(|s| {
-        std::thread::Builder::new()
-            .name("haptic2d-rt".into())
-            .spawn_scoped(s, || {
-                run_loop(&config, &stop as &AtomicBool, |info| side.tick(&info))
-            })
-            .map_err(|e| Failure::error(format!("cannot start the loop thread: {e}")))?
-            .join()
-            .map_err(|_| Failure::error("the loop thread panicked"))?
-            .map_err(Failure::error)
-    })?;
+    let summary = crate::rt_thread::run_on_rt_thread(&config, &stop, |info| side.tick(&info))?;
     side.io.io().zero_torques();
     side.bye(side.latch.is_some());
     Ok(report(&mut side, &summary, stop.load(Ordering::Relaxed)))

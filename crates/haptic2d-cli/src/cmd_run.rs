@@ -20,8 +20,8 @@ use haptic2d_rt::mcap::{LoggedTick, McapSetup};
 use haptic2d_rt::signal::install_stop_signals;
 use haptic2d_rt::telemetry::{ring_capacity, MAX_RING_BYTES};
 use haptic2d_rt::{
-    run_loop, telemetry_channel, DeviceError, LoopConfig, SnapshotRx, TelemetryTx, TickControl,
-    TickInfo, TimingSummary, Watchdog,
+    telemetry_channel, DeviceError, LoopConfig, SnapshotRx, TelemetryTx, TickControl, TickInfo,
+    TimingSummary, Watchdog,
 };
 use std::collections::BTreeMap;
 use std::net::SocketAddr;
@@ -254,7 +254,7 @@ pub fn run(a: &RunArgs) -> Result<Status, Failure> {
         end: None,
         worst: WorstStep::default(),
     };
-    let summary = run_on_rt_thread(&loop_config, &stop, &mut state);
+    let summary = crate::rt_thread::run_on_rt_thread(&loop_config, &stop, |info| state.tick(&info));
     // Zero torques before anything else (Ctrl-C, the end of --duration, a failure alike); the port
     // closes when the rig is dropped, after the report.
     state.rig.io.zero_torques();
@@ -535,24 +535,6 @@ impl LoopState<'_> {
         }
         TickControl::Continue
     }
-}
-
-/// Step 6: runs the loop on its own thread; everything it touches is borrowed for the run.
-fn run_on_rt_thread(
-    loop_config: &LoopConfig,
-    stop: &AtomicBool,
-    state: &mut LoopState<'_>,
-) -> Result<TimingSummary, Failure> {
-    std::thread::scope(|s| {
-        let handle = std::thread::Builder::new()
-            .name("haptic2d-rt".into())
-            .spawn_scoped(s, || run_loop(loop_config, stop, |info| state.tick(&info)))
-            .map_err(|e| Failure::error(format!("cannot start the real-time loop thread: {e}")))?;
-        handle
-            .join()
-            .map_err(|_| Failure::error("the real-time loop thread panicked"))?
-            .map_err(Failure::from)
-    })
 }
 
 /// The exit status of a run that stopped for `end` (`None`: the duration ended, or a signal when

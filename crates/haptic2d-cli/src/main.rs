@@ -29,6 +29,7 @@ mod loop_end;
 mod pipe;
 mod push_arg;
 mod real_end;
+mod rt_thread;
 mod run_log;
 mod run_rig;
 mod run_view;

@@ -21,13 +21,13 @@
 //! lab's `Link` keeps its messages in a `VecDeque` that grows during the first `delay` ticks: 8
 //! allocations at 25 ms each way, counted in `tests::once_the_link_is_full_a_tick_allocates_nothing`).
 
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::Ordering;
 use std::time::Duration;
 
 use haptic2d::device::linalg::V3;
 use haptic2d::haptic::SafetyTrip;
 use haptic2d_lab::network::{Impairment, Link};
-use haptic2d_rt::{run_loop, DeviceError, LoopConfig, TickControl, TickInfo, TickInterval};
+use haptic2d_rt::{DeviceError, LoopConfig, TickControl, TickInfo, TickInterval};
 
 use crate::cmd_teleop::{ArchitectureArg, TeleopArgs};
 use crate::exit::{Failure, Status};
@@ -343,17 +343,7 @@ pub fn run(a: &TeleopArgs, link: Impairment) -> Result<Status, Failure> {
         ..LoopConfig::default()
     };
     config.validate().map_err(Failure::from)?;
-    let summary = std::thread::scope(|sc| {
-        std::thread::Builder::new()
-            .name("haptic2d-rt".into())
-            .spawn_scoped(sc, || {
-                run_loop(&config, &stop as &AtomicBool, |info| live.tick(&info))
-            })
-            .map_err(|e| Failure::error(format!("cannot start the loop thread: {e}")))?
-            .join()
-            .map_err(|_| Failure::error("the loop thread panicked"))?
-            .map_err(Failure::error)
-    });
+    let summary = crate::rt_thread::run_on_rt_thread(&config, &stop, |info| live.tick(&info));
     // Whatever ended the loop (the duration, a signal, a stop, a failure): both at zero.
     live.m.zero(None);
     live.s.zero(None);
