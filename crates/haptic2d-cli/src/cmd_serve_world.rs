@@ -429,6 +429,11 @@ fn slave_device(
     device: &str,
     dt: f64,
 ) -> Result<(SlavePlant, String), Failure> {
+    if device == "sim" {
+        return Err(Failure::from(
+            "--device sim: serve-world drives a real slave device; a simulated slave runs in `haptic2d teleop --live` (one process)\n    fix: --device haply:PATH, udp:ADDR:PORT or inverse3[:URL]",
+        ));
+    }
     let r = crate::real_end::open(device, a.device_file.as_deref(), a.allow_remote_device, dt)?;
     let what = format!("slave device {} ({})", r.name, r.summary);
     let (io, end) = (r.io, r.end);

@@ -7,6 +7,9 @@
 //!   udp:…` (the slave) and `haptic2d run --device sim --world udp:…` (the master).
 //!
 //! Either end runs its device as a `DeviceEnd`, the same safety stage as every device's in `run`.
+//! The tests take turns (`common::turn`): each starts devices at real-time priority (the emulator,
+//! the reference UDP device), and two such sets on a 2-core machine starve the unprivileged loops
+//! beside them (a 2DIY reply 100 ms late, measured).
 //!
 //! The world side's coupling is softened for the 2DIY (100 N/m, 0.5 N·s/m: its handle is about
 //! 0.03 kg, against the twin's 0.4 kg for which the defaults are set; docs/TELEOP.md). Timing
@@ -103,6 +106,7 @@ fn assert_rendered(out: &str, world_out: &str) {
 #[test]
 fn a_udp_device_on_the_device_side_renders_the_world_and_the_link_stays_passive() {
     let _m = crate::common::module_turn(module_path!());
+    let _t = crate::common::turn();
     let file = crate::cli_udp::device_file("world-side");
     // The reference five-bar's hand pushes 1 N along +y from 0.6 s after the first command.
     let dev = crate::cli_udp::sim_device(&["--push", "0,1", "--push-after", "0.6"]);
@@ -121,6 +125,7 @@ fn a_udp_device_on_the_device_side_renders_the_world_and_the_link_stays_passive(
 #[test]
 fn a_2diy_board_on_the_device_side_runs_clean_and_the_link_stays_passive() {
     let _m = crate::common::module_turn(module_path!());
+    let _t = crate::common::turn();
     let dir = tempfile::tempdir().unwrap();
     let file = haply_file(dir.path(), "haply-2diy-gen3.toml", "gen3.toml", |t| t);
     // The emulated hand holds the handle at its rest pose (where the board is set up). A scripted
@@ -140,6 +145,7 @@ fn a_2diy_board_on_the_device_side_runs_clean_and_the_link_stays_passive() {
 #[test]
 fn a_2diy_board_lost_mid_run_latches_zero_torques_and_exits_4_naming_it() {
     let _m = crate::common::module_turn(module_path!());
+    let _t = crate::common::turn();
     let dir = tempfile::tempdir().unwrap();
     let file = haply_file(dir.path(), "haply-2diy-gen3.toml", "gen3.toml", |t| t);
     let (mut emu, pty) = emulate_haply(&file, &[]);
@@ -201,6 +207,7 @@ fn master(w: &World, key: &Path, secs: &str, extra: &[&str]) -> Child {
 #[test]
 fn a_udp_slave_device_follows_a_simulated_master_at_50_ms_and_5_percent_and_its_hand_is_felt() {
     let _m = crate::common::module_turn(module_path!());
+    let _t = crate::common::turn();
     // The slave's own (simulated) hand holds it at its start with a spring: what the master feels.
     let dev = crate::cli_udp::sim_device(&[]);
     let impaired = ["--delay-ms", "25", "--loss", "0.05"];
@@ -231,6 +238,7 @@ fn a_udp_slave_device_follows_a_simulated_master_at_50_ms_and_5_percent_and_its_
 #[test]
 fn a_slave_device_lost_mid_run_latches_its_own_and_its_masters_torques() {
     let _m = crate::common::module_turn(module_path!());
+    let _t = crate::common::turn();
     let mut dev = crate::cli_udp::sim_device(&[]);
     let (w, key) = slave_world(&dev, "teleop-slave-lost", &[]);
     let child = master(&w, &key, "20", &[]);
@@ -254,4 +262,17 @@ fn a_slave_device_lost_mid_run_latches_its_own_and_its_masters_torques() {
             "torques set to zero and latched",
         ],
     );
+}
+
+#[test]
+fn serve_world_refuses_a_simulated_slave_device_and_a_scene_beside_a_device() {
+    let _m = crate::common::module_turn(module_path!());
+    let _t = crate::common::turn();
+    let key = key_file("refuse-slave", 0x40);
+    let k = key.to_str().unwrap();
+    let o = crate::common::haptic2d(&["serve-world", "--device", "sim", "--key", k]);
+    crate::common::expect_exit(&o, 2, &["teleop --live", "fix: --device haply:PATH"]);
+    let o =
+        crate::common::haptic2d(&["serve-world", "box-in-walls", "--device", "udp:127.0.0.1:9"]);
+    crate::common::expect_exit(&o, 2, &["cannot be used with"]);
 }
