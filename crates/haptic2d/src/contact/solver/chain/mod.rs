@@ -67,6 +67,8 @@
 
 mod rows;
 #[cfg(test)]
+mod sweep_tests;
+#[cfg(test)]
 mod tests;
 
 use crate::body::Body;
@@ -93,8 +95,9 @@ struct Row {
     rnb: f64,
     /// Inverse effective normal mass `w` (1/kg).
     w: f64,
-    /// `c = r/((1 + r)·w)` with `r = T/τ` (kg).
-    c: f64,
+    /// `−c`, with `c = r/((1 + r)·w)` and `r = T/τ` (kg): the sweep's factor, stored negated so
+    /// that the sweep does not negate it every time (`(−c)·x` is `−(c·x)` exactly).
+    neg_c: f64,
     /// Lower bound `−T·f_n` of the impulse (N·s).
     lo: f64,
     /// Accumulated impulse (N·s, along `+n` on A).
@@ -128,7 +131,7 @@ impl Row {
         rna: 0.0,
         rnb: 0.0,
         w: 0.0,
-        c: 0.0,
+        neg_c: 0.0,
         lo: 0.0,
         lambda: 0.0,
     };
@@ -164,16 +167,16 @@ impl Row {
             rna,
             rnb,
             w,
-            c: r / ((1.0 + r) * w),
+            neg_c: -(r / ((1.0 + r) * w)),
             lo,
-            lambda: if warm.is_finite() { warm } else { 0.0 },
+            lambda: if finite(warm) { warm } else { 0.0 },
         }
     }
 
     /// Whether the effective mass is finite and positive.
     #[inline(always)]
     fn valid(&self) -> bool {
-        self.w > 0.0 && self.w.is_finite()
+        (self.w > 0.0) & finite(self.w)
     }
 
     /// Relative normal velocity of the row's points (m/s; positive separating) in the working
@@ -464,20 +467,19 @@ impl ChainDamping {
         self.last_warm_scale = s;
         // 5. Projected Gauss–Seidel on F = −B_c·v⁺_n, F ≥ −f_n, until converged. The rows still
         //    hold the whole warm impulses: the first sweep scales each by `s` as it reads it.
-        let solver = &mut self.solver;
+        //    The sweeps take the rows and velocities as slices: their lengths and addresses stay
+        //    in registers (a `Vec` behind `&mut` is reloaded after every store to a row).
+        let (rows, solver) = (&mut self.sorted[..], &mut self.solver[..]);
         let mut scale = s;
         for _ in 0..sweeps {
-            // Largest change of a row's relative velocity in this sweep (m/s).
-            let mut largest = 0.0f64;
-            for row in self.sorted.iter_mut() {
-                let lambda = row.lambda * scale;
-                let v_rel = row.v_rel(solver);
-                let new = select_max(-row.c * (v_rel - row.w * lambda), row.lo);
-                let d = new - lambda;
-                row.lambda = new;
-                row.apply(d, solver);
-                largest = select_max((d * row.w).abs(), largest);
-            }
+            // Largest change of a row's relative velocity in this sweep (m/s). After the first
+            // sweep the scale is 1 and `sweep` is inlined without the multiplication (`λ·1 = λ`
+            // exactly).
+            let largest = if scale == 1.0 {
+                sweep(rows, solver, 1.0)
+            } else {
+                sweep(rows, solver, scale)
+            };
             scale = 1.0;
             self.last_sweeps += 1;
             if largest <= CONVERGED {
@@ -612,6 +614,34 @@ impl ChainDamping {
             *s = star.s;
         }
     }
+}
+
+/// One projected Gauss–Seidel sweep of `rows` (colour order) on the working velocities `solver`,
+/// each row's impulse first scaled by `scale` (the warm start's, in the first sweep; 1 after):
+/// `λ ← max(−c·(v_rel − w·λ), lo)` and the change applied to both bodies. Returns the largest
+/// change of a row's relative velocity, `|Δλ·w|` (m/s).
+#[inline(always)]
+fn sweep(rows: &mut [Row], solver: &mut [SolverBody], scale: f64) -> f64 {
+    let mut largest = 0.0f64;
+    for row in rows.iter_mut() {
+        let lambda = row.lambda * scale;
+        let v_rel = row.v_rel(solver);
+        let new = select_max(row.neg_c * (v_rel - row.w * lambda), row.lo);
+        let d = new - lambda;
+        row.lambda = new;
+        row.apply(d, solver);
+        largest = select_max((d * row.w).abs(), largest);
+    }
+    largest
+}
+
+/// Whether `x` is finite: `x − x` is `+0` exactly for a finite `x` and NaN for an infinite or
+/// NaN one, so this is [`f64::is_finite`] — in two floating-point instructions, where the
+/// compiler lowers `is_finite` (and `x > 0 && x.is_finite()`) to a dozen integer ones on the
+/// bit pattern (`refresh_rows` asks twice per row).
+#[inline(always)]
+fn finite(x: f64) -> bool {
+    x - x == 0.0
 }
 
 /// Kinetic energy of body `b` at velocity `v` (m/s) and spin `omega` (rad/s) (J).
