@@ -638,7 +638,9 @@ fn sweep(rows: &mut [Row], solver: &mut [SolverBody], scale: f64) -> f64 {
 /// Whether `x` is finite: `x − x` is `+0` exactly for a finite `x` and NaN for an infinite or
 /// NaN one, so this is [`f64::is_finite`] — in two floating-point instructions, where the
 /// compiler lowers `is_finite` (and `x > 0 && x.is_finite()`) to a dozen integer ones on the
-/// bit pattern (`refresh_rows` asks twice per row).
+/// bit pattern (`refresh_rows` asks twice per row). (`x − x` of the same `x` is the point, hence
+/// the allowance.)
+#[allow(clippy::eq_op)]
 #[inline(always)]
 fn finite(x: f64) -> bool {
     x - x == 0.0
