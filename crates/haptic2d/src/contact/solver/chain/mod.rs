@@ -403,36 +403,7 @@ impl ChainDamping {
         // 1. The velocities the integrator would reach without the dampers (semi-implicit
         //    Euler), with the inverse masses the impulses act through (none for fixed bodies);
         //    the sweeps' working velocities start there.
-        let mut ke_star = 0.0;
-        let mut same_bodies = true;
-        for (i, b) in bodies.iter().enumerate() {
-            let s = if b.is_dynamic() {
-                let f = b.force - b.vel * b.damping;
-                let (v, omega) = (
-                    b.vel + f * (dt * b.inv_mass),
-                    b.omega + b.torque * dt * b.inv_inertia,
-                );
-                ke_star += kinetic_of(b, v, omega);
-                SolverBody {
-                    v,
-                    omega,
-                    inv_mass: b.inv_mass,
-                    inv_inertia: b.inv_inertia,
-                }
-            } else {
-                SolverBody {
-                    v: b.vel,
-                    omega: b.omega,
-                    inv_mass: 0.0,
-                    inv_inertia: 0.0,
-                }
-            };
-            self.star[i] = StarBody { s, pos: b.pose.pos };
-            self.solver[i] = s;
-            let d = s.inv_mass > 0.0 || s.inv_inertia > 0.0;
-            same_bodies &= self.dynamic[i] == d;
-            self.dynamic[i] = d;
-        }
+        let (ke_star, same_bodies) = self.start_velocities(dt, bodies);
         // 2–4. The rows: refreshed in place when the loaded contacts are those of the last
         //      sample (a pile at rest, most samples), patched when a few of them changed, built
         //      from scratch otherwise.
@@ -500,12 +471,14 @@ impl ChainDamping {
         //    that touch it.
         let inv_dt = 1.0 / dt;
         let mut ke = 0.0;
-        for (i, b) in bodies.iter_mut().enumerate() {
-            let (s, v) = (&self.solver[i], &self.star[i].s);
+        let per_body = (self.solver.iter().zip(&self.star)).zip(&self.dynamic);
+        for ((b, w), ((s, v), &dynamic)) in bodies.iter_mut().zip(&mut wrenches[..n]).zip(per_body)
+        {
+            let v = &v.s;
             if b.is_dynamic() {
                 ke += kinetic_of(b, s.v, s.omega);
             }
-            if !self.dynamic[i] {
+            if !dynamic {
                 continue; // summed over its rows below
             }
             let f = if v.inv_mass > 0.0 {
@@ -518,8 +491,8 @@ impl ChainDamping {
             } else {
                 0.0
             };
-            wrenches[i].force += f;
-            wrenches[i].torque += t;
+            w.force += f;
+            w.torque += t;
             b.force += f;
             b.torque += t;
         }
@@ -547,6 +520,45 @@ impl ChainDamping {
             }
         }
         removed
+    }
+
+    /// Step 1 of [`apply`](Self::apply): `star` and the working velocities `solver` from the
+    /// `bodies` (per-body buffers already sized to them), with `dynamic`. Returns the kinetic
+    /// energy at `v*` (J) and whether every body is as dynamic as in the last sample. The
+    /// buffers are zipped, not indexed: no index checks, no reloads of their addresses.
+    fn start_velocities(&mut self, dt: f64, bodies: &[Body]) -> (f64, bool) {
+        let mut ke_star = 0.0;
+        let mut same_bodies = true;
+        let per_body = (self.star.iter_mut().zip(&mut self.solver)).zip(&mut self.dynamic);
+        for (b, ((star, solver), dynamic)) in bodies.iter().zip(per_body) {
+            let s = if b.is_dynamic() {
+                let f = b.force - b.vel * b.damping;
+                let (v, omega) = (
+                    b.vel + f * (dt * b.inv_mass),
+                    b.omega + b.torque * dt * b.inv_inertia,
+                );
+                ke_star += kinetic_of(b, v, omega);
+                SolverBody {
+                    v,
+                    omega,
+                    inv_mass: b.inv_mass,
+                    inv_inertia: b.inv_inertia,
+                }
+            } else {
+                SolverBody {
+                    v: b.vel,
+                    omega: b.omega,
+                    inv_mass: 0.0,
+                    inv_inertia: 0.0,
+                }
+            };
+            *star = StarBody { s, pos: b.pose.pos };
+            *solver = s;
+            let d = s.inv_mass > 0.0 || s.inv_inertia > 0.0;
+            same_bodies &= *dynamic == d;
+            *dynamic = d;
+        }
+        (ke_star, same_bodies)
     }
 
     /// Drops the rows of the last sample: the next sample starts cold.
