@@ -67,6 +67,8 @@
 
 mod rows;
 #[cfg(test)]
+mod sweep_tests;
+#[cfg(test)]
 mod tests;
 
 use crate::body::Body;
@@ -93,8 +95,9 @@ struct Row {
     rnb: f64,
     /// Inverse effective normal mass `w` (1/kg).
     w: f64,
-    /// `c = r/((1 + r)·w)` with `r = T/τ` (kg).
-    c: f64,
+    /// `−c`, with `c = r/((1 + r)·w)` and `r = T/τ` (kg): the sweep's factor, stored negated so
+    /// that the sweep does not negate it every time (`(−c)·x` is `−(c·x)` exactly).
+    neg_c: f64,
     /// Lower bound `−T·f_n` of the impulse (N·s).
     lo: f64,
     /// Accumulated impulse (N·s, along `+n` on A).
@@ -128,7 +131,7 @@ impl Row {
         rna: 0.0,
         rnb: 0.0,
         w: 0.0,
-        c: 0.0,
+        neg_c: 0.0,
         lo: 0.0,
         lambda: 0.0,
     };
@@ -164,16 +167,16 @@ impl Row {
             rna,
             rnb,
             w,
-            c: r / ((1.0 + r) * w),
+            neg_c: -(r / ((1.0 + r) * w)),
             lo,
-            lambda: if warm.is_finite() { warm } else { 0.0 },
+            lambda: if finite(warm) { warm } else { 0.0 },
         }
     }
 
     /// Whether the effective mass is finite and positive.
     #[inline(always)]
     fn valid(&self) -> bool {
-        self.w > 0.0 && self.w.is_finite()
+        (self.w > 0.0) & finite(self.w)
     }
 
     /// Relative normal velocity of the row's points (m/s; positive separating) in the working
@@ -400,36 +403,7 @@ impl ChainDamping {
         // 1. The velocities the integrator would reach without the dampers (semi-implicit
         //    Euler), with the inverse masses the impulses act through (none for fixed bodies);
         //    the sweeps' working velocities start there.
-        let mut ke_star = 0.0;
-        let mut same_bodies = true;
-        for (i, b) in bodies.iter().enumerate() {
-            let s = if b.is_dynamic() {
-                let f = b.force - b.vel * b.damping;
-                let (v, omega) = (
-                    b.vel + f * (dt * b.inv_mass),
-                    b.omega + b.torque * dt * b.inv_inertia,
-                );
-                ke_star += kinetic_of(b, v, omega);
-                SolverBody {
-                    v,
-                    omega,
-                    inv_mass: b.inv_mass,
-                    inv_inertia: b.inv_inertia,
-                }
-            } else {
-                SolverBody {
-                    v: b.vel,
-                    omega: b.omega,
-                    inv_mass: 0.0,
-                    inv_inertia: 0.0,
-                }
-            };
-            self.star[i] = StarBody { s, pos: b.pose.pos };
-            self.solver[i] = s;
-            let d = s.inv_mass > 0.0 || s.inv_inertia > 0.0;
-            same_bodies &= self.dynamic[i] == d;
-            self.dynamic[i] = d;
-        }
+        let (ke_star, same_bodies) = self.start_velocities(dt, bodies);
         // 2–4. The rows: refreshed in place when the loaded contacts are those of the last
         //      sample (a pile at rest, most samples), patched when a few of them changed, built
         //      from scratch otherwise.
@@ -464,20 +438,19 @@ impl ChainDamping {
         self.last_warm_scale = s;
         // 5. Projected Gauss–Seidel on F = −B_c·v⁺_n, F ≥ −f_n, until converged. The rows still
         //    hold the whole warm impulses: the first sweep scales each by `s` as it reads it.
-        let solver = &mut self.solver;
+        //    The sweeps take the rows and velocities as slices: their lengths and addresses stay
+        //    in registers (a `Vec` behind `&mut` is reloaded after every store to a row).
+        let (rows, solver) = (&mut self.sorted[..], &mut self.solver[..]);
         let mut scale = s;
         for _ in 0..sweeps {
-            // Largest change of a row's relative velocity in this sweep (m/s).
-            let mut largest = 0.0f64;
-            for row in self.sorted.iter_mut() {
-                let lambda = row.lambda * scale;
-                let v_rel = row.v_rel(solver);
-                let new = select_max(-row.c * (v_rel - row.w * lambda), row.lo);
-                let d = new - lambda;
-                row.lambda = new;
-                row.apply(d, solver);
-                largest = select_max((d * row.w).abs(), largest);
-            }
+            // Largest change of a row's relative velocity in this sweep (m/s). After the first
+            // sweep the scale is 1 and `sweep` is inlined without the multiplication (`λ·1 = λ`
+            // exactly).
+            let largest = if scale == 1.0 {
+                sweep(rows, solver, 1.0)
+            } else {
+                sweep(rows, solver, scale)
+            };
             scale = 1.0;
             self.last_sweeps += 1;
             if largest <= CONVERGED {
@@ -498,12 +471,14 @@ impl ChainDamping {
         //    that touch it.
         let inv_dt = 1.0 / dt;
         let mut ke = 0.0;
-        for (i, b) in bodies.iter_mut().enumerate() {
-            let (s, v) = (&self.solver[i], &self.star[i].s);
+        let per_body = (self.solver.iter().zip(&self.star)).zip(&self.dynamic);
+        for ((b, w), ((s, v), &dynamic)) in bodies.iter_mut().zip(&mut wrenches[..n]).zip(per_body)
+        {
+            let v = &v.s;
             if b.is_dynamic() {
                 ke += kinetic_of(b, s.v, s.omega);
             }
-            if !self.dynamic[i] {
+            if !dynamic {
                 continue; // summed over its rows below
             }
             let f = if v.inv_mass > 0.0 {
@@ -516,8 +491,8 @@ impl ChainDamping {
             } else {
                 0.0
             };
-            wrenches[i].force += f;
-            wrenches[i].torque += t;
+            w.force += f;
+            w.torque += t;
             b.force += f;
             b.torque += t;
         }
@@ -545,6 +520,45 @@ impl ChainDamping {
             }
         }
         removed
+    }
+
+    /// Step 1 of [`apply`](Self::apply): `star` and the working velocities `solver` from the
+    /// `bodies` (per-body buffers already sized to them), with `dynamic`. Returns the kinetic
+    /// energy at `v*` (J) and whether every body is as dynamic as in the last sample. The
+    /// buffers are zipped, not indexed: no index checks, no reloads of their addresses.
+    fn start_velocities(&mut self, dt: f64, bodies: &[Body]) -> (f64, bool) {
+        let mut ke_star = 0.0;
+        let mut same_bodies = true;
+        let per_body = (self.star.iter_mut().zip(&mut self.solver)).zip(&mut self.dynamic);
+        for (b, ((star, solver), dynamic)) in bodies.iter().zip(per_body) {
+            let s = if b.is_dynamic() {
+                let f = b.force - b.vel * b.damping;
+                let (v, omega) = (
+                    b.vel + f * (dt * b.inv_mass),
+                    b.omega + b.torque * dt * b.inv_inertia,
+                );
+                ke_star += kinetic_of(b, v, omega);
+                SolverBody {
+                    v,
+                    omega,
+                    inv_mass: b.inv_mass,
+                    inv_inertia: b.inv_inertia,
+                }
+            } else {
+                SolverBody {
+                    v: b.vel,
+                    omega: b.omega,
+                    inv_mass: 0.0,
+                    inv_inertia: 0.0,
+                }
+            };
+            *star = StarBody { s, pos: b.pose.pos };
+            *solver = s;
+            let d = s.inv_mass > 0.0 || s.inv_inertia > 0.0;
+            same_bodies &= *dynamic == d;
+            *dynamic = d;
+        }
+        (ke_star, same_bodies)
     }
 
     /// Drops the rows of the last sample: the next sample starts cold.
@@ -612,6 +626,36 @@ impl ChainDamping {
             *s = star.s;
         }
     }
+}
+
+/// One projected Gauss–Seidel sweep of `rows` (colour order) on the working velocities `solver`,
+/// each row's impulse first scaled by `scale` (the warm start's, in the first sweep; 1 after):
+/// `λ ← max(−c·(v_rel − w·λ), lo)` and the change applied to both bodies. Returns the largest
+/// change of a row's relative velocity, `|Δλ·w|` (m/s).
+#[inline(always)]
+fn sweep(rows: &mut [Row], solver: &mut [SolverBody], scale: f64) -> f64 {
+    let mut largest = 0.0f64;
+    for row in rows.iter_mut() {
+        let lambda = row.lambda * scale;
+        let v_rel = row.v_rel(solver);
+        let new = select_max(row.neg_c * (v_rel - row.w * lambda), row.lo);
+        let d = new - lambda;
+        row.lambda = new;
+        row.apply(d, solver);
+        largest = select_max((d * row.w).abs(), largest);
+    }
+    largest
+}
+
+/// Whether `x` is finite: `x − x` is `+0` exactly for a finite `x` and NaN for an infinite or
+/// NaN one, so this is [`f64::is_finite`] — in two floating-point instructions, where the
+/// compiler lowers `is_finite` (and `x > 0 && x.is_finite()`) to a dozen integer ones on the
+/// bit pattern (`refresh_rows` asks twice per row). (`x − x` of the same `x` is the point, hence
+/// the allowance.)
+#[allow(clippy::eq_op)]
+#[inline(always)]
+fn finite(x: f64) -> bool {
+    x - x == 0.0
 }
 
 /// Kinetic energy of body `b` at velocity `v` (m/s) and spin `omega` (rad/s) (J).

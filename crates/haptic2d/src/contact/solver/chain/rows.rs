@@ -327,14 +327,18 @@ impl ChainDamping {
         dt: f64,
         loaded: &[LoadedContact],
     ) -> Option<(f64, f64)> {
-        // `solver` holds `v*` (step 1): nothing has applied an impulse to it yet.
-        let star = &self.star;
+        // `solver` holds `v*` (step 1): nothing has applied an impulse to it yet. Slices: their
+        // lengths and addresses stay in registers over the loop, and `solver` cut to `star`'s
+        // length (both are the bodies') lets the compiler drop its index checks after `star`'s.
+        let (rows, src) = (&mut self.sorted[..], &self.src[..]);
+        let star = &self.star[..];
+        let solver = &mut self.solver[..star.len()];
         let (mut g, mut k) = (0.0, 0.0);
         // Checked once at the end (no branch per row): if a row failed, the caller rebuilds from
         // scratch, from `star` and the rows' impulses; every row keeps `max(λ, lo)` or 0 here,
         // which `build_rows` maps the same way.
         let mut valid = true;
-        for (row, &i) in self.sorted.iter_mut().zip(&self.src) {
+        for (row, &i) in rows.iter_mut().zip(src) {
             if i == NONE {
                 continue; // a hole left by a patch: a no-op row
             }
@@ -343,7 +347,7 @@ impl ChainDamping {
             if row.lambda != 0.0 {
                 g += row.lambda * row.v_rel_star(star);
                 k += row.lambda * row.lambda * row.w;
-                row.apply(row.lambda, &mut self.solver);
+                row.apply(row.lambda, solver);
             }
         }
         valid.then(|| (g, self.curvature(k / r)))

@@ -423,7 +423,7 @@ fn rows_patched_are_the_rows_a_build_gives() {
             for (p, row) in patched.sorted.iter().enumerate() {
                 if !live.contains(&(p as u32)) {
                     assert_eq!(patched.src[p], NONE, "{k}: hole {p}");
-                    assert_eq!((row.w, row.c, row.lo, row.lambda), (0.0, 0.0, 0.0, 0.0));
+                    assert_eq!((row.w, row.neg_c, row.lo, row.lambda), (0.0, 0.0, 0.0, 0.0));
                     assert_eq!((row.n, row.rna, row.rnb), (Vec2::ZERO, 0.0, 0.0));
                 }
             }
@@ -445,7 +445,7 @@ fn rows_patched_are_the_rows_a_build_gives() {
                     (p.rna, b.rna),
                     (p.rnb, b.rnb),
                     (p.w, b.w),
-                    (p.c, b.c),
+                    (p.neg_c, b.neg_c),
                     (p.lo, b.lo),
                 ] {
                     assert_eq!(x.to_bits(), y.to_bits(), "{k}: {kp:?}");
