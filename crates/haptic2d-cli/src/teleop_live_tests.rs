@@ -144,28 +144,24 @@ fn a_lost_slave_zeroes_the_master_and_names_the_slave() {
     );
 }
 
-/// The hot path: two simulated devices across a 25 ms link with 5 % loss. While the first
-/// messages are in flight the lab's `Link` grows its queue (a few allocations, counted and
-/// bounded here); from then on a tick allocates nothing (1 000 ticks counted, on this thread, by
-/// the counting allocator the CLI's unit tests install: run_view.rs).
+/// The hot path: two simulated devices across a 25 ms link with 5 % loss. The lab's `Link` sizes
+/// its queue for everything that can be in flight, so no tick allocates, from the first (1 100
+/// ticks counted, on this thread, by the counting allocator the CLI's unit tests install:
+/// run_view.rs).
 #[test]
-fn once_the_link_is_full_a_tick_allocates_nothing() {
+fn no_tick_allocates_even_while_the_link_fills() {
     let m = LiveEnd::open(Role::Master, "sim", None, false, None, 1e-3).unwrap();
     let s = LiveEnd::open(Role::Slave, "sim", None, false, None, 1e-3).unwrap();
     let link = Impairment::delay_loss(25, 0.05, 3);
     let mut l = Live::new(m, s, link, (500.0, 5.0), true, 1e-3, 3.0);
     let count = haptic2d_test_support::alloc::allocations;
+    // The counter counts (so the zero below means something).
+    let a = count();
+    std::hint::black_box(Box::new(1u64));
+    assert!(count() > a, "the counting allocator is installed");
     let a0 = count();
-    run(&mut l, 0, 100);
-    let warm = count() - a0;
-    // At least one: the queues grew (and the counter counts, so the zero below means something).
-    assert!(
-        (1..=16).contains(&warm),
-        "{warm} allocations while the link filled"
-    );
-    let a1 = count();
-    run(&mut l, 100, 1100);
-    assert_eq!(count() - a1, 0, "allocations in 1 000 ticks");
+    run(&mut l, 0, 1100);
+    assert_eq!(count() - a0, 0, "allocations in 1 100 ticks");
 }
 
 /// `run`'s watchdog: with the slave's device file allowing 10 consecutive missed deadlines, the

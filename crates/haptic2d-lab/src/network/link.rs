@@ -63,13 +63,16 @@ pub struct Link<T: Copy> {
 }
 
 impl<T: Copy> Link<T> {
-    /// A link with impairment `imp`.
+    /// A link with impairment `imp`. Its queue is sized for everything that can be in flight
+    /// (one message a sample, each held at most `delay + jitter` samples, plus its duplicate), so
+    /// that sending and receiving never allocate: the link can sit in a real-time loop.
     pub fn new(imp: Impairment) -> Self {
+        let in_flight = 2 * (imp.delay as usize + imp.jitter as usize + 2);
         Self {
             imp,
             rng: imp.seed ^ 0x9e37_79b9_7f4a_7c15,
             seq: 0,
-            flight: VecDeque::new(),
+            flight: VecDeque::with_capacity(in_flight),
             newest: None,
             lost: 0,
             stale: 0,
