@@ -39,9 +39,10 @@ use haptic2d_devices::world_link::{
 use haptic2d_lab::network::wave::{WaveMaster, WaveMsg};
 use haptic2d_rt::clock::now_ns;
 use haptic2d_rt::{
-    DeviceError, DeviceIo, LoopConfig, SharedTarget, SimIo, TickControl, TickInfo, TickInterval,
+    DeviceError, LoopConfig, SharedTarget, SimIo, TickControl, TickInfo, TickInterval,
 };
 
+use crate::end_io::EndIo;
 use crate::exit::{Failure, Status};
 use crate::hand_arg::HandSpec;
 use crate::outln;
@@ -151,35 +152,11 @@ enum Latch {
     DeviceLost(DeviceError),
 }
 
-/// The device the side drives: the simulated twin (whose plant's true motion is known, for the
-/// plants' ledger) or a real device of the registry. One per run, never moved in the loop.
-#[allow(clippy::large_enum_variant)]
-enum SideIo {
-    Sim(SimIo),
-    Real(Box<dyn DeviceIo + Send>),
-}
-
-impl SideIo {
-    fn io(&mut self) -> &mut dyn DeviceIo {
-        match self {
-            SideIo::Sim(s) => s,
-            SideIo::Real(r) => r.as_mut(),
-        }
-    }
-
-    /// The simulated plant's true pose (m, m, rad); `None` on a real device.
-    fn plant_pose(&self) -> Option<V3> {
-        match self {
-            SideIo::Sim(s) => Some(s.plant().pose()),
-            SideIo::Real(_) => None,
-        }
-    }
-}
-
 /// The device side's state, owned by the loop.
 struct DeviceSide {
-    io: SideIo,
-    push: Option<(Push, Arc<SharedTarget>, V3)>,
+    /// The simulated twin (whose plant's true motion is known, for the plants' ledger) with its
+    /// grip's push, or a real device of the registry.
+    io: EndIo,
     /// The device with the tick's safety steps, the same as every device's (stall, joint
     /// plausibility, workspace bound, limit cycle, ramp, final gate).
     end: DeviceEnd,
@@ -222,10 +199,7 @@ impl DeviceSide {
     fn tick(&mut self, info: &TickInfo) -> TickControl {
         let (k, dt, t) = (info.deadline_index, info.period_s, info.t_s);
         let at = (k, t);
-        if let Some((p, target, start)) = &self.push {
-            target.set(p.target(start, t));
-        }
-        let q = match self.read() {
+        let q = match self.read(t) {
             Ok(q) => q,
             Err(e) => return self.stop(t, Latch::DeviceLost(e)),
         };
@@ -256,11 +230,11 @@ impl DeviceSide {
         self.max_force = self.max_force.max(applied[0].hypot(applied[1]));
         let d = (x[0] - origin[0]).hypot(x[1] - origin[1]);
         self.max_excursion = self.max_excursion.max(d);
-        let before = self.io.plant_pose();
+        let before = self.plant_pose();
         if let Err(e) = self.io.io().write_torques(&out.tau) {
             return self.stop(t, Latch::DeviceLost(e));
         }
-        if let (Some(b), Some(a)) = (before, self.io.plant_pose()) {
+        if let (Some(b), Some(a)) = (before, self.plant_pose()) {
             let moved: V3 = std::array::from_fn(|i| (a[i] - b[i]) / dt);
             self.plant_ledger.observe(&applied, &moved, dt);
         }
@@ -269,31 +243,26 @@ impl DeviceSide {
         self.finish(t)
     }
 
-    /// Reads the device, timing the wait of a real one (left out of the stall check, as in `run`).
-    fn read(&mut self) -> Result<V4, DeviceError> {
-        let t0 = now_ns();
-        let q = self.io.io().read_encoders();
-        self.read_wait_ns = (now_ns().saturating_sub(t0), self.read_wait_ns.0);
+    /// Reads the device at loop time `t` (s), timing the wait of a real one (left out of the stall
+    /// check, as in `run`).
+    fn read(&mut self, t: f64) -> Result<V4, DeviceError> {
+        let (q, wait) = self.io.read(t);
+        self.read_wait_ns = (wait, self.read_wait_ns.0);
         q
     }
 
-    /// Steps 0–2 of the device: the stall check on the loop's own time, the pose and twist. The
-    /// simulated plant advances one period a tick, so its signals use one period (the run stays
-    /// deterministic) while the stall check sees the real interval; a real device's signals use
-    /// the measured interval, less the previous read's wait for the stall check.
+    /// Steps 0–2 of the device ([`EndIo::sense`]): the stall check on the loop's own time (the
+    /// interval less the previous read's wait), the pose and twist.
     fn sense(&mut self, info: &TickInfo, q: &V4) -> Option<haptic2d::device::DeviceEstimate> {
         let at = (info.deadline_index, info.t_s);
         let elapsed = self.interval.update(info) as f64 * 1e-9;
-        match self.io {
-            SideIo::Sim(_) => {
-                self.end.check_stall(at, elapsed, 0.0);
-                self.end.sense(at, q, info.period_s, f64::NAN)
-            }
-            SideIo::Real(_) => {
-                let wait = self.read_wait_ns.1 as f64 * 1e-9;
-                self.end.sense(at, q, elapsed, wait)
-            }
-        }
+        let wait = self.read_wait_ns.1 as f64 * 1e-9;
+        (self.io).sense(&mut self.end, at, q, (elapsed, wait, info.period_s))
+    }
+
+    /// The simulated plant's true pose (m, m, rad); `None` on a real device.
+    fn plant_pose(&self) -> Option<V3> {
+        self.io.sim().map(|s| s.plant().pose())
     }
 
     /// The force to render this period from the world's newest message: through the master
@@ -582,16 +551,11 @@ fn sim_device(p: &Plan, hand: &HandSpec, safety: SafetyConfig, dt: f64) -> Resul
         d.reset(start[2]);
     }
     let what = format!("simulated twin pantograph, hand {}", p.hand);
-    Ok((SideIo::Sim(io), end, push, what))
+    Ok((EndIo::Sim { io, push }, end, what))
 }
 
-/// A device side's I/O, its end, the `--push` of a simulated hand and a description.
-type Opened = (
-    SideIo,
-    DeviceEnd,
-    Option<(Push, Arc<SharedTarget>, V3)>,
-    String,
-);
+/// A device side's I/O (with the `--push` of a simulated hand), its end and a description.
+type Opened = (EndIo, DeviceEnd, String);
 
 /// A real device of the registry, its device file read and checked, then opened at period `dt`.
 fn real_device(p: &Plan, dt: f64) -> Result<Opened, Failure> {
@@ -604,7 +568,7 @@ fn real_device(p: &Plan, dt: f64) -> Result<Opened, Failure> {
     let r = crate::real_end::open(p.device, p.device_file, p.allow_remote, dt)?;
     let what = format!("{} ({})", r.name, r.summary);
     let (io, end) = (r.io, r.end);
-    Ok((SideIo::Real(io), end, None, what))
+    Ok((EndIo::Real(io), end, what))
 }
 
 fn run_device_side(p: &Plan) -> Result<Status, Failure> {
@@ -614,7 +578,7 @@ fn run_device_side(p: &Plan) -> Result<Status, Failure> {
     let hand = HandSpec::parse(p.hand).map_err(Failure::from)?;
     let safety_config = check_run_settings(p.duration, a.max_stall_periods)?;
     let dt = 1.0 / p.rate;
-    let (io, end, push, what) = if p.device == "sim" {
+    let (io, end, what) = if p.device == "sim" {
         sim_device(p, &hand, safety_config, dt)?
     } else {
         real_device(p, dt)?
@@ -637,7 +601,6 @@ fn run_device_side(p: &Plan) -> Result<Status, Failure> {
     let timeout_periods = (a.link.link_timeout_ms * 1e-3 * p.rate).ceil() as u64;
     let mut side = DeviceSide {
         io,
-        push,
         axes: end.axes(),
         end,
         tdpa: a.link.tdpa(),
@@ -696,7 +659,7 @@ fn report(
     outln!("master port (device): {}", energies(mine));
 
     let plant = side.plant_ledger.totals();
-    if side.io.plant_pose().is_some() {
+    if side.plant_pose().is_some() {
         outln!(
             "master port (plant, true displacement): energy in {:.6} J, out {:.6} J",
             plant.0,

@@ -20,6 +20,7 @@ mod cmd_teleop;
 mod controller_file;
 mod csv_out;
 mod device_arg;
+mod end_io;
 mod exit;
 mod foxglove_live;
 mod grip_twist;

@@ -9,13 +9,14 @@
 //! `run`: ramp, workspace wall, saturation, limit cycle, final gate) to its motors. A device's
 //! latch or loss ends the session ([`SlavePlant::stop`]). None of this allocates.
 
-use haptic2d::device::linalg::{V3, V4};
+use haptic2d::device::linalg::V3;
 use haptic2d::device::DeviceEstimate;
 use haptic2d::geom::Vec2;
 use haptic2d::haptic::{DeviceEnd, SafetyTrip};
 use haptic2d::world::World;
-use haptic2d_rt::clock::now_ns;
 use haptic2d_rt::{DeviceError, DeviceIo, TickInfo, TickInterval};
+
+use crate::end_io::EndIo;
 
 /// A scene's body driven by the coupling.
 pub struct BodySlave {
@@ -38,7 +39,7 @@ pub enum SlaveStop {
 
 /// A device driven by the coupling, with its safety stage.
 pub struct DeviceSlave {
-    io: Box<dyn DeviceIo + Send>,
+    io: EndIo,
     end: DeviceEnd,
     axes: [bool; 3],
     interval: TickInterval,
@@ -53,7 +54,7 @@ impl DeviceSlave {
     /// The opened device `io` and its end.
     pub fn new(io: Box<dyn DeviceIo + Send>, end: DeviceEnd) -> Self {
         Self {
-            io,
+            io: EndIo::Real(io),
             axes: end.axes(),
             end,
             interval: TickInterval::new(),
@@ -157,7 +158,7 @@ impl SlavePlant {
     /// Zero torques on a slave device (best effort; nothing on a body): the end of a session.
     pub fn zero(&mut self) {
         if let SlavePlant::Device(d) = self {
-            d.io.zero_torques();
+            d.io.io().zero_torques();
         }
     }
 }
@@ -165,9 +166,8 @@ impl SlavePlant {
 impl DeviceSlave {
     fn sense(&mut self, info: &TickInfo) -> Option<(V3, V3)> {
         let at = (info.deadline_index, info.t_s);
-        let t0 = now_ns();
-        let q: Result<V4, DeviceError> = self.io.read_encoders();
-        self.read_wait_ns = (now_ns().saturating_sub(t0), self.read_wait_ns.0);
+        let (q, wait) = self.io.read(info.t_s);
+        self.read_wait_ns = (wait, self.read_wait_ns.0);
         let elapsed = self.interval.update(info) as f64 * 1e-9;
         let q = match q {
             Ok(q) => q,
@@ -177,7 +177,8 @@ impl DeviceSlave {
             }
         };
         let wait = self.read_wait_ns.1 as f64 * 1e-9;
-        self.est = self.end.sense(at, &q, elapsed, wait);
+        let timing = (elapsed, wait, info.period_s);
+        self.est = self.io.sense(&mut self.end, at, &q, timing);
         let e = self.est?;
         let o = self.end.origin().unwrap_or(e.pose);
         let mask = |v: V3| -> V3 { std::array::from_fn(|i| if self.axes[i] { v[i] } else { 0.0 }) };
@@ -199,10 +200,10 @@ impl DeviceSlave {
             };
         }
         let out = self.end.actuate(at, self.est.as_ref(), &f);
-        if let Err(e) = self.io.write_torques(&out.tau) {
+        if let Err(e) = self.io.io().write_torques(&out.tau) {
             self.lose(e);
         } else if let (None, Some(trip)) = (&self.stop, self.end.trip_info()) {
-            self.io.zero_torques();
+            self.io.io().zero_torques();
             self.stop = Some(SlaveStop::Safety(trip));
         }
         Applied {
@@ -214,7 +215,7 @@ impl DeviceSlave {
     }
 
     fn lose(&mut self, e: DeviceError) {
-        self.io.zero_torques();
+        self.io.io().zero_torques();
         if self.stop.is_none() {
             self.stop = Some(SlaveStop::Lost(e));
         }

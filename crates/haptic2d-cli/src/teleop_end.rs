@@ -17,9 +17,9 @@ use haptic2d::device::linalg::{V3, V4};
 use haptic2d::device::{DeviceEstimate, DeviceParams, HandModel};
 use haptic2d::haptic::safety_stage::TickClock;
 use haptic2d::haptic::{DeviceEnd, SafetyConfig};
-use haptic2d_rt::clock::now_ns;
 use haptic2d_rt::{DeviceError, DeviceIo, SharedTarget, SimIo};
 
+use crate::end_io::EndIo;
 use crate::exit::Failure;
 use crate::push_arg::Push;
 
@@ -47,20 +47,6 @@ impl Role {
             Role::Slave => "slave",
         }
     }
-}
-
-/// The I/O of an end.
-// One per end, built once and never moved in the loop: the size difference costs nothing.
-#[allow(clippy::large_enum_variant)]
-enum EndIo {
-    /// The simulated twin; the push's target (master) moved every tick.
-    Sim {
-        io: SimIo,
-        push: Option<(Push, Arc<SharedTarget>)>,
-        start: V3,
-    },
-    /// A real device, opened.
-    Real(Box<dyn DeviceIo + Send>),
 }
 
 /// One device of the live teleop (see the module doc).
@@ -157,7 +143,7 @@ impl LiveEnd {
             (Role::Master, Some(p)) => {
                 let target = Arc::new(SharedTarget::new(start));
                 io.follow(target.clone());
-                Some((p, target))
+                Some((p, target, start))
             }
             _ => None,
         };
@@ -173,7 +159,7 @@ impl LiveEnd {
                 -WALL_X * 1e3
             ),
         };
-        let io = EndIo::Sim { io, push, start };
+        let io = EndIo::Sim { io, push };
         Ok(Self::assemble(role, "sim".into(), summary, io, end))
     }
 
@@ -206,29 +192,16 @@ impl LiveEnd {
     }
 
     fn io(&mut self) -> &mut dyn DeviceIo {
-        match &mut self.io {
-            EndIo::Sim { io, .. } => io,
-            EndIo::Real(io) => io.as_mut(),
-        }
+        self.io.io()
     }
 
     /// Reads the device at time `t` (s; moves the simulated grip's target first), timing the read
     /// of a real device (the wait is the driver's, bounded by its own timeout: see
     /// [`Self::read_wait_ns`]).
     pub fn read(&mut self, t: f64) -> Result<V4, DeviceError> {
-        if let EndIo::Sim {
-            io,
-            push: Some((p, target)),
-            start,
-        } = &mut self.io
-        {
-            target.set(p.target(start, t));
-            return io.read_encoders();
-        }
-        let t0 = now_ns();
-        let r = self.io().read_encoders();
-        self.read_wait_ns = now_ns().saturating_sub(t0);
-        r
+        let (q, wait) = self.io.read(t);
+        self.read_wait_ns = wait;
+        q
     }
 
     /// How long the last [`Self::read`] waited for the device (ns).
@@ -250,14 +223,7 @@ impl LiveEnd {
         device_wait: f64,
         dt: f64,
     ) -> Option<(V3, V3)> {
-        self.est = if let EndIo::Sim { .. } = self.io {
-            // A simulated plant advances one period per tick: its signals use one period (the
-            // run stays deterministic when nothing stalls), the stall check the real interval.
-            self.end.check_stall(at, elapsed, device_wait);
-            self.end.sense(at, q, dt, 0.0)
-        } else {
-            self.end.sense(at, q, elapsed, device_wait)
-        };
+        self.est = (self.io).sense(&mut self.end, at, q, (elapsed, device_wait, dt));
         let est = self.est?;
         let o = self.end.origin().unwrap_or(est.pose);
         let rate = self.prev.map_or([0.0; 3], |p| {
@@ -322,8 +288,8 @@ impl LiveEnd {
     /// The simulated slave's contact: the wall's force on the handle along x (N) and the
     /// penetration (m) at the plant's true state; `None` for a real device or the master.
     pub fn contact(&self) -> Option<(f64, f64)> {
-        match (&self.io, self.role) {
-            (EndIo::Sim { io, .. }, Role::Slave) => {
+        match (self.io.sim(), self.role) {
+            (Some(io), Role::Slave) => {
                 let (x, v) = (io.plant().pose(), io.plant().velocity());
                 let f = io.hand().wrench(&x, &v, 0.0)[0];
                 let pen = match io.hand() {
