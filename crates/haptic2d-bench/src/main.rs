@@ -257,9 +257,21 @@ fn run(args: &Args) -> Result<(), String> {
         // The machine's own spread on a deterministic workload, interleaved like a fifth engine
         // and sized during the warm-up to take haptic2d's median step (`reference.rs`).
         let reference = std::cell::RefCell::new(reference::Reference::new(64 << 10));
+        let mut stage_log = Vec::with_capacity(if haptic2d::stage_time::ENABLED {
+            args.warmup + args.steps
+        } else {
+            0
+        });
         let mut samples = {
-            let (mut fh, mut fr, mut f4, mut f1) =
-                (|| drop(h.step()), || r.step(), || b4.step(), || b1.step());
+            // haptic2d's stage times, step by step, for the phase table (a `stage-timing` build).
+            let log = &mut stage_log;
+            let mut fh = || {
+                drop(h.step());
+                if haptic2d::stage_time::ENABLED {
+                    log.push(*h.stage_times());
+                }
+            };
+            let (mut fr, mut f4, mut f1) = (|| r.step(), || b4.step(), || b1.step());
             let mut fref = || reference.borrow_mut().step();
             timing::interleaved(
                 args.clock,
@@ -332,6 +344,10 @@ fn run(args: &Args) -> Result<(), String> {
                 .zip(samples.iter())
                 .collect();
             print!("{}", phases::table(&label, p, &named));
+            if haptic2d::stage_time::ENABLED {
+                let timed = &stage_log[args.warmup.min(stage_log.len())..];
+                print!("{}", phases::stage_table(&label, p, &samples[0], timed));
+            }
         }
         let states = [
             state::of(&h, &haptic_poses),

@@ -6,6 +6,7 @@
 //! then sample `i`, 1 ms each).
 
 use crate::timing::Samples;
+use haptic2d::stage_time::{Stage, StageTimes};
 
 /// The two phases, in timed-step indices: landing `[0, landing_end)`, settled `[settled_from, ..)`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -100,6 +101,54 @@ pub fn table(label: &str, phases: Phases, engines: &[(&str, &Samples)]) -> Strin
     out
 }
 
+/// haptic2d's stage profile per phase (a `stage-timing` build): the mean wall time of each stage
+/// over the landing, over the landing's worst 1 % of steps (those at or above its p99) and over
+/// the settled phase, so that the landing's tail names the stages that make it. `steps` are
+/// haptic2d's timed steps (µs) and `stages` the stage times of the same steps, in order.
+pub fn stage_table(label: &str, phases: Phases, steps: &Samples, stages: &[StageTimes]) -> String {
+    let n = steps.0.len().min(stages.len());
+    let (land, _) = phases.split(&Samples(steps.0[..n].to_vec()));
+    let p99 = land.p99();
+    let landing: Vec<usize> = (0..land.0.len()).collect();
+    let tail: Vec<usize> = landing
+        .iter()
+        .copied()
+        .filter(|&i| steps.0[i] >= p99)
+        .collect();
+    let settled_steps: Vec<usize> = (phases.settled_from.min(n)..n).collect();
+    let sets = [
+        ("landing", &landing),
+        ("landing ≥ p99", &tail),
+        ("settled", &settled_steps),
+    ];
+    let mut out = format!(
+        "{label}: haptic2d's mean µs per stage (stage-timing build: the wall clock at each stage boundary, which counts preemption that --clock cpu does not) — {} landing steps ≥ p99 {:.1} µs\n",
+        tail.len(),
+        p99
+    );
+    out.push_str(&format!("  {:<14}", "stage"));
+    for (name, _) in sets {
+        out.push_str(&format!(" | {name:>14}"));
+    }
+    out.push('\n');
+    let mean = |set: &[usize], f: &dyn Fn(&StageTimes) -> u64| {
+        set.iter().map(|&i| f(&stages[i]) as f64).sum::<f64>() / set.len().max(1) as f64 * 1e-3
+    };
+    for s in Stage::ALL {
+        out.push_str(&format!("  {:<14}", s.name()));
+        for (_, set) in sets {
+            out.push_str(&format!(" | {:>14.1}", mean(set, &|t| t.get(s))));
+        }
+        out.push('\n');
+    }
+    out.push_str(&format!("  {:<14}", "step"));
+    for (_, set) in sets {
+        out.push_str(&format!(" | {:>14.1}", mean(set, &|t| t.total())));
+    }
+    out.push('\n');
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -139,5 +188,45 @@ mod tests {
             "{t}"
         );
         assert!(t.contains("landing p99 / settled median 5.00"), "{t}");
+    }
+
+    #[test]
+    fn the_stage_table_averages_each_phase_and_the_landing_tail() {
+        // 100 landing steps, the last two slow (the p99 of 100 steps is the 99th smallest); the
+        // slow steps spent 900 ns each in the damper.
+        let mut t = vec![10.0; 100];
+        t[98] = 100.0;
+        t[99] = 100.0;
+        t.extend(vec![1.0; 50]);
+        let mut st = vec![StageTimes::default(); 150];
+        st[98].ns[Stage::ChainDamper as usize] = 900;
+        st[99].ns[Stage::ChainDamper as usize] = 900;
+        for x in &mut st[100..] {
+            x.ns[Stage::ContactForces as usize] = 500;
+        }
+        let out = stage_table(
+            "pile",
+            Phases {
+                landing_end: 100,
+                settled_from: 100,
+            },
+            &Samples(t),
+            &st,
+        );
+        // The damper: 0.018 µs over the landing, 0.9 µs over its tail, 0 settled.
+        let damper = out
+            .lines()
+            .find(|l| l.trim_start().starts_with("damper"))
+            .unwrap();
+        assert!(
+            damper.contains("0.0 |            0.9 |            0.0"),
+            "{out}"
+        );
+        let forces = out
+            .lines()
+            .find(|l| l.trim_start().starts_with("forces"))
+            .unwrap();
+        assert!(forces.ends_with("0.5"), "{out}");
+        assert!(out.contains("2 landing steps ≥ p99 100.0 µs"), "{out}");
     }
 }
