@@ -48,7 +48,11 @@ pub fn apply(w: &mut World, sets: &[String]) -> Result<(), String> {
                 w.params.contact.impact_sweeps = v as u32;
                 Ok(())
             }
-            _ => Err("expected normal.KEY, friction.KEY, world.{proximity_spread, proximity_skip, chain_tau, chain_sweeps} or contact.impact_sweeps (sweeps a whole number, impact_sweeps 1 to 200)".into()),
+            Some(("contact", "impact_rows")) if v >= 0.0 && v.fract() == 0.0 => {
+                w.params.contact.impact_rows = Some(v as u64);
+                Ok(())
+            }
+            _ => Err("expected normal.KEY, friction.KEY, world.{proximity_spread, proximity_skip, chain_tau, chain_sweeps} or contact.{impact_sweeps, impact_rows} (sweeps and rows whole numbers, impact_sweeps 1 to 200, impact_rows 0 = unbounded)".into()),
         };
         r.map_err(|e| format!("--set {s}: {e}"))?;
     }

@@ -213,8 +213,8 @@ fn print_contacts(world: &World, max_depth: f64, overlap: &OverlapSummary) {
         // Large impact islands (MODELS §7.7): how often the sweep budget and its passive fallback
         // acted, so a user sees when restitution in a pile was cut.
         println!(
-            "large impact islands: {} solved ({} row updates); {} solver phases stopped by the sweep budget ([contact] impact_sweeps); {} with restitution scaled down to stay passive",
-            budget.islands, budget.row_updates, budget.phases_cut, budget.restitution_scaled
+            "large impact islands: {} solved ({} row updates); {} solver phases stopped by the sweep budget ([contact] impact_sweeps), {} of them given fewer sweeps by the sample's row budget ([contact] impact_rows); {} with restitution scaled down to stay passive",
+            budget.islands, budget.row_updates, budget.phases_cut, budget.phases_capped, budget.restitution_scaled
         );
     }
 }

@@ -167,6 +167,9 @@ pub struct ImpactSolver {
     /// Sweep budget of each projected Gauss–Seidel phase of the sparse path (§7.7; default
     /// [`PGS_MAX_SWEEPS`], the world sets its own from `ContactParams::impact_sweeps`).
     sweep_budget: usize,
+    /// Row updates the sparse path may still run in this sample (§7.7; `u64::MAX` = unbounded,
+    /// the default; the world sets it every sample from `ContactParams::impact_row_budget`).
+    rows_left: u64,
     /// Work counters of the sparse path (§7.7), since the solver was made.
     budget: BudgetCounters,
 }
@@ -181,6 +184,9 @@ pub struct BudgetCounters {
     /// Sparse PGS phases (compression or correction) stopped by the sweep budget before their
     /// `1e-9 N·s` convergence test.
     pub phases_cut: u64,
+    /// Sparse PGS phases that ran fewer sweeps than `impact_sweeps` because the sample's row
+    /// budget did not hold that many over their island (§7.7).
+    pub phases_capped: u64,
     /// Islands whose restitution impulses were scaled down (the passive fallback: the full
     /// Poisson restitution would have raised the kinetic energy, as it can after a compression
     /// the budget cut short, or by round-off after one stopped at its tolerance).
@@ -237,6 +243,7 @@ impl ImpactSolver {
             // Grown on first use only: the frictionless default keeps §7's memory (impact_memory.rs).
             fric: FrictionalImpactSolver::default(),
             sweep_budget: PGS_MAX_SWEEPS,
+            rows_left: u64::MAX,
             budget: BudgetCounters::default(),
         };
         s.reserve(rows);
@@ -273,6 +280,12 @@ impl ImpactSolver {
     /// at most (§7.7; at least 1, at most `PGS_MAX_SWEEPS`; default `PGS_MAX_SWEEPS`).
     pub fn set_sweep_budget(&mut self, sweeps: usize) {
         self.sweep_budget = sweeps.clamp(1, PGS_MAX_SWEEPS);
+    }
+
+    /// Starts a sample whose sparse solves may run `rows` row updates in all, over every island
+    /// and phase (§7.7; `u64::MAX` = unbounded). Each phase still runs at least one sweep.
+    pub fn set_sample_rows(&mut self, rows: u64) {
+        self.rows_left = rows;
     }
 
     /// The sparse path's sweep budget in use (§7.7).
@@ -619,9 +632,16 @@ impl ImpactSolver {
     /// largest increment of a sweep is below 1e-9 N·s, or after the sweep budget (§7.7).
     fn pgs_on_bodies(&mut self, rows: &[ImpactRow], bodies: &mut [Body], into: Buf) -> LcpReport {
         let n = rows.len();
+        // The sweeps this phase may run: the sweep budget, or what the sample's rows left allow
+        // over this island (at least one sweep).
+        let fit = (self.rows_left / (n.max(1) as u64)).max(1);
+        let cap = (self.sweep_budget as u64).min(fit) as usize;
+        if cap < self.sweep_budget {
+            self.budget.phases_capped += 1;
+        }
         let mut sweeps = 0;
         let mut converged = false;
-        while sweeps < self.sweep_budget {
+        while sweeps < cap {
             sweeps += 1;
             let mut max_delta = 0.0f64;
             for (i, row) in rows.iter().enumerate() {
@@ -649,6 +669,7 @@ impl ImpactSolver {
             }
         }
         self.budget.row_updates += (sweeps * n) as u64;
+        self.rows_left = self.rows_left.saturating_sub((sweeps * n) as u64);
         if !converged {
             self.budget.phases_cut += 1;
         }

@@ -19,7 +19,7 @@ mod test_pile;
 pub use god_object::entry_point;
 pub use impact_friction::{default_impact_mu, ImpactFriction};
 pub use manager::{ContactSet, PastPoses, Wrench2};
-pub use params::{ContactParams, DEFAULT_IMPACT_SWEEPS};
+pub use params::{ContactParams, DEFAULT_IMPACT_ROWS_PER_MS, DEFAULT_IMPACT_SWEEPS};
 pub use record::{
     ContactEvent, ContactState, EventKind, LawState, Loaded, LoadedContact, VeContact, NO_LAW,
 };

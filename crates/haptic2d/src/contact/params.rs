@@ -41,7 +41,21 @@ pub struct ContactParams {
     /// scaled so that the impact cannot create energy. Default [`DEFAULT_IMPACT_SWEEPS`]; 200 is
     /// the limit of §7.3 (before issue 42's budget).
     pub impact_sweeps: u32,
+    /// Row updates the sparse path's projected Gauss–Seidel may run in one sample, over all its
+    /// islands and phases (docs/MODELS.md §7.7, issue 42): `None` (default) derives it from the
+    /// sample period, [`DEFAULT_IMPACT_ROWS_PER_MS`] per millisecond
+    /// ([`ContactParams::impact_row_budget`]); `Some(0)` leaves it unbounded (only
+    /// `impact_sweeps` bounds a phase); `Some(n)` is `n` row updates. A phase whose island does
+    /// not fit what is left runs `⌊left / rows⌋` sweeps, at least one.
+    pub impact_rows: Option<u64>,
 }
+
+/// Row updates of the sparse impact solve per millisecond of the sample period (§7.7): at 1 kHz
+/// an impact sample's sweeps may cost about 1.1 M instructions (about 90 a row update,
+/// callgrind), a quarter of a settled pile:1000 step's 4.5–5 M, so that the landing's worst
+/// samples stay near twice a settled one (docs/PERFORMANCE.md, session 30). Scales with the
+/// period: a real-time loop at 500 Hz has twice the time for a sample.
+pub const DEFAULT_IMPACT_ROWS_PER_MS: f64 = 12_000.0;
 
 /// Default sweep budget of a large island's impact phases (§7.7): the two phases together get
 /// the chain damper's default of 16 sweeps, so an impact sample's solve costs about `2 × 8` row
@@ -65,6 +79,23 @@ impl Default for ContactParams {
             impact_mu: None,
             impact_surface_offset: true,
             impact_sweeps: DEFAULT_IMPACT_SWEEPS,
+            impact_rows: None,
+        }
+    }
+}
+
+impl ContactParams {
+    /// The sparse impact solve's row updates for a sample of period `dt` (s), `u64::MAX` when
+    /// unbounded (§7.7): `impact_rows` if set (0 = unbounded), else
+    /// `⌊DEFAULT_IMPACT_ROWS_PER_MS × dt / 1 ms⌋`, at least 1.
+    pub fn impact_row_budget(&self, dt: f64) -> u64 {
+        match self.impact_rows {
+            Some(0) => u64::MAX,
+            Some(n) => n,
+            None if dt.is_finite() && dt > 0.0 => {
+                ((DEFAULT_IMPACT_ROWS_PER_MS * dt * 1e3).floor() as u64).max(1)
+            }
+            None => u64::MAX,
         }
     }
 }

@@ -203,5 +203,8 @@ pub(super) fn contact_params(
         }
         cp.impact_sweeps = n.clamp(1, 200);
     }
+    if let Some(n) = c.impact_rows {
+        cp.impact_rows = Some(n);
+    }
     cp
 }

@@ -156,3 +156,99 @@ fn a_landing_pile_with_a_tight_budget_creates_no_energy() {
     assert!(c.islands > 0 && c.phases_cut > 0, "{c:?}");
     assert!(worst <= 1e-9, "ledger excess {worst} J");
 }
+
+/// The sample's row budget (§7.7, issue 42): a phase runs the sweeps that fit in what the sample
+/// has left over its island, at least one, so a sample's sparse row updates are at most the
+/// budget, or one sweep over the island for each phase that found it spent; the kinetic energy
+/// never rises; and a budget that holds every sweep changes nothing, bit for bit.
+#[test]
+fn a_sample_row_budget_gives_each_phase_the_sweeps_that_fit() {
+    let (bodies0, rows) = wedges(13, 1.0);
+    let n = rows.len() as u64;
+    let solve = |sample_rows: u64| {
+        let mut bodies = bodies0.clone();
+        let mut solver = ImpactSolver::new();
+        solver.set_sweep_budget(8);
+        solver.set_sample_rows(sample_rows);
+        solver.solve(&rows, &mut bodies);
+        (bodies, solver.budget_counters())
+    };
+    let (free, c_free) = solve(u64::MAX);
+    assert_eq!(c_free.phases_capped, 0, "{c_free:?}");
+    let before = kinetic(&bodies0);
+    for sample_rows in 1..=(3 * 8 * n + 5) {
+        let (bodies, c) = solve(sample_rows);
+        // Phases run: compression, correction, and the fallback's second correction at most.
+        assert!(
+            c.row_updates <= sample_rows.max(n) + 2 * n,
+            "budget {sample_rows}: {} row updates over {n} rows",
+            c.row_updates
+        );
+        // The compression is capped below 8 sweeps over the island; above three phases of 8
+        // sweeps nothing is.
+        if sample_rows < 8 * n {
+            assert!(c.phases_capped > 0, "budget {sample_rows}: {c:?}");
+        }
+        if sample_rows >= 3 * 8 * n {
+            assert_eq!(c.phases_capped, 0, "budget {sample_rows}: {c:?}");
+        }
+        let after = kinetic(&bodies);
+        assert!(
+            after <= before * (1.0 + 1e-12),
+            "budget {sample_rows}: kinetic energy {before} J → {after} J"
+        );
+        if sample_rows >= c_free.row_updates {
+            for (a, b) in bodies.iter().zip(&free) {
+                assert_eq!(
+                    (a.vel.x.to_bits(), a.vel.y.to_bits(), a.omega.to_bits()),
+                    (b.vel.x.to_bits(), b.vel.y.to_bits(), b.omega.to_bits()),
+                    "budget {sample_rows} ≥ the unbounded solve's {} row updates",
+                    c_free.row_updates
+                );
+            }
+        }
+    }
+}
+
+/// The sample's row budget by default follows the sample period: 12 000 row updates per
+/// millisecond (§7.7); `[contact] impact_rows` sets it, 0 leaving it unbounded.
+#[test]
+fn the_impact_row_budget_follows_the_sample_period() {
+    use haptic2d::contact::{ContactParams, DEFAULT_IMPACT_ROWS_PER_MS};
+    use haptic2d::scene::Scene;
+    let p = ContactParams::default();
+    assert_eq!(DEFAULT_IMPACT_ROWS_PER_MS, 12_000.0);
+    assert_eq!(p.impact_row_budget(1e-3), 12_000);
+    assert_eq!(p.impact_row_budget(2e-3), 24_000);
+    assert_eq!(p.impact_row_budget(1e-6), 12);
+    assert_eq!(p.impact_row_budget(1e-9), 1);
+    let off = ContactParams {
+        impact_rows: Some(0),
+        ..p
+    };
+    assert_eq!(off.impact_row_budget(1e-3), u64::MAX);
+    let wall = crate::shared::WALL_TOML;
+    let text = format!("[contact]\nimpact_rows = 500\n{wall}");
+    let s = Scene::from_toml(&text, "t.toml", None).expect("impact_rows = 500");
+    assert_eq!(s.world.params.contact.impact_row_budget(1e-3), 500);
+}
+
+/// A landing pile with a row budget far below what its islands' sweeps need: phases get fewer
+/// sweeps than `impact_sweeps` and the ledger shows no energy created.
+#[test]
+fn a_landing_pile_with_a_tight_row_budget_creates_no_energy() {
+    let mut w = haptic2d::scene::builtin("pile:100", None)
+        .unwrap()
+        .unwrap()
+        .world;
+    w.params.contact.impact_rows = Some(60);
+    let mut worst = f64::NEG_INFINITY;
+    for _ in 0..1500 {
+        w.step();
+        worst = worst.max(w.ledger().excess());
+    }
+    let c = w.contacts().impact_budget();
+    eprintln!("pile:100, impact_rows = 60, 1.5 s: {c:?}; ledger excess at most {worst:e} J");
+    assert!(c.islands > 0 && c.phases_capped > 0, "{c:?}");
+    assert!(worst <= 1e-9, "ledger excess {worst} J");
+}

@@ -375,6 +375,8 @@ impl ContactSet {
             self.solver.set_friction(self.params.impact_friction, mu);
             self.solver
                 .set_sweep_budget(self.params.impact_sweeps as usize);
+            self.solver
+                .set_sample_rows(self.params.impact_row_budget(dt));
             self.resolve_impacts(tick, bodies);
         }
         lap.charge(times, Stage::ContactEvents);
