@@ -41,10 +41,15 @@ impl ContactSet {
         };
         // One pass per form of the law slots (`LawPool`), so the per-record loop has no branch on
         // it.
-        let (stored, records, breaks, rewritten) = match self.laws.slots_mut() {
-            Slots::Lean(store) => pass.run(store),
-            Slots::Compact(store) => pass.run(store),
-            Slots::Whole(store) => pass.run(store),
+        // The classical model's two loops are a second instance of the pass (`EXT`), so neither
+        // instance tests the model per record.
+        let (stored, records, breaks, rewritten) = match (self.laws.slots_mut(), pass.needs_ext) {
+            (Slots::Lean(store), false) => pass.run::<_, false>(store),
+            (Slots::Compact(store), false) => pass.run::<_, false>(store),
+            (Slots::Whole(store), false) => pass.run::<_, false>(store),
+            (Slots::Lean(store), true) => pass.run::<_, true>(store),
+            (Slots::Compact(store), true) => pass.run::<_, true>(store),
+            (Slots::Whole(store), true) => pass.run::<_, true>(store),
         };
         self.stored = stored;
         self.record_count = records;
@@ -89,10 +94,17 @@ impl ForcePass<'_> {
     /// Kept out of line: in a release build where LLVM inlined it into `forces` (session 28,
     /// after the duplicate clean-up moved code between modules), `simulate pile:100 --duration 5`
     /// ran 0.36 % more instructions (callgrind: 2.8037 G against 2.7937 G); out of line, 2.7936 G.
+    ///
+    /// `EXT` is `needs_ext` (the caller picks the instance).
     #[inline(never)]
-    fn run<S: SlotAccess>(self, laws: &mut S) -> (f64, usize, usize, bool) {
-        let (dt, bodies, needs_ext) = (self.dt, self.bodies, self.needs_ext);
-        let wrenches = self.wrenches;
+    fn run<S: SlotAccess, const EXT: bool>(self, laws: &mut S) -> (f64, usize, usize, bool) {
+        debug_assert_eq!(EXT, self.needs_ext);
+        let (dt, needs_ext) = (self.dt, EXT);
+        // The bodies and their wrenches cut to one length (they are the same; a record's body
+        // out of range still panics), so that the compiler checks a record's body index once for
+        // both instead of once each.
+        let n = self.bodies.len().min(self.wrenches.len());
+        let (bodies, wrenches) = (&self.bodies[..n], &mut self.wrenches[..n]);
         let mut stored = 0.0;
         // Every record is Continuous here (Colliding ones were resolved by the impacts of step 5).
         let mut records = 0;
@@ -102,7 +114,9 @@ impl ForcePass<'_> {
         if rewrite {
             self.keys.clear();
         }
-        let mut impact_entries = self.impact_entries.iter().peekable();
+        // The next struck entry at or after the current one (`usize::MAX` past the last).
+        let mut impacts = self.impact_entries.iter();
+        let mut next_impact = impacts.next().copied().unwrap_or(usize::MAX);
         for (idx, e) in self.entries.iter_mut().enumerate() {
             if e.state != Some(ContactState::Continuous) {
                 continue;
@@ -131,14 +145,10 @@ impl ForcePass<'_> {
                 stored += u;
             }
             // Loaded: pushing, not struck in this sample, not approaching faster than v_c.
-            let mut in_impact = false;
-            while let Some(&&j) = impact_entries.peek() {
-                if j > idx {
-                    break;
-                }
-                in_impact |= j == idx;
-                impact_entries.next();
+            while next_impact < idx {
+                next_impact = impacts.next().copied().unwrap_or(usize::MAX);
             }
+            let in_impact = next_impact == idx;
             let loaded = e.f_n > 0.0 && !in_impact && e.c0 >= -self.v_damp;
             if loaded != e.loaded && !rewrite {
                 // The first change: the keys before it are the last sample's.
@@ -238,7 +248,12 @@ fn friction_step<N, F: FrictionLaw>(
         f_ext_t,
     };
     e.f_t = law.friction.update(&input);
-    e.s_g = law.friction.anchor(e.s).unwrap_or(e.s.clamp(0.0, e.len));
+    // `unwrap_or_else`: the clamp (and its check that `0 ≤ len`) only for a model without an
+    // anchor, not for every record.
+    e.s_g = law
+        .friction
+        .anchor(e.s)
+        .unwrap_or_else(|| e.s.clamp(0.0, e.len));
 }
 
 #[inline(always)]
