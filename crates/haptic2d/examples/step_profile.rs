@@ -1,5 +1,5 @@
 //! Steps a built-in scene for a number of seconds and nothing else, for instruction counts of the
-//! step's stages under callgrind without the CLI's output (docs: `/work/wt/tasks/sync-perf.md`).
+//! step's stages under callgrind without the CLI's output (issue 42; docs/PERFORMANCE.md).
 //!
 //! `cargo build --release -p haptic2d --example step_profile`, then
 //! `valgrind --tool=callgrind target/release/examples/step_profile pile:100 3`.
