@@ -66,7 +66,10 @@ use crate::laws::normal::NormalModel;
 /// of angle), could reach the margin: the answer is the one the full test gives. (The colliders'
 /// world features are those of the bodies' poses here: both are updated at step 3a, and nothing
 /// in the contact stage moves a body.)
-#[inline]
+///
+/// The remembered answer is inlined into the stage's loop; the recomputation, rare on a pile at
+/// rest, is a call ([`own_axis_recompute`]).
+#[inline(always)]
 fn own_axis_clears(
     e: &mut VeContact,
     colliders: &[Collider],
@@ -88,6 +91,20 @@ fn own_axis_clears(
             return true;
         }
     }
+    own_axis_recompute(e, ca, cb, phi, plain, margin)
+}
+
+/// The own-axis test computed in full ([`own_axis_clears`]) at relative angle `phi` (rad),
+/// remembered in the record when the pair has no seams (`plain`).
+#[inline(never)]
+fn own_axis_recompute(
+    e: &mut VeContact,
+    ca: &Collider,
+    cb: &Collider,
+    phi: f64,
+    plain: bool,
+    margin: f64,
+) -> bool {
     let edge = e.key.edge as usize;
     let along = ca
         .world_vertices()

@@ -50,6 +50,7 @@ impl ContactSet {
     /// (a candidate exchanged for another, the usual change on a settling pile, moves the
     /// entries between the two).
     #[allow(clippy::too_many_arguments)]
+    #[inline(never)]
     pub(super) fn sync(
         &mut self,
         tick: u64,
@@ -64,13 +65,16 @@ impl ContactSet {
         let flag = |j: usize| flags.is_some_and(|f| f[j]);
         let p = self.params;
         let delta_c = self.delta_c;
-        let recollide = p.v_re.filter(|_| p.impacts);
+        // `c0 < −v_re` of the re-collision rule, with −∞ when it is off (no `c0` is below it).
+        let neg_v_re = recollision_floor(p.v_re.filter(|_| p.impacts));
+        // One rotation per body: cut to the bodies' count, an index checked against `bodies`
+        // needs no second check against `rots`.
+        let rots = &rots[..bodies.len()];
         let mut work = StageWork::default();
         self.changes.clear();
         let mut j = 0;
         for (i, e) in self.entries.iter_mut().enumerate() {
             measure(e, bodies, rots);
-            e.nearest_edge = false;
             while j < candidates.len() && candidates[j] < e.key {
                 self.changes.push(Change::Insert {
                     at: i as u32,
@@ -81,17 +85,17 @@ impl ContactSet {
             if j < candidates.len() && e.key == candidates[j] {
                 e.nearest_edge = flag(j);
                 j += 1;
-            } else if !e.is_contact() {
-                self.changes.push(Change::Drop(i as u32));
-                continue;
+            } else {
+                e.nearest_edge = false;
+                if !e.is_contact() {
+                    self.changes.push(Change::Drop(i as u32));
+                    continue;
+                }
             }
             // The tests of `release`, `hand_over` and `create`, on this sample's measures.
             match e.state {
                 Some(ContactState::Continuous) => {
-                    if e.d[0] > p.delta_off
-                        || !in_range(e, colliders, p.eps_s)
-                        || recollide.is_some_and(|v_re| e.c0 < -v_re)
-                    {
+                    if e.d[0] > p.delta_off || !in_range(e, colliders, p.eps_s) || e.c0 < neg_v_re {
                         work.release = true;
                     } else if !e.nearest_edge && !work.hand_over {
                         let cb = &colliders[e.key.edge_collider as usize];
@@ -139,6 +143,13 @@ impl ContactSet {
             }
         });
     }
+}
+
+/// The re-collision rule's floor on `c0` (m/s): `−v_re`, or −∞ without the rule, so that
+/// `c0 < floor` is the rule's `c0 < −v_re` (false for every `c0`, NaN included, without it).
+#[inline(always)]
+fn recollision_floor(v_re: Option<f64>) -> f64 {
+    v_re.map_or(f64::NEG_INFINITY, |v| -v)
 }
 
 /// Applies a merge's `changes` (in order, positions in `v` as it is) to `v` in place, with
@@ -241,13 +252,21 @@ pub(super) fn measure(e: &mut VeContact, bodies: &[Body], rots: &[Rot]) {
     let t = e.t();
     let rel = v - e0;
     e.d = [n.dot(rel), e.d[0], e.d[1]];
-    e.hist = (e.hist + 1).min(3);
+    e.hist = next_hist(e.hist);
     e.s_prev = e.s;
     e.s = t.dot(rel);
     e.point = v;
     let v_rel = ba.point_velocity(v) - bb.point_velocity(v);
     e.c0 = n.dot(v_rel);
     e.s0 = t.dot(v_rel);
+}
+
+/// The number of valid distance samples after one more (`hist ∈ 1..=3`, [`VeContact::hist`]):
+/// one more, at most 3. The same as `(hist + 1).min(3)` on `0..=3`, in fewer instructions (a
+/// compare and an add with carry instead of an add, a compare and a conditional move).
+#[inline(always)]
+fn next_hist(hist: u8) -> u8 {
+    hist + u8::from(hist < 3)
 }
 
 /// A new tracked entry; its distance history and previous edge coordinate are rebuilt from the past
@@ -353,7 +372,7 @@ pub(super) fn past_ds(
 
 #[cfg(test)]
 mod tests {
-    use super::{merge_in_place, Change};
+    use super::{merge_in_place, next_hist, recollision_floor, Change};
 
     /// A small deterministic generator (xorshift64*).
     struct Rng(u64);
@@ -388,6 +407,43 @@ mod tests {
             }
         }
         out
+    }
+
+    #[test]
+    fn the_history_count_grows_to_three_as_min_did() {
+        for hist in 0..=3u8 {
+            assert_eq!(next_hist(hist), (hist + 1).min(3), "hist {hist}");
+        }
+    }
+
+    #[test]
+    fn the_recollision_floor_answers_as_the_rule() {
+        let special = [
+            0.0,
+            -0.0,
+            1e-300,
+            -1e-300,
+            0.25,
+            -0.25,
+            3.0,
+            f64::MAX,
+            f64::MIN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+        ];
+        let mut rng = Rng(0x0123_4567_89ab_cdef);
+        let random: Vec<f64> = (0..2000)
+            .map(|_| f64::from_bits(rng.next()))
+            .chain(special)
+            .collect();
+        for v_re in random.iter().map(|&v| Some(v)).chain([None]) {
+            let floor = recollision_floor(v_re);
+            for &c0 in &random {
+                let rule = v_re.is_some_and(|v| c0 < -v);
+                assert_eq!(c0 < floor, rule, "c0 {c0:e}, v_re {v_re:?}");
+            }
+        }
     }
 
     #[test]
