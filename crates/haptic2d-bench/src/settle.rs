@@ -4,7 +4,7 @@
 //! largest overlap. Used to find why the pile keeps moving (docs/PERFORMANCE.md, issue 17).
 
 use haptic2d::stage_time::{self, Stage, StageTimes};
-use haptic2d::world::World;
+use haptic2d::world::{ChainBudget, World};
 
 use crate::state;
 use crate::timing::{now, Clock};
@@ -12,7 +12,8 @@ use crate::timing::{now, Clock};
 /// Applies `law.key=value` overrides (`normal.bc=200`, `friction.beta=40`) to the prototypes of the
 /// world's laws (every contact created afterwards gets them), and the world options
 /// `world.proximity_spread=0/1`, `world.proximity_skip=0/1`, `world.chain_tau=SECONDS` (0 = chain damper off) and
-/// `world.chain_sweeps=N`, and `contact.impact_sweeps=N` (the impact work budget, 1–200,
+/// `world.chain_sweeps=N`, `world.chain_budget=N` (row updates per sample, 0 = unbounded;
+/// docs/MODELS.md §6.7), and `contact.impact_sweeps=N` (the impact work budget, 1–200,
 /// docs/MODELS.md §7.7; 200 is the limit before the budget).
 pub fn apply(w: &mut World, sets: &[String]) -> Result<(), String> {
     for s in sets {
@@ -42,13 +43,17 @@ pub fn apply(w: &mut World, sets: &[String]) -> Result<(), String> {
                 w.params.chain_sweeps = v as u32;
                 Ok(())
             }
+            Some(("world", "chain_budget")) if v >= 0.0 && v.fract() == 0.0 => {
+                w.params.chain_budget = ChainBudget::from_setting(v as u64);
+                Ok(())
+            }
             Some(("contact", "impact_sweeps"))
                 if (1.0..=200.0).contains(&v) && v.fract() == 0.0 =>
             {
                 w.params.contact.impact_sweeps = v as u32;
                 Ok(())
             }
-            _ => Err("expected normal.KEY, friction.KEY, world.{proximity_spread, proximity_skip, chain_tau, chain_sweeps} or contact.impact_sweeps (sweeps a whole number, impact_sweeps 1 to 200)".into()),
+            _ => Err("expected normal.KEY, friction.KEY, world.{proximity_spread, proximity_skip, chain_tau, chain_sweeps, chain_budget} or contact.impact_sweeps (sweeps and budget whole numbers, impact_sweeps 1 to 200)".into()),
         };
         r.map_err(|e| format!("--set {s}: {e}"))?;
     }
@@ -273,6 +278,8 @@ pub fn run(
                 k,
                 sweeps: d.last_sweeps,
                 rows: d.last_rows,
+                row_updates: d.last_row_updates,
+                cut: d.last_cut,
                 events: w.contacts().events().len(),
                 rows_by: if d.last_refreshed {
                     RowsBy::Refresh
@@ -349,6 +356,7 @@ pub fn run(
     }
     print_merges(label, profile_after, &each);
     print_damper_kinds(label, profile_after, &each);
+    print_row_updates(label, profile_after, &each);
     let (median, p99) = (all_steps.median(), all_steps.p99());
     println!(
         "{label}: CPU µs per step after {profile_after} s: median {median:.1}, p99 {p99:.1} (p99/median {:.2}), largest {:.1}",
@@ -466,9 +474,11 @@ struct ProfiledStep {
     step_us: f64,
     /// The step's number (from 1).
     k: usize,
-    /// The chain damper's sweeps and rows.
+    /// The chain damper's sweeps and rows, its row updates and whether its budget cut them.
     sweeps: u32,
     rows: usize,
+    row_updates: u64,
+    cut: bool,
     /// Contact events of the step.
     events: usize,
     /// How the chain damper made its rows.
@@ -566,4 +576,69 @@ fn print_damper_kinds(label: &str, profile_after: f64, kinds: &[ProfiledStep]) {
             );
         }
     }
+}
+
+/// The chain damper's row updates per warm step (median, p99, largest, steps its work budget cut)
+/// and, with the `stage-timing` feature, their cost: the least-squares fit of the damper stage's
+/// wall time `a + b·rows + c·row updates` over the steps with rows (`c`, ns per row update, is the
+/// sweeps' cost; `b` the rows' build or refresh; docs/MODELS.md §6.7).
+fn print_row_updates(label: &str, profile_after: f64, kinds: &[ProfiledStep]) {
+    let with_rows: Vec<&ProfiledStep> = kinds.iter().filter(|k| k.rows > 0).collect();
+    if with_rows.is_empty() {
+        return;
+    }
+    let updates = crate::timing::Samples(with_rows.iter().map(|k| k.row_updates as f64).collect());
+    println!(
+        "{label}: chain damper row updates per warm step after {profile_after} s ({} steps with rows): median {:.0}, p99 {:.0}, largest {:.0}; {} steps cut by the work budget",
+        with_rows.len(),
+        updates.median(),
+        updates.quantile(0.99),
+        updates.quantile(1.0),
+        with_rows.iter().filter(|k| k.cut).count()
+    );
+    if !stage_time::ENABLED {
+        return;
+    }
+    // Normal equations of the fit, in µs; x = (1, rows, row updates).
+    let (mut m, mut r) = ([[0.0f64; 3]; 3], [0.0f64; 3]);
+    for k in &with_rows {
+        let x = [1.0, k.rows as f64, k.row_updates as f64];
+        for i in 0..3 {
+            r[i] += x[i] * k.damper_us;
+            for j in 0..3 {
+                m[i][j] += x[i] * x[j];
+            }
+        }
+    }
+    match solve3(m, r) {
+        Some([a, b, c]) => println!(
+            "{label}: damper wall µs ≈ {a:.2} + {:.2} ns × rows + {:.2} ns × row updates (least squares over those steps)",
+            b * 1e3,
+            c * 1e3
+        ),
+        None => println!("{label}: damper cost fit: singular (rows and row updates not independent)"),
+    }
+}
+
+/// Solves `m·x = r` (3 × 3) by Cramer's rule; `None` when `m` is (nearly) singular.
+fn solve3(m: [[f64; 3]; 3], r: [f64; 3]) -> Option<[f64; 3]> {
+    let det = |a: [[f64; 3]; 3]| {
+        a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1])
+            - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
+            + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0])
+    };
+    let d = det(m);
+    let scale = m.iter().flatten().fold(0.0f64, |x, y| x.max(y.abs()));
+    if d.abs() <= 1e-12 * scale * scale * scale {
+        return None;
+    }
+    let mut x = [0.0; 3];
+    for (col, xc) in x.iter_mut().enumerate() {
+        let mut mc = m;
+        for (row, rv) in mc.iter_mut().zip(r) {
+            row[col] = rv;
+        }
+        *xc = det(mc) / d;
+    }
+    Some(x)
 }

@@ -217,4 +217,23 @@ fn print_contacts(world: &World, max_depth: f64, overlap: &OverlapSummary) {
             budget.islands, budget.row_updates, budget.phases_cut, budget.restitution_scaled
         );
     }
+    if let Some(line) = chain_budget_line(world) {
+        println!("{line}");
+    }
+}
+
+/// The chain damper's work budget (MODELS §6.7) when it stopped the sweeps of any sample: in how
+/// many samples, the budget, and the row updates run; `None` when it never cut.
+pub(crate) fn chain_budget_line(world: &World) -> Option<String> {
+    let d = world.chain_damper();
+    let budget = world.params.chain_budget.row_updates(world.params.dt);
+    (d.budget_cuts > 0).then(|| {
+        format!(
+            "chain damper: sweeps stopped by the work budget ([world] chain_budget, {} row updates a sample) in {} samples; {} row updates in all, at most {} in one sample",
+            budget.map_or("unbounded".to_string(), |b| b.to_string()),
+            d.budget_cuts,
+            d.row_updates,
+            d.max_row_updates
+        )
+    })
 }

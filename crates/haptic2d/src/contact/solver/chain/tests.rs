@@ -69,7 +69,7 @@ fn pass(
     bodies: &mut [Body],
     wrenches: &mut [Wrench2],
 ) -> f64 {
-    d.apply(Some(2e-4), sweeps, 1e-3, loaded, bodies, wrenches)
+    d.apply(Some(2e-4), sweeps, None, 1e-3, loaded, bodies, wrenches)
 }
 
 fn kinetic_of(bodies: &[Body]) -> f64 {

@@ -1,0 +1,222 @@
+//! Tests of the chain damper's work budget (issue 42 item 2, MODELS §6.7): the row updates of a
+//! sample stay within it, a cut damper is still passive, a cut is exactly a smaller sweep limit,
+//! and no budget changes nothing.
+
+use super::*;
+use crate::geom::Pose;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+/// `boxes` boxes of random masses (0.2–5 kg) stacked on a fixed floor (body 0), two loaded
+/// contacts per interface at the box's bottom corners, normals tilted up to ±0.2 rad, random
+/// loads (0.5–50 N), random velocities (±0.5 m/s, ±3 rad/s) and random held forces: a chain the
+/// damper needs many sweeps for.
+fn random_column(
+    rng: &mut ChaCha8Rng,
+    boxes: u32,
+) -> (Vec<Body>, Vec<LoadedContact>, Vec<VeCandidate>) {
+    let mut bodies = vec![Body::fixed("floor", Pose::new(0.0, -0.05, 0.0))];
+    for i in 0..boxes {
+        let m = rng.random_range(0.2..5.0);
+        let mut b = Body::dynamic(
+            "box",
+            m,
+            m / 600.0,
+            Pose::new(0.0, 0.05 + 0.1 * i as f64, 0.0),
+        );
+        b.vel = Vec2::new(rng.random_range(-0.5..0.5), rng.random_range(-0.5..0.5));
+        b.omega = rng.random_range(-3.0..3.0);
+        b.force = Vec2::new(rng.random_range(-20.0..20.0), rng.random_range(-20.0..20.0));
+        b.torque = rng.random_range(-1.0..1.0);
+        bodies.push(b);
+    }
+    let (mut contacts, mut keys) = (Vec::new(), Vec::new());
+    for i in 0..boxes {
+        for corner in 0..2u32 {
+            keys.push(VeCandidate {
+                vertex_collider: i + 1,
+                vertex: corner,
+                edge_collider: i,
+                edge: 2,
+            });
+            let tilt: f64 = rng.random_range(-0.2..0.2);
+            contacts.push(LoadedContact {
+                body_a: i + 1,
+                body_b: i,
+                point: Vec2::new(0.1 * corner as f64 - 0.05, 0.1 * i as f64),
+                n: Vec2::new(tilt.sin(), tilt.cos()),
+                f_n: rng.random_range(0.5..50.0),
+            });
+        }
+    }
+    (bodies, contacts, keys)
+}
+
+/// Kinetic energy of `bodies` after a semi-implicit Euler step of their held forces (J): the
+/// velocities the integrator reaches, computed here independently of the damper.
+fn kinetic_after_step(bodies: &[Body], dt: f64) -> f64 {
+    bodies
+        .iter()
+        .filter(|b| b.is_dynamic())
+        .map(|b| {
+            let f = b.force - b.vel * b.damping;
+            let v = b.vel + f * (dt * b.inv_mass);
+            let omega = b.omega + b.torque * dt * b.inv_inertia;
+            0.5 * (b.mass * v.dot(v) + b.inertia * omega * omega)
+        })
+        .sum()
+}
+
+/// One damper pass at `τ` = 0.2 ms, `T` = 1 ms, up to 16 sweeps within `budget`, over the
+/// column's whole loaded list.
+fn pass_within(
+    d: &mut ChainDamping,
+    budget: Option<u64>,
+    sweeps: u32,
+    bodies: &mut [Body],
+    contacts: &[LoadedContact],
+    keys: &[VeCandidate],
+) -> f64 {
+    let loaded = Loaded {
+        contacts,
+        keys,
+        generation: 1,
+    };
+    let mut wrenches = vec![Wrench2::default(); bodies.len()];
+    d.apply(
+        Some(2e-4),
+        sweeps,
+        budget,
+        1e-3,
+        loaded,
+        bodies,
+        &mut wrenches,
+    )
+}
+
+/// Over random columns and budgets, a sample's row updates are its sweeps × its rows and never
+/// exceed `max(budget, one sweep)`; the budget stops the sweeps in some samples (the property is
+/// not vacuous) and never where the unbudgeted solve needed no more than it allows.
+#[test]
+fn a_samples_row_updates_never_exceed_its_budget() {
+    let mut rng = ChaCha8Rng::seed_from_u64(42);
+    let mut cuts = 0;
+    for case in 0..300 {
+        let boxes = rng.random_range(2..40);
+        let (bodies0, contacts, keys) = random_column(&mut rng, boxes);
+        let budget = rng.random_range(0..(16 * 2 * boxes as u64 + 20));
+        let mut free = bodies0.clone();
+        let mut unbounded = ChainDamping::default();
+        pass_within(&mut unbounded, None, 16, &mut free, &contacts, &keys);
+        let (mut bodies, mut d) = (bodies0, ChainDamping::default());
+        pass_within(&mut d, Some(budget), 16, &mut bodies, &contacts, &keys);
+        let rows = d.sorted.len() as u64;
+        assert!(rows > 0, "case {case}: no rows");
+        assert_eq!(
+            d.last_row_updates,
+            d.last_sweeps as u64 * rows,
+            "case {case}"
+        );
+        assert!(
+            d.last_row_updates <= budget.max(rows),
+            "case {case}: {} row updates, budget {budget}, {rows} rows",
+            d.last_row_updates
+        );
+        assert!(
+            d.last_sweeps >= 1,
+            "case {case}: the first sweep always runs"
+        );
+        assert_eq!(
+            d.last_cut,
+            unbounded.last_row_updates > d.last_row_updates,
+            "case {case}: cut exactly when the unbudgeted solve ran more"
+        );
+        assert_eq!(d.budget_cuts, d.last_cut as u64);
+        cuts += d.last_cut as u32;
+    }
+    assert!(cuts > 50, "only {cuts} of 300 cases were cut");
+}
+
+/// Over random columns and budgets, the budgeted damper only removes energy: the energy it
+/// reports removed is at least −rounding, and the kinetic energy after the step with its forces
+/// (computed here from the bodies' held forces) is at most that without them, by what it reports.
+#[test]
+fn a_cut_damper_still_only_removes_energy() {
+    let mut rng = ChaCha8Rng::seed_from_u64(7);
+    let dt = 1e-3;
+    let mut cut = 0;
+    for case in 0..300 {
+        let boxes = rng.random_range(2..40);
+        let (mut bodies, contacts, keys) = random_column(&mut rng, boxes);
+        let budget = rng.random_range(0..(16 * 2 * boxes as u64));
+        let before = kinetic_after_step(&bodies, dt);
+        let mut d = ChainDamping::default();
+        let removed = pass_within(&mut d, Some(budget), 16, &mut bodies, &contacts, &keys);
+        let after = kinetic_after_step(&bodies, dt);
+        let tol = 1e-12 * before.max(1.0);
+        assert!(removed >= -tol, "case {case}: removed {removed} J");
+        assert!(after <= before + tol, "case {case}: {before} → {after} J");
+        assert!(
+            ((before - after) - removed).abs() <= 1e-9 * before.max(1.0),
+            "case {case}: removed {removed} J, kinetic {before} → {after} J"
+        );
+        cut += d.last_cut as u32;
+    }
+    assert!(cut > 50, "only {cut} of 300 cases were cut");
+}
+
+/// A budget that stops the sweeps after `k` is bit for bit a limit of `k` sweeps without a
+/// budget (forces, velocities and the energy removed), and no budget is bit for bit a budget
+/// never reached: the budget only chooses where the unchanged sweeps stop.
+#[test]
+fn a_budget_cut_is_exactly_a_smaller_sweep_limit() {
+    let mut rng = ChaCha8Rng::seed_from_u64(3);
+    let bits = |bodies: &[Body]| -> Vec<[u64; 3]> {
+        bodies
+            .iter()
+            .map(|b| [b.force.x.to_bits(), b.force.y.to_bits(), b.torque.to_bits()])
+            .collect()
+    };
+    let mut cut = 0;
+    for case in 0..100 {
+        let boxes = rng.random_range(5..40);
+        let (bodies0, contacts, keys) = random_column(&mut rng, boxes);
+        let budget = rng.random_range(1..(8 * 2 * boxes as u64));
+        let (mut a, mut da) = (bodies0.clone(), ChainDamping::default());
+        let ea = pass_within(&mut da, Some(budget), 16, &mut a, &contacts, &keys);
+        let k = da.last_sweeps;
+        let (mut b, mut db) = (bodies0.clone(), ChainDamping::default());
+        let eb = pass_within(&mut db, None, k, &mut b, &contacts, &keys);
+        assert_eq!(bits(&a), bits(&b), "case {case}");
+        assert_eq!(ea.to_bits(), eb.to_bits(), "case {case}");
+        assert_eq!((db.last_sweeps, db.last_cut), (k, false), "case {case}");
+        let (mut c, mut dc) = (bodies0.clone(), ChainDamping::default());
+        let ec = pass_within(&mut dc, Some(u64::MAX), 16, &mut c, &contacts, &keys);
+        let (mut n, mut dn) = (bodies0, ChainDamping::default());
+        let en = pass_within(&mut dn, None, 16, &mut n, &contacts, &keys);
+        assert_eq!(bits(&c), bits(&n), "case {case}");
+        assert_eq!(ec.to_bits(), en.to_bits(), "case {case}");
+        assert_eq!(
+            (dc.last_sweeps, dc.last_cut),
+            (dn.last_sweeps, false),
+            "case {case}"
+        );
+        cut += da.last_cut as u32;
+    }
+    assert!(cut > 20, "only {cut} of 100 cases were cut");
+}
+
+/// The default budget is the documented share of the period at the documented cost of a row
+/// update: at 1 kHz, 25 % of 1 ms = 250 µs at 10 ns a row update = 25 000 row updates; at
+/// 500 Hz twice that; 0 turns it off; a set number is taken as it is.
+#[test]
+fn the_default_budget_is_a_share_of_the_period() {
+    use crate::world::{ChainBudget, CHAIN_BUDGET_SHARE, CHAIN_ROW_UPDATE_NS};
+    assert_eq!((CHAIN_BUDGET_SHARE, CHAIN_ROW_UPDATE_NS), (0.25, 10.0));
+    assert_eq!(ChainBudget::default(), ChainBudget::FromPeriod);
+    assert_eq!(ChainBudget::FromPeriod.row_updates(1e-3), Some(25_000));
+    assert_eq!(ChainBudget::FromPeriod.row_updates(2e-3), Some(50_000));
+    assert_eq!(ChainBudget::FromPeriod.row_updates(f64::NAN), Some(0));
+    assert_eq!(ChainBudget::from_setting(0).row_updates(1e-3), None);
+    assert_eq!(ChainBudget::from_setting(7).row_updates(1e-3), Some(7));
+}
