@@ -579,9 +579,7 @@ fn print_damper_kinds(label: &str, profile_after: f64, kinds: &[ProfiledStep]) {
 }
 
 /// The chain damper's row updates per warm step (median, p99, largest, steps its work budget cut)
-/// and, with the `stage-timing` feature, their cost: the least-squares fit of the damper stage's
-/// wall time `a + b·rows + c·row updates` over the steps with rows (`c`, ns per row update, is the
-/// sweeps' cost; `b` the rows' build or refresh; docs/MODELS.md §6.7).
+/// and, with the `stage-timing` feature, the cost of a row update (ns; docs/MODELS.md §6.7).
 fn print_row_updates(label: &str, profile_after: f64, kinds: &[ProfiledStep]) {
     let with_rows: Vec<&ProfiledStep> = kinds.iter().filter(|k| k.rows > 0).collect();
     if with_rows.is_empty() {
@@ -599,46 +597,45 @@ fn print_row_updates(label: &str, profile_after: f64, kinds: &[ProfiledStep]) {
     if !stage_time::ENABLED {
         return;
     }
-    // Normal equations of the fit, in µs; x = (1, rows, row updates).
-    let (mut m, mut r) = ([[0.0f64; 3]; 3], [0.0f64; 3]);
-    for k in &with_rows {
-        let x = [1.0, k.rows as f64, k.row_updates as f64];
-        for i in 0..3 {
-            r[i] += x[i] * k.damper_us;
-            for j in 0..3 {
-                m[i][j] += x[i] * x[j];
-            }
+    // The sweeps' cost: steps whose rows were refreshed in place (a pile at rest: the same rows,
+    // the same refresh cost) grouped by their sweeps; the slope of the groups' median damper time
+    // against their median row updates (least squares over groups of 5 steps or more) is the
+    // cost of a row update, the preempted steps left out by the medians.
+    let mut points = Vec::new();
+    for sweeps in 1..=64u32 {
+        let group: Vec<&&ProfiledStep> = with_rows
+            .iter()
+            .filter(|k| k.rows_by == RowsBy::Refresh && k.sweeps == sweeps)
+            .collect();
+        if group.len() >= 5 {
+            let median = |f: fn(&ProfiledStep) -> f64| {
+                crate::timing::Samples(group.iter().map(|k| f(k)).collect()).median()
+            };
+            points.push((
+                median(|k| k.row_updates as f64),
+                median(|k| k.damper_us),
+                sweeps,
+            ));
         }
     }
-    match solve3(m, r) {
-        Some([a, b, c]) => println!(
-            "{label}: damper wall µs ≈ {a:.2} + {:.2} ns × rows + {:.2} ns × row updates (least squares over those steps)",
-            b * 1e3,
-            c * 1e3
-        ),
-        None => println!("{label}: damper cost fit: singular (rows and row updates not independent)"),
+    if points.len() < 2 {
+        return;
     }
-}
-
-/// Solves `m·x = r` (3 × 3) by Cramer's rule; `None` when `m` is (nearly) singular.
-fn solve3(m: [[f64; 3]; 3], r: [f64; 3]) -> Option<[f64; 3]> {
-    let det = |a: [[f64; 3]; 3]| {
-        a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1])
-            - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
-            + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0])
-    };
-    let d = det(m);
-    let scale = m.iter().flatten().fold(0.0f64, |x, y| x.max(y.abs()));
-    if d.abs() <= 1e-12 * scale * scale * scale {
-        return None;
-    }
-    let mut x = [0.0; 3];
-    for (col, xc) in x.iter_mut().enumerate() {
-        let mut mc = m;
-        for (row, rv) in mc.iter_mut().zip(r) {
-            row[col] = rv;
-        }
-        *xc = det(mc) / d;
-    }
-    Some(x)
+    let n = points.len() as f64;
+    let (mx, my) = (
+        points.iter().map(|p| p.0).sum::<f64>() / n,
+        points.iter().map(|p| p.1).sum::<f64>() / n,
+    );
+    let sxy: f64 = points.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+    let sxx: f64 = points.iter().map(|p| (p.0 - mx) * (p.0 - mx)).sum();
+    let groups: Vec<String> = points
+        .iter()
+        .map(|p| format!("{} sweeps: {:.0} updates, {:.1} µs", p.2, p.0, p.1))
+        .collect();
+    println!(
+        "{label}: damper wall µs of refreshed steps by sweeps (medians; {}): {:.2} ns per row update (slope), {:.1} µs at none (intercept)",
+        groups.join("; "),
+        sxy / sxx * 1e3,
+        my - sxy / sxx * mx
+    );
 }

@@ -207,16 +207,66 @@ fn a_budget_cut_is_exactly_a_smaller_sweep_limit() {
 }
 
 /// The default budget is the documented share of the period at the documented cost of a row
-/// update: at 1 kHz, 25 % of 1 ms = 250 µs at 10 ns a row update = 25 000 row updates; at
-/// 500 Hz twice that; 0 turns it off; a set number is taken as it is.
+/// update: at 1 kHz, 40 % of 1 ms = 400 µs at 14 ns a row update = 28 571.4, rounded 28 571; at
+/// 500 Hz 57 142.9, rounded 57 143; 0 turns it off; a set number is taken as it is.
 #[test]
 fn the_default_budget_is_a_share_of_the_period() {
     use crate::world::{ChainBudget, CHAIN_BUDGET_SHARE, CHAIN_ROW_UPDATE_NS};
-    assert_eq!((CHAIN_BUDGET_SHARE, CHAIN_ROW_UPDATE_NS), (0.25, 10.0));
+    assert_eq!((CHAIN_BUDGET_SHARE, CHAIN_ROW_UPDATE_NS), (0.4, 14.0));
     assert_eq!(ChainBudget::default(), ChainBudget::FromPeriod);
-    assert_eq!(ChainBudget::FromPeriod.row_updates(1e-3), Some(25_000));
-    assert_eq!(ChainBudget::FromPeriod.row_updates(2e-3), Some(50_000));
+    assert_eq!(ChainBudget::FromPeriod.row_updates(1e-3), Some(28_571));
+    assert_eq!(ChainBudget::FromPeriod.row_updates(2e-3), Some(57_143));
     assert_eq!(ChainBudget::FromPeriod.row_updates(f64::NAN), Some(0));
     assert_eq!(ChainBudget::from_setting(0).row_updates(1e-3), None);
     assert_eq!(ChainBudget::from_setting(7).row_updates(1e-3), Some(7));
+}
+
+/// A landing pile (pile:100 thrown down at 1 m/s, then shoved sideways) under small budgets: no
+/// sample's row updates exceed `max(budget, one sweep)`, every sample's damper removes energy
+/// (the ledger's loss never decreases), the budget does cut, and the world's counters add up the
+/// samples'.
+#[test]
+fn a_landing_pile_keeps_every_samples_row_updates_within_the_budget() {
+    use crate::contact::test_pile::shove;
+    use crate::world::ChainBudget;
+    for budget in [1u64, 500, 2000] {
+        let mut w = crate::scene::builtin("pile:100", None)
+            .unwrap()
+            .unwrap()
+            .world;
+        w.params.chain_budget = ChainBudget::RowUpdates(budget);
+        for b in w.bodies.iter_mut().filter(|b| b.inv_mass > 0.0) {
+            b.vel.y -= 1.0;
+        }
+        let (mut total, mut cuts, mut loss) = (0u64, 0u64, 0.0);
+        for k in 0..1500 {
+            if k == 600 {
+                shove(&mut w);
+            }
+            w.step();
+            let d = w.chain_damper();
+            let per_sweep = d.last_row_updates / (d.last_sweeps.max(1) as u64);
+            assert!(
+                d.last_row_updates <= budget.max(per_sweep),
+                "budget {budget}, step {k}: {} row updates, {} sweeps",
+                d.last_row_updates,
+                d.last_sweeps
+            );
+            let now = w.ledger().chain_damping_loss;
+            assert!(
+                now >= loss - 1e-12,
+                "budget {budget}, step {k}: loss {loss} → {now} J"
+            );
+            loss = now;
+            total += d.last_row_updates;
+            cuts += d.last_cut as u64;
+        }
+        let d = w.chain_damper();
+        assert_eq!(
+            (d.row_updates, d.budget_cuts),
+            (total, cuts),
+            "budget {budget}"
+        );
+        assert!(cuts > 0, "budget {budget}: never cut");
+    }
 }

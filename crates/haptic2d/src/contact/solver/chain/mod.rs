@@ -28,6 +28,18 @@
 //! removes energy (returned by [`ChainDamping::apply`]). Positions then advance with the damped
 //! velocity (semi-implicit Euler), as they do with any other held force.
 //!
+//! **Work budget** (issue 42 item 2; `WorldParams::chain_budget`, MODELS §6.7). A sample's sweeps
+//! run at most a budget of row updates (one row update: one row's projected update; a sweep is
+//! one per row of `sorted`, holes included): before each sweep after the first, they stop if
+//! that whole sweep would take the sample past the budget. The first sweep always runs, so a
+//! sample does at most `max(budget, one sweep)` row updates and at least a settled sample's one
+//! sweep. Passive by the argument above, which holds after every sweep: stopping at the budget is
+//! stopping after some number of sweeps, bit for bit the solve with that sweep limit (test
+//! `a_budget_cut_is_exactly_a_smaller_sweep_limit`). What it costs: a cut sample has not
+//! converged, so `F ≠ −B_c·v⁺` in that sample (it removes less energy than the converged solve;
+//! its impulses warm-start the next sample). The default is derived from the sample period
+//! (`ChainBudget::FromPeriod`).
+//!
 //! **Choice of τ and sweeps** (pile:1000 at 1 kHz, `haptic2d-bench --settle 6 --every 0.25 (or
 //! 0.05) --set world.chain_tau=τ,world.chain_sweeps=S`; "at rest from" = the first check after
 //! which no body moved ≥ 1 cm/s): off, 1000 bodies moving at 6 s; τ = 1 ms / 8 sweeps, 4.5 s
