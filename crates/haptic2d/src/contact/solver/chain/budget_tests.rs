@@ -207,12 +207,12 @@ fn a_budget_cut_is_exactly_a_smaller_sweep_limit() {
 }
 
 /// The default budget is the documented share of the period at the documented cost of a row
-/// update: at 1 kHz, 40 % of 1 ms = 400 µs at 14 ns a row update = 28 571.4, rounded 28 571; at
+/// update: at 1 kHz, 20 % of 1 ms = 200 µs at 7 ns a row update = 28 571.4, rounded 28 571; at
 /// 500 Hz 57 142.9, rounded 57 143; 0 turns it off; a set number is taken as it is.
 #[test]
 fn the_default_budget_is_a_share_of_the_period() {
     use crate::world::{ChainBudget, CHAIN_BUDGET_SHARE, CHAIN_ROW_UPDATE_NS};
-    assert_eq!((CHAIN_BUDGET_SHARE, CHAIN_ROW_UPDATE_NS), (0.4, 14.0));
+    assert_eq!((CHAIN_BUDGET_SHARE, CHAIN_ROW_UPDATE_NS), (0.2, 7.0));
     assert_eq!(ChainBudget::default(), ChainBudget::FromPeriod);
     assert_eq!(ChainBudget::FromPeriod.row_updates(1e-3), Some(28_571));
     assert_eq!(ChainBudget::FromPeriod.row_updates(2e-3), Some(57_143));
