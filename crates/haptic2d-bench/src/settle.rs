@@ -272,26 +272,7 @@ pub fn run(
                     updates.2 += b.gjk_iterations;
                 }
             }
-            let d = w.chain_damper();
-            each.push(ProfiledStep {
-                step_us: dt_cpu * 1e6,
-                k,
-                sweeps: d.last_sweeps,
-                rows: d.last_rows,
-                row_updates: d.last_row_updates,
-                cut: d.last_cut,
-                events: w.contacts().events().len(),
-                rows_by: if d.last_refreshed {
-                    RowsBy::Refresh
-                } else if d.last_patched {
-                    RowsBy::Patch
-                } else {
-                    RowsBy::Build
-                },
-                damper_us: w.stage_times().get(Stage::ChainDamper) as f64 / 1e3,
-                merge_changes: w.contacts().last_merge_changes(),
-                sync_us: w.stage_times().get(Stage::ContactSync) as f64 / 1e3,
-            });
+            each.push(ProfiledStep::of(w, k, dt_cpu));
         }
         since += 1;
         if k % every == 0 || k == steps {
@@ -489,6 +470,32 @@ struct ProfiledStep {
     merge_changes: usize,
     /// The sync stage's wall time (merge and measure; µs; 0 without the `stage-timing` feature).
     sync_us: f64,
+}
+
+impl ProfiledStep {
+    /// Step `k` of `w`, just run, which took `dt_cpu` s of CPU time.
+    fn of(w: &World, k: usize, dt_cpu: f64) -> Self {
+        let d = w.chain_damper();
+        ProfiledStep {
+            step_us: dt_cpu * 1e6,
+            k,
+            sweeps: d.last_sweeps,
+            rows: d.last_rows,
+            row_updates: d.last_row_updates,
+            cut: d.last_cut,
+            events: w.contacts().events().len(),
+            rows_by: if d.last_refreshed {
+                RowsBy::Refresh
+            } else if d.last_patched {
+                RowsBy::Patch
+            } else {
+                RowsBy::Build
+            },
+            damper_us: w.stage_times().get(Stage::ChainDamper) as f64 / 1e3,
+            merge_changes: w.contacts().last_merge_changes(),
+            sync_us: w.stage_times().get(Stage::ContactSync) as f64 / 1e3,
+        }
+    }
 }
 
 /// The warm steps whose contact merge changed the tracked set against the others: how many,

@@ -51,7 +51,7 @@ pub const CHAIN_BUDGET_SHARE: f64 = 0.2;
 
 /// Cost of one row update of the chain damper's sweeps (ns), measured on the development machine
 /// under load (docs/MODELS.md §6.7: the slope of the damper stage's wall time against its row
-/// updates, 5.8–13.8 ns in four measurements, median 6.65 ns, rounded).
+/// updates, 5.8–13.8 ns in five measurements, median 6.9 ns, rounded).
 pub const CHAIN_ROW_UPDATE_NS: f64 = 7.0;
 
 /// Row updates per second of sample period the default budget allows (1/s):

@@ -3,53 +3,34 @@
 //! and no budget changes nothing.
 
 use super::*;
-use crate::geom::Pose;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 /// `boxes` boxes of random masses (0.2–5 kg) stacked on a fixed floor (body 0), two loaded
-/// contacts per interface at the box's bottom corners, normals tilted up to ±0.2 rad, random
-/// loads (0.5–50 N), random velocities (±0.5 m/s, ±3 rad/s) and random held forces: a chain the
+/// contacts per interface at the box's bottom corners (the column of
+/// [`tall_column`](super::tests::tall_column)), normals tilted up to ±0.2 rad, random loads
+/// (0.5–50 N), random velocities (±0.5 m/s, ±3 rad/s) and random held forces: a chain the
 /// damper needs many sweeps for.
 fn random_column(
     rng: &mut ChaCha8Rng,
     boxes: u32,
 ) -> (Vec<Body>, Vec<LoadedContact>, Vec<VeCandidate>) {
-    let mut bodies = vec![Body::fixed("floor", Pose::new(0.0, -0.05, 0.0))];
-    for i in 0..boxes {
+    let (mut bodies, column) = super::tests::tall_column(boxes);
+    for b in bodies.iter_mut().skip(1) {
         let m = rng.random_range(0.2..5.0);
-        let mut b = Body::dynamic(
-            "box",
-            m,
-            m / 600.0,
-            Pose::new(0.0, 0.05 + 0.1 * i as f64, 0.0),
-        );
+        *b = Body::dynamic("box", m, m / 600.0, b.pose);
         b.vel = Vec2::new(rng.random_range(-0.5..0.5), rng.random_range(-0.5..0.5));
         b.omega = rng.random_range(-3.0..3.0);
         b.force = Vec2::new(rng.random_range(-20.0..20.0), rng.random_range(-20.0..20.0));
         b.torque = rng.random_range(-1.0..1.0);
-        bodies.push(b);
     }
-    let (mut contacts, mut keys) = (Vec::new(), Vec::new());
-    for i in 0..boxes {
-        for corner in 0..2u32 {
-            keys.push(VeCandidate {
-                vertex_collider: i + 1,
-                vertex: corner,
-                edge_collider: i,
-                edge: 2,
-            });
-            let tilt: f64 = rng.random_range(-0.2..0.2);
-            contacts.push(LoadedContact {
-                body_a: i + 1,
-                body_b: i,
-                point: Vec2::new(0.1 * corner as f64 - 0.05, 0.1 * i as f64),
-                n: Vec2::new(tilt.sin(), tilt.cos()),
-                f_n: rng.random_range(0.5..50.0),
-            });
-        }
+    let mut contacts = column.contacts;
+    for c in contacts.iter_mut() {
+        let tilt: f64 = rng.random_range(-0.2..0.2);
+        c.n = Vec2::new(tilt.sin(), tilt.cos());
+        c.f_n = rng.random_range(0.5..50.0);
     }
-    (bodies, contacts, keys)
+    (bodies, contacts, column.keys)
 }
 
 /// Kinetic energy of `bodies` after a semi-implicit Euler step of their held forces (J): the
