@@ -251,3 +251,38 @@ fn a_landing_pile_keeps_every_samples_row_updates_within_the_budget() {
         assert!(cuts > 0, "budget {budget}: never cut");
     }
 }
+
+/// `[world] chain_budget`: absent, the budget follows the scene's rate (28 571 row updates at
+/// 1 kHz, 57 143 at 500 Hz, as the documented formula gives); `N` sets `N` row updates; 0 turns
+/// it off; a negative value is refused.
+#[test]
+fn a_scene_sets_the_chain_budget_or_takes_it_from_its_rate() {
+    use crate::scene::Scene;
+    use crate::world::ChainBudget;
+    const WALL: &str = "[[body]]\nname = \"wall\"\nkind = \"fixed\"\npolygon = [[-0.1, -0.2], [0.0, -0.2], [0.0, 0.2], [-0.1, 0.2]]\n";
+    let budget_of = |world: &str| {
+        let p = Scene::from_toml(&format!("[world]\n{world}\n{WALL}"), "t.toml", None)
+            .expect("a valid scene")
+            .world
+            .params;
+        (p.chain_budget, p.chain_budget.row_updates(p.dt))
+    };
+    assert_eq!(
+        budget_of("rate = 1000"),
+        (ChainBudget::FromPeriod, Some(28_571))
+    );
+    assert_eq!(
+        budget_of("rate = 500"),
+        (ChainBudget::FromPeriod, Some(57_143))
+    );
+    assert_eq!(
+        budget_of("rate = 1000\nchain_budget = 5000"),
+        (ChainBudget::RowUpdates(5000), Some(5000))
+    );
+    assert_eq!(
+        budget_of("chain_budget = 0"),
+        (ChainBudget::Unbounded, None)
+    );
+    let text = format!("[world]\nchain_budget = -1\n{WALL}");
+    assert!(Scene::from_toml(&text, "t.toml", None).is_err());
+}
