@@ -4,7 +4,7 @@
 //! largest overlap. Used to find why the pile keeps moving (docs/PERFORMANCE.md, issue 17).
 
 use haptic2d::stage_time::{self, Stage, StageTimes};
-use haptic2d::world::World;
+use haptic2d::world::{ChainBudget, World};
 
 use crate::state;
 use crate::timing::{now, Clock};
@@ -12,7 +12,8 @@ use crate::timing::{now, Clock};
 /// Applies `law.key=value` overrides (`normal.bc=200`, `friction.beta=40`) to the prototypes of the
 /// world's laws (every contact created afterwards gets them), and the world options
 /// `world.proximity_spread=0/1`, `world.proximity_skip=0/1`, `world.chain_tau=SECONDS` (0 = chain damper off) and
-/// `world.chain_sweeps=N`, and `contact.impact_sweeps=N` (the impact work budget, 1–200,
+/// `world.chain_sweeps=N`, `world.chain_budget=N` (row updates per sample, 0 = unbounded;
+/// docs/MODELS.md §6.7), and `contact.impact_sweeps=N` (the impact work budget, 1–200,
 /// docs/MODELS.md §7.7; 200 is the limit before the budget).
 pub fn apply(w: &mut World, sets: &[String]) -> Result<(), String> {
     for s in sets {
@@ -42,6 +43,10 @@ pub fn apply(w: &mut World, sets: &[String]) -> Result<(), String> {
                 w.params.chain_sweeps = v as u32;
                 Ok(())
             }
+            Some(("world", "chain_budget")) if v >= 0.0 && v.fract() == 0.0 => {
+                w.params.chain_budget = ChainBudget::from_setting(v as u64);
+                Ok(())
+            }
             Some(("contact", "impact_sweeps"))
                 if (1.0..=200.0).contains(&v) && v.fract() == 0.0 =>
             {
@@ -52,7 +57,7 @@ pub fn apply(w: &mut World, sets: &[String]) -> Result<(), String> {
                 w.params.contact.impact_rows = Some(v as u64);
                 Ok(())
             }
-            _ => Err("expected normal.KEY, friction.KEY, world.{proximity_spread, proximity_skip, chain_tau, chain_sweeps} or contact.{impact_sweeps, impact_rows} (sweeps and rows whole numbers, impact_sweeps 1 to 200, impact_rows 0 = unbounded)".into()),
+            _ => Err("expected normal.KEY, friction.KEY, world.{proximity_spread, proximity_skip, chain_tau, chain_sweeps, chain_budget} or contact.{impact_sweeps, impact_rows} (sweeps, budget and rows whole numbers, impact_sweeps 1 to 200, chain_budget and impact_rows 0 = unbounded)".into()),
         };
         r.map_err(|e| format!("--set {s}: {e}"))?;
     }
@@ -271,24 +276,7 @@ pub fn run(
                     updates.2 += b.gjk_iterations;
                 }
             }
-            let d = w.chain_damper();
-            each.push(ProfiledStep {
-                step_us: dt_cpu * 1e6,
-                k,
-                sweeps: d.last_sweeps,
-                rows: d.last_rows,
-                events: w.contacts().events().len(),
-                rows_by: if d.last_refreshed {
-                    RowsBy::Refresh
-                } else if d.last_patched {
-                    RowsBy::Patch
-                } else {
-                    RowsBy::Build
-                },
-                damper_us: w.stage_times().get(Stage::ChainDamper) as f64 / 1e3,
-                merge_changes: w.contacts().last_merge_changes(),
-                sync_us: w.stage_times().get(Stage::ContactSync) as f64 / 1e3,
-            });
+            each.push(ProfiledStep::of(w, k, dt_cpu));
         }
         since += 1;
         if k % every == 0 || k == steps {
@@ -353,6 +341,7 @@ pub fn run(
     }
     print_merges(label, profile_after, &each);
     print_damper_kinds(label, profile_after, &each);
+    print_row_updates(label, profile_after, &each);
     let (median, p99) = (all_steps.median(), all_steps.p99());
     println!(
         "{label}: CPU µs per step after {profile_after} s: median {median:.1}, p99 {p99:.1} (p99/median {:.2}), largest {:.1}",
@@ -470,9 +459,11 @@ struct ProfiledStep {
     step_us: f64,
     /// The step's number (from 1).
     k: usize,
-    /// The chain damper's sweeps and rows.
+    /// The chain damper's sweeps and rows, its row updates and whether its budget cut them.
     sweeps: u32,
     rows: usize,
+    row_updates: u64,
+    cut: bool,
     /// Contact events of the step.
     events: usize,
     /// How the chain damper made its rows.
@@ -483,6 +474,32 @@ struct ProfiledStep {
     merge_changes: usize,
     /// The sync stage's wall time (merge and measure; µs; 0 without the `stage-timing` feature).
     sync_us: f64,
+}
+
+impl ProfiledStep {
+    /// Step `k` of `w`, just run, which took `dt_cpu` s of CPU time.
+    fn of(w: &World, k: usize, dt_cpu: f64) -> Self {
+        let d = w.chain_damper();
+        ProfiledStep {
+            step_us: dt_cpu * 1e6,
+            k,
+            sweeps: d.last_sweeps,
+            rows: d.last_rows,
+            row_updates: d.last_row_updates,
+            cut: d.last_cut,
+            events: w.contacts().events().len(),
+            rows_by: if d.last_refreshed {
+                RowsBy::Refresh
+            } else if d.last_patched {
+                RowsBy::Patch
+            } else {
+                RowsBy::Build
+            },
+            damper_us: w.stage_times().get(Stage::ChainDamper) as f64 / 1e3,
+            merge_changes: w.contacts().last_merge_changes(),
+            sync_us: w.stage_times().get(Stage::ContactSync) as f64 / 1e3,
+        }
+    }
 }
 
 /// The warm steps whose contact merge changed the tracked set against the others: how many,
@@ -570,4 +587,66 @@ fn print_damper_kinds(label: &str, profile_after: f64, kinds: &[ProfiledStep]) {
             );
         }
     }
+}
+
+/// The chain damper's row updates per warm step (median, p99, largest, steps its work budget cut)
+/// and, with the `stage-timing` feature, the cost of a row update (ns; docs/MODELS.md §6.7).
+fn print_row_updates(label: &str, profile_after: f64, kinds: &[ProfiledStep]) {
+    let with_rows: Vec<&ProfiledStep> = kinds.iter().filter(|k| k.rows > 0).collect();
+    if with_rows.is_empty() {
+        return;
+    }
+    let updates = crate::timing::Samples(with_rows.iter().map(|k| k.row_updates as f64).collect());
+    println!(
+        "{label}: chain damper row updates per warm step after {profile_after} s ({} steps with rows): median {:.0}, p99 {:.0}, largest {:.0}; {} steps cut by the work budget",
+        with_rows.len(),
+        updates.median(),
+        updates.quantile(0.99),
+        updates.quantile(1.0),
+        with_rows.iter().filter(|k| k.cut).count()
+    );
+    if !stage_time::ENABLED {
+        return;
+    }
+    // The sweeps' cost: steps whose rows were refreshed in place (a pile at rest: the same rows,
+    // the same refresh cost) grouped by their sweeps; the slope of the groups' median damper time
+    // against their median row updates (least squares over groups of 5 steps or more) is the
+    // cost of a row update, the preempted steps left out by the medians.
+    let mut points = Vec::new();
+    for sweeps in 1..=64u32 {
+        let group: Vec<&&ProfiledStep> = with_rows
+            .iter()
+            .filter(|k| k.rows_by == RowsBy::Refresh && k.sweeps == sweeps)
+            .collect();
+        if group.len() >= 5 {
+            let median = |f: fn(&ProfiledStep) -> f64| {
+                crate::timing::Samples(group.iter().map(|k| f(k)).collect()).median()
+            };
+            points.push((
+                median(|k| k.row_updates as f64),
+                median(|k| k.damper_us),
+                sweeps,
+            ));
+        }
+    }
+    if points.len() < 2 {
+        return;
+    }
+    let n = points.len() as f64;
+    let (mx, my) = (
+        points.iter().map(|p| p.0).sum::<f64>() / n,
+        points.iter().map(|p| p.1).sum::<f64>() / n,
+    );
+    let sxy: f64 = points.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+    let sxx: f64 = points.iter().map(|p| (p.0 - mx) * (p.0 - mx)).sum();
+    let groups: Vec<String> = points
+        .iter()
+        .map(|p| format!("{} sweeps: {:.0} updates, {:.1} µs", p.2, p.0, p.1))
+        .collect();
+    println!(
+        "{label}: damper wall µs of refreshed steps by sweeps (medians; {}): {:.2} ns per row update (slope), {:.1} µs at none (intercept)",
+        groups.join("; "),
+        sxy / sxx * 1e3,
+        my - sxy / sxx * mx
+    );
 }

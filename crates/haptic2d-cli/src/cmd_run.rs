@@ -272,6 +272,22 @@ pub fn run(a: &RunArgs) -> Result<Status, Failure> {
     report(a, &rig, &summary, worst, end, interrupted, logger)
 }
 
+/// The ticks whose world step the work budgets cut (one world step a tick): the chain damper's
+/// (MODELS §6.7), and the impact solver's phases (§7.7, counted in phases, not ticks). Nothing
+/// when neither cut.
+fn print_budget_cuts(world: &haptic2d::world::World) {
+    if let Some(line) = crate::cmd_simulate::chain_budget_line(world) {
+        crate::outln!("  {line}");
+    }
+    let impacts = world.contacts().impact_budget();
+    if impacts.phases_cut > 0 {
+        crate::outln!(
+            "  impact solver: {} phases stopped by the sweep budget ([contact] impact_sweeps)",
+            impacts.phases_cut
+        );
+    }
+}
+
 /// The line that starts a run: scene, device and where its parameters came from, controller,
 /// hand, rate and duration.
 fn print_banner(a: &RunArgs, rig: &Rig, scene_name: &str, origin: &str, hand_name: &str) {
@@ -577,6 +593,7 @@ fn report(
     if let Some(line) = worst.line() {
         crate::outln!("  {line}");
     }
+    print_budget_cuts(rig.system.world());
     crate::outln!(
         "on time: {:.3} % of {} deadlines ({} ticks, {} skipped, {} overruns)",
         summary.on_time_fraction * 100.0,

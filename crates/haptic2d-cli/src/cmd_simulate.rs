@@ -217,4 +217,66 @@ fn print_contacts(world: &World, max_depth: f64, overlap: &OverlapSummary) {
             budget.islands, budget.row_updates, budget.phases_cut, budget.phases_capped, budget.restitution_scaled
         );
     }
+    if let Some(line) = chain_budget_line(world) {
+        println!("{line}");
+    }
+}
+
+/// The chain damper's work budget (MODELS §6.7) when it stopped the sweeps of any sample: in how
+/// many samples, the budget, and the row updates run; `None` when it never cut.
+pub(crate) fn chain_budget_line(world: &World) -> Option<String> {
+    let d = world.chain_damper();
+    let budget = world.params.chain_budget.row_updates(world.params.dt);
+    (d.budget_cuts > 0).then(|| {
+        format!(
+            "chain damper: sweeps stopped by the work budget ([world] chain_budget, {} row updates a sample) in {} samples; {} row updates in all, at most {} in one sample",
+            budget.map_or("unbounded".to_string(), |b| b.to_string()),
+            d.budget_cuts,
+            d.row_updates,
+            d.max_row_updates
+        )
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use haptic2d::world::ChainBudget;
+
+    /// The world of built-in scene `name`.
+    fn builtin(name: &str) -> World {
+        haptic2d::scene::builtin(name, None)
+            .expect("a known scene")
+            .expect("a valid scene")
+            .world
+    }
+
+    /// The summary's chain-budget line names the samples the budget cut and the row updates the
+    /// damper counted (a landing pile:100 under a budget of one row update: every sample that
+    /// wanted a second sweep is cut); a run the budget never cut (the default budget on the
+    /// paper's box-in-walls, which has no chains) prints none.
+    #[test]
+    fn the_chain_budget_line_counts_the_samples_the_budget_cut() {
+        let mut w = builtin("pile:100");
+        w.params.chain_budget = ChainBudget::RowUpdates(1);
+        let mut cut = 0;
+        for _ in 0..300 {
+            w.step();
+            cut += w.chain_damper().last_cut as u64;
+        }
+        assert!(cut > 0, "the budget never cut");
+        let line = chain_budget_line(&w).expect("a line when the budget cut");
+        assert!(line.contains("1 row updates a sample"), "{line}");
+        assert!(line.contains(&format!(" in {cut} samples;")), "{line}");
+        let total = w.chain_damper().row_updates;
+        assert!(
+            line.contains(&format!("; {total} row updates in all")),
+            "{line}"
+        );
+        let mut quiet = builtin("box-in-walls");
+        for _ in 0..300 {
+            quiet.step();
+        }
+        assert_eq!(chain_budget_line(&quiet), None);
+    }
 }

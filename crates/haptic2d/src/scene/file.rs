@@ -60,6 +60,9 @@ pub struct WorldSection {
     /// Gauss–Seidel sweeps of the chain damper per sample, at most (fewer once converged);
     /// default 16.
     pub chain_sweeps: Option<u32>,
+    /// Work budget of the chain damper per sample, in row updates (whole sweeps, the first
+    /// always runs); 0 = unbounded; default derived from the rate (`WorldParams::chain_budget`).
+    pub chain_budget: Option<u64>,
     /// Accept bodies lighter than 1.5 × min_mass with a warning instead of an error.
     pub allow_light_bodies: Option<bool>,
     /// Accept bodies that start overlapping by more than `delta_c` (reported as warnings instead

@@ -9,7 +9,7 @@ use super::file::{ContactSection, WorldSection};
 use super::SceneError;
 use crate::contact::ContactParams;
 use crate::integrate::IntegrationMode;
-use crate::world::WorldParams;
+use crate::world::{ChainBudget, WorldParams};
 
 /// `[world]`: the rate (Hz) and the world's numerical parameters. Returns them and whether the
 /// rate was valid (an invalid one is reported and replaced by 500 Hz so the other tables can still
@@ -102,6 +102,9 @@ pub(super) fn world_params(
             ));
         }
         params.chain_sweeps = n.min(MAX_CHAIN_SWEEPS);
+    }
+    if let Some(n) = w.chain_budget {
+        params.chain_budget = ChainBudget::from_setting(n);
     }
     let margin_needed = 2.0 * 1.0 * dt * params.proximity_every as f64 + params.delta_c;
     if params.delta_prox < margin_needed {

@@ -39,6 +39,61 @@ pub struct WorldParams {
     /// Gauss–Seidel sweeps of the chain damper per sample, at most (they stop once no row's
     /// velocity changes by more than 2e-4 m/s; warm-started, a settled pile needs 1–4); default 16.
     pub chain_sweeps: u32,
+    /// Work budget of the chain damper per sample, in row updates (whole sweeps, the first always
+    /// runs; MODELS §6.7): by default derived from the sample period `dt`
+    /// ([`ChainBudget::FromPeriod`]).
+    pub chain_budget: ChainBudget,
+}
+
+/// Share of the sample period the chain damper's sweeps may take by default (dimensionless):
+/// with [`CHAIN_ROW_UPDATE_NS`] it sets [`CHAIN_ROW_UPDATES_PER_S`].
+pub const CHAIN_BUDGET_SHARE: f64 = 0.2;
+
+/// Cost of one row update of the chain damper's sweeps (ns), measured on the development machine
+/// under load (docs/MODELS.md §6.7: the slope of the damper stage's wall time against its row
+/// updates, 5.8–13.8 ns in five measurements, median 6.9 ns, rounded).
+pub const CHAIN_ROW_UPDATE_NS: f64 = 7.0;
+
+/// Row updates per second of sample period the default budget allows (1/s):
+/// `CHAIN_BUDGET_SHARE / (CHAIN_ROW_UPDATE_NS · 1e-9)`.
+pub const CHAIN_ROW_UPDATES_PER_S: f64 = CHAIN_BUDGET_SHARE / (CHAIN_ROW_UPDATE_NS * 1e-9);
+
+/// The chain damper's work budget per sample, in row updates (one row update: one projected
+/// Gauss–Seidel update of one chain contact, MODELS §6.7). The sweeps stop before a whole sweep
+/// that would take the sample past the budget; the first sweep always runs. Any number of
+/// sweeps is passive, so a cut sample only leaves `F ≠ −B_c·v⁺` in that sample.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ChainBudget {
+    /// `round(dt × CHAIN_ROW_UPDATES_PER_S)` row updates, `dt` the sample period (s): a fixed
+    /// share of the period at the measured cost of a row update (the default).
+    #[default]
+    FromPeriod,
+    /// At most this many row updates per sample (and always the first sweep).
+    RowUpdates(u64),
+    /// No budget: the sweeps stop at `chain_sweeps` or once converged.
+    Unbounded,
+}
+
+impl ChainBudget {
+    /// The budget a setting `n` names (`[world] chain_budget = n`, the bench's
+    /// `--set world.chain_budget=n`): 0 = [`Unbounded`](Self::Unbounded), else `n` row updates.
+    pub fn from_setting(n: u64) -> Self {
+        if n == 0 {
+            Self::Unbounded
+        } else {
+            Self::RowUpdates(n)
+        }
+    }
+
+    /// Row updates allowed per sample at sample period `dt` (s); `None` = unbounded. A period
+    /// that is NaN or not positive gives 0 (one sweep a sample).
+    pub fn row_updates(self, dt: f64) -> Option<u64> {
+        match self {
+            Self::FromPeriod => Some((dt * CHAIN_ROW_UPDATES_PER_S).round().max(0.0) as u64),
+            Self::RowUpdates(n) => Some(n),
+            Self::Unbounded => None,
+        }
+    }
 }
 
 impl Default for WorldParams {
@@ -55,6 +110,7 @@ impl Default for WorldParams {
             contact: ContactParams::default(),
             chain_tau: Some(DEFAULT_CHAIN_TAU),
             chain_sweeps: DEFAULT_CHAIN_SWEEPS,
+            chain_budget: ChainBudget::FromPeriod,
         }
     }
 }

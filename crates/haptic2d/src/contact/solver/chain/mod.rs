@@ -28,6 +28,18 @@
 //! removes energy (returned by [`ChainDamping::apply`]). Positions then advance with the damped
 //! velocity (semi-implicit Euler), as they do with any other held force.
 //!
+//! **Work budget** (issue 42 item 2; `WorldParams::chain_budget`, MODELS §6.7). A sample's sweeps
+//! run at most a budget of row updates (one row update: one row's projected update; a sweep is
+//! one per row of `sorted`, holes included): before each sweep after the first, they stop if
+//! that whole sweep would take the sample past the budget. The first sweep always runs, so a
+//! sample does at most `max(budget, one sweep)` row updates and at least a settled sample's one
+//! sweep. Passive by the argument above, which holds after every sweep: stopping at the budget is
+//! stopping after some number of sweeps, bit for bit the solve with that sweep limit (test
+//! `a_budget_cut_is_exactly_a_smaller_sweep_limit`). What it costs: a cut sample has not
+//! converged, so `F ≠ −B_c·v⁺` in that sample (it removes less energy than the converged solve;
+//! its impulses warm-start the next sample). The default is derived from the sample period
+//! (`ChainBudget::FromPeriod`).
+//!
 //! **Choice of τ and sweeps** (pile:1000 at 1 kHz, `haptic2d-bench --settle 6 --every 0.25 (or
 //! 0.05) --set world.chain_tau=τ,world.chain_sweeps=S`; "at rest from" = the first check after
 //! which no body moved ≥ 1 cm/s): off, 1000 bodies moving at 6 s; τ = 1 ms / 8 sweeps, 4.5 s
@@ -65,6 +77,8 @@
 //! the rows it sweeps; `rows.rs` the row set (which contacts are chain contacts, their colours,
 //! and building, patching or refreshing the rows from the last sample's).
 
+#[cfg(test)]
+mod budget_tests;
 mod rows;
 #[cfg(test)]
 mod sweep_tests;
@@ -270,8 +284,21 @@ pub struct ChainDamping {
     pub last_patched: bool,
     /// The rows that died and the rows that were born in the last sample's patch.
     pub last_patch_size: (usize, usize),
-    /// Sweeps run in the last sample (at most the `sweeps` asked for; fewer once converged).
+    /// Sweeps run in the last sample (at most the `sweeps` asked for; fewer once converged or
+    /// when the work budget stopped them).
     pub last_sweeps: u32,
+    /// Row updates run in the last sample: its sweeps × its rows (holes included: a sweep visits
+    /// them too).
+    pub last_row_updates: u64,
+    /// Whether the work budget stopped the last sample's sweeps (another sweep was due: the
+    /// last one had not converged and fewer than `sweeps` had run).
+    pub last_cut: bool,
+    /// Samples whose sweeps the work budget stopped, since the damper was made.
+    pub budget_cuts: u64,
+    /// Row updates run since the damper was made.
+    pub row_updates: u64,
+    /// The most row updates run in one sample since the damper was made.
+    pub max_row_updates: u64,
     /// Scale `s ∈ [0, 1]` of the warm start in the last sample (1 = the last sample's impulses
     /// kept whole; see [`ChainDamping::apply`]).
     pub last_warm_scale: f64,
@@ -322,6 +349,11 @@ impl Default for ChainDamping {
             last_patched: false,
             last_patch_size: (0, 0),
             last_sweeps: 0,
+            last_row_updates: 0,
+            last_cut: false,
+            budget_cuts: 0,
+            row_updates: 0,
+            max_row_updates: 0,
             last_warm_scale: 0.0,
         }
     }
@@ -335,8 +367,15 @@ impl ChainDamping {
     /// the sample period `dt`
     /// (s), with damping time `tau` (s: a chain contact's damper is `B_c = m_c/τ`, N·s/m; `None`
     /// = off) and at most `sweeps` Gauss–Seidel sweeps (each one passive; they stop once a sweep
-    /// changes no row's relative velocity by more than 2e-4 m/s). Returns the kinetic energy the
-    /// dampers remove over the sample (J, ≥ 0 up to rounding).
+    /// changes no row's relative velocity by more than 2e-4 m/s), within `budget` row updates
+    /// (`None` = unbounded). Returns the kinetic energy the dampers remove over the sample (J, ≥ 0
+    /// up to rounding).
+    ///
+    /// **Budget.** Before each sweep after the first, the sweeps stop if that whole sweep would
+    /// take the sample's row updates past `budget` (`last_cut`, counted in `budget_cuts`): a
+    /// sample runs at most `max(budget, rows)` row updates. The first sweep always runs, so the
+    /// sample does at least the work of a settled one. Passive wherever it stops (module docs);
+    /// a cut sample leaves `F ≠ −B_c·v⁺` in that sample.
     ///
     /// **Warm start.** The sweeps start from the last sample's impulses of the same contacts
     /// (by key), clamped to this sample's bounds and scaled by the `s ∈ [0, 1]` that minimises
@@ -362,21 +401,18 @@ impl ChainDamping {
     /// deterministic, but dependent on the history of the contacts, not only on this sample's
     /// list. Past an eighth of the rows (at least 16) in holes and appended rows since the last
     /// build, the rows are built from scratch again, in colour order.
+    #[allow(clippy::too_many_arguments)]
     pub fn apply(
         &mut self,
         tau: Option<f64>,
         sweeps: u32,
+        budget: Option<u64>,
         dt: f64,
         loaded: Loaded<'_>,
         bodies: &mut [Body],
         wrenches: &mut [Wrench2],
     ) -> f64 {
-        self.last_rows = 0;
-        self.last_refreshed = false;
-        self.last_patched = false;
-        self.last_patch_size = (0, 0);
-        self.last_sweeps = 0;
-        self.last_warm_scale = 0.0;
+        self.clear_last();
         let tau = match tau {
             Some(t) if t > 0.0 && t.is_finite() && dt > 0.0 => t,
             _ => {
@@ -442,7 +478,13 @@ impl ChainDamping {
         //    in registers (a `Vec` behind `&mut` is reloaded after every store to a row).
         let (rows, solver) = (&mut self.sorted[..], &mut self.solver[..]);
         let mut scale = s;
+        let (limit, per_sweep) = (budget.unwrap_or(u64::MAX), rows.len() as u64);
         for _ in 0..sweeps {
+            // The budget: whole sweeps, the first always (passive wherever the sweeps stop).
+            if self.last_sweeps > 0 && self.last_row_updates + per_sweep > limit {
+                self.last_cut = true;
+                break;
+            }
             // Largest change of a row's relative velocity in this sweep (m/s). After the first
             // sweep the scale is 1 and `sweep` is inlined without the multiplication (`λ·1 = λ`
             // exactly).
@@ -453,10 +495,12 @@ impl ChainDamping {
             };
             scale = 1.0;
             self.last_sweeps += 1;
+            self.last_row_updates += per_sweep;
             if largest <= CONVERGED {
                 break;
             }
         }
+        self.count_work();
         if scale != 1.0 {
             // No sweep ran: the scaled warm impulses are the result.
             for row in self.sorted.iter_mut() {
@@ -496,7 +540,13 @@ impl ChainDamping {
             b.force += f;
             b.torque += t;
         }
-        let removed = ke_star - ke;
+        self.add_fixed_reactions(inv_dt, bodies, wrenches);
+        ke_star - ke
+    }
+
+    /// Step 6 for the bodies that are not dynamic: the reaction of each row's impulse (held
+    /// over the sample, `1/T = inv_dt`) added to their wrench and held force, row by row.
+    fn add_fixed_reactions(&self, inv_dt: f64, bodies: &mut [Body], wrenches: &mut [Wrench2]) {
         let dynamic = &self.dynamic;
         for row in &self.sorted {
             let (a, b) = (row.a as usize, row.b as usize);
@@ -519,7 +569,25 @@ impl ChainDamping {
                 bodies[b].torque -= tb;
             }
         }
-        removed
+    }
+
+    /// Clears what [`apply`](Self::apply) reports of the last sample, before it runs.
+    fn clear_last(&mut self) {
+        self.last_rows = 0;
+        self.last_refreshed = false;
+        self.last_patched = false;
+        self.last_patch_size = (0, 0);
+        self.last_sweeps = 0;
+        self.last_row_updates = 0;
+        self.last_cut = false;
+        self.last_warm_scale = 0.0;
+    }
+
+    /// Adds the last sample's row updates and budget cut to the damper's totals.
+    fn count_work(&mut self) {
+        self.row_updates += self.last_row_updates;
+        self.max_row_updates = self.max_row_updates.max(self.last_row_updates);
+        self.budget_cuts += self.last_cut as u64;
     }
 
     /// Step 1 of [`apply`](Self::apply): `star` and the working velocities `solver` from the

@@ -44,9 +44,9 @@ fn column() -> (Vec<Body>, Column) {
 }
 
 /// A loaded list of the column's contacts, and its keys.
-struct Column {
-    contacts: Vec<LoadedContact>,
-    keys: Vec<VeCandidate>,
+pub(super) struct Column {
+    pub(super) contacts: Vec<LoadedContact>,
+    pub(super) keys: Vec<VeCandidate>,
 }
 
 impl Column {
@@ -69,7 +69,7 @@ fn pass(
     bodies: &mut [Body],
     wrenches: &mut [Wrench2],
 ) -> f64 {
-    d.apply(Some(2e-4), sweeps, 1e-3, loaded, bodies, wrenches)
+    d.apply(Some(2e-4), sweeps, None, 1e-3, loaded, bodies, wrenches)
 }
 
 fn kinetic_of(bodies: &[Body]) -> f64 {
@@ -303,7 +303,7 @@ fn rows_refreshed_in_place_match_rows_rebuilt() {
 
 /// A tall column of boxes on a fixed floor, two contacts (the bottom corners) at each
 /// interface: the whole loaded list, in key order.
-fn tall_column(boxes: u32) -> (Vec<Body>, Column) {
+pub(super) fn tall_column(boxes: u32) -> (Vec<Body>, Column) {
     let bodies = column_bodies(boxes);
     let (mut contacts, mut keys) = (Vec::new(), Vec::new());
     for i in 0..boxes {
