@@ -3,8 +3,9 @@
 //! every `--every` seconds of simulated time: largest speed, bodies above 1 cm/s, mean height,
 //! largest overlap. Used to find why the pile keeps moving (docs/PERFORMANCE.md, issue 17).
 
+use haptic2d::contact::WorkBudget;
 use haptic2d::stage_time::{self, Stage, StageTimes};
-use haptic2d::world::{ChainBudget, World};
+use haptic2d::world::World;
 
 use crate::state;
 use crate::timing::{now, Clock};
@@ -44,7 +45,7 @@ pub fn apply(w: &mut World, sets: &[String]) -> Result<(), String> {
                 Ok(())
             }
             Some(("world", "chain_budget")) if v >= 0.0 && v.fract() == 0.0 => {
-                w.params.chain_budget = ChainBudget::from_setting(v as u64);
+                w.params.chain_budget = WorkBudget::from_setting(v as u64);
                 Ok(())
             }
             Some(("contact", "impact_sweeps"))
@@ -53,11 +54,11 @@ pub fn apply(w: &mut World, sets: &[String]) -> Result<(), String> {
                 w.params.contact.impact_sweeps = v as u32;
                 Ok(())
             }
-            Some(("contact", "impact_rows")) if v >= 0.0 && v.fract() == 0.0 => {
-                w.params.contact.impact_rows = Some(v as u64);
+            Some(("contact", "impact_budget")) if v >= 0.0 && v.fract() == 0.0 => {
+                w.params.contact.impact_budget = WorkBudget::from_setting(v as u64);
                 Ok(())
             }
-            _ => Err("expected normal.KEY, friction.KEY, world.{proximity_spread, proximity_skip, chain_tau, chain_sweeps, chain_budget} or contact.{impact_sweeps, impact_rows} (sweeps, budget and rows whole numbers, impact_sweeps 1 to 200, chain_budget and impact_rows 0 = unbounded)".into()),
+            _ => Err("expected normal.KEY, friction.KEY, world.{proximity_spread, proximity_skip, chain_tau, chain_sweeps, chain_budget} or contact.{impact_sweeps, impact_budget} (sweeps, budget and rows whole numbers, impact_sweeps 1 to 200, chain_budget and impact_budget 0 = unbounded)".into()),
         };
         r.map_err(|e| format!("--set {s}: {e}"))?;
     }

@@ -213,7 +213,7 @@ fn print_contacts(world: &World, max_depth: f64, overlap: &OverlapSummary) {
         // Large impact islands (MODELS §7.7): how often the sweep budget and its passive fallback
         // acted, so a user sees when restitution in a pile was cut.
         println!(
-            "large impact islands: {} solved ({} row updates); {} solver phases stopped by the sweep budget ([contact] impact_sweeps), {} of them given fewer sweeps by the sample's row budget ([contact] impact_rows); {} with restitution scaled down to stay passive",
+            "large impact islands: {} solved ({} row updates); {} solver phases stopped by the sweep budget ([contact] impact_sweeps), {} of them given fewer sweeps by the sample's row budget ([contact] impact_budget); {} with restitution scaled down to stay passive",
             budget.islands, budget.row_updates, budget.phases_cut, budget.phases_capped, budget.restitution_scaled
         );
     }
@@ -226,7 +226,7 @@ fn print_contacts(world: &World, max_depth: f64, overlap: &OverlapSummary) {
 /// many samples, the budget, and the row updates run; `None` when it never cut.
 pub(crate) fn chain_budget_line(world: &World) -> Option<String> {
     let d = world.chain_damper();
-    let budget = world.params.chain_budget.row_updates(world.params.dt);
+    let budget = world.params.chain_row_updates();
     (d.budget_cuts > 0).then(|| {
         format!(
             "chain damper: sweeps stopped by the work budget ([world] chain_budget, {} row updates a sample) in {} samples; {} row updates in all, at most {} in one sample",
@@ -241,7 +241,7 @@ pub(crate) fn chain_budget_line(world: &World) -> Option<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use haptic2d::world::ChainBudget;
+    use haptic2d::contact::WorkBudget;
 
     /// The world of built-in scene `name`.
     fn builtin(name: &str) -> World {
@@ -258,7 +258,7 @@ mod tests {
     #[test]
     fn the_chain_budget_line_counts_the_samples_the_budget_cut() {
         let mut w = builtin("pile:100");
-        w.params.chain_budget = ChainBudget::RowUpdates(1);
+        w.params.chain_budget = WorkBudget::RowUpdates(1);
         let mut cut = 0;
         for _ in 0..300 {
             w.step();

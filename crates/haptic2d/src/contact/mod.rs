@@ -15,11 +15,13 @@ mod record;
 pub mod solver;
 #[cfg(test)]
 mod test_pile;
+mod work_budget;
 
 pub use god_object::entry_point;
 pub use impact_friction::{default_impact_mu, ImpactFriction};
 pub use manager::{ContactSet, PastPoses, Wrench2};
-pub use params::{ContactParams, DEFAULT_IMPACT_ROWS_PER_MS, DEFAULT_IMPACT_SWEEPS};
+pub use params::{ContactParams, DEFAULT_IMPACT_SWEEPS, IMPACT_ROW_UPDATES_PER_S};
 pub use record::{
     ContactEvent, ContactState, EventKind, LawState, Loaded, LoadedContact, VeContact, NO_LAW,
 };
+pub use work_budget::WorkBudget;

@@ -1,5 +1,7 @@
 //! Parameters of the contact state machine (§8.2) and of impacts (§7).
 
+use super::WorkBudget;
+
 /// Thresholds and options of the contact pipeline.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ContactParams {
@@ -42,20 +44,19 @@ pub struct ContactParams {
     /// the limit of §7.3 (before issue 42's budget).
     pub impact_sweeps: u32,
     /// Row updates the sparse path's projected Gauss–Seidel may run in one sample, over all its
-    /// islands and phases (docs/MODELS.md §7.7, issue 42): `None` (default) derives it from the
-    /// sample period, [`DEFAULT_IMPACT_ROWS_PER_MS`] per millisecond
-    /// ([`ContactParams::impact_row_budget`]); `Some(0)` leaves it unbounded (only
-    /// `impact_sweeps` bounds a phase); `Some(n)` is `n` row updates. A phase whose island does
-    /// not fit what is left runs `⌊left / rows⌋` sweeps, at least one.
-    pub impact_rows: Option<u64>,
+    /// islands and phases (docs/MODELS.md §7.7, issue 42): by default derived from the sample
+    /// period, [`IMPACT_ROW_UPDATES_PER_S`] ([`ContactParams::impact_row_budget`]). A phase whose
+    /// island does not fit what is left runs `⌊left / rows⌋` sweeps, at least one.
+    pub impact_budget: WorkBudget,
 }
 
-/// Row updates of the sparse impact solve per millisecond of the sample period (§7.7): at 1 kHz
+/// Row updates of the sparse impact solve per second of the sample period (§7.7), 12 000 per
+/// millisecond: at 1 kHz
 /// an impact sample's sweeps may cost about 1.1 M instructions (about 90 a row update,
 /// callgrind), a quarter of a settled pile:1000 step's 4.5–5 M, so that the landing's worst
 /// samples stay near twice a settled one (docs/PERFORMANCE.md, session 30). Scales with the
 /// period: a real-time loop at 500 Hz has twice the time for a sample.
-pub const DEFAULT_IMPACT_ROWS_PER_MS: f64 = 12_000.0;
+pub const IMPACT_ROW_UPDATES_PER_S: f64 = 12.0e6;
 
 /// Default sweep budget of a large island's impact phases (§7.7): the two phases together get
 /// the chain damper's default of 16 sweeps, so an impact sample's solve costs about `2 × 8` row
@@ -79,23 +80,17 @@ impl Default for ContactParams {
             impact_mu: None,
             impact_surface_offset: true,
             impact_sweeps: DEFAULT_IMPACT_SWEEPS,
-            impact_rows: None,
+            impact_budget: WorkBudget::FromPeriod,
         }
     }
 }
 
 impl ContactParams {
     /// The sparse impact solve's row updates for a sample of period `dt` (s), `u64::MAX` when
-    /// unbounded (§7.7): `impact_rows` if set (0 = unbounded), else
-    /// `⌊DEFAULT_IMPACT_ROWS_PER_MS × dt / 1 ms⌋`, at least 1.
+    /// unbounded (§7.7): [`impact_budget`](Self::impact_budget) at this period.
     pub fn impact_row_budget(&self, dt: f64) -> u64 {
-        match self.impact_rows {
-            Some(0) => u64::MAX,
-            Some(n) => n,
-            None if dt.is_finite() && dt > 0.0 => {
-                ((DEFAULT_IMPACT_ROWS_PER_MS * dt * 1e3).floor() as u64).max(1)
-            }
-            None => u64::MAX,
-        }
+        (self.impact_budget)
+            .row_updates(dt, IMPACT_ROW_UPDATES_PER_S)
+            .unwrap_or(u64::MAX)
     }
 }

@@ -96,7 +96,7 @@ pub struct ContactSection {
     pub impact_sweeps: Option<u32>,
     /// Row updates of the large islands' impact solve per sample, over all islands and phases
     /// (0 = unbounded; default 12 000 per millisecond of the sample period; docs/MODELS.md §7.7).
-    pub impact_rows: Option<u64>,
+    pub impact_budget: Option<u64>,
 }
 
 /// `[[body]]`.

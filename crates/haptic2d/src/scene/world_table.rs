@@ -8,8 +8,9 @@ use super::bounds::{
 use super::file::{ContactSection, WorldSection};
 use super::SceneError;
 use crate::contact::ContactParams;
+use crate::contact::WorkBudget;
 use crate::integrate::IntegrationMode;
-use crate::world::{ChainBudget, WorldParams};
+use crate::world::WorldParams;
 
 /// `[world]`: the rate (Hz) and the world's numerical parameters. Returns them and whether the
 /// rate was valid (an invalid one is reported and replaced by 500 Hz so the other tables can still
@@ -104,7 +105,7 @@ pub(super) fn world_params(
         params.chain_sweeps = n.min(MAX_CHAIN_SWEEPS);
     }
     if let Some(n) = w.chain_budget {
-        params.chain_budget = ChainBudget::from_setting(n);
+        params.chain_budget = WorkBudget::from_setting(n);
     }
     let margin_needed = 2.0 * 1.0 * dt * params.proximity_every as f64 + params.delta_c;
     if params.delta_prox < margin_needed {
@@ -206,8 +207,8 @@ pub(super) fn contact_params(
         }
         cp.impact_sweeps = n.clamp(1, 200);
     }
-    if let Some(n) = c.impact_rows {
-        cp.impact_rows = Some(n);
+    if let Some(n) = c.impact_budget {
+        cp.impact_budget = WorkBudget::from_setting(n);
     }
     cp
 }

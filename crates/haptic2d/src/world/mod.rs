@@ -21,9 +21,7 @@ mod step;
 mod swept;
 
 pub use context::StepContext;
-pub use params::{
-    ChainBudget, WorldParams, CHAIN_BUDGET_SHARE, CHAIN_ROW_UPDATES_PER_S, CHAIN_ROW_UPDATE_NS,
-};
+pub use params::{WorldParams, CHAIN_BUDGET_SHARE, CHAIN_ROW_UPDATES_PER_S, CHAIN_ROW_UPDATE_NS};
 
 use crate::body::Body;
 use crate::collide::{mark_seams, speed_limit, Collider, LocalStage};

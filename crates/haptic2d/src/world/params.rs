@@ -1,5 +1,7 @@
 //! The rates, margins and options of a world ([`WorldParams`]).
 
+use crate::contact::WorkBudget;
+
 use crate::contact::solver::{DEFAULT_CHAIN_SWEEPS, DEFAULT_CHAIN_TAU};
 use crate::contact::ContactParams;
 use crate::integrate::IntegrationMode;
@@ -41,8 +43,8 @@ pub struct WorldParams {
     pub chain_sweeps: u32,
     /// Work budget of the chain damper per sample, in row updates (whole sweeps, the first always
     /// runs; MODELS §6.7): by default derived from the sample period `dt`
-    /// ([`ChainBudget::FromPeriod`]).
-    pub chain_budget: ChainBudget,
+    /// ([`WorkBudget::FromPeriod`]).
+    pub chain_budget: WorkBudget,
 }
 
 /// Share of the sample period the chain damper's sweeps may take by default (dimensionless):
@@ -58,41 +60,12 @@ pub const CHAIN_ROW_UPDATE_NS: f64 = 7.0;
 /// `CHAIN_BUDGET_SHARE / (CHAIN_ROW_UPDATE_NS · 1e-9)`.
 pub const CHAIN_ROW_UPDATES_PER_S: f64 = CHAIN_BUDGET_SHARE / (CHAIN_ROW_UPDATE_NS * 1e-9);
 
-/// The chain damper's work budget per sample, in row updates (one row update: one projected
-/// Gauss–Seidel update of one chain contact, MODELS §6.7). The sweeps stop before a whole sweep
-/// that would take the sample past the budget; the first sweep always runs. Any number of
-/// sweeps is passive, so a cut sample only leaves `F ≠ −B_c·v⁺` in that sample.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum ChainBudget {
-    /// `round(dt × CHAIN_ROW_UPDATES_PER_S)` row updates, `dt` the sample period (s): a fixed
-    /// share of the period at the measured cost of a row update (the default).
-    #[default]
-    FromPeriod,
-    /// At most this many row updates per sample (and always the first sweep).
-    RowUpdates(u64),
-    /// No budget: the sweeps stop at `chain_sweeps` or once converged.
-    Unbounded,
-}
-
-impl ChainBudget {
-    /// The budget a setting `n` names (`[world] chain_budget = n`, the bench's
-    /// `--set world.chain_budget=n`): 0 = [`Unbounded`](Self::Unbounded), else `n` row updates.
-    pub fn from_setting(n: u64) -> Self {
-        if n == 0 {
-            Self::Unbounded
-        } else {
-            Self::RowUpdates(n)
-        }
-    }
-
-    /// Row updates allowed per sample at sample period `dt` (s); `None` = unbounded. A period
-    /// that is NaN or not positive gives 0 (one sweep a sample).
-    pub fn row_updates(self, dt: f64) -> Option<u64> {
-        match self {
-            Self::FromPeriod => Some((dt * CHAIN_ROW_UPDATES_PER_S).round().max(0.0) as u64),
-            Self::RowUpdates(n) => Some(n),
-            Self::Unbounded => None,
-        }
+impl WorldParams {
+    /// The chain damper's row updates per sample (`None` = unbounded): [`chain_budget`](Self::chain_budget)
+    /// at this period, [`CHAIN_ROW_UPDATES_PER_S`] by default.
+    pub fn chain_row_updates(&self) -> Option<u64> {
+        self.chain_budget
+            .row_updates(self.dt, CHAIN_ROW_UPDATES_PER_S)
     }
 }
 
@@ -110,7 +83,7 @@ impl Default for WorldParams {
             contact: ContactParams::default(),
             chain_tau: Some(DEFAULT_CHAIN_TAU),
             chain_sweeps: DEFAULT_CHAIN_SWEEPS,
-            chain_budget: ChainBudget::FromPeriod,
+            chain_budget: WorkBudget::FromPeriod,
         }
     }
 }

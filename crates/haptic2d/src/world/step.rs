@@ -209,7 +209,7 @@ impl World {
             self.ledger.chain_damping_loss += self.chain.apply(
                 self.params.chain_tau,
                 self.params.chain_sweeps,
-                self.params.chain_budget.row_updates(self.params.dt),
+                self.params.chain_row_updates(),
                 self.params.dt,
                 self.contacts.loaded(),
                 &mut self.bodies,

@@ -211,25 +211,25 @@ fn a_sample_row_budget_gives_each_phase_the_sweeps_that_fit() {
 }
 
 /// The sample's row budget by default follows the sample period: 12 000 row updates per
-/// millisecond (§7.7); `[contact] impact_rows` sets it, 0 leaving it unbounded.
+/// millisecond (§7.7); `[contact] impact_budget` sets it, 0 leaving it unbounded.
 #[test]
 fn the_impact_row_budget_follows_the_sample_period() {
-    use haptic2d::contact::{ContactParams, DEFAULT_IMPACT_ROWS_PER_MS};
+    use haptic2d::contact::{ContactParams, WorkBudget, IMPACT_ROW_UPDATES_PER_S};
     use haptic2d::scene::Scene;
     let p = ContactParams::default();
-    assert_eq!(DEFAULT_IMPACT_ROWS_PER_MS, 12_000.0);
+    assert_eq!(IMPACT_ROW_UPDATES_PER_S, 12.0e6);
     assert_eq!(p.impact_row_budget(1e-3), 12_000);
     assert_eq!(p.impact_row_budget(2e-3), 24_000);
     assert_eq!(p.impact_row_budget(1e-6), 12);
-    assert_eq!(p.impact_row_budget(1e-9), 1);
+    assert_eq!(p.impact_row_budget(f64::NAN), 0);
     let off = ContactParams {
-        impact_rows: Some(0),
+        impact_budget: WorkBudget::from_setting(0),
         ..p
     };
     assert_eq!(off.impact_row_budget(1e-3), u64::MAX);
     let wall = crate::shared::WALL_TOML;
-    let text = format!("[contact]\nimpact_rows = 500\n{wall}");
-    let s = Scene::from_toml(&text, "t.toml", None).expect("impact_rows = 500");
+    let text = format!("[contact]\nimpact_budget = 500\n{wall}");
+    let s = Scene::from_toml(&text, "t.toml", None).expect("impact_budget = 500");
     assert_eq!(s.world.params.contact.impact_row_budget(1e-3), 500);
 }
 
@@ -241,14 +241,14 @@ fn a_landing_pile_with_a_tight_row_budget_creates_no_energy() {
         .unwrap()
         .unwrap()
         .world;
-    w.params.contact.impact_rows = Some(60);
+    w.params.contact.impact_budget = haptic2d::contact::WorkBudget::RowUpdates(60);
     let mut worst = f64::NEG_INFINITY;
     for _ in 0..1500 {
         w.step();
         worst = worst.max(w.ledger().excess());
     }
     let c = w.contacts().impact_budget();
-    eprintln!("pile:100, impact_rows = 60, 1.5 s: {c:?}; ledger excess at most {worst:e} J");
+    eprintln!("pile:100, impact_budget = 60, 1.5 s: {c:?}; ledger excess at most {worst:e} J");
     assert!(c.islands > 0 && c.phases_capped > 0, "{c:?}");
     assert!(worst <= 1e-9, "ledger excess {worst} J");
 }

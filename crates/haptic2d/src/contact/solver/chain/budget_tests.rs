@@ -192,14 +192,30 @@ fn a_budget_cut_is_exactly_a_smaller_sweep_limit() {
 /// 500 Hz 57 142.9, rounded 57 143; 0 turns it off; a set number is taken as it is.
 #[test]
 fn the_default_budget_is_a_share_of_the_period() {
-    use crate::world::{ChainBudget, CHAIN_BUDGET_SHARE, CHAIN_ROW_UPDATE_NS};
+    use crate::contact::WorkBudget;
+    use crate::world::{CHAIN_BUDGET_SHARE, CHAIN_ROW_UPDATE_NS};
     assert_eq!((CHAIN_BUDGET_SHARE, CHAIN_ROW_UPDATE_NS), (0.2, 7.0));
-    assert_eq!(ChainBudget::default(), ChainBudget::FromPeriod);
-    assert_eq!(ChainBudget::FromPeriod.row_updates(1e-3), Some(28_571));
-    assert_eq!(ChainBudget::FromPeriod.row_updates(2e-3), Some(57_143));
-    assert_eq!(ChainBudget::FromPeriod.row_updates(f64::NAN), Some(0));
-    assert_eq!(ChainBudget::from_setting(0).row_updates(1e-3), None);
-    assert_eq!(ChainBudget::from_setting(7).row_updates(1e-3), Some(7));
+    assert_eq!(WorkBudget::default(), WorkBudget::FromPeriod);
+    assert_eq!(
+        WorkBudget::FromPeriod.row_updates(1e-3, crate::world::CHAIN_ROW_UPDATES_PER_S),
+        Some(28_571)
+    );
+    assert_eq!(
+        WorkBudget::FromPeriod.row_updates(2e-3, crate::world::CHAIN_ROW_UPDATES_PER_S),
+        Some(57_143)
+    );
+    assert_eq!(
+        WorkBudget::FromPeriod.row_updates(f64::NAN, crate::world::CHAIN_ROW_UPDATES_PER_S),
+        Some(0)
+    );
+    assert_eq!(
+        WorkBudget::from_setting(0).row_updates(1e-3, crate::world::CHAIN_ROW_UPDATES_PER_S),
+        None
+    );
+    assert_eq!(
+        WorkBudget::from_setting(7).row_updates(1e-3, crate::world::CHAIN_ROW_UPDATES_PER_S),
+        Some(7)
+    );
 }
 
 /// A landing pile (pile:100 thrown down at 1 m/s, then shoved sideways) under small budgets: no
@@ -209,13 +225,13 @@ fn the_default_budget_is_a_share_of_the_period() {
 #[test]
 fn a_landing_pile_keeps_every_samples_row_updates_within_the_budget() {
     use crate::contact::test_pile::shove;
-    use crate::world::ChainBudget;
+    use crate::contact::WorkBudget;
     for budget in [1u64, 500, 2000] {
         let mut w = crate::scene::builtin("pile:100", None)
             .unwrap()
             .unwrap()
             .world;
-        w.params.chain_budget = ChainBudget::RowUpdates(budget);
+        w.params.chain_budget = WorkBudget::RowUpdates(budget);
         for b in w.bodies.iter_mut().filter(|b| b.inv_mass > 0.0) {
             b.vel.y -= 1.0;
         }
@@ -257,32 +273,29 @@ fn a_landing_pile_keeps_every_samples_row_updates_within_the_budget() {
 /// it off; a negative value is refused.
 #[test]
 fn a_scene_sets_the_chain_budget_or_takes_it_from_its_rate() {
+    use crate::contact::WorkBudget;
     use crate::scene::Scene;
-    use crate::world::ChainBudget;
     const WALL: &str = "[[body]]\nname = \"wall\"\nkind = \"fixed\"\npolygon = [[-0.1, -0.2], [0.0, -0.2], [0.0, 0.2], [-0.1, 0.2]]\n";
     let budget_of = |world: &str| {
         let p = Scene::from_toml(&format!("[world]\n{world}\n{WALL}"), "t.toml", None)
             .expect("a valid scene")
             .world
             .params;
-        (p.chain_budget, p.chain_budget.row_updates(p.dt))
+        (p.chain_budget, p.chain_row_updates())
     };
     assert_eq!(
         budget_of("rate = 1000"),
-        (ChainBudget::FromPeriod, Some(28_571))
+        (WorkBudget::FromPeriod, Some(28_571))
     );
     assert_eq!(
         budget_of("rate = 500"),
-        (ChainBudget::FromPeriod, Some(57_143))
+        (WorkBudget::FromPeriod, Some(57_143))
     );
     assert_eq!(
         budget_of("rate = 1000\nchain_budget = 5000"),
-        (ChainBudget::RowUpdates(5000), Some(5000))
+        (WorkBudget::RowUpdates(5000), Some(5000))
     );
-    assert_eq!(
-        budget_of("chain_budget = 0"),
-        (ChainBudget::Unbounded, None)
-    );
+    assert_eq!(budget_of("chain_budget = 0"), (WorkBudget::Unbounded, None));
     let text = format!("[world]\nchain_budget = -1\n{WALL}");
     assert!(Scene::from_toml(&text, "t.toml", None).is_err());
 }

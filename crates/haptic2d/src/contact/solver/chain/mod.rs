@@ -38,7 +38,7 @@
 //! `a_budget_cut_is_exactly_a_smaller_sweep_limit`). What it costs: a cut sample has not
 //! converged, so `F ≠ −B_c·v⁺` in that sample (it removes less energy than the converged solve;
 //! its impulses warm-start the next sample). The default is derived from the sample period
-//! (`ChainBudget::FromPeriod`).
+//! (`WorkBudget::FromPeriod`).
 //!
 //! **Choice of τ and sweeps** (pile:1000 at 1 kHz, `haptic2d-bench --settle 6 --every 0.25 (or
 //! 0.05) --set world.chain_tau=τ,world.chain_sweeps=S`; "at rest from" = the first check after
