@@ -280,10 +280,11 @@ fn print_budget_cuts(world: &haptic2d::world::World) {
         crate::outln!("  {line}");
     }
     let impacts = world.contacts().impact_budget();
-    if impacts.phases_cut > 0 {
+    if impacts.phases_cut > 0 || impacts.phases_capped > 0 {
         crate::outln!(
-            "  impact solver: {} phases stopped by the sweep budget ([contact] impact_sweeps)",
-            impacts.phases_cut
+            "  impact solver: {} phases stopped by the sweep budget ([contact] impact_sweeps), {} given fewer sweeps by the sample's row budget ([contact] impact_budget)",
+            impacts.phases_cut,
+            impacts.phases_capped
         );
     }
 }
