@@ -289,6 +289,30 @@ fn print_budget_cuts(world: &haptic2d::world::World) {
     }
 }
 
+/// After a host-side stall of a `SCHED_FIFO` loop: whether the kernel's real-time throttling
+/// explains it (`haptic2d_rt::throttle`).
+fn print_throttle_hint(reason: &SafetyReason, summary: &TimingSummary) {
+    let fifo = summary
+        .rt
+        .as_ref()
+        .is_some_and(|r| r.scheduler.is_applied());
+    if let SafetyReason::Stall {
+        elapsed,
+        device_wait,
+        ..
+    } = reason
+    {
+        let host = elapsed - device_wait.max(0.0);
+        if let Some(note) = fifo
+            .then(haptic2d_rt::throttle::rt_limit)
+            .flatten()
+            .and_then(|l| haptic2d_rt::throttle::hint(host, Some(l)))
+        {
+            crate::outln!("{note}");
+        }
+    }
+}
+
 /// The line that starts a run: scene, device and where its parameters came from, controller,
 /// hand, rate and duration.
 fn print_banner(a: &RunArgs, rig: &Rig, scene_name: &str, origin: &str, hand_name: &str) {
@@ -612,6 +636,7 @@ fn report(
         if !lost_reading {
             crate::outln!("{trip}");
         }
+        print_throttle_hint(&trip.reason, summary);
     }
     let (status, why) = end_status(end.as_ref(), interrupted);
     if let Some(why) = why {

@@ -31,6 +31,7 @@ pub mod signal;
 pub mod sim_io;
 pub mod stats;
 pub mod telemetry;
+pub mod throttle;
 pub mod tick_log;
 pub mod watchdog;
 
