@@ -44,9 +44,11 @@ pub struct ContactParams {
     /// the limit of §7.3 (before issue 42's budget).
     pub impact_sweeps: u32,
     /// Row updates the sparse path's projected Gauss–Seidel may run in one sample, over all its
-    /// islands and phases (docs/MODELS.md §7.7, issue 42): by default derived from the sample
-    /// period, [`IMPACT_ROW_UPDATES_PER_S`] ([`ContactParams::impact_row_budget`]). A phase whose
-    /// island does not fit what is left runs `⌊left / rows⌋` sweeps, at least one.
+    /// islands and phases (docs/MODELS.md §7.7, issue 42): by default unbounded (a budget cut
+    /// short the impacts of pile:5000's collapse and made it bounce, §7.7); `FromPeriod` derives
+    /// it from the sample period at [`IMPACT_ROW_UPDATES_PER_S`]
+    /// ([`ContactParams::impact_row_budget`]). A phase whose island does not fit what is left runs
+    /// `⌊left / rows⌋` sweeps, at least one.
     pub impact_budget: WorkBudget,
 }
 
@@ -80,7 +82,7 @@ impl Default for ContactParams {
             impact_mu: None,
             impact_surface_offset: true,
             impact_sweeps: DEFAULT_IMPACT_SWEEPS,
-            impact_budget: WorkBudget::FromPeriod,
+            impact_budget: WorkBudget::Unbounded,
         }
     }
 }

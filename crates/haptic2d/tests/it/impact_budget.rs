@@ -210,13 +210,17 @@ fn a_sample_row_budget_gives_each_phase_the_sweeps_that_fit() {
     }
 }
 
-/// The sample's row budget by default follows the sample period: 12 000 row updates per
-/// millisecond (§7.7); `[contact] impact_budget` sets it, 0 leaving it unbounded.
+/// The sample's row budget is off by default; derived from the period it is 12 000 row updates
+/// per millisecond (§7.7); `[contact] impact_budget` sets it, 0 leaving it unbounded.
 #[test]
 fn the_impact_row_budget_follows_the_sample_period() {
     use haptic2d::contact::{ContactParams, WorkBudget, IMPACT_ROW_UPDATES_PER_S};
     use haptic2d::scene::Scene;
-    let p = ContactParams::default();
+    assert_eq!(ContactParams::default().impact_row_budget(1e-3), u64::MAX);
+    let p = ContactParams {
+        impact_budget: WorkBudget::FromPeriod,
+        ..ContactParams::default()
+    };
     assert_eq!(IMPACT_ROW_UPDATES_PER_S, 12.0e6);
     assert_eq!(p.impact_row_budget(1e-3), 12_000);
     assert_eq!(p.impact_row_budget(2e-3), 24_000);
