@@ -141,17 +141,7 @@ fn impact_sweeps_scene_field_is_checked() {
 /// energy created (excess ≤ 0; measured −9.6e-3 J).
 #[test]
 fn a_landing_pile_with_a_tight_budget_creates_no_energy() {
-    let mut w = haptic2d::scene::builtin("pile:100", None)
-        .unwrap()
-        .unwrap()
-        .world;
-    w.params.contact.impact_sweeps = 2;
-    let mut worst = f64::NEG_INFINITY;
-    for _ in 0..1500 {
-        w.step();
-        worst = worst.max(w.ledger().excess());
-    }
-    let c = w.contacts().impact_budget();
+    let (c, worst) = land_pile_100(|p| p.impact_sweeps = 2);
     eprintln!("pile:100, impact_sweeps = 2, 1.5 s: {c:?}; ledger excess at most {worst:e} J");
     assert!(c.islands > 0 && c.phases_cut > 0, "{c:?}");
     assert!(worst <= 1e-9, "ledger excess {worst} J");
@@ -241,18 +231,27 @@ fn the_impact_row_budget_follows_the_sample_period() {
 /// sweeps than `impact_sweeps` and the ledger shows no energy created.
 #[test]
 fn a_landing_pile_with_a_tight_row_budget_creates_no_energy() {
+    let (c, worst) =
+        land_pile_100(|p| p.impact_budget = haptic2d::contact::WorkBudget::RowUpdates(60));
+    eprintln!("pile:100, impact_budget = 60, 1.5 s: {c:?}; ledger excess at most {worst:e} J");
+    assert!(c.islands > 0 && c.phases_capped > 0, "{c:?}");
+    assert!(worst <= 1e-9, "ledger excess {worst} J");
+}
+
+/// pile:100 landing for 1.5 s with its contact parameters changed by `set`: the impact budget's
+/// counters and the largest excess of the world's energy ledger (J) over the run.
+fn land_pile_100(
+    set: impl FnOnce(&mut haptic2d::contact::ContactParams),
+) -> (haptic2d::contact::impact::BudgetCounters, f64) {
     let mut w = haptic2d::scene::builtin("pile:100", None)
         .unwrap()
         .unwrap()
         .world;
-    w.params.contact.impact_budget = haptic2d::contact::WorkBudget::RowUpdates(60);
+    set(&mut w.params.contact);
     let mut worst = f64::NEG_INFINITY;
     for _ in 0..1500 {
         w.step();
         worst = worst.max(w.ledger().excess());
     }
-    let c = w.contacts().impact_budget();
-    eprintln!("pile:100, impact_budget = 60, 1.5 s: {c:?}; ledger excess at most {worst:e} J");
-    assert!(c.islands > 0 && c.phases_capped > 0, "{c:?}");
-    assert!(worst <= 1e-9, "ledger excess {worst} J");
+    (w.contacts().impact_budget(), worst)
 }
