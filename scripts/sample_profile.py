@@ -4,7 +4,8 @@
 `haptic2d-bench`'s phase table times the steps on a clock, which a shared machine's load
 inflates. This reads callgrind's instruction counts instead, one dump per world step
 (`--dump-before` at `World::begin_step`), and prints the median and the worst 1 % of a range of
-steps, each with the functions that cost them (self instructions, inlined code included). The
+steps, and the functions that cost them (self instructions, inlined code included) averaged over
+the steps near the median (the middle 10 %) and over the worst 1 %. The
 summary's overlap report (`max_overlap`, not the step) is left out.
 
 Usage (docs/PERFORMANCE.md, session 30):
@@ -94,7 +95,7 @@ def main():
         return {f: v / len(group) for f, v in c.items()}
 
     m, w = mean(middle), mean(worst)
-    print(f"{'function (self, M instructions a step)':<72} {'median':>8} {'worst1%':>8}")
+    print(f"{'function (self, M instructions a step)':<72} {'mid 10%':>8} {'worst1%':>8}")
     for f in sorted(set(m) | set(w), key=lambda f: -w.get(f, 0))[: a.top]:
         print(f"{f:<72} {m.get(f, 0) / 1e6:>8.3f} {w.get(f, 0) / 1e6:>8.3f}")
 

@@ -58,7 +58,7 @@ pub fn apply(w: &mut World, sets: &[String]) -> Result<(), String> {
                 w.params.contact.impact_budget = WorkBudget::from_setting(v as u64);
                 Ok(())
             }
-            _ => Err("expected normal.KEY, friction.KEY, world.{proximity_spread, proximity_skip, chain_tau, chain_sweeps, chain_budget} or contact.{impact_sweeps, impact_budget} (sweeps, budget and rows whole numbers, impact_sweeps 1 to 200, chain_budget and impact_budget 0 = unbounded)".into()),
+            _ => Err("expected normal.KEY, friction.KEY, world.{proximity_spread, proximity_skip, chain_tau, chain_sweeps, chain_budget} or contact.{impact_sweeps, impact_budget} (sweeps and budgets whole numbers, impact_sweeps 1 to 200, chain_budget and impact_budget 0 = unbounded)".into()),
         };
         r.map_err(|e| format!("--set {s}: {e}"))?;
     }

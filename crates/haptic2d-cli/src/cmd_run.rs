@@ -303,11 +303,8 @@ fn print_throttle_hint(reason: &SafetyReason, summary: &TimingSummary) {
     } = reason
     {
         let host = elapsed - device_wait.max(0.0);
-        if let Some(note) = fifo
-            .then(haptic2d_rt::throttle::rt_limit)
-            .flatten()
-            .and_then(|l| haptic2d_rt::throttle::hint(host, Some(l)))
-        {
+        let limit = fifo.then(haptic2d_rt::throttle::rt_limit).flatten();
+        if let Some(note) = haptic2d_rt::throttle::hint(host, limit) {
             crate::outln!("{note}");
         }
     }

@@ -3,10 +3,11 @@
 //! The kernel lets `SCHED_FIFO` threads run `kernel.sched_rt_runtime_us` out of every
 //! `kernel.sched_rt_period_us` (950 000 of 1 000 000 by default): a loop thread whose ticks keep
 //! overrunning never sleeps, reaches the limit and is stopped for the rest of the period (50 ms),
-//! longer than a 1 kHz loop's stall limit. On the development machine `haptic2d run pile:1000`
-//! stopped this way 1.5–3 s into the landing with stalls of 41.8–49 ms whenever the machine ran
-//! slow (compute p50 600–700 µs against 350 µs): the stall is the throttle, not the machine's
-//! other programs. [`hint`] names it after the loop has stopped (never on the hot path).
+//! longer than a 1 kHz loop's stall limit. On the development machine, while the VM ran slow
+//! (compute p50 540–700 µs against 350 µs), six of nine `haptic2d run pile:1000` runs stopped
+//! 1.9–5.0 s in, with nothing else running; the three stop messages kept name host-side stalls
+//! of 41.8–49.0 ms, within the throttle's 50 ms. The throttle fits these stalls; it was not
+//! proven to cause them. [`hint`] names it after the loop has stopped (never on the hot path).
 
 use std::path::Path;
 

@@ -5,12 +5,14 @@
 //! passive; counting row updates, not time, keeps the result independent of the machine.
 
 /// A per-sample budget of row updates (one row update: one projected Gauss–Seidel update of one
-/// row). By default it is derived from the sample period, at a rate each solve sets, so a
-/// real-time loop at a longer period gets proportionally more work per sample.
+/// row). `FromPeriod` derives it from the sample period, at a rate each solve sets, so a
+/// real-time loop at a longer period gets proportionally more work per sample. Each solve's
+/// parameter has its own default (the chain damper's `FromPeriod`, the impact islands'
+/// `Unbounded`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum WorkBudget {
     /// `round(dt × rate)` row updates, `dt` the sample period (s) and `rate` the solve's row
-    /// updates per second of period (the default).
+    /// updates per second of period (the type's `Default`).
     #[default]
     FromPeriod,
     /// At most this many row updates per sample (each solve says what it always runs).

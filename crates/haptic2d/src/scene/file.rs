@@ -95,7 +95,7 @@ pub struct ContactSection {
     /// Sweep budget of a large island's impact phases, 1 to 200 (default 8; docs/MODELS.md §7.7).
     pub impact_sweeps: Option<u32>,
     /// Row updates of the large islands' impact solve per sample, over all islands and phases
-    /// (0 = unbounded; default 12 000 per millisecond of the sample period; docs/MODELS.md §7.7).
+    /// (0 = unbounded, the default; docs/MODELS.md §7.7).
     pub impact_budget: Option<u64>,
 }
 

@@ -1,9 +1,7 @@
 //! The rates, margins and options of a world ([`WorldParams`]).
 
-use crate::contact::WorkBudget;
-
 use crate::contact::solver::{DEFAULT_CHAIN_SWEEPS, DEFAULT_CHAIN_TAU};
-use crate::contact::ContactParams;
+use crate::contact::{ContactParams, WorkBudget};
 use crate::integrate::IntegrationMode;
 
 /// Rates, margins and options of a world.

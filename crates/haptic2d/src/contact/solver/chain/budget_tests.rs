@@ -193,27 +193,27 @@ fn a_budget_cut_is_exactly_a_smaller_sweep_limit() {
 #[test]
 fn the_default_budget_is_a_share_of_the_period() {
     use crate::contact::WorkBudget;
-    use crate::world::{CHAIN_BUDGET_SHARE, CHAIN_ROW_UPDATE_NS};
+    use crate::world::{CHAIN_BUDGET_SHARE, CHAIN_ROW_UPDATES_PER_S, CHAIN_ROW_UPDATE_NS};
     assert_eq!((CHAIN_BUDGET_SHARE, CHAIN_ROW_UPDATE_NS), (0.2, 7.0));
     assert_eq!(WorkBudget::default(), WorkBudget::FromPeriod);
     assert_eq!(
-        WorkBudget::FromPeriod.row_updates(1e-3, crate::world::CHAIN_ROW_UPDATES_PER_S),
+        WorkBudget::FromPeriod.row_updates(1e-3, CHAIN_ROW_UPDATES_PER_S),
         Some(28_571)
     );
     assert_eq!(
-        WorkBudget::FromPeriod.row_updates(2e-3, crate::world::CHAIN_ROW_UPDATES_PER_S),
+        WorkBudget::FromPeriod.row_updates(2e-3, CHAIN_ROW_UPDATES_PER_S),
         Some(57_143)
     );
     assert_eq!(
-        WorkBudget::FromPeriod.row_updates(f64::NAN, crate::world::CHAIN_ROW_UPDATES_PER_S),
+        WorkBudget::FromPeriod.row_updates(f64::NAN, CHAIN_ROW_UPDATES_PER_S),
         Some(0)
     );
     assert_eq!(
-        WorkBudget::from_setting(0).row_updates(1e-3, crate::world::CHAIN_ROW_UPDATES_PER_S),
+        WorkBudget::from_setting(0).row_updates(1e-3, CHAIN_ROW_UPDATES_PER_S),
         None
     );
     assert_eq!(
-        WorkBudget::from_setting(7).row_updates(1e-3, crate::world::CHAIN_ROW_UPDATES_PER_S),
+        WorkBudget::from_setting(7).row_updates(1e-3, CHAIN_ROW_UPDATES_PER_S),
         Some(7)
     );
 }
