@@ -167,7 +167,18 @@ pub fn divergence(world: &crate::world::World) -> Option<Divergence> {
     let max_v = MAX_SPEED_M_S * DIVERGENCE_FACTOR;
     let max_w = MAX_OMEGA_RAD_S * DIVERGENCE_FACTOR;
     let max_a = MAX_ANGLE_RAD * DIVERGENCE_FACTOR;
-    for b in &world.bodies {
+    // The common case first, branch-free: a body whose six numbers are all within their bounds
+    // (`|x| ≤ max` fails for NaN and ±inf, as the test below does) needs no message. Called twice
+    // a sample, so a pile:1000 spent 0.17 M instructions a step here with the tuple-array test.
+    let within = |b: &crate::body::Body| {
+        (b.pose.pos.x.abs() <= max_pos)
+            & (b.pose.pos.y.abs() <= max_pos)
+            & (b.pose.angle.abs() <= max_a)
+            & (b.vel.x.abs() <= max_v)
+            & (b.vel.y.abs() <= max_v)
+            & (b.omega.abs() <= max_w)
+    };
+    for b in world.bodies.iter().filter(|b| !within(b)) {
         let checks = [
             ("x", b.pose.pos.x, max_pos, "m"),
             ("y", b.pose.pos.y, max_pos, "m"),

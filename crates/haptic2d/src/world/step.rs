@@ -294,6 +294,45 @@ mod tests {
     }
 
     #[test]
+    fn every_number_of_a_body_beyond_its_bound_or_not_finite_is_a_divergence_and_at_it_is_not() {
+        use crate::scene::bounds::{
+            DIVERGENCE_FACTOR, MAX_ANGLE_RAD, MAX_LENGTH_M, MAX_OMEGA_RAD_S, MAX_SPEED_M_S,
+        };
+        type Field = fn(&mut crate::body::Body) -> &mut f64;
+        let fields: [(&str, Field, f64); 6] = [
+            ("x", |b| &mut b.pose.pos.x, MAX_LENGTH_M),
+            ("y", |b| &mut b.pose.pos.y, MAX_LENGTH_M),
+            ("theta", |b| &mut b.pose.angle, MAX_ANGLE_RAD),
+            ("vx", |b| &mut b.vel.x, MAX_SPEED_M_S),
+            ("vy", |b| &mut b.vel.y, MAX_SPEED_M_S),
+            ("omega", |b| &mut b.omega, MAX_OMEGA_RAD_S),
+        ];
+        let w0 = pile();
+        let last = w0.bodies.len() - 1;
+        for (name, field, bound) in fields {
+            let max = bound * DIVERGENCE_FACTOR;
+            for (x, diverged) in [
+                (max, false),
+                (-max, false),
+                (max * (1.0 + 1e-15), true),
+                (-max * (1.0 + 1e-15), true),
+                (f64::NAN, true),
+                (f64::INFINITY, true),
+                (f64::NEG_INFINITY, true),
+            ] {
+                let mut w = w0.clone();
+                *field(&mut w.bodies[last]) = x;
+                let d = crate::scene::divergence(&w);
+                assert_eq!(d.is_some(), diverged, "{name} = {x}: {d:?}");
+                if let Some(d) = d {
+                    assert_eq!(d.body.as_deref(), Some(w.bodies[last].name.as_str()));
+                    assert!(d.what.starts_with(&format!("{name} = ")), "{d}");
+                }
+            }
+        }
+    }
+
+    #[test]
     fn a_runaway_speed_beyond_the_divergence_bound_is_reported_by_the_step() {
         // The bound is the input bound × 1e3 (scene/bounds.rs): 1e3 m/s × 1e3 = 1e6 m/s.
         let mut w = pile();

@@ -27,6 +27,7 @@ mod fixed_body_velocity;
 mod fuzz_scene;
 mod haptic_loop;
 mod haptic_no_alloc;
+mod haptic_prime;
 mod impact_budget;
 mod impact_friction;
 mod impact_friction_no_alloc;
