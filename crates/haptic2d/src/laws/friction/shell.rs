@@ -38,7 +38,7 @@ pub(crate) fn engage(s_a: &mut f64, engaged: &mut bool, mode: &mut FrictionMode,
 }
 
 /// Implements [`FrictionLaw`](super::FrictionLaw) for a [`LoadedFriction`] `$ty` with a field
-/// `mode: FrictionMode`.
+/// `mode: FrictionMode`. A sample with `F_n ≤ 0` or a NaN `F_n` is unloaded.
 macro_rules! friction_law {
     ($ty:ident) => {
         impl $crate::laws::friction::FrictionLaw for $ty {
@@ -52,11 +52,13 @@ macro_rules! friction_law {
             }
             #[inline(always)]
             fn update(&mut self, input: &$crate::laws::friction::FrictionInput) -> f64 {
-                if input.fn_ <= 0.0 {
-                    self.reset();
-                    return 0.0;
+                // Loaded only when `F_n > 0`: a NaN load (a world about to be stopped as
+                // diverged) is no load, rather than a panic in the models' clamps.
+                if input.fn_ > 0.0 {
+                    return $crate::laws::friction::shell::LoadedFriction::loaded(self, input);
                 }
-                $crate::laws::friction::shell::LoadedFriction::loaded(self, input)
+                self.reset();
+                0.0
             }
             fn stored_energy(&self) -> f64 {
                 $crate::laws::friction::shell::LoadedFriction::spring_energy(self)
@@ -71,3 +73,33 @@ macro_rules! friction_law {
     };
 }
 pub(crate) use friction_law;
+
+#[cfg(test)]
+mod tests {
+    use crate::laws::friction::{FrictionInput, FrictionLaw, FrictionModel};
+
+    fn input(fn_: f64) -> FrictionInput {
+        FrictionInput {
+            ds: 1e-4,
+            s: 0.01,
+            s0: 0.1,
+            fn_,
+            dt: 1e-3,
+            f_ext_t: 0.5,
+        }
+    }
+
+    #[test]
+    fn a_nan_normal_force_unloads_every_friction_model_instead_of_panicking() {
+        for name in FrictionModel::NAMES {
+            for per_contact in [false, true] {
+                let mut m = FrictionModel::from_name(name, per_contact).unwrap();
+                m.begin(0.0);
+                let loaded = m.update(&input(2.0));
+                assert!(loaded.is_finite(), "{name}: {loaded}");
+                assert_eq!(m.update(&input(f64::NAN)), 0.0, "{name}");
+                assert_eq!(m.stored_energy(), 0.0, "{name}: the state is forgotten");
+            }
+        }
+    }
+}
