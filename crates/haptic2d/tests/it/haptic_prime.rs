@@ -32,7 +32,7 @@ fn a_primed_system_ticks_bit_for_bit_as_an_unprimed_one() {
     let hand = HandModel::Constant {
         wrench: [-1.0, 0.5, 0.0],
     };
-    let mut plain = DeviceInTheLoop::new(system.clone(), hand.clone(), 4, true).unwrap();
+    let mut plain = DeviceInTheLoop::new(system.clone(), hand, 4, true).unwrap();
     let mut early = DeviceInTheLoop::new(primed(system), hand, 4, true).unwrap();
     let w = early.system.world();
     assert!(
