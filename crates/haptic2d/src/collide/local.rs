@@ -682,8 +682,13 @@ impl LocalStage {
     fn assemble(&mut self, fresh: &[VeCandidate], colliders: usize) {
         self.sorted.clear();
         self.from_scan.clear();
-        for c in self.candidates.iter().filter(|c| !c.overflows()) {
-            self.sorted.extend_from_slice(c.get());
+        // Most pairs have none (`get` is empty for an overflowing pair too): they cost a test.
+        for c in &self.candidates {
+            let found = c.get();
+            if found.is_empty() {
+                continue;
+            }
+            self.sorted.extend_from_slice(found);
             self.from_scan.resize(self.sorted.len(), c.scan);
         }
         for &(start, end, scan) in &self.overflow {

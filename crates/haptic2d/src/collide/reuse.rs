@@ -155,12 +155,6 @@ impl PairCandidates {
         Some(r)
     }
 
-    /// Whether the candidates did not fit.
-    #[inline]
-    pub fn overflows(&self) -> bool {
-        self.len == u8::MAX
-    }
-
     /// The candidates (none if they overflowed).
     #[inline]
     pub fn get(&self) -> &[VeCandidate] {
