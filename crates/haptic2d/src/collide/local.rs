@@ -211,16 +211,22 @@ struct RelPose {
 impl RelPose {
     fn of(poses: &[Pose], body_a: u32, body_b: u32) -> RelPose {
         match (poses.get(body_a as usize), poses.get(body_b as usize)) {
-            (Some(a), Some(b)) => RelPose {
-                rel: a.pos - b.pos,
-                angle_a: a.angle,
-                angle_b: b.angle,
-            },
+            (Some(a), Some(b)) => RelPose::between(a, b),
             _ => RelPose {
                 rel: Vec2::splat(f64::NAN),
                 angle_a: f64::NAN,
                 angle_b: f64::NAN,
             },
+        }
+    }
+
+    /// The relative pose of two bodies with poses `a`, `b`.
+    #[inline(always)]
+    fn between(a: &Pose, b: &Pose) -> RelPose {
+        RelPose {
+            rel: a.pos - b.pos,
+            angle_a: a.angle,
+            angle_b: b.angle,
         }
     }
 
@@ -233,6 +239,38 @@ impl RelPose {
             + (self.angle_a - g.angle_a).abs() * g.l_a
             + (self.angle_b - g.angle_b).abs() * g.l_b
     }
+}
+
+impl Gap {
+    /// Whether the gap still holds at the bodies' poses `poses` for contact distance `delta_c`
+    /// (m): `m < clear − δ_c`. False when a body has no pose (`RelPose::of`'s NaN motion).
+    #[inline(always)]
+    fn holds(&self, poses: &[Pose], delta_c: f64) -> bool {
+        match (
+            poses.get(self.body_a as usize),
+            poses.get(self.body_b as usize),
+        ) {
+            (Some(a), Some(b)) => RelPose::between(a, b).moved_since(self) < self.clear - delta_c,
+            _ => false,
+        }
+    }
+}
+
+/// The first of `gaps` at or after `from` that does not [hold](Gap::holds) (`gaps.len()` if
+/// none), with how many before it held and how many of those were reused scans. A loop of its
+/// own: a settled pile skips most of its pairs, and this keeps their test to the gap record and
+/// the two poses, away from the tracking code's registers.
+#[inline(never)]
+fn first_unheld(gaps: &[Gap], from: usize, poses: &[Pose], delta_c: f64) -> (usize, usize, usize) {
+    let (mut held, mut reused) = (0usize, 0usize);
+    for (k, g) in gaps.iter().enumerate().skip(from) {
+        if !g.holds(poses, delta_c) {
+            return (k, held, reused);
+        }
+        held += 1;
+        reused += usize::from(g.reused);
+    }
+    (gaps.len(), held, reused)
 }
 
 impl Default for LocalStage {
@@ -593,19 +631,19 @@ impl LocalStage {
         let mut fresh = std::mem::take(&mut self.fresh);
         fresh.clear();
         self.overflow.clear();
-        for (k, &(ia, ib)) in pairs.iter().enumerate() {
-            // The gap certified at the last tracked sample still holds: nothing to do (a reused
-            // scan's candidates are its last ones).
+        let mut from = 0;
+        loop {
+            // Pairs whose gap certified at the last tracked sample still holds: nothing to do (a
+            // reused scan's candidates are its last ones).
+            let (k, held, reused) = first_unheld(&self.gaps[..pairs.len()], from, poses, delta_c);
+            self.skipped += held - reused;
+            self.reused += reused;
+            let Some(&(ia, ib)) = pairs.get(k) else {
+                break;
+            };
+            from = k + 1;
             let g = self.gaps[k];
             let now = RelPose::of(poses, g.body_a, g.body_b);
-            if now.moved_since(&g) < g.clear - delta_c {
-                if g.reused {
-                    self.reused += 1;
-                } else {
-                    self.skipped += 1;
-                }
-                continue;
-            }
             let (Some(a), Some(b)) = (colliders.get(ia as usize), colliders.get(ib as usize))
             else {
                 continue;
@@ -644,8 +682,13 @@ impl LocalStage {
     fn assemble(&mut self, fresh: &[VeCandidate], colliders: usize) {
         self.sorted.clear();
         self.from_scan.clear();
-        for c in self.candidates.iter().filter(|c| !c.overflows()) {
-            self.sorted.extend_from_slice(c.get());
+        // Most pairs have none (`get` is empty for an overflowing pair too): they cost a test.
+        for c in &self.candidates {
+            let found = c.get();
+            if found.is_empty() {
+                continue;
+            }
+            self.sorted.extend_from_slice(found);
             self.from_scan.resize(self.sorted.len(), c.scan);
         }
         for &(start, end, scan) in &self.overflow {
@@ -908,6 +951,80 @@ mod tests {
                 "seed {seed}: some splices kept the assembled output"
             );
         }
+    }
+
+    /// The held-pair scan stops at exactly the pairs whose gap fails the per-pair test
+    /// (`RelPose::of(..).moved_since(g) < g.clear − δ_c`, what every pair used to run) and
+    /// counts the held ones between, reused scans apart: random gaps against random poses, with
+    /// bodies without a pose (`u32::MAX` too), gaps of 0 (tracked every sample), NaN poses and
+    /// certificates rounded onto their threshold, 200 seeds.
+    #[test]
+    fn held_pair_scan_stops_where_the_per_pair_test_fails() {
+        use rand::{Rng, SeedableRng};
+        let delta_c = DEFAULT_DELTA_C;
+        let (mut held_total, mut on_edge) = (0, 0);
+        for seed in 0..200u64 {
+            let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+            let mut r = |lo: f64, hi: f64| rng.random_range(lo..hi);
+            let mut poses: Vec<Pose> = (0..10)
+                .map(|_| Pose::new(r(-0.1, 0.1), r(-0.1, 0.1), r(-1.0, 1.0)))
+                .collect();
+            poses[9].pos.x = f64::NAN;
+            let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed + 1000);
+            let mut gaps = Vec::new();
+            for _ in 0..rng.random_range(0..60) {
+                let body = |rng: &mut rand_chacha::ChaCha8Rng| match rng.random_range(0..24) {
+                    0 => u32::MAX,
+                    k => k % 12,
+                };
+                let (ba, bb) = (body(&mut rng), body(&mut rng));
+                let mut g = Gap::track(ba, bb);
+                g.reused = rng.random_bool(0.3);
+                if rng.random_bool(0.9) {
+                    // Certified at poses near the current ones.
+                    let old = RelPose::of(&poses, ba, bb);
+                    g.rel = old.rel + Vec2::new(rng.random_range(-1e-3..1e-3), 0.0);
+                    g.angle_a = old.angle_a + rng.random_range(-1e-3..1e-3);
+                    g.angle_b = old.angle_b;
+                    (g.l_a, g.l_b) = (rng.random_range(0.0..0.05), rng.random_range(0.0..0.05));
+                    // NaN for a body without a pose: then any clear.
+                    let m = old.moved_since(&g);
+                    let edge = if m.is_nan() { 0.005 } else { m + delta_c };
+                    g.clear = match rng.random_range(0..3) {
+                        0 => edge,
+                        1 => rng.random_range(0.0..2.0 * edge),
+                        _ => edge.next_down(),
+                    };
+                }
+                gaps.push(g);
+            }
+            let (mut want, mut held, mut reused) = (Vec::new(), 0, 0);
+            for (k, g) in gaps.iter().enumerate() {
+                let m = RelPose::of(&poses, g.body_a, g.body_b).moved_since(g);
+                on_edge += usize::from(m == g.clear - delta_c);
+                if m < g.clear - delta_c {
+                    held += 1;
+                    reused += usize::from(g.reused);
+                } else {
+                    want.push((k, held, reused));
+                    (held, reused) = (0, 0);
+                }
+            }
+            want.push((gaps.len(), held, reused));
+            let mut got = Vec::new();
+            let mut from = 0;
+            while from <= gaps.len() {
+                let (k, h, r) = first_unheld(&gaps, from, &poses, delta_c);
+                got.push((k, h, r));
+                held_total += h;
+                from = k + 1;
+            }
+            assert_eq!(got, want, "seed {seed}");
+        }
+        assert!(
+            held_total > 500 && on_edge > 20,
+            "{held_total} held, {on_edge} on the edge"
+        );
     }
 
     /// A pair that stays penetrating is confirmed by its tracker once; the samples after that

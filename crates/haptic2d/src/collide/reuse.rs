@@ -67,7 +67,7 @@ impl Slack {
     /// Records a comparison of a quantity `slack` (m) away from its threshold.
     #[inline(always)]
     pub fn decided(&mut self, slack: f64) {
-        self.decided = self.decided.min(slack);
+        self.decided = least(self.decided, slack);
     }
 
     /// The scan's certificate: `σ` (m) and the levers `l_A`, `l_B` (m/rad) of the module docs, or
@@ -83,6 +83,29 @@ impl Slack {
         let sigma = self.decided.min(self.inside).min(delta_c) - guard;
         let (l_a, l_b) = (lever(a, delta_c, eps_s), lever(b, delta_c, eps_s));
         (sigma > 0.0 && l_a.is_finite() && l_b.is_finite()).then_some((sigma, l_a, l_b))
+    }
+}
+
+/// `x.min(y)` for a running least `x` that is never NaN (started at a number, updated only by
+/// this): a compare and a select, where `f64::min` also tests `x` for NaN. For such an `x` the two
+/// agree on every `y` (a NaN `y` keeps `x`); where `x` and `y` are zeros of both signs either
+/// sign is the least, and the scans only compare it or subtract from it.
+#[inline(always)]
+pub(super) fn least(x: f64, y: f64) -> f64 {
+    if y < x {
+        y
+    } else {
+        x
+    }
+}
+
+/// `x.max(y)` for a running greatest `x` that is never NaN: [`least`] mirrored.
+#[inline(always)]
+pub(super) fn greatest(x: f64, y: f64) -> f64 {
+    if y > x {
+        y
+    } else {
+        x
     }
 }
 
@@ -132,15 +155,44 @@ impl PairCandidates {
         Some(r)
     }
 
-    /// Whether the candidates did not fit.
-    #[inline]
-    pub fn overflows(&self) -> bool {
-        self.len == u8::MAX
-    }
-
     /// The candidates (none if they overflowed).
     #[inline]
     pub fn get(&self) -> &[VeCandidate] {
         self.candidates.get(..self.len as usize).unwrap_or(&[])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// For a running value `x` that is a number, `least`/`greatest` give `f64::min`/`f64::max`
+    /// on every `y` (as values: zeros of both signs compare equal), NaN, ±∞ and ±0 included, and
+    /// a NaN `y` keeps `x`.
+    #[test]
+    fn least_and_greatest_are_min_and_max_for_a_running_number() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(31);
+        let mut values = vec![
+            0.0,
+            -0.0,
+            1.0,
+            -1.0,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            1e-300,
+        ];
+        values.extend(
+            (0..200).map(|_| rng.random_range(-1.0..1.0) * 10f64.powi(rng.random_range(-9..3))),
+        );
+        let ys = values.iter().copied().chain([f64::NAN]);
+        for (x, y) in values.iter().flat_map(|&x| ys.clone().map(move |y| (x, y))) {
+            assert_eq!(least(x, y), x.min(y), "least({x}, {y})");
+            assert_eq!(greatest(x, y), x.max(y), "greatest({x}, {y})");
+            if y.is_nan() {
+                assert_eq!(least(x, y).to_bits(), x.to_bits());
+                assert_eq!(greatest(x, y).to_bits(), x.to_bits());
+            }
+        }
     }
 }

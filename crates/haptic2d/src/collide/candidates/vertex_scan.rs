@@ -2,7 +2,7 @@
 //! against its edge of least depth, with the corner-on-corner rule at a corner of two edges.
 
 use super::{Ctx, Side};
-use crate::collide::reuse::Slack;
+use crate::collide::reuse::{greatest, least, Slack};
 use crate::collide::{Collider, VeCandidate};
 use crate::geom::Vec2;
 
@@ -91,11 +91,11 @@ impl Ctx {
                         continue 'vertex;
                     }
                 }
-                max_all = max_all.max(d);
+                max_all = greatest(max_all, d);
                 if b.c.seams != 0 && b.c.is_seam(e) {
-                    max_seam = max_seam.max(d);
+                    max_seam = greatest(max_seam, d);
                     // A seam is no surface of B's body: never the vertex's contact normal.
-                    slack.decided((self.delta_c - d).min((d + self.delta_c).abs()));
+                    slack.decided(least(self.delta_c - d, (d + self.delta_c).abs()));
                     continue;
                 }
                 if d > max_d {
@@ -103,10 +103,10 @@ impl Ctx {
                     max_d = d;
                     nearest = e;
                 } else {
-                    second = second.max(d);
+                    second = greatest(second, d);
                 }
                 near_lines += (d >= -self.delta_c) as u32;
-                slack.decided((self.delta_c - d).min((d + self.delta_c).abs()));
+                slack.decided(least(self.delta_c - d, (d + self.delta_c).abs()));
             }
             slack.decided(0.5 * (max_d - second));
             if max_all < 0.0 {
