@@ -69,13 +69,22 @@ impl ImpactRow {
     /// The Jacobian row `G_i` as two blocks `(n, r_A × n)` for A and `(−n, −(r_B × n))` for B (§7.1).
     /// A fixed body's block is zero.
     pub(super) fn jacobian(&self, bodies: &[Body]) -> [f64; 6] {
+        self.jacobian_of(
+            bodies[self.body_a].is_dynamic(),
+            bodies[self.body_b].is_dynamic(),
+        )
+    }
+
+    /// [`jacobian`](Self::jacobian) for A dynamic or not (`dynamic_a`), and B (`dynamic_b`).
+    #[inline]
+    pub(super) fn jacobian_of(&self, dynamic_a: bool, dynamic_b: bool) -> [f64; 6] {
         let mut j = [0.0; 6];
-        if bodies[self.body_a].is_dynamic() {
+        if dynamic_a {
             j[0] = self.n.x;
             j[1] = self.n.y;
             j[2] = cross(self.r_a, self.n);
         }
-        if bodies[self.body_b].is_dynamic() {
+        if dynamic_b {
             j[3] = -self.n.x;
             j[4] = -self.n.y;
             j[5] = -cross(self.r_b, self.n);

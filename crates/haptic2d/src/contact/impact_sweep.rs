@@ -76,6 +76,13 @@ impl SweepRow {
     }
 }
 
+/// One body of a row being gathered: its slot and inverse masses (1/kg, 1/(kg·m²)).
+struct Side {
+    slot: u32,
+    inv_mass: f64,
+    inv_inertia: f64,
+}
+
 /// The gathered island: sweep rows in the impact set's order and the solver bodies' twists.
 ///
 /// Owns its buffers; they grow only with a larger island (or, for `slot_of`, a longer body slice)
@@ -119,17 +126,17 @@ impl SparseIsland {
         self.twists.push([0.0; 3]);
         self.body_of.push(UNSEEN);
         for row in rows {
-            let j = row.jacobian(bodies);
+            let (a, b) = (self.side(bodies, row.body_a), self.side(bodies, row.body_b));
+            let j = row.jacobian_of(a.slot != FIXED_SLOT, b.slot != FIXED_SLOT);
             let (mut d, mut k) = (0.0, [0.0; 6]);
-            for (off, bi) in [(0usize, row.body_a), (3, row.body_b)] {
-                let b = &bodies[bi];
-                d += b.inv_mass * (j[off] * j[off] + j[off + 1] * j[off + 1])
-                    + b.inv_inertia * j[off + 2] * j[off + 2];
-                k[off] = b.inv_mass * j[off];
-                k[off + 1] = b.inv_mass * j[off + 1];
-                k[off + 2] = b.inv_inertia * j[off + 2];
+            for (off, s) in [(0usize, &a), (3, &b)] {
+                d += s.inv_mass * (j[off] * j[off] + j[off + 1] * j[off + 1])
+                    + s.inv_inertia * j[off + 2] * j[off + 2];
+                k[off] = s.inv_mass * j[off];
+                k[off + 1] = s.inv_mass * j[off + 1];
+                k[off + 2] = s.inv_inertia * j[off + 2];
             }
-            let (a, b) = (self.slot(bodies, row.body_a), self.slot(bodies, row.body_b));
+            let (a, b) = (a.slot, b.slot);
             let inv_diag = if d > 0.0 { 1.0 / d } else { 0.0 };
             self.rows.push(SweepRow {
                 a,
@@ -141,18 +148,27 @@ impl SparseIsland {
         }
     }
 
-    /// The slot of `bodies[i]`, given one (with its twist) on first sight.
-    fn slot(&mut self, bodies: &[Body], i: usize) -> u32 {
+    /// `bodies[i]` as a row sees it, read once: its slot (given one, with its twist, on first
+    /// sight; [`FIXED_SLOT`] for a fixed body) and its inverse masses.
+    #[inline]
+    fn side(&mut self, bodies: &[Body], i: usize) -> Side {
         let body = &bodies[i];
-        if !body.is_dynamic() {
-            return FIXED_SLOT;
-        }
-        if self.slot_of[i] == UNSEEN {
-            self.slot_of[i] = self.twists.len() as u32;
+        let slot = if !body.is_dynamic() {
+            FIXED_SLOT
+        } else if self.slot_of[i] == UNSEEN {
+            let s = self.twists.len() as u32;
+            self.slot_of[i] = s;
             self.twists.push([body.vel.x, body.vel.y, body.omega]);
             self.body_of.push(i as u32);
+            s
+        } else {
+            self.slot_of[i]
+        };
+        Side {
+            slot,
+            inv_mass: body.inv_mass,
+            inv_inertia: body.inv_inertia,
         }
-        self.slot_of[i]
     }
 
     /// Writes the island's twists back to its dynamic bodies and forgets their slots.
@@ -297,7 +313,7 @@ mod tests {
             b.omega = rng.random_range(-3.0..3.0);
             bodies.push(b);
         }
-        let mut row = |rng: &mut ChaCha8Rng, a: usize, b: usize| {
+        let row = |rng: &mut ChaCha8Rng, a: usize, b: usize| {
             let t: f64 = rng.random_range(-0.3..0.3);
             let lever = |rng: &mut ChaCha8Rng| {
                 Vec2::new(rng.random_range(-0.03..0.03), rng.random_range(-0.03..0.03))
