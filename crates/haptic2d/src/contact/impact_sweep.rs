@@ -42,7 +42,8 @@ struct SweepRow {
     /// interleaved entry by entry, `(A₀, B₀, A₁, B₁, A₂, B₂)`: the two blocks' products are then
     /// pairs in memory, and the compiler computes them two at a time without shuffling.
     j: [f64; 6],
-    /// `M⁻¹·G_iᵀ` blockwise: `(j₀/m_A, j₁/m_A, j₂/I_A, j₃/m_B, j₄/m_B, j₅/I_B)` ((m/s, rad/s) per N·s).
+    /// `M⁻¹·G_iᵀ` in block order, not interleaved: `(A₀/m_A, A₁/m_A, A₂/I_A, B₀/m_B, B₁/m_B, B₂/I_B)`
+    /// ((m/s, rad/s) per N·s), each the product `(1/m)·G` the sweeps on the bodies formed first.
     k: [f64; 6],
 }
 
