@@ -195,14 +195,16 @@ impl ContactSet {
         mut reactions: Option<(&mut [Wrench2], f64)>,
         forest: Forest,
     ) {
-        if let Forest::Build = forest {
-            // Union–find over dynamic bodies (fixed bodies connect nothing).
-            singletons(&mut self.parent);
-            for r in &self.rows {
-                if bodies[r.body_a].is_dynamic() && bodies[r.body_b].is_dynamic() {
-                    union(&mut self.parent, r.body_a, r.body_b);
-                }
+        match forest {
+            Forest::Build => {
+                singletons(&mut self.parent);
+                rows_forest(&mut self.parent, &self.rows, bodies);
             }
+            // The unit tests (piles landing) check the claim on every impact sample.
+            #[cfg(test)]
+            Forest::Built => self.assert_forest_is_the_rows(bodies),
+            #[cfg(not(test))]
+            Forest::Built => {}
         }
         // Island id of each row: the root of its dynamic body.
         self.row_island.clear();
@@ -266,6 +268,30 @@ fn fixed_reactions(
         if !bodies[r.body_b].is_dynamic() {
             w[r.body_b].force -= f;
             w[r.body_b].torque -= cross(r.r_b, f);
+        }
+    }
+}
+
+/// Union–find over the dynamic bodies of `rows` (fixed bodies connect nothing) into `parent`.
+fn rows_forest(parent: &mut [u32], rows: &[ImpactRow], bodies: &[Body]) {
+    for r in rows {
+        if bodies[r.body_a].is_dynamic() && bodies[r.body_b].is_dynamic() {
+            union(parent, r.body_a, r.body_b);
+        }
+    }
+}
+
+#[cfg(test)]
+impl ContactSet {
+    /// Asserts that `parent` gives every row's body the root a forest built over the rows gives it.
+    fn assert_forest_is_the_rows(&mut self, bodies: &[Body]) {
+        let mut fresh: Vec<u32> = (0..self.parent.len() as u32).collect();
+        rows_forest(&mut fresh, &self.rows, bodies);
+        for r in &self.rows {
+            for b in [r.body_a, r.body_b] {
+                let (kept, built) = (find(&mut self.parent, b as u32), find(&mut fresh, b as u32));
+                assert_eq!(kept, built, "body {b}'s island");
+            }
         }
     }
 }
