@@ -8,10 +8,11 @@
 //! ([`super::impact_friction`]).
 
 use super::impact_friction::{FrictionalImpactSolver, ImpactFriction, PhaseMethod};
+use super::impact_sweep::SparseIsland;
 use super::last_solve::last_solve_views;
 use super::lcp::{LcpReport, LcpSolver};
 use crate::body::Body;
-use crate::geom::{cross, select_max, Vec2};
+use crate::geom::{cross, Vec2};
 
 /// Default constraint-check tolerance `ε_v` (m/s): after restitution, a row with `b⁺_i < −ε_v`
 /// triggers the plastic correction (§7.2 step 3).
@@ -68,13 +69,22 @@ impl ImpactRow {
     /// The Jacobian row `G_i` as two blocks `(n, r_A × n)` for A and `(−n, −(r_B × n))` for B (§7.1).
     /// A fixed body's block is zero.
     pub(super) fn jacobian(&self, bodies: &[Body]) -> [f64; 6] {
+        self.jacobian_of(
+            bodies[self.body_a].is_dynamic(),
+            bodies[self.body_b].is_dynamic(),
+        )
+    }
+
+    /// [`jacobian`](Self::jacobian) for A dynamic or not (`dynamic_a`), and B (`dynamic_b`).
+    #[inline]
+    pub(super) fn jacobian_of(&self, dynamic_a: bool, dynamic_b: bool) -> [f64; 6] {
         let mut j = [0.0; 6];
-        if bodies[self.body_a].is_dynamic() {
+        if dynamic_a {
             j[0] = self.n.x;
             j[1] = self.n.y;
             j[2] = cross(self.r_a, self.n);
         }
-        if bodies[self.body_b].is_dynamic() {
+        if dynamic_b {
             j[3] = -self.n.x;
             j[4] = -self.n.y;
             j[5] = -cross(self.r_b, self.n);
@@ -138,10 +148,11 @@ pub struct ImpactSolver {
     jac: Vec<[f64; 6]>,
     /// Delassus matrix `A = G M⁻¹ Gᵀ`, row-major `n × n` (dense path only).
     a: Vec<f64>,
-    /// The inverse `1/A_ii` of the diagonal (0 where `A_ii ≤ 0`: the row is skipped) (sparse
-    /// path): the sweeps multiply by it instead of dividing, so that a row's update does not wait
-    /// on a division (about 13 cycles against 3 on this machine) at every sweep.
-    inv_diag: Vec<f64>,
+    /// The sparse path's gathered island (`contact/impact_sweep.rs`): its rows with the inverse
+    /// `1/A_ii` of the diagonal (the sweeps multiply by it instead of dividing, so that a row's
+    /// update does not wait on a division, about 13 cycles against 3 on this machine, at every
+    /// sweep) and its bodies' twists.
+    island: SparseIsland,
     /// Pre-impact normal velocities `b⁻` (m/s).
     b_pre: Vec<f64>,
     /// Post-restitution normal velocities, before any plastic correction (m/s).
@@ -229,7 +240,7 @@ impl ImpactSolver {
             n: 0,
             jac: Vec::new(),
             a: Vec::new(),
-            inv_diag: Vec::new(),
+            island: SparseIsland::default(),
             b_pre: Vec::new(),
             b_mid: Vec::new(),
             b_post: Vec::new(),
@@ -325,7 +336,7 @@ impl ImpactSolver {
         if self.a.len() < dense * dense {
             self.a.resize(dense * dense, 0.0);
         }
-        self.inv_diag.resize(rows, 0.0);
+        self.island.reserve(rows);
         for v in [
             &mut self.b_pre,
             &mut self.b_mid,
@@ -473,6 +484,10 @@ impl ImpactSolver {
     /// but with `A_i·λ + b_i = G_i·u` read from the bodies' current twists, to which every impulse
     /// increment is applied at once ("sequential impulses"). Each row update then costs O(1) instead
     /// of O(n), and no `n × n` matrix is built. Iterates are identical to dense PGS.
+    ///
+    /// The island's rows and bodies are gathered once into compact arrays
+    /// (`contact/impact_sweep.rs`), every phase runs on them, and the twists are written back to
+    /// `bodies` before the outcome reads them: the same bits as running on the bodies.
     fn solve_sparse(
         &mut self,
         rows: &[ImpactRow],
@@ -481,24 +496,14 @@ impl ImpactSolver {
     ) -> ImpactOutcome {
         let n = rows.len();
         let ke_before = totals.kinetic(bodies);
-        for (i, row) in rows.iter().enumerate() {
-            self.jac[i] = row.jacobian(bodies);
-            let j = &self.jac[i];
-            let mut d = 0.0;
-            for (off, bi) in [(0usize, row.body_a), (3, row.body_b)] {
-                let b = &bodies[bi];
-                d += b.inv_mass * (j[off] * j[off] + j[off + 1] * j[off + 1])
-                    + b.inv_inertia * j[off + 2] * j[off + 2];
-            }
-            self.inv_diag[i] = if d > 0.0 { 1.0 / d } else { 0.0 };
-        }
-        self.normal_velocities(rows, bodies, Buf::Pre);
+        self.island.gather(rows, bodies);
+        self.island.normal_velocities(&mut self.b_pre[..n]);
         self.budget.islands += 1;
         // 1. Compression: PGS on the bodies' twists, starting from λ = 0. Every row update is
         // the exact minimiser of the kinetic energy along its row under `λ_i ≥ 0`, so the
         // kinetic energy falls at every update, wherever the budget stops it (§7.7).
         self.lambda[..n].fill(0.0);
-        let compression = self.pgs_on_bodies(rows, bodies, Buf::Impulse);
+        let compression = self.pgs_on_island(Buf::Impulse);
         // 2. Poisson restitution: the bodies already carry λ; add p_i = e_i·λ_i. The energy
         // terms of the passive check (§7.7) are read on the way: with `b_c = G·u_c` after the
         // compression (held in `b_post` for now) and `b_1` after the restitution, the
@@ -509,14 +514,14 @@ impl ImpactSolver {
             self.impulse[i] = (1.0 + row.restitution) * self.lambda[i];
             self.correction[i] = 0.0;
         }
-        self.normal_velocities(rows, bodies, Buf::Post);
+        self.island.normal_velocities(&mut self.b_post[..n]);
         let (mut dke_compression, mut c) = (0.0, 0.0);
         for i in 0..n {
             dke_compression += 0.5 * self.lambda[i] * (self.b_pre[i] + self.b_post[i]);
             c += self.step[i] * self.b_post[i];
         }
-        self.apply_impulses(rows, bodies, Buf::Step);
-        self.normal_velocities(rows, bodies, Buf::Mid);
+        self.island.apply_impulses(&self.step[..n]);
+        self.island.normal_velocities(&mut self.b_mid[..n]);
         let mut q = 0.0;
         for i in 0..n {
             q += 0.5 * self.step[i] * (self.b_mid[i] - self.b_post[i]);
@@ -524,7 +529,7 @@ impl ImpactSolver {
         self.b_post[..n].copy_from_slice(&self.b_mid[..n]);
         // 3. Plastic correction: PGS again from the post-restitution twists, λ' from 0 (it only
         // removes kinetic energy, for the same reason as the compression).
-        let (mut correction, mut passes) = self.sparse_correction(rows, bodies);
+        let (mut correction, mut passes) = self.sparse_correction();
         // 4. The passive check (§7.7): Poisson's restitution cannot raise the kinetic energy
         // only if `λ ⟂ G·u_c`, which a compression cut short by the budget breaks (and one
         // stopped by the 1e-9 N·s test leaves a residual of). If the whole impact raised it, the
@@ -553,37 +558,34 @@ impl ImpactSolver {
             for (i, row) in rows.iter().enumerate() {
                 self.step[i] = (s - 1.0) * row.restitution * self.lambda[i] - self.correction[i];
             }
-            self.apply_impulses(rows, bodies, Buf::Step);
+            self.island.apply_impulses(&self.step[..n]);
             for (i, row) in rows.iter().enumerate() {
                 self.impulse[i] = (1.0 + s * row.restitution) * self.lambda[i];
                 self.correction[i] = 0.0;
             }
-            self.normal_velocities(rows, bodies, Buf::Mid);
+            self.island.normal_velocities(&mut self.b_mid[..n]);
             self.b_post[..n].copy_from_slice(&self.b_mid[..n]);
-            (correction, passes) = self.sparse_correction(rows, bodies);
+            (correction, passes) = self.sparse_correction();
         }
+        self.island.scatter(bodies);
         self.outcome(bodies, totals, ke_before, passes, compression, correction)
     }
 
     /// The sparse path's plastic correction: if some `b_post < −ε_v`, projected Gauss–Seidel from
     /// the current twists with `λ'` from 0, added to `correction` and `impulse`; `b_post` then
     /// holds the final normal velocities. Returns its report and the number of passes (0 or 1).
-    fn sparse_correction(
-        &mut self,
-        rows: &[ImpactRow],
-        bodies: &mut [Body],
-    ) -> (Option<LcpReport>, usize) {
-        let n = rows.len();
+    fn sparse_correction(&mut self) -> (Option<LcpReport>, usize) {
+        let n = self.n;
         if !self.b_post[..n].iter().any(|&v| v < -self.eps_v) {
             return (None, 0);
         }
         self.step[..n].fill(0.0);
-        let report = self.pgs_on_bodies(rows, bodies, Buf::Step);
+        let report = self.pgs_on_island(Buf::Step);
         for i in 0..n {
             self.correction[i] = self.step[i];
             self.impulse[i] += self.step[i];
         }
-        self.normal_velocities(rows, bodies, Buf::Post);
+        self.island.normal_velocities(&mut self.b_post[..n]);
         (Some(report), 1)
     }
 
@@ -627,11 +629,12 @@ impl ImpactSolver {
         o
     }
 
-    /// Projected Gauss–Seidel applied directly to the bodies' twists; accumulates the impulses in
-    /// `lambda` (`Buf::Impulse`) or `step` (`Buf::Step`), which must start at zero. Stops when the
-    /// largest increment of a sweep is below 1e-9 N·s, or after the sweep budget (§7.7).
-    fn pgs_on_bodies(&mut self, rows: &[ImpactRow], bodies: &mut [Body], into: Buf) -> LcpReport {
-        let n = rows.len();
+    /// Projected Gauss–Seidel applied directly to the gathered island's twists; accumulates the
+    /// impulses in `lambda` (`Buf::Impulse`) or `step` (`Buf::Step`), which must start at zero.
+    /// Stops when the largest increment of a sweep is below 1e-9 N·s, or after the sweep budget
+    /// (§7.7).
+    fn pgs_on_island(&mut self, into: Buf) -> LcpReport {
+        let n = self.n;
         // The sweeps this phase may run: the sweep budget, or what the sample's rows left allow
         // over this island (at least one sweep).
         let fit = (self.rows_left / (n.max(1) as u64)).max(1);
@@ -639,31 +642,15 @@ impl ImpactSolver {
         if cap < self.sweep_budget {
             self.budget.phases_capped += 1;
         }
+        let acc = match into {
+            Buf::Step => &mut self.step[..n],
+            _ => &mut self.lambda[..n],
+        };
         let mut sweeps = 0;
         let mut converged = false;
         while sweeps < cap {
             sweeps += 1;
-            let mut max_delta = 0.0f64;
-            for (i, row) in rows.iter().enumerate() {
-                if self.inv_diag[i] <= 0.0 {
-                    continue;
-                }
-                let j = self.jac[i];
-                let w = dot_twist(&j[0..3], &bodies[row.body_a])
-                    + dot_twist(&j[3..6], &bodies[row.body_b]);
-                let acc = match into {
-                    Buf::Step => &mut self.step[i],
-                    _ => &mut self.lambda[i],
-                };
-                let new = select_max(*acc - w * self.inv_diag[i], 0.0);
-                let delta = new - *acc;
-                *acc = new;
-                if delta != 0.0 {
-                    max_delta = select_max(delta.abs(), max_delta);
-                    apply_row(&j, row, bodies, delta);
-                }
-            }
-            if max_delta < 1e-9 {
+            if self.island.sweep(acc) < 1e-9 {
                 converged = true;
                 break;
             }
@@ -773,19 +760,6 @@ impl Totals {
         match self {
             Totals::Summed => bodies.iter().map(Body::kinetic_energy).sum(),
             Totals::Skipped => 0.0,
-        }
-    }
-}
-
-/// Applies the impulse `p` (N·s) of `row` (Jacobian `j`) to its dynamic bodies: `Δu = M⁻¹·G_iᵀ·p`.
-#[inline]
-fn apply_row(j: &[f64; 6], row: &ImpactRow, bodies: &mut [Body], p: f64) {
-    for (off, bi) in [(0usize, row.body_a), (3, row.body_b)] {
-        let b = &mut bodies[bi];
-        if b.is_dynamic() {
-            b.vel.x += b.inv_mass * j[off] * p;
-            b.vel.y += b.inv_mass * j[off + 1] * p;
-            b.omega += b.inv_inertia * j[off + 2] * p;
         }
     }
 }

@@ -5,6 +5,7 @@ mod god_object;
 pub mod impact;
 pub mod impact_friction;
 pub mod impact_mlcp;
+mod impact_sweep;
 mod last_solve;
 mod law_pool;
 pub mod lcp;

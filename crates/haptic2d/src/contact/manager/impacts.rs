@@ -89,7 +89,9 @@ impl ContactSet {
             self.row_entry.push(idx);
         }
         let before: f64 = bodies.iter().map(|b| b.kinetic_energy()).sum();
-        self.solve_islands(bodies, None);
+        // The rows are every record of the struck islands, so their islands are those islands:
+        // `parent` already holds them (see `solve_islands`).
+        self.solve_islands(bodies, None, Forest::Built);
         let after: f64 = bodies.iter().map(|b| b.kinetic_energy()).sum();
         self.last_impact_loss = before - after;
         self.impacts_solved += 1;
@@ -163,7 +165,7 @@ impl ContactSet {
         std::mem::swap(&mut self.rows, &mut self.carry_rows);
         // Frictionless: the carry is normal only (the next impact sets the mode again).
         self.solver.set_friction(ImpactFriction::None, 0.0);
-        self.solve_islands(bodies, Some((&mut *wrenches, dt)));
+        self.solve_islands(bodies, Some((&mut *wrenches, dt)), Forest::Build);
         std::mem::swap(&mut self.rows, &mut self.carry_rows);
         let inv_dt = 1.0 / dt;
         for (i, b) in bodies.iter_mut().enumerate() {
@@ -181,13 +183,28 @@ impl ContactSet {
     /// Delassus matrix is block diagonal), so each connected component is its own small LCP. Islands
     /// are taken in the order of their root body, rows in key order: the result is deterministic and
     /// identical to solving the whole set at once.
-    fn solve_islands(&mut self, bodies: &mut [Body], mut reactions: Option<(&mut [Wrench2], f64)>) {
-        // Union–find over dynamic bodies (fixed bodies connect nothing).
-        singletons(&mut self.parent);
-        for r in &self.rows {
-            if bodies[r.body_a].is_dynamic() && bodies[r.body_b].is_dynamic() {
-                union(&mut self.parent, r.body_a, r.body_b);
+    ///
+    /// With [`Forest::Built`], `parent` already holds the union–find forest of the records of
+    /// `resolve_impacts`: its rows are every Continuous or Colliding record (both bodies dynamic
+    /// or not) of each struck island, so the rows join exactly the bodies those records join, and
+    /// a root is the smallest body index of its set whatever the order of the unions: the same
+    /// roots as a forest built over the rows.
+    fn solve_islands(
+        &mut self,
+        bodies: &mut [Body],
+        mut reactions: Option<(&mut [Wrench2], f64)>,
+        forest: Forest,
+    ) {
+        match forest {
+            Forest::Build => {
+                singletons(&mut self.parent);
+                rows_forest(&mut self.parent, &self.rows, bodies);
             }
+            // The unit tests (piles landing) check the claim on every impact sample.
+            #[cfg(test)]
+            Forest::Built => self.assert_forest_is_the_rows(bodies),
+            #[cfg(not(test))]
+            Forest::Built => {}
         }
         // Island id of each row: the root of its dynamic body.
         self.row_island.clear();
@@ -199,6 +216,16 @@ impl ContactSet {
             };
             let root = find(&mut self.parent, b as u32);
             self.row_island.push(root);
+        }
+        // One island (a landing pile's collapse): the rows in key order are its rows; no grouping.
+        if self.row_island.windows(2).all(|w| w[0] == w[1]) {
+            if !self.rows.is_empty() {
+                self.solver.solve_island(&self.rows, bodies);
+                if let Some((w, dt)) = reactions {
+                    fixed_reactions(&self.rows, self.solver.impulses(), bodies, w, dt);
+                }
+            }
+            return;
         }
         // Group rows by island (stable: rows keep key order inside an island), then solve each run.
         self.row_order.clear();
@@ -216,22 +243,66 @@ impl ContactSet {
                 k += 1;
             }
             self.solver.solve_island(&self.island_rows, bodies);
-            // Fixed bodies' share of the impulses, as forces held over `T` (the carry).
             if let Some((w, dt)) = reactions.as_mut() {
-                for (r, &p) in self.island_rows.iter().zip(self.solver.impulses()) {
-                    let f = r.n * (p / *dt);
-                    if !bodies[r.body_a].is_dynamic() {
-                        w[r.body_a].force += f;
-                        w[r.body_a].torque += cross(r.r_a, f);
-                    }
-                    if !bodies[r.body_b].is_dynamic() {
-                        w[r.body_b].force -= f;
-                        w[r.body_b].torque -= cross(r.r_b, f);
-                    }
-                }
+                fixed_reactions(&self.island_rows, self.solver.impulses(), bodies, w, *dt);
             }
         }
     }
+}
+
+/// The fixed bodies' share of an island's impulses `impulses` (N·s, one per row of `rows`), added
+/// to their wrenches `w` as forces held over `dt` (s) (the carry).
+fn fixed_reactions(
+    rows: &[ImpactRow],
+    impulses: &[f64],
+    bodies: &[Body],
+    w: &mut [Wrench2],
+    dt: f64,
+) {
+    for (r, &p) in rows.iter().zip(impulses) {
+        let f = r.n * (p / dt);
+        if !bodies[r.body_a].is_dynamic() {
+            w[r.body_a].force += f;
+            w[r.body_a].torque += cross(r.r_a, f);
+        }
+        if !bodies[r.body_b].is_dynamic() {
+            w[r.body_b].force -= f;
+            w[r.body_b].torque -= cross(r.r_b, f);
+        }
+    }
+}
+
+/// Union–find over the dynamic bodies of `rows` (fixed bodies connect nothing) into `parent`.
+fn rows_forest(parent: &mut [u32], rows: &[ImpactRow], bodies: &[Body]) {
+    for r in rows {
+        if bodies[r.body_a].is_dynamic() && bodies[r.body_b].is_dynamic() {
+            union(parent, r.body_a, r.body_b);
+        }
+    }
+}
+
+#[cfg(test)]
+impl ContactSet {
+    /// Asserts that `parent` gives every row's body the root a forest built over the rows gives it.
+    fn assert_forest_is_the_rows(&mut self, bodies: &[Body]) {
+        let mut fresh: Vec<u32> = (0..self.parent.len() as u32).collect();
+        rows_forest(&mut fresh, &self.rows, bodies);
+        for r in &self.rows {
+            for b in [r.body_a, r.body_b] {
+                let (kept, built) = (find(&mut self.parent, b as u32), find(&mut fresh, b as u32));
+                assert_eq!(kept, built, "body {b}'s island");
+            }
+        }
+    }
+}
+
+/// Whether `solve_islands` finds `parent` holding its rows' islands already.
+#[derive(Clone, Copy)]
+enum Forest {
+    /// Built by the caller over records joining exactly the bodies the rows join.
+    Built,
+    /// To be built over the rows.
+    Build,
 }
 
 /// Makes every body its own set (union–find roots: `parent[i] = i`).
