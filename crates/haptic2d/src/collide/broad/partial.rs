@@ -117,7 +117,7 @@ impl BroadPhase {
                     &mut cache,
                 );
                 gjk_runs += 1;
-                if !(g.distance >= reach) {
+                if g.distance < reach || g.distance.is_nan() || reach.is_nan() {
                     found.push((a, b));
                 }
             }
