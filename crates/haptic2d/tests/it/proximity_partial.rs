@@ -6,25 +6,22 @@
 
 use crate::polygon_support::random_polygon;
 use haptic2d::body::Body;
-use haptic2d::collide::{Collider, LocalStage, VeCandidate};
+use haptic2d::collide::{LocalStage, VeCandidate};
 use haptic2d::geom::{ConvexPolygon, Pose, Vec2};
 use haptic2d::scene::builtin;
 use haptic2d::world::World;
+use parry2d_f64::math::Pose as ParryPose;
+use parry2d_f64::shape::ConvexPolygon as ParryPolygon;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::f64::consts::TAU;
 
-/// Parry's distance (m) between two colliders at their bodies' poses.
-fn parry_gap(w: &World, a: &Collider, b: &Collider) -> f64 {
-    let (pa, pb) = (w.bodies[a.body].pose, w.bodies[b.body].pose);
-    parry2d_f64::query::distance(
-        &pa.to_parry(),
-        &a.local.to_parry(),
-        &pb.to_parry(),
-        &b.local.to_parry(),
-    )
-    .expect("polygon–polygon distance is supported")
-    .distance
+/// Each collider's polygon in parry's form, at its body's pose (parry is the distance oracle).
+fn parry_colliders(w: &World) -> Vec<(ParryPose, ParryPolygon)> {
+    w.colliders
+        .iter()
+        .map(|c| (w.bodies[c.body].pose.to_parry(), c.local.to_parry()))
+        .collect()
 }
 
 /// Every collider pair of two bodies, not both fixed (what the global stage may report).
@@ -46,6 +43,7 @@ fn all_pairs(w: &World) -> Vec<(u32, u32)> {
 fn assert_margin_rule(w: &World, pairs: &[(u32, u32)], what: &str) -> usize {
     let delta_c = w.params.delta_c;
     let set = w.proximate_pairs();
+    let shapes = parry_colliders(w);
     let mut close = 0;
     for &(a, b) in pairs {
         let (ca, cb) = (&w.colliders[a as usize], &w.colliders[b as usize]);
@@ -55,7 +53,12 @@ fn assert_margin_rule(w: &World, pairs: &[(u32, u32)], what: &str) -> usize {
             .max(p.min.x - q.max.x)
             .max(q.min.y - p.max.y)
             .max(p.min.y - q.max.y);
-        if gap >= delta_c || parry_gap(w, ca, cb) >= delta_c {
+        if gap >= delta_c {
+            continue;
+        }
+        let ((pa, sa), (pb, sb)) = (&shapes[a as usize], &shapes[b as usize]);
+        let d = parry2d_f64::query::distance(pa, sa, pb, sb).expect("polygons are supported");
+        if d.distance >= delta_c {
             continue;
         }
         close += 1;
