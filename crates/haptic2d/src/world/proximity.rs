@@ -115,8 +115,9 @@ impl Proximity {
     /// - with spreading, every sample that did not begin an update: advance the update in
     ///   progress by its share, so that it ends by the next `N_g`-th sample;
     /// - then, unless the whole stage ran now: the bodies that may have outrun the margin since
-    ///   their global poses (`moved_past_margin`) get their pairs decided again at the current
-    ///   poses (the partial update, `collide/broad/partial.rs`); when more than
+    ///   their global poses (`moved_past_margin`), and with them those past [`BATCH`] of it,
+    ///   get their pairs decided again at the current poses (the partial update,
+    ///   `collide/broad/partial.rs`); when more than
     ///   1/[`WHOLE_FRACTION`] of the dynamic bodies did, the whole stage runs instead (early,
     ///   and with spreading a new spread update begins).
     ///
@@ -226,10 +227,12 @@ impl Proximity {
         }
     }
 
-    /// Marks the bodies that may have moved, by the end of this sample, more than
-    /// `(δ_prox − δ_c)/2` since their global poses (`moved`), so that the proximity set may miss
-    /// one of their pairs, and writes each body's motion since its global pose (`motion`, m).
-    /// Returns how many bodies moved past, and how many bodies are dynamic.
+    /// Marks the bodies to update (`moved`): when some body may have moved, by the end of this
+    /// sample, more than `(δ_prox − δ_c)/2` since its global pose, so that the proximity set may
+    /// miss one of its pairs, every body that may have moved more than [`BATCH`] of that; none
+    /// otherwise. Writes each body's motion since its global pose (`motion`, m).
+    /// Returns how many bodies to update, how many of them moved past, and how many bodies are
+    /// dynamic.
     ///
     /// A pair left out at the update that last decided it stays more than `δ_c` apart while
     /// neither body has moved more than `(δ_prox − δ_c)/2` since its global pose
@@ -266,11 +269,14 @@ impl Proximity {
     }
 }
 
-/// The bodies [`Proximity::moved_past_margin`] marked, and the dynamic bodies.
+/// Counts of [`Proximity::moved_past_margin`].
 #[derive(Clone, Copy, Debug, Default)]
 struct Moved {
+    /// Bodies marked to update (0 when none moved past the margin).
     bodies: usize,
+    /// Marked bodies that moved past the margin itself.
     past: usize,
+    /// Dynamic bodies.
     dynamic: usize,
 }
 
