@@ -44,6 +44,7 @@ mod pile_settle;
 mod planar2_no_alloc;
 mod planar2_safety;
 mod planar2_twist;
+mod proximity_partial;
 mod proximity_spread;
 mod repro_contacts;
 mod safety_gate;

@@ -31,8 +31,9 @@
 //! `sweep.rs` the sort-and-sweep and the pair test (with reused distances); `spread.rs` an update
 //! spread over the samples of a period; `publish.rs` the merge or in-place patch that publishes
 //! an update; `skip.rs` the certificate that lets the world skip an update that cannot change the
-//! set.
+//! set; `partial.rs` the partial update of the bodies that moved past the margin.
 
+mod partial;
 mod publish;
 mod skip;
 mod spread;
@@ -42,7 +43,7 @@ mod tests;
 
 use super::gjk::{gjk_distance, GjkCache};
 use super::Collider;
-use crate::geom::Vec2;
+use crate::geom::{Aabb, Vec2};
 
 /// Default proximity distance `δ_prox` (m), §9.1: `2·(1 m/s)·(0.02 s) + 0.002 m`.
 pub const DEFAULT_DELTA_PROX: f64 = 0.042;
@@ -95,6 +96,20 @@ struct Tested {
     cache: GjkCache,
     distance: f64,
     odo_ref: f64,
+}
+
+impl SweepEntry {
+    /// The entry of collider `i`, `c`, with box `bx` (m; the sweep's is inflated).
+    fn of(i: usize, c: &Collider, bx: Aabb) -> Self {
+        SweepEntry {
+            min_x: bx.min.x,
+            max_x: bx.max.x,
+            min_y: bx.min.y,
+            max_y: bx.max.y,
+            index: i as u32,
+            body: body_code(c),
+        }
+    }
 }
 
 /// The sweep's total order: by `min.x`, then by collider index.
@@ -219,6 +234,14 @@ pub struct BroadPhase {
     /// The same for the update in progress, once sorted, with its proximity set.
     ready: Published,
     stats: BroadStats,
+    /// The pairs a partial update found (`partial.rs`), and the buffer its merged set is written
+    /// to (then swapped with the caller's).
+    found: Vec<(u32, u32)>,
+    merged: Vec<(u32, u32)>,
+    /// The dynamic colliders' world boxes (not inflated) sorted by [`sweep_order`], for a
+    /// partial update's search by x, and the fixed colliders' boxes.
+    near: Vec<SweepEntry>,
+    fixed_near: Vec<SweepEntry>,
 }
 
 /// How far the bodies may move before an update could give another proximity set than the one
@@ -354,6 +377,10 @@ impl BroadPhase {
             set: Vec::new(),
             ready: Published::default(),
             stats: BroadStats::default(),
+            found: Vec::new(),
+            merged: Vec::new(),
+            near: Vec::new(),
+            fixed_near: Vec::new(),
         })
     }
 
@@ -369,7 +396,13 @@ impl BroadPhase {
         b.source.reserve(pairs);
         b.patches.reserve(pairs);
         b.set.reserve(pairs);
-        for v in [&mut b.cache_pairs, &mut b.ready.pairs, &mut b.ready.set] {
+        for v in [
+            &mut b.cache_pairs,
+            &mut b.ready.pairs,
+            &mut b.ready.set,
+            &mut b.found,
+            &mut b.merged,
+        ] {
             v.reserve(pairs);
         }
         b.caches.reserve(pairs);

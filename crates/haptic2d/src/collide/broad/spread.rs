@@ -20,8 +20,10 @@
 //! and caches: each pair's GJK depends only on its vertices and its own cache, not on the order
 //! of the pairs). It is used until `(k+2)·N_g`: a pair it leaves out was `≥ δ_prox` apart at
 //! `k·N_g` and, at `v_rel,max`, is still `> δ_c` apart `2·T_g` later, which is the margin rule.
-//! The world's early update (a body that moved more than `(δ_prox − δ_c)/2` since the poses of
-//! the set in use) still runs the whole stage at once, so fast bodies keep their guarantee.
+//! A body that moved more than `(δ_prox − δ_c)/2` since the poses its pairs were decided for gets
+//! them decided again at once by a partial update (`partial.rs`), which leaves the update in
+//! progress going on; the world runs the whole stage at once instead only when many bodies did
+//! (`world/proximity.rs`), so fast bodies keep their guarantee.
 
 use super::*;
 
@@ -58,17 +60,7 @@ impl BroadPhase {
         // 1. Inflated boxes, sorted by (min.x, index): in the last update's order, which is
         //    nearly sorted when the bodies move little between updates (insertion sort), or by
         //    index (a full sort) when the colliders changed.
-        let entry = |i: usize, c: &Collider| {
-            let bx = c.aabb.inflated(half);
-            SweepEntry {
-                min_x: bx.min.x,
-                max_x: bx.max.x,
-                min_y: bx.min.y,
-                max_y: bx.max.y,
-                index: i as u32,
-                body: body_code(c),
-            }
-        };
+        let entry = |i: usize, c: &Collider| SweepEntry::of(i, c, c.aabb.inflated(half));
         if self.sweep.len() == colliders.len() {
             for e in self.sweep.iter_mut() {
                 *e = entry(e.index as usize, &colliders[e.index as usize]);
@@ -85,6 +77,9 @@ impl BroadPhase {
         // unswapped for many periods, so the second one would otherwise grow late).
         room(&mut self.cache_start, colliders.len() + 1);
         room(&mut self.ready.start, colliders.len() + 1);
+        // And the partial update's boxes (`partial.rs`), so that its first run does not allocate.
+        room(&mut self.near, colliders.len());
+        room(&mut self.fixed_near, colliders.len());
         self.tested.clear();
         self.kept.clear();
         self.fresh.clear();

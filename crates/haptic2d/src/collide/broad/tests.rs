@@ -632,3 +632,32 @@ fn a_failed_check_backs_off() {
     assert!(!stage.skip_update(&moved));
     assert_eq!(stage.wait, MAX_BACKOFF);
 }
+
+/// The partial update (`partial.rs`) decides the moved body's pairs again at the current poses:
+/// a partner of body `B` joins when closer than `δ_prox + motion[B]` (`δ_prox` when `B` moved
+/// too; a NaN motion keeps it), a stale pair of the moved body goes, and the other pairs stay,
+/// in pair order. The squares are 0.04 m wide, so the face gaps follow from the centres.
+#[test]
+fn partial_update_decides_the_moved_bodys_pairs_with_the_partners_motion() {
+    let cols = vec![
+        square(0, true, 0.0, 0.0),  // the moved body
+        square(1, true, 0.09, 0.0), // 0.05 from 0: beyond δ_prox, within δ_prox + 0.01
+        square(2, true, 0.0, 0.07), // 0.03 from 0: within δ_prox
+        square(3, true, 1.0, 0.0),  // far from 0: its stale pair goes
+        square(4, true, 1.05, 0.0), // 0.01 from 3: a pair of two other bodies, kept
+    ];
+    let mut bp = BroadPhase::new(DEFAULT_DELTA_PROX).unwrap();
+    let run = |bp: &mut BroadPhase, moved: [bool; 5], motion: [f64; 5]| {
+        let mut set = vec![(0, 3), (3, 4)];
+        bp.update_bodies(&cols, &moved, &motion, &mut set);
+        set
+    };
+    let only_0 = [true, false, false, false, false];
+    assert_eq!(run(&mut bp, only_0, [0.0; 5]), vec![(0, 2), (3, 4)]);
+    let b_moved = [0.0, 0.01, 0.0, 0.0, 0.0];
+    assert_eq!(run(&mut bp, only_0, b_moved), vec![(0, 1), (0, 2), (3, 4)]);
+    let both = [true, true, false, false, false];
+    assert_eq!(run(&mut bp, both, b_moved), vec![(0, 2), (3, 4)]);
+    let unknown = [0.0, f64::NAN, 0.0, 0.0, 0.0];
+    assert_eq!(run(&mut bp, only_0, unknown), vec![(0, 1), (0, 2), (3, 4)]);
+}
