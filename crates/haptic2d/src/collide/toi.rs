@@ -39,8 +39,9 @@
 //! # Limits
 //!
 //! The test runs on the proximity set, so a pair must be proximate before it can be swept: the
-//! global stage is re-run whenever a body may have moved more than `(δ_prox − δ_c)/2` since the
-//! last update (`world/proximity.rs`), which covers every pair as long as each body moves less than
+//! pairs of a body are decided again whenever it may have moved more than `(δ_prox − δ_c)/2`
+//! since they were last decided (`world/proximity.rs`, `collide/broad/partial.rs`; the whole
+//! global stage when many bodies did), which covers every pair as long as each body moves less than
 //! `(δ_prox − δ_c)/2` per sample (20 mm with the defaults: 20 m/s at 1 kHz, 10 m/s at 500 Hz);
 //! [`speed_limit`] gives that bound for a world. Poses are interpolated linearly, so a body that
 //! turns by more than about a radian per sample is swept only approximately.

@@ -55,7 +55,7 @@ impl World {
         self.update_poses();
         lap.charge(&mut self.stage_times, Stage::Poses);
         // 3b. Global proximity stage: AABB sort-and-sweep + GJK, every N_g samples (spread,
-        //     skipped when still exact), and early when a body may have outrun the margin.
+        //     skipped when still exact), and early for the bodies that may have outrun the margin.
         self.proximity
             .run(self.tick, &self.params, &self.bodies, &self.colliders);
         lap.charge(&mut self.stage_times, Stage::Global);
