@@ -297,9 +297,19 @@ impl World {
         }
     }
 
-    /// Samples at which the swept test put a body back, and global updates run early, so far.
+    /// Samples at which the swept test put a body back, and whole global updates run early
+    /// (because many bodies had moved past the margin), so far.
     pub fn continuous_stats(&self) -> (u64, u64) {
         (self.swept.hits, self.proximity.early_updates)
+    }
+
+    /// Partial global updates run so far (the pairs of the bodies that moved past the margin
+    /// decided again, `collide/broad/partial.rs`), and the bodies they updated in all.
+    pub fn partial_global_updates(&self) -> (u64, u64) {
+        (
+            self.proximity.partial_updates,
+            self.proximity.partial_bodies,
+        )
     }
 }
 

@@ -34,8 +34,8 @@ pub(super) struct Proximity {
     /// Number of whole global updates run early because many bodies had moved far.
     pub(super) early_updates: u64,
     /// Number of partial global updates (some bodies had moved far), and the bodies they updated.
-    partial_updates: u64,
-    partial_bodies: u64,
+    pub(super) partial_updates: u64,
+    pub(super) partial_bodies: u64,
     /// Per body: whether it moved past the margin in this sample, and its motion since its
     /// global pose (m), as [`moved_past_margin`](Self::moved_past_margin) wrote them.
     moved: Vec<bool>,
@@ -287,16 +287,5 @@ const BATCH: f64 = 0.5;
 
 /// When more than one in this many dynamic bodies are to be updated in a sample, the whole stage
 /// runs instead of the partial update: on pile:1000's landing, 8 gave the fewest instructions of
-/// the values measured (2 and 8; `docs/perf-s31-global.md`).
+/// the values measured (2 and 8; docs/archive/PERFORMANCE-NOTEBOOK.md, "Issue 42, session 31").
 const WHOLE_FRACTION: usize = 8;
-
-impl super::World {
-    /// Partial global updates run so far (the pairs of the bodies that moved past the margin
-    /// decided again, `collide/broad/partial.rs`), and the bodies they updated in all.
-    pub fn partial_global_updates(&self) -> (u64, u64) {
-        (
-            self.proximity.partial_updates,
-            self.proximity.partial_bodies,
-        )
-    }
-}
