@@ -41,7 +41,7 @@
 //! too. A change of `δ_c` or `ε_s` drops every reused scan.
 
 use super::{Collider, VeCandidate};
-use crate::geom::Vec2;
+use crate::geom::{select_min, Vec2};
 
 /// Candidates a reused scan can hold; a pair with more is scanned every sample.
 pub(super) const SLOT: usize = 4;
@@ -67,7 +67,9 @@ impl Slack {
     /// Records a comparison of a quantity `slack` (m) away from its threshold.
     #[inline(always)]
     pub fn decided(&mut self, slack: f64) {
-        self.decided = least(self.decided, slack);
+        // A running least that is never NaN: `f64::min`'s NaN fix-up is not needed (a NaN
+        // `slack` keeps it).
+        self.decided = select_min(slack, self.decided);
     }
 
     /// The scan's certificate: `σ` (m) and the levers `l_A`, `l_B` (m/rad) of the module docs, or
@@ -83,29 +85,6 @@ impl Slack {
         let sigma = self.decided.min(self.inside).min(delta_c) - guard;
         let (l_a, l_b) = (lever(a, delta_c, eps_s), lever(b, delta_c, eps_s));
         (sigma > 0.0 && l_a.is_finite() && l_b.is_finite()).then_some((sigma, l_a, l_b))
-    }
-}
-
-/// `x.min(y)` for a running least `x` that is never NaN (started at a number, updated only by
-/// this): a compare and a select, where `f64::min` also tests `x` for NaN. For such an `x` the two
-/// agree on every `y` (a NaN `y` keeps `x`); where `x` and `y` are zeros of both signs either
-/// sign is the least, and the scans only compare it or subtract from it.
-#[inline(always)]
-pub(super) fn least(x: f64, y: f64) -> f64 {
-    if y < x {
-        y
-    } else {
-        x
-    }
-}
-
-/// `x.max(y)` for a running greatest `x` that is never NaN: [`least`] mirrored.
-#[inline(always)]
-pub(super) fn greatest(x: f64, y: f64) -> f64 {
-    if y > x {
-        y
-    } else {
-        x
     }
 }
 
@@ -164,13 +143,12 @@ impl PairCandidates {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
-
-    /// For a running value `x` that is a number, `least`/`greatest` give `f64::min`/`f64::max`
-    /// on every `y` (as values: zeros of both signs compare equal), NaN, ±∞ and ±0 included, and
-    /// a NaN `y` keeps `x`.
+    /// For a running value `x` that is a number, `select_min(y, x)`/`select_max(y, x)` (the scans'
+    /// running least and greatest) give `f64::min`/`f64::max` on every `y` (as values: zeros of
+    /// both signs compare equal), NaN, ±∞ and ±0 included, and a NaN `y` keeps `x`.
     #[test]
-    fn least_and_greatest_are_min_and_max_for_a_running_number() {
+    fn running_least_and_greatest_are_min_and_max_for_a_running_number() {
+        use crate::geom::{select_max, select_min};
         use rand::{Rng, SeedableRng};
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(31);
         let mut values = vec![
@@ -187,11 +165,11 @@ mod tests {
         );
         let ys = values.iter().copied().chain([f64::NAN]);
         for (x, y) in values.iter().flat_map(|&x| ys.clone().map(move |y| (x, y))) {
-            assert_eq!(least(x, y), x.min(y), "least({x}, {y})");
-            assert_eq!(greatest(x, y), x.max(y), "greatest({x}, {y})");
+            assert_eq!(select_min(y, x), x.min(y), "least({x}, {y})");
+            assert_eq!(select_max(y, x), x.max(y), "greatest({x}, {y})");
             if y.is_nan() {
-                assert_eq!(least(x, y).to_bits(), x.to_bits());
-                assert_eq!(greatest(x, y).to_bits(), x.to_bits());
+                assert_eq!(select_min(y, x).to_bits(), x.to_bits());
+                assert_eq!(select_max(y, x).to_bits(), x.to_bits());
             }
         }
     }

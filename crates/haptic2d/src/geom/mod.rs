@@ -34,6 +34,18 @@ pub fn select_max(x: f64, y: f64) -> f64 {
     }
 }
 
+/// The smaller of `x` and `y` as one compare-select (`minsd`): `x` if `x < y`, else `y` (so `y`
+/// when `x` is NaN): [`select_max`] mirrored. A running least `m` kept as `m = select_min(d, m)`
+/// never becomes NaN once it is a number.
+#[inline(always)]
+pub fn select_min(x: f64, y: f64) -> f64 {
+    if x < y {
+        x
+    } else {
+        y
+    }
+}
+
 /// `perp(a) = (−a_y, a_x)`: `a` rotated by +90° (§0.3).
 #[inline]
 pub fn perp(a: Vec2) -> Vec2 {

@@ -2,9 +2,9 @@
 //! against its edge of least depth, with the corner-on-corner rule at a corner of two edges.
 
 use super::{Ctx, Side};
-use crate::collide::reuse::{greatest, least, Slack};
+use crate::collide::reuse::Slack;
 use crate::collide::{Collider, VeCandidate};
-use crate::geom::Vec2;
+use crate::geom::{select_max, select_min, Vec2};
 
 impl Ctx {
     /// Penetrating pair (§9.4): every vertex of `a` inside `b` or within `δ_c` of it, against the
@@ -91,11 +91,11 @@ impl Ctx {
                         continue 'vertex;
                     }
                 }
-                max_all = greatest(max_all, d);
+                max_all = select_max(d, max_all);
                 if b.c.seams != 0 && b.c.is_seam(e) {
-                    max_seam = greatest(max_seam, d);
+                    max_seam = select_max(d, max_seam);
                     // A seam is no surface of B's body: never the vertex's contact normal.
-                    slack.decided(least(self.delta_c - d, (d + self.delta_c).abs()));
+                    slack.decided(select_min((d + self.delta_c).abs(), self.delta_c - d));
                     continue;
                 }
                 if d > max_d {
@@ -103,10 +103,10 @@ impl Ctx {
                     max_d = d;
                     nearest = e;
                 } else {
-                    second = greatest(second, d);
+                    second = select_max(d, second);
                 }
                 near_lines += (d >= -self.delta_c) as u32;
-                slack.decided(least(self.delta_c - d, (d + self.delta_c).abs()));
+                slack.decided(select_min((d + self.delta_c).abs(), self.delta_c - d));
             }
             slack.decided(0.5 * (max_d - second));
             if max_all < 0.0 {
