@@ -337,12 +337,13 @@ impl DeviceSide {
             let now = now_ns();
             self.stats.arrived(now, m.echo_time_ns, m.echo_age_ns);
             (self.last, self.last_k, self.last_arrival_ns) = (Some(m), k, now);
-            if m.flags & FLAG_BYE != 0 {
-                return Err(self.stop(t, Latch::WorldClosed));
-            }
+            // The link kind first: a world that stopped on the mismatch says goodbye with it.
             let world_waves = m.flags & FLAG_WAVE != 0;
             if world_waves != self.wave.is_some() {
                 return Err(self.stop(t, Latch::Mismatch { world_waves }));
+            }
+            if m.flags & FLAG_BYE != 0 {
+                return Err(self.stop(t, Latch::WorldClosed));
             }
         }
         let silent = k.saturating_sub(self.last_k);

@@ -217,13 +217,7 @@ impl WorldSide {
         let now = now_ns();
         let msg = PortMessage {
             seq: self.seq,
-            flags: if self.tdpa {
-                FLAG_TDPA
-            } else if self.wave.is_some() {
-                FLAG_WAVE
-            } else {
-                0
-            },
+            flags: self.method_flags(),
             time_ns: now,
             echo_time_ns: self.last.map_or(0, |m| m.time_ns),
             echo_age_ns: u32::try_from(now.saturating_sub(self.last_arrival_ns))
@@ -261,14 +255,27 @@ impl WorldSide {
 }
 
 impl WorldSide {
-    /// Tells the device side the session is over and latched (three times, past the impairment):
-    /// a slave device that stopped stops its master at once rather than after its link timeout.
+    /// `FLAG_TDPA` or `FLAG_WAVE` as this end runs.
+    fn method_flags(&self) -> u32 {
+        if self.tdpa {
+            FLAG_TDPA
+        } else if self.wave.is_some() {
+            FLAG_WAVE
+        } else {
+            0
+        }
+    }
+
+    /// Tells the device side the session is over and latched (three times, past the impairment),
+    /// with this end's link kind: a slave device that stopped stops its master at once rather
+    /// than after its link timeout, and a device side running the other link kind hears why even
+    /// when this end stops before any of its delayed messages left the impairment queue.
     fn bye(&mut self) {
         for _ in 0..3 {
             self.seq = self.seq.wrapping_add(1);
             let msg = PortMessage {
                 seq: self.seq,
-                flags: FLAG_BYE | FLAG_LATCHED,
+                flags: FLAG_BYE | FLAG_LATCHED | self.method_flags(),
                 time_ns: now_ns(),
                 energy_in: self.ports.energy_in(),
                 energy_out: self.ports.energy_out(),
@@ -367,7 +374,7 @@ pub fn run(a: &ServeWorldArgs) -> Result<Status, Failure> {
     let summary =
         run_loop(&config, &stop as &AtomicBool, |info| side.tick(&info)).map_err(Failure::error)?;
     side.plant.zero();
-    if side.plant.stop().is_some() {
+    if side.plant.stop().is_some() || side.end.is_some_and(|e| e.starts_with("link mismatch")) {
         side.bye();
     }
     report(&mut side, &summary);

@@ -379,6 +379,49 @@ fn a_wave_device_side_against_a_tdpa_world_latches_and_says_link_mismatch() {
     assert_has(&r.device, &says);
 }
 
+/// The same mismatch when the world side stops before any of its own (delayed) messages has left
+/// its impairment queue: its goodbye carries its link kind, so the device side still says
+/// "link mismatch" rather than waiting out a lost link. Pinned deterministically by a world whose
+/// outgoing delay (400 ms) is far longer than the device side's first message takes to arrive.
+#[test]
+fn a_world_that_stops_on_a_mismatch_before_sending_says_goodbye_with_its_link_kind() {
+    let _turn = crate::common::loop_turn(module_path!());
+    let key = key_file("mismatch-early", 0x5b);
+    let world = World::start(
+        &key,
+        &[
+            "--link",
+            "tdpa",
+            "--delay-ms",
+            "400",
+            "--link-timeout-ms",
+            "300",
+        ],
+    );
+    let (status, text) = device(
+        &world,
+        &key,
+        &[
+            "--link",
+            "wave",
+            "--link-timeout-ms",
+            "300",
+            "--duration",
+            "3",
+            "--no-rt",
+            "--max-stall-periods",
+            "100",
+        ],
+    );
+    let w = world.finish(Duration::from_secs(10));
+    assert_eq!(status, 3, "{text}\n{w}");
+    let says = [
+        "link mismatch: the world side runs force/velocity",
+        "torques set to zero and latched",
+    ];
+    assert_has(&text, &says);
+}
+
 #[test]
 fn a_silent_world_latches_zero_torques_and_says_lost_link() {
     let _turn = crate::common::loop_turn(module_path!());
