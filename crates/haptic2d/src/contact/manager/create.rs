@@ -33,16 +33,14 @@ impl ContactSet {
         for c in self.new_count.iter_mut() {
             *c = 0;
         }
-        // Rule 1, one vertex–collider group at a time (entries of a group are adjacent).
-        let mut g = 0;
-        while g < self.entries.len() {
-            let mut h = g + 1;
-            while h < self.entries.len() && same_group(&self.entries[g].key, &self.entries[h].key) {
-                h += 1;
-            }
+        // Rule 1, one vertex–collider group at a time (entries of a group are adjacent), in key
+        // order: only the groups with a touching pair without a record (`may_touch`), found by
+        // one cheap pass, are looked at.
+        let mut i = 0;
+        while let Some((g, h)) = next_group(&self.entries, i, |e| may_touch(e, p)) {
+            i = h;
             // A group with a record creates nothing (rule 1: one record per vertex).
             if self.entries[g..h].iter().any(|e| e.is_contact()) {
-                g = h;
                 continue;
             }
             let touching = self.entries[g..h]
@@ -76,7 +74,6 @@ impl ContactSet {
                 } else if depth_ok(key, colliders, dc, cos) {
                     key.edge
                 } else {
-                    g = h;
                     continue;
                 };
                 if edge != key.edge
@@ -88,7 +85,6 @@ impl ContactSet {
                         cos,
                     )
                 {
-                    g = h;
                     continue;
                 }
                 let target = self.entries[g..h]
@@ -114,7 +110,6 @@ impl ContactSet {
                     }
                 }
             }
-            g = h;
         }
         if !self.pending.is_empty() {
             self.entries.extend_from_slice(&self.pending);
@@ -141,14 +136,10 @@ impl ContactSet {
             }
         }
         if any && p.impacts {
-            let mut g = 0;
-            while g < self.entries.len() {
-                let mut h = g + 1;
-                while h < self.entries.len()
-                    && same_group(&self.entries[g].key, &self.entries[h].key)
-                {
-                    h += 1;
-                }
+            // Only a group with a pair that approaches while apart (`may_strike`) can pick one.
+            let mut i = 0;
+            while let Some((g, h)) = next_group(&self.entries, i, |e| may_strike(e, p)) {
+                i = h;
                 if !self.entries[g..h].iter().any(|e| e.is_contact()) {
                     let flag = &self.body_flag;
                     let (entries, pending) = (&self.entries, &self.pending);
@@ -171,7 +162,6 @@ impl ContactSet {
                         self.new_count[e.body_a] += 1;
                     }
                 }
-                g = h;
             }
         }
         // Effective masses for the braking pulse: the pair's reduced mass shared by the contacts that
@@ -222,6 +212,43 @@ fn found_inside(
     if (seams || clip) && e.hist >= 2 && e.d[0] < 0.0 && e.d[1] < -delta_c {
         laws.impact_resolved(e.law, e.d, 0);
     }
+}
+
+/// The vertex–collider group (entries `g..h`, adjacent in key order) of the first entry at or
+/// after `from` that `hint` accepts; `None` when no entry from there on does. A pass that looks
+/// only at such groups, continuing from `h`, visits in key order the groups of the pass over
+/// every group that can act, when `hint` holds for every entry on which that pass acts.
+#[inline]
+fn next_group(
+    entries: &[VeContact],
+    from: usize,
+    hint: impl Fn(&VeContact) -> bool,
+) -> Option<(usize, usize)> {
+    let i = from + entries.get(from..)?.iter().position(hint)?;
+    let key = &entries[i].key;
+    let g = entries[..i]
+        .iter()
+        .rposition(|e| !same_group(&e.key, key))
+        .map_or(0, |k| k + 1);
+    let h = i + entries[i..]
+        .iter()
+        .position(|e| !same_group(&e.key, key))
+        .unwrap_or(entries.len() - i);
+    Some((g, h))
+}
+
+/// A pair without a record within `δ_on` of its edge line: rule 1's `touching` test without
+/// the range test (it holds wherever that test does).
+#[inline(always)]
+fn may_touch(e: &VeContact, p: ContactParams) -> bool {
+    e.state.is_none() && e.d[0] <= p.delta_on
+}
+
+/// A pair without a record, apart and approaching faster than `v_c`: the part of rule 2's pick
+/// that reads the entry alone (it holds wherever the pick does, whose group has no record).
+#[inline(always)]
+fn may_strike(e: &VeContact, p: ContactParams) -> bool {
+    e.state.is_none() && e.d[0] > 0.0 && e.c0 < -p.v_c
 }
 
 #[inline]
@@ -382,4 +409,118 @@ fn crossed_edge(
         }
     }
     best.map(|(_, e)| e)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{next_group, same_group};
+    use crate::body::Body;
+    use crate::collide::{Collider, VeCandidate};
+    use crate::contact::manager::sync::new_entry;
+    use crate::contact::manager::PastPoses;
+    use crate::contact::record::{ContactState, VeContact};
+    use crate::geom::{ConvexPolygon, Pose};
+
+    /// A tracked pair of a box on a floor, to copy with other keys, states and depths.
+    fn template() -> VeContact {
+        let bodies = [
+            Body::dynamic("box", 1.0, 1e-3, Pose::new(0.0, 0.05, 0.0)),
+            Body::fixed("floor", Pose::new(0.0, -0.1, 0.0)),
+        ];
+        let colliders = [
+            Collider::new(
+                0,
+                true,
+                ConvexPolygon::rectangle(0.1, 0.1).unwrap(),
+                &bodies[0].pose,
+            ),
+            Collider::new(
+                1,
+                false,
+                ConvexPolygon::rectangle(2.0, 0.2).unwrap(),
+                &bodies[1].pose,
+            ),
+        ];
+        let key = VeCandidate {
+            vertex_collider: 0,
+            vertex: 0,
+            edge_collider: 1,
+            edge: 2,
+        };
+        let past = PastPoses {
+            prev: &[],
+            prev2: &[],
+        };
+        new_entry(0, key, &colliders, &bodies, &past)
+    }
+
+    /// Over 3 000 seeded random sorted entry lists (groups of one to four entries, some with a
+    /// record), the groups `next_group` visits from 0, each search going on from the last group's
+    /// end, are exactly the groups that the walk over every group finds to hold an entry the hint
+    /// accepts, in the same order.
+    #[test]
+    fn groups_found_by_a_hint_are_the_groups_with_an_accepted_entry() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut below = move |n: u64| {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (state >> 33) % n
+        };
+        let base = template();
+        let hint = |e: &VeContact| e.state.is_none() && e.d[0] <= 0.0;
+        let (mut visited, mut passed) = (0, 0);
+        for _ in 0..3_000 {
+            let mut entries: Vec<VeContact> = (0..below(40))
+                .map(|_| {
+                    let mut e = base;
+                    e.key = VeCandidate {
+                        vertex_collider: below(5) as u32,
+                        vertex: below(3) as u32,
+                        edge_collider: below(3) as u32,
+                        edge: below(4) as u32,
+                    };
+                    e.state = (below(4) == 0).then_some(ContactState::Continuous);
+                    e.d[0] = below(100) as f64 * 1e-3 - 0.08;
+                    e
+                })
+                .collect();
+            entries.sort_by_key(|e| e.key);
+            entries.dedup_by_key(|e| e.key);
+            // Every group, by a walk over all entries.
+            let mut all = Vec::new();
+            let mut g = 0;
+            while g < entries.len() {
+                let mut h = g + 1;
+                while h < entries.len() && same_group(&entries[g].key, &entries[h].key) {
+                    h += 1;
+                }
+                all.push((g, h));
+                g = h;
+            }
+            let wanted: Vec<_> = all
+                .iter()
+                .copied()
+                .filter(|&(g, h)| entries[g..h].iter().any(hint))
+                .collect();
+            let mut found = Vec::new();
+            let mut i = 0;
+            while let Some((g, h)) = next_group(&entries, i, hint) {
+                found.push((g, h));
+                i = h;
+            }
+            assert_eq!(
+                found,
+                wanted,
+                "{:?}",
+                entries.iter().map(|e| e.key).collect::<Vec<_>>()
+            );
+            visited += found.len();
+            passed += all.len() - found.len();
+        }
+        assert!(
+            visited > 5_000 && passed > 5_000,
+            "{visited} groups visited, {passed} passed over"
+        );
+    }
 }
