@@ -330,11 +330,8 @@ impl ContactSet {
 #[cfg(test)]
 mod tests {
     use super::{crossing_index, mark_pairs, own_axis_clears};
-    use crate::body::Body;
-    use crate::collide::{Collider, VeCandidate};
-    use crate::contact::manager::sync::new_entry;
-    use crate::contact::manager::PastPoses;
-    use crate::geom::{ConvexPolygon, Pose};
+    use crate::contact::manager::{box_on_floor, fresh_entry};
+    use crate::geom::Pose;
 
     /// A 0.1 m box rocking and sliding on a floor, its bottom-right corner on the floor's top
     /// edge: over 20 000 seeded random motions (some in place) the remembered own-axis test answers
@@ -343,36 +340,9 @@ mod tests {
     #[test]
     fn remembered_own_axis_test_answers_as_the_full_test() {
         let floor_pose = Pose::new(0.3, -0.1, 0.0);
-        let mut bodies = vec![
-            Body::dynamic("box", 1.0, 1e-3, Pose::new(0.0, 0.048, 0.0)),
-            Body::fixed("floor", floor_pose),
-        ];
-        let mut colliders = vec![
-            Collider::new(
-                0,
-                true,
-                ConvexPolygon::rectangle(0.1, 0.1).unwrap(),
-                &bodies[0].pose,
-            ),
-            Collider::new(
-                1,
-                false,
-                ConvexPolygon::rectangle(2.0, 0.2).unwrap(),
-                &floor_pose,
-            ),
-        ];
-        let key = VeCandidate {
-            vertex_collider: 0,
-            vertex: 1,
-            edge_collider: 1,
-            edge: 2,
-        };
-        let past = PastPoses {
-            prev: &[],
-            prev2: &[],
-        };
+        let (mut bodies, mut colliders, key) = box_on_floor(Pose::new(0.0, 0.048, 0.0), floor_pose);
         let margin = 1e-3;
-        let mut remembered = new_entry(0, key, &colliders, &bodies, &past);
+        let mut remembered = fresh_entry(key, &colliders, &bodies);
         let mut state = 0x9e37_79b9_7f4a_7c15u64;
         let mut uniform = move || {
             state = state
@@ -390,7 +360,7 @@ mod tests {
             }
             let pose = bodies[0].pose;
             colliders[0].update(&pose);
-            let fresh = new_entry(0, key, &colliders, &bodies, &past);
+            let fresh = fresh_entry(key, &colliders, &bodies);
             remembered.d = fresh.d;
             let full = own_axis_clears(&mut fresh.clone(), &colliders, &bodies, margin);
             let answer = own_axis_clears(&mut remembered, &colliders, &bodies, margin);

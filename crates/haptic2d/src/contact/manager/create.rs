@@ -414,44 +414,16 @@ fn crossed_edge(
 #[cfg(test)]
 mod tests {
     use super::{next_group, same_group};
-    use crate::body::Body;
-    use crate::collide::{Collider, VeCandidate};
-    use crate::contact::manager::sync::new_entry;
-    use crate::contact::manager::PastPoses;
+    use crate::collide::VeCandidate;
+    use crate::contact::manager::{box_on_floor, fresh_entry};
     use crate::contact::record::{ContactState, VeContact};
-    use crate::geom::{ConvexPolygon, Pose};
+    use crate::geom::Pose;
 
     /// A tracked pair of a box on a floor, to copy with other keys, states and depths.
     fn template() -> VeContact {
-        let bodies = [
-            Body::dynamic("box", 1.0, 1e-3, Pose::new(0.0, 0.05, 0.0)),
-            Body::fixed("floor", Pose::new(0.0, -0.1, 0.0)),
-        ];
-        let colliders = [
-            Collider::new(
-                0,
-                true,
-                ConvexPolygon::rectangle(0.1, 0.1).unwrap(),
-                &bodies[0].pose,
-            ),
-            Collider::new(
-                1,
-                false,
-                ConvexPolygon::rectangle(2.0, 0.2).unwrap(),
-                &bodies[1].pose,
-            ),
-        ];
-        let key = VeCandidate {
-            vertex_collider: 0,
-            vertex: 0,
-            edge_collider: 1,
-            edge: 2,
-        };
-        let past = PastPoses {
-            prev: &[],
-            prev2: &[],
-        };
-        new_entry(0, key, &colliders, &bodies, &past)
+        let (bodies, colliders, key) =
+            box_on_floor(Pose::new(0.0, 0.05, 0.0), Pose::new(0.0, -0.1, 0.0));
+        fresh_entry(key, &colliders, &bodies)
     }
 
     /// Over 3 000 seeded random sorted entry lists (groups of one to four entries, some with a

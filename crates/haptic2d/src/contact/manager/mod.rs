@@ -436,6 +436,61 @@ fn start_continuous(e: &mut VeContact, tick: u64, events: &mut Vec<ContactEvent>
     });
 }
 
+/// A 0.1 m box (body and collider 0, at `box_pose`) over a fixed 2 m × 0.2 m floor (body and
+/// collider 1, at `floor_pose`), and the key of the box's vertex 1 against the floor's top edge
+/// (edge 2), for the stages' tests.
+#[cfg(test)]
+fn box_on_floor(
+    box_pose: Pose,
+    floor_pose: Pose,
+) -> (
+    Vec<crate::body::Body>,
+    Vec<crate::collide::Collider>,
+    VeCandidate,
+) {
+    use crate::{body::Body, collide::Collider, geom::ConvexPolygon};
+    let bodies = vec![
+        Body::dynamic("box", 1.0, 1e-3, box_pose),
+        Body::fixed("floor", floor_pose),
+    ];
+    let colliders = vec![
+        Collider::new(
+            0,
+            true,
+            ConvexPolygon::rectangle(0.1, 0.1).unwrap(),
+            &box_pose,
+        ),
+        Collider::new(
+            1,
+            false,
+            ConvexPolygon::rectangle(2.0, 0.2).unwrap(),
+            &floor_pose,
+        ),
+    ];
+    let key = VeCandidate {
+        vertex_collider: 0,
+        vertex: 1,
+        edge_collider: 1,
+        edge: 2,
+    };
+    (bodies, colliders, key)
+}
+
+/// The tracked pair `key` measured now, without past poses (`sync::new_entry`), for the stages'
+/// tests.
+#[cfg(test)]
+fn fresh_entry(
+    key: VeCandidate,
+    colliders: &[crate::collide::Collider],
+    bodies: &[crate::body::Body],
+) -> VeContact {
+    let past = PastPoses {
+        prev: &[],
+        prev2: &[],
+    };
+    sync::new_entry(0, key, colliders, bodies, &past)
+}
+
 #[cfg(test)]
 mod tests {
     use crate::contact::record::{ContactState, EventKind};
