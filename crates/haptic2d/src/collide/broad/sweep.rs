@@ -50,9 +50,13 @@ impl BroadPhase {
                     let overlaps =
                         (ej.min_y <= ei.max_y) & (ei.min_y <= ej.max_y) & (ei.min_x <= ej.max_x);
                     if CERTIFY {
-                        // The y gap to a box it could be paired with but does not overlap,
-                        // without a branch either (`certify_gap`).
-                        cert.gap = certify_gap(cert.gap, &ei, ej, overlaps);
+                        // The y gap to a box it could be paired with but does not overlap.
+                        let gap = if overlaps || unpaired(&ei, ej) {
+                            f64::INFINITY
+                        } else {
+                            (ej.min_y - ei.max_y).max(ei.min_y - ej.max_y)
+                        };
+                        cert.gap = cert.gap.min(gap);
                     }
                     bits |= (overlaps as u64) << k;
                 }
@@ -146,20 +150,4 @@ impl BroadPhase {
         let to = *self.cache_start.get(a as usize + 1)? as usize;
         Some(from + self.cache_pairs[from..to].iter().position(|p| p.1 == b)?)
     }
-}
-
-/// The certificate's gap `gap` (m) with box `ej` of `ei`'s run taken in: `ej`'s y gap to `ei`
-/// (m) when the two could be paired (not of one body, not both fixed) but do not overlap
-/// (`overlaps`), else unchanged. The same `f64::min` of the same values as a branch per box would
-/// take, in the same order, so the same certificate; but every term is computed and the unwanted
-/// one replaced by `+∞` with a select, so the sweep's y test stays free of branches a pile's
-/// random pattern of overlaps would mispredict (a certified whole update of pile:1000 landing
-/// spent 60 % of its 4.4 M instructions on the branchy form; `docs/perf-s32-broad.md`).
-#[inline(always)]
-fn certify_gap(gap: f64, ei: &SweepEntry, ej: &SweepEntry, overlaps: bool) -> f64 {
-    let same_body = (ei.body ^ ej.body) < 2;
-    let both_fixed = (ei.body | ej.body) & 1 == 0;
-    let y_gap = (ej.min_y - ei.max_y).max(ei.min_y - ej.max_y);
-    let skip = overlaps | same_body | both_fixed;
-    gap.min(if skip { f64::INFINITY } else { y_gap })
 }
