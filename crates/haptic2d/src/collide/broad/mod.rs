@@ -42,6 +42,8 @@ mod spread;
 mod sweep;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_axis;
 
 use self::axis::{sweep_axis, Axis};
 use super::gjk::{gjk_distance, GjkCache};

@@ -62,7 +62,7 @@ fn grid(shift: f64, pitch: f64) -> Vec<Collider> {
 }
 
 /// A seeded xorshift generator of uniform numbers in `[0, 1)`.
-fn uniform(seed: u64) -> impl FnMut() -> f64 {
+pub(super) fn uniform(seed: u64) -> impl FnMut() -> f64 {
     let mut rng = seed;
     move || {
         rng ^= rng << 13;
