@@ -1,7 +1,7 @@
 //! Tests of the sweep axis (`axis.rs`): the same result swept along x and along y, against a
 //! test of every pair, on wide and tall random worlds; and the axis chosen.
 
-use super::tests::uniform;
+use super::tests::{uniform, update_along};
 use super::*;
 use crate::geom::{ConvexPolygon, Pose};
 
@@ -34,28 +34,6 @@ fn world(
             (Collider::new(body, dynamic, shape.unwrap(), &pose), pose)
         })
         .collect()
-}
-
-/// One update of `bp` for `cols` with odometers `odo` (m), its sweep along `axis` whatever
-/// [`sweep_axis`] would choose: `begin`'s sweep rebuilt along `axis`, then published.
-fn update_along(
-    bp: &mut BroadPhase,
-    cols: &[Collider],
-    odo: &[f64],
-    axis: Axis,
-) -> Vec<(u32, u32)> {
-    bp.begin_with_motion(cols, odo);
-    let half = 0.5 * bp.delta_prox;
-    bp.sweep.clear();
-    for (i, c) in cols.iter().enumerate() {
-        bp.sweep
-            .push(SweepEntry::along(i, c, c.aabb.inflated(half), axis));
-    }
-    bp.sweep.sort_unstable_by(sweep_order);
-    bp.axis = axis;
-    let mut out = Vec::new();
-    bp.publish(&mut out);
-    out
 }
 
 /// Every pair of two bodies, not both fixed, with its cold GJK distance (m), when their inflated
