@@ -1,4 +1,4 @@
-//! The global proximity stage (§9.1): inflated AABBs, sort-and-sweep on x, then GJK distance.
+//! The global proximity stage (§9.1): inflated AABBs, sort-and-sweep on x or y, then GJK distance.
 //!
 //! # The algorithm
 //!
@@ -6,7 +6,8 @@
 //!
 //! 1. Each collider's world AABB is enlarged by `δ_prox/2` on every side, so two boxes overlap
 //!    whenever the polygons are closer than `δ_prox` (a necessary condition).
-//! 2. Sort-and-sweep: the boxes are sorted by `(min.x, collider index)` (a total order, so the
+//! 2. Sort-and-sweep along x or y, whichever meets fewer boxes (`axis.rs`; said here for x): the
+//!    boxes are sorted by `(min.x, collider index)` (a total order, so the
 //!    result does not depend on the sort algorithm) and each box is tested only against the boxes
 //!    that start before it ends in x; y overlap is then checked directly, 64 boxes at a time into
 //!    a bit mask (no branch per box: on a pile, which box of the run overlaps in y follows no
@@ -28,11 +29,12 @@
 //! ```
 //!
 //! The folder, one concern a file: this file the stage's types, its buffers and the whole update;
-//! `sweep.rs` the sort-and-sweep and the pair test (with reused distances); `spread.rs` an update
+//! `axis.rs` the sweep's axis; `sweep.rs` the sort-and-sweep and the pair test (with reused distances); `spread.rs` an update
 //! spread over the samples of a period; `publish.rs` the merge or in-place patch that publishes
 //! an update; `skip.rs` the certificate that lets the world skip an update that cannot change the
 //! set; `partial.rs` the partial update of the bodies that moved past the margin.
 
+mod axis;
 mod partial;
 mod publish;
 mod skip;
@@ -40,7 +42,10 @@ mod spread;
 mod sweep;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_axis;
 
+use self::axis::{sweep_axis, Axis};
 use super::gjk::{gjk_distance, GjkCache};
 use super::Collider;
 use crate::geom::{Aabb, Vec2};
@@ -76,7 +81,8 @@ pub struct BroadStats {
 /// One box in the sweep: the inflated box's x and y ranges, the collider index and its body (the
 /// y range here too, so that the sweep rejects boxes apart in y without reading anything else:
 /// in a pile, every box of a column overlaps in x; the body too, so that the same-body and
-/// fixed–fixed filters need no lookup either; 40 bytes with both).
+/// fixed–fixed filters need no lookup either; 40 bytes with both). In a sweep along y
+/// (`axis.rs`) the box's axes are exchanged: `min_x`, `max_x` are then its y range.
 #[derive(Clone, Copy, Debug)]
 struct SweepEntry {
     min_x: f64,
@@ -182,6 +188,8 @@ impl Snapshot {
 pub struct BroadPhase {
     delta_prox: f64,
     sweep: Vec<SweepEntry>,
+    /// The axis `sweep` runs along (`axis.rs`).
+    axis: Axis,
     snapshot: Snapshot,
     /// Sweep position of the update in progress (`None` = no update in progress).
     next: Option<usize>,
@@ -351,6 +359,7 @@ impl BroadPhase {
         Ok(Self {
             delta_prox,
             sweep: Vec::new(),
+            axis: Axis::X,
             snapshot: Snapshot::default(),
             next: None,
             tested: Vec::new(),

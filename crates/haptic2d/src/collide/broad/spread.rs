@@ -57,11 +57,12 @@ impl BroadPhase {
         }
         self.progress = (self.wait == 0).then_some(Certificate::OPEN);
         self.wait = self.wait.saturating_sub(1);
-        // 1. Inflated boxes, sorted by (min.x, index): in the last update's order, which is
-        //    nearly sorted when the bodies move little between updates (insertion sort), or by
-        //    index (a full sort) when the colliders changed.
-        let entry = |i: usize, c: &Collider| SweepEntry::of(i, c, c.aabb.inflated(half));
-        if self.sweep.len() == colliders.len() {
+        // 1. Inflated boxes along the sweep axis (`axis.rs`), sorted by (min, index): in the last
+        //    update's order, which is nearly sorted when the bodies move little between updates
+        //    (insertion sort), or by index (a full sort) when the colliders or the axis changed.
+        let axis = sweep_axis(colliders, half);
+        let entry = |i: usize, c: &Collider| SweepEntry::along(i, c, c.aabb.inflated(half), axis);
+        if self.sweep.len() == colliders.len() && axis == self.axis {
             for e in self.sweep.iter_mut() {
                 *e = entry(e.index as usize, &colliders[e.index as usize]);
             }
@@ -73,6 +74,7 @@ impl BroadPhase {
             }
             self.sweep.sort_unstable_by(sweep_order);
         }
+        self.axis = axis;
         // Both buffers of the per-collider starts, sized here (an update in place leaves them
         // unswapped for many periods, so the second one would otherwise grow late).
         room(&mut self.cache_start, colliders.len() + 1);

@@ -22,7 +22,7 @@ impl BroadPhase {
         stop: usize,
         mut cert: Certificate,
     ) -> Certificate {
-        // 2. Sweep on x, test y, filter same-body and fixed–fixed pairs; 3. warm-started GJK per
+        // 2. Sweep along the axis (`axis.rs`; said here for x), test y, filter same-body and fixed–fixed pairs; 3. warm-started GJK per
         //    pair (each pair's result depends on its own cache only, so the order of this loop
         //    does not change any result).
         // Same body, or both fixed (the dynamic flags are the low bits): never a pair.
@@ -42,6 +42,8 @@ impl BroadPhase {
                 let to = (from + 64).min(n);
                 let mut end = to;
                 let mut bits = 0u64;
+                // With `CERTIFY`, a bit for each box apart in y by less than the gap so far.
+                let (mut nearer, gap) = (0u64, cert.gap);
                 for (k, ej) in self.sweep[from..to].iter().enumerate() {
                     if ej.min_x > ei.max_x {
                         end = from + k;
@@ -50,15 +52,20 @@ impl BroadPhase {
                     let overlaps =
                         (ej.min_y <= ei.max_y) & (ei.min_y <= ej.max_y) & (ei.min_x <= ej.max_x);
                     if CERTIFY {
-                        // The y gap to a box it could be paired with but does not overlap.
-                        let gap = if overlaps || unpaired(&ei, ej) {
-                            f64::INFINITY
-                        } else {
-                            (ej.min_y - ei.max_y).max(ei.min_y - ej.max_y)
-                        };
-                        cert.gap = cert.gap.min(gap);
+                        let lower = y_gap(&ei, ej) < gap;
+                        nearer |= ((lower & !overlaps) as u64) << k;
                     }
                     bits |= (overlaps as u64) << k;
+                }
+                // The y gap to a box it could be paired with but does not overlap: only the
+                // boxes that can lower the gap are looked at again (the smallest of the same
+                // values; the others are at least the gap already).
+                while CERTIFY && nearer != 0 {
+                    let ej = self.sweep[from + nearer.trailing_zeros() as usize];
+                    nearer &= nearer - 1;
+                    if !unpaired(&ei, &ej) {
+                        cert.gap = cert.gap.min(y_gap(&ei, &ej));
+                    }
                 }
                 while bits != 0 {
                     let ej = self.sweep[from + bits.trailing_zeros() as usize];
@@ -150,4 +157,10 @@ impl BroadPhase {
         let to = *self.cache_start.get(a as usize + 1)? as usize;
         Some(from + self.cache_pairs[from..to].iter().position(|p| p.1 == b)?)
     }
+}
+
+/// The gap in y between the boxes of two sweep entries (m; negative when they overlap in y).
+#[inline(always)]
+fn y_gap(p: &SweepEntry, q: &SweepEntry) -> f64 {
+    (q.min_y - p.max_y).max(p.min_y - q.max_y)
 }
