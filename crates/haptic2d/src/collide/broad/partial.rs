@@ -157,10 +157,22 @@ impl BroadPhase {
                 self.fixed_near.push(entry(i, c));
             }
         }
-        if self.near.len() == dynamic {
+        // The last order is kept when it holds exactly the dynamic colliders: as many, each
+        // still dynamic (distinct indices, so then all of them). A collider whose kind changed
+        // with the count unchanged makes it rebuild.
+        let mut same = self.near.len() == dynamic;
+        if same {
             for e in self.near.iter_mut() {
-                *e = entry(e.index as usize, &colliders[e.index as usize]);
+                match colliders.get(e.index as usize) {
+                    Some(c) if c.dynamic => *e = entry(e.index as usize, c),
+                    _ => {
+                        same = false;
+                        break;
+                    }
+                }
             }
+        }
+        if same {
             sort_sweep(&mut self.near);
         } else {
             self.near.clear();

@@ -688,3 +688,30 @@ fn partial_update_decides_the_moved_bodys_pairs_with_the_partners_motion() {
     let unknown = [0.0, f64::NAN, 0.0, 0.0, 0.0];
     assert_eq!(run(&mut bp, only_0, unknown), vec![(0, 1), (0, 2), (3, 4)]);
 }
+
+/// The partial update's sorted dynamic boxes (`near`) are rebuilt when a collider's kind changed,
+/// even with the number of dynamic colliders unchanged: a collider that became dynamic (not moved)
+/// is still a partner of a moved body. Before, `near` was refreshed by index whenever the count
+/// matched, so it kept the collider that became fixed and missed the one that became dynamic.
+#[test]
+fn partial_update_sees_a_collider_that_became_dynamic_with_the_count_unchanged() {
+    let mut cols = vec![
+        square(0, true, 1.0, 0.0),  // dynamic, becomes fixed
+        square(1, false, 0.0, 0.0), // fixed, becomes dynamic
+        square(2, true, 0.07, 0.0), // the moved body: 0.03 from 1, within δ_prox
+    ];
+    let mut bp = BroadPhase::new(DEFAULT_DELTA_PROX).unwrap();
+    let moved = [false, false, true];
+    let mut set = Vec::new();
+    bp.update_bodies(&cols, &moved, &[0.0; 3], &mut set);
+    assert_eq!(set, vec![(1, 2)], "a fixed partner is found");
+    cols[0].dynamic = false;
+    cols[1].dynamic = true;
+    let mut set = Vec::new();
+    bp.update_bodies(&cols, &moved, &[0.0; 3], &mut set);
+    assert_eq!(
+        set,
+        vec![(1, 2)],
+        "the partner that became dynamic is found too"
+    );
+}
