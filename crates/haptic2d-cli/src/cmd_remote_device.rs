@@ -32,7 +32,7 @@ use haptic2d::device::linalg::{V3, V4};
 use haptic2d::device::DeviceParams;
 use haptic2d::haptic::safety::{SafetyConfig, SafetyReason};
 use haptic2d::haptic::DeviceEnd;
-use haptic2d_devices::world_link::message::{FLAG_BYE, FLAG_LATCHED, FLAG_TDPA, FLAG_WAVE};
+use haptic2d_devices::world_link::message::{link_flags, FLAG_BYE, FLAG_LATCHED, FLAG_WAVE};
 use haptic2d_devices::world_link::{
     LinkEndpoint, PortMessage, KIND_TO_DEVICE, KIND_TO_WORLD, PORT_LEN,
 };
@@ -393,13 +393,7 @@ impl DeviceSide {
 
     /// `FLAG_TDPA` or `FLAG_WAVE` as this end runs.
     fn method_flags(&self) -> u32 {
-        if self.tdpa {
-            FLAG_TDPA
-        } else if self.wave.is_some() {
-            FLAG_WAVE
-        } else {
-            0
-        }
+        link_flags(self.tdpa, self.wave.is_some())
     }
 
     /// Latches zero torques, says so to the world, and stops the loop.

@@ -16,7 +16,9 @@ use std::sync::atomic::AtomicBool;
 use std::time::Duration;
 
 use haptic2d::control::tdpa::PlanarTdpa;
-use haptic2d_devices::world_link::message::{FLAG_BYE, FLAG_LATCHED, FLAG_TDPA, FLAG_WAVE};
+use haptic2d_devices::world_link::message::{
+    link_flags, FLAG_BYE, FLAG_LATCHED, FLAG_TDPA, FLAG_WAVE,
+};
 use haptic2d_devices::world_link::{
     LinkEndpoint, PortMessage, KIND_TO_DEVICE, KIND_TO_WORLD, PORT_LEN,
 };
@@ -257,13 +259,7 @@ impl WorldSide {
 impl WorldSide {
     /// `FLAG_TDPA` or `FLAG_WAVE` as this end runs.
     fn method_flags(&self) -> u32 {
-        if self.tdpa {
-            FLAG_TDPA
-        } else if self.wave.is_some() {
-            FLAG_WAVE
-        } else {
-            0
-        }
+        link_flags(self.tdpa, self.wave.is_some())
     }
 
     /// Tells the device side the session is over and latched (three times, past the impairment),

@@ -55,6 +55,18 @@ pub const FLAG_WAVE: u32 = 1 << 3;
 /// Every flag this version defines.
 pub const FLAGS: u32 = FLAG_BYE | FLAG_LATCHED | FLAG_TDPA | FLAG_WAVE;
 
+/// The link-kind flag of an end running TDPA (`tdpa`), else wave variables (`wave`), else plain
+/// force/velocity (no flag): what every message of that end carries, its goodbye included.
+pub fn link_flags(tdpa: bool, wave: bool) -> u32 {
+    if tdpa {
+        FLAG_TDPA
+    } else if wave {
+        FLAG_WAVE
+    } else {
+        0
+    }
+}
+
 /// Why a datagram was not accepted as a port message.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Refused {
