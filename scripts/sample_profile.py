@@ -16,6 +16,9 @@ Usage (docs/PERFORMANCE.md, session 30):
         --callgrind-out-file=/tmp/steps/s.out target/release/haptic2d simulate pile:1000 --duration 1.2
     python3 scripts/sample_profile.py /tmp/steps/s.out --from 0 --to 1000 --top 16
 
+`--self-test` checks the reader on a small profile written both ways callgrind writes one (with and
+without `--dump-instr=yes`).
+
 Dump `s.out.K` (K ≥ 2) holds the work from the start of step K − 2 to the start of step K − 1.
 """
 
@@ -41,11 +44,17 @@ NOT_THE_STEP = (
 
 def self_costs(path):
     """Self instructions by function name in one callgrind dump (the cost lines after `calls=`
-    are the callee's inclusive cost and are skipped)."""
+    are the callee's inclusive cost and are skipped). A cost line holds the positions named by
+    the dump's `positions:` header (`line`, or `instr line` with `--dump-instr=yes`), then the
+    events (`Ir` first)."""
     names, by, current, skip = {}, collections.Counter(), "?", False
+    cost_at = 1
     name_re = re.compile(r"c?fn=\((\d+)\)(?: (.*))?")
     with open(path, errors="replace") as f:
         for line in f:
+            if line.startswith("positions:"):
+                cost_at = len(line.split()) - 1
+                continue
             if skip:
                 skip = False
                 continue
@@ -61,9 +70,38 @@ def self_costs(path):
                 continue
             if line[:1].isdigit() or line[:1] in "+-*":
                 parts = line.split()
-                if len(parts) >= 2 and parts[1].isdigit():
-                    by[current] += int(parts[1])
+                if len(parts) > cost_at and parts[cost_at].isdigit():
+                    by[current] += int(parts[cost_at])
     return by
+
+
+def self_test():
+    """Reads the same small profile written both ways callgrind writes it (`positions: line`, and
+    `positions: instr line` with `--dump-instr=yes`) and fails unless both give each function's
+    self cost as written into it: alpha 100 + 50 (the 999 after `calls=` is beta's inclusive cost,
+    not alpha's), beta 7."""
+    import os
+    import tempfile
+
+    by_line = (
+        "version: 1\npositions: line\nevents: Ir\nfl=(1) a.rs\nfn=(1) alpha\n10 100\n+1 50\n"
+        "cfn=(2) beta\ncalls=3 20\n12 999\nfn=(2)\n20 7\n"
+    )
+    by_instr = (
+        "version: 1\npositions: instr line\nevents: Ir\nfl=(1) a.rs\nfn=(1) alpha\n0x10 10 100\n"
+        "+4 +1 50\ncfn=(2) beta\ncalls=3 0x20 20\n+4 12 999\nfn=(2)\n0x20 20 7\n"
+    )
+    for text in (by_line, by_instr):
+        with tempfile.NamedTemporaryFile("w", suffix=".out", delete=False) as f:
+            f.write(text)
+        try:
+            got = dict(self_costs(f.name))
+        finally:
+            os.unlink(f.name)
+        want = {"alpha": 150, "beta": 7}
+        if got != want:
+            sys.exit(f"sample_profile self-test: {text.split(chr(10))[1]!r} read as {got}, want {want}")
+    print("sample_profile self-test: both dump formats read alike")
 
 
 def short(name):
@@ -72,6 +110,9 @@ def short(name):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    if sys.argv[1:] == ["--self-test"]:
+        self_test()
+        return
     ap.add_argument("out", help="the --callgrind-out-file given to valgrind (its dumps are OUT.K)")
     ap.add_argument("--from", dest="lo", type=int, default=0, help="first step (default 0)")
     ap.add_argument("--to", dest="hi", type=int, default=1000, help="end step (default 1000)")
