@@ -411,6 +411,8 @@ fn slave_body(a: &ServeWorldArgs) -> Result<(SlavePlant, String), Failure> {
     }
     // The hand drives the slave: the scene's loads on it are for the world alone (as in `run`).
     world.loads.retain(|l| l.body != slave);
+    // Room for the contacts before the loop, so that a collapse does not allocate in its ticks.
+    world.reserve_contacts(world.contact_room());
     world.prime();
     let body = &world.bodies[slave];
     let what = format!(

@@ -326,6 +326,12 @@ impl ImpactSolver {
         self.cap
     }
 
+    /// Grows the sparse path's per-body buffer to `bodies` bodies (no-op if it already does), so
+    /// that the first large island on that many bodies allocates nothing.
+    pub fn reserve_bodies(&mut self, bodies: usize) {
+        self.island.reserve_bodies(bodies);
+    }
+
     /// Grows the buffers to hold impact sets of `rows` rows (no-op if they already do).
     pub fn reserve(&mut self, rows: usize) {
         if rows <= self.cap {

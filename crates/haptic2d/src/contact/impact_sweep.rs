@@ -111,6 +111,13 @@ impl SparseIsland {
             .reserve(bodies.saturating_sub(self.body_of.len()));
     }
 
+    /// Room for a body slice of `bodies` bodies (`slot_of`, which `gather` grows otherwise).
+    pub(super) fn reserve_bodies(&mut self, bodies: usize) {
+        if self.slot_of.len() < bodies {
+            self.slot_of.resize(bodies, UNSEEN);
+        }
+    }
+
     /// Gathers `rows` and the twists of their dynamic bodies from `bodies` (which the sweeps then
     /// leave alone until [`scatter`](Self::scatter)). `1/A_ii` is computed as the sweeps on the
     /// bodies computed it.

@@ -86,6 +86,12 @@ impl<T: Copy> Store<T> {
         }
     }
 
+    /// Room for `n` slots in both buffers (no-op when they have it).
+    pub(crate) fn reserve(&mut self, n: usize) {
+        self.states.reserve(n.saturating_sub(self.states.len()));
+        self.spare.reserve(n.saturating_sub(self.spare.len()));
+    }
+
     /// Puts `fresh` in a free slot, or a new one.
     pub(crate) fn put(&mut self, free: &mut Vec<u32>, fresh: T) -> u32 {
         match free.pop() {
@@ -274,6 +280,17 @@ impl LawPool {
             Slots::Compact(s) => s.get_mut(slot).normal.impact_resolved(d, hist),
             Slots::Whole(s) => s.get_mut(slot).normal.impact_resolved(d, hist),
         }
+    }
+
+    /// Room for `n` slots in the current form and its free list, so that up to `n` live records
+    /// allocate nothing (a form change, to a larger slot, still does).
+    pub(crate) fn reserve(&mut self, n: usize) {
+        match &mut self.slots {
+            Slots::Lean(s) => s.reserve(n),
+            Slots::Compact(s) => s.reserve(n),
+            Slots::Whole(s) => s.reserve(n),
+        }
+        self.free.reserve(n.saturating_sub(self.free.len()));
     }
 
     /// Moves the states of `records` (every entry whose `law` is a slot) into slots `0, 1, 2, …`

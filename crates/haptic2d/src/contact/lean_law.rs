@@ -71,6 +71,11 @@ pub(crate) struct LeanStore {
 }
 
 impl LeanStore {
+    /// Room for `n` slots.
+    pub(crate) fn reserve(&mut self, n: usize) {
+        self.slots.reserve(n);
+    }
+
     /// An empty store with room for `n` slots; its parameters are set by the first
     /// [`put`](Self::put).
     pub(crate) fn with_capacity(n: usize) -> Self {

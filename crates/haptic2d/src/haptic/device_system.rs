@@ -103,9 +103,13 @@ impl DeviceSystem {
     /// costs what the others do (a pile:1000's sample 0 is about four of its settled samples).
     /// The ticks then compute exactly what they would have without it (the first tick's world
     /// step finds its contact stage done; `haptic_tick` changes nothing the stage reads before
-    /// it). Idempotent; allocates.
+    /// it). It also gives the contact stage room for [`World::contact_room`] records
+    /// ([`World::reserve_contacts`]), so that a landing pile's collapse allocates nothing in the
+    /// loop. Idempotent; allocates.
     pub fn prime(&mut self) {
-        self.world_mut().prime();
+        let w = self.world_mut();
+        w.reserve_contacts(w.contact_room());
+        w.prime();
     }
 
     /// The world.

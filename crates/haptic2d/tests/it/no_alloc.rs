@@ -57,3 +57,45 @@ fn chain_damper_patches_do_not_allocate() {
         "only {patches} patches: the window tests too little"
     );
 }
+
+/// A landing pile's collapse grows the contact stage's and the chain damper's per-record buffers
+/// sample after sample (pile:1000: about 250 allocations, up to 1.1 MB at once), which inside
+/// `run`'s real-time loop are allocations in its ticks. Given room first, as `run` and
+/// `serve-world` do before their loops (`reserve_contacts(contact_room())`), pile:1000's fall,
+/// collapse and settling (1.2 s) allocate nothing, and every body ends bit for bit where it ends
+/// without the room.
+#[test]
+fn a_landing_pile_allocates_nothing_once_given_room_for_its_contacts() {
+    let run = |room: bool| {
+        let mut w = builtin("pile:1000", None).unwrap().unwrap().world;
+        if room {
+            let records = w.contact_room();
+            w.reserve_contacts(records);
+        }
+        w.prime();
+        let before = allocations();
+        for _ in 0..1200 {
+            w.step();
+        }
+        (allocations() - before, w)
+    };
+    let (grown, plain) = run(false);
+    let (with_room, roomy) = run(true);
+    assert!(grown > 0, "the landing allocated nothing even without room");
+    assert_eq!(with_room, 0, "allocations with room ({grown} without)");
+    assert!(roomy.contacts().contact_count() > 3000);
+    for (a, b) in plain.bodies.iter().zip(&roomy.bodies) {
+        let bits = |b: &haptic2d::body::Body| {
+            [
+                b.pose.pos.x,
+                b.pose.pos.y,
+                b.pose.angle,
+                b.vel.x,
+                b.vel.y,
+                b.omega,
+            ]
+            .map(f64::to_bits)
+        };
+        assert_eq!(bits(a), bits(b), "{}", a.name);
+    }
+}

@@ -23,6 +23,7 @@ mod hand_over;
 mod impacts;
 mod invariant;
 mod release;
+mod reserve;
 mod sync;
 
 use crate::collide::{VeCandidate, DEFAULT_DELTA_C, NEAR_PARALLEL_ANGLE};

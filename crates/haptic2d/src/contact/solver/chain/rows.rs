@@ -6,6 +6,34 @@
 use super::*;
 
 impl ChainDamping {
+    /// Grows the row buffers to hold `contacts` loaded contacts as rows (a build and the patches
+    /// after it: `place_rows`' room) and the per-body ones to `bodies` bodies, so that a sample
+    /// with at most that many allocates nothing. Changes no result: only capacities.
+    pub fn reserve(&mut self, contacts: usize, bodies: usize) {
+        fn room<T>(v: &mut Vec<T>, n: usize) {
+            v.reserve(n.saturating_sub(v.len()));
+        }
+        room(&mut self.partner, bodies);
+        room(&mut self.multi, bodies);
+        room(&mut self.solver, bodies);
+        room(&mut self.star, bodies);
+        room(&mut self.used, bodies);
+        room(&mut self.dynamic, bodies);
+        let n = contacts + contacts / 7 + 20;
+        room(&mut self.sorted, n);
+        room(&mut self.src, n);
+        room(&mut self.colour_of, n);
+        room(&mut self.hole_next, n);
+        room(&mut self.colour, n);
+        room(&mut self.keys, n);
+        room(&mut self.prev_keys, n);
+        room(&mut self.prev_lambda, n);
+        room(&mut self.place, n);
+        room(&mut self.new_place, n);
+        room(&mut self.dead, n);
+        room(&mut self.born, n);
+    }
+
     /// Steps 2–4 from scratch: the chain contacts of `loaded` (`keys` in key order, `place` the
     /// place of each in `sorted`), each with its colour, as rows in colour order (`sorted`, with
     /// `src` the loaded-list index of each), each warm-started from the last sample's impulse of
