@@ -367,7 +367,7 @@ mod tests {
                 e0: Vec2::ZERO,
                 n: Vec2::new(0.0, 1.0),
             },
-            own_axis: (f64::NAN, f64::NAN),
+            own_axis: (f64::NAN, f64::NAN, f64::NAN),
         }
     }
 

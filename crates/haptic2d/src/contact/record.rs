@@ -112,9 +112,11 @@ pub struct VeContact {
     /// The pair's geometry in the bodies' own frames (fixed for the life of the entry).
     pub local: LocalGeom,
     /// The crossing-corner stage's own-axis test, remembered (`contact/manager/clip.rs`): the
-    /// relative angle `θ_A − θ_B` (rad) at which it was last computed, and the excess (m) it found
-    /// there (the overlap along the record's normal less the record's own depth). NaN: not yet.
-    pub own_axis: (f64, f64),
+    /// relative angle `θ_A − θ_B` (rad) at which it was last computed, the excess (m) it found
+    /// there (the overlap along the record's normal less the record's own depth), and the vertex
+    /// collider's radius (m) its bound uses. NaN: not yet, or a pair with seams (never
+    /// remembered).
+    pub own_axis: (f64, f64, f64),
 }
 
 /// Body-frame geometry of a VE pair: the vertex in A's frame, the edge's start, normal and tangent

@@ -76,21 +76,21 @@ fn own_axis_clears(
     bodies: &[Body],
     margin: f64,
 ) -> bool {
+    // The remembered answer reads the record and the two bodies' poses only (the record's bodies
+    // are its colliders' bodies, `A` the vertex's). It is remembered only for a pair without
+    // seams, so a pair with seams holds NaN, which fails the comparison, as does "not yet".
+    let (pa, pb) = (&bodies[e.body_a].pose, &bodies[e.body_b].pose);
+    let phi = pa.angle - pb.angle;
+    let (phi0, excess0, radius) = e.own_axis;
+    let rounding = 1e-9 * (1.0 + pa.pos.x.abs() + pa.pos.y.abs() + pb.pos.x.abs() + pb.pos.y.abs());
+    let turned = (phi - phi0).abs() + 1e-15 * (pa.angle.abs() + pb.angle.abs() + phi0.abs());
+    if excess0 + turned * 2.0 * radius + rounding <= margin {
+        return true;
+    }
     let ca = &colliders[e.key.vertex_collider as usize];
     let cb = &colliders[e.key.edge_collider as usize];
+    debug_assert_eq!((e.body_a, e.body_b), (ca.body, cb.body));
     let plain = ca.seams == 0 && cb.seams == 0;
-    let (pa, pb) = (&bodies[ca.body].pose, &bodies[cb.body].pose);
-    let phi = pa.angle - pb.angle;
-    if plain {
-        let (phi0, excess0) = e.own_axis;
-        let rounding =
-            1e-9 * (1.0 + pa.pos.x.abs() + pa.pos.y.abs() + pb.pos.x.abs() + pb.pos.y.abs());
-        let turned = (phi - phi0).abs() + 1e-15 * (pa.angle.abs() + pb.angle.abs() + phi0.abs());
-        // NaN (not yet computed) fails the comparison.
-        if excess0 + turned * 2.0 * ca.local.radius() + rounding <= margin {
-            return true;
-        }
-    }
     own_axis_recompute(e, ca, cb, phi, plain, margin)
 }
 
@@ -112,7 +112,7 @@ fn own_axis_recompute(
         .map(|&v| -cb.edge_distance(edge, v))
         .fold(f64::NEG_INFINITY, f64::max);
     if plain {
-        e.own_axis = (phi, along + e.d[0]);
+        e.own_axis = (phi, along + e.d[0], ca.local.radius());
     }
     along <= -e.d[0] + margin && !cb.is_seam(edge) && admissible_axis(ca, cb, e.n)
 }

@@ -330,7 +330,7 @@ pub(super) fn new_entry(
         f_t: 0.0,
         since: tick,
         local,
-        own_axis: (f64::NAN, f64::NAN),
+        own_axis: (f64::NAN, f64::NAN, f64::NAN),
     }
 }
 
