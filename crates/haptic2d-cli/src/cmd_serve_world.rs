@@ -32,6 +32,11 @@ use crate::slave_plant::{BodySlave, DeviceSlave, SlavePlant, SlaveStop};
 use crate::world_link_arg::{energies, report_link, wave_totals, EndWording};
 use crate::world_link_arg::{LinkArgs, LinkStats, Outbox};
 
+/// Why a session ends when the device side runs the other link kind; such an end also says
+/// goodbye with this end's link kind (the device side may not have heard any other message).
+const LINK_MISMATCH: &str =
+    "link mismatch: one end runs wave variables, the other forces (both ends need the same --link)";
+
 /// Examples of `serve-world --help`.
 pub const EXAMPLES: &[crate::Example] = &[
     (
@@ -146,7 +151,7 @@ impl WorldSide {
             if m.flags & FLAG_BYE != 0 {
                 self.end = Some("the device side closed the session");
             } else if peer_wave != self.wave.is_some() {
-                self.end = Some("link mismatch: one end runs wave variables, the other forces (both ends need the same --link)");
+                self.end = Some(LINK_MISMATCH);
             }
         }
         fresh
@@ -370,7 +375,7 @@ pub fn run(a: &ServeWorldArgs) -> Result<Status, Failure> {
     let summary =
         run_loop(&config, &stop as &AtomicBool, |info| side.tick(&info)).map_err(Failure::error)?;
     side.plant.zero();
-    if side.plant.stop().is_some() || side.end.is_some_and(|e| e.starts_with("link mismatch")) {
+    if side.plant.stop().is_some() || side.end == Some(LINK_MISMATCH) {
         side.bye();
     }
     report(&mut side, &summary);

@@ -10,6 +10,7 @@
 #![warn(missing_docs)]
 
 pub mod body;
+mod buffers;
 pub mod collide;
 pub mod contact;
 pub mod control;

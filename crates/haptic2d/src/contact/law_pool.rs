@@ -18,6 +18,7 @@
 use super::compact_law::CompactNormal;
 use super::lean_law::{lean_pair, LeanStore};
 use super::record::{LawState, VeContact, NO_LAW};
+use crate::buffers::room;
 use crate::laws::friction::{FrictionLaw, FrictionModel, ResetIntegrator};
 use crate::laws::normal::{ContactNormal, NormalLaw, NormalModel, PaperLaw};
 
@@ -88,8 +89,8 @@ impl<T: Copy> Store<T> {
 
     /// Room for `n` slots in both buffers (no-op when they have it).
     pub(crate) fn reserve(&mut self, n: usize) {
-        self.states.reserve(n.saturating_sub(self.states.len()));
-        self.spare.reserve(n.saturating_sub(self.spare.len()));
+        room(&mut self.states, n);
+        room(&mut self.spare, n);
     }
 
     /// Puts `fresh` in a free slot, or a new one.
@@ -290,7 +291,7 @@ impl LawPool {
             Slots::Compact(s) => s.reserve(n),
             Slots::Whole(s) => s.reserve(n),
         }
-        self.free.reserve(n.saturating_sub(self.free.len()));
+        room(&mut self.free, n);
     }
 
     /// Moves the states of `records` (every entry whose `law` is a slot) into slots `0, 1, 2, …`

@@ -18,9 +18,6 @@ pub(super) struct SweptTest {
     thinnest: f64,
     /// Velocities `(v, ω)` before this sample's integration, per body.
     vel_before: Vec<(Vec2, f64)>,
-    /// Point-motion bound of each body over this sample (m), 0 for a body that is not dynamic
-    /// (filled only when the pass over the pairs runs).
-    motion: Vec<f64>,
     /// Point-motion bound of each body over this sample (m), whatever its kind (a kinematic
     /// body's motion counts in its pairs' swept test).
     reach: Vec<f64>,
@@ -42,7 +39,6 @@ impl SweptTest {
             thickness,
             thinnest,
             vel_before: vec![(Vec2::ZERO, 0.0); bodies],
-            motion: vec![0.0; bodies],
             reach: vec![0.0; bodies],
             put_back: vec![1.0; bodies],
             sweep: SweepScratch::with_capacity(max_vertices),
@@ -82,10 +78,15 @@ impl SweptTest {
         if 2.0 * max_motion <= least_allowed {
             return;
         }
-        for (i, b) in bodies.iter().enumerate() {
-            self.motion[i] = if b.is_dynamic() { self.reach[i] } else { 0.0 };
-            self.put_back[i] = 1.0;
-        }
+        self.put_back.fill(1.0);
+        // A dynamic body's motion this sample (m), 0 for any other (the swept boxes' growth).
+        let motion = |i: usize| {
+            if bodies[i].is_dynamic() {
+                self.reach[i]
+            } else {
+                0.0
+            }
+        };
         let mut hit = false;
         for &(ca, cb) in pairs {
             let (ca, cb) = (ca as usize, cb as usize);
@@ -103,7 +104,7 @@ impl SweptTest {
             // Swept boxes apart: the start AABBs (this sample's colliders), each grown by its
             // body's motion, do not overlap, so the pair cannot touch during the sample.
             let (ba, bb) = (&colliders[ca].aabb, &colliders[cb].aabb);
-            let grow = self.motion[ia] + self.motion[ib];
+            let grow = motion(ia) + motion(ib);
             if ba.min.x - bb.max.x > grow
                 || bb.min.x - ba.max.x > grow
                 || ba.min.y - bb.max.y > grow

@@ -7,8 +7,8 @@
 //! 1. Each collider's world AABB is enlarged by `δ_prox/2` on every side, so two boxes overlap
 //!    whenever the polygons are closer than `δ_prox` (a necessary condition).
 //! 2. Sort-and-sweep along x or y, whichever meets fewer boxes (`axis.rs`; said here for x): the
-//!    boxes are sorted by `(min.x, collider index)` (a total order, so the
-//!    result does not depend on the sort algorithm) and each box is tested only against the boxes
+//!    boxes are sorted by `(min.x, collider index)` (a total order, so the result does not depend
+//!    on the sort algorithm) and each box is tested only against the boxes
 //!    that start before it ends in x; y overlap is then checked directly, 64 boxes at a time into
 //!    a bit mask (no branch per box: on a pile, which box of the run overlaps in y follows no
 //!    pattern a branch predictor learns), and the marked pairs are tested in order. Pairs on the
@@ -29,10 +29,11 @@
 //! ```
 //!
 //! The folder, one concern a file: this file the stage's types, its buffers and the whole update;
-//! `axis.rs` the sweep's axis; `sweep.rs` the sort-and-sweep and the pair test (with reused distances); `spread.rs` an update
-//! spread over the samples of a period; `publish.rs` the merge or in-place patch that publishes
-//! an update; `skip.rs` the certificate that lets the world skip an update that cannot change the
-//! set; `partial.rs` the partial update of the bodies that moved past the margin.
+//! `axis.rs` the sweep's axis; `sweep.rs` the sort-and-sweep and the pair test (with reused
+//! distances); `spread.rs` an update spread over the samples of a period; `publish.rs` the merge
+//! or in-place patch that publishes an update; `skip.rs` the certificate that lets the world skip
+//! an update that cannot change the set; `partial.rs` the partial update of the bodies that moved
+//! past the margin.
 
 mod axis;
 mod partial;
@@ -48,6 +49,7 @@ mod tests_axis;
 use self::axis::{sweep_axis, Axis};
 use super::gjk::{gjk_distance, GjkCache};
 use super::Collider;
+use crate::buffers::room;
 use crate::geom::{Aabb, Vec2};
 
 /// Default proximity distance `δ_prox` (m), §9.1: `2·(1 m/s)·(0.02 s) + 0.002 m`.
@@ -140,13 +142,6 @@ fn sort_sweep(sweep: &mut [SweepEntry]) {
             sweep.sort_unstable_by(sweep_order);
             return;
         }
-    }
-}
-
-/// Grows `v`'s capacity to at least `n` (no allocation when it has that room already).
-fn room<T>(v: &mut Vec<T>, n: usize) {
-    if v.capacity() < n {
-        v.reserve(n - v.len());
     }
 }
 

@@ -35,9 +35,10 @@
 //! x window around its own (the boxes sorted by their left side, from the last partial update's
 //! order; the window is wide by the largest reach and the widest dynamic box) and against every
 //! fixed collider (few, and wide: a floor). The gap between two world boxes (a lower bound on the
-//! distance, in x or in y) rejects most; the rest get GJK at the current world vertices, warm-started from the published update's cache of the pair when
-//! it has one (read only: the published arrays stay those of the update that made them, which
-//! the spread update in progress, the skip check and the in-place patch rely on). The pairs found
+//! distance, in x or in y) rejects most; the rest get GJK at the current world vertices,
+//! warm-started from the published update's cache of the pair when it has one (read only: the
+//! published arrays stay those of the update that made them, which the spread update in
+//! progress, the skip check and the in-place patch rely on). The pairs found
 //! are sorted and merged with the kept ones, so the set stays sorted (`(a, b)`, `a < b`, the
 //! order the local stage merges by). Per update: one pass over the colliders (their boxes, a
 //! nearly linear sort) and over the set, plus, per moved collider, a binary search and its

@@ -22,9 +22,9 @@ impl BroadPhase {
         stop: usize,
         mut cert: Certificate,
     ) -> Certificate {
-        // 2. Sweep along the axis (`axis.rs`; said here for x), test y, filter same-body and fixed–fixed pairs; 3. warm-started GJK per
-        //    pair (each pair's result depends on its own cache only, so the order of this loop
-        //    does not change any result).
+        // 2. Sweep along the axis (`axis.rs`; said here for x), test y, filter same-body and
+        //    fixed–fixed pairs; 3. warm-started GJK per pair (each pair's result depends on its
+        //    own cache only, so the order of this loop does not change any result).
         // Same body, or both fixed (the dynamic flags are the low bits): never a pair.
         let unpaired = |p: &SweepEntry, q: &SweepEntry| {
             p.body >> 1 == q.body >> 1 || (p.body | q.body) & 1 == 0

@@ -3,6 +3,7 @@
 //! about 250 allocations, up to 1.1 MB at once, inside the loop's ticks).
 
 use super::ContactSet;
+use crate::buffers::room;
 
 impl ContactSet {
     /// Grows every per-record buffer of the set (the records, their law slots, the force pass's
@@ -11,9 +12,6 @@ impl ContactSet {
     /// sample with at most that many records allocates nothing. Changes no result: only
     /// capacities.
     pub fn reserve(&mut self, records: usize, colliders: usize, bodies: usize) {
-        fn room<T>(v: &mut Vec<T>, n: usize) {
-            v.reserve(n.saturating_sub(v.len()));
-        }
         room(&mut self.entries, records);
         room(&mut self.pending, records);
         room(&mut self.changes, records);

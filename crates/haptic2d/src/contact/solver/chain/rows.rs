@@ -4,22 +4,27 @@
 //! none did (steps 2–4 of [`ChainDamping::apply`]).
 
 use super::*;
+use crate::buffers::room;
+
+/// The rows the patches may append to a build of `rows` rows before the next build
+/// (`patch_rows`' budget: at most an eighth of the rows, at least 16), which a build leaves room
+/// for so that a patch allocates nothing.
+fn patch_room(rows: usize) -> usize {
+    rows / 7 + 20
+}
 
 impl ChainDamping {
     /// Grows the row buffers to hold `contacts` loaded contacts as rows (a build and the patches
     /// after it: `place_rows`' room) and the per-body ones to `bodies` bodies, so that a sample
     /// with at most that many allocates nothing. Changes no result: only capacities.
     pub fn reserve(&mut self, contacts: usize, bodies: usize) {
-        fn room<T>(v: &mut Vec<T>, n: usize) {
-            v.reserve(n.saturating_sub(v.len()));
-        }
         room(&mut self.partner, bodies);
         room(&mut self.multi, bodies);
         room(&mut self.solver, bodies);
         room(&mut self.star, bodies);
         room(&mut self.used, bodies);
         room(&mut self.dynamic, bodies);
-        let n = contacts + contacts / 7 + 20;
+        let n = contacts + patch_room(contacts);
         room(&mut self.sorted, n);
         room(&mut self.src, n);
         room(&mut self.colour_of, n);
@@ -159,22 +164,21 @@ impl ChainDamping {
         (self.holes, self.appended) = (0, 0);
         self.keys.clear();
         self.place.clear();
-        // Room for the rows the patches may append before the next build (`patch_rows`' budget:
-        // at most an eighth of the rows, at least 16), so that a patch allocates nothing.
-        let room = n / 7 + 20;
-        self.sorted.reserve(room);
-        self.src.reserve(room);
-        self.colour_of.reserve(room);
-        self.hole_next.reserve(room);
+        // Room for the rows the patches may append before the next build (`patch_room`).
+        let extra = patch_room(n);
+        self.sorted.reserve(extra);
+        self.src.reserve(extra);
+        self.colour_of.reserve(extra);
+        self.hole_next.reserve(extra);
         for keys in [&mut self.keys, &mut self.prev_keys] {
-            keys.reserve(n + room);
+            keys.reserve(n + extra);
         }
-        self.place.reserve(n + room);
-        self.new_place.reserve(n + room);
+        self.place.reserve(n + extra);
+        self.new_place.reserve(n + extra);
         self.dead.clear();
-        self.dead.reserve(room);
+        self.dead.reserve(extra);
         self.born.clear();
-        self.born.reserve(room);
+        self.born.reserve(extra);
         // A refresh that gave up may have applied impulses: start again from `v*`.
         self.reset_solver();
         let (star, multi) = (&self.star, &self.multi);
