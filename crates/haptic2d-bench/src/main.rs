@@ -39,6 +39,16 @@ use clap::Parser;
 use haptic2d::world::World;
 use std::path::PathBuf;
 
+/// The instruction set the Rust engines (haptic2d, rapier2d) were compiled for: `x86-64-v3` when
+/// built with `RUSTFLAGS="-C target-cpu=x86-64-v3"` (or for a newer CPU), else `baseline` (no
+/// AVX2 and FMA; docs/PERFORMANCE.md, "The x86-64-v3 build"). Box2D's C build is chosen by the
+/// `box2d-avx2` feature instead.
+const RUST_BUILD: &str = if cfg!(all(target_feature = "avx2", target_feature = "fma")) {
+    "x86-64-v3"
+} else {
+    "baseline"
+};
+
 /// Command-line options.
 #[derive(Parser, Debug)]
 #[command(
@@ -248,9 +258,10 @@ fn run(args: &Args) -> Result<(), String> {
         let (mut r, mut b4, mut b1) =
             peers(&h, &label, case.rapier_friction, case.rapier_restitution)?;
         eprintln!(
-            "{label}: {} warm-up + {} timed steps per engine (4 engines, box2d build {}, {:?} clock) ...",
+            "{label}: {} warm-up + {} timed steps per engine (4 engines, haptic2d build {}, box2d build {}, {:?} clock) ...",
             args.warmup,
             args.steps,
+            RUST_BUILD,
             box2d_world::BUILD,
             args.clock
         );
