@@ -58,18 +58,20 @@ impl<N: NormalLaw, F: FrictionLaw> LawState<N, F> {
 /// A tracked VE pair: a candidate from the local stage, or a contact record when `state` is set.
 ///
 /// Geometry fields are refreshed every sample; `n`, `t`, `point` are world quantities of this sample.
+///
+/// **Layout** (`repr(C, align(64))`: 256 bytes, four whole cache lines, issue 42 item 1,
+/// docs/perf-s33-layout.md). The fields are ordered by the passes of a settled sample that read
+/// them: line 0 holds what every pass reads (the state, the bodies) with the crossing-corner
+/// stage's remembered own-axis test, so that stage (`manager/clip.rs`) reads one line a record;
+/// lines 0–2 hold everything the force pass reads; the merge-and-measure pass (`manager/sync.rs`)
+/// reads all four (its key and the body-frame geometry in line 3). The tick and the entry point,
+/// read only where a record is created, fill lines 2 and 3.
 #[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
 pub struct VeContact {
-    /// Identity: (vertex collider, vertex, edge collider, edge).
-    pub key: VeCandidate,
-    /// Body owning the vertex ("A").
-    pub body_a: usize,
-    /// Body owning the edge ("B").
-    pub body_b: usize,
+    // Line 0 (bytes 0..64): every pass.
     /// `None` while only tracked; `Some(state)` for a contact record.
     pub state: Option<ContactState>,
-    /// Signed-distance history (m): `d[0] = d_k`, `d[1] = d_{k−1}`, `d[2] = d_{k−2}`.
-    pub d: [f64; 3],
     /// Number of valid entries in `d` (1..=3).
     pub hist: u8,
     /// This sample's local stage proposed the key from its vertex scan
@@ -80,6 +82,26 @@ pub struct VeContact {
     /// The last force pass listed the record among the loaded ones
     /// ([`ContactSet::loaded`](super::ContactSet::loaded): Continuous, `f_n > 0`).
     pub loaded: bool,
+    /// Slot of this record's [`LawState`] in the contact set's pool (see
+    /// [`ContactSet::laws`](super::ContactSet::laws)); [`NO_LAW`] while only tracked.
+    pub law: u32,
+    /// Body owning the vertex ("A").
+    pub body_a: usize,
+    /// Body owning the edge ("B").
+    pub body_b: usize,
+    /// The crossing-corner stage's own-axis test, remembered (`contact/manager/clip.rs`): the
+    /// relative angle `θ_A − θ_B` (rad) at which it was last computed, the excess (m) it found
+    /// there (the overlap along the record's normal less the record's own depth), and the vertex
+    /// collider's radius (m) its bound uses. NaN: not yet, or a pair with seams (never
+    /// remembered).
+    pub own_axis: (f64, f64, f64),
+    /// Normal relative velocity `C0` (m/s), positive when separating.
+    pub c0: f64,
+    /// Tangential slip velocity `S0` (m/s).
+    pub s0: f64,
+    // Line 1 (bytes 64..128): the merge and the force pass.
+    /// Signed-distance history (m): `d[0] = d_k`, `d[1] = d_{k−1}`, `d[2] = d_{k−2}`.
+    pub d: [f64; 3],
     /// Edge coordinate `s^B_k` (m).
     pub s: f64,
     /// Previous edge coordinate `s^B_{k−1}` (m).
@@ -88,35 +110,26 @@ pub struct VeContact {
     pub len: f64,
     /// World position of the vertex `V` (m).
     pub point: Vec2,
+    // Line 2 (bytes 128..192): the force pass (and the merge's normal).
     /// Outward edge normal (world); the tangent is [`VeContact::t`].
     pub n: Vec2,
-    /// Normal relative velocity `C0` (m/s), positive when separating.
-    pub c0: f64,
-    /// Tangential slip velocity `S0` (m/s).
-    pub s0: f64,
-    /// God-object edge coordinate `s_g` in B's frame (m), §8.3.
-    pub s_g: f64,
-    /// Entry point: the edge coordinate where the vertex crossed the edge line at creation (m), §8.3.
-    pub s_entry: f64,
     /// Effective mass behind the contact for the braking pulse (kg).
     pub m_eff: f64,
-    /// Slot of this record's [`LawState`] in the contact set's pool (see
-    /// [`ContactSet::laws`](super::ContactSet::laws)); [`NO_LAW`] while only tracked.
-    pub law: u32,
     /// Normal force of the last sample (N).
     pub f_n: f64,
     /// Friction force on A along `+t` of the last sample (N).
     pub f_t: f64,
+    /// God-object edge coordinate `s_g` in B's frame (m), §8.3.
+    pub s_g: f64,
+    /// Entry point: the edge coordinate where the vertex crossed the edge line at creation (m), §8.3.
+    pub s_entry: f64,
     /// Tick at which this entry was first tracked.
     pub since: u64,
+    // Line 3 (bytes 192..256): the merge.
+    /// Identity: (vertex collider, vertex, edge collider, edge).
+    pub key: VeCandidate,
     /// The pair's geometry in the bodies' own frames (fixed for the life of the entry).
     pub local: LocalGeom,
-    /// The crossing-corner stage's own-axis test, remembered (`contact/manager/clip.rs`): the
-    /// relative angle `θ_A − θ_B` (rad) at which it was last computed, the excess (m) it found
-    /// there (the overlap along the record's normal less the record's own depth), and the vertex
-    /// collider's radius (m) its bound uses. NaN: not yet, or a pair with seams (never
-    /// remembered).
-    pub own_axis: (f64, f64, f64),
 }
 
 /// Body-frame geometry of a VE pair: the vertex in A's frame, the edge's start, normal and tangent
@@ -217,6 +230,7 @@ pub enum EventKind {
 
 #[cfg(test)]
 mod tests {
+    use super::VeContact;
     use crate::geom::{ConvexPolygon, Rot, Vec2};
     use rand::{Rng, SeedableRng};
 
@@ -257,6 +271,61 @@ mod tests {
                     assert_eq!((tw.x, tw.y), (-nw.y, nw.x));
                 }
             }
+        }
+    }
+
+    /// The cache lines (64 bytes) a field at `offset` spans in a record.
+    fn lines<T>(offset: usize, _field: fn(&VeContact) -> &T) -> std::ops::RangeInclusive<usize> {
+        offset / 64..=(offset + std::mem::size_of::<T>() - 1) / 64
+    }
+
+    /// The lines of a field of `VeContact`, by name.
+    macro_rules! lines_of {
+        ($field:ident) => {
+            lines(std::mem::offset_of!(VeContact, $field), |e| &e.$field)
+        };
+    }
+
+    /// A record is four whole cache lines, and the fields a settled sample's passes read sit in
+    /// the lines its layout documents: what the crossing-corner stage's remembered test reads
+    /// (`manager/clip.rs`: the state, the bodies, the remembered answer) in line 0, everything
+    /// the force pass reads (`manager/forces.rs`, the key aside: read only when the loaded list
+    /// changes) in lines 0–2.
+    #[test]
+    fn a_record_is_four_cache_lines_with_each_pass_fields_in_its_lines() {
+        assert_eq!(std::mem::size_of::<VeContact>(), 256);
+        assert_eq!(std::mem::align_of::<VeContact>(), 64);
+        let clip = [
+            lines_of!(state),
+            lines_of!(body_a),
+            lines_of!(body_b),
+            lines_of!(own_axis),
+        ];
+        for (i, l) in clip.iter().enumerate() {
+            assert_eq!(*l, 0..=0, "clip field {i}");
+        }
+        let forces = [
+            lines_of!(state),
+            lines_of!(law),
+            lines_of!(d),
+            lines_of!(hist),
+            lines_of!(c0),
+            lines_of!(s0),
+            lines_of!(m_eff),
+            lines_of!(f_n),
+            lines_of!(f_t),
+            lines_of!(s),
+            lines_of!(s_prev),
+            lines_of!(s_g),
+            lines_of!(len),
+            lines_of!(loaded),
+            lines_of!(body_a),
+            lines_of!(body_b),
+            lines_of!(point),
+            lines_of!(n),
+        ];
+        for (i, l) in forces.iter().enumerate() {
+            assert!(*l.end() <= 2, "force-pass field {i} in lines {l:?}");
         }
     }
 }
