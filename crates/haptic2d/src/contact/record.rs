@@ -61,11 +61,11 @@ impl<N: NormalLaw, F: FrictionLaw> LawState<N, F> {
 ///
 /// **Layout** (`repr(C, align(64))`: 256 bytes, four whole cache lines, issue 42 item 1,
 /// docs/perf-s33-layout.md). The fields are ordered by the passes of a settled sample that read
-/// them: line 0 holds what every pass reads (the state, the bodies) with the crossing-corner
-/// stage's remembered own-axis test, so that stage (`manager/clip.rs`) reads one line a record;
-/// lines 0–2 hold everything the force pass reads; the merge-and-measure pass (`manager/sync.rs`)
-/// reads all four (its key and the body-frame geometry in line 3). The tick and the entry point,
-/// read only where a record is created, fill lines 2 and 3.
+/// them: lines 0 and 1 hold what both the merge-and-measure pass (`manager/sync.rs`) and the
+/// force pass read, line 2 what only the force pass reads with the crossing-corner stage's
+/// remembered own-axis test (`manager/clip.rs`, which reads lines 0 and 2), line 3 what only the
+/// merge reads (the key and the body-frame geometry): each of the two heavy passes reads three
+/// lines of four. The tick and the entry point, read only where a record is created, fill line 2.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
 pub struct VeContact {
@@ -89,19 +89,13 @@ pub struct VeContact {
     pub body_a: usize,
     /// Body owning the edge ("B").
     pub body_b: usize,
-    /// The crossing-corner stage's own-axis test, remembered (`contact/manager/clip.rs`): the
-    /// relative angle `θ_A − θ_B` (rad) at which it was last computed, the excess (m) it found
-    /// there (the overlap along the record's normal less the record's own depth), and the vertex
-    /// collider's radius (m) its bound uses. NaN: not yet, or a pair with seams (never
-    /// remembered).
-    pub own_axis: (f64, f64, f64),
     /// Normal relative velocity `C0` (m/s), positive when separating.
     pub c0: f64,
     /// Tangential slip velocity `S0` (m/s).
     pub s0: f64,
-    // Line 1 (bytes 64..128): the merge and the force pass.
     /// Signed-distance history (m): `d[0] = d_k`, `d[1] = d_{k−1}`, `d[2] = d_{k−2}`.
     pub d: [f64; 3],
+    // Line 1 (bytes 64..128): the merge and the force pass.
     /// Edge coordinate `s^B_k` (m).
     pub s: f64,
     /// Previous edge coordinate `s^B_{k−1}` (m).
@@ -110,17 +104,23 @@ pub struct VeContact {
     pub len: f64,
     /// World position of the vertex `V` (m).
     pub point: Vec2,
-    // Line 2 (bytes 128..192): the force pass (and the merge's normal).
     /// Outward edge normal (world); the tangent is [`VeContact::t`].
     pub n: Vec2,
-    /// Effective mass behind the contact for the braking pulse (kg).
-    pub m_eff: f64,
     /// Normal force of the last sample (N).
     pub f_n: f64,
+    // Line 2 (bytes 128..192): the force pass and the crossing-corner stage.
+    /// Effective mass behind the contact for the braking pulse (kg).
+    pub m_eff: f64,
     /// Friction force on A along `+t` of the last sample (N).
     pub f_t: f64,
     /// God-object edge coordinate `s_g` in B's frame (m), §8.3.
     pub s_g: f64,
+    /// The crossing-corner stage's own-axis test, remembered (`contact/manager/clip.rs`): the
+    /// relative angle `θ_A − θ_B` (rad) at which it was last computed, the excess (m) it found
+    /// there (the overlap along the record's normal less the record's own depth), and the vertex
+    /// collider's radius (m) its bound uses. NaN: not yet, or a pair with seams (never
+    /// remembered).
+    pub own_axis: (f64, f64, f64),
     /// Entry point: the edge coordinate where the vertex crossed the edge line at creation (m), §8.3.
     pub s_entry: f64,
     /// Tick at which this entry was first tracked.
@@ -286,24 +286,32 @@ mod tests {
         };
     }
 
-    /// A record is four whole cache lines, and the fields a settled sample's passes read sit in
-    /// the lines its layout documents: what the crossing-corner stage's remembered test reads
-    /// (`manager/clip.rs`: the state, the bodies, the remembered answer) in line 0, everything
-    /// the force pass reads (`manager/forces.rs`, the key aside: read only when the loaded list
-    /// changes) in lines 0–2.
+    /// A record is four whole cache lines, and the fields each pass of a settled sample reads
+    /// sit in the lines its layout documents: the merge-and-measure pass (`manager/sync.rs`,
+    /// `measure` and the merge's tests) in lines 0, 1 and 3; the force pass
+    /// (`manager/forces.rs`; the key aside, read only when the loaded list changes) in lines
+    /// 0–2; the crossing-corner stage's remembered test (`manager/clip.rs`) in lines 0 and 2.
     #[test]
     fn a_record_is_four_cache_lines_with_each_pass_fields_in_its_lines() {
         assert_eq!(std::mem::size_of::<VeContact>(), 256);
         assert_eq!(std::mem::align_of::<VeContact>(), 64);
-        let clip = [
-            lines_of!(state),
+        let sync = [
+            lines_of!(key),
             lines_of!(body_a),
             lines_of!(body_b),
-            lines_of!(own_axis),
+            lines_of!(state),
+            lines_of!(d),
+            lines_of!(hist),
+            lines_of!(nearest_edge),
+            lines_of!(s),
+            lines_of!(s_prev),
+            lines_of!(len),
+            lines_of!(point),
+            lines_of!(n),
+            lines_of!(c0),
+            lines_of!(s0),
+            lines_of!(local),
         ];
-        for (i, l) in clip.iter().enumerate() {
-            assert_eq!(*l, 0..=0, "clip field {i}");
-        }
         let forces = [
             lines_of!(state),
             lines_of!(law),
@@ -324,8 +332,24 @@ mod tests {
             lines_of!(point),
             lines_of!(n),
         ];
-        for (i, l) in forces.iter().enumerate() {
-            assert!(*l.end() <= 2, "force-pass field {i} in lines {l:?}");
+        let clip = [
+            lines_of!(state),
+            lines_of!(body_a),
+            lines_of!(body_b),
+            lines_of!(own_axis),
+        ];
+        let passes: [(&str, &[_], &[usize]); 3] = [
+            ("merge", &sync, &[0, 1, 3]),
+            ("forces", &forces, &[0, 1, 2]),
+            ("clip", &clip, &[0, 2]),
+        ];
+        for (pass, fields, allowed) in passes {
+            for (i, l) in fields.iter().enumerate() {
+                assert!(
+                    l.clone().all(|line| allowed.contains(&line)),
+                    "{pass}: field {i} in lines {l:?}"
+                );
+            }
         }
     }
 }
