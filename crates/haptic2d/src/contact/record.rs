@@ -58,21 +58,18 @@ impl<N: NormalLaw, F: FrictionLaw> LawState<N, F> {
 /// A tracked VE pair: a candidate from the local stage, or a contact record when `state` is set.
 ///
 /// Geometry fields are refreshed every sample; `n`, `t`, `point` are world quantities of this sample.
-///
-/// **Layout** (`repr(C)`: 256 bytes, 8-byte aligned, so the four 64-byte groups below are cache
-/// lines only where the vector's buffer happens to be line-aligned; issue 42 item 1,
-/// docs/perf-s33-layout.md). The fields are ordered by the passes of a settled sample that read
-/// them: lines 0 and 1 hold what both the merge-and-measure pass (`manager/sync.rs`) and the
-/// force pass read, line 2 what only the force pass reads with the crossing-corner stage's
-/// remembered own-axis test (`manager/clip.rs`, which reads lines 0 and 2), line 3 what only the
-/// merge reads (the key and the body-frame geometry): each of the two heavy passes reads three
-/// lines of four. The tick and the entry point, read only where a record is created, fill line 2.
 #[derive(Clone, Copy, Debug)]
-#[repr(C)]
 pub struct VeContact {
-    // Line 0 (bytes 0..64): every pass.
+    /// Identity: (vertex collider, vertex, edge collider, edge).
+    pub key: VeCandidate,
+    /// Body owning the vertex ("A").
+    pub body_a: usize,
+    /// Body owning the edge ("B").
+    pub body_b: usize,
     /// `None` while only tracked; `Some(state)` for a contact record.
     pub state: Option<ContactState>,
+    /// Signed-distance history (m): `d[0] = d_k`, `d[1] = d_{k−1}`, `d[2] = d_{k−2}`.
+    pub d: [f64; 3],
     /// Number of valid entries in `d` (1..=3).
     pub hist: u8,
     /// This sample's local stage proposed the key from its vertex scan
@@ -83,20 +80,6 @@ pub struct VeContact {
     /// The last force pass listed the record among the loaded ones
     /// ([`ContactSet::loaded`](super::ContactSet::loaded): Continuous, `f_n > 0`).
     pub loaded: bool,
-    /// Slot of this record's [`LawState`] in the contact set's pool (see
-    /// [`ContactSet::laws`](super::ContactSet::laws)); [`NO_LAW`] while only tracked.
-    pub law: u32,
-    /// Body owning the vertex ("A").
-    pub body_a: usize,
-    /// Body owning the edge ("B").
-    pub body_b: usize,
-    /// Normal relative velocity `C0` (m/s), positive when separating.
-    pub c0: f64,
-    /// Tangential slip velocity `S0` (m/s).
-    pub s0: f64,
-    /// Signed-distance history (m): `d[0] = d_k`, `d[1] = d_{k−1}`, `d[2] = d_{k−2}`.
-    pub d: [f64; 3],
-    // Line 1 (bytes 64..128): the merge and the force pass.
     /// Edge coordinate `s^B_k` (m).
     pub s: f64,
     /// Previous edge coordinate `s^B_{k−1}` (m).
@@ -107,30 +90,33 @@ pub struct VeContact {
     pub point: Vec2,
     /// Outward edge normal (world); the tangent is [`VeContact::t`].
     pub n: Vec2,
-    /// Normal force of the last sample (N).
-    pub f_n: f64,
-    // Line 2 (bytes 128..192): the force pass and the crossing-corner stage.
-    /// Effective mass behind the contact for the braking pulse (kg).
-    pub m_eff: f64,
-    /// Friction force on A along `+t` of the last sample (N).
-    pub f_t: f64,
+    /// Normal relative velocity `C0` (m/s), positive when separating.
+    pub c0: f64,
+    /// Tangential slip velocity `S0` (m/s).
+    pub s0: f64,
     /// God-object edge coordinate `s_g` in B's frame (m), §8.3.
     pub s_g: f64,
+    /// Entry point: the edge coordinate where the vertex crossed the edge line at creation (m), §8.3.
+    pub s_entry: f64,
+    /// Effective mass behind the contact for the braking pulse (kg).
+    pub m_eff: f64,
+    /// Slot of this record's [`LawState`] in the contact set's pool (see
+    /// [`ContactSet::laws`](super::ContactSet::laws)); [`NO_LAW`] while only tracked.
+    pub law: u32,
+    /// Normal force of the last sample (N).
+    pub f_n: f64,
+    /// Friction force on A along `+t` of the last sample (N).
+    pub f_t: f64,
+    /// Tick at which this entry was first tracked.
+    pub since: u64,
+    /// The pair's geometry in the bodies' own frames (fixed for the life of the entry).
+    pub local: LocalGeom,
     /// The crossing-corner stage's own-axis test, remembered (`contact/manager/clip.rs`): the
     /// relative angle `θ_A − θ_B` (rad) at which it was last computed, the excess (m) it found
     /// there (the overlap along the record's normal less the record's own depth), and the vertex
     /// collider's radius (m) its bound uses. NaN: not yet, or a pair with seams (never
     /// remembered).
     pub own_axis: (f64, f64, f64),
-    /// Entry point: the edge coordinate where the vertex crossed the edge line at creation (m), §8.3.
-    pub s_entry: f64,
-    /// Tick at which this entry was first tracked.
-    pub since: u64,
-    // Line 3 (bytes 192..256): the merge.
-    /// Identity: (vertex collider, vertex, edge collider, edge).
-    pub key: VeCandidate,
-    /// The pair's geometry in the bodies' own frames (fixed for the life of the entry).
-    pub local: LocalGeom,
 }
 
 /// Body-frame geometry of a VE pair: the vertex in A's frame, the edge's start, normal and tangent
@@ -231,7 +217,6 @@ pub enum EventKind {
 
 #[cfg(test)]
 mod tests {
-    use super::VeContact;
     use crate::geom::{ConvexPolygon, Rot, Vec2};
     use rand::{Rng, SeedableRng};
 
@@ -271,85 +256,6 @@ mod tests {
                     let (tw, nw) = (rot.apply(*t), rot.apply(*nl));
                     assert_eq!((tw.x, tw.y), (-nw.y, nw.x));
                 }
-            }
-        }
-    }
-
-    /// The cache lines (64 bytes) a field at `offset` spans in a record.
-    fn lines<T>(offset: usize, _field: fn(&VeContact) -> &T) -> std::ops::RangeInclusive<usize> {
-        offset / 64..=(offset + std::mem::size_of::<T>() - 1) / 64
-    }
-
-    /// The lines of a field of `VeContact`, by name.
-    macro_rules! lines_of {
-        ($field:ident) => {
-            lines(std::mem::offset_of!(VeContact, $field), |e| &e.$field)
-        };
-    }
-
-    /// A record is four whole cache lines, and the fields each pass of a settled sample reads
-    /// sit in the lines its layout documents: the merge-and-measure pass (`manager/sync.rs`,
-    /// `measure` and the merge's tests) in lines 0, 1 and 3; the force pass
-    /// (`manager/forces.rs`; the key aside, read only when the loaded list changes) in lines
-    /// 0–2; the crossing-corner stage's remembered test (`manager/clip.rs`) in lines 0 and 2.
-    #[test]
-    fn a_record_is_four_cache_lines_with_each_pass_fields_in_its_lines() {
-        assert_eq!(std::mem::size_of::<VeContact>(), 256);
-        assert_eq!(std::mem::align_of::<VeContact>(), 8);
-        let sync = [
-            lines_of!(key),
-            lines_of!(body_a),
-            lines_of!(body_b),
-            lines_of!(state),
-            lines_of!(d),
-            lines_of!(hist),
-            lines_of!(nearest_edge),
-            lines_of!(s),
-            lines_of!(s_prev),
-            lines_of!(len),
-            lines_of!(point),
-            lines_of!(n),
-            lines_of!(c0),
-            lines_of!(s0),
-            lines_of!(local),
-        ];
-        let forces = [
-            lines_of!(state),
-            lines_of!(law),
-            lines_of!(d),
-            lines_of!(hist),
-            lines_of!(c0),
-            lines_of!(s0),
-            lines_of!(m_eff),
-            lines_of!(f_n),
-            lines_of!(f_t),
-            lines_of!(s),
-            lines_of!(s_prev),
-            lines_of!(s_g),
-            lines_of!(len),
-            lines_of!(loaded),
-            lines_of!(body_a),
-            lines_of!(body_b),
-            lines_of!(point),
-            lines_of!(n),
-        ];
-        let clip = [
-            lines_of!(state),
-            lines_of!(body_a),
-            lines_of!(body_b),
-            lines_of!(own_axis),
-        ];
-        let passes: [(&str, &[_], &[usize]); 3] = [
-            ("merge", &sync, &[0, 1, 3]),
-            ("forces", &forces, &[0, 1, 2]),
-            ("clip", &clip, &[0, 2]),
-        ];
-        for (pass, fields, allowed) in passes {
-            for (i, l) in fields.iter().enumerate() {
-                assert!(
-                    l.clone().all(|line| allowed.contains(&line)),
-                    "{pass}: field {i} in lines {l:?}"
-                );
             }
         }
     }
