@@ -1,10 +1,10 @@
 //! The force pass in blocks for lean law slots (issue 42 item 1, after Box2D's wide contact
 //! solver): the paper's pair of laws ([`PaperLaw`] with its impact surface offset, and the
-//! [`ResetIntegrator`] scaling its strain limit) run on [`W`] Continuous records at once, their
-//! inputs and slot states gathered into small structure-of-arrays lanes ([`Lanes`]), the laws'
-//! branches written as selects so that LLVM may vectorise the lanes (SSE2 `f64x2`), and the
-//! results scattered back; the loaded list and the wrenches then follow record by record, in
-//! record order, as in the scalar pass.
+//! [`ResetIntegrator`] scaling its strain limit) run on two Continuous records at once, their
+//! inputs and slot states gathered straight from the records into two-lane registers ([`Pair`],
+//! SSE2 `f64x2` on x86-64), the laws' branches written as selects, and the results scattered
+//! back; the loaded list and the wrenches then follow record by record, in record order, as in
+//! the scalar pass.
 //!
 //! Every lane runs the same IEEE operations in the same order as the scalar laws
 //! (`ContactNormal::force`, `PaperLaw::force`, `ResetIntegrator::loaded`, its shell's unloaded
@@ -13,57 +13,65 @@
 //! (`0.5·Kc`, `−Kc`, `1 + a`, `(1 + a)·Kr`) are computed once: the same operations on the same
 //! values.
 
+mod pair;
+
 use super::{ForcePass, Tally};
 use crate::contact::lean_law::{LeanState, LeanStore};
 use crate::contact::record::{ContactState, VeContact};
 use crate::laws::friction::{FrictionMode, LoadScaling, ResetIntegrator};
 use crate::laws::normal::PaperLaw;
+use pair::Pair;
 
-/// Records in a block.
-const W: usize = 4;
-
-/// The shared parameters of the lean slots, with the constants the laws derive from them.
+/// The shared parameters of the lean slots, with the constants the laws derive from them, in
+/// both lanes.
 #[derive(Clone, Copy, Debug)]
 struct Params {
     /// `0.5·Kc` (N/m), `−Kc` (N/m) and `Bc` (N·s/m) of the paper's law.
-    half_kc: f64,
-    neg_kc: f64,
-    bc: f64,
+    half_kc: Pair,
+    neg_kc: Pair,
+    bc: Pair,
     /// `Kr` (N/m), `−Kr`, `μk`, `β` (N·s/m), `1 + a = 1 + (μs/μk − 1)` and `(1 + a)·Kr` (N/m).
-    kr: f64,
-    neg_kr: f64,
-    mu_k: f64,
-    beta: f64,
-    one_a: f64,
-    one_a_kr: f64,
+    kr: Pair,
+    neg_kr: Pair,
+    mu_k: Pair,
+    beta: Pair,
+    one_a: Pair,
+    one_a_kr: Pair,
 }
 
-/// A block of records: the laws' inputs, the slots' states (read and written) and the results.
-#[derive(Clone, Copy, Debug, Default)]
-struct Lanes {
-    /// Signed distance history (m), and whether it has three samples (the SEH estimate).
-    d0: [f64; W],
-    d1: [f64; W],
-    d2: [f64; W],
-    seh: [bool; W],
+/// Two records' law inputs and slot states.
+#[derive(Clone, Copy, Debug)]
+struct Inputs {
+    /// Signed distance history (m) and its length (samples, 1 to 3).
+    d: [Pair; 3],
+    hist: Pair,
     /// `C0` (m/s), `s` (m), `Δs = s − s_prev` (m) and `S0` (m/s).
-    c0: [f64; W],
-    s: [f64; W],
-    ds: [f64; W],
-    s0: [f64; W],
-    /// Slot state: surface offset `σ` (m), strain `p` (m), stiffness of the last sample (N/m),
-    /// slip (else stick).
-    offset: [f64; W],
-    p: [f64; W],
-    k_used: [f64; W],
-    slip: [bool; W],
-    /// Results: the paper law's stored energy (J), `F_n` (N), `F_t` (N), the god-object `s_g`
-    /// (m) and the record's stored energy (J, normal plus friction).
-    stored: [f64; W],
-    f_n: [f64; W],
-    f_t: [f64; W],
-    s_g: [f64; W],
-    energy: [f64; W],
+    c0: Pair,
+    s: Pair,
+    ds: Pair,
+    s0: Pair,
+    /// Slot state: surface offset `σ` (m), strain `p` (m), stiffness of the last sample (N/m).
+    offset: Pair,
+    p: Pair,
+    k_used: Pair,
+}
+
+/// Two records' results and new slot states.
+#[derive(Clone, Copy, Debug)]
+struct Outputs {
+    /// Slot state: surface offset `σ` (m), the paper law's stored energy (J), strain `p` (m),
+    /// stiffness (N/m), slip (else stick).
+    offset: Pair,
+    stored: Pair,
+    p: Pair,
+    k_used: Pair,
+    slip: [bool; 2],
+    /// `F_n` (N), `F_t` (N), the god-object `s_g` (m), the record's stored energy (J, normal
+    /// plus friction).
+    f_n: Pair,
+    f_t: Pair,
+    s_g: Pair,
+    energy: Pair,
 }
 
 impl Params {
@@ -71,87 +79,75 @@ impl Params {
     fn of(paper: &PaperLaw, friction: &ResetIntegrator) -> Self {
         let one_a = 1.0 + friction.a();
         Self {
-            half_kc: 0.5 * paper.kc,
-            neg_kc: -paper.kc,
-            bc: paper.bc,
-            kr: friction.kr,
-            neg_kr: -friction.kr,
-            mu_k: friction.mu_k,
-            beta: friction.beta,
-            one_a,
-            one_a_kr: one_a * friction.kr,
+            half_kc: Pair::splat(0.5 * paper.kc),
+            neg_kc: Pair::splat(-paper.kc),
+            bc: Pair::splat(paper.bc),
+            kr: Pair::splat(friction.kr),
+            neg_kr: Pair::splat(-friction.kr),
+            mu_k: Pair::splat(friction.mu_k),
+            beta: Pair::splat(friction.beta),
+            one_a: Pair::splat(one_a),
+            one_a_kr: Pair::splat(one_a * friction.kr),
         }
     }
 
-    /// Runs the laws on every lane of `l` (the lanes past a short block's end too, on stale
-    /// values, which nobody reads).
+    /// Runs the laws on both lanes of `i`.
     #[inline(always)]
-    fn lanes(&self, l: &mut Lanes) {
-        for i in 0..W {
-            // The surface offset (`ContactNormal::force`): `σ ← min(σ, δ)` while `σ > 0`, and
-            // the law acts on the history shifted by `σ` while it stays positive.
-            let depth = (-l.d0[i]).max(0.0);
-            let offset = if l.offset[i] > 0.0 && depth < l.offset[i] {
-                depth
-            } else {
-                l.offset[i]
-            };
-            let shifted = offset > 0.0;
-            let x0 = if shifted { l.d0[i] + offset } else { l.d0[i] };
-            let x1 = if shifted { l.d1[i] + offset } else { l.d1[i] };
-            let x2 = if shifted { l.d2[i] + offset } else { l.d2[i] };
-            // The paper's law (`PaperLaw::force`).
-            let delta = (-x0).max(0.0);
-            let stored = self.half_kc * delta * delta;
-            let seh = if l.seh[i] {
-                2.0 * x0 - 1.5 * x1 + 0.5 * x2
-            } else {
-                x0
-            };
-            let push = (self.neg_kc * seh - self.bc * l.c0[i]).max(0.0);
-            let f_n = if x0 > 0.0 { 0.0 } else { push };
-            // The reset integrator (`ResetIntegrator::loaded` while `F_n > 0`, else the shell's
-            // reset: stick, `p = 0`, no force).
-            let loaded = f_n > 0.0;
-            let p0 = self.mu_k * f_n / self.kr;
-            let (ds, p_star) = (l.ds[i], l.p[i] + l.ds[i]);
-            let slip_up = ds > 0.0 && p_star >= p0;
-            let slip_down = ds < 0.0 && p_star <= -p0;
-            // `p_star.clamp(−p0, p0)`.
-            let low = if p_star < -p0 { -p0 } else { p_star };
-            let stick_p = if low > p0 { p0 } else { low };
-            let slip = slip_up || slip_down;
-            let held = if slip_up {
-                p0
-            } else if slip_down {
-                -p0
-            } else {
-                stick_p
-            };
-            let f_slip = self.neg_kr * held;
-            let f_stick = -(self.one_a_kr * stick_p + self.beta * l.s0[i]);
-            let f_t = if slip { f_slip } else { f_stick };
-            let p = if loaded { held } else { 0.0 };
-            let k_used = if loaded { self.kr } else { l.k_used[i] };
-            let slip = loaded && slip;
-            // `spring_energy`: `½(1 + a)·Kr·p²` in stick, `½Kr·p²` in slip.
-            let k = if slip { k_used } else { self.one_a * k_used };
-            l.offset[i] = offset;
-            l.p[i] = p;
-            l.k_used[i] = k_used;
-            l.slip[i] = slip;
-            l.stored[i] = stored;
-            l.f_n[i] = f_n;
-            l.f_t[i] = if loaded { f_t } else { 0.0 };
-            l.s_g[i] = l.s[i] - p;
-            l.energy[i] = stored + 0.5 * k * p * p;
+    fn laws(&self, i: &Inputs) -> Outputs {
+        let (zero, half) = (Pair::splat(0.0), Pair::splat(0.5));
+        // The surface offset (`ContactNormal::force`): `σ ← min(σ, δ)` while `σ > 0`, and the
+        // law acts on the history shifted by `σ` while it stays positive.
+        let depth = (-i.d[0]).max0();
+        let offset = i
+            .offset
+            .gt(zero)
+            .and(depth.lt(i.offset))
+            .select(depth, i.offset);
+        let shifted = offset.gt(zero);
+        let [x0, x1, x2] = i.d.map(|d| shifted.select(d + offset, d));
+        // The paper's law (`PaperLaw::force`).
+        let delta = (-x0).max0();
+        let stored = self.half_kc * delta * delta;
+        let extrapolated = Pair::splat(2.0) * x0 - Pair::splat(1.5) * x1 + half * x2;
+        let seh = i.hist.ge(Pair::splat(3.0)).select(extrapolated, x0);
+        let push = (self.neg_kc * seh - self.bc * i.c0).max0();
+        let f_n = x0.gt(zero).select(zero, push);
+        // The reset integrator (`ResetIntegrator::loaded` while `F_n > 0`, else the shell's
+        // reset: stick, `p = 0`, no force).
+        let loaded = f_n.gt(zero);
+        let p0 = self.mu_k * f_n / self.kr;
+        let p_star = i.p + i.ds;
+        let slip_up = i.ds.gt(zero).and(p_star.ge(p0));
+        let slip_down = i.ds.lt(zero).and(p_star.le(-p0));
+        // `p_star.clamp(−p0, p0)`.
+        let low = p_star.lt(-p0).select(-p0, p_star);
+        let stick_p = low.gt(p0).select(p0, low);
+        let held = slip_up.select(p0, slip_down.select(-p0, stick_p));
+        let slip = slip_up.or(slip_down);
+        let f_slip = self.neg_kr * held;
+        let f_stick = -(self.one_a_kr * stick_p + self.beta * i.s0);
+        let p = loaded.select(held, zero);
+        let k_used = loaded.select(self.kr, i.k_used);
+        let slip = loaded.and(slip);
+        // `spring_energy`: `½(1 + a)·Kr·p²` in stick, `½Kr·p²` in slip.
+        let k = slip.select(k_used, self.one_a * k_used);
+        Outputs {
+            offset,
+            stored,
+            p,
+            k_used,
+            slip: slip.bits(),
+            f_n,
+            f_t: loaded.select(slip.select(f_slip, f_stick), zero),
+            s_g: i.s - p,
+            energy: stored + half * k * p * p,
         }
     }
 }
 
 impl ForcePass<'_> {
-    /// The pass without the classical model's external force, on lean slots: in blocks of `W`
-    /// records when the friction scales its strain limit with the load, else the scalar pass.
+    /// The pass without the classical model's external force, on lean slots: two records at a
+    /// time when the friction scales its strain limit with the load, else the scalar pass.
     /// Returns what [`run`](Self::run) returns, bit for bit.
     #[inline(never)]
     pub(super) fn run_lean(mut self, store: &mut LeanStore) -> (f64, usize, usize, bool) {
@@ -161,70 +157,73 @@ impl ForcePass<'_> {
         let (paper, friction, slots) = store.parts_mut();
         let params = Params::of(paper, friction);
         let (entries, mut t) = self.begin();
-        let mut lanes = Lanes::default();
-        let (mut block, mut n) = ([0usize; W], 0);
+        let mut first = None;
         for idx in 0..entries.len() {
             if entries[idx].state != Some(ContactState::Continuous) {
                 continue;
             }
-            block[n] = idx;
-            n += 1;
-            if n == W {
-                self.block(&params, &mut lanes, slots, entries, &block, &mut t);
-                n = 0;
+            match first.take() {
+                None => first = Some(idx),
+                Some(a) => self.pair(&params, slots, entries, [a, idx], &mut t),
             }
         }
-        self.block(&params, &mut lanes, slots, entries, &block[..n], &mut t);
+        if let Some(a) = first {
+            // The last record alone: the second lane computes it again, and is dropped.
+            self.pair(&params, slots, entries, [a, a], &mut t);
+        }
         debug_assert_eq!(self.keys.len(), self.loaded.len());
         (t.stored, t.records, t.breaks, t.rewrite)
     }
 
-    /// The records `block` (ascending, at most `W`, each with its own slot): gathers their inputs
-    /// and slot states into `lanes`, runs the laws, scatters the results, then lists and applies
-    /// each record in order (`finish`).
+    /// The records `idx` (ascending, each with its own slot; both the same for a record alone):
+    /// gathers their inputs and slot states, runs the laws, scatters the results, then lists and
+    /// applies each record in order (`finish`).
     #[inline(always)]
-    fn block(
+    fn pair(
         &mut self,
         params: &Params,
-        lanes: &mut Lanes,
         slots: &mut [LeanState],
         entries: &mut [VeContact],
-        block: &[usize],
+        idx: [usize; 2],
         t: &mut Tally,
     ) {
-        for (i, &idx) in block.iter().enumerate().take(W) {
-            let e = &entries[idx];
-            let st = &slots[e.law as usize];
-            [lanes.d0[i], lanes.d1[i], lanes.d2[i]] = e.d;
-            lanes.seh[i] = e.hist >= 3;
-            lanes.c0[i] = e.c0;
-            lanes.s[i] = e.s;
-            lanes.ds[i] = e.s - e.s_prev;
-            lanes.s0[i] = e.s0;
-            lanes.offset[i] = st.offset;
-            lanes.p[i] = st.p;
-            lanes.k_used[i] = st.k_used;
-            lanes.slip[i] = st.mode == FrictionMode::Slip;
-        }
-        params.lanes(lanes);
-        for (i, &idx) in block.iter().enumerate().take(W) {
+        let (a, b) = (&entries[idx[0]], &entries[idx[1]]);
+        let (sa, sb) = (&slots[a.law as usize], &slots[b.law as usize]);
+        let two = |f: fn(&VeContact) -> f64| Pair::new(f(a), f(b));
+        let inputs = Inputs {
+            d: [0, 1, 2].map(|j| Pair::new(a.d[j], b.d[j])),
+            hist: Pair::new(a.hist as f64, b.hist as f64),
+            c0: two(|e| e.c0),
+            s: two(|e| e.s),
+            ds: two(|e| e.s - e.s_prev),
+            s0: two(|e| e.s0),
+            offset: Pair::new(sa.offset, sb.offset),
+            p: Pair::new(sa.p, sb.p),
+            k_used: Pair::new(sa.k_used, sb.k_used),
+        };
+        let out = params.laws(&inputs);
+        let [offset, stored, p, k_used] =
+            [out.offset, out.stored, out.p, out.k_used].map(Pair::lanes);
+        let [f_n, f_t, s_g, energy] = [out.f_n, out.f_t, out.s_g, out.energy].map(Pair::lanes);
+        let lanes = if idx[0] == idx[1] { 1 } else { 2 };
+        for (i, &idx) in idx.iter().enumerate().take(lanes) {
             let e = &mut entries[idx];
             t.count(e.law);
             slots[e.law as usize] = LeanState {
-                offset: lanes.offset[i],
-                stored: lanes.stored[i],
-                p: lanes.p[i],
-                k_used: lanes.k_used[i],
-                mode: if lanes.slip[i] {
+                offset: offset[i],
+                stored: stored[i],
+                p: p[i],
+                k_used: k_used[i],
+                mode: if out.slip[i] {
                     FrictionMode::Slip
                 } else {
                     FrictionMode::Stick
                 },
             };
-            e.f_n = lanes.f_n[i];
-            e.f_t = lanes.f_t[i];
-            e.s_g = lanes.s_g[i];
-            t.stored += lanes.energy[i];
+            e.f_n = f_n[i];
+            e.f_t = f_t[i];
+            e.s_g = s_g[i];
+            t.stored += energy[i];
             self.finish::<false>(t, idx, e);
         }
     }
