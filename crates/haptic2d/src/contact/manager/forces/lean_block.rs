@@ -111,7 +111,7 @@ impl Params {
         let extrapolated = Pair::splat(2.0) * x0 - Pair::splat(1.5) * x1 + half * x2;
         let seh = i.hist.ge(Pair::splat(3.0)).select(extrapolated, x0);
         let push = (self.neg_kc * seh - self.bc * i.c0).max0();
-        let f_n = x0.gt(zero).select(zero, push);
+        let f_n = x0.gt(zero).clear(push);
         // The reset integrator (`ResetIntegrator::loaded` while `F_n > 0`, else the shell's
         // reset: stick, `p = 0`, no force).
         let loaded = f_n.gt(zero);
@@ -126,7 +126,7 @@ impl Params {
         let slip = slip_up.or(slip_down);
         let f_slip = self.neg_kr * held;
         let f_stick = -(self.one_a_kr * stick_p + self.beta * i.s0);
-        let p = loaded.select(held, zero);
+        let p = loaded.keep(held);
         let k_used = loaded.select(self.kr, i.k_used);
         let slip = loaded.and(slip);
         // `spring_energy`: `½(1 + a)·Kr·p²` in stick, `½Kr·p²` in slip.
@@ -138,7 +138,7 @@ impl Params {
             k_used,
             slip: slip.bits(),
             f_n,
-            f_t: loaded.select(slip.select(f_slip, f_stick), zero),
+            f_t: loaded.keep(slip.select(f_slip, f_stick)),
             s_g: i.s - p,
             energy: stored + half * k * p * p,
         }
@@ -202,30 +202,41 @@ impl ForcePass<'_> {
             k_used: Pair::new(sa.k_used, sb.k_used),
         };
         let out = params.laws(&inputs);
-        let [offset, stored, p, k_used] =
-            [out.offset, out.stored, out.p, out.k_used].map(Pair::lanes);
-        let [f_n, f_t, s_g, energy] = [out.f_n, out.f_t, out.s_g, out.energy].map(Pair::lanes);
-        let lanes = if idx[0] == idx[1] { 1 } else { 2 };
-        for (i, &idx) in idx.iter().enumerate().take(lanes) {
-            let e = &mut entries[idx];
-            t.count(e.law);
-            slots[e.law as usize] = LeanState {
-                offset: offset[i],
-                stored: stored[i],
-                p: p[i],
-                k_used: k_used[i],
-                mode: if out.slip[i] {
-                    FrictionMode::Slip
-                } else {
-                    FrictionMode::Stick
-                },
-            };
-            e.f_n = f_n[i];
-            e.f_t = f_t[i];
-            e.s_g = s_g[i];
-            t.stored += energy[i];
-            self.finish::<false>(t, idx, e);
+        self.put(slots, entries, idx[0], &out, 0, t);
+        if idx[1] != idx[0] {
+            self.put(slots, entries, idx[1], &out, 1, t);
         }
+    }
+
+    /// Lane `lane` of `out` into record `idx` and its slot, then the record's `finish`.
+    #[inline(always)]
+    fn put(
+        &mut self,
+        slots: &mut [LeanState],
+        entries: &mut [VeContact],
+        idx: usize,
+        out: &Outputs,
+        lane: usize,
+        t: &mut Tally,
+    ) {
+        let e = &mut entries[idx];
+        t.count(e.law);
+        slots[e.law as usize] = LeanState {
+            offset: out.offset.lanes()[lane],
+            stored: out.stored.lanes()[lane],
+            p: out.p.lanes()[lane],
+            k_used: out.k_used.lanes()[lane],
+            mode: if out.slip[lane] {
+                FrictionMode::Slip
+            } else {
+                FrictionMode::Stick
+            },
+        };
+        e.f_n = out.f_n.lanes()[lane];
+        e.f_t = out.f_t.lanes()[lane];
+        e.s_g = out.s_g.lanes()[lane];
+        t.stored += out.energy.lanes()[lane];
+        self.finish::<false>(t, idx, e);
     }
 }
 

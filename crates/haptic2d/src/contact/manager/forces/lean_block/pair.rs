@@ -89,6 +89,14 @@ mod imp {
         unsafe { _mm_or_pd(_mm_and_pd(m, a), _mm_andnot_pd(m, b)) }
     }
     #[inline(always)]
+    pub(super) fn keep(m: M, a: V) -> V {
+        unsafe { _mm_and_pd(m, a) }
+    }
+    #[inline(always)]
+    pub(super) fn clear(m: M, a: V) -> V {
+        unsafe { _mm_andnot_pd(m, a) }
+    }
+    #[inline(always)]
     pub(super) fn bits(m: M) -> [bool; 2] {
         let b = unsafe { _mm_movemask_pd(m) };
         [b & 1 != 0, b & 2 != 0]
@@ -159,6 +167,12 @@ mod imp {
             if m[1] { a[1] } else { b[1] },
         ]
     }
+    pub(super) fn keep(m: M, a: V) -> V {
+        select(m, a, [0.0; 2])
+    }
+    pub(super) fn clear(m: M, a: V) -> V {
+        select(m, [0.0; 2], a)
+    }
     pub(super) fn bits(m: M) -> [bool; 2] {
         m
     }
@@ -222,6 +236,16 @@ impl Mask {
     #[inline(always)]
     pub(super) fn select(self, a: Pair, b: Pair) -> Pair {
         Pair(imp::select(self.0, a.0, b.0))
+    }
+    /// `a` where the mask holds, else `+0.0` (`select(a, 0.0)` in one operation).
+    #[inline(always)]
+    pub(super) fn keep(self, a: Pair) -> Pair {
+        Pair(imp::keep(self.0, a.0))
+    }
+    /// `+0.0` where the mask holds, else `a` (`select(0.0, a)` in one operation).
+    #[inline(always)]
+    pub(super) fn clear(self, a: Pair) -> Pair {
+        Pair(imp::clear(self.0, a.0))
     }
     /// The mask's lanes.
     #[inline(always)]
