@@ -44,7 +44,7 @@ struct Params {
 struct Inputs {
     /// Signed distance history (m) and its length (samples, 1 to 3).
     d: [Pair; 3],
-    hist: Pair,
+    hist: [u8; 2],
     /// `C0` (m/s), `s` (m), `Δs = s − s_prev` (m) and `S0` (m/s).
     c0: Pair,
     s: Pair,
@@ -98,18 +98,26 @@ impl Params {
         // The surface offset (`ContactNormal::force`): `σ ← min(σ, δ)` while `σ > 0`, and the
         // law acts on the history shifted by `σ` while it stays positive.
         let depth = (-i.d[0]).max0();
-        let offset = i
-            .offset
-            .gt(zero)
-            .and(depth.lt(i.offset))
-            .select(depth, i.offset);
-        let shifted = offset.gt(zero);
-        let [x0, x1, x2] = i.d.map(|d| shifted.select(d + offset, d));
+        let had = i.offset.gt(zero);
+        // Without an offset in either lane, both keep theirs and the history as it is (the
+        // selects below would pick exactly that).
+        let (offset, [x0, x1, x2]) = if had.any() {
+            let offset = had.and(depth.lt(i.offset)).select(depth, i.offset);
+            let shifted = offset.gt(zero);
+            (offset, i.d.map(|d| shifted.select(d + offset, d)))
+        } else {
+            (i.offset, i.d)
+        };
         // The paper's law (`PaperLaw::force`).
         let delta = (-x0).max0();
         let stored = self.half_kc * delta * delta;
         let extrapolated = Pair::splat(2.0) * x0 - Pair::splat(1.5) * x1 + half * x2;
-        let seh = i.hist.ge(Pair::splat(3.0)).select(extrapolated, x0);
+        let seh = if i.hist[0] >= 3 && i.hist[1] >= 3 {
+            extrapolated
+        } else {
+            let hist = Pair::new(i.hist[0] as f64, i.hist[1] as f64);
+            hist.ge(Pair::splat(3.0)).select(extrapolated, x0)
+        };
         let push = (self.neg_kc * seh - self.bc * i.c0).max0();
         let f_n = x0.gt(zero).clear(push);
         // The reset integrator (`ResetIntegrator::loaded` while `F_n > 0`, else the shell's
@@ -122,23 +130,29 @@ impl Params {
         // `p_star.clamp(−p0, p0)`.
         let low = p_star.lt(-p0).select(-p0, p_star);
         let stick_p = low.gt(p0).select(p0, low);
-        let held = slip_up.select(p0, slip_down.select(-p0, stick_p));
-        let slip = slip_up.or(slip_down);
-        let f_slip = self.neg_kr * held;
         let f_stick = -(self.one_a_kr * stick_p + self.beta * i.s0);
-        let p = loaded.keep(held);
         let k_used = loaded.select(self.kr, i.k_used);
-        let slip = loaded.and(slip);
         // `spring_energy`: `½(1 + a)·Kr·p²` in stick, `½Kr·p²` in slip.
-        let k = slip.select(k_used, self.one_a * k_used);
+        let slip = loaded.and(slip_up.or(slip_down));
+        // Without a loaded slip in either lane, the selects would pick the stick values (or
+        // values that `loaded` clears: an unloaded lane's strain is `+0.0`).
+        let (held, f_t, k, slip) = if slip.any() {
+            let held = slip_up.select(p0, slip_down.select(-p0, stick_p));
+            let f_slip = self.neg_kr * held;
+            let k = slip.select(k_used, self.one_a * k_used);
+            (held, slip.select(f_slip, f_stick), k, slip.bits())
+        } else {
+            (stick_p, f_stick, self.one_a * k_used, [false; 2])
+        };
+        let p = loaded.keep(held);
         Outputs {
             offset,
             stored,
             p,
             k_used,
-            slip: slip.bits(),
+            slip,
             f_n,
-            f_t: loaded.keep(slip.select(f_slip, f_stick)),
+            f_t: loaded.keep(f_t),
             s_g: i.s - p,
             energy: stored + half * k * p * p,
         }
@@ -192,7 +206,7 @@ impl ForcePass<'_> {
         let two = |f: fn(&VeContact) -> f64| Pair::new(f(a), f(b));
         let inputs = Inputs {
             d: [0, 1, 2].map(|j| Pair::new(a.d[j], b.d[j])),
-            hist: Pair::new(a.hist as f64, b.hist as f64),
+            hist: [a.hist, b.hist],
             c0: two(|e| e.c0),
             s: two(|e| e.s),
             ds: two(|e| e.s - e.s_prev),

@@ -247,6 +247,12 @@ impl Mask {
     pub(super) fn clear(self, a: Pair) -> Pair {
         Pair(imp::clear(self.0, a.0))
     }
+    /// Whether either lane holds.
+    #[inline(always)]
+    pub(super) fn any(self) -> bool {
+        let [a, b] = self.bits();
+        a || b
+    }
     /// The mask's lanes.
     #[inline(always)]
     pub(super) fn bits(self) -> [bool; 2] {
