@@ -171,70 +171,69 @@ impl ForcePass<'_> {
         let (paper, friction, slots) = store.parts_mut();
         let params = Params::of(paper, friction);
         let (entries, mut t) = self.begin();
-        // A Continuous record waiting for the next one, to run the laws on both at once.
         let mut first = None;
-        for (idx, e) in entries.iter_mut().enumerate() {
-            if e.state != Some(ContactState::Continuous) {
+        for idx in 0..entries.len() {
+            if entries[idx].state != Some(ContactState::Continuous) {
                 continue;
             }
             match first.take() {
-                None => first = Some((idx, e)),
-                Some(a) => self.pair(&params, slots, a, Some((idx, e)), &mut t),
+                None => first = Some(idx),
+                Some(a) => self.pair(&params, slots, entries, [a, idx], &mut t),
             }
         }
         if let Some(a) = first {
             // The last record alone: the second lane computes it again, and is dropped.
-            self.pair(&params, slots, a, None, &mut t);
+            self.pair(&params, slots, entries, [a, a], &mut t);
         }
         debug_assert_eq!(self.keys.len(), self.loaded.len());
         (t.stored, t.records, t.breaks, t.rewrite)
     }
 
-    /// The records `a` and `b` (with their entry numbers, ascending, each with its own slot; `a`
-    /// alone without `b`): gathers their inputs and slot states, runs the laws, scatters the
-    /// results, then lists and applies each record in order (`finish`).
+    /// The records `idx` (ascending, each with its own slot; both the same for a record alone):
+    /// gathers their inputs and slot states, runs the laws, scatters the results, then lists and
+    /// applies each record in order (`finish`).
     #[inline(always)]
     fn pair(
         &mut self,
         params: &Params,
         slots: &mut [LeanState],
-        a: (usize, &mut VeContact),
-        b: Option<(usize, &mut VeContact)>,
+        entries: &mut [VeContact],
+        idx: [usize; 2],
         t: &mut Tally,
     ) {
-        let out = {
-            let (ea, eb) = (&*a.1, b.as_ref().map_or(&*a.1, |b| &*b.1));
-            let (sa, sb) = (&slots[ea.law as usize], &slots[eb.law as usize]);
-            let two = |f: fn(&VeContact) -> f64| Pair::new(f(ea), f(eb));
-            params.laws(&Inputs {
-                d: [0, 1, 2].map(|j| Pair::new(ea.d[j], eb.d[j])),
-                hist: [ea.hist, eb.hist],
-                c0: two(|e| e.c0),
-                s: two(|e| e.s),
-                ds: two(|e| e.s - e.s_prev),
-                s0: two(|e| e.s0),
-                offset: Pair::new(sa.offset, sb.offset),
-                p: Pair::new(sa.p, sb.p),
-                k_used: Pair::new(sa.k_used, sb.k_used),
-            })
+        let (a, b) = (&entries[idx[0]], &entries[idx[1]]);
+        let (sa, sb) = (&slots[a.law as usize], &slots[b.law as usize]);
+        let two = |f: fn(&VeContact) -> f64| Pair::new(f(a), f(b));
+        let inputs = Inputs {
+            d: [0, 1, 2].map(|j| Pair::new(a.d[j], b.d[j])),
+            hist: [a.hist, b.hist],
+            c0: two(|e| e.c0),
+            s: two(|e| e.s),
+            ds: two(|e| e.s - e.s_prev),
+            s0: two(|e| e.s0),
+            offset: Pair::new(sa.offset, sb.offset),
+            p: Pair::new(sa.p, sb.p),
+            k_used: Pair::new(sa.k_used, sb.k_used),
         };
-        self.put(slots, a, &out, 0, t);
-        if let Some(b) = b {
-            self.put(slots, b, &out, 1, t);
+        let out = params.laws(&inputs);
+        self.put(slots, entries, idx[0], &out, 0, t);
+        if idx[1] != idx[0] {
+            self.put(slots, entries, idx[1], &out, 1, t);
         }
     }
 
-    /// Lane `lane` of `out` into record `idx` (entry number, record) and its slot, then the
-    /// record's `finish`.
+    /// Lane `lane` of `out` into record `idx` and its slot, then the record's `finish`.
     #[inline(always)]
     fn put(
         &mut self,
         slots: &mut [LeanState],
-        (idx, e): (usize, &mut VeContact),
+        entries: &mut [VeContact],
+        idx: usize,
         out: &Outputs,
         lane: usize,
         t: &mut Tally,
     ) {
+        let e = &mut entries[idx];
         t.count(e.law);
         slots[e.law as usize] = LeanState {
             offset: out.offset.lanes()[lane],
