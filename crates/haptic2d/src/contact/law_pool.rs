@@ -119,12 +119,6 @@ impl<T: Copy> Store<T> {
         std::mem::swap(&mut self.states, &mut self.spare);
     }
 
-    /// Every slot handed out so far (free ones hold stale states), by slot number.
-    #[inline]
-    pub(crate) fn as_mut_slice(&mut self) -> &mut [T] {
-        &mut self.states
-    }
-
     /// Slots handed out so far (free ones included).
     #[inline]
     pub(crate) fn len(&self) -> usize {

@@ -36,13 +36,13 @@ pub(crate) fn lean_pair<'a>(
 #[repr(C)]
 pub(crate) struct LeanState {
     /// The impact surface offset `σ` (m, [`ContactNormal::offset`]).
-    pub(crate) offset: f64,
+    offset: f64,
     /// The paper law's stored energy of the last sample (J).
-    pub(crate) stored: f64,
+    stored: f64,
     /// The reset integrator's strain (m), stiffness of the last sample (N/m) and mode.
-    pub(crate) p: f64,
-    pub(crate) k_used: f64,
-    pub(crate) mode: FrictionMode,
+    p: f64,
+    k_used: f64,
+    mode: FrictionMode,
 }
 
 impl LeanState {
@@ -122,13 +122,6 @@ impl LeanStore {
             friction: self.friction.with_state((s.p, s.k_used, s.mode)),
             normal: ContactNormal::with_offset(self.paper.with_state(s.stored), s.offset),
         }
-    }
-
-    /// The shared parameters and every slot's state, by slot number (the force pass's block
-    /// form, `contact/manager/forces/lean_block.rs`).
-    #[inline(always)]
-    pub(crate) fn parts_mut(&mut self) -> (&PaperLaw, &ResetIntegrator, &mut [LeanState]) {
-        (&self.paper, &self.friction, self.slots.as_mut_slice())
     }
 
     /// Stores the state of `law` in `slot`.

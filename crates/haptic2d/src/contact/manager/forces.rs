@@ -1,8 +1,6 @@
 //! Stage 6 of the contact step (§0.5 step 6): continuous-contact forces, normal then friction, per
 //! Continuous record (§1–§4, §5.9); god-objects follow (§8.3).
 
-mod lean_block;
-
 use super::ContactSet;
 use super::Wrench2;
 use crate::body::Body;
@@ -46,7 +44,7 @@ impl ContactSet {
         // The classical model's two loops are a second instance of the pass (`EXT`), so neither
         // instance tests the model per record.
         let (stored, records, breaks, rewritten) = match (self.laws.slots_mut(), pass.needs_ext) {
-            (Slots::Lean(store), false) => pass.run_lean(store),
+            (Slots::Lean(store), false) => pass.run::<_, false>(store),
             (Slots::Compact(store), false) => pass.run::<_, false>(store),
             (Slots::Whole(store), false) => pass.run::<_, false>(store),
             (Slots::Lean(store), true) => pass.run::<_, true>(store),
@@ -88,7 +86,7 @@ struct ForcePass<'a> {
     wrenches: &'a mut [Wrench2],
 }
 
-impl<'a> ForcePass<'a> {
+impl ForcePass<'_> {
     /// Runs the pass with the law slots `laws`: returns the stored energy (J), the number of
     /// Continuous records, how many of them have a law slot that does not follow the previous
     /// record's (see `LawPool::repack`), and whether the loaded keys were rewritten.
@@ -99,15 +97,33 @@ impl<'a> ForcePass<'a> {
     ///
     /// `EXT` is `needs_ext` (the caller picks the instance).
     #[inline(never)]
-    fn run<S: SlotAccess, const EXT: bool>(mut self, laws: &mut S) -> (f64, usize, usize, bool) {
+    fn run<S: SlotAccess, const EXT: bool>(self, laws: &mut S) -> (f64, usize, usize, bool) {
         debug_assert_eq!(EXT, self.needs_ext);
         let (dt, needs_ext) = (self.dt, EXT);
-        let (entries, mut t) = self.begin();
-        for (idx, e) in entries.iter_mut().enumerate() {
+        // The bodies and their wrenches cut to one length (they are the same; a record's body
+        // out of range still panics), so that the compiler checks a record's body index once for
+        // both instead of once each.
+        let n = self.bodies.len().min(self.wrenches.len());
+        let (bodies, wrenches) = (&self.bodies[..n], &mut self.wrenches[..n]);
+        let mut stored = 0.0;
+        // Every record is Continuous here (Colliding ones were resolved by the impacts of step 5).
+        let mut records = 0;
+        let (mut last_slot, mut breaks) = (u32::MAX, 0usize);
+        self.loaded.clear();
+        let mut rewrite = self.rewrite;
+        if rewrite {
+            self.keys.clear();
+        }
+        // The next struck entry at or after the current one (`usize::MAX` past the last).
+        let mut impacts = self.impact_entries.iter();
+        let mut next_impact = impacts.next().copied().unwrap_or(usize::MAX);
+        for (idx, e) in self.entries.iter_mut().enumerate() {
             if e.state != Some(ContactState::Continuous) {
                 continue;
             }
-            t.count(e.law);
+            records += 1;
+            breaks += (e.law != last_slot.wrapping_add(1)) as usize;
+            last_slot = e.law;
             let input = NormalInput {
                 d: e.d,
                 hist: e.hist,
@@ -126,9 +142,40 @@ impl<'a> ForcePass<'a> {
                 Some(law.normal.stored_energy() + law.friction.stored_energy())
             });
             if let Some(u) = energy {
-                t.stored += u;
+                stored += u;
             }
-            self.finish::<EXT>(&mut t, idx, e);
+            // Loaded: pushing, not struck in this sample, not approaching faster than v_c.
+            while next_impact < idx {
+                next_impact = impacts.next().copied().unwrap_or(usize::MAX);
+            }
+            let in_impact = next_impact == idx;
+            let loaded = e.f_n > 0.0 && !in_impact && e.c0 >= -self.v_damp;
+            if loaded != e.loaded && !rewrite {
+                // The first change: the keys before it are the last sample's.
+                rewrite = true;
+                self.keys.truncate(self.loaded.len());
+            }
+            e.loaded = loaded;
+            if loaded {
+                if rewrite {
+                    self.keys.push(e.key);
+                }
+                self.loaded.push(LoadedContact {
+                    body_a: e.body_a as u32,
+                    body_b: e.body_b as u32,
+                    point: e.point,
+                    n: e.n,
+                    f_n: e.f_n,
+                });
+            }
+            // The normal and the friction force act at the same point: one wrench (the classical
+            // model adds its friction in the second loop below, after every normal force).
+            let f = if needs_ext {
+                e.n * e.f_n
+            } else {
+                e.n * e.f_n + e.t() * e.f_t
+            };
+            add_force(wrenches, bodies, e.body_a, e.body_b, f, e.point);
         }
         debug_assert_eq!(
             self.keys.len(),
@@ -136,17 +183,16 @@ impl<'a> ForcePass<'a> {
             "one key per loaded record"
         );
         if needs_ext {
-            let (bodies, wrenches) = (self.bodies, &mut *self.wrenches);
             for (i, b) in bodies.iter().enumerate() {
                 self.nonfric[i] = b.force + wrenches[i].force;
             }
-            for idx in 0..entries.len() {
-                if entries[idx].state != Some(ContactState::Continuous) {
+            for idx in 0..self.entries.len() {
+                if self.entries[idx].state != Some(ContactState::Continuous) {
                     continue;
                 }
-                let f_ext_t = external_share(entries, self.nonfric, idx);
-                let e = &mut entries[idx];
-                t.stored += laws.with(e.law, |law| {
+                let f_ext_t = external_share(self.entries, self.nonfric, idx);
+                let e = &mut self.entries[idx];
+                stored += laws.with(e.law, |law| {
                     friction_step(e, law, dt, f_ext_t);
                     law.normal.stored_energy() + law.friction.stored_energy()
                 });
@@ -155,102 +201,7 @@ impl<'a> ForcePass<'a> {
                 }
             }
         }
-        (t.stored, t.records, t.breaks, t.rewrite)
-    }
-
-    /// Starts a pass: takes the records out of `self` (so that a record and the rest of the pass
-    /// can be borrowed together), cuts the bodies and their wrenches to one length (they are the
-    /// same; a record's body out of range still panics, and the compiler checks a record's body
-    /// index once for both instead of once each), clears the loaded list (and its keys when they
-    /// are rewritten) and returns the records with an empty tally.
-    #[inline(always)]
-    fn begin(&mut self) -> (&'a mut [VeContact], Tally<'a>) {
-        let n = self.bodies.len().min(self.wrenches.len());
-        self.bodies = &self.bodies[..n];
-        let wrenches = std::mem::take(&mut self.wrenches);
-        self.wrenches = &mut wrenches[..n];
-        self.loaded.clear();
-        if self.rewrite {
-            self.keys.clear();
-        }
-        // The next struck entry at or after the current one (`usize::MAX` past the last).
-        let mut impacts = self.impact_entries.iter();
-        let next_impact = impacts.next().copied().unwrap_or(usize::MAX);
-        let tally = Tally {
-            stored: 0.0,
-            records: 0,
-            last_slot: u32::MAX,
-            breaks: 0,
-            rewrite: self.rewrite,
-            impacts,
-            next_impact,
-        };
-        (std::mem::take(&mut self.entries), tally)
-    }
-
-    /// What follows a Continuous record's laws (its `f_n` and, unless `EXT`, `f_t` set): the
-    /// loaded list and its keys, and the record's wrench on its two bodies.
-    #[inline(always)]
-    fn finish<const EXT: bool>(&mut self, t: &mut Tally, idx: usize, e: &mut VeContact) {
-        // Loaded: pushing, not struck in this sample, not approaching faster than v_c.
-        while t.next_impact < idx {
-            t.next_impact = t.impacts.next().copied().unwrap_or(usize::MAX);
-        }
-        let in_impact = t.next_impact == idx;
-        let loaded = e.f_n > 0.0 && !in_impact && e.c0 >= -self.v_damp;
-        if loaded != e.loaded && !t.rewrite {
-            // The first change: the keys before it are the last sample's.
-            t.rewrite = true;
-            self.keys.truncate(self.loaded.len());
-        }
-        e.loaded = loaded;
-        if loaded {
-            if t.rewrite {
-                self.keys.push(e.key);
-            }
-            self.loaded.push(LoadedContact {
-                body_a: e.body_a as u32,
-                body_b: e.body_b as u32,
-                point: e.point,
-                n: e.n,
-                f_n: e.f_n,
-            });
-        }
-        // The normal and the friction force act at the same point: one wrench (the classical
-        // model adds its friction in the second loop of `run`, after every normal force).
-        let f = if EXT {
-            e.n * e.f_n
-        } else {
-            e.n * e.f_n + e.t() * e.f_t
-        };
-        add_force(self.wrenches, self.bodies, e.body_a, e.body_b, f, e.point);
-    }
-}
-
-/// The running totals of a force pass over the records in order.
-struct Tally<'a> {
-    /// Stored energy (J) of the records so far.
-    stored: f64,
-    /// Continuous records so far, and how many of them have a law slot that does not follow the
-    /// previous record's (`last_slot`).
-    records: usize,
-    last_slot: u32,
-    breaks: usize,
-    /// The loaded keys are being rewritten (from the first change on).
-    rewrite: bool,
-    /// The struck entries after `next_impact`, and the next one at or after the current record
-    /// (`usize::MAX` past the last).
-    impacts: std::slice::Iter<'a, usize>,
-    next_impact: usize,
-}
-
-impl Tally<'_> {
-    /// Counts a Continuous record whose law slot is `slot`.
-    #[inline(always)]
-    fn count(&mut self, slot: u32) {
-        self.records += 1;
-        self.breaks += (slot != self.last_slot.wrapping_add(1)) as usize;
-        self.last_slot = slot;
+        (stored, records, breaks, rewrite)
     }
 }
 
