@@ -68,12 +68,15 @@ pub fn run(a: &SimulateArgs) -> Result<Status, Failure> {
     }
     let ticks = samples as u64;
     let stop = install_stop_signals()?;
+    // The true largest overlap of two bodies (issue 35) from t = 0; the CSV's column reads it.
+    let mut overlap = OverlapSummary::default();
+    overlap.sample(&world);
     let mut csv = match a.out {
         Some(p) => {
             let mut w = WorldOut::create(p, &world, a.scene, &scene.name)
                 .map_err(|e| Failure::error(format!("cannot write {}: {e}", p.display())))?;
             // The t = 0 row: primed above, so it reports the contacts and stored energy at t = 0.
-            w.row(&world)
+            w.row(&world, &overlap)
                 .map_err(|e| Failure::error(format!("cannot write CSV: {e}")))?;
             Some(w)
         }
@@ -92,9 +95,6 @@ pub fn run(a: &SimulateArgs) -> Result<Status, Failure> {
     let mut max_excess = f64::NEG_INFINITY;
     let mut max_contacts = 0;
     let mut max_depth = 0.0f64;
-    // The true largest overlap of two bodies (separating-axis depth, issue 35), from t = 0.
-    let mut overlap = OverlapSummary::default();
-    overlap.sample(&world);
     let mut done = 0u64;
     let mut status = Status::Clean;
     for k in 1..=ticks {
@@ -136,7 +136,7 @@ pub fn run(a: &SimulateArgs) -> Result<Status, Failure> {
         }
         if let Some(c) = csv.as_mut() {
             if k % a.every == 0 {
-                c.row(&world)
+                c.row(&world, &overlap)
                     .map_err(|e| Failure::error(format!("cannot write CSV: {e}")))?;
             }
         }

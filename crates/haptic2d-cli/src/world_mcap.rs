@@ -59,10 +59,11 @@ impl WorldOut {
     }
 
     /// Writes the current state of `world` (log_time = the Unix time the file was started +
-    /// round(t · 10⁹) ns).
-    pub fn row(&mut self, world: &World) -> std::io::Result<()> {
+    /// round(t · 10⁹) ns); `overlap` has just [sampled](OverlapSummary::sample) it (the CSV's
+    /// overlap column).
+    pub fn row(&mut self, world: &World, overlap: &OverlapSummary) -> std::io::Result<()> {
         match self {
-            Self::Csv(c) => c.row(world),
+            Self::Csv(c) => c.row(world, overlap.end_m),
             Self::Mcap { sink, sample, seq } => {
                 sample.capture(world);
                 let log_time = sink.sim_log_time(world.time());

@@ -16,11 +16,13 @@
 //! - [`signal`]: Ctrl-C to a stop flag;
 //! - [`sim_io`]: the simulated twin pantograph and hand behind [`DeviceIo`];
 //! - [`tick_log`]: CSV rows of the haptic tick record;
+//! - [`float_text`]: an `f64` as `Display` writes it, fast (CSV numbers);
 //! - [`mcap`]: MCAP logs (logger thread, schemas, reader).
 #![warn(missing_docs)]
 
 pub mod clock;
 pub mod drain_thread;
+pub mod float_text;
 pub mod histogram;
 pub mod io;
 pub mod logger;

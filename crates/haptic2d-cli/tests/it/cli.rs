@@ -35,6 +35,46 @@ fn simulate_writes_the_documented_columns() {
     assert_eq!(lines.count(), 51);
 }
 
+/// The CSV's overlap column is the world's largest overlap of two bodies at each written sample
+/// (`World::max_overlap`, computed here in the test's own world, stepped alongside), from the
+/// t = 0 row on: `simulate` takes it from its run summary, sampled after the same step, instead
+/// of running the separating-axis tests a second time.
+#[test]
+fn the_csv_overlap_column_is_the_worlds_overlap_at_each_written_sample() {
+    let _m = crate::common::module_turn(module_path!());
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("pile.csv");
+    run_ok("simulate pile:20 --duration 0.6 --every 7 --out {}", &[&p]);
+    let csv = std::fs::read_to_string(&p).unwrap();
+    let column: Vec<f64> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(5).unwrap().parse().unwrap())
+        .collect();
+    let mut world = haptic2d::scene::builtin("pile:20", None)
+        .unwrap()
+        .unwrap()
+        .world;
+    world.prime();
+    let mut want = vec![world.max_overlap().depth];
+    let ticks = (0.6 / world.params.dt).round() as u64;
+    for k in 1..=ticks {
+        assert!(world.step().is_none(), "diverged at {k}");
+        if k % 7 == 0 {
+            want.push(world.max_overlap().depth);
+        }
+    }
+    assert_eq!(column.len(), want.len());
+    assert!(want.iter().any(|&d| d > 0.0), "the pile never overlaps");
+    for (i, (got, want)) in column.iter().zip(&want).enumerate() {
+        assert_eq!(
+            got.to_bits(),
+            want.to_bits(),
+            "row {i}: {got} against {want}"
+        );
+    }
+}
+
 #[test]
 fn scenes_lists_the_builtins() {
     let _m = crate::common::module_turn(module_path!());
