@@ -2,6 +2,7 @@
 
 use haptic2d::haptic::{TickRecord, TICK_COLUMNS};
 
+use crate::float_text::push_f64;
 use crate::logger::CsvRecord;
 
 impl CsvRecord for TickRecord {
@@ -9,9 +10,14 @@ impl CsvRecord for TickRecord {
         TICK_COLUMNS.iter().map(|s| s.to_string()).collect()
     }
 
+    /// Each value as `{}` writes it ([`push_f64`]: the same characters, without a `String` a
+    /// field or `core::fmt`).
     fn write_row<W: std::io::Write>(&self, out: &mut csv::Writer<W>) -> csv::Result<()> {
+        let mut text = String::with_capacity(32);
         for v in self.values() {
-            out.write_field(v.to_string())?;
+            text.clear();
+            push_f64(&mut text, v);
+            out.write_field(&text)?;
         }
         Ok(())
     }
