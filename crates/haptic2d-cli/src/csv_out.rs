@@ -53,15 +53,7 @@ impl<W: Write> WorldCsv<W> {
         l.push(',');
         push_f64(l, overlap_m);
         for &i in &self.dynamic {
-            let b = &world.bodies[i];
-            for x in [
-                b.pose.pos.x,
-                b.pose.pos.y,
-                b.pose.angle,
-                b.vel.x,
-                b.vel.y,
-                b.omega,
-            ] {
+            for x in world.bodies[i].state() {
                 l.push(',');
                 push_f64(l, x);
             }

@@ -101,4 +101,18 @@ impl Body {
             0.0
         }
     }
+
+    /// The body's state as the world CSV's six columns per body write it: position `x`, `y`
+    /// (m), angle `θ` (rad), velocity `v_x`, `v_y` (m/s), angular velocity `ω` (rad/s).
+    #[inline]
+    pub fn state(&self) -> [f64; 6] {
+        [
+            self.pose.pos.x,
+            self.pose.pos.y,
+            self.pose.angle,
+            self.vel.x,
+            self.vel.y,
+            self.omega,
+        ]
+    }
 }

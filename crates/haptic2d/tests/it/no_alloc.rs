@@ -85,17 +85,7 @@ fn a_landing_pile_allocates_nothing_once_given_room_for_its_contacts() {
     assert_eq!(with_room, 0, "allocations with room ({grown} without)");
     assert!(roomy.contacts().contact_count() > 3000);
     for (a, b) in plain.bodies.iter().zip(&roomy.bodies) {
-        let bits = |b: &haptic2d::body::Body| {
-            [
-                b.pose.pos.x,
-                b.pose.pos.y,
-                b.pose.angle,
-                b.vel.x,
-                b.vel.y,
-                b.omega,
-            ]
-            .map(f64::to_bits)
-        };
+        let bits = |b: &haptic2d::body::Body| b.state().map(f64::to_bits);
         assert_eq!(bits(a), bits(b), "{}", a.name);
     }
 }
